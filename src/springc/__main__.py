@@ -1,0 +1,5 @@
+"""``python -m springc``: the command-line interface."""
+
+from .cli import main
+
+main()

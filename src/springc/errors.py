@@ -1,0 +1,136 @@
+"""Diagnostics shared by every stage: source spans, errors with notes, and rendering.
+
+Each stage raises its own subclass of :class:`SpringcError`; the CLI renders them as
+``file:line:col: error: message``, the source line, a caret under the span, then notes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """A region of source text; lines and columns are 1-based, ``end_column`` exclusive."""
+
+    file: str
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}:{self.column}"
+
+
+@dataclass(frozen=True, slots=True)
+class Note:
+    """A secondary message, optionally pointing at its own location."""
+
+    message: str
+    span: Span | None = None
+
+
+class SpringcError(Exception):
+    """A user-facing error: a message, where it happened, notes, and what to do."""
+
+    def __init__(
+        self,
+        message: str,
+        span: Span | None = None,
+        notes: Iterable[Note] = (),
+        hint: str | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.message = message
+        self.span = span
+        self.notes = tuple(notes)
+        self.hint = hint
+
+
+class ParseError(SpringcError):
+    """Lexical or syntax error, or a construct that is not supported yet."""
+
+
+class LoadError(SpringcError):
+    """A file or library folder could not be read."""
+
+
+class FlattenError(SpringcError):
+    """Name lookup, modification, array or connection error while flattening."""
+
+
+class BalanceError(SpringcError):
+    """The flat model is not balanced or is structurally singular."""
+
+
+class SimplifyError(SpringcError):
+    """Structural simplification or initialization failed."""
+
+
+class SimulationError(SpringcError):
+    """The solver failed; the message names the time and the quantity at fault."""
+
+
+class ErrorGroup(Exception):
+    """Several independent errors reported together, in source order."""
+
+    def __init__(self, errors: Iterable[SpringcError]) -> None:
+        self.errors = tuple(errors)
+        super().__init__(f"{len(self.errors)} errors")
+
+
+def errors_of(exc: SpringcError | ErrorGroup) -> tuple[SpringcError, ...]:
+    """The individual errors carried by ``exc``."""
+    return exc.errors if isinstance(exc, ErrorGroup) else (exc,)
+
+
+SourceLookup = Callable[[str], "str | None"]
+
+
+def read_source(path: str) -> str | None:
+    """Default source lookup: read the file from disk, ``None`` if unreadable."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+
+
+def _excerpt(span: Span, lookup: SourceLookup) -> list[str]:
+    text = lookup(span.file)
+    if text is None:
+        return []
+    lines = text.splitlines()
+    if not 1 <= span.line <= len(lines):
+        return []
+    line = lines[span.line - 1].expandtabs(1)
+    end = span.end_column if span.end_line == span.line else len(line) + 1
+    width = max(1, end - span.column)
+    gutter = f"{span.line:>5} | "
+    return [gutter + line, " " * (len(gutter) - 2) + "| " + " " * (span.column - 1) + "^" * width]
+
+
+def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -> list[str]:
+    head = f"{span}: {kind}: {message}" if span else f"{kind}: {message}"
+    return [head] + (_excerpt(span, lookup) if span else [])
+
+
+def render(error: SpringcError, lookup: SourceLookup = read_source) -> str:
+    """Render one error in the ``file:line:col: error: ...`` format with caret and notes."""
+    lines = _located("error", error.message, error.span, lookup)
+    for note in error.notes:
+        lines += _located("note", note.message, note.span, lookup)
+    if error.hint:
+        lines.append(f"help: {error.hint}")
+    return "\n".join(lines)
+
+
+def render_all(exc: SpringcError | ErrorGroup, lookup: SourceLookup = read_source) -> str:
+    """Render every error of ``exc``, separated by blank lines, with a count at the end."""
+    errors = errors_of(exc)
+    text = "\n\n".join(render(e, lookup) for e in errors)
+    if len(errors) > 1:
+        text += f"\n\n{len(errors)} errors"
+    return text

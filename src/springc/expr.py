@@ -1,0 +1,390 @@
+"""Scalar expressions of the flat model and later stages.
+
+A deliberately small, fast tree: flattening builds hundreds of thousands of these, so
+they are plain frozen dataclasses rather than sympy objects. Symbolic work that needs
+a computer-algebra system converts to sympy on demand (:mod:`springc.symbolic`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from typing import Union
+
+
+@dataclass(frozen=True, slots=True)
+class Const:
+    value: float | int | bool
+
+
+@dataclass(frozen=True, slots=True)
+class Var:
+    """A flat scalar variable or parameter, by its flat name (``mass.pos[1]``)."""
+
+    name: str
+
+
+@dataclass(frozen=True, slots=True)
+class Time:
+    """The built-in variable ``time``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Der:
+    """``der(arg)``; after flattening ``arg`` may be any expression of variables."""
+
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Neg:
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Not:
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class BinOp:
+    """``op`` is one of ``+ - * / ^ < <= > >= == <> and or`` (scalar semantics)."""
+
+    op: str
+    left: Expr
+    right: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Call:
+    """A built-in scalar function (``sqrt``, ``atan2``, ``noEvent``, ...)."""
+
+    name: str
+    args: tuple[Expr, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class If:
+    cond: Expr
+    then: Expr
+    otherwise: Expr
+
+
+Expr = Union[Const, Var, Time, Der, Neg, Not, BinOp, Call, If]
+
+ZERO = Const(0)
+ONE = Const(1)
+TIME = Time()
+
+RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
+
+MATH: dict[str, Callable[..., float]] = {
+    "sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "tan": math.tan,
+    "asin": math.asin, "acos": math.acos, "atan": math.atan, "atan2": math.atan2,
+    "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh, "exp": math.exp,
+    "log": math.log, "log10": math.log10, "abs": abs,
+    "sign": lambda x: (x > 0) - (x < 0), "min": min, "max": max,
+    "floor": math.floor, "ceil": math.ceil, "integer": math.floor,
+    "mod": lambda x, y: x - math.floor(x / y) * y, "rem": lambda x, y: math.fmod(x, y),
+    "div": lambda x, y: math.trunc(x / y),
+    "noEvent": lambda x: x, "smooth": lambda p, x: x, "homotopy": lambda a, s: a,
+}
+
+_BINARY: dict[str, Callable[[object, object], object]] = {
+    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
+    "/": lambda a, b: a / b, "^": lambda a, b: a**b,
+    "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
+    ">=": lambda a, b: a >= b, "==": lambda a, b: a == b, "<>": lambda a, b: a != b,
+    "and": lambda a, b: bool(a) and bool(b), "or": lambda a, b: bool(a) or bool(b),
+}
+
+# ------------------------------------------------------------------ traversal
+
+
+def children(e: Expr) -> tuple[Expr, ...]:
+    """The direct sub-expressions of ``e``."""
+    if isinstance(e, BinOp):
+        return (e.left, e.right)
+    if isinstance(e, (Neg, Not, Der)):
+        return (e.arg,)
+    if isinstance(e, Call):
+        return e.args
+    if isinstance(e, If):
+        return (e.cond, e.then, e.otherwise)
+    return ()
+
+
+def walk(e: Expr) -> Iterator[Expr]:
+    """All nodes of ``e``, parents before children."""
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        yield node
+        stack.extend(children(node))
+
+
+def variables(e: Expr) -> set[str]:
+    """Names of all variables referenced in ``e`` (inside ``der`` too)."""
+    return {n.name for n in walk(e) if isinstance(n, Var)}
+
+
+def derivatives(e: Expr) -> set[str]:
+    """Names ``x`` of all ``der(x)`` in ``e`` whose argument is a plain variable."""
+    return {n.arg.name for n in walk(e) if isinstance(n, Der) and isinstance(n.arg, Var)}
+
+
+def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
+    """Replace variables by expressions; unchanged subtrees are shared, not copied."""
+    if isinstance(e, Var):
+        return mapping.get(e.name, e)
+    if isinstance(e, (Const, Time)):
+        return e
+    if isinstance(e, BinOp):
+        left, right = substitute(e.left, mapping), substitute(e.right, mapping)
+        return e if left is e.left and right is e.right else BinOp(e.op, left, right)
+    if isinstance(e, (Neg, Not, Der)):
+        arg = substitute(e.arg, mapping)
+        return e if arg is e.arg else type(e)(arg)
+    if isinstance(e, Call):
+        args = tuple(substitute(a, mapping) for a in e.args)
+        return e if all(a is b for a, b in zip(args, e.args)) else Call(e.name, args)
+    if isinstance(e, If):
+        c, t, o = (substitute(x, mapping) for x in (e.cond, e.then, e.otherwise))
+        return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
+    raise TypeError(f"not an expression: {e!r}")
+
+
+def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> object:
+    """Numeric value of ``e``; raises ``KeyError`` for a variable missing from ``env``."""
+    if isinstance(e, Const):
+        return e.value
+    if isinstance(e, Var):
+        return env[e.name]
+    if isinstance(e, BinOp):
+        return _BINARY[e.op](evaluate(e.left, env, time), evaluate(e.right, env, time))
+    if isinstance(e, Neg):
+        return -evaluate(e.arg, env, time)
+    if isinstance(e, Not):
+        return not evaluate(e.arg, env, time)
+    if isinstance(e, Call):
+        return MATH[e.name](*(evaluate(a, env, time) for a in e.args))
+    if isinstance(e, If):
+        branch = e.then if evaluate(e.cond, env, time) else e.otherwise
+        return evaluate(branch, env, time)
+    if isinstance(e, Time):
+        return time
+    raise KeyError(f"der({to_text(e.arg)})")
+
+
+# ------------------------------------------------------------- construction
+
+
+def add(a: Expr, b: Expr) -> Expr:
+    """``a + b`` with constant folding and zero elimination."""
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value + b.value)
+    if a == ZERO:
+        return b
+    if b == ZERO:
+        return a
+    if isinstance(b, Neg):
+        return BinOp("-", a, b.arg)
+    return BinOp("+", a, b)
+
+
+def sub(a: Expr, b: Expr) -> Expr:
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value - b.value)
+    if b == ZERO:
+        return a
+    if a == ZERO:
+        return neg(b)
+    return BinOp("-", a, b)
+
+
+def mul(a: Expr, b: Expr) -> Expr:
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value * b.value)
+    if a == ZERO or b == ZERO:
+        return ZERO
+    if a == ONE:
+        return b
+    if b == ONE:
+        return a
+    return BinOp("*", a, b)
+
+
+def div(a: Expr, b: Expr) -> Expr:
+    if b == ONE:
+        return a
+    if a == ZERO:
+        return ZERO
+    return BinOp("/", a, b)
+
+
+def neg(a: Expr) -> Expr:
+    if isinstance(a, Const):
+        return Const(-a.value)
+    if isinstance(a, Neg):
+        return a.arg
+    return Neg(a)
+
+
+def power(a: Expr, b: Expr) -> Expr:
+    if b == ONE:
+        return a
+    if b == ZERO:
+        return ONE
+    return BinOp("^", a, b)
+
+
+# ------------------------------------------------------------ differentiation
+
+
+def diff(e: Expr, name: str) -> Expr:
+    """Partial derivative of ``e`` with respect to the variable ``name``."""
+    return _diff(e, lambda v: ONE if v.name == name else ZERO, ZERO)
+
+
+def time_derivative(e: Expr) -> Expr:
+    """Total time derivative: ``x`` becomes ``der(x)``, ``time`` becomes 1."""
+    return _diff(e, Der, ONE)
+
+
+def _diff(e: Expr, dvar: Callable[[Var], Expr], dtime: Expr) -> Expr:
+    def d(x: Expr) -> Expr:
+        return _diff(x, dvar, dtime)
+
+    if isinstance(e, Const):
+        return ZERO
+    if isinstance(e, Var):
+        return dvar(e)
+    if isinstance(e, Time):
+        return dtime
+    if isinstance(e, Neg):
+        return neg(d(e.arg))
+    if isinstance(e, BinOp):
+        return _diff_binop(e, d)
+    if isinstance(e, Call):
+        return _diff_call(e, d)
+    if isinstance(e, If):
+        return If(e.cond, d(e.then), d(e.otherwise))
+    if isinstance(e, Not):
+        return ZERO
+    if isinstance(e, Der) and dtime == ONE:
+        raise ValueError(f"second derivative der({to_text(e)}) is not supported")
+    raise ValueError(f"cannot differentiate {to_text(e)}")
+
+
+def _diff_binop(e: BinOp, d: Callable[[Expr], Expr]) -> Expr:
+    a, b = e.left, e.right
+    if e.op == "+":
+        return add(d(a), d(b))
+    if e.op == "-":
+        return sub(d(a), d(b))
+    if e.op == "*":
+        return add(mul(d(a), b), mul(a, d(b)))
+    if e.op == "/":
+        return sub(div(d(a), b), div(mul(a, d(b)), mul(b, b)))
+    if e.op == "^":
+        db = d(b)
+        base = mul(mul(b, power(a, sub(b, ONE))), d(a))
+        if db == ZERO:
+            return base
+        return add(base, mul(mul(e, Call("log", (a,))), db))
+    return ZERO  # relations and logic are piecewise constant
+
+
+def _diff_call(e: Call, d: Callable[[Expr], Expr]) -> Expr:
+    name, args = e.name, e.args
+    x = args[0]
+    dx = d(x)
+    rules: dict[str, Callable[[], Expr]] = {
+        "sqrt": lambda: div(dx, mul(Const(2), e)),
+        "sin": lambda: mul(Call("cos", (x,)), dx),
+        "cos": lambda: neg(mul(Call("sin", (x,)), dx)),
+        "tan": lambda: div(dx, power(Call("cos", (x,)), Const(2))),
+        "asin": lambda: div(dx, Call("sqrt", (sub(ONE, mul(x, x)),))),
+        "acos": lambda: neg(div(dx, Call("sqrt", (sub(ONE, mul(x, x)),)))),
+        "atan": lambda: div(dx, add(ONE, mul(x, x))),
+        "sinh": lambda: mul(Call("cosh", (x,)), dx),
+        "cosh": lambda: mul(Call("sinh", (x,)), dx),
+        "tanh": lambda: mul(sub(ONE, mul(e, e)), dx),
+        "exp": lambda: mul(e, dx),
+        "log": lambda: div(dx, x),
+        "log10": lambda: div(dx, mul(x, Const(math.log(10)))),
+        "abs": lambda: mul(Call("sign", (x,)), dx),
+        "noEvent": lambda: Call("noEvent", (dx,)),
+        "homotopy": lambda: dx,
+    }
+    if name in rules:
+        return rules[name]()
+    if name == "atan2":
+        y, xx = args
+        return div(sub(mul(xx, d(y)), mul(y, d(xx))), add(mul(xx, xx), mul(y, y)))
+    if name in ("min", "max"):
+        a, b = args
+        cond = BinOp("<" if name == "min" else ">", a, b)
+        return If(Call("noEvent", (cond,)), d(a), d(b))
+    if name == "smooth":
+        return Call("smooth", (args[0], d(args[1])))
+    if name in ("sign", "floor", "ceil", "integer", "div"):
+        return ZERO
+    if name in ("mod", "rem"):
+        return dx
+    raise ValueError(f"cannot differentiate {name}(...)")
+
+
+# ------------------------------------------------------------------ printing
+
+_PRECEDENCE = {
+    "or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
+    "+": 5, "-": 5, "*": 6, "/": 6, "^": 8,
+}
+
+
+def format_number(value: float | int | bool) -> str:
+    """Modelica literal for a number; floats round-trip exactly (``repr``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if math.isinf(value):
+        return "1e1000" if value > 0 else "-1e1000"
+    return repr(value)
+
+
+def to_text(e: Expr, name: Callable[[str], str] = lambda n: n) -> str:
+    """Modelica text of ``e``; ``name`` renders variable names (e.g. quoting them)."""
+    return _print(e, name, 0)
+
+
+def _print(e: Expr, name: Callable[[str], str], outer: int) -> str:
+    if isinstance(e, Const):
+        text = format_number(e.value)
+        return f"({text})" if text.startswith("-") and outer > 0 else text
+    if isinstance(e, Var):
+        return name(e.name)
+    if isinstance(e, Time):
+        return "time"
+    if isinstance(e, Der):
+        return f"der({_print(e.arg, name, 0)})"
+    if isinstance(e, Call):
+        return f"{e.name}({', '.join(_print(a, name, 0) for a in e.args)})"
+    if isinstance(e, Neg):
+        text = "-" + _print(e.arg, name, 6)
+        return f"({text})" if outer > 5 else text
+    if isinstance(e, Not):
+        text = "not " + _print(e.arg, name, 3)
+        return f"({text})" if outer > 3 else text
+    if isinstance(e, If):
+        text = (f"if {_print(e.cond, name, 0)} then {_print(e.then, name, 0)}"
+                f" else {_print(e.otherwise, name, 0)}")
+        return f"({text})" if outer > 0 else text
+    prec = _PRECEDENCE[e.op]
+    # Left-associative: the right operand needs parentheses at equal precedence
+    # ("^" is non-associative in Modelica, so both sides do).
+    left_prec = prec + 1 if e.op == "^" or prec == 4 else prec
+    text = f"{_print(e.left, name, left_prec)} {e.op} {_print(e.right, name, prec + 1)}"
+    return f"({text})" if prec < outer else text

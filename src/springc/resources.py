@@ -1,0 +1,27 @@
+"""Locate files shipped with springc: the grammar and the bundled model library.
+
+In a built wheel they sit inside the package (``springc/grammar``, ``springc/models``);
+in a source checkout or editable install they are the repository's top-level folders.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+_PACKAGE = Path(__file__).resolve().parent
+
+
+def resource_dir(name: str) -> Path:
+    """The folder ``name`` (``grammar`` or ``models``), wherever this install keeps it."""
+    for candidate in (_PACKAGE / name, _PACKAGE.parents[1] / name):
+        if candidate.is_dir():
+            return candidate
+    raise FileNotFoundError(f"springc installation is missing its '{name}' folder")
+
+
+def grammar_path() -> Path:
+    return resource_dir("grammar") / "modelica.lark"
+
+
+def models_dir() -> Path:
+    return resource_dir("models")
