@@ -1,0 +1,1 @@
+"""springc: a compiler and simulator for spring-mass models written in a Modelica subset."""
