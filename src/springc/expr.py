@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
-from typing import Union
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,7 +70,7 @@ class If:
     otherwise: Expr
 
 
-Expr = Union[Const, Var, Time, Der, Neg, Not, BinOp, Call, If]
+Expr = Const | Var | Time | Der | Neg | Not | BinOp | Call | If
 
 ZERO = Const(0)
 ONE = Const(1)

@@ -191,3 +191,48 @@ def format_flat(model: FlatModel, origins: bool = False) -> str:
         lines.append(f"  annotation(experiment({args}));")
     lines.append(f"end {quote(model.name)};")
     return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------- JSON
+
+
+def _span_dict(span: Span) -> dict[str, object]:
+    return {"file": span.file, "line": span.line, "column": span.column}
+
+
+def _equation_dict(eq: Equation) -> dict[str, object]:
+    return {"lhs": to_text(eq.lhs), "rhs": to_text(eq.rhs),
+            "origin": {"kind": eq.origin.kind, "component": eq.origin.component,
+                       "detail": eq.origin.detail},
+            "location": _span_dict(eq.span)}
+
+
+def to_json_dict(model: FlatModel) -> dict[str, object]:
+    """The machine-readable form of ``springc flatten --json`` (README, "JSON output")."""
+    def attrs(a: Attributes) -> dict[str, object]:
+        out: dict[str, object] = {}
+        for key in ("start", "nominal", "min", "max"):
+            value = getattr(a, key)
+            if value is not None:
+                out[key] = to_text(value)
+        for key, value in (("fixed", a.fixed), ("unit", a.unit),
+                           ("displayUnit", a.display_unit), ("stateSelect", a.state_select)):
+            if value is not None:
+                out[key] = value
+        return out
+
+    ex = model.experiment
+    return {
+        "model": model.name,
+        "variables": [
+            {"name": v.name, "type": v.type, "variability": v.variability,
+             "causality": v.causality, "flow": v.flow,
+             "binding": to_text(v.binding) if v.binding is not None else None,
+             "attributes": attrs(v.attributes), "description": v.description,
+             "component": v.component, "location": _span_dict(v.span)}
+            for v in model.variables],
+        "equations": [_equation_dict(e) for e in model.equations],
+        "initial_equations": [_equation_dict(e) for e in model.initial_equations],
+        "experiment": {k: getattr(ex, k) for k in ("start", "stop", "interval", "tolerance")
+                       if getattr(ex, k) is not None},
+    }

@@ -7,7 +7,6 @@ it came from. Names are plain strings; dotted names are tuples of strings.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Union
 
 from .errors import Span
 
@@ -160,10 +159,10 @@ class Range:
     span: Span
 
 
-Expr = Union[
-    Number, Bool, String, Ref, Colon, End, Unary, Binary, IfExpr, Call, Comprehension,
-    ArrayLit, MatrixLit, Range,
-]
+Expr = (
+    Number | Bool | String | Ref | Colon | End | Unary | Binary | IfExpr | Call
+    | Comprehension | ArrayLit | MatrixLit | Range
+)
 
 # -------------------------------------------------------------- modifications
 
@@ -290,7 +289,7 @@ class CallEquation:
     span: Span
 
 
-Equation = Union[Equality, Connect, ForEquation, IfEquation, CallEquation]
+Equation = Equality | Connect | ForEquation | IfEquation | CallEquation
 
 # ----------------------------------------------------------------- statements
 
@@ -318,7 +317,7 @@ class ForStatement:
     span: Span
 
 
-Statement = Union[Assign, IfStatement, ForStatement]
+Statement = Assign | IfStatement | ForStatement
 
 # -------------------------------------------------------------------- classes
 
@@ -344,7 +343,7 @@ class ClassDef:
     span: Span
 
 
-Element = Union[Component, Extends, Import, ClassDef]
+Element = Component | Extends | Import | ClassDef
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,0 +1,174 @@
+"""Connection sets (Modelica chapter 9.2): from ``connect`` statements to equations.
+
+Set members are scalar connector variables tagged inside or outside: a connector
+reached through a sub-component (``spring.flange_a``) is inside, a connector of the
+model that writes the ``connect`` (``flange_a``) is outside. Each set gives equal
+potentials and a zero sum of flows (outside flows counted negative); flow variables of
+connectors that are connected nowhere are set to zero.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import expr as x
+from . import flat
+from . import syntax as s
+from .errors import FlattenError, Note
+from .instance import ClassScope, Primitive
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+
+Key = tuple[str, bool]  # (flat variable name, outside)
+
+
+@dataclass(frozen=True, slots=True)
+class Leaf:
+    relative: str
+    name: str
+    flow: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Link:
+    """Why a member joined its set: the connect statement, its owner and its text."""
+
+    span: s.Span
+    owner: str
+    text: str
+
+
+def connector_leaves(scope: ClassScope) -> list[Leaf]:
+    """Scalar non-parameter variables of a connector, in declaration order."""
+    cached = getattr(scope, "_leaves", None)
+    if cached is not None:
+        return cached
+    leaves: list[Leaf] = []
+    cut = len(scope.prefix) + 1
+    for _, member in scope.all_members():
+        if isinstance(member, Primitive):
+            if member.variability in ("parameter", "constant"):
+                continue
+            names = [member.names] if isinstance(member.names, str) else list(member.names.flat)
+            leaves += [Leaf(n[cut:], n, member.flow) for n in names]
+        else:
+            for item in (member.flat if isinstance(member, np.ndarray) else [member]):
+                leaves += [Leaf(leaf.name[cut:], leaf.name, leaf.flow)
+                           for leaf in connector_leaves(item)]
+    scope._leaves = leaves  # type: ignore[attr-defined]
+    return leaves
+
+
+class ConnectionSets:
+    def __init__(self) -> None:
+        self.parent: dict[Key, Key] = {}
+        self.flow: dict[Key, bool] = {}
+        self.link: dict[Key, Link] = {}
+
+    def _find(self, key: Key) -> Key:
+        root = key
+        while self.parent[root] != root:
+            root = self.parent[root]
+        while self.parent[key] != root:
+            self.parent[key], key = root, self.parent[key]
+        return root
+
+    def _add(self, key: Key, flow: bool, link: Link) -> None:
+        if key not in self.parent:
+            self.parent[key] = key
+            self.flow[key] = flow
+            self.link[key] = link
+
+    def connect(self, ev: Evaluator, eq: s.Connect, where: Any, owner: ClassScope) -> None:
+        """Record ``connect(a, b)``; both sides may be arrays of connectors."""
+        sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
+        (left, left_out), (right, right_out) = sides
+        if left.shape != right.shape:
+            raise FlattenError(
+                f"cannot connect arrays of {left.size} and {right.size} connectors",
+                eq.span, hint="connect arrays of connectors of the same size")
+        for ca, cb in zip(left.flat, right.flat):
+            self._pair(ca, cb, left_out, right_out, eq, owner)
+
+    def _connectors(self, ev: Evaluator, ref: s.Ref, where: Any, owner: ClassScope
+                    ) -> tuple[np.ndarray, bool]:
+        value = ev.reference(ref, where)
+        items = np.atleast_1d(np.asarray(value, dtype=object)) if not isinstance(
+            value, ClassScope) else np.array([value], dtype=object)
+        if not items.size or not all(isinstance(c, ClassScope) and c.kind == "connector"
+                                     for c in items.flat):
+            raise FlattenError(f"'{ref.dotted}' is not a connector", ref.span,
+                               hint="connect(...) joins connectors, such as flanges")
+        head = ref.parts[0].name
+        outside = owner.has_member(head) and isinstance(owner.member(head), (ClassScope,
+                                                                            np.ndarray)) \
+            and all(c.outer is owner for c in items.flat)
+        return items, outside
+
+    def _pair(self, ca: ClassScope, cb: ClassScope, out_a: bool, out_b: bool,
+              eq: s.Connect, owner: ClassScope) -> None:
+        leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
+        if [(p.relative, p.flow) for p in leaves_a] != [(q.relative, q.flow) for q in leaves_b]:
+            raise FlattenError(
+                f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
+                f"({cb.entry.full_name}) do not match", eq.span,
+                [Note(f"'{ca.entry.full_name}' is defined here", ca.entry.defn.span),
+                 Note(f"'{cb.entry.full_name}' is defined here", cb.entry.defn.span)],
+                "connect connectors of the same type")
+        link = Link(eq.span, owner.prefix, f"connect({ca.prefix}, {cb.prefix})")
+        for p, q in zip(leaves_a, leaves_b):
+            ka, kb = (p.name, out_a), (q.name, out_b)
+            self._add(ka, p.flow, link)
+            self._add(kb, q.flow, link)
+            ra, rb = self._find(ka), self._find(kb)
+            if ra != rb:
+                self.parent[rb] = ra
+
+    def equations(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
+        """Equations of all sets (in order of first connection), then zero flows."""
+        sets: dict[Key, list[Key]] = {}
+        for key in self.parent:
+            sets.setdefault(self._find(key), []).append(key)
+        out: list[flat.Equation] = []
+        for members in sets.values():
+            first = self.link[members[0]]
+            if self.flow[members[0]]:
+                out.append(self._flow_sum(members, first))
+            else:
+                out += [flat.Equation(x.Var(members[0][0]), x.Var(k[0]), self.link[k].span,
+                                      flat.Origin("connect", self.link[k].owner,
+                                                  self.link[k].text))
+                        for k in members[1:]]
+        out += self._unconnected(scopes, top)
+        return out
+
+    def _flow_sum(self, members: list[Key], first: Link) -> flat.Equation:
+        total: x.Expr = x.ZERO
+        for name, outside in members:
+            total = x.sub(total, x.Var(name)) if outside else x.add(total, x.Var(name))
+        names = ", ".join(("-" if o else "") + n for n, o in members)
+        return flat.Equation(total, x.ZERO, first.span,
+                             flat.Origin("flow", first.owner, f"sum of {{{names}}}"))
+
+    def _unconnected(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
+        out = []
+        for scope in scopes:
+            if scope.kind != "connector" or (scope.outer is not None
+                                             and scope.outer.kind == "connector"):
+                continue
+            at_top = scope.outer is top
+            for leaf in connector_leaves(scope):
+                if not leaf.flow:
+                    continue
+                if (leaf.name, False) in self.parent or (at_top and (leaf.name, True)
+                                                         in self.parent):
+                    continue
+                out.append(flat.Equation(x.Var(leaf.name), x.ZERO, scope.span,
+                                         flat.Origin("unconnected", scope.outer.prefix
+                                                     if scope.outer else "",
+                                                     f"{scope.prefix} is not connected")))
+        return out

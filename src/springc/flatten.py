@@ -1,0 +1,494 @@
+"""Flatten a model: load.ClassTree + model name -> flat.FlatModel.
+
+Instantiates the model's components with their modifications and inheritance,
+expands arrays, ``for`` loops and ``if``-equations with parameter conditions, and
+turns ``connect`` statements into potential equalities and flow sums.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import numpy as np
+
+from . import arrays as a
+from . import expr as x
+from . import flat
+from . import syntax as s
+from .builtins import CONSTANTS
+from .connections import ConnectionSets
+from .errors import ErrorGroup, FlattenError, Note, SpringcError
+from .evaluate import Evaluator
+from .instance import (
+    PRIMITIVES,
+    ClassScope,
+    ClassView,
+    LocalScope,
+    Primitive,
+    ResolvedType,
+    ViewComponent,
+    build_view,
+    instance_mod,
+)
+from .load import ClassEntry, ClassTree, lookup_class, member_class
+from .modification import Mod, ModValue, from_syntax, merge_all, select
+from .variables import attributes_of, check_attribute_mods
+
+STATE_SELECT = ("never", "avoid", "default", "prefer", "always")
+
+
+class ParameterValues(Mapping[str, Any]):
+    """Numeric values of parameters and constants, evaluated from bindings on demand."""
+
+    def __init__(self) -> None:
+        self.bindings: dict[str, x.Expr | None] = {}
+        self.cache: dict[str, Any] = {}
+        self.active: set[str] = set()
+
+    def __getitem__(self, name: str) -> Any:
+        if name in self.cache:
+            return self.cache[name]
+        if name not in self.bindings:
+            raise KeyError(f"the variable '{name}'")
+        binding = self.bindings[name]
+        if binding is None or name in self.active:
+            raise KeyError(f"the parameter '{name}', which has no value")
+        self.active.add(name)
+        try:
+            value = x.evaluate(binding, self)
+        finally:
+            self.active.discard(name)
+        self.cache[name] = value
+        return value
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.bindings)
+
+    def __len__(self) -> int:
+        return len(self.bindings)
+
+
+class Flattener:
+    """One flattening run over a class tree."""
+
+    def __init__(self, tree: ClassTree) -> None:
+        self.tree = tree
+        self.views: dict[int, ClassView] = {}
+        self.package_scopes: dict[int, ClassScope] = {}
+        self.parameter_values = ParameterValues()
+        self.evaluator = Evaluator(self)
+        self.connections = ConnectionSets()
+        self.equations: list[flat.Equation] = []
+        self.initial_equations: list[flat.Equation] = []
+        self.errors: list[SpringcError] = []
+        # Evaluated modification values by (expression, scope); the scope is kept
+        # alive in the entry so that its id cannot be reused.
+        self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
+
+    # ------------------------------------------------------------ class lookup
+
+    def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
+        found = self.views.get(id(entry))
+        if found is None:
+            found = self.views[id(entry)] = build_view(entry, self, seen)
+        return found
+
+    def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None
+                      ) -> ClassEntry:
+        for part in ref.parts:
+            if part.subscripts:
+                raise FlattenError("a class name cannot have subscripts", part.span)
+        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span)
+
+    def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
+        """Follow short class definitions down to a primitive type or a full class."""
+        name = ref.dotted
+        dims: list[tuple[s.Expr, Any]] = []
+        mods: list[tuple[s.Modification, ClassEntry]] = []
+        prefixes = ("", "", False)
+        if name in PRIMITIVES and lookup_class(name, scope) is None:
+            return ResolvedType(name, None, (), (), prefixes)
+        if name in ("String", "StateSelect") or name.startswith("Modelica."):
+            raise FlattenError(f"the type `{name}` is not supported yet", ref.span,
+                               hint="use Real, Integer, Boolean or classes of your own")
+        entry = self.resolve_class(ref, scope)
+        for _ in range(100):
+            short = entry.defn.short
+            if short is None:
+                return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
+            if short.modification is not None:
+                mods.append((short.modification, entry))
+            dims += [(d, entry) for d in short.dims]
+            prefixes = (prefixes[0] or short.variability, prefixes[1] or short.causality,
+                        prefixes[2] or short.flow)
+            base = short.base.dotted
+            if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
+                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes)
+            entry = self.resolve_class(short.base, entry.parent or entry)
+        raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
+
+    def find_function(self, name: str, scope: Any) -> ClassEntry | None:
+        entry = lookup_class(name, scope.entry)
+        return entry if entry is not None and entry.defn.kind == "function" else None
+
+    def resolve_function(self, ref: s.Ref, scope: Any) -> ClassEntry:
+        entry = self.resolve_class(ref, scope.entry)
+        if entry.defn.kind != "function":
+            raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
+                               ref.span, [Note("defined here", entry.defn.span)])
+        return entry
+
+    def class_member(self, entry: ClassEntry, name: str, span: s.Span) -> Any:
+        """``P.c``: a nested class or a constant of a package."""
+        nested = member_class(entry, name)
+        if nested is not None:
+            return nested
+        package = self.package_scope(entry)
+        if package.has_member(name):
+            return package.member(name, span)
+        raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
+
+    def package_scope(self, entry: ClassEntry) -> ClassScope:
+        scope = self.package_scopes.get(id(entry))
+        if scope is None:
+            view = self.view(entry)
+            scope = ClassScope(self, entry.full_name, view, None, entry.defn.span)
+            self.package_scopes[id(entry)] = scope
+        return scope
+
+    def lookup_global(self, name: str, entry: ClassEntry, span: s.Span) -> Any:
+        """A name not declared in the instance: time, a constant of an enclosing class,
+        a class (for dotted references), or a built-in constant."""
+        if name == "time":
+            return x.TIME
+        enclosing: ClassEntry | None = entry
+        while enclosing is not None:
+            view = self.view(enclosing) if enclosing.parent is not None else None
+            if view is not None and name in view.components and enclosing is not entry:
+                decl = view.components[name].decl
+                if decl.variability != "constant":
+                    raise FlattenError(
+                        f"'{name}' belongs to the enclosing class '{enclosing.full_name}'; "
+                        "only its constants are visible here", span,
+                        [Note("declared here", decl.span)])
+                return self.package_scope(enclosing).member(name, span)
+            enclosing = enclosing.parent
+        found = lookup_class(name, entry)
+        if found is not None:
+            return found
+        if name in CONSTANTS:
+            return x.Const(CONSTANTS[name])
+        raise FlattenError(f"undefined name '{name}'", span,
+                           hint="declare it, or check the spelling")
+
+    # --------------------------------------------------------- instantiation
+
+    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
+        decl = comp.decl
+        rtype = self.resolve_type(decl.type_name, comp.defined_in)
+        outer = scope.mod.child(decl.name) if scope.mod is not None else None
+        mods = [outer, from_syntax(decl.modification, scope)]
+        mods += [from_syntax(m, self.package_scope(e.parent or e)) for m, e in rtype.mods]
+        mod = merge_all(mods, scope.flat_name(decl.name))
+        if decl.final and outer is not None:
+            raise FlattenError(f"'{scope.flat_name(decl.name)}' is final and cannot be "
+                               "modified", outer.span, [Note("declared final here",
+                                                              decl.span)])
+        dims = self._dims(decl, scope, rtype)
+        name = scope.flat_name(decl.name)
+        if rtype.primitive is not None:
+            return self._primitive(scope, decl, rtype, mod, dims, name)
+        assert rtype.entry is not None
+        if rtype.entry.defn.kind in ("function", "package"):
+            raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
+                               "cannot be instantiated", decl.type_name.span)
+        view = self.view(rtype.entry)
+        if not dims:
+            return self._class_scope(name, view, mod, decl, scope)
+        out = np.empty(dims, dtype=object)
+        for idx in np.ndindex(dims):
+            sub = tuple(i + 1 for i in idx)
+            out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
+                                         select(mod, sub), decl, scope)
+        return out
+
+    def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
+                     parent: ClassScope) -> ClassScope:
+        scope = ClassScope(self, name, view, None, decl.span, parent)
+        scope.mod = instance_mod(mod, view, scope)
+        if scope.mod is not None:
+            for key, child in scope.mod.children.items():
+                if key not in view.components:
+                    self._unknown_target(key, child, view, name)
+            if scope.mod.value is not None:
+                raise FlattenError(f"'{name}' is a component of class "
+                                   f"'{view.entry.full_name}' and cannot be given a value",
+                                   scope.mod.value.span)
+        return scope
+
+    def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
+        import difflib
+
+        close = difflib.get_close_matches(key, list(view.components), 1)
+        raise FlattenError(
+            f"'{name}' (of class '{view.entry.full_name}') has no element '{key}' to modify",
+            child.span, [Note(f"class '{view.entry.full_name}' is defined here",
+                              view.entry.defn.span)],
+            f"did you mean '{close[0]}'?" if close else
+            f"the elements of '{view.entry.full_name}' are: "
+            + ", ".join(view.components))
+
+    def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType
+              ) -> tuple[int, ...]:
+        exprs = [(d, scope) for d in decl.dims + decl.type_dims]
+        exprs += [(d, self.package_scope(e.parent or e)) for d, e in rtype.dims]
+        dims = []
+        for d, where in exprs:
+            if isinstance(d, s.Colon):
+                raise FlattenError("the size of this dimension must be given ('[:]' is only "
+                                   "allowed for function inputs)", d.span)
+            n = self.evaluator.integer(d, where, "an array size")
+            if n < 0:
+                raise FlattenError(f"array size must not be negative, found {n}", d.span)
+            dims.append(n)
+        return tuple(dims)
+
+    def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
+                   mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
+        variability = decl.variability or rtype.prefixes[0] or (
+            "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous")
+        causality = decl.causality or rtype.prefixes[1]
+        check_attribute_mods(mod, rtype.primitive, name)
+        names = _element_names(name, dims)
+        binding = self._binding(mod, dims, name, decl)
+        if variability == "constant":
+            if binding is None:
+                raise FlattenError(f"constant '{name}' needs a value", decl.span)
+            value = self.evaluator.fold(binding)
+            value = a.elementwise(lambda v: x.Const(v), value) if a.is_array(value) \
+                else x.Const(value)
+        else:
+            value = a.elementwise(x.Var, names) if dims else x.Var(names)  # type: ignore
+        prim = Primitive(names, value, decl, variability, causality,
+                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+        if variability in ("parameter", "constant"):
+            for n, b in zip(a.scalars(names), _binding_scalars(binding, dims)):  # type: ignore
+                self.parameter_values.bindings[n] = b
+        else:
+            prim_binding = binding
+            self._binding_equations(scope, prim, prim_binding)
+        return prim
+
+    def _binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
+                 ) -> a.Value | None:
+        if mod is None or mod.value is None:
+            return None
+        value = self.mod_value(mod.value)
+        if isinstance(value, str):
+            raise FlattenError(f"'{name}' cannot be given a string", mod.value.span)
+        if a.shape(value) != dims:
+            raise FlattenError(
+                f"'{name}' has size {a.describe_shape(dims)} but is given a value of size "
+                f"{a.describe_shape(a.shape(value))}", mod.value.span,
+                [Note("declared here", decl.span)],
+                "make the sizes agree, or use `each` to give every element the same value")
+        return value
+
+    def mod_value(self, mv: ModValue) -> a.Value:
+        """Evaluate a modification value where it was written, then pick the element."""
+        key = (id(mv.expr), id(mv.scope))
+        cached = self.mod_values.get(key)
+        if cached is None:
+            cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
+        value = cached[1]
+        for i in mv.index:
+            if not a.is_array(value) or value.shape[0] < i:
+                raise FlattenError(
+                    "the value of this modification is not an array matching the array "
+                    "of components it modifies", mv.span,
+                    hint="use `each` to give every element the same value")
+            value = value[i - 1]
+        return value
+
+    def _binding_equations(self, scope: ClassScope, prim: Primitive,
+                           binding: a.Value | None) -> None:
+        if binding is None:
+            return
+        origin = flat.Origin("binding", scope.prefix, prim.decl.name)
+        span = prim.mod.value.span if prim.mod and prim.mod.value else prim.decl.span
+        for v, b in zip(a.scalars(prim.value), a.scalars(binding)):
+            self.equations.append(flat.Equation(v, b, span, origin))
+
+    # ----------------------------------------------------------------- queries
+
+    def is_parameter_expression(self, e: x.Expr) -> bool:
+        bindings = self.parameter_values.bindings
+        return all(n in bindings for n in x.variables(e)) and not any(
+            isinstance(n, (x.Der, x.Time)) for n in x.walk(e))
+
+    # --------------------------------------------------------------- equations
+
+    def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
+        view = scope.view
+        for item in view.initial_equations if initial else view.equations:
+            try:
+                self.equation(item.equation, scope, scope, initial)
+            except FlattenError as err:
+                self.errors.append(err)
+
+    def equation(self, eq: s.Equation, where: Any, owner: ClassScope, initial: bool) -> None:
+        if isinstance(eq, s.Equality):
+            self._equality(eq, where, owner, initial)
+        elif isinstance(eq, s.Connect):
+            if initial:
+                raise FlattenError("`connect` is not allowed in an initial equation section",
+                                   eq.span)
+            self.connections.connect(self.evaluator, eq, where, owner)
+        elif isinstance(eq, s.ForEquation):
+            self._for(eq, eq.indices, where, owner, initial)
+        elif isinstance(eq, s.IfEquation):
+            for cond, body in eq.branches:
+                if self.evaluator.constant(cond, where, "an if-equation condition"):
+                    self._body(body, where, owner, initial)
+                    return
+            self._body(eq.otherwise, where, owner, initial)
+        else:
+            name = eq.call.func.dotted
+            raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
+                               hint="see the 'Later' list in LANGUAGE.md")
+
+    def _body(self, body: tuple[s.Equation, ...], where: Any, owner: ClassScope,
+              initial: bool) -> None:
+        for eq in body:
+            self.equation(eq, where, owner, initial)
+
+    def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Any,
+             owner: ClassScope, initial: bool) -> None:
+        index, rest = indices[0], indices[1:]
+        for value in self.evaluator.range_values(index, where):
+            local = LocalScope({index.name: value}, where)
+            if rest:
+                self._for(eq, rest, local, owner, initial)
+            else:
+                self._body(eq.body, local, owner, initial)
+
+    def _equality(self, eq: s.Equality, where: Any, owner: ClassScope, initial: bool) -> None:
+        lhs = self.evaluator.value(eq.lhs, where)
+        rhs = self.evaluator.value(eq.rhs, where)
+        if a.shape(lhs) != a.shape(rhs):
+            raise FlattenError(
+                f"the two sides of this equation differ in size: "
+                f"{a.describe_shape(a.shape(lhs))} and {a.describe_shape(a.shape(rhs))}",
+                eq.span, hint="both sides of an equation must have the same size")
+        for side, e in ((lhs, eq.lhs), (rhs, eq.rhs)):
+            if isinstance(side, str):
+                raise FlattenError("strings cannot appear in equations", e.span)
+        origin = flat.Origin("initial" if initial else "equation", owner.prefix)
+        target = self.initial_equations if initial else self.equations
+        for left, right in zip(a.scalars(lhs), a.scalars(rhs)):
+            target.append(flat.Equation(left, right, eq.span, origin))
+
+    # --------------------------------------------------------------- the model
+
+    def walk(self, scope: ClassScope) -> Iterator[ClassScope]:
+        """Every class instance below ``scope`` (depth first, declaration order)."""
+        for _, member in scope.all_members():
+            if isinstance(member, ClassScope):
+                yield from self._walk_one(member)
+            elif isinstance(member, np.ndarray):
+                for item in member.flat:
+                    yield from self._walk_one(item)
+
+    def _walk_one(self, scope: ClassScope) -> Iterator[ClassScope]:
+        yield from self.walk(scope)
+        yield scope
+
+    def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
+        for _name, member in scope.all_members():
+            if isinstance(member, Primitive):
+                if member.variability != "constant":
+                    yield from attributes_of(self, scope, member)
+            else:
+                for item in (member.flat if isinstance(member, np.ndarray) else [member]):
+                    yield from self.variables(item)
+
+
+def _element_names(name: str, dims: tuple[int, ...]) -> np.ndarray | str:
+    if not dims:
+        return name
+    out = np.empty(dims, dtype=object)
+    for idx in np.ndindex(dims):
+        out[idx] = f"{name}[{','.join(str(i + 1) for i in idx)}]"
+    return out
+
+
+def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:
+    if binding is None:
+        return [None] * int(np.prod(dims, dtype=int))
+    return a.scalars(binding)
+
+
+def flatten(tree: ClassTree, model: str | None = None) -> flat.FlatModel:
+    """Flatten ``model`` (a dotted name; default: the last model of the last user file)."""
+    entry = select_model(tree, model)
+    flattener = Flattener(tree)
+    view = flattener.view(entry)
+    top = ClassScope(flattener, "", view, None, entry.defn.span)
+    top.mod = instance_mod(None, view, top)
+    scopes = [top]
+    try:
+        scopes = [*flattener.walk(top), top]
+        for scope in scopes:
+            flattener.equations_of(scope)
+        for scope in scopes:
+            flattener.equations_of(scope, initial=True)
+        variables = tuple(flattener.variables(top))
+    except FlattenError as err:
+        raise ErrorGroup([*flattener.errors, err]) if flattener.errors else err from None
+    if flattener.errors:
+        errs = flattener.errors
+        raise errs[0] if len(errs) == 1 else ErrorGroup(errs)
+    flattener.equations += flattener.connections.equations(scopes, top)
+    from .experiment import experiment_of
+
+    return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
+                          tuple(flattener.initial_equations),
+                          experiment_of(flattener, entry, top), entry.defn.span)
+
+
+def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
+    """The class to flatten: ``model`` by dotted name, else the last model of the last
+    user file."""
+    if model is not None:
+        parts = model.split(".")
+        entry: ClassEntry | None = tree.root
+        for part in parts:
+            entry = entry.classes.get(part) if entry is not None else None
+        if entry is None:
+            raise FlattenError(f"no class named '{model}' is loaded",
+                               hint="give the dotted name of a model in the loaded files, "
+                               "e.g. --model Scenes.Chain")
+        return entry
+    user_files = [f for f in tree.files if _from_user(tree, f)]
+    for stored in reversed(user_files):
+        for defn in reversed(stored.classes):
+            if defn.kind in ("model", "block", "class"):
+                return _entry_of(tree, stored, defn)
+    raise FlattenError("no model found in the given files",
+                       hint="name a file that defines a model, or use --model")
+
+
+def _from_user(tree: ClassTree, stored: s.StoredDefinition) -> bool:
+    package = tree.root
+    for part in stored.within or ():
+        package = package.classes.get(part, package)
+    return any(package.classes.get(d.name) is not None and package.classes[d.name].from_user
+               and package.classes[d.name].defn is d for d in stored.classes)
+
+
+def _entry_of(tree: ClassTree, stored: s.StoredDefinition, defn: s.ClassDef) -> ClassEntry:
+    package = tree.root
+    for part in stored.within or ():
+        package = package.classes[part]
+    return package.classes[defn.name]
