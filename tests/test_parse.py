@@ -479,6 +479,10 @@ def test_other_lexical_and_syntax_errors() -> None:
         "t.mo:1:18: error: this expression is not an equation")
     assert error_text("model A Real x = f(a = 1, 2); end A;").startswith(
         "t.mo:1:27: error: positional argument after a named argument")
+    assert error_text("model A Real x = {end}; end A;").startswith(
+        "t.mo:1:19: error: `end` may only be used inside array subscripts such as x[end]")
+    assert error_text("function f equation x = 1; end f;").startswith(
+        "t.mo:1:12: error: a function cannot have an `equation` section")
     with pytest.raises(ParseError, match="unexpected end of file"):
         parse_expression("1 +")
 
@@ -505,6 +509,12 @@ UNSUPPORTED = [
     ("operator record R end R;", "`operator` classes are"),
     ("impure function f end f;", "`impure` functions are"),
     ("function f algorithm g(1); end f;", "call statements (`f(x);`) are"),
+    ("model A equation (a, b) = f(x); end A;",
+     "output lists (`(a, b)`) outside `(a, b) := f(x)` are"),
+    ("model A Real x = (y)[1]; end A;", "subscripts on a parenthesized expression (`(e)[i]`) are"),
+    ("model A .B b; end A;", "global names (`.A.B`) are"),
+    ("model A Real x := 1; end A;", "`:=` in a declaration is"),
+    ("model A M m constrainedby N; end A;", "`constrainedby` is"),
 ]
 
 

@@ -13,12 +13,13 @@ yet``); all of them in a file are reported together as an :class:`~springc.error
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from lark import Lark, Token, Tree
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken
+from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
 from .errors import ErrorGroup, LoadError, Note, ParseError, Span
 from .resources import grammar_path
@@ -149,7 +150,7 @@ def parse_expression(text: str, file: str = "<expr>") -> Expr:
     return _build(tree, file)
 
 
-def _parse(text: str, file: str, start: str):  # -> lark.Tree
+def _parse(text: str, file: str, start: str) -> Tree:
     text = text.removeprefix("\ufeff")
     try:
         return _lark().parse(text, start=start)
@@ -162,9 +163,9 @@ def _parse(text: str, file: str, start: str):  # -> lark.Tree
         raise _syntax_error(exc, text, file) from None
 
 
-def _build(tree, file: str):
+def _build(tree: Tree, file: str) -> Any:  # StoredDefinition or Expr, by start rule
     builder = _ToSyntax(file)
-    result = builder.transform(tree)
+    result = builder.convert(tree)
     if builder.errors:
         errors = sorted(builder.errors, key=lambda e: (e.span.line, e.span.column))
         raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
@@ -183,6 +184,7 @@ _OPERATORS = frozenset(
      ":", ".", "and", "or", "not"]
 )
 _MAX_EXPECTED = 5
+_IGNORED = frozenset({"WHITESPACE", "LINE_COMMENT", "BLOCK_COMMENT"})
 
 
 def _display(terminal: str) -> str:
@@ -196,7 +198,7 @@ def _display(terminal: str) -> str:
 
 
 def _expected(terminals: Iterable[str]) -> str:
-    shown = {_display(t) for t in terminals}
+    shown = {_display(t) for t in terminals if t not in _IGNORED}
     operators = {s for s in shown if s.strip("'") in _OPERATORS}
     if len(operators) > 1:
         shown = (shown - operators) | {"an operator"}
@@ -254,13 +256,12 @@ def _syntax_error(exc: UnexpectedInput, text: str, file: str) -> ParseError:
             if prev is not None and prev.end_line < tok.line:
                 hint = f"a ';' may be missing at the end of line {prev.end_line}"
         return ParseError(f"unexpected {_describe(tok)}{_expected(expected)}", span, hint=hint)
-    expected = getattr(exc, "expected", ()) or ()
-    if isinstance(exc, UnexpectedToken):
-        expected = exc.accepts or exc.expected
-    last = _previous_token(text, len(text))
-    line, column = (last.end_line, last.end_column) if last else (1, 1)
+    # The end of the input: lark's $END token borrows the position of the last token.
+    expected = (exc.accepts or exc.expected) if isinstance(exc, UnexpectedToken) else set()
+    tok = getattr(exc, "token", None)
+    line = getattr(tok, "end_line", None) or 1
+    column = getattr(tok, "end_column", None) or 1
     span = Span(file, line, column, line, column + 1)
-    assert isinstance(exc, UnexpectedToken | UnexpectedEOF)
     return ParseError(f"unexpected end of file{_expected(expected)}", span)
 
 
@@ -386,18 +387,23 @@ class _ToSyntax:
     def __init__(self, file: str) -> None:
         self.file = file
         self.errors: list[ParseError] = []
-        self._methods: dict[str, object] = {}
+        self._methods: dict[str, Callable[[Any, list], Any]] = {}
+        self._loose_ends: list[End] = []  # `end`s not yet known to sit in a subscript
 
-    def transform(self, tree: Tree):
+    def convert(self, tree: Tree) -> Any:
+        """The syntax node for the whole ``tree``; problems are left in ``errors``."""
+        result = self.transform(tree)
+        for end in self._loose_ends:
+            self._error("`end` may only be used inside array subscripts such as x[end]",
+                        end.span)
+        return result
+
+    def transform(self, tree: Tree) -> Any:
         children = [self.transform(c) if type(c) is Tree else c for c in tree.children]
         method = self._methods.get(tree.data)
-        if method is None:
-            method = self._methods[tree.data] = getattr(self, tree.data, self._keep)
+        if method is None:  # every rule has a method: a missing one is a bug, not a skip
+            method = self._methods[tree.data] = getattr(self, tree.data)
         return method(tree.meta, children)
-
-    def _keep(self, meta, ch):
-        """Rules of rejected constructs need no syntax node of their own."""
-        return ch
 
     # ---------------------------------------------------------------- helpers
 
@@ -468,7 +474,7 @@ class _ToSyntax:
                         "expandable": "`expandable` connectors are",
                         "impure": "`impure` functions are"}[tok]
                 self._reject(kind, self._tspan(tok))
-        kind = words[-1] if words[-1] != "operator" else "record"
+        kind = words[-1]
         name = self._ident(spec.name)
         span = self._span(meta)
         if spec.end_name is not None and spec.end_name != spec.name:
@@ -541,6 +547,11 @@ class _ToSyntax:
     def enum_class(self, meta, ch):
         keyword = next(t for t in _tokens(ch) if t.type == "ENUMERATION")
         return self._reject("`enumeration` types are", self._tspan(keyword))
+
+    def enum_body(self, meta, ch):
+        return None
+
+    enum_literal = enum_body
 
     def composition(self, meta, ch):
         elements = [i for c in ch if not isinstance(c, _Section) for i in c]
@@ -862,7 +873,9 @@ class _ToSyntax:
     def component_reference(self, meta, ch):
         first = ch[0]
         if first == "end" and len(ch) == 1:
-            return End(self._span(meta))
+            end = End(self._span(meta))
+            self._loose_ends.append(end)
+            return end
         subs = ch[1] if len(ch) > 1 and isinstance(ch[1], _Subs) else None
         head = self._tspan(first)
         if subs:
@@ -880,7 +893,12 @@ class _ToSyntax:
         return RefPart(self._ident(ch[0]), subs.items if subs else (), self._span(meta))
 
     def array_subscripts(self, meta, ch):
-        return _Subs(tuple(ch), self._span(meta))
+        span = self._span(meta)
+        if self._loose_ends:  # those inside these brackets are where they belong
+            inside = (span.line, span.column), (span.end_line, span.end_column)
+            self._loose_ends = [e for e in self._loose_ends
+                                if not inside[0] <= (e.span.line, e.span.column) < inside[1]]
+        return _Subs(tuple(ch), span)
 
     def colon(self, meta, ch):
         return Colon(self._span(meta))
