@@ -58,9 +58,12 @@ def describe_shape(dims: tuple[int, ...]) -> str:
 
 def elementwise(f: Callable[..., x.Expr], *args: Value) -> Value:
     """Apply a scalar function element by element; scalars broadcast, arrays must agree."""
-    dims = [shape(a) for a in args if is_array(a)]
+    dims = [a.shape for a in args if isinstance(a, np.ndarray)]
     if not dims:
         return f(*args)
+    if len(args) == 1:
+        (arg,) = args
+        return make_array([f(item) for item in arg.flat], arg.shape)
     if any(d != dims[0] for d in dims):
         raise ValueError("element-wise operation on arrays of different sizes: "
                          + " and ".join(_fmt(d) for d in dims))

@@ -246,9 +246,14 @@ def diff(e: Expr, name: str) -> Expr:
     return _diff(e, lambda v: ONE if v.name == name else ZERO, ZERO)
 
 
-def time_derivative(e: Expr) -> Expr:
-    """Total time derivative: ``x`` becomes ``der(x)``, ``time`` becomes 1."""
-    return _diff(e, Der, ONE)
+def time_derivative(e: Expr, varying: Callable[[str], bool] | None = None) -> Expr:
+    """Total time derivative: ``x`` becomes ``der(x)``, ``time`` becomes 1.
+
+    Variables for which ``varying(name)`` is false (parameters) have derivative 0.
+    """
+    if varying is None:
+        return _diff(e, Der, ONE)
+    return _diff(e, lambda v: Der(v) if varying(v.name) else ZERO, ONE)
 
 
 def _diff(e: Expr, dvar: Callable[[Var], Expr], dtime: Expr) -> Expr:

@@ -32,7 +32,7 @@ from .instance import (
     instance_mod,
 )
 from .load import ClassEntry, ClassTree, lookup_class, member_class
-from .modification import Mod, ModValue, from_syntax, merge_all, select
+from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .variables import attributes_of, check_attribute_mods
 
 STATE_SELECT = ("never", "avoid", "default", "prefer", "always")
@@ -85,6 +85,7 @@ class Flattener:
         # Evaluated modification values by (expression, scope); the scope is kept
         # alive in the entry so that its id cannot be reused.
         self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
+        self.declared_types: dict[int, tuple[ViewComponent, ResolvedType, list[Mod | None]]] = {}
 
     # ------------------------------------------------------------ class lookup
 
@@ -127,6 +128,24 @@ class Flattener:
                 return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes)
             entry = self.resolve_class(short.base, entry.parent or entry)
         raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
+
+    def follow_short(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:
+        """``model M2 = M(k = 2)``: the full class behind a short definition, and the
+        modifications met on the way (outermost first)."""
+        mods: list[Mod | None] = []
+        seen = 0
+        while entry.defn.short is not None and seen < 100:
+            short = entry.defn.short
+            if short.dims:
+                raise FlattenError("a model defined as an array is not supported", short.span)
+            mods.append(from_syntax(short.modification, self.package_scope(entry.parent
+                                                                            or entry)))
+            entry = self.resolve_class(short.base, entry.parent or entry)
+            seen += 1
+        if entry.defn.short is not None:
+            raise FlattenError(f"'{entry.full_name}' is defined in terms of itself",
+                               entry.defn.span)
+        return entry, mods
 
     def find_function(self, name: str, scope: Any) -> ClassEntry | None:
         entry = lookup_class(name, scope.entry)
@@ -186,10 +205,9 @@ class Flattener:
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
         decl = comp.decl
-        rtype = self.resolve_type(decl.type_name, comp.defined_in)
+        rtype, type_mods = self._declared_type(comp)
         outer = scope.mod.child(decl.name) if scope.mod is not None else None
-        mods = [outer, from_syntax(decl.modification, scope)]
-        mods += [from_syntax(m, self.package_scope(e.parent or e)) for m, e in rtype.mods]
+        mods = [outer, from_syntax(decl.modification, scope), *type_mods]
         mod = merge_all(mods, scope.flat_name(decl.name))
         if decl.final and outer is not None:
             raise FlattenError(f"'{scope.flat_name(decl.name)}' is final and cannot be "
@@ -212,6 +230,18 @@ class Flattener:
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _declared_type(self, comp: ViewComponent) -> tuple[ResolvedType, list[Mod | None]]:
+        """The resolved type of a declaration and its type modifiers, computed once."""
+        key = id(comp)
+        found = self.declared_types.get(key)
+        if found is None:
+            rtype = self.resolve_type(comp.decl.type_name, comp.defined_in)
+            # A type's own modifications apply to every element of an array of that type.
+            mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
+                    for m, e in rtype.mods]
+            found = self.declared_types[key] = (comp, rtype, mods)
+        return found[1], found[2]
 
     def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
                      parent: ClassScope) -> ClassScope:
@@ -433,9 +463,10 @@ def flatten(tree: ClassTree, model: str | None = None) -> flat.FlatModel:
     """Flatten ``model`` (a dotted name; default: the last model of the last user file)."""
     entry = select_model(tree, model)
     flattener = Flattener(tree)
-    view = flattener.view(entry)
+    base, mods = flattener.follow_short(entry)
+    view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
-    top.mod = instance_mod(None, view, top)
+    top.mod = instance_mod(merge_all(mods), view, top)
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), top]

@@ -93,9 +93,12 @@ def merge(outer: Mod | None, inner: Mod | None, name: str = "") -> Mod | None:
 
 def merge_all(mods: list[Mod | None], name: str = "") -> Mod | None:
     """Merge a list of modifications ordered from outermost to innermost."""
-    result: Mod | None = None
-    for mod in reversed(mods):
-        result = merge(mod, result, name) if result is not None else mod
+    present = [m for m in mods if m is not None]
+    if len(present) <= 1:
+        return present[0] if present else None
+    result = present[-1]
+    for mod in reversed(present[:-1]):
+        result = merge(mod, result, name)
     return result
 
 
@@ -106,3 +109,11 @@ def select(mod: Mod | None, index: tuple[int, ...]) -> Mod | None:
     value = replace(mod.value, index=mod.value.index + index) if mod.value else None
     children = {k: select(v, index) for k, v in mod.children.items()}
     return Mod(value, children, False, mod.final, mod.span)  # type: ignore[arg-type]
+
+
+def each(mod: Mod | None) -> Mod | None:
+    """``mod`` with ``each`` on all its element modifications (for type modifiers)."""
+    if mod is None:
+        return None
+    children = {k: replace(v, each=True) for k, v in mod.children.items()}
+    return replace(mod, children=children)

@@ -5,19 +5,28 @@ Output: matchings, Dulmage-Mendelsohn parts, BLT blocks and tearings of loops.
 """
 
 from .blt import blt
+from .dummy import NumericallySingular, StateSelection, dummy_derivatives, state_priority
 from .graph import Incidence, biadjacency, to_incidence, transpose
 from .matching import DMParts, Matching, dulmage_mendelsohn, maximum_matching, validate_matching
+from .pantelides import IndexReduction, StructurallySingular, pantelides
 from .tearing import Tearing, tear
 
 __all__ = [
     "DMParts",
     "Incidence",
+    "IndexReduction",
     "Matching",
+    "NumericallySingular",
+    "StateSelection",
+    "StructurallySingular",
     "Tearing",
     "biadjacency",
     "blt",
     "dulmage_mendelsohn",
+    "dummy_derivatives",
     "maximum_matching",
+    "pantelides",
+    "state_priority",
     "tear",
     "to_incidence",
     "transpose",

@@ -1,0 +1,47 @@
+"""Structural simplification: flat.FlatModel -> ode.ODE.
+
+The pipeline is a short list of passes, each in its own module:
+
+1. ``lower`` (:mod:`springc.lower`): residual equations and derivative variables;
+2. ``eliminate_aliases`` (:mod:`springc.alias`): ``a = ±b`` and ``a = p`` removed;
+3. ``index_reduce`` (:mod:`springc.reduce`): Pantelides and dummy derivatives;
+4. ``causalize`` (:mod:`springc.causalize`): matching, BLT, solved blocks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import flat, ode
+from .alias import eliminate_aliases
+from .causalize import causalize
+from .errors import Note
+from .lower import lower
+from .reduce import index_reduce
+
+
+@dataclass(frozen=True)
+class Simplified:
+    ode: ode.ODE
+    warnings: tuple[Note, ...]
+
+
+def simplify(model: flat.FlatModel) -> Simplified:
+    """Run the passes of the module docstring on ``model``."""
+    system = lower(model)
+    aliased = eliminate_aliases(system)
+    reduced = index_reduce(aliased.dae)
+    steps = causalize(reduced)
+    unknowns = {u.name: u for u in aliased.dae.unknowns}
+    states = []
+    for state, derivative in reduced.states:
+        name = reduced.names[state]
+        u = unknowns.get(name)
+        states.append(ode.State(name, reduced.names[derivative],
+                                u.start if u else None, bool(u and u.fixed),
+                                u.nominal if u else None, u.unit if u else None,
+                                u.span if u else model.span))
+    observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
+    result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
+                     aliased.dae.parameters, aliased.dae)
+    return Simplified(result, aliased.warnings)
