@@ -63,21 +63,47 @@ def check_balance(model: flat.FlatModel) -> Balance:
         return Balance(model.name, n_var, n_eq, *count_parameters(model))
     parts = dulmage_mendelsohn(rows, n_var, matching)
     notes: list[Note] = []
+    used = {i for row in rows for i in row}
+    under_names = _names(unknowns, parts.under_variables)
+    n_under_eq = len(parts.under_equations)
     for i in parts.under_variables:
         v = unknowns[i]
         where = f" (in {v.component})" if v.component else ""
-        notes.append(Note(f"'{v.name}'{where} is not determined by any equation", v.span))
-    over_names = ", ".join(f"'{unknowns[i].name}'" for i in parts.over_variables[:6])
+        if i not in used:
+            text = f"'{v.name}'{where} appears in no equation"
+        else:
+            text = (f"'{v.name}'{where} is left undetermined: {_count(n_under_eq, 'equation')}"
+                    f" for the {_count(len(parts.under_variables), 'unknown')} {under_names}")
+        notes.append(Note(text, v.span))
+    over_names = _names(unknowns, parts.over_variables)
+    n_over_eq = len(parts.over_equations)
     for i in parts.over_equations:
         eq = model.equations[i]
         where = f" in {eq.origin.component}" if eq.origin.component else ""
         text = f"{x.to_text(eq.lhs)} = {x.to_text(eq.rhs)}"
-        notes.append(Note(f"equation{where} over-determines {over_names or 'nothing'}: {text}"
-                          f" ({eq.origin.kind})", eq.span))
+        notes.append(Note(f"{_KINDS.get(eq.origin.kind, eq.origin.kind)}{where} `{text}` is "
+                          f"one of {n_over_eq} equations for only "
+                          f"{_count(len(parts.over_variables), 'unknown')} {over_names}",
+                          eq.span))
     if len(notes) > MAX_NOTES:
         notes = [*notes[:MAX_NOTES], Note(f"... and {len(notes) - MAX_NOTES} more")]
     raise BalanceError(_headline(model.name, n_var, n_eq, parts), model.span, notes,
                        _hint(parts))
+
+
+_KINDS = {"binding": "binding equation", "connect": "connection equation",
+          "flow": "flow-sum equation", "unconnected": "unconnected-flow equation",
+          "initial": "initial equation"}
+
+
+def _count(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _names(unknowns: tuple[flat.Variable, ...], indices: tuple[int, ...]) -> str:
+    """``'x', 'y'`` (the first six, then ``...``)."""
+    names = ", ".join(f"'{unknowns[i].name}'" for i in indices[:6])
+    return names + (", ..." if len(indices) > 6 else "")
 
 
 def _headline(name: str, n_var: int, n_eq: int, parts: object) -> str:
@@ -97,6 +123,6 @@ def _hint(parts: object) -> str:
         advice.append("add an equation for each undetermined variable, or give it a "
                       "binding (`Real x = ...`) or make it a parameter")
     if over:
-        advice.append("remove the redundant equations, or declare one of the "
-                      "over-determined quantities as a variable they can determine")
+        advice.append("remove the redundant equations (as many as there are surplus "
+                      "equations), or turn a parameter they constrain into an unknown")
     return "; ".join(advice)

@@ -53,7 +53,8 @@ class Evaluator:
             raise FlattenError(f"expected a scalar, found {self.describe(v)}", e.span)
         return v  # type: ignore[return-value]
 
-    def constant(self, e: s.Expr, scope: Any, what: str) -> Any:
+    def constant(self, e: s.Expr, scope: Any, what: str,
+                 hint: str = "use parameters and constants with values here") -> Any:
         """Numeric value (number or numpy array) of a parameter expression."""
         v = self.value(e, scope)
         try:
@@ -61,8 +62,7 @@ class Evaluator:
         except KeyError as missing:
             raise FlattenError(
                 f"{what} must be a parameter expression, but it depends on "
-                f"{missing.args[0]}", e.span,
-                hint="use parameters and constants with values here") from None
+                f"{missing.args[0]}", e.span, hint=hint) from None
         except (ArithmeticError, ValueError, TypeError) as err:
             raise FlattenError(f"cannot evaluate {what}: {err}", e.span) from None
 
@@ -310,7 +310,8 @@ class Evaluator:
         name = e.func.dotted
         if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
-                               hint="see the 'Later' list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see the "
+                               "\"Later\" list in LANGUAGE.md")
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)

@@ -379,14 +379,28 @@ class Flattener:
             self._for(eq, eq.indices, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
             for cond, body in eq.branches:
-                if self.evaluator.constant(cond, where, "an if-equation condition"):
+                if self._if_condition(cond, where):
                     self._body(body, where, owner, initial)
                     return
             self._body(eq.otherwise, where, owner, initial)
         else:
             name = eq.call.func.dotted
             raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
-                               hint="see the 'Later' list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see the "
+                               "\"Later\" list in LANGUAGE.md")
+
+    def _if_condition(self, cond: s.Expr, where: Any) -> Any:
+        """The value of an if-equation condition, which must be a parameter expression
+        (a condition on variables would switch equations at events)."""
+        self.evaluator.no_event += 1
+        try:
+            return self.evaluator.constant(
+                cond, where, "the condition of an if-equation",
+                "switching equations on a variable needs events, which are not supported "
+                "yet; for a continuous switch write one equation with an if-expression "
+                "inside noEvent(...)")
+        finally:
+            self.evaluator.no_event -= 1
 
     def _body(self, body: tuple[s.Equation, ...], where: Any, owner: ClassScope,
               initial: bool) -> None:
@@ -498,8 +512,13 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
             entry = entry.classes.get(part) if entry is not None else None
         if entry is None:
             raise FlattenError(f"no class named '{model}' is loaded",
-                               hint="give the dotted name of a model in the loaded files, "
-                               "e.g. --model Scenes.Chain")
+                               hint=_model_hint(tree, model))
+        if entry.defn.kind not in ("model", "block", "class"):
+            inner = [e.full_name for e in entry.classes.values()
+                     if e.defn.kind in ("model", "block", "class")]
+            raise FlattenError(f"'{model}' is a {entry.defn.kind}, not a model",
+                               hint=("its models are: " + ", ".join(inner)) if inner
+                               else "give the dotted name of a model")
         return entry
     user_files = [f for f in tree.files if _from_user(tree, f)]
     for stored in reversed(user_files):
@@ -508,6 +527,22 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
                 return _entry_of(tree, stored, defn)
     raise FlattenError("no model found in the given files",
                        hint="name a file that defines a model, or use --model")
+
+
+def _model_hint(tree: ClassTree, model: str) -> str:
+    import difflib
+
+    names: list[str] = []
+    pending = list(tree.root.classes.values())
+    while pending:
+        entry = pending.pop()
+        if entry.defn.kind in ("model", "block", "class"):
+            names.append(entry.full_name)
+        pending += entry.classes.values()
+    close = difflib.get_close_matches(model, sorted(names), 3, 0.8)
+    if close:
+        return "did you mean " + " or ".join(f"'{n}'" for n in close) + "?"
+    return "give the dotted name of a model in the loaded files, e.g. --model Scenes.Chain"
 
 
 def _from_user(tree: ClassTree, stored: s.StoredDefinition) -> bool:

@@ -91,7 +91,7 @@ class ClassScope:
     span: s.Span
     outer: ClassScope | None = None
     members: dict[str, Any] = field(default_factory=dict)
-    in_progress: set[str] = field(default_factory=set)
+    in_progress: dict[str, None] = field(default_factory=dict)  # ordered: a chain
 
     @property
     def entry(self) -> ClassEntry:
@@ -114,14 +114,16 @@ class ClassScope:
             return found
         if name in self.in_progress:
             decl = self.view.components[name].decl
-            raise FlattenError(f"'{self.flat_name(name)}' is defined in terms of itself",
+            chain = [*list(self.in_progress)[list(self.in_progress).index(name):], name]
+            raise FlattenError(f"'{self.flat_name(name)}' is defined in terms of itself: "
+                               + " -> ".join(self.flat_name(n) for n in chain),
                                span or decl.span, [Note("declared here", decl.span)],
                                "break the cycle in the bindings or array sizes")
-        self.in_progress.add(name)
+        self.in_progress[name] = None
         try:
             created = self.flattener.instantiate(self, self.view.components[name])
         finally:
-            self.in_progress.discard(name)
+            self.in_progress.pop(name, None)
         self.members[name] = created
         return created
 

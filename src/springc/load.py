@@ -168,6 +168,19 @@ def _imported(entry: ClassEntry, name: str) -> ClassEntry | None:
 
 
 def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
+    import difflib
+
+    visible: set[str] = set()
+    entry: ClassEntry | None = scope
+    while entry is not None:
+        visible.update(entry.classes)
+        for e in entry.defn.elements:
+            if isinstance(e, s.Import):
+                visible.update([e.alias] if e.alias else e.names)
+        entry = entry.parent
+    close = difflib.get_close_matches(name, sorted(visible), 1)
+    if close:
+        return f"did you mean '{close[0]}'?"
     return (f"no class '{name}' is visible here: check the spelling, add an `import`, "
             "or load the file that defines it (name it on the command line or pass "
             "its folder with -L)")
