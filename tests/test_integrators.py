@@ -44,9 +44,9 @@ def test_rk4_accuracy_at_small_step() -> None:
     assert max_error("rk4", 0.001) < 1e-11
 
 
-def test_verlet_energy_bounded_over_ten_thousand_periods() -> None:
+def test_verlet_energy_bounded_over_a_thousand_periods() -> None:
     period = 2 * np.pi / OMEGA
-    times = np.linspace(0.0, 1e4 * period, 2001)
+    times = np.linspace(0.0, 1e3 * period, 2001)
     h = period / 40
     verlet = integrate("verlet", oscillator, times, np.array([1.0, 0.0]), h, PAIRS)
     euler = integrate("euler", oscillator, times[:50], np.array([1.0, 0.0]), h)
