@@ -12,7 +12,9 @@ Format (``tests/cases/**/*.case``)::
 
 Files named ``models/...`` refer to the repository's model library instead of an
 inline file. The command runs in a temporary folder holding the inline files, with
-``models/`` linked in; the output is stdout followed by stderr.
+``models/`` linked in; the output is stdout followed by stderr. Locations in the
+bundled library (an absolute path that depends on the install) are shown as
+``models/...`` so that goldens do not depend on where springc is installed.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from pathlib import Path
 from click.testing import CliRunner
 
 from springc.cli import main
+from springc.resources import models_dir
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = Path(__file__).resolve().parent / "cases"
@@ -79,10 +82,12 @@ def run_case(case: Case, workdir: Path) -> tuple[int, str]:
     old = os.getcwd()
     os.chdir(workdir)
     try:
-        result = CliRunner().invoke(main, case.command, env={"SPRINGC_PATH": ""})
+        result = CliRunner().invoke(main, case.command, prog_name="springc",
+                                    env={"SPRINGC_PATH": ""})
     finally:
         os.chdir(old)
-    return result.exit_code, result.stdout + result.stderr
+    output = result.stdout + result.stderr
+    return result.exit_code, output.replace(str(models_dir()) + os.sep, "models/")
 
 
 def all_cases() -> list[Path]:

@@ -298,8 +298,9 @@ class Evaluator:
         for i in values.flat:
             if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
                 raise FlattenError(
-                    f"index {i} is out of range for '{part.name}' of size {size}",
-                    sub.span, hint=f"subscripts of '{part.name}' run from 1 to {size}")
+                    f"index {i} is out of range for '{part.name}' of size {size}"
+                    + _loop_context(scope), sub.span,
+                    hint=f"subscripts of '{part.name}' run from 1 to {size}")
         if isinstance(v, np.ndarray):
             return np.array([int(i) - 1 for i in v.flat], dtype=int)
         return int(v) - 1
@@ -351,3 +352,14 @@ class Evaluator:
     @staticmethod
     def _plain(v: Any) -> Any:
         return int(v) if isinstance(v, float) and v.is_integer() else v
+
+
+def _loop_context(scope: Any) -> str:
+    """`` (with i = 3)``: the values of the enclosing for-loop indices, if any."""
+    values: list[str] = []
+    while isinstance(scope, LocalScope):
+        values = [f"{k} = {v.value}" for k, v in scope.names.items()
+                  if isinstance(v, x.Const) and isinstance(v.value, (int, np.integer))
+                  and not isinstance(v.value, bool)] + values
+        scope = scope.parent
+    return f" (with {', '.join(values)})" if values else ""
