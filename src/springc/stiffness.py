@@ -48,7 +48,7 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
         return float(np.max(np.abs(np.linalg.eigvals(dense))))
     operator = sp.csr_matrix(jac, dtype=float)
     try:
-        largest = eigs(operator, k=1, which="LM", tol=1e-3, maxiter=20 * n,
+        largest = eigs(operator, k=1, which="LM", tol=1e-2, maxiter=500,
                        return_eigenvectors=False)
     except ArpackNoConvergence as partial:
         largest = partial.eigenvalues
