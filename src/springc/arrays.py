@@ -9,6 +9,7 @@ attaches the source location.
 from __future__ import annotations
 
 from collections.abc import Callable
+import math
 from functools import reduce
 
 import numpy as np
@@ -67,7 +68,12 @@ def elementwise(f: Callable[..., x.Expr], *args: Value) -> Value:
     if any(d != dims[0] for d in dims):
         raise ValueError("element-wise operation on arrays of different sizes: "
                          + " and ".join(_fmt(d) for d in dims))
-    return np.frompyfunc(f, len(args), 1)(*args).astype(object).reshape(dims[0])
+    # Arrays here are small (a 2-D position, a row of masses): a Python loop over the
+    # elements beats building a numpy ufunc per call.
+    count = math.prod(dims[0])
+    columns = [list(arg.flat) if isinstance(arg, np.ndarray) else [arg] * count
+               for arg in args]
+    return make_array([f(*items) for items in zip(*columns)], dims[0])
 
 
 def _same_size(op: str, a: Value, b: Value) -> None:
