@@ -8,8 +8,8 @@ attaches the source location.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 import math
+from collections.abc import Callable
 from functools import reduce
 
 import numpy as np

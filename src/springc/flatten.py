@@ -8,8 +8,10 @@ turns ``connect`` statements into potential equalities and flow sums.
 from __future__ import annotations
 
 import gc
+import itertools
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -87,7 +89,8 @@ class Flattener:
         # Evaluated modification values by (expression, scope); the scope is kept
         # alive in the entry so that its id cannot be reused.
         self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
-        self.declared_types: dict[int, tuple[ViewComponent, ResolvedType, list[Mod | None]]] = {}
+        self.declared_types: dict[int, Declared] = {}
+        self.attribute_cache: dict[int, tuple[Mod, flat.Attributes]] = {}
 
     # ------------------------------------------------------------ class lookup
 
@@ -207,16 +210,17 @@ class Flattener:
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
         decl = comp.decl
-        rtype, type_mods = self._declared_type(comp)
-        outer = scope.mod.child(decl.name) if scope.mod is not None else None
-        mods = [outer, from_syntax(decl.modification, scope), *type_mods]
-        mod = merge_all(mods, scope.flat_name(decl.name))
+        declared = self._declared_type(comp)
+        rtype = declared.rtype
+        name = scope.flat_name(decl.name)
+        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
+        mods = [outer, from_syntax(decl.modification, scope), *declared.type_mods]
+        mod = merge_all(mods, name)
         if decl.final and outer is not None:
-            raise FlattenError(f"'{scope.flat_name(decl.name)}' is final and cannot be "
+            raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = self._dims(decl, scope, rtype)
-        name = scope.flat_name(decl.name)
+        dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name)
         assert rtype.entry is not None
@@ -233,7 +237,7 @@ class Flattener:
                                          select(mod, sub), decl, scope)
         return out
 
-    def _declared_type(self, comp: ViewComponent) -> tuple[ResolvedType, list[Mod | None]]:
+    def _declared_type(self, comp: ViewComponent) -> Declared:
         """The resolved type of a declaration and its type modifiers, computed once."""
         key = id(comp)
         found = self.declared_types.get(key)
@@ -242,8 +246,9 @@ class Flattener:
             # A type's own modifications apply to every element of an array of that type.
             mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
                     for m, e in rtype.mods]
-            found = self.declared_types[key] = (comp, rtype, mods)
-        return found[1], found[2]
+            found = self.declared_types[key] = Declared(comp, rtype, mods,
+                                                        _literal_dims(comp.decl, rtype))
+        return found
 
     def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
                      parent: ClassScope) -> ClassScope:
@@ -460,13 +465,30 @@ class Flattener:
                     yield from self.variables(item)
 
 
+@dataclass(frozen=True)
+class Declared:
+    """What a component declaration contributes independently of the instance: its
+    resolved type, the type's modifications, and its sizes when they are literals."""
+
+    comp: ViewComponent  # kept alive: declared_types is keyed by its id
+    rtype: ResolvedType
+    type_mods: list[Mod | None]
+    dims: tuple[int, ...] | None
+
+
+def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | None:
+    """The sizes of a declaration if all are integer literals (``pos[2]``), else None."""
+    exprs = [*decl.dims, *decl.type_dims, *(d for d, _ in rtype.dims)]
+    if all(isinstance(d, s.Number) and type(d.value) is int for d in exprs):
+        return tuple(d.value for d in exprs)  # type: ignore[union-attr]
+    return None
+
+
 def _element_names(name: str, dims: tuple[int, ...]) -> np.ndarray | str:
     if not dims:
         return name
-    out = np.empty(dims, dtype=object)
-    for idx in np.ndindex(dims):
-        out[idx] = f"{name}[{','.join(str(i + 1) for i in idx)}]"
-    return out
+    indices = itertools.product(*(range(1, n + 1) for n in dims))
+    return a.make_array([f"{name}[{','.join(map(str, idx))}]" for idx in indices], dims)
 
 
 def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:

@@ -106,6 +106,8 @@ def select(mod: Mod | None, index: tuple[int, ...]) -> Mod | None:
     """The modification of one element of an array of components (``each`` is kept whole)."""
     if mod is None or mod.each:
         return mod
+    if mod.value is None and all(v.each for v in mod.children.values()):
+        return mod  # nothing to pick (type modifiers): share the object
     value = replace(mod.value, index=mod.value.index + index) if mod.value else None
     children = {k: select(v, index) for k, v in mod.children.items()}
     return Mod(value, children, False, mod.final, mod.span)  # type: ignore[arg-type]

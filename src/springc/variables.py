@@ -7,10 +7,9 @@ one :class:`~springc.flat.Variable` per array element, attributes evaluated.
 from __future__ import annotations
 
 import difflib
+import itertools
 from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
-
-import numpy as np
 
 from . import arrays as a
 from . import expr as x
@@ -52,8 +51,8 @@ def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
                   ) -> Iterator[flat.Variable]:
     """The flat variables of one primitive component."""
     names = [prim.names] if not prim.dims else list(prim.names.flat)  # type: ignore[union-attr]
-    indices = [()] if not prim.dims else [tuple(i + 1 for i in idx)
-                                         for idx in np.ndindex(prim.dims)]
+    indices = [()] if not prim.dims else list(itertools.product(
+        *(range(1, n + 1) for n in prim.dims)))
     bindings = flattener.parameter_values.bindings
     is_param = prim.variability == "parameter"
     for name, idx in zip(names, indices):
@@ -66,8 +65,18 @@ def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
 
 
 def _attributes(flattener: Flattener, mod: Mod | None, name: str) -> flat.Attributes:
+    """The attributes given by ``mod``; remembered per modification object, since a
+    type's modifiers (``unit = "m"``) are one object shared by all its variables."""
     if mod is None or not mod.children:
         return _EMPTY
+    cached = flattener.attribute_cache.get(id(mod))
+    if cached is None:
+        # The entry keeps ``mod`` alive so that its id is not reused.
+        cached = flattener.attribute_cache[id(mod)] = (mod, _evaluate(flattener, mod, name))
+    return cached[1]
+
+
+def _evaluate(flattener: Flattener, mod: Mod, name: str) -> flat.Attributes:
     values: dict[str, Any] = {}
     for key, child in mod.children.items():
         if child.value is None:
