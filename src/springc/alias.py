@@ -15,6 +15,7 @@ from . import dae
 from . import expr as x
 from .errors import Note
 from .lower import differentiate
+from .solve import free_variables
 
 _SELECT_RANK = {"never": 0, "avoid": 1, "default": 2, "prefer": 3, "always": 4}
 
@@ -46,8 +47,8 @@ def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
     if isinstance(e, x.Var) and e.name in unknowns:
         out.append((sign, e.name))
         return len(out) <= 2
-    if isinstance(e, x.Time) or any(isinstance(n, x.Time) or (isinstance(n, x.Var) and (
-            n.name in unknowns or n.name.startswith("der("))) for n in x.walk(e)):
+    if any(n in unknowns or n.startswith("der(") for n in free_variables(e)) or any(
+            isinstance(n, x.Time) for n in x.walk(e)):
         return False
     rest.append((sign, e))
     return True
@@ -154,7 +155,7 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     for name, value in mapping.items():
         if name in differentiated:
             der_map[dae.der_name(name)] = differentiate(value, varying)
-            differentiated.update(v for v in x.variables(value) if v in names)
+            differentiated.update(v for v in free_variables(value) if v in names)
     full = {**mapping, **der_map}
     equations = tuple(replace(r, expr=x.substitute(r.expr, full)) if _uses(r.expr, full)
                       else r for r in kept)
@@ -169,7 +170,7 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
 
 
 def _uses(e: x.Expr, mapping: dict[str, x.Expr]) -> bool:
-    return any(isinstance(n, x.Var) and n.name in mapping for n in x.walk(e))
+    return any(n in mapping for n in free_variables(e))
 
 
 def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]

@@ -14,7 +14,7 @@ from . import expr as x
 from . import ode
 from .errors import Note, SimplifyError
 from .reduce import Reduced
-from .solve import fold, solvable, solve_for
+from .solve import fold, free_variables, partial, solvable, solve_for
 from .structure import blt, dulmage_mendelsohn, maximum_matching, tear
 
 
@@ -62,12 +62,12 @@ def _linear_system(exprs: list[x.Expr], names: list[str]
     entries: list[tuple[int, int, x.Expr]] = []
     rhs: list[x.Expr] = []
     for i, r in enumerate(exprs):
-        present = x.variables(r) & block
+        present = free_variables(r) & block
         for j, name in enumerate(names):
             if name not in present:
                 continue
-            coeff = fold(x.diff(r, name))
-            if x.variables(coeff) & block:
+            coeff = partial(r, name)
+            if free_variables(coeff) & block:
                 return None
             if coeff != x.ZERO:
                 entries.append((i, j, coeff))
@@ -104,24 +104,24 @@ def _nonlinear(residuals: list[x.Expr], tearing: list[str],
     inner_names = [name for name, _, _ in inner]
     for name, value, span in inner:
         for t in tearing:
-            total = fold(x.diff(value, t))
+            total = partial(value, t)
             for prev in inner_names:
                 if prev == name:
                     break
-                if prev in x.variables(value) and (prev, t) in sens:
-                    total = fold(x.add(total, x.mul(fold(x.diff(value, prev)), sens[prev, t])))
+                if prev in free_variables(value) and (prev, t) in sens:
+                    total = fold(x.add(total, x.mul(partial(value, prev), sens[prev, t])))
             if total != x.ZERO:
                 sens_name = f"d({name})/d({t})"
                 sensitivities.append(ode.Assign(sens_name, total, span))  # type: ignore
                 sens[name, t] = x.Var(sens_name)
     jacobian: list[tuple[int, int, x.Expr]] = []
     for i, r in enumerate(residuals):
-        used = x.variables(r)
+        used = free_variables(r)
         for j, t in enumerate(tearing):
-            total = fold(x.diff(r, t))
+            total = partial(r, t)
             for prev in inner_names:
                 if prev in used and (prev, t) in sens:
-                    total = fold(x.add(total, x.mul(fold(x.diff(r, prev)), sens[prev, t])))
+                    total = fold(x.add(total, x.mul(partial(r, prev), sens[prev, t])))
             if total != x.ZERO:
                 jacobian.append((i, j, total))
     assigns = tuple(ode.Assign(n, v, s) for n, v, s in inner)  # type: ignore[arg-type]

@@ -48,10 +48,13 @@ class Residual:
     expr: Expr
     span: Span
     origin: flat.Origin
-    text: str = ""
+    source: flat.Equation | None = None
 
     def describe(self) -> str:
-        return self.text or f"{to_text(self.expr)} = 0"
+        """The equation as the user wrote it (flattened): ``lhs = rhs``."""
+        if self.source is not None:
+            return f"{to_text(self.source.lhs)} = {to_text(self.source.rhs)}"
+        return f"{to_text(self.expr)} = 0"
 
 
 @dataclass(frozen=True)

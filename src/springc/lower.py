@@ -11,6 +11,7 @@ from collections.abc import Callable
 from . import dae, flat
 from . import expr as x
 from .errors import Note, SimplifyError
+from .solve import COUNTERS, free_variables
 
 
 def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
@@ -40,18 +41,28 @@ def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
 
 def differentiate(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
     """d/dt of a lowered expression, again in terms of derivative variables."""
+    COUNTERS["diff"] += 1
     return lower_derivatives(x.time_derivative(e, varying), varying)
 
 
 def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual:
     lhs = lower_derivatives(eq.lhs, varying) if _has_der(eq.lhs) else eq.lhs
     rhs = lower_derivatives(eq.rhs, varying) if _has_der(eq.rhs) else eq.rhs
-    text = f"{x.to_text(eq.lhs)} = {x.to_text(eq.rhs)}"
-    return dae.Residual(x.sub(lhs, rhs), eq.span, eq.origin, text)
+    return dae.Residual(x.sub(lhs, rhs), eq.span, eq.origin, eq)
 
 
 def _has_der(e: x.Expr) -> bool:
-    return any(isinstance(n, x.Der) for n in x.walk(e))
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        kind = type(node)
+        if kind is x.Der:
+            return True
+        if kind is x.BinOp:
+            stack += (node.left, node.right)  # type: ignore[union-attr]
+        elif kind is not x.Var and kind is not x.Const:
+            stack.extend(x.children(node))
+    return False
 
 
 def lower(model: flat.FlatModel) -> dae.DAE:
@@ -78,7 +89,7 @@ def lower(model: flat.FlatModel) -> dae.DAE:
     equations = tuple(_residual(eq, varying) for eq in model.equations)
     initial = tuple(_residual(eq, varying) for eq in model.initial_equations)
     differentiated = frozenset(
-        n[4:-1] for r in equations + initial for n in x.variables(r.expr)
+        n[4:-1] for r in equations + initial for n in free_variables(r.expr)
         if n.startswith("der(") and n[4:-1] in names)
     return dae.DAE(model.name, unknowns, parameters, equations, initial, model.experiment,
                    model.span, differentiated)

@@ -8,19 +8,27 @@ states; everything else is algebraic.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+
+import numpy as np
 
 from . import dae
 from . import expr as x
 from .errors import Note, SimplifyError
+from .evaluate_ode import evaluate_with, parameter_values, start_values
 from .lower import differentiate
+from .solve import free_variables, partial
 from .structure import (
+    NumericallySingular,
     StructurallySingular,
     dummy_derivatives,
     pantelides,
     state_priority,
 )
+
+START_BONUS = 0.25
+"""Priority added for a (non-fixed) start value: below the fixed-start bonus (0.5)."""
 
 
 @dataclass(frozen=True)
@@ -40,7 +48,7 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     names = [u.name for u in system.unknowns]
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
-    pending = sorted({n for r in system.equations for n in x.variables(r.expr)
+    pending = sorted({n for r in system.equations for n in free_variables(r.expr)
                       if n.startswith("der(")}, key=len)
     for name in pending:
         base = name[4:-1]
@@ -59,7 +67,7 @@ def index_reduce(system: dae.DAE) -> Reduced:
     exprs = [r.expr for r in system.equations]
     sources = list(system.equations)
     orders = [0] * len(exprs)
-    incidence = [tuple(sorted(index[n] for n in x.variables(e) if n in index)) for e in exprs]
+    incidence = [tuple(sorted(index[n] for n in free_variables(e) if n in index)) for e in exprs]
 
     def varying(name: str) -> bool:
         return name in index or name.startswith("der(")
@@ -77,7 +85,7 @@ def index_reduce(system: dae.DAE) -> Reduced:
         exprs.append(new)
         sources.append(sources[eq])
         orders.append(orders[eq] + 1)
-        return [index[n] for n in x.variables(new) if n in index]
+        return [index[n] for n in free_variables(new) if n in index]
 
     try:
         reduction = pantelides(incidence, derivative, [-1] * len(exprs), len(names),
@@ -85,12 +93,63 @@ def index_reduce(system: dae.DAE) -> Reduced:
     except StructurallySingular as err:
         raise _singular(system, err, names) from None
     unknowns = {u.name: u for u in system.unknowns}
-    priority = [state_priority(unknowns[n].state_select, unknowns[n].fixed)
-                if n in unknowns else state_priority() for n in names]
-    selection = dummy_derivatives(reduction, priority)
+    priority = [_priority(unknowns[n]) if n in unknowns else state_priority() for n in names]
+    check = _nonsingular_at_start(system, names, exprs)
+    try:
+        selection = dummy_derivatives(reduction, priority, check)
+    except NumericallySingular as err:
+        raise _numerically_singular(system, err, names, sources) from None
     states = tuple(zip(selection.states, selection.state_derivatives))
     return Reduced(tuple(names), tuple(exprs), tuple(sources), tuple(orders),
                    reduction.incidence, states)
+
+
+def _priority(u: dae.Unknown) -> float:
+    """``stateSelect`` and a fixed start rank first; any start value breaks ties, so
+    that a variable the user gave a start value stays a state when possible."""
+    bonus = START_BONUS if u.start is not None and not u.fixed else 0.0
+    return state_priority(u.state_select, u.fixed and u.start is not None) + bonus
+
+
+def _nonsingular_at_start(system: dae.DAE, names: list[str], exprs: list[x.Expr]
+                          ) -> Callable[[tuple[int, ...], tuple[int, ...]], bool]:
+    """``is_nonsingular`` for the dummy-derivative method: the Jacobian block evaluated
+    at the start values (0 where none is given) must be well conditioned, so that e.g.
+    a rod that starts horizontal does not get its vertical position as a dummy."""
+    env: dict[str, float] = {}
+
+    def check(rows: tuple[int, ...], cols: tuple[int, ...]) -> bool:
+        if not env:
+            try:
+                env.update(parameter_values(system.parameters))
+                env.update(start_values(system.unknowns, env))
+            except SimplifyError:
+                env["$failed"] = 1.0
+        if "$failed" in env:
+            return True
+        jac = np.zeros((len(rows), len(cols)))
+        try:
+            for i, e in enumerate(rows):
+                for j, v in enumerate(cols):
+                    jac[i, j] = evaluate_with(partial(exprs[e], names[v]),
+                                              lambda n: env.get(n, 0.0))
+        except (ArithmeticError, ValueError):
+            return True
+        sv = np.linalg.svd(jac, compute_uv=False)
+        return bool(sv[-1] > 1e-8 * max(1.0, sv[0]))
+
+    return check
+
+
+def _numerically_singular(system: dae.DAE, err: NumericallySingular, names: list[str],
+                          sources: list[dae.Residual]) -> SimplifyError:
+    notes = [Note(f"equation: {sources[e].describe()}", sources[e].span)
+             for e in err.equations[:10]]
+    involved = ", ".join(f"'{names[v]}'" for v in err.variables[:10])
+    return SimplifyError(f"no choice of states is valid at the start values: the "
+                         f"constraints are singular with respect to {involved}",
+                         system.span, notes, "check the start values of the constrained "
+                         "variables against the constraints listed")
 
 
 def _singular(system: dae.DAE, err: StructurallySingular, names: list[str]) -> SimplifyError:
