@@ -29,8 +29,9 @@ class Balance:
     def summary(self) -> str:
         arrays = (f", {self.parameter_arrays} parameter array"
                   f"{'s' if self.parameter_arrays != 1 else ''}") if self.parameter_arrays else ""
-        return (f"{self.model}: {self.unknowns} unknowns, {self.equations} equations, "
-                f"{self.parameters} parameters{arrays}: balanced")
+        return (f"{self.model}: {_count(self.unknowns, 'unknown')}, "
+                f"{_count(self.equations, 'equation')}, "
+                f"{_count(self.parameters, 'parameter')}{arrays}: balanced")
 
 
 def incidence(model: flat.FlatModel) -> list[list[int]]:
@@ -63,32 +64,54 @@ def check_balance(model: flat.FlatModel) -> Balance:
         return Balance(model.name, n_var, n_eq, *count_parameters(model))
     parts = dulmage_mendelsohn(rows, n_var, matching)
     notes: list[Note] = []
-    used = {i for row in rows for i in row}
-    under_names = _names(unknowns, parts.under_variables)
-    n_under_eq = len(parts.under_equations)
-    for i in parts.under_variables:
-        v = unknowns[i]
-        where = f" (in {v.component})" if v.component else ""
-        if i not in used:
-            text = f"'{v.name}'{where} appears in no equation"
-        else:
-            text = (f"'{v.name}'{where} is left undetermined: {_count(n_under_eq, 'equation')}"
-                    f" for the {_count(len(parts.under_variables), 'unknown')} {under_names}")
-        notes.append(Note(text, v.span))
-    over_names = _names(unknowns, parts.over_variables)
-    n_over_eq = len(parts.over_equations)
-    for i in parts.over_equations:
-        eq = model.equations[i]
-        where = f" in {eq.origin.component}" if eq.origin.component else ""
-        text = f"{x.to_text(eq.lhs)} = {x.to_text(eq.rhs)}"
-        notes.append(Note(f"{_KINDS.get(eq.origin.kind, eq.origin.kind)}{where} `{text}` is "
-                          f"one of {n_over_eq} equations for only "
-                          f"{_count(len(parts.over_variables), 'unknown')} {over_names}",
-                          eq.span))
+    for eqs, var_ids in _blocks(rows, parts.under_equations, parts.under_variables):
+        names = _names(unknowns, var_ids)
+        for i in var_ids:
+            v = unknowns[i]
+            where = f" (in {v.component})" if v.component else ""
+            text = (f"'{v.name}'{where} appears in no equation" if not eqs else
+                    f"'{v.name}'{where} is left undetermined: {_count(len(eqs), 'equation')}"
+                    f" for the {_count(len(var_ids), 'unknown')} {names}")
+            notes.append(Note(text, v.span))
+    for eqs, var_ids in _blocks(rows, parts.over_equations, parts.over_variables):
+        names = _names(unknowns, var_ids)
+        for i in eqs:
+            eq = model.equations[i]
+            where = f" in {eq.origin.component}" if eq.origin.component else ""
+            text = f"{x.to_text(eq.lhs)} = {x.to_text(eq.rhs)}"
+            kind = _KINDS.get(eq.origin.kind, eq.origin.kind)
+            notes.append(Note(f"{kind}{where} `{text}` " + (
+                f"is one of {len(eqs)} equations for only "
+                f"{_count(len(var_ids), 'unknown')} {names}" if var_ids else
+                "involves no unknown"), eq.span))
     if len(notes) > MAX_NOTES:
         notes = [*notes[:MAX_NOTES], Note(f"... and {len(notes) - MAX_NOTES} more")]
     raise BalanceError(_headline(model.name, n_var, n_eq, parts), model.span, notes,
                        _hint(parts))
+
+
+def _blocks(rows: list[list[int]], eqs: tuple[int, ...], var_ids: tuple[int, ...]
+            ) -> list[tuple[list[int], list[int]]]:
+    """Split a part of the Dulmage-Mendelsohn decomposition into its connected pieces
+    (equations, variables), so that each note counts only what is related to it."""
+    parent: dict[tuple[str, int], tuple[str, int]] = {}
+
+    def find(k: tuple[str, int]) -> tuple[str, int]:
+        while parent.setdefault(k, k) != k:
+            k = parent[k]
+        return k
+
+    in_part = set(var_ids)
+    for i in eqs:
+        for j in rows[i]:
+            if j in in_part:
+                parent[find(("e", i))] = find(("v", j))
+    pieces: dict[tuple[str, int], tuple[list[int], list[int]]] = {}
+    for i in eqs:
+        pieces.setdefault(find(("e", i)), ([], []))[0].append(i)
+    for j in var_ids:
+        pieces.setdefault(find(("v", j)), ([], []))[1].append(j)
+    return sorted(pieces.values(), key=lambda p: (min(p[1], default=-1), min(p[0], default=-1)))
 
 
 _KINDS = {"binding": "binding equation", "connect": "connection equation",
@@ -100,14 +123,14 @@ def _count(n: int, word: str) -> str:
     return f"{n} {word}{'' if n == 1 else 's'}"
 
 
-def _names(unknowns: tuple[flat.Variable, ...], indices: tuple[int, ...]) -> str:
+def _names(unknowns: tuple[flat.Variable, ...], indices: list[int]) -> str:
     """``'x', 'y'`` (the first six, then ``...``)."""
     names = ", ".join(f"'{unknowns[i].name}'" for i in indices[:6])
     return names + (", ..." if len(indices) > 6 else "")
 
 
 def _headline(name: str, n_var: int, n_eq: int, parts: object) -> str:
-    counts = f"{n_var} unknowns, {n_eq} equations"
+    counts = f"{_count(n_var, 'unknown')}, {_count(n_eq, 'equation')}"
     if n_var > n_eq:
         return f"model '{name}' is under-determined: {counts}"
     if n_eq > n_var:
