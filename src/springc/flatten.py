@@ -37,6 +37,7 @@ from .instance import (
 )
 from .load import ClassEntry, ClassTree, lookup_class, member_class
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
+from .templates import Template, make_template, reusable
 from .variables import attributes_of, check_attribute_mods
 
 STATE_SELECT = ("never", "avoid", "default", "prefer", "always")
@@ -49,8 +50,10 @@ class ParameterValues(Mapping[str, Any]):
         self.bindings: dict[str, x.Expr | None] = {}
         self.cache: dict[str, Any] = {}
         self.active: set[str] = set()
+        self.reads = 0  # how often a value was asked for (see templates.reusable)
 
     def __getitem__(self, name: str) -> Any:
+        self.reads += 1
         if name in self.cache:
             return self.cache[name]
         if name not in self.bindings:
@@ -91,6 +94,9 @@ class Flattener:
         self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
         self.declared_types: dict[int, Declared] = {}
         self.attribute_cache: dict[int, tuple[Mod, flat.Attributes]] = {}
+        self.reusable_views: dict[int, bool] = {}
+        # Equation templates by (id of the ClassView, initial); None: not reusable.
+        self.templates: dict[tuple[int, bool], Template | None] = {}
 
     # ------------------------------------------------------------ class lookup
 
@@ -210,7 +216,7 @@ class Flattener:
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
         decl = comp.decl
-        declared = self._declared_type(comp)
+        declared = self.declared_type(comp)
         rtype = declared.rtype
         name = scope.flat_name(decl.name)
         outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
@@ -237,7 +243,7 @@ class Flattener:
                                          select(mod, sub), decl, scope)
         return out
 
-    def _declared_type(self, comp: ViewComponent) -> Declared:
+    def declared_type(self, comp: ViewComponent) -> Declared:
         """The resolved type of a declaration and its type modifiers, computed once."""
         key = id(comp)
         found = self.declared_types.get(key)
@@ -367,12 +373,27 @@ class Flattener:
     # --------------------------------------------------------------- equations
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
+        """The equations of one instance; from the class's template when it has one."""
         view = scope.view
-        for item in view.initial_equations if initial else view.equations:
+        items = view.initial_equations if initial else view.equations
+        if not items:
+            return
+        target = self.initial_equations if initial else self.equations
+        key = (id(view), initial)
+        template = self.templates.get(key)
+        if template is not None:
+            target += template.instantiate(scope.prefix)
+            return
+        start, errors, reads = len(target), len(self.errors), self.parameter_values.reads
+        for item in items:
             try:
                 self.equation(item.equation, scope, scope, initial)
             except FlattenError as err:
                 self.errors.append(err)
+        if key not in self.templates and scope.prefix and len(self.errors) == errors:
+            independent = self.parameter_values.reads == reads and reusable(self, view)
+            self.templates[key] = make_template(scope.prefix, target[start:]) \
+                if independent else None
 
     def equation(self, eq: s.Equation, where: Any, owner: ClassScope, initial: bool) -> None:
         if isinstance(eq, s.Equality):
