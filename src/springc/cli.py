@@ -70,15 +70,26 @@ def main(debug: bool) -> None:
 @_model_options
 @click.option("--origins", is_flag=True, help="Show where each equation comes from.")
 @click.option("--json", "as_json", is_flag=True, help="Print the flat model as JSON.")
+@click.option("--simplify", "simplified", is_flag=True,
+              help="Print the simplified system: states, evaluation order, observed.")
 @_guard
 def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
-            origins: bool, as_json: bool) -> None:
+            origins: bool, as_json: bool, simplified: bool) -> None:
     """Print the flat model of FILES as Modelica text (or JSON)."""
     from .flat import format_flat, to_json_dict
     from .pipeline import flatten_files
 
     flat_model = flatten_files(files, model, libraries)
-    if as_json:
+    if simplified:
+        from .ode import format_ode
+        from .simplify import simplify
+
+        result = simplify(flat_model)
+        click.echo(format_ode(result.ode), nl=False)
+        for note in result.warnings:
+            click.echo(f"{note.span}: warning: {note.message}" if note.span
+                       else f"warning: {note.message}", err=True)
+    elif as_json:
         click.echo(json.dumps(to_json_dict(flat_model), indent=1))
     else:
         click.echo(format_flat(flat_model, origins), nl=False)

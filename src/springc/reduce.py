@@ -49,7 +49,7 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
     pending = sorted({n for r in system.equations for n in free_variables(r.expr)
-                      if n.startswith("der(")}, key=len)
+                      if n.startswith("der(")}, key=lambda n: (len(n), n))
     for name in pending:
         base = name[4:-1]
         if base not in index:
@@ -85,7 +85,7 @@ def index_reduce(system: dae.DAE) -> Reduced:
         exprs.append(new)
         sources.append(sources[eq])
         orders.append(orders[eq] + 1)
-        return [index[n] for n in free_variables(new) if n in index]
+        return sorted(index[n] for n in free_variables(new) if n in index)
 
     try:
         reduction = pantelides(incidence, derivative, [-1] * len(exprs), len(names),
