@@ -62,6 +62,15 @@ class FlattenError(SpringcError):
     """Name lookup, modification, array or connection error while flattening."""
 
 
+class FollowUpError(FlattenError):
+    """A use of a component whose instantiation failed: not shown itself, the original
+    error (``original``) is reported once instead."""
+
+    def __init__(self, original: SpringcError) -> None:
+        super().__init__(original.message, original.span, original.notes, original.hint)
+        self.original = original
+
+
 class BalanceError(SpringcError):
     """The flat model is not balanced or is structurally singular."""
 

@@ -22,7 +22,7 @@ from . import flat
 from . import syntax as s
 from .builtins import CONSTANTS
 from .connections import ConnectionSets
-from .errors import ErrorGroup, FlattenError, Note, SpringcError
+from .errors import ErrorGroup, FlattenError, FollowUpError, Note, SpringcError
 from .evaluate import Evaluator
 from .instance import (
     PRIMITIVES,
@@ -389,7 +389,7 @@ class Flattener:
             try:
                 self.equation(item.equation, scope, scope, initial)
             except FlattenError as err:
-                self.errors.append(err)
+                self.report(err)
         if key not in self.templates and scope.prefix and len(self.errors) == errors:
             independent = self.parameter_values.reads == reads and reusable(self, view)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
@@ -463,9 +463,21 @@ class Flattener:
 
     # --------------------------------------------------------------- the model
 
+    def report(self, err: FlattenError) -> None:
+        """Record an error and go on; a follow-up error records its original, once."""
+        original = err.original if isinstance(err, FollowUpError) else err
+        if all(e is not original for e in self.errors):
+            self.errors.append(original)
+
     def walk(self, scope: ClassScope) -> Iterator[ClassScope]:
-        """Every class instance below ``scope`` (depth first, declaration order)."""
-        for _, member in scope.all_members():
+        """Every class instance below ``scope`` (depth first, declaration order);
+        a component that cannot be instantiated is reported and skipped."""
+        for name in scope.view.components:
+            try:
+                member = scope.member(name)
+            except FlattenError as err:
+                self.report(err)
+                continue
             if isinstance(member, ClassScope):
                 yield from self._walk_one(member)
             elif isinstance(member, np.ndarray):
@@ -552,9 +564,10 @@ def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
             flattener.equations_of(scope)
         for scope in scopes:
             flattener.equations_of(scope, initial=True)
-        variables = tuple(flattener.variables(top))
+        if not flattener.errors:
+            variables = tuple(flattener.variables(top))
     except FlattenError as err:
-        raise ErrorGroup([*flattener.errors, err]) if flattener.errors else err from None
+        flattener.report(err)
     if flattener.errors:
         errs = flattener.errors
         raise errs[0] if len(errs) == 1 else ErrorGroup(errs)

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import syntax as s
-from .errors import FlattenError, Note
+from .errors import FlattenError, FollowUpError, Note
 from .load import ClassEntry
 from .modification import Mod, from_syntax, merge_all
 
@@ -92,6 +92,7 @@ class ClassScope:
     outer: ClassScope | None = None
     members: dict[str, Any] = field(default_factory=dict)
     in_progress: dict[str, None] = field(default_factory=dict)  # ordered: a chain
+    failed: dict[str, FlattenError] = field(default_factory=dict)
 
     @property
     def entry(self) -> ClassEntry:
@@ -112,6 +113,8 @@ class ClassScope:
         found = self.members.get(name)
         if found is not None:
             return found
+        if name in self.failed:
+            raise FollowUpError(self.failed[name])
         if name in self.in_progress:
             decl = self.view.components[name].decl
             chain = [*list(self.in_progress)[list(self.in_progress).index(name):], name]
@@ -122,6 +125,9 @@ class ClassScope:
         self.in_progress[name] = None
         try:
             created = self.flattener.instantiate(self, self.view.components[name])
+        except FlattenError as err:
+            self.failed[name] = err.original if isinstance(err, FollowUpError) else err
+            raise
         finally:
             self.in_progress.pop(name, None)
         self.members[name] = created
