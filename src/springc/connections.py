@@ -116,9 +116,12 @@ class ConnectionSets:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
                 f"({cb.entry.full_name}) do not match", eq.span,
-                [Note(f"'{ca.entry.full_name}' is defined here", ca.entry.defn.span),
-                 Note(f"'{cb.entry.full_name}' is defined here", cb.entry.defn.span)],
-                "connect connectors of the same type")
+                [Note(f"'{ca.entry.full_name}' has {_describe_leaves(leaves_a)}",
+                      ca.entry.defn.span),
+                 Note(f"'{cb.entry.full_name}' has {_describe_leaves(leaves_b)}",
+                      cb.entry.defn.span)],
+                "connect connectors with the same variables (names, sizes and flow "
+                "prefixes)")
         link = Link(eq.span, owner.prefix, f"connect({ca.prefix}, {cb.prefix})")
         for p, q in zip(leaves_a, leaves_b):
             ka, kb = (p.name, out_a), (q.name, out_b)
@@ -172,3 +175,8 @@ class ConnectionSets:
                                                      if scope.outer else "",
                                                      f"{scope.prefix} is not connected")))
         return out
+
+
+def _describe_leaves(leaves: list[Leaf]) -> str:
+    """``s, flow f``: the scalar variables of a connector, relative to it."""
+    return ", ".join(("flow " if p.flow else "") + p.relative for p in leaves) or "no variables"
