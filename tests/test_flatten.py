@@ -611,3 +611,13 @@ def test_size_mismatch_in_equation(tmp_path: Path) -> None:
     err = error_of(tmp_path, "model M\n  Real x[2];\nequation\n  x = {1, 2, 3};\nend M;\n")
     assert isinstance(err, FlattenError)
     assert err.message == "the two sides of this equation differ in size: [2] and [3]"
+
+
+def test_per_element_values_must_match_the_component_array(tmp_path: Path) -> None:
+    src = BASES + "model M\n  Inner p[2, 2](c = {VALUE});\nend M;\n"
+    m = flat_of(tmp_path, src.replace("VALUE", "{1, 2}, {3, 4}"))
+    assert [bindings(m)[f"p[{i},{j}].c"] for i in (1, 2) for j in (1, 2)] == \
+        ["1", "2", "3", "4"]
+    err = error_of(tmp_path, src.replace("VALUE", "{1, 2, 3}, {4, 5, 6}"))
+    assert err.message == ("the value of 'c' has size [2, 3], but 'p' is an array of "
+                           "components of size [2, 2]")

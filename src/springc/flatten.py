@@ -236,12 +236,32 @@ class Flattener:
         view = self.view(rtype.entry)
         if not dims:
             return self._class_scope(name, view, mod, decl, scope)
+        if mod is not None:
+            self._check_array_mod(mod, dims, name, "")
         out = np.empty(dims, dtype=object)
         for idx in np.ndindex(dims):
             sub = tuple(i + 1 for i in idx)
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _check_array_mod(self, mod: Mod, dims: tuple[int, ...], name: str, path: str
+                         ) -> None:
+        """Values (without ``each``) modifying an array of components must start with
+        the array's sizes: ``Mass m[3](s0 = {1, 2, 3})``."""
+        if mod.each:
+            return
+        if mod.value is not None:
+            value = self.mod_value(mod.value)
+            if not isinstance(value, str) and a.shape(value)[:len(dims)] != dims:
+                raise FlattenError(
+                    f"the value of '{path or name}' has size {a.describe_shape(a.shape(value))}, "
+                    f"but '{name}' is an array of components of size "
+                    f"{a.describe_shape(dims)}", mod.value.span,
+                    hint="give one value per element, or use `each` to give every element "
+                    "the same value")
+        for key, child in mod.children.items():
+            self._check_array_mod(child, dims, name, f"{path}.{key}" if path else key)
 
     def declared_type(self, comp: ViewComponent) -> Declared:
         """The resolved type of a declaration and its type modifiers, computed once."""
