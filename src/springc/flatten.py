@@ -163,6 +163,13 @@ class Flattener:
         return entry if entry is not None and entry.defn.kind == "function" else None
 
     def resolve_function(self, ref: s.Ref, scope: Any) -> ClassEntry:
+        if lookup_class(ref.parts[0].name, scope.entry) is None:
+            import difflib
+
+            close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
+            raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
+                               hint=f"did you mean '{close[0]}'?" if close else
+                               "define it as a `function`, or load the file that defines it")
         entry = self.resolve_class(ref, scope.entry)
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
