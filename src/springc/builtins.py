@@ -71,7 +71,8 @@ class Builtins:
             raise FlattenError(f"'{name}' takes no named arguments", call.named[0].span)
         if not lo <= len(call.args) <= hi:
             expected = str(lo) if lo == hi else f"{lo} to {hi}"
-            raise FlattenError(f"'{name}' takes {expected} argument(s), "
+            noun = "argument" if expected == "1" else "arguments"
+            raise FlattenError(f"'{name}' takes {expected} {noun}, "
                                f"{len(call.args)} given", call.span)
         return [self.ev.value(arg, scope) for arg in call.args]
 
