@@ -60,6 +60,8 @@ def connector_leaves(scope: ClassScope) -> list[Leaf]:
                 leaves += [Leaf(leaf.name[cut:], leaf.name, leaf.flow)
                            for leaf in connector_leaves(item)]
     scope._leaves = leaves  # type: ignore[attr-defined]
+    # What must match for two connectors to be connected: names and flow prefixes.
+    scope._signature = tuple((leaf.relative, leaf.flow) for leaf in leaves)  # type: ignore
     return leaves
 
 
@@ -86,33 +88,39 @@ class ConnectionSets:
     def connect(self, ev: Evaluator, eq: s.Connect, where: Any, owner: ClassScope) -> None:
         """Record ``connect(a, b)``; both sides may be arrays of connectors."""
         sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
-        (left, left_out), (right, right_out) = sides
-        if left.shape != right.shape:
+        (left_shape, left, left_out), (right_shape, right, right_out) = sides
+        if left_shape != right_shape:
             raise FlattenError(
-                f"cannot connect arrays of {left.size} and {right.size} connectors",
+                f"cannot connect arrays of {len(left)} and {len(right)} connectors",
                 eq.span, hint="connect arrays of connectors of the same size")
-        for ca, cb in zip(left.flat, right.flat):
+        for ca, cb in zip(left, right):
             self._pair(ca, cb, left_out, right_out, eq, owner)
 
     def _connectors(self, ev: Evaluator, ref: s.Ref, where: Any, owner: ClassScope
-                    ) -> tuple[np.ndarray, bool]:
+                    ) -> tuple[tuple[int, ...], list[Any], bool]:
+        """The connectors a reference denotes: their array shape (a single connector
+        counts as an array of one), the connectors in order, and whether they are
+        outside connectors of ``owner``."""
         value = ev.reference(ref, where)
-        items = np.atleast_1d(np.asarray(value, dtype=object)) if not isinstance(
-            value, ClassScope) else np.array([value], dtype=object)
-        if not items.size or not all(isinstance(c, ClassScope) and c.kind == "connector"
-                                     for c in items.flat):
+        if isinstance(value, ClassScope):  # the common case, without numpy
+            shape, items = (1,), [value]
+        else:
+            array = np.atleast_1d(np.asarray(value, dtype=object))
+            shape, items = array.shape, list(array.flat)
+        if not items or not all(isinstance(c, ClassScope) and c.kind == "connector"
+                                for c in items):
             raise FlattenError(f"'{ref.dotted}' is not a connector", ref.span,
                                hint="connect(...) joins connectors, such as flanges")
         head = ref.parts[0].name
         outside = owner.has_member(head) and isinstance(owner.member(head), (ClassScope,
                                                                             np.ndarray)) \
-            and all(c.outer is owner for c in items.flat)
-        return items, outside
+            and all(c.outer is owner for c in items)
+        return shape, items, outside
 
     def _pair(self, ca: ClassScope, cb: ClassScope, out_a: bool, out_b: bool,
               eq: s.Connect, owner: ClassScope) -> None:
         leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
-        if [(p.relative, p.flow) for p in leaves_a] != [(q.relative, q.flow) for q in leaves_b]:
+        if ca._signature != cb._signature:  # type: ignore[attr-defined]
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
                 f"({cb.entry.full_name}) do not match", eq.span,
