@@ -40,6 +40,9 @@ class Evaluator:
         self.flattener = flattener
         self.no_event = 0
         self.builtins = Builtins(self)
+        # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
+        # outlives the evaluator, so ids are not reused).
+        self.uses_end: dict[int, bool] = {}
 
     # ------------------------------------------------------------ entry points
 
@@ -291,18 +294,22 @@ class Evaluator:
     def _index(self, sub: s.Expr, size: int, scope: Any, part: s.RefPart) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
-        local = LocalScope({}, scope)
-        local.end_value = size  # type: ignore[attr-defined]
-        v = self.constant(sub, local, "a subscript")
-        values = np.atleast_1d(v)
-        for i in values.flat:
+        uses_end = self.uses_end.get(id(sub))
+        if uses_end is None:
+            uses_end = self.uses_end[id(sub)] = _uses_end(sub)
+        if uses_end:
+            scope = LocalScope({}, scope)
+            scope.end_value = size  # type: ignore[attr-defined]
+        v = self.constant(sub, scope, "a subscript")
+        values = list(v.flat) if isinstance(v, np.ndarray) else [v]
+        for i in values:
             if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
                 raise FlattenError(
                     f"index {i} is out of range for '{part.name}' of size {size}"
                     + _loop_context(scope), sub.span,
                     hint=f"subscripts of '{part.name}' run from 1 to {size}")
         if isinstance(v, np.ndarray):
-            return np.array([int(i) - 1 for i in v.flat], dtype=int)
+            return np.array([int(i) - 1 for i in values], dtype=int)
         return int(v) - 1
 
     # ------------------------------------------------------------------ calls
@@ -352,6 +359,19 @@ class Evaluator:
     @staticmethod
     def _plain(v: Any) -> Any:
         return int(v) if isinstance(v, float) and v.is_integer() else v
+
+
+def _uses_end(e: Any) -> bool:
+    """Whether a subscript expression contains ``end`` (which needs the dimension's
+    size in scope)."""
+    if isinstance(e, s.End):
+        return True
+    if isinstance(e, tuple):
+        return any(_uses_end(item) for item in e)
+    fields = getattr(e, "__dataclass_fields__", None)
+    if fields is None or isinstance(e, s.Span):
+        return False
+    return any(_uses_end(getattr(e, name)) for name in fields)
 
 
 def _loop_context(scope: Any) -> str:
