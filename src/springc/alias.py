@@ -57,6 +57,9 @@ def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
 def _classify(r: dae.Residual, unknowns: set[str]
               ) -> tuple[str, str, int, x.Expr] | None:
     """``(a, b, sign, 0)`` for ``a = sign*b``, ``(a, "", 0, value)`` for ``a = value``."""
+    if sum(n in unknowns for n in r.variables) > 2 or any(
+            n.startswith("der(") for n in r.variables):
+        return None
     terms: list[tuple[int, str]] = []
     rest: list[tuple[int, x.Expr]] = []
     if not _terms(r.expr, 1, unknowns, terms, rest):
@@ -157,20 +160,23 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
             der_map[dae.der_name(name)] = differentiate(value, varying)
             differentiated.update(v for v in free_variables(value) if v in names)
     full = {**mapping, **der_map}
-    equations = tuple(replace(r, expr=x.substitute(r.expr, full)) if _uses(r.expr, full)
-                      else r for r in kept)
-    initial = tuple(replace(r, expr=x.substitute(r.expr, full)) if _uses(r.expr, full)
-                    else r for r in system.initial_equations)
+    value_vars = {name: free_variables(value) for name, value in full.items()}
+
+    def rewrite(r: dae.Residual) -> dae.Residual:
+        used = [n for n in r.variables if n in full]
+        if not used:
+            return r
+        names = set(r.variables).difference(used).union(*(value_vars[n] for n in used))
+        return replace(r, expr=x.substitute(r.expr, full), variables=frozenset(names))
+
+    equations = tuple(rewrite(r) for r in kept)
+    initial = tuple(rewrite(r) for r in system.initial_equations)
     remaining = tuple(new_unknowns.get(u.name, u) for u in system.unknowns
                       if u.name not in mapping)
     differentiated -= set(mapping)
     reduced = replace(system, unknowns=remaining, equations=equations,
                       initial_equations=initial, differentiated=frozenset(differentiated))
     return AliasResult(reduced, tuple(aliases), tuple(warnings))
-
-
-def _uses(e: x.Expr, mapping: dict[str, x.Expr]) -> bool:
-    return any(n in mapping for n in free_variables(e))
 
 
 def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]

@@ -49,6 +49,8 @@ class Residual:
     span: Span
     origin: flat.Origin
     source: flat.Equation | None = None
+    # The names in ``expr`` (derivative variables included), computed once.
+    variables: frozenset[str] = frozenset()
 
     def describe(self) -> str:
         """The equation as the user wrote it (flattened): ``lhs = rhs``."""

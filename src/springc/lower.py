@@ -48,7 +48,8 @@ def differentiate(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
 def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual:
     lhs = lower_derivatives(eq.lhs, varying) if _has_der(eq.lhs) else eq.lhs
     rhs = lower_derivatives(eq.rhs, varying) if _has_der(eq.rhs) else eq.rhs
-    return dae.Residual(x.sub(lhs, rhs), eq.span, eq.origin, eq)
+    residual = x.sub(lhs, rhs)
+    return dae.Residual(residual, eq.span, eq.origin, eq, frozenset(free_variables(residual)))
 
 
 def _has_der(e: x.Expr) -> bool:
@@ -89,7 +90,7 @@ def lower(model: flat.FlatModel) -> dae.DAE:
     equations = tuple(_residual(eq, varying) for eq in model.equations)
     initial = tuple(_residual(eq, varying) for eq in model.initial_equations)
     differentiated = frozenset(
-        n[4:-1] for r in equations + initial for n in free_variables(r.expr)
+        n[4:-1] for r in equations + initial for n in r.variables
         if n.startswith("der(") and n[4:-1] in names)
     return dae.DAE(model.name, unknowns, parameters, equations, initial, model.experiment,
                    model.span, differentiated)

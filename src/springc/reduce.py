@@ -48,7 +48,7 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     names = [u.name for u in system.unknowns]
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
-    pending = sorted({n for r in system.equations for n in free_variables(r.expr)
+    pending = sorted({n for r in system.equations for n in r.variables
                       if n.startswith("der(")}, key=lambda n: (len(n), n))
     for name in pending:
         base = name[4:-1]
@@ -67,7 +67,8 @@ def index_reduce(system: dae.DAE) -> Reduced:
     exprs = [r.expr for r in system.equations]
     sources = list(system.equations)
     orders = [0] * len(exprs)
-    incidence = [tuple(sorted(index[n] for n in free_variables(e) if n in index)) for e in exprs]
+    incidence = [tuple(sorted(index[n] for n in r.variables if n in index))
+                 for r in system.equations]
 
     def varying(name: str) -> bool:
         return name in index or name.startswith("der(")

@@ -10,6 +10,7 @@ The pipeline is a short list of passes, each in its own module:
 
 from __future__ import annotations
 
+import gc
 from dataclasses import dataclass
 
 from . import flat, ode
@@ -27,7 +28,22 @@ class Simplified:
 
 
 def simplify(model: flat.FlatModel) -> Simplified:
-    """Run the passes of the module docstring on ``model``."""
+    """Run the passes of the module docstring on ``model``.
+
+    The cyclic garbage collector is paused meanwhile: the passes allocate millions of
+    small acyclic nodes, and its full collections, each scanning the whole (large)
+    flat model, made the run superlinear in the model size.
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _simplify(model)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _simplify(model: flat.FlatModel) -> Simplified:
     system = lower(model)
     aliased = eliminate_aliases(system)
     reduced = index_reduce(aliased.dae)

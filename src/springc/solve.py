@@ -160,7 +160,7 @@ def linear_split(r: x.Expr, name: str) -> tuple[x.Expr, x.Expr] | None:
     a = fold(split[0])
     if a == x.ZERO:
         return None
-    return a, fold(split[1])
+    return a, split[1]
 
 
 def solve_for(r: x.Expr, name: str) -> x.Expr | None:
