@@ -216,7 +216,7 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = ()) -> C
             continue
         seen.add(path.resolve())
         try:
-            parsed.append((parse_file(path), from_user))
+            parsed.append((_parse_cached(path), from_user))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:
@@ -227,3 +227,20 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = ()) -> C
     if errors:
         raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
     return tree
+
+
+_PARSED: dict[tuple[str, int, int], s.StoredDefinition] = {}
+
+
+def _parse_cached(path: Path) -> s.StoredDefinition:
+    """Parse a file, reusing the syntax tree while the file is unchanged (syntax trees
+    are immutable, so a process that flattens many models parses each library once)."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return parse_file(path)
+    key = (str(path), stat.st_mtime_ns, stat.st_size)
+    stored = _PARSED.get(key)
+    if stored is None:
+        stored = _PARSED[key] = parse_file(path)
+    return stored
