@@ -8,7 +8,8 @@ variable, ``diff``: differentiations) per equation. Ratios are against the small
 size of the same family in this run (baseline), and the scaling exponent is the
 least-squares slope of log(time) over log(equations). Wall and CPU time are
 both shown: on a shared machine the CPU time of this process is the steadier
-figure. Targets: under 5 s for the 10,000-mass chain and the 50x50 cloth; ``--full`` adds the 100x100 cloth.
+figure. Targets: under 5 s for the 10,000-mass chain and the 50x50 cloth;
+``--full`` adds the 100x100 cloth.
 """
 
 from __future__ import annotations
