@@ -330,7 +330,8 @@ class Flattener:
             "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous")
         causality = decl.causality or rtype.prefixes[1]
         check_attribute_mods(mod, rtype.primitive, name)
-        names = _element_names(name, dims)
+        name_list = _element_names(name, dims)
+        names = a.make_array(name_list, dims) if dims else name
         binding = self._binding(mod, dims, name, decl)
         if variability == "constant":
             if binding is None:
@@ -339,7 +340,7 @@ class Flattener:
             value = a.elementwise(lambda v: x.Const(v), value) if a.is_array(value) \
                 else x.Const(value)
         else:
-            value = a.elementwise(x.Var, names) if dims else x.Var(names)  # type: ignore
+            value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         prim = Primitive(names, value, decl, variability, causality,
                          decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
         if variability in ("parameter", "constant"):
@@ -544,11 +545,14 @@ def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | N
     return None
 
 
-def _element_names(name: str, dims: tuple[int, ...]) -> np.ndarray | str:
+def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
+    """The flat names of the elements of ``name`` in row-major order (``x[1,2]``)."""
     if not dims:
-        return name
+        return [name]
+    if len(dims) == 1:
+        return [f"{name}[{i}]" for i in range(1, dims[0] + 1)]
     indices = itertools.product(*(range(1, n + 1) for n in dims))
-    return a.make_array([f"{name}[{','.join(map(str, idx))}]" for idx in indices], dims)
+    return [f"{name}[{','.join(map(str, idx))}]" for idx in indices]
 
 
 def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:
