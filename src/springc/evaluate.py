@@ -33,6 +33,11 @@ UNSUPPORTED_CALLS = {
 }
 
 
+# Scalar expression types, and the builders that arrays.add & co. apply to two scalars.
+_SCALARS = frozenset({x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If})
+_ARITHMETIC = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
+
+
 class Evaluator:
     """Evaluates expressions for one flattening run (it shares the flattener's caches)."""
 
@@ -173,6 +178,9 @@ class Evaluator:
     def _Binary(self, e: s.Binary, scope: Any) -> a.Value:
         left = self.value(e.left, scope)
         right = self.value(e.right, scope)
+        scalar = _ARITHMETIC.get(e.op)
+        if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
+            return scalar(left, right)  # the common case: no sizes to check
         self._numeric(left, e.left.span)
         self._numeric(right, e.right.span)
         op = e.op

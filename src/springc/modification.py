@@ -50,8 +50,9 @@ def from_syntax(modification: s.Modification | None, scope: Any) -> Mod | None:
         return None
     children: dict[str, Mod] = {}
     for arg in modification.arguments:
-        sub = from_syntax(arg.modification, scope) or Mod(span=arg.span)
-        sub = replace(sub, each=arg.each, final=arg.final, span=arg.span)
+        inner = from_syntax(arg.modification, scope)
+        sub = Mod(inner.value, inner.children, arg.each, arg.final, arg.span) \
+            if inner is not None else Mod(each=arg.each, final=arg.final, span=arg.span)
         for name in reversed(arg.path[1:]):
             sub = Mod(children={name: sub}, span=arg.span)
         head = arg.path[0]
