@@ -109,7 +109,8 @@ def select(mod: Mod | None, index: tuple[int, ...]) -> Mod | None:
         return mod
     if mod.value is None and all(v.each for v in mod.children.values()):
         return mod  # nothing to pick (type modifiers): share the object
-    value = replace(mod.value, index=mod.value.index + index) if mod.value else None
+    value = ModValue(mod.value.expr, mod.value.scope, mod.value.index + index) \
+        if mod.value else None
     children = {k: select(v, index) for k, v in mod.children.items()}
     return Mod(value, children, False, mod.final, mod.span)  # type: ignore[arg-type]
 
