@@ -308,7 +308,9 @@ class Evaluator:
         if uses_end:
             scope = LocalScope({}, scope)
             scope.end_value = size  # type: ignore[attr-defined]
-        v = self.constant(sub, scope, "a subscript")
+        v = self._loop_index(sub, scope)
+        if v is None:
+            v = self.constant(sub, scope, "a subscript")
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
         for i in values:
             if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
@@ -319,6 +321,20 @@ class Evaluator:
         if isinstance(v, np.ndarray):
             return np.array([int(i) - 1 for i in values], dtype=int)
         return int(v) - 1
+
+    @staticmethod
+    def _loop_index(sub: s.Expr, scope: Any) -> Any:
+        """The value of a subscript that names a for-loop index (``p[i]``), the most
+        common subscript, without the general evaluator; None for any other."""
+        if type(sub) is not s.Ref or len(sub.parts) != 1 or sub.parts[0].subscripts:
+            return None
+        part = sub.parts[0]
+        while type(scope) is LocalScope:
+            if part.name in scope.names:
+                found = scope.names[part.name]
+                return found.value if type(found) is x.Const else None
+            scope = scope.parent
+        return None
 
     # ------------------------------------------------------------------ calls
 
