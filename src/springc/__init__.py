@@ -1,1 +1,16 @@
 """springc: a compiler and simulator for spring-mass models written in a Modelica subset."""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["compile_model", "simulate"]
+
+
+def __getattr__(name: str) -> Any:
+    # Lazy: ``import springc`` stays fast; numpy/scipy load on first use.
+    if name in __all__:
+        from . import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'springc' has no attribute {name!r}")

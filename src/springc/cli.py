@@ -104,3 +104,107 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
     from .pipeline import flatten_files
 
     click.echo(check_balance(flatten_files(files, model, libraries)).summary())
+
+
+# ------------------------------------------------------------------ simulate, compile
+
+SOLVER_CHOICES = ("rk45", "dop853", "radau", "bdf", "lsoda")  # springc.simulate.SOLVERS
+
+
+def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in values:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise click.BadParameter(f"expected NAME=VALUE, got '{item}'", param_hint="--set")
+        word = text.strip().lower()
+        if word in ("true", "false"):
+            out[name.strip()] = 1.0 if word == "true" else 0.0
+            continue
+        try:
+            out[name.strip()] = float(text)
+        except ValueError:
+            raise click.BadParameter(f"'{text}' is not a number (in '{item}')",
+                                     param_hint="--set") from None
+    return out
+
+
+def _compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    func = click.option("--no-cache", is_flag=True,
+                        help="Regenerate the code instead of using the on-disk cache.")(func)
+    func = click.option("--vars", "patterns", multiple=True, metavar="PATTERN",
+                        help="Output only these variables: flat names, * and ? as "
+                        "wildcards (repeatable). Default: all states and observed.")(func)
+    return click.option("--backend", type=click.Choice(["python", "numba"]),
+                        default="python", show_default=True,
+                        help="Generated code: plain Python/numpy, or numba-compiled.")(func)
+
+
+@main.command()
+@_model_options
+@_compile_options
+@click.option("--start", type=float, help="Start time [s] (default: experiment, else 0).")
+@click.option("--stop", type=float, help="Stop time [s] (default: experiment, else 10).")
+@click.option("--interval", type=float,
+              help="Output interval [s] (default: experiment, else (stop-start)/500).")
+@click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
+              default="dop853", show_default=True, help="scipy solve_ivp method.")
+@click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
+              "Tolerance, else 1e-6).")
+@click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
+              help="Set a parameter (repeatable); array sizes re-flatten the model.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the trajectory as CSV (default: stdout unless --plot).")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Write a PNG plot.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@_guard
+def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
+             stop: float | None, interval: float | None, solver: str, rtol: float | None,
+             atol: float | None, assignments: tuple[str, ...], output: str | None,
+             plot: str | None, quiet: bool) -> None:
+    """Simulate a model and write its trajectory (CSV) and/or a plot (PNG)."""
+    values = _parse_set(assignments)
+    from .api import simulate as run
+
+    progress = None if quiet or not sys.stderr.isatty() else sys.stderr
+    result = run(files, model_name=model, libraries=libraries, backend=backend,
+                 outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
+                 interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
+                 parameters=values, progress=progress)
+    if output:
+        result.to_csv(output)
+    elif not plot:
+        from .results import write_csv
+
+        write_csv(result, sys.stdout)
+    if plot:
+        result.plot(plot)
+    if not quiet:
+        click.echo(result.stats.summary(result.model), err=True)
+
+
+@main.command(name="compile")
+@_model_options
+@_compile_options
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the generated Python module here (default: stdout).")
+@_guard
+def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool,
+             output: str | None) -> None:
+    """Generate a standalone Python module (numpy/scipy, or numba) for a model."""
+    from .build import CompileOptions, compile_files
+
+    compiled = compile_files(CompileOptions(files, model, libraries, backend,
+                                            patterns or None, (), not no_cache))
+    if output:
+        from pathlib import Path
+
+        from .results import atomic_write
+
+        with atomic_write(Path(output), "w") as f:
+            f.write(compiled.source)
+    else:
+        click.echo(compiled.source, nl=False)

@@ -1,0 +1,375 @@
+"""Simulation: CompiledModel + SimulationOptions -> SimulationResult.
+
+The step loop is that of ``scipy.integrate.solve_ivp`` (its solver classes ``RK45``,
+``DOP853``, ``Radau``, ``BDF``, ``LSODA``, stepped one by one), so that springc can
+show progress, stop at the first non-finite value, and name the time and the states
+at fault. Output is interpolated with each step's dense output exactly at
+``t0, t0 + dt, ..., stop``. Implicit methods get the generated analytic Jacobian:
+dense for small systems, ``scipy.sparse`` CSC beyond :data:`DENSE_JACOBIAN_LIMIT`.
+
+Defaults: start 0 s, stop 10 s, 500 output intervals, unless the model's
+``experiment`` annotation says otherwise; rtol 1e-6 (or the experiment's Tolerance),
+atol = rtol / 1000; solver :data:`DEFAULT_SOLVER`.
+"""
+
+from __future__ import annotations
+
+import linecache
+import math
+import sys
+import time
+import traceback
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, TextIO
+
+import numpy as np
+
+from .build import CompiledModel, check_parameter_names
+from .errors import Note, SimulationError
+from .results import SimulationResult, SimulationStats
+
+SOLVERS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
+           "lsoda": "LSODA"}
+IMPLICIT = frozenset({"radau", "bdf", "lsoda"})
+DEFAULT_SOLVER = "dop853"
+"""An 8th-order explicit Runge-Kutta method: the spring-mass scenes are oscillatory
+and mostly non-stiff, where it takes far fewer steps than rk45 at tight tolerances;
+stiff scenes (strong damping, very stiff springs) want ``radau`` or ``bdf``."""
+
+DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
+DEFAULT_RTOL = 1e-6
+DENSE_JACOBIAN_LIMIT = 64
+LSODA_LIMIT = 2000
+
+
+@dataclass(frozen=True)
+class SimulationOptions:
+    """``None`` means: from the experiment annotation, else the documented default."""
+
+    start: float | None = None
+    stop: float | None = None
+    interval: float | None = None
+    solver: str = DEFAULT_SOLVER
+    rtol: float | None = None
+    atol: float | None = None
+    parameters: Mapping[str, float] = field(default_factory=dict)
+    progress: TextIO | None = None
+
+
+def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
+    """``start, start + interval, ..., stop``; the last point is ``stop`` exactly."""
+    if not (math.isfinite(start) and math.isfinite(stop)) or stop <= start:
+        raise SimulationError(f"the stop time {stop:g} must be after the start time "
+                              f"{start:g}")
+    if not interval > 0:
+        raise SimulationError(f"the output interval must be positive, not {interval:g}")
+    count = (stop - start) / interval
+    n = max(1, round(count)) if abs(count - round(count)) < 1e-9 * max(1.0, count) \
+        else math.ceil(count)
+    if n > 10_000_000:
+        raise SimulationError(f"{n} output intervals are too many",
+                              hint="use a larger --interval")
+    grid = start + interval * np.arange(n + 1, dtype=float)
+    grid[-1] = stop
+    return grid
+
+
+def resolve(model: CompiledModel, options: SimulationOptions) -> tuple[float, float, float,
+                                                                        float, float]:
+    """start, stop, interval, rtol, atol from options, experiment and defaults."""
+    exp = model.module.EXPERIMENT
+    start = _first(options.start, exp.get("start"), DEFAULT_START)
+    stop = _first(options.stop, exp.get("stop"), DEFAULT_STOP)
+    if options.interval is not None:
+        interval = options.interval
+    elif exp.get("interval") is not None and options.stop is None and options.start is None:
+        interval = exp["interval"]
+    else:
+        interval = (stop - start) / DEFAULT_INTERVALS
+    rtol = _first(options.rtol, exp.get("tolerance"), DEFAULT_RTOL)
+    atol = _first(options.atol, None, rtol / 1000)
+    return start, stop, interval, rtol, atol
+
+
+def _first(*values: float | None) -> float:
+    for v in values:
+        if v is not None:
+            return float(v)
+    raise AssertionError("no default")
+
+
+def initial_state(model: CompiledModel, p: np.ndarray) -> np.ndarray:
+    """The states at the start time.
+
+    Hook for initialization (``initial equation``, ``fixed``): for now every state
+    starts at its ``start`` value, as Modelica tools do when nothing else fixes it.
+    """
+    return np.asarray(model.module.start(p), dtype=float)
+
+
+# ------------------------------------------------------------------ failures
+
+class _Stop(Exception):
+    """Raised inside the right-hand side to end the integration with an error."""
+
+    def __init__(self, error: SimulationError) -> None:
+        super().__init__(error.message)
+        self.error = error
+
+
+def _fmt(t: float) -> str:
+    return f"{t:.9g}"
+
+
+def _remedy(solver: str) -> str:
+    if solver in IMPLICIT:
+        return ("check the parameters and start values near that time (a spring of zero "
+                "length? a mass of zero?), or try a tighter --rtol")
+    return "the system looks stiff or unstable: try --solver radau (or bdf)"
+
+
+def _state_notes(names: tuple[str, ...], x: np.ndarray, dx: np.ndarray | None,
+                 limit: int = 4) -> list[Note]:
+    bad = [i for i in range(len(x)) if not math.isfinite(x[i])]
+    if dx is not None:
+        bad += [i for i in range(len(dx)) if not math.isfinite(dx[i]) and i not in bad]
+    if not bad and dx is not None:
+        scale = np.abs(dx) / (1e-300 + np.abs(x) + 1.0)
+        bad = [int(i) for i in np.argsort(-scale)[:limit]]
+    notes = [Note(f"{names[i]} = {x[i]:.6g}" + (f", der({names[i]}) = {dx[i]:.6g}"
+                                                 if dx is not None else ""))
+             for i in bad[:limit]]
+    if len(bad) > limit:
+        notes.append(Note(f"... and {len(bad) - limit} more states"))
+    return notes
+
+
+def _code_location(err: BaseException, path: str) -> str | None:
+    """The flat name and source location of the generated line that raised ``err``."""
+    frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename == path]
+    if not frames:
+        return None
+    lineno = frames[-1].lineno or 0
+    for n in range(lineno, max(0, lineno - 200), -1):
+        line = linecache.getline(path, n).strip()
+        if "  # " in line:
+            return line.split("  # ", 1)[1].strip()
+        if line.startswith("# "):
+            return line[2:].strip()
+        if line.startswith("def "):
+            break
+    return None
+
+
+# ------------------------------------------------------------------ progress
+
+class Progress:
+    """A progress bar on ``stream``, shown once a run has taken about a second."""
+
+    def __init__(self, stream: TextIO | None, start: float, stop: float) -> None:
+        self.stream, self.start, self.stop = stream, start, stop
+        self.began = time.perf_counter()
+        self.next = self.began + 1.0
+        self.shown = False
+
+    def update(self, t: float) -> None:
+        now = time.perf_counter()
+        if self.stream is None or now < self.next:
+            return
+        self.next = now + 0.1
+        frac = min(1.0, max(0.0, (t - self.start) / (self.stop - self.start)))
+        bar = "#" * int(30 * frac)
+        self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t = {t:.4g} s  "
+                          f"{now - self.began:.1f} s ")
+        self.stream.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.shown and self.stream is not None:
+            self.stream.write("\r" + " " * 70 + "\r")
+            self.stream.flush()
+
+
+# ------------------------------------------------------------------ the run
+
+class _Problem:
+    """The generated functions wrapped for scipy: counting, timing, checking."""
+
+    def __init__(self, model: CompiledModel, p: np.ndarray, solver: str,
+                 progress: Progress) -> None:
+        mod = model.module
+        self.model, self.mod, self.p, self.solver = model, mod, p, solver
+        self.z = np.asarray(mod.guesses(p), dtype=float)
+        self.names = tuple(mod.STATES)
+        self.path = str(model.path)
+        self.nfev = self.njev = 0
+        self.model_time = 0.0
+        self.progress = progress
+        self.t = 0.0
+
+    def _fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> _Stop:
+        where = _code_location(err, self.path)
+        kind = {ZeroDivisionError: "division by zero", OverflowError: "overflow"}.get(
+            type(err), str(err) or type(err).__name__)
+        message = f"{kind} while computing {where or what} at time {_fmt(t)}"
+        if "singular" in str(err).lower():
+            message = f"{where or 'a linear system'} is singular at time {_fmt(t)}"
+        return _Stop(SimulationError(message, notes=_state_notes(self.names, x, None),
+                                     hint=_remedy(self.solver)))
+
+    def _newton(self, t: float, x: np.ndarray) -> _Stop:
+        step = int(self.z[-1])
+        names = self.mod.NEWTON_SYSTEMS.get(step, ("?",))
+        self.z[-1] = 0.0
+        return _Stop(SimulationError(
+            f"the nonlinear system for {', '.join(names)} did not converge at time "
+            f"{_fmt(t)}", notes=_state_notes(self.names, x, None),
+            hint="the model may have reached a singular configuration (a rod or "
+                 "pendulum at the end of its range?); check the start values"))
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        self.nfev += 1
+        began = time.perf_counter()
+        try:
+            dx = self.mod.rhs(t, x, self.p, self.z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise self._fail(err, t, x, "the derivatives") from err
+        self.model_time += time.perf_counter() - began
+        if self.z[-1] != 0.0:
+            raise self._newton(t, x)
+        if not np.isfinite(dx).all():
+            bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
+            shown = ", ".join(f"der({n})" for n in bad[:3]) + (", ..." if len(bad) > 3 else "")
+            what = "NaN" if np.isnan(dx).any() else "infinite"
+            raise _Stop(SimulationError(
+                f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {_fmt(t)}",
+                notes=_state_notes(self.names, x, dx), hint=_remedy(self.solver)))
+        self.progress.update(t)
+        return dx
+
+    def jac(self, t: float, x: np.ndarray) -> Any:
+        self.njev += 1
+        began = time.perf_counter()
+        try:
+            if len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda":
+                out = self.mod.jacobian_dense(t, x, self.p, self.z)
+            else:
+                out = self.mod.jacobian(t, x, self.p, self.z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise self._fail(err, t, x, "the Jacobian") from err
+        self.model_time += time.perf_counter() - began
+        if self.z[-1] != 0.0:
+            raise self._newton(t, x)
+        return out
+
+
+def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
+                   ) -> SimulationResult:
+    """Integrate ``model`` and return the selected outputs on the output grid."""
+    import scipy.integrate
+
+    began = time.perf_counter()
+    solver = options.solver.lower()
+    if solver not in SOLVERS:
+        raise SimulationError(f"unknown solver '{options.solver}'",
+                              hint=f"choose one of {', '.join(SOLVERS)}")
+    start, stop, interval, rtol, atol = resolve(model, options)
+    grid = output_grid(start, stop, interval)
+    check_parameter_names(model, options.parameters)
+    structural = [n for n in options.parameters if n in model.structural]
+    if structural:
+        raise SimulationError(f"'{structural[0]}' is a structural parameter: changing it "
+                              "needs a new compilation",
+                              hint="pass it to compile_model(parameters=...) or use "
+                              "springc.simulate(files, parameters=...)")
+    n = len(model.states)
+    if solver == "lsoda" and n > LSODA_LIMIT:
+        raise SimulationError(f"lsoda uses dense Jacobians, too large for {n} states",
+                              hint="use --solver bdf or radau (sparse Jacobians)")
+    p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
+    x0 = initial_state(model, p)
+    progress = Progress(options.progress, start, stop)
+    problem = _Problem(model, p, solver, progress)
+    kwargs: dict[str, Any] = {}
+    if solver in IMPLICIT:
+        kwargs["jac"] = problem.jac
+    states = np.empty((len(grid), n))
+    states[0] = x0
+    steps = 0
+    try:
+        if not np.isfinite(x0).all():
+            raise _Stop(SimulationError(f"the start values are not finite at time {start}",
+                                        notes=_state_notes(problem.names, x0, None)))
+        if n == 0:
+            states = np.empty((len(grid), 0))
+        else:
+            cls = getattr(scipy.integrate, SOLVERS[solver])
+            integrator = cls(problem.rhs, start, x0, stop, rtol=rtol, atol=atol, **kwargs)
+            k = 1
+            while k < len(grid):
+                message = integrator.step()
+                steps += 1
+                if integrator.status == "failed":
+                    raise _Stop(_solver_failure(problem, integrator, message))
+                j = int(np.searchsorted(grid, integrator.t, side="right"))
+                if j > k:
+                    dense = integrator.dense_output()
+                    states[k:j] = dense(grid[k:j]).T
+                    if grid[j - 1] == integrator.t:
+                        states[j - 1] = integrator.y
+                    k = j
+                if integrator.status == "finished" and k < len(grid):
+                    states[k:] = integrator.y
+                    break
+        outputs = _outputs(model, problem, grid, states)
+    except _Stop as stop_:
+        raise stop_.error from None
+    finally:
+        progress.close()
+    stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
+                            time.perf_counter() - began, problem.model_time,
+                            model.compile_time, model.cached)
+    units = dict(zip(model.states, model.module.STATE_UNITS))
+    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    names = model.outputs
+    return SimulationResult(model.name, grid, names, outputs,
+                            tuple(units.get(n, "") for n in names), stats,
+                            dict(zip(model.parameter_names, p.tolist())))
+
+
+def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
+             states: np.ndarray) -> np.ndarray:
+    names = model.outputs
+    columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
+    wanted = [o for o in model.observed if o in set(names)]
+    if wanted:
+        z = np.asarray(model.module.guesses(problem.p), dtype=float)
+        try:
+            obs = model.module.observed_grid(grid, np.ascontiguousarray(states), problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise problem._fail(err, float(grid[-1]), states[-1], "an observed variable") \
+                from err
+        columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
+    out = np.empty((len(grid), len(names)))
+    for i, name in enumerate(names):
+        out[:, i] = columns[name]
+    return out
+
+
+def _solver_failure(problem: _Problem, integrator: Any, message: str | None
+                    ) -> SimulationError:
+    t, x = float(integrator.t), np.asarray(integrator.y)
+    dx = np.asarray(problem.mod.rhs(t, x, problem.p, problem.z))
+    collapse = message is not None and "step size" in message.lower()
+    text = (f"the step size of {problem.solver} collapsed at time {_fmt(t)}" if collapse
+            else f"the {problem.solver} solver failed at time {_fmt(t)}: {message}")
+    notes = [Note("fastest-changing states:"), *_state_notes(problem.names, x, dx)]
+    return SimulationError(text, notes=notes, hint=_remedy(problem.solver))
+
+
+def print_summary(result: SimulationResult, stream: TextIO = sys.stderr) -> None:
+    stream.write(result.stats.summary(result.model) + "\n")
+
+
+ProgressStream = Callable[[], TextIO | None]
