@@ -227,8 +227,11 @@ class Flattener:
         rtype = declared.rtype
         name = scope.flat_name(decl.name)
         outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
-        mods = [outer, from_syntax(decl.modification, scope), *declared.type_mods]
-        mod = merge_all(mods, name)
+        own = from_syntax(decl.modification, scope)
+        if outer is None and own is None and len(declared.type_mods) <= 1:
+            mod = declared.type_mods[0] if declared.type_mods else None  # nothing to merge
+        else:
+            mod = merge_all([outer, own, *declared.type_mods], name)
         if decl.final and outer is not None:
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
@@ -286,7 +289,8 @@ class Flattener:
     def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
                      parent: ClassScope) -> ClassScope:
         scope = ClassScope(self, name, view, None, decl.span, parent)
-        scope.mod = instance_mod(mod, view, scope)
+        if mod is not None or view.extends_mods:
+            scope.mod = instance_mod(mod, view, scope)
         if scope.mod is not None:
             for key, child in scope.mod.children.items():
                 if key not in view.components:
