@@ -21,7 +21,7 @@ from .build import (
     modification_value,
 )
 from .results import SimulationResult
-from .simulate import DEFAULT_SOLVER, SimulationOptions, simulate_model
+from .simulation import DEFAULT_SOLVER, SimulationOptions, simulate_model
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 

@@ -108,7 +108,7 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
 
 # ------------------------------------------------------------------ simulate, compile
 
-SOLVER_CHOICES = ("rk45", "dop853", "radau", "bdf", "lsoda")  # springc.simulate.SOLVERS
+SOLVER_CHOICES = ("rk45", "dop853", "radau", "bdf", "lsoda")  # springc.simulation.SOLVERS
 
 
 def _parse_set(values: tuple[str, ...]) -> dict[str, float]:

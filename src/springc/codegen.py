@@ -140,7 +140,7 @@ class _Model:
     def _nonlinear(self, block: ode.NonlinearBlock, index: int, comment: str) -> Stmt:
         k = len(block.tearing)
         slots = [self.guess_slots[t] for t in block.tearing]
-        body: list[Stmt] = [Load(t, f"z[{s}]", f"{t} (warm start)")
+        body: list[Stmt] = [Load(t, f"float(z[{s}])", f"{t} (warm start)")
                             for t, s in zip(block.tearing, slots)]
         body.append(Raw(f"_ok{index} = False\n_done{index} = False"))
         loop: list[Stmt] = [Let(a.name, a.expr, _comment(a.name, a.span)) for a in block.inner]
@@ -309,7 +309,10 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
          jac, "jv"),
         ("observed", "The OBSERVED variables at time t.", obs, "out"),
     ]
-    bodies = [(fn, doc, function_lines(namer, helpers, stmts), ret)
+    # Plain Python computes fastest on Python floats, which also raise
+    # ZeroDivisionError or ValueError where they happen (springc names the line).
+    prologue = [] if options.backend == "numba" else [Raw("x = x.tolist()\np = p.tolist()")]
+    bodies = [(fn, doc, function_lines(namer, helpers, prologue + stmts), ret)
               for fn, doc, stmts, ret in functions]
     structural = structural_parameters(system, flat_model)
     source = _module_text(m, options, bodies, helpers, pattern, outputs, structural, namer)
@@ -391,10 +394,14 @@ def _module_text(m: _Model, options: CodegenOptions,
         lines += [f"def {fn}(t, x, p, z):", f'    """{doc}"""', *body, f"    return {ret}"]
     lines += ["", ""] + (["@_jit"] if numba else []) + [
         "def observed_grid(ts, X, p, z):",
-        '    """OBSERVED at each time ts[i] with states X[i] (a row per time)."""',
+        '    """OBSERVED at each time ts[i] with states X[i] (a row per time); rows from',
+        '    a failed Newton iteration on are NaN (and z[-1] says which system)."""',
         f"    out = np.empty((ts.shape[0], {len(outputs)}))",
         "    for i in range(ts.shape[0]):",
         "        out[i] = observed(ts[i], X[i], p, z)",
+        "        if z[-1] != 0.0:",
+        "            out[i:] = np.nan",
+        "            break",
         "    return out",
     ]
     lines += ["", "", *_FOOTER.splitlines()]

@@ -8,8 +8,12 @@ at fault. Output is interpolated with each step's dense output exactly at
 dense for small systems, ``scipy.sparse`` CSC beyond :data:`DENSE_JACOBIAN_LIMIT`.
 
 Defaults: start 0 s, stop 10 s, 500 output intervals, unless the model's
-``experiment`` annotation says otherwise; rtol 1e-6 (or the experiment's Tolerance),
+``experiment`` annotation says otherwise (its Interval applies even when the start or
+stop time is given); rtol 1e-6 (or the experiment's Tolerance),
 atol = rtol / 1000; solver :data:`DEFAULT_SOLVER`.
+
+(The module is not named ``simulate``: ``springc.simulate`` is the API function, and a
+submodule of that name would replace it on the package once imported.)
 """
 
 from __future__ import annotations
@@ -83,7 +87,7 @@ def resolve(model: CompiledModel, options: SimulationOptions) -> tuple[float, fl
     stop = _first(options.stop, exp.get("stop"), DEFAULT_STOP)
     if options.interval is not None:
         interval = options.interval
-    elif exp.get("interval") is not None and options.stop is None and options.start is None:
+    elif exp.get("interval") is not None:
         interval = exp["interval"]
     else:
         interval = (stop - start) / DEFAULT_INTERVALS
@@ -137,6 +141,8 @@ def _state_notes(names: tuple[str, ...], x: np.ndarray, dx: np.ndarray | None,
     if not bad and dx is not None:
         scale = np.abs(dx) / (1e-300 + np.abs(x) + 1.0)
         bad = [int(i) for i in np.argsort(-scale)[:limit]]
+    elif not bad:
+        bad = list(range(min(len(x), limit)))
     notes = [Note(f"{names[i]} = {x[i]:.6g}" + (f", der({names[i]}) = {dx[i]:.6g}"
                                                  if dx is not None else ""))
              for i in bad[:limit]]
@@ -154,7 +160,8 @@ def _code_location(err: BaseException, path: str) -> str | None:
     for n in range(lineno, max(0, lineno - 200), -1):
         line = linecache.getline(path, n).strip()
         if "  # " in line:
-            return line.split("  # ", 1)[1].strip()
+            name, _, where = line.split("  # ", 1)[1].strip().partition("  ")
+            return f"{name} ({where})" if where else name
         if line.startswith("# "):
             return line[2:].strip()
         if line.startswith("def "):
@@ -215,8 +222,10 @@ class _Problem:
         message = f"{kind} while computing {where or what} at time {_fmt(t)}"
         if "singular" in str(err).lower():
             message = f"{where or 'a linear system'} is singular at time {_fmt(t)}"
-        return _Stop(SimulationError(message, notes=_state_notes(self.names, x, None),
-                                     hint=_remedy(self.solver)))
+        return _Stop(SimulationError(
+            message, notes=_state_notes(self.names, x, None),
+            hint="the model leaves the domain of an operation there; check the "
+                 "parameters (--set) and start values, or guard the expression"))
 
     def _newton(self, t: float, x: np.ndarray) -> _Stop:
         step = int(self.z[-1])
@@ -267,8 +276,6 @@ class _Problem:
 def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
                    ) -> SimulationResult:
     """Integrate ``model`` and return the selected outputs on the output grid."""
-    import scipy.integrate
-
     began = time.perf_counter()
     solver = options.solver.lower()
     if solver not in SOLVERS:
@@ -291,38 +298,14 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     x0 = initial_state(model, p)
     progress = Progress(options.progress, start, stop)
     problem = _Problem(model, p, solver, progress)
-    kwargs: dict[str, Any] = {}
-    if solver in IMPLICIT:
-        kwargs["jac"] = problem.jac
-    states = np.empty((len(grid), n))
-    states[0] = x0
-    steps = 0
     try:
-        if not np.isfinite(x0).all():
-            raise _Stop(SimulationError(f"the start values are not finite at time {start}",
-                                        notes=_state_notes(problem.names, x0, None)))
-        if n == 0:
-            states = np.empty((len(grid), 0))
-        else:
-            cls = getattr(scipy.integrate, SOLVERS[solver])
-            integrator = cls(problem.rhs, start, x0, stop, rtol=rtol, atol=atol, **kwargs)
-            k = 1
-            while k < len(grid):
-                message = integrator.step()
-                steps += 1
-                if integrator.status == "failed":
-                    raise _Stop(_solver_failure(problem, integrator, message))
-                j = int(np.searchsorted(grid, integrator.t, side="right"))
-                if j > k:
-                    dense = integrator.dense_output()
-                    states[k:j] = dense(grid[k:j]).T
-                    if grid[j - 1] == integrator.t:
-                        states[j - 1] = integrator.y
-                    k = j
-                if integrator.status == "finished" and k < len(grid):
-                    states[k:] = integrator.y
-                    break
-        outputs = _outputs(model, problem, grid, states)
+        with np.errstate(all="ignore"):
+            if not np.isfinite(x0).all():
+                raise _Stop(SimulationError(
+                    f"the start values are not finite at time {start}",
+                    notes=_state_notes(problem.names, x0, None)))
+            states, steps = _integrate(problem, grid, x0, rtol, atol)
+            outputs = _outputs(model, problem, grid, states)
     except _Stop as stop_:
         raise stop_.error from None
     finally:
@@ -338,6 +321,38 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                             dict(zip(model.parameter_names, p.tolist())))
 
 
+def _integrate(problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
+               atol: float) -> tuple[np.ndarray, int]:
+    """The states on ``grid`` and the number of steps taken (solve_ivp's loop)."""
+    import scipy.integrate
+
+    n = len(x0)
+    states = np.empty((len(grid), n))
+    states[0] = x0
+    if n == 0:
+        return states, 0
+    kwargs: dict[str, Any] = {"jac": problem.jac} if problem.solver in IMPLICIT else {}
+    cls = getattr(scipy.integrate, SOLVERS[problem.solver])
+    integrator = cls(problem.rhs, grid[0], x0, grid[-1], rtol=rtol, atol=atol, **kwargs)
+    k, steps = 1, 0
+    while k < len(grid):
+        message = integrator.step()
+        steps += 1
+        if integrator.status == "failed":
+            raise _Stop(_solver_failure(problem, integrator, message))
+        j = int(np.searchsorted(grid, integrator.t, side="right"))
+        if j > k:
+            dense = integrator.dense_output()
+            states[k:j] = dense(grid[k:j]).T
+            if grid[j - 1] == integrator.t:
+                states[j - 1] = integrator.y
+            k = j
+        if integrator.status == "finished" and k < len(grid):
+            states[k:] = integrator.y
+            break
+    return states, steps
+
+
 def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
              states: np.ndarray) -> np.ndarray:
     names = model.outputs
@@ -350,6 +365,10 @@ def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise problem._fail(err, float(grid[-1]), states[-1], "an observed variable") \
                 from err
+        if z[-1] != 0.0:
+            row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
+            problem.z[-1] = z[-1]
+            raise problem._newton(float(grid[row]), states[row])
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     out = np.empty((len(grid), len(names)))
     for i, name in enumerate(names):
