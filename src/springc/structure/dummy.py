@@ -30,7 +30,13 @@ The caller may pass ``is_nonsingular(rows, cols)``, which then vets each block (
 into connected components first); a rejected block is replaced by the next
 structurally regular column set in priority order. Without it every block is assumed
 nonsingular and :attr:`StateSelection.blocks` lists what the caller must check later.
-Dynamic state selection (switching states during simulation) is not done.
+
+Instead the caller may pass ``choose(equations, columns, tiers)``, which picks the
+dummies itself among all candidate columns of a block (given in priority order, with
+``tiers`` grouping columns of equal priority and differentiation order), e.g. the
+best-conditioned choice at given values. This is what dynamic state selection
+(:mod:`springc.switching`) re-runs during simulation; each block records its
+candidates and tiers so that the choice can be monitored.
 
 Cost: O(n_eq + n_var) when no equation was differentiated; otherwise the augmenting
 searches run only over the differentiated equations and their columns.
@@ -66,6 +72,11 @@ DEFAULT_MAX_TRIES = 1000
 IsNonsingular = Callable[[tuple[int, ...], tuple[int, ...]], bool]
 """``is_nonsingular(equations, variables)``: is this square Jacobian block regular?"""
 
+Choose = Callable[[tuple[int, ...], tuple[int, ...], tuple[int, ...]], tuple[int, ...] | None]
+"""``choose(equations, columns, tiers)``: the dummies among ``columns`` (priority order;
+``tiers[k]`` numbers the priority class of ``columns[k]``, ascending), or None when no
+choice is acceptable."""
+
 
 class NumericallySingular(Exception):
     """The caller's ``is_nonsingular`` rejected every structurally regular choice.
@@ -90,6 +101,10 @@ class SelectedBlock:
     level: int
     equations: tuple[int, ...]
     dummies: tuple[int, ...]
+    candidates: tuple[int, ...] = ()
+    """All columns of the block, in priority order (the first becomes a dummy first)."""
+    tiers: tuple[int, ...] = ()
+    """Priority class of each candidate (equal priority and differentiation order)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,6 +138,7 @@ def dummy_derivatives(
     priority: Sequence[float] | None = None,
     is_nonsingular: IsNonsingular | None = None,
     max_tries: int = DEFAULT_MAX_TRIES,
+    choose: Choose | None = None,
 ) -> StateSelection:
     """Choose the dummy derivatives of ``reduction``; keep high-priority states.
 
@@ -135,6 +151,8 @@ def dummy_derivatives(
     rejected the best one. Raises :class:`StructurallySingular` (naming input indices
     of Pantelides, as there) when a level has no structurally regular choice, and
     :class:`NumericallySingular` when the caller rejects every choice tried.
+    ``choose``, when given, replaces the greedy choice and ``is_nonsingular`` (see the
+    module docstring); its choice must be structurally regular.
     """
     # Step 1: antiderivatives and the order in which columns become dummies.
     antiderivative = _inverse(reduction.var_derivative)
@@ -152,7 +170,8 @@ def dummy_derivatives(
     blocks: list[SelectedBlock] = []
     level = 1
     while rows:
-        chosen = _choose_level(reduction, level, rows, allowed, key, is_nonsingular, max_tries)
+        chosen = _choose_level(reduction, level, rows, allowed, key, is_nonsingular, max_tries,
+                               choose)
         blocks.extend(chosen)
         picked = [v for block in chosen for v in block.dummies]
         allowed = {antiderivative[v] for v in picked if antiderivative[antiderivative[v]] != NONE}
@@ -210,6 +229,7 @@ def _choose_level(
     key: Callable[[int], tuple[float, int, int, int]],
     is_nonsingular: IsNonsingular | None,
     max_tries: int,
+    choose: Choose | None = None,
 ) -> list[SelectedBlock]:
     """The dummies of one level, one block per connected component of rows x columns."""
     columns_of = {e: [v for v in reduction.incidence[e] if v in allowed] for e in rows}
@@ -220,13 +240,31 @@ def _choose_level(
             for v in columns_of[e]:
                 rows_of.setdefault(v, []).append(e)
         columns = sorted(rows_of, key=key)
+        tiers = _tiers(columns, key)
         dummies = _greedy(group, columns, rows_of)
         if len(dummies) < len(group):
             raise _singular(reduction, group, columns_of, level)
-        if is_nonsingular is not None and not is_nonsingular(tuple(group), dummies):
+        if choose is not None:
+            picked = choose(tuple(group), tuple(columns), tiers)
+            if picked is None:
+                raise NumericallySingular(group, columns, 1)
+            if len(picked) != len(group) or len(_greedy(group, picked, rows_of)) < len(group):
+                raise ValueError(f"choose returned a structurally singular block {picked}")
+            dummies = tuple(picked)
+        elif is_nonsingular is not None and not is_nonsingular(tuple(group), dummies):
             dummies = _search(group, columns, rows_of, dummies, is_nonsingular, max_tries)
-        blocks.append(SelectedBlock(level, tuple(group), dummies))
+        blocks.append(SelectedBlock(level, tuple(group), dummies, tuple(columns), tiers))
     return blocks
+
+
+def _tiers(columns: Sequence[int], key: Callable[[int], tuple[float, int, int, int]]
+           ) -> tuple[int, ...]:
+    """Number the priority classes (priority and differentiation order) of ``columns``."""
+    tiers: list[int] = []
+    for k, column in enumerate(columns):
+        same = k and key(column)[:2] == key(columns[k - 1])[:2]
+        tiers.append(tiers[-1] if same else (tiers[-1] + 1 if tiers else 0))
+    return tuple(tiers)
 
 
 def _components(rows: list[int], columns_of: dict[int, list[int]]) -> list[list[int]]:
