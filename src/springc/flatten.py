@@ -93,7 +93,8 @@ class Flattener:
         # alive in the entry so that its id cannot be reused.
         self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
         self.declared_types: dict[int, Declared] = {}
-        self.attribute_cache: dict[int, tuple[Mod, flat.Attributes]] = {}
+        self.attribute_cache: dict[tuple[tuple[str, int], ...],
+                                   tuple[tuple[Mod, ...], flat.Attributes]] = {}
         self.reusable_views: dict[int, bool] = {}
         # Equation templates by (id of the ClassView, initial); None: not reusable.
         self.templates: dict[tuple[int, bool], Template | None] = {}

@@ -65,14 +65,17 @@ def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
 
 
 def _attributes(flattener: Flattener, mod: Mod | None, name: str) -> flat.Attributes:
-    """The attributes given by ``mod``; remembered per modification object, since a
-    type's modifiers (``unit = "m"``) are one object shared by all its variables."""
+    """The attributes given by ``mod``, remembered per combination of attribute
+    modification objects: a type's modifiers (``unit = "m"``) are objects shared by all
+    its variables, also where a merge with a binding built a new ``mod`` around them."""
     if mod is None or not mod.children:
         return _EMPTY
-    cached = flattener.attribute_cache.get(id(mod))
+    key = tuple((k, id(child)) for k, child in mod.children.items())
+    cached = flattener.attribute_cache.get(key)
     if cached is None:
-        # The entry keeps ``mod`` alive so that its id is not reused.
-        cached = flattener.attribute_cache[id(mod)] = (mod, _evaluate(flattener, mod, name))
+        # The entry keeps the children alive so that their ids are not reused.
+        cached = flattener.attribute_cache[key] = (tuple(mod.children.values()),
+                                                   _evaluate(flattener, mod, name))
     return cached[1]
 
 
