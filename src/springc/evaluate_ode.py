@@ -76,15 +76,22 @@ def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
 
 
 class Evaluator:
-    """Evaluates the steps of ``model`` for given parameter values."""
+    """Evaluates the steps of ``model`` for given parameter values.
+
+    ``guess`` (by name) overrides the start values as the first Newton guess of the
+    tearing variables: after a switch of states, the current values keep Newton on the
+    branch the simulation is on (e.g. the sign of a coordinate solved from a length).
+    """
 
     def __init__(self, model: ode.ODE, params: Mapping[str, float],
-                 newton_tol: float = 1e-10, max_iterations: int = 50) -> None:
+                 newton_tol: float = 1e-10, max_iterations: int = 50,
+                 guess: Mapping[str, float] | None = None) -> None:
         self.model = model
         self.params = dict(params)
         self.names = [s.name for s in model.states]
         self.derivatives = [s.derivative for s in model.states]
         self.guess = start_values(model.dae.unknowns, self.params)
+        self.guess.update(guess or {})
         self.newton_tol = newton_tol
         self.max_iterations = max_iterations
 

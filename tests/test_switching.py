@@ -1,0 +1,168 @@
+"""Dynamic state selection: ``simplify(model, at=...)``, the conditioning monitor and
+the reference driver ``simulate_switching`` on the rigid pair and the pendulum."""
+
+from __future__ import annotations
+
+import math
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from springc.evaluate_ode import parameter_values
+from springc.flat import FlatModel
+from springc.initialize import initial_state
+from springc.pipeline import flatten_files
+from springc.reduce import pivoted_choice
+from springc.simplify import simplify
+from springc.switching import (
+    THRESHOLD,
+    EvaluatorFunctions,
+    conditioning,
+    needs_switch,
+    select_states,
+    simulate_switching,
+    state_vector,
+    switch,
+)
+
+SCENES = Path(__file__).resolve().parents[1] / "models" / "Scenes.mdl"
+G = 9.81
+
+
+@cache
+def scene(name: str) -> FlatModel:
+    return flatten_files([SCENES], f"Scenes.{name}")
+
+
+def rod_at(angle: float) -> dict[str, float]:
+    """RigidPair positions with p1 at the spring's rest point and the rod at
+    ``angle`` (radians, from the +x axis)."""
+    return {"p1.pos[1]": 0.0, "p1.pos[2]": -1.0,
+            "p2.pos[1]": math.cos(angle), "p2.pos[2]": -1.0 + math.sin(angle)}
+
+
+def states(name: str, at: dict[str, float] | None = None) -> set[str]:
+    return {s.name for s in simplify(scene(name), at).ode.states}
+
+
+P1 = {"p1.pos[1]", "p1.pos[2]", "p1.v[1]", "p1.v[2]"}
+
+
+def test_default_choice_is_unchanged_and_at_none_is_the_default() -> None:
+    assert states("RigidPair") == P1 | {"p2.pos[2]", "p2.v[2]"}
+    assert states("RigidPair", None) == states("RigidPair")
+    assert states("Pendulum") == {"x", "vx"}
+
+
+@pytest.mark.parametrize(("angle", "kept"), [(0.0, "2"), (-0.6, "2"), (-1.0, "1"),
+                                              (-math.pi / 2, "1"), (-2.8, "2")])
+def test_choice_at_values_keeps_the_better_conditioned_coordinate(angle: float,
+                                                                  kept: str) -> None:
+    """p2's coordinate along the rod is solved from the constraint, the other stays
+    a state (the crossover is at 45 degrees); p1 keeps its states (priority order)."""
+    assert states("RigidPair", rod_at(angle)) == P1 | {f"p2.pos[{kept}]", f"p2.v[{kept}]"}
+
+
+def test_pivoted_choice_prefers_priority_classes_then_the_largest_pivot() -> None:
+    # Class 0: columns 0, 1; class 1: columns 2, 3. Rows: one constraint.
+    assert pivoted_choice(np.array([[0.1, 0.5, 9.0, 9.0]]), [0, 0, 1, 1]) == [1]
+    assert pivoted_choice(np.array([[0.5, 0.5, 9.0]]), [0, 0, 1]) == [0]  # tie: earlier
+    assert pivoted_choice(np.array([[0.0, 0.0, 2.0]]), [0, 0, 1]) == [2]
+    assert pivoted_choice(np.array([[1.0, 2.0], [2.0, 4.0]]), [0, 0]) is None
+
+
+def test_monitor_is_one_after_selection_and_falls_towards_the_singularity() -> None:
+    flat = scene("RigidPair")
+    horizontal = select_states(flat)  # p2.pos[1] solved from the rod: bad when vertical
+    params = parameter_values(horizontal.ode.parameters)
+    values = {**params, **rod_at(0.0)}
+    assert conditioning(horizontal, values) == pytest.approx(1.0)
+    ratios = [conditioning(horizontal, {**params, **rod_at(-a)}) for a in (0.5, 1.2, 1.5)]
+    assert ratios[0] > ratios[1] > ratios[2] > 0
+    assert not needs_switch(horizontal, {**params, **rod_at(-1.2)})
+    assert needs_switch(horizontal, {**params, **rod_at(-1.5)})
+    vertical = select_states(flat, at={**params, **rod_at(-1.5)})
+    assert conditioning(vertical, {**params, **rod_at(-1.5)}) == pytest.approx(1.0)
+    assert select_states(scene("Pendulum")).blocks  # it has a choice to monitor
+
+
+def test_switch_maps_values_onto_the_new_states_consistently() -> None:
+    flat = scene("RigidPair")
+    old = select_states(flat)
+    _, info = initial_state(old.ode)
+    params = parameter_values(old.ode.parameters)
+    # Move p2 (with the rod) to -80 degrees, at rest: consistent with the constraints.
+    values = {**info.values, **rod_at(-80 * math.pi / 180)}
+    new = switch(flat, values)
+    assert set(new.states) == P1 | {"p2.pos[1]", "p2.v[1]"}
+    x = state_vector(new, values)
+    env = EvaluatorFunctions(new, params, values).values(0.0, x)
+    assert env["p2.pos[2]"] == pytest.approx(values["p2.pos[2]"], abs=1e-12)  # same branch
+    assert env["p2.v[2]"] == pytest.approx(0.0, abs=1e-12)
+
+
+def energy_of_rigid_pair(v: dict[str, np.ndarray]) -> np.ndarray:
+    """Kinetic + spring + gravity (m1 = m2 = 1, k = 1000, rest length 1)."""
+    kinetic = sum(0.5 * (v[f"{p}.v[1]"] ** 2 + v[f"{p}.v[2]"] ** 2) for p in ("p1", "p2"))
+    gravity = sum(G * v[f"{p}.pos[2]"] for p in ("p1", "p2"))
+    return kinetic + gravity + 0.5 * 1e3 * (v["spring.len"] - 1.0) ** 2
+
+
+def test_rigid_pair_switches_before_the_rod_turns_vertical() -> None:
+    """0-5 s at rtol 1e-8: the static choice fails at t = 0.556 s (rod vertical);
+    with switching the rod length holds to 1e-6 and the energy to 1e-5 J (of 19.6 J)."""
+    built: list[set[str]] = []
+
+    def make_functions(choice, params, guess):  # type: ignore[no-untyped-def]
+        built.append(set(choice.states))
+        return EvaluatorFunctions(choice, params, guess)
+
+    times = np.linspace(0.0, 5.0, 251)
+    result = simulate_switching(scene("RigidPair"), (0.0, 5.0), times, rtol=1e-8,
+                                atol=1e-10, make_functions=make_functions)
+    np.testing.assert_allclose(result.t, times, rtol=0, atol=1e-12)
+    v = result.values
+    rod = np.hypot(v["p2.pos[1]"] - v["p1.pos[1]"], v["p2.pos[2]"] - v["p1.pos[2]"])
+    assert np.max(np.abs(rod - 1.0)) < 1e-6
+    energy = energy_of_rigid_pair(v)
+    assert energy[0] == pytest.approx(-2 * G)
+    assert np.max(np.abs(energy - energy[0])) < 1e-5
+    assert len(result.switches) >= 1
+    first = result.switches[0]
+    assert 0.3 < first.time < 0.556
+    assert first.conditioning == pytest.approx(THRESHOLD, rel=1e-3)
+    assert {"p2.pos[2]", "p2.v[2]"} <= set(first.old_states)
+    assert set(first.new_states) == P1 | {"p2.pos[1]", "p2.v[1]"}
+    assert built[:2] == [set(first.old_states), set(first.new_states)]
+    assert len(built) == len(result.switches) + 1
+
+
+def test_pendulum_runs_without_switching() -> None:
+    """|phi| <= 45 degrees: y stays the better coordinate to solve; no switch."""
+    times = np.linspace(0.0, 10.0, 101)
+    result = simulate_switching(scene("Pendulum"), (0.0, 10.0), times, rtol=1e-8,
+                                atol=1e-10)
+    assert result.switches == ()
+    v = result.values
+    assert np.max(np.abs(np.hypot(v["x"], v["y"]) - 1.0)) < 1e-12
+
+
+def test_pendulum_over_the_horizontal_switches_back_and_forth() -> None:
+    """phi0 = 2 rad: x is singular at the horizontal, y at the bottom; the angle
+    matches theta'' = -g sin(theta) to 1e-4 over 5 s with alternating switches."""
+    times = np.linspace(0.0, 5.0, 101)
+    result = simulate_switching(scene("Pendulum"), (0.0, 5.0), times, rtol=1e-8,
+                                atol=1e-10, parameters={"phi0": 2.0})
+    chosen = [set(s.new_states) for s in result.switches]
+    assert len(chosen) >= 6
+    assert all(c == ({"y", "vy"} if k % 2 == 0 else {"x", "vx"}) for k, c in enumerate(chosen))
+    v = result.values
+    theta = np.arctan2(v["x"], -v["y"])
+    ref = solve_ivp(lambda t, s: [s[1], -G * math.sin(s[0])], (0.0, 5.0), [2.0, 0.0],
+                    method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times)
+    assert np.max(np.abs(theta - ref.y[0])) < 1e-4
+    energy = 0.5 * (v["vx"] ** 2 + v["vy"] ** 2) + G * v["y"]
+    assert np.max(np.abs(energy - energy[0])) < 1e-4
