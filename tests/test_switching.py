@@ -166,3 +166,14 @@ def test_pendulum_over_the_horizontal_switches_back_and_forth() -> None:
     assert np.max(np.abs(theta - ref.y[0])) < 1e-4
     energy = 0.5 * (v["vx"] ** 2 + v["vy"] ** 2) + G * v["y"]
     assert np.max(np.abs(energy - energy[0])) < 1e-4
+
+
+def test_loose_tolerance_steps_past_the_singularity_are_rejected_not_fatal() -> None:
+    """At rtol 1e-3 DOP853 tries stages beyond the vertical rod, where Newton fails:
+    the driver turns the failure into a rejected step and still switches in time."""
+    result = simulate_switching(scene("RigidPair"), (0.0, 1.0), [0.0, 0.5, 1.0], rtol=1e-3,
+                                atol=1e-5)
+    assert [round(s.time, 2) for s in result.switches] == [0.51]
+    v = result.values
+    rod = np.hypot(v["p2.pos[1]"] - v["p1.pos[1]"], v["p2.pos[2]"] - v["p1.pos[2]"])
+    assert np.max(np.abs(rod - 1.0)) < 1e-9

@@ -250,11 +250,13 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         if requested is not None:
             later = requested > t if times else requested >= t
             segment = requested[later & (requested <= t1)]
-        sol = solve_ivp(functions.rhs, (t, t1), state, method=method, t_eval=segment,
+        rhs = _RejectingRhs(functions)
+        sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
                         rtol=rtol, atol=atol, events=event if choice.blocks else None)
         if sol.status == -1:
+            cause = f" (last failure: {rhs.failure})" if rhs.failure else ""
             raise SimulationError(f"the integration failed at t = {sol.t[-1]:g}: "
-                                  f"{sol.message}")
+                                  f"{sol.message}{cause}")
         skip_first = requested is None and bool(times)
         for k, tk in enumerate(sol.t):
             if skip_first and k == 0:
@@ -275,6 +277,23 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         state = state_vector(choice, values)
     out = {n: np.array([r.get(n, np.nan) for r in rows]) for n in names}
     return SwitchingResult(np.array(times), out, tuple(switches))
+
+
+class _RejectingRhs:
+    """``functions.rhs`` returning NaN where the steps fail (e.g. Newton diverges on a
+    trial stage that went past a singularity): solve_ivp's methods then reject the
+    step and retry a smaller one, so the conditioning event gets its chance."""
+
+    def __init__(self, functions: Functions) -> None:
+        self.functions = functions
+        self.failure: SimulationError | None = None
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        try:
+            return self.functions.rhs(t, y)
+        except SimulationError as err:
+            self.failure = err
+            return np.full(len(y), np.nan)
 
 
 def conditioning_event(choice: StateChoice, functions: Functions,
