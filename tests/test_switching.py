@@ -136,8 +136,8 @@ def test_rigid_pair_switches_before_the_rod_turns_vertical() -> None:
     assert first.conditioning == pytest.approx(THRESHOLD, rel=1e-3)
     assert {"p2.pos[2]", "p2.v[2]"} <= set(first.old_states)
     assert set(first.new_states) == P1 | {"p2.pos[1]", "p2.v[1]"}
-    assert built[:2] == [set(first.old_states), set(first.new_states)]
-    assert len(built) == len(result.switches) + 1
+    assert built[:4] == [set(first.old_states)] * 2 + [set(first.new_states)] * 2
+    assert len(built) == 2 * (len(result.switches) + 1)  # integration and output
 
 
 def test_pendulum_runs_without_switching() -> None:
@@ -177,3 +177,11 @@ def test_loose_tolerance_steps_past_the_singularity_are_rejected_not_fatal() -> 
     v = result.values
     rod = np.hypot(v["p2.pos[1]"] - v["p1.pos[1]"], v["p2.pos[2]"] - v["p1.pos[2]"])
     assert np.max(np.abs(rod - 1.0)) < 1e-9
+
+
+def test_without_t_eval_every_step_is_output_once_with_the_switch_times() -> None:
+    result = simulate_switching(scene("Pendulum"), (0.0, 1.0), rtol=1e-6, atol=1e-8,
+                                parameters={"phi0": 2.0})
+    assert np.all(np.diff(result.t) > 0) and result.t[-1] == 1.0
+    assert len(result.switches) >= 2
+    assert all(s.time in result.t for s in result.switches)

@@ -248,7 +248,7 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         event = conditioning_event(choice, functions, threshold)
         segment = None
         if requested is not None:
-            later = requested > t if times else requested >= t
+            later = (requested >= t) & (requested > times[-1] if times else True)
             segment = requested[later & (requested <= t1)]
         rhs = _RejectingRhs(functions)
         sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
@@ -257,19 +257,19 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
             cause = f" (last failure: {rhs.failure})" if rhs.failure else ""
             raise SimulationError(f"the integration failed at t = {sol.t[-1]:g}: "
                                   f"{sol.message}{cause}")
+        # Outputs in time order from the segment's start values: each Newton guess is
+        # the previous output's solution, never one from the segment's end.
+        output = make_functions(choice, params, values)
         skip_first = requested is None and bool(times)
         for k, tk in enumerate(sol.t):
             if skip_first and k == 0:
                 continue
             times.append(float(tk))
-            rows.append(functions.values(float(tk), sol.y[:, k]))
+            rows.append(output.values(float(tk), sol.y[:, k]))
         if sol.status == 0:
             break
         t = float(sol.t_events[0][0])
         values = functions.values(t, sol.y_events[0][0])
-        if requested is None:
-            times.append(t)
-            rows.append(values)
         if len(switches) >= MAX_SWITCHES:
             raise SimulationError(f"more than {MAX_SWITCHES} switches of states by "
                                   f"t = {t:g}")
