@@ -22,6 +22,7 @@ from .equations import EquationFlattening
 from .errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from .evaluate import Evaluator
 from .instance import ClassScope, ClassView, Primitive, instance_mod
+from .instance_templates import InstanceTemplates
 from .instantiate import Declared, Instantiation
 from .load import ClassTree
 from .lookup import ClassLookup, select_model
@@ -89,6 +90,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.reusable_views: dict[int, bool] = {}
         # Equation templates by (id of the ClassView, initial); None: not reusable.
         self.templates: dict[tuple[int, bool], Template | None] = {}
+        self.instance_templates = InstanceTemplates(self)
 
     # ----------------------------------------------------------------- queries
 
@@ -121,7 +123,10 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
                     yield from self._walk_one(item)
 
     def _walk_one(self, scope: ClassScope) -> Iterator[ClassScope]:
+        recording = self.instance_templates.begin(scope)  # may fill scope's members
         yield from self.walk(scope)
+        if recording is not None:
+            self.instance_templates.finish(recording)
         yield scope
 
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
@@ -131,7 +136,10 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
                     yield from attributes_of(self, scope, member)
             else:
                 for item in (member.flat if isinstance(member, np.ndarray) else [member]):
-                    yield from self.variables(item)
+                    if item.template is not None:
+                        yield from self.instance_templates.variables(item)
+                    else:
+                        yield from self.variables(item)
 
 
 def flatten(tree: ClassTree, model: str | None = None) -> flat.FlatModel:

@@ -93,6 +93,7 @@ class ClassScope:
     members: dict[str, Any] = field(default_factory=dict)
     in_progress: dict[str, None] = field(default_factory=dict)  # ordered: a chain
     failed: dict[str, FlattenError] = field(default_factory=dict)
+    template: Any = None  # the InstanceTemplate this instance was copied from, if any
 
     @property
     def entry(self) -> ClassEntry:
