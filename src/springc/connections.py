@@ -18,7 +18,7 @@ from . import expr as x
 from . import flat
 from . import syntax as s
 from .errors import FlattenError, Note
-from .instance import ClassScope, Primitive
+from .instance import ClassScope, LocalScope, Primitive
 
 if TYPE_CHECKING:
     from .evaluate import Evaluator
@@ -65,6 +65,58 @@ def connector_leaves(scope: ClassScope) -> list[Leaf]:
     return leaves
 
 
+def direct_reference(ref: s.Ref, where: Any) -> ClassScope | None:
+    """``p[i - 1, j].flange`` inside ``for`` loops, resolved by indexing the arrays of
+    components directly; None (use the general evaluator) for anything else. Valid
+    because the general evaluator gives the same instance for such a reference: the
+    components exist (the walk created them), the subscripts are integers computed
+    from loop indices and literals, and an index out of range goes the general way,
+    which reports it."""
+    indices: dict[str, Any] = {}
+    while type(where) is LocalScope:
+        for name, value in where.names.items():
+            indices.setdefault(name, value)
+        where = where.parent
+    current: Any = where
+    for part in ref.parts:
+        if type(current) is not ClassScope or part.name in indices \
+                or part.name not in current.view.components:
+            return None
+        current = current.member(part.name)
+        if part.subscripts:
+            if type(current) is not np.ndarray or current.ndim != len(part.subscripts):
+                return None
+            position = []
+            for sub, size in zip(part.subscripts, current.shape):
+                k = _integer(sub, indices)
+                if k is None or not 1 <= k <= size:
+                    return None
+                position.append(k - 1)
+            current = current[tuple(position)]
+    return current if type(current) is ClassScope else None
+
+
+def _integer(e: s.Expr, indices: dict[str, Any]) -> int | None:
+    """An integer subscript made of literals, loop indices, ``+`` and ``-``; else None."""
+    kind = type(e)
+    if kind is s.Number:
+        return e.value if type(e.value) is int else None  # type: ignore[union-attr]
+    if kind is s.Ref:
+        if len(e.parts) != 1 or e.parts[0].subscripts:  # type: ignore[union-attr]
+            return None
+        found = indices.get(e.parts[0].name)  # type: ignore[union-attr]
+        if type(found) is x.Const and type(found.value) is int:
+            return found.value
+        return None
+    if kind is s.Binary and e.op in ("+", "-"):  # type: ignore[union-attr]
+        left = _integer(e.left, indices)  # type: ignore[union-attr]
+        right = _integer(e.right, indices)  # type: ignore[union-attr]
+        if left is None or right is None:
+            return None
+        return left + right if e.op == "+" else left - right  # type: ignore[union-attr]
+    return None
+
+
 class ConnectionSets:
     def __init__(self) -> None:
         self.parent: dict[Key, Key] = {}
@@ -101,7 +153,9 @@ class ConnectionSets:
         """The connectors a reference denotes: their array shape (a single connector
         counts as an array of one), the connectors in order, and whether they are
         outside connectors of ``owner``."""
-        value = ev.reference(ref, where)
+        value = direct_reference(ref, where)
+        if value is None:
+            value = ev.reference(ref, where)
         if isinstance(value, ClassScope):  # the common case, without numpy
             shape, items = (1,), [value]
         else:
