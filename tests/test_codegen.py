@@ -272,3 +272,78 @@ def test_unused_statements_are_dropped() -> None:
         Let("unused", BinOp("+", Var("a"), Const(1))), Raw("out = 0"),
         Store("out", Var("a"))])
     assert not any("unused" in line for line in writer_lines)
+
+
+# ------------------------------------------------------------------ vector layout
+
+CLOTH = """
+model SmallCloth
+  extends Scenes.Cloth(N = 3, M = 4);
+end SmallCloth;
+"""
+
+
+def _generated(files: list[str], model: str, **options: object):
+    from springc.codegen import CodegenOptions, generate
+    from springc.pipeline import flatten_files
+    from springc.simplify import simplify
+
+    flat_model = flatten_files(files, model)
+    system = simplify(flat_model).ode
+    return generate(system, flat_model, CodegenOptions(**options))  # type: ignore[arg-type]
+
+
+def _load(source: str, tmp_path: Path, name: str):
+    import importlib.util
+
+    path = tmp_path / f"{name}.py"
+    path.write_text(source)
+    spec = importlib.util.spec_from_file_location(name, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.parametrize("backend", ["python", "numba"])
+@pytest.mark.parametrize("scene", ["chain", "cloth"])
+def test_vector_layout_matches_scalar_layout(tmp_path: Path, backend: str, scene: str) -> None:
+    if backend == "numba":
+        pytest.importorskip("numba")
+    if scene == "cloth":
+        (tmp_path / "cloth.mdl").write_text(CLOTH)
+        files, model = [str(tmp_path / "cloth.mdl")], "SmallCloth"
+    else:
+        files, model = [SCENES], "Scenes.Chain"
+    scalar = _load(_generated(files, model, vector=False).source, tmp_path,
+                   f"scalar_{scene}_{backend}")
+    vector_source = _generated(files, model, backend=backend, vector=True).source
+    assert "for _q in range(" in vector_source or backend == "python"
+    vector = _load(vector_source, tmp_path, f"vector_{scene}_{backend}")
+    assert vector.STATES == scalar.STATES and vector.OBSERVED == scalar.OBSERVED
+    given = {"k": 50.0} if scene == "chain" else {"k_shear": 150.0}
+    p = vector.parameters(given)
+    assert np.array_equal(p, scalar.parameters(given))
+    assert np.array_equal(vector.start(p), scalar.start(p))
+    rng = np.random.default_rng(4)
+    x = scalar.start(p) + 0.01 * rng.standard_normal(len(scalar.STATES))
+    z = scalar.guesses(p)
+    assert np.allclose(vector.rhs(0.1, x, p, z), scalar.rhs(0.1, x, p, z), rtol=1e-13,
+                       atol=1e-11)
+    assert np.array_equal(vector.sparsity().toarray(), scalar.sparsity().toarray())
+    assert np.allclose(vector.jacobian_dense(0.1, x, p, z), scalar.jacobian_dense(0.1, x, p, z),
+                       rtol=1e-12, atol=1e-9)
+    assert np.allclose(vector.observed(0.1, x, p, z), scalar.observed(0.1, x, p, z),
+                       rtol=1e-13, atol=1e-11)
+    grid = np.array([0.0, 0.5])
+    states = np.vstack([x, x])
+    assert np.allclose(vector.observed_grid(grid, states, p, z)[1],
+                       scalar.observed(0.5, x, p, z), rtol=1e-13, atol=1e-11)
+
+
+def test_vector_layout_groups_a_chain_into_loops() -> None:
+    source = _generated([SCENES], "Scenes.Chain", backend="numba", vector=True).source
+    rhs = source[source.index("def _rhs("):source.index("def rhs(")]
+    assert rhs.count("for _q in range(") <= 8  # a handful of loops, not 10 x 5 statements
+    assert "# 9 x s[2].s_rel := m[2].s - m[1].s" in rhs

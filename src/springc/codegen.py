@@ -33,6 +33,13 @@ from .codegen_print import (
     Store,
     function_lines,
 )
+from .codegen_vector import (
+    VECTOR_THRESHOLD,
+    VectorLayout,
+    encode_floats,
+    encode_ints,
+    encode_strings,
+)
 from .errors import Span
 from .expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
 
@@ -44,10 +51,12 @@ NEWTON_TOLERANCE = 1e-10
 
 @dataclass(frozen=True)
 class CodegenOptions:
-    """``outputs``: observed variables to generate (``None``: all of them)."""
+    """``outputs``: observed variables to generate (``None``: all of them);
+    ``vector``: loops over groups of same-shaped assignments (large systems)."""
 
     backend: str = "python"
     outputs: tuple[str, ...] | None = None
+    vector: bool | None = None  # None: by size (codegen_vector.VECTOR_THRESHOLD)
 
 
 @dataclass(frozen=True)
@@ -79,6 +88,8 @@ class _Model:
         self.states = [s.name for s in system.states]
         self.derivatives = [s.derivative for s in system.states]
         self.params = [q.name for q in system.parameters]
+        self.param_set = set(self.params)
+        self.derivative_set = set(self.derivatives)
         self.aliases = {a.name: a for a in system.observed}
         self.variables = {v.name: v for v in flat_model.variables} if flat_model else {}
         self.unknowns = {u.name: u for u in system.dae.unknowns}
@@ -279,16 +290,67 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     computed = system.step_names()
     available = [n for n in system.observed_names()]
     outputs = list(available if options.outputs is None else options.outputs)
-    missing = [n for n in outputs if n not in set(available)]
+    available_set = set(available)
+    missing = [n for n in outputs if n not in available_set]
     if missing:
         raise CodegenError(f"'{missing[0]}' is not an observed variable of {system.name}")
     _check_defined(m, computed)
 
     namer = Namer()
     helpers: set[str] = set()
+    numba = options.backend == "numba"
+    vector = options.vector
+    if vector is None:
+        vector = _vector_suits(system)
+    elif vector and not _vector_suits(system, 0):
+        raise CodegenError("the vector layout needs a system of explicit assignments only")
+    if vector:
+        layout = VectorLayout(m, _vector_statements(m, outputs), numba)
+        jac_lines, pattern = layout.jacobian_body(helpers)
+        bodies = [
+            ("rhs", "Time derivatives of the states at time t.",
+             layout.body(m.derivatives, helpers), "dx"),
+            ("jacobian_values", _JAC_DOC, jac_lines, "jv"),
+            ("observed", "The OBSERVED variables at time t.",
+             layout.body(outputs, helpers) + layout.gather(outputs), "out"),
+        ]
+        table: list[int] | None = layout.table
+    else:
+        bodies, pattern = _scalar_bodies(m, outputs, namer, helpers, numba)
+        table = None
+    structural = structural_parameters(system, flat_model)
+    source = _module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
+                          table)
+    return GeneratedModel(system.name, source, options.backend, tuple(m.states),
+                          tuple(outputs), tuple(m.params), tuple(structural))
+
+
+_JAC_DOC = "Non-zeros of d(rhs)/dx in CSC order (JAC_INDICES, JAC_INDPTR)."
+
+
+def _vector_suits(system: ode.ODE, threshold: int = VECTOR_THRESHOLD) -> bool:
+    return (len(system.steps) >= threshold
+            and all(isinstance(s, ode.Assign) for s in system.steps))
+
+
+def _vector_statements(m: _Model, outputs: Sequence[str]) -> list[tuple[str, Expr, Span]]:
+    statements = [(s.name, s.expr, s.span) for s in m.ode.steps if isinstance(s, ode.Assign)]
+    computed = {s[0] for s in statements}
+    wanted = [d for d in m.derivatives if d not in computed] + list(outputs)
+    for let in m.alias_stmts(wanted):
+        assert isinstance(let, Let)
+        statements.append((let.name, let.expr, m.aliases[let.name].span))
+    return statements
+
+
+def _scalar_bodies(m: _Model, outputs: Sequence[str], namer: Namer, helpers: set[str],
+                   numba: bool) -> tuple[list[tuple[str, str, list[str], str]],
+                                         list[tuple[int, int]]]:
+    """Straight-line bodies: one statement per assignment, named locals."""
+    computed = m.ode.step_names()
     steps, described = m.step_stmts()
     loads = m.loads()
-    n, _nz = len(m.states), len(m.guess_slots)
+    n = len(m.states)
 
     rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
     rhs.append(Raw(f"dx = np.empty({n})"))
@@ -297,7 +359,7 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
 
     jac_body, pattern = jacobian_statements(
         m.states, m.derivatives, described,
-        {a.name: a.expr for a in system.observed if a.name in set(m.derivatives)})
+        {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
     jac = loads + steps + jac_body
 
     obs = loads + steps + m.alias_stmts(outputs) + [Raw(f"out = np.empty({len(outputs)})")]
@@ -305,19 +367,15 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
 
     functions = [
         ("rhs", "Time derivatives of the states at time t.", rhs, "dx"),
-        ("jacobian_values", "Non-zeros of d(rhs)/dx in CSC order (JAC_INDICES, JAC_INDPTR).",
-         jac, "jv"),
+        ("jacobian_values", _JAC_DOC, jac, "jv"),
         ("observed", "The OBSERVED variables at time t.", obs, "out"),
     ]
     # Plain Python computes fastest on Python floats, which also raise
     # ZeroDivisionError or ValueError where they happen (springc names the line).
-    prologue = [] if options.backend == "numba" else [Raw("x = x.tolist()\np = p.tolist()")]
+    prologue = [] if numba else [Raw("x = x.tolist()\np = p.tolist()")]
     bodies = [(fn, doc, function_lines(namer, helpers, prologue + stmts), ret)
               for fn, doc, stmts, ret in functions]
-    structural = structural_parameters(system, flat_model)
-    source = _module_text(m, options, bodies, helpers, pattern, outputs, structural, namer)
-    return GeneratedModel(system.name, source, options.backend, tuple(m.states),
-                          tuple(outputs), tuple(m.params), tuple(structural))
+    return bodies, pattern
 
 
 def _check_defined(m: _Model, computed: Sequence[str]) -> None:
@@ -332,15 +390,16 @@ def _check_defined(m: _Model, computed: Sequence[str]) -> None:
                 name = sorted(unknown)[0]
                 raise CodegenError(f"the simplified system reads '{name}' but nothing "
                                    "computes it", hint="this is a bug in springc")
+    computed_set = set(computed)
     for d in m.derivatives:
-        if d not in set(computed) and d not in m.aliases:
+        if d not in computed_set and d not in m.aliases:
             raise CodegenError(f"nothing computes {d}", hint="this is a bug in springc")
 
 
 def _module_text(m: _Model, options: CodegenOptions,
                  bodies: list[tuple[str, str, list[str], str]], helpers: set[str],
                  pattern: list[tuple[int, int]], outputs: list[str],
-                 structural: list[str], namer: Namer) -> str:
+                 structural: list[str], namer: Namer, table: list[int] | None) -> str:
     numba = options.backend == "numba"
     n = len(m.states)
     files = sorted({_where(s.span).rsplit(":", 1)[0] for s in m.ode.states} or {"?"})
@@ -357,7 +416,9 @@ def _module_text(m: _Model, options: CodegenOptions,
         "number of a system that did not converge).",
         '"""',
         "",
+        "import base64",
         "import math",
+        "import zlib",
         "",
         "import numpy as np",
     ]
@@ -369,41 +430,56 @@ def _module_text(m: _Model, options: CodegenOptions,
         f"MODEL = {m.ode.name!r}",
         f"BACKEND = {options.backend!r}",
         f"CODEGEN_VERSION = {CODEGEN_VERSION}",
-        f"STATES = {_tuple(m.states)}",
-        f"STATE_UNITS = {_tuple([m.unit(s) for s in m.states])}",
-        f"DERIVATIVES = {_tuple(m.derivatives)}",
-        f"PARAMETERS = {_tuple(m.params)}",
-        f"PARAMETER_UNITS = {_tuple([m.unit(q) for q in m.params])}",
-        f"PARAMETER_TYPES = {_tuple([m.type(q) for q in m.params])}",
-        f"STRUCTURAL = {_tuple(structural)}",
-        f"OBSERVED = {_tuple(outputs)}",
-        f"OBSERVED_UNITS = {_tuple([m.unit(o) for o in outputs])}",
+        f"STATES = {encode_strings(m.states)}",
+        f"STATE_UNITS = {encode_strings([m.unit(s) for s in m.states])}",
+        f"DERIVATIVES = {encode_strings(m.derivatives)}",
+        f"PARAMETERS = {encode_strings(m.params)}",
+        f"PARAMETER_UNITS = {encode_strings([m.unit(q) for q in m.params])}",
+        f"PARAMETER_TYPES = {encode_strings([m.type(q) for q in m.params])}",
+        f"STRUCTURAL = {encode_strings(structural)}",
+        f"OBSERVED = {encode_strings(outputs)}",
+        f"OBSERVED_UNITS = {encode_strings([m.unit(o) for o in outputs])}",
         f"GUESSES = {_tuple(list(m.guess_slots))}",
         f"NEWTON_SYSTEMS = {m.newton_systems()!r}",
         f"EXPERIMENT = {experiment!r}",
-        f"JAC_ROWS = np.array({[r for r, _ in pattern]!r}, dtype=np.int64)",
-        f"JAC_COLS = np.array({[c for _, c in pattern]!r}, dtype=np.int64)",
+        f"JAC_ROWS = {encode_ints([r for r, _ in pattern])}",
+        f"JAC_COLS = {encode_ints([c for _, c in pattern])}",
         "JAC_INDICES = JAC_ROWS",
         f"JAC_INDPTR = np.searchsorted(JAC_COLS, np.arange({n + 1}))",
     ]
     lines += _parameters_function(m, namer, helpers)
     for name in sorted(helpers):
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()
+    kernel = table is not None and numba  # numba kernels take the index table _I
+    if table is not None:
+        lines += ["", "# Indices of the vector layout (see springc.codegen_vector).",
+                  f"_I = {encode_ints(table) if table else 'np.zeros(1, dtype=np.int64)'}"]
     for fn, doc, body, ret in bodies:
         lines += ["", ""] + (["@_jit"] if numba else [])
-        lines += [f"def {fn}(t, x, p, z):", f'    """{doc}"""', *body, f"    return {ret}"]
+        if kernel:
+            lines += [f"def _{fn}(t, x, p, z, _I):", f'    """{doc}"""', *body,
+                      f"    return {ret}", "", "",
+                      f"def {fn}(t, x, p, z):", f'    """{doc}"""',
+                      f"    return _{fn}(t, x, p, z, _I)"]
+        else:
+            lines += [f"def {fn}(t, x, p, z):", f'    """{doc}"""', *body, f"    return {ret}"]
+    grid_call = "_observed(ts[i], X[i], p, z, _I)" if kernel else "observed(ts[i], X[i], p, z)"
     lines += ["", ""] + (["@_jit"] if numba else []) + [
-        "def observed_grid(ts, X, p, z):",
+        "def _observed_grid(ts, X, p, z, _I):" if kernel else "def observed_grid(ts, X, p, z):",
         '    """OBSERVED at each time ts[i] with states X[i] (a row per time); rows from',
         '    a failed Newton iteration on are NaN (and z[-1] says which system)."""',
         f"    out = np.empty((ts.shape[0], {len(outputs)}))",
         "    for i in range(ts.shape[0]):",
-        "        out[i] = observed(ts[i], X[i], p, z)",
+        f"        out[i] = {grid_call}",
         "        if z[-1] != 0.0:",
         "            out[i:] = np.nan",
         "            break",
         "    return out",
     ]
+    if kernel:
+        lines += ["", "", "def observed_grid(ts, X, p, z):",
+                  '    """OBSERVED at each time ts[i] with states X[i] (a row per time)."""',
+                  "    return _observed_grid(ts, X, p, z, _I)"]
     lines += ["", "", *_FOOTER.splitlines()]
     return "\n".join(lines) + "\n"
 
@@ -440,8 +516,58 @@ def _tuple(items: Sequence[str]) -> str:
     return "(" + ", ".join(repr(i) for i in items) + ("," if len(items) == 1 else "") + ")"
 
 
+def _parameters_vector(m: _Model, helpers: set[str]) -> list[str]:
+    """``parameters(values)`` and ``start(p)`` for many parameters: numpy, by level."""
+    params = VectorLayout(m, [(q.name, _value(q), q.span)
+                              for q in _topological(m.ode.parameters)],
+                          numba=False, table_name="_IP", lift_constants=True)
+    given = ["    for i, v in given:", "        p[i] = v"]
+    body = params.body(m.params, helpers, given)
+    starts = VectorLayout(m, [(s.name, _start_of(m, s.name, s.start), s.span)
+                              for s in m.ode.states],
+                          numba=False, table_name="_IS", lift_constants=True)
+    start_body = starts.body(m.states, helpers)
+    floats = params.floats + starts.floats
+    offset = len(params.floats)
+    start_body = [line.replace("_F[", "_FS[") for line in start_body]
+    return [
+        "",
+        "# Tables of parameters() and start() (see springc.codegen_vector).",
+        f"_IP = {encode_ints(params.table or [0])}",
+        f"_IS = {encode_ints(starts.table or [0])}",
+        f"_F = {encode_floats(floats or [0.0])}",
+        f"_FS = _F[{offset}:]",
+        "_PINDEX = {name: i for i, name in enumerate(PARAMETERS)}",
+        "", "",
+        "def parameters(values=None):",
+        '    """The parameter vector p: the model\'s values, overridden by values (flat',
+        "    name -> number); parameters bound to others follow them unless given too.",
+        '    """',
+        "    values = dict(values or {})",
+        "    unknown = sorted(set(values) - set(PARAMETERS))",
+        "    if unknown:",
+        '        raise KeyError(f"unknown parameter {unknown[0]!r}")',
+        "    given = [(_PINDEX[name], float(v)) for name, v in values.items()]",
+        f"    p = np.empty({len(m.params)})",
+        *body,
+        "    return p",
+        "", "",
+        "def start(p):",
+        '    """Start values of the states (initialization: see springc.simulate)."""',
+        f"    x = np.zeros({len(m.states)})",
+        *start_body,
+        "    return x",
+        "", "",
+        "def guesses(p):",
+        '    """Initial Newton guesses of the tearing variables, then the flag."""',
+        "    return np.zeros(1)",
+    ]
+
+
 def _parameters_function(m: _Model, namer: Namer, helpers: set[str]) -> list[str]:
     """``parameters(values)``, ``start(p)`` and ``guesses(p)``: plain Python."""
+    if m.guess_slots == {} and len(m.params) + len(m.states) >= VECTOR_THRESHOLD:
+        return _parameters_vector(m, helpers)
     index = {name: i for i, name in enumerate(m.params)}
     stmts: list[Stmt] = []
     for q in _topological(m.ode.parameters):
@@ -486,8 +612,7 @@ def _start_of(m: _Model, name: str, start: Expr | None, depth: int = 0) -> Expr:
     """The start value of ``name`` as an expression of parameters (0 by default)."""
     if start is None:
         return Const(0.0)
-    params = set(m.params)
-    for v in variables(start) - params:
+    for v in variables(start) - m.param_set:
         u = m.unknowns.get(v)
         if depth > 8 or u is None:
             raise CodegenError(f"the start value of '{name}' reads '{v}', which is not a "

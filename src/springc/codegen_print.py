@@ -16,7 +16,7 @@ from __future__ import annotations
 import keyword
 import math
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 from .errors import SimulationError
@@ -208,7 +208,8 @@ class FunctionWriter:
     variable it reads is reassigned or when the loop that computed it ends.
     """
 
-    def __init__(self, namer: Namer, helpers: set[str]) -> None:
+    def __init__(self, namer: Callable[[str], str], helpers: set[str],
+                 indent: str = "    ") -> None:
         self.name = namer
         self.helpers = helpers
         self.lines: list[str] = []
@@ -219,7 +220,7 @@ class FunctionWriter:
         self._temp_vars: dict[int, set[str]] = {}
         self._scopes: list[set[int]] = [set()]
         self._in_branch = 0
-        self._indent = "    "
+        self._indent = indent
 
     # Step 1: canonical ids and use counts.
     def _id(self, e: Expr) -> int:
@@ -432,9 +433,11 @@ def _exprs(stmts: Sequence[Stmt]) -> Iterator[Expr]:
             yield from _exprs(s.body)
 
 
-def function_lines(namer: Namer, helpers: set[str], stmts: Sequence[Stmt]) -> list[str]:
+def function_lines(namer: Callable[[str], str], helpers: set[str], stmts: Sequence[Stmt],
+                   indent: str = "    ", writer_class: type[FunctionWriter] | None = None
+                   ) -> list[str]:
     """The indented body of a function computing ``stmts`` (after dead-code removal)."""
-    writer = FunctionWriter(namer, helpers)
+    writer = (writer_class or FunctionWriter)(namer, helpers, indent)
     kept = prune(stmts)
     writer.count(kept)
     writer.write(kept)
