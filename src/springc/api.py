@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import TextIO
 
 from .build import (
@@ -47,19 +48,24 @@ def compile_model(files: Files, model: str | None = None, *,
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
                              backend, tuple(outputs) if outputs is not None else None,
                              (), cache)
-    compiled = compile_files(options)
-    structural = {k: v for k, v in (parameters or {}).items() if k in compiled.structural}
-    check_parameter_names(compiled, parameters or {})
-    return _with_structural(compiled, structural)
+    if not parameters:
+        return compile_files(options)
+    # Which parameters are structural is known once the unmodified model is compiled
+    # (all outputs: the selection may name variables that only the modified one has).
+    base = compile_files(replace(options, outputs=None))
+    check_parameter_names(base, parameters)
+    structural = {k: v for k, v in parameters.items() if k in base.structural}
+    if not structural:
+        return compile_files(options)
+    return _with_structural(base, structural, options)
 
 
-def _with_structural(compiled: CompiledModel, values: Mapping[str, float]) -> CompiledModel:
+def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
+                     options: CompileOptions | None = None) -> CompiledModel:
     if not values:
         return compiled
     mods = tuple(sorted((k, modification_value(compiled, k, v)) for k, v in values.items()))
-    from dataclasses import replace
-
-    return compile_files(replace(compiled.options, modifications=mods))
+    return compile_files(replace(options or compiled.options, modifications=mods))
 
 
 def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
@@ -79,10 +85,12 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
         model = compile_model(model, model_name, libraries=libraries, backend=backend,
-                              outputs=outputs, cache=cache)
-    check_parameter_names(model, values)
-    structural = {k: v for k, v in values.items() if k in model.structural}
-    model = _with_structural(model, structural)
+                              outputs=outputs, cache=cache, parameters=values)
+        structural = {k for k, v in model.options.modifications}
+    else:
+        check_parameter_names(model, values)
+        structural = {k for k in values if k in model.structural}
+        model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress)
     return simulate_model(model, options)
