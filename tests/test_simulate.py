@@ -238,3 +238,40 @@ def test_numba_backend_simulates_like_python(models: str) -> None:
     a = springc.simulate(models, model_name="Damped", backend="numba", rtol=1e-9, stop=2.0)
     b = springc.simulate(models, model_name="Damped", backend="python", rtol=1e-9, stop=2.0)
     assert np.array_equal(a.values, b.values)
+
+
+def test_progress_bar_draws_and_clears() -> None:
+    import io
+
+    from springc.simulation import Progress
+
+    stream = io.StringIO()
+    bar = Progress(stream, 0.0, 10.0)
+    bar.update(5.0)
+    assert stream.getvalue() == ""  # nothing during the first second
+    bar.next = 0.0
+    bar.update(5.0)
+    assert "50.0%" in stream.getvalue() and "t = 5 s" in stream.getvalue()
+    bar.close()
+    assert stream.getvalue().endswith("\r")
+    quiet = Progress(None, 0.0, 1.0)
+    quiet.next = 0.0
+    quiet.update(0.5)
+    quiet.close()
+
+
+def test_progress_stream_receives_updates(models: str) -> None:
+    import io
+
+    stream = io.StringIO()
+    springc.simulate(models, model_name="Harmonic", stop=1.0, progress=stream)
+    assert stream.getvalue() == ""  # a short run shows no bar
+
+
+def test_output_size_guard(monkeypatch: pytest.MonkeyPatch, models: str) -> None:
+    import springc.simulation
+
+    monkeypatch.setattr(springc.simulation, "MAX_OUTPUT_BYTES", 1000)
+    with pytest.raises(SimulationError, match="output times") as info:
+        springc.simulate(models, model_name="Harmonic")
+    assert "--vars" in (info.value.hint or "")

@@ -44,6 +44,7 @@ stiff scenes (strong damping, very stiff springs) want ``radau`` or ``bdf``."""
 DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
 DEFAULT_RTOL = 1e-6
 DENSE_JACOBIAN_LIMIT = 64
+MAX_OUTPUT_BYTES = 4_000_000_000
 LSODA_LIMIT = 2000
 
 
@@ -294,6 +295,12 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     if solver == "lsoda" and n > LSODA_LIMIT:
         raise SimulationError(f"lsoda uses dense Jacobians, too large for {n} states",
                               hint="use --solver bdf or radau (sparse Jacobians)")
+    size = len(grid) * (len(model.outputs) + n) * 8
+    if size > MAX_OUTPUT_BYTES:
+        raise SimulationError(
+            f"{len(grid)} output times x {len(model.outputs)} variables need "
+            f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
+            "use a larger --interval")
     p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
     x0 = initial_state(model, p)
     progress = Progress(options.progress, start, stop)
