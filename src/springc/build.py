@@ -147,7 +147,7 @@ def _library_folders(libraries: Sequence[str]) -> list[Path]:
 
 def cache_key(options: CompileOptions) -> str:
     """A digest of everything the generated module depends on."""
-    from .codegen import CODEGEN_VERSION
+    from .codegen_module import CODEGEN_VERSION
 
     h = hashlib.sha256()
     h.update(repr((CODEGEN_VERSION, options.model, options.backend, options.outputs,
