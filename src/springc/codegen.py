@@ -10,7 +10,10 @@ variables only, and the names, units and experiment settings as constants.
 
 Every assignment carries a comment with its flat name and source ``file:line``;
 common subexpressions are shared (:mod:`springc.codegen_print`); the Jacobian is
-analytic (:mod:`springc.codegen_jac`).
+analytic (:mod:`springc.codegen_jac`). Systems of thousands of explicit assignments
+(chains, cloths) use the vector layout of :mod:`springc.codegen_vector` instead, whose
+code grows with the number of distinct equation shapes; :mod:`springc.codegen_module`
+writes the rest of the module.
 """
 
 from __future__ import annotations
