@@ -117,8 +117,11 @@ def test_jacobian_matches_finite_differences(name: str) -> None:
         assert np.abs(fd[~pattern]).max(initial=0.0) < 1e-6 * scale
 
 
-def test_chain_rhs_and_jacobian_match_hand_written() -> None:
-    mod = springc.compile_model(SCENES, "Scenes.Chain").module
+@pytest.mark.parametrize("backend", ["python", "numba"])
+def test_chain_rhs_and_jacobian_match_hand_written(backend: str) -> None:
+    if backend == "numba":
+        pytest.importorskip("numba")
+    mod = springc.compile_model(SCENES, "Scenes.Chain", backend=backend).module
     p = mod.parameters()
     n, k, length, mass = 10, 100.0, 1.0, 1.0
     assert mod.STATES[:4] == ("m[1].s", "m[1].v", "m[2].s", "m[2].v")
