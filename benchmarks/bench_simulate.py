@@ -1,6 +1,6 @@
 """Benchmarks of code generation and simulation, with baselines measured in the same run.
 
-    python benchmarks/bench_simulate.py [--quick]
+    python benchmarks/bench_simulate.py [--quick] [--only abc]
 
 (a) generated numba right-hand side vs a hand-written numba one (``handwritten.py``)
     for the 1,000-mass chain and the 50x50 cloth (20x20 with --quick): target 1.5x;
@@ -112,20 +112,26 @@ def bench_large_chain(n: int) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller scenes")
-    quick = parser.parse_args().quick
-    from handwritten import chain_rhs, cloth_rhs
+    parser.add_argument("--only", default="abc", help="which benchmarks, e.g. 'bc'")
+    args = parser.parse_args()
+    quick, only = args.quick, args.only
 
     side = 20 if quick else 50
-    print("(a) right-hand sides", flush=True)
-    bench_rhs("Scenes.Chain", {"N": 1000}, lambda t, x: chain_rhs(t, x, 100.0, 1.0, 1.0),
-              "chain N=1000")
-    bench_rhs("Scenes.Cloth", {"N": side, "M": side},
-              lambda t, x: cloth_rhs(t, x, side, side, 0.1, 0.01, 1000.0, 200.0),
-              f"cloth {side}x{side}")
-    print("(b) end to end", flush=True)
-    bench_end_to_end()
-    print("(c) large chain", flush=True)
-    bench_large_chain(2000 if quick else 10000)
+    if "a" in only:
+        from handwritten import chain_rhs, cloth_rhs
+
+        print("(a) right-hand sides", flush=True)
+        bench_rhs("Scenes.Chain", {"N": 1000},
+                  lambda t, x: chain_rhs(t, x, 100.0, 1.0, 1.0), "chain N=1000")
+        bench_rhs("Scenes.Cloth", {"N": side, "M": side},
+                  lambda t, x: cloth_rhs(t, x, side, side, 0.1, 0.01, 1000.0, 200.0),
+                  f"cloth {side}x{side}")
+    if "b" in only:
+        print("(b) end to end", flush=True)
+        bench_end_to_end()
+    if "c" in only:
+        print("(c) large chain", flush=True)
+        bench_large_chain(2000 if quick else 10000)
     header: Row = ("benchmark", "springc", "baseline (same run)", "ratio", "target")
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(5)]
     print()
