@@ -24,9 +24,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .errors import SimulationError
+
+if TYPE_CHECKING:
+    from . import flat, ode
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
@@ -219,9 +222,8 @@ def _outputs(module: ModuleType, options: CompileOptions) -> tuple[str, ...]:
                               options.outputs))
 
 
-def generate_source(options: CompileOptions) -> str:
-    """Flatten, simplify and generate the module text for ``options``."""
-    from .codegen import CodegenOptions, generate
+def derive_system(options: CompileOptions) -> tuple[ode.ODE, flat.FlatModel]:
+    """Flatten and simplify the model of ``options`` (structural values applied)."""
     from .pipeline import flatten_files
     from .simplify import simplify
 
@@ -239,6 +241,14 @@ def generate_source(options: CompileOptions) -> str:
         system = dataclasses.replace(
             system, name=base.name,
             dae=dataclasses.replace(system.dae, experiment=base.experiment))
+    return system, flat_model
+
+
+def generate_source(options: CompileOptions) -> str:
+    """Flatten, simplify and generate the module text for ``options``."""
+    from .codegen import CodegenOptions, generate
+
+    system, flat_model = derive_system(options)
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)

@@ -22,11 +22,12 @@ from .codegen_vector import (
 )
 from .errors import Span
 from .expr import ZERO, Const, Expr, Var, substitute, variables
+from .initialize import conditions as initial_conditions
 
 if TYPE_CHECKING:
     from .codegen import CodegenOptions, _Model
 
-CODEGEN_VERSION = 1
+CODEGEN_VERSION = 2
 
 
 def _where(span: Span) -> str:
@@ -113,6 +114,7 @@ def module_text(m: _Model, options: CodegenOptions,
         f"GUESSES = {_tuple(list(m.guess_slots))}",
         f"NEWTON_SYSTEMS = {m.newton_systems()!r}",
         f"EXPERIMENT = {experiment!r}",
+        f"INITIAL_CONDITIONS = {len(initial_conditions(m.ode))}",
         f"JAC_ROWS = {encode_ints([r for r, _ in pattern])}",
         f"JAC_COLS = {encode_ints([c for _, c in pattern])}",
         "JAC_INDICES = JAC_ROWS",

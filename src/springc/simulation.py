@@ -104,13 +104,25 @@ def _first(*values: float | None) -> float:
     raise AssertionError("no default")
 
 
-def initial_state(model: CompiledModel, p: np.ndarray) -> np.ndarray:
+def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.ndarray:
     """The states at the start time.
 
-    Hook for initialization (``initial equation``, ``fixed``): for now every state
-    starts at its ``start`` value, as Modelica tools do when nothing else fixes it.
+    States start at their ``start`` values, as Modelica tools do when nothing else
+    fixes them. A model with ``initial equation``s or fixed start values on variables
+    that are not states has an initial problem: it is solved by
+    :func:`springc.initialize.initial_state` on the simplified system (derived again
+    here, since the generated module holds only the ODE).
     """
-    return np.asarray(model.module.start(p), dtype=float)
+    if not getattr(model.module, "INITIAL_CONDITIONS", 0):
+        return np.asarray(model.module.start(p), dtype=float)
+    from .build import derive_system
+    from .initialize import initial_state as solve_initial
+
+    system, _ = derive_system(model.options)
+    values = dict(zip(model.parameter_names, (float(v) for v in p)))
+    x0, _info = solve_initial(system, values, t0)
+    order = {s.name: i for i, s in enumerate(system.states)}
+    return np.array([x0[order[name]] for name in model.states], dtype=float)
 
 
 # ------------------------------------------------------------------ failures
@@ -302,7 +314,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
             "use a larger --interval")
     p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
-    x0 = initial_state(model, p)
+    x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
     problem = _Problem(model, p, solver, progress)
     try:
