@@ -30,7 +30,7 @@ from . import flat
 from .errors import FlattenError
 from .instance import ClassScope, ClassView, Primitive, ViewComponent
 from .modification import Mod
-from .templates import renamer
+from .templates import fixed_shape, renamer
 
 if TYPE_CHECKING:
     from .flatten import Flattener
@@ -154,14 +154,7 @@ class InstanceTemplates:
 
     def _component_reusable(self, comp: ViewComponent) -> bool:
         """Literal sizes and no constants: the same members in every instance."""
-        declared = self.flattener.declared_type(comp)
-        rtype = declared.rtype
-        if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]):
-            return False
-        if rtype.entry is None:
-            return True
-        return rtype.entry.defn.kind not in ("function", "package") \
-            and self._class_reusable(self.flattener.view(rtype.entry))
+        return fixed_shape(self.flattener, comp, self._class_reusable)
 
     # ------------------------------------------------------------------ fill
 

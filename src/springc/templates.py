@@ -65,7 +65,10 @@ def reusable(flattener: Flattener, view: ClassView) -> bool:
     return found
 
 
-def _component_reusable(flattener: Flattener, comp: ViewComponent) -> bool:
+def fixed_shape(flattener: Flattener, comp: ViewComponent,
+                class_ok: Callable[[ClassView], bool]) -> bool:
+    """Literal sizes and no constants: ``comp`` has the same members in every instance
+    (for a component of class type, when ``class_ok`` accepts its class)."""
     declared = flattener.declared_type(comp)
     rtype = declared.rtype
     if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]):
@@ -73,7 +76,11 @@ def _component_reusable(flattener: Flattener, comp: ViewComponent) -> bool:
     if rtype.entry is None:
         return True
     return rtype.entry.defn.kind not in ("function", "package") \
-        and reusable(flattener, flattener.view(rtype.entry))
+        and class_ok(flattener.view(rtype.entry))
+
+
+def _component_reusable(flattener: Flattener, comp: ViewComponent) -> bool:
+    return fixed_shape(flattener, comp, lambda view: reusable(flattener, view))
 
 
 def _equations_only(equations: Iterable[s.Equation]) -> bool:
