@@ -222,7 +222,17 @@ def _outputs(module: ModuleType, options: CompileOptions) -> tuple[str, ...]:
                               options.outputs))
 
 
-def derive_system(options: CompileOptions) -> tuple[ode.ODE, flat.FlatModel]:
+@dataclass(frozen=True)
+class Derived:
+    """The simplified system of a model, its flat model, and whether index reduction
+    left a choice of states that may turn singular during a run (``switchable``)."""
+
+    system: ode.ODE
+    flat_model: flat.FlatModel
+    switchable: bool
+
+
+def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
     from .pipeline import flatten_files
     from .simplify import simplify
@@ -235,24 +245,30 @@ def derive_system(options: CompileOptions) -> tuple[ode.ODE, flat.FlatModel]:
         files.append(str(_wrapper_file(base.name, options.modifications)))
         model = "SpringcModified"
     flat_model = flatten_files(files, model, options.libraries)
-    system = simplify(flat_model).ode
+    simplified = simplify(flat_model)
+    system = simplified.ode
+    switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
     if base is not None:
         # Keep the simulated model's name and experiment (annotations are not inherited).
         system = dataclasses.replace(
             system, name=base.name,
             dae=dataclasses.replace(system.dae, experiment=base.experiment))
-    return system, flat_model
+    return Derived(system, flat_model, switchable)
 
 
 def generate_source(options: CompileOptions) -> str:
     """Flatten, simplify and generate the module text for ``options``."""
     from .codegen import CodegenOptions, generate
 
-    system, flat_model = derive_system(options)
+    derived = derive_system(options)
+    system, flat_model = derived.system, derived.flat_model
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)
-    return generate(system, flat_model, CodegenOptions(options.backend, observed)).source
+    source = generate(system, flat_model, CodegenOptions(options.backend, observed)).source
+    # Index reduction left a choice of states that may turn singular during the run:
+    # the simulator then switches states (springc.simulation_switching).
+    return source + f"\nSWITCHABLE = {derived.switchable}\n"
 
 
 def _wrapper_file(model: str, modifications: Sequence[tuple[str, str]]) -> Path:

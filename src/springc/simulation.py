@@ -118,7 +118,7 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
     from .build import derive_system
     from .initialize import initial_state as solve_initial
 
-    system, _ = derive_system(model.options)
+    system = derive_system(model.options).system
     values = dict(zip(model.parameter_names, (float(v) for v in p)))
     x0, _info = solve_initial(system, values, t0)
     order = {s.name: i for i, s in enumerate(system.states)}
@@ -313,6 +313,11 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             f"{len(grid)} output times x {len(model.outputs)} variables need "
             f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
             "use a larger --interval")
+    if getattr(model.module, "SWITCHABLE", False):
+        from .simulation_switching import simulate_switching_model
+
+        return simulate_switching_model(model, solver, grid, rtol, atol,
+                                        dict(options.parameters))
     p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
     x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
