@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from springc.cli import SOLVER_CHOICES, main
-from springc.simulation import DEFAULT_SOLVER, SOLVERS
+from springc.simulation import AUTO, FIXED_STEP, SOLVERS
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -55,8 +55,8 @@ def test_seed_csv_and_png(tmp_path: Path) -> None:
     for line in out.read_text().splitlines()[1:5]:
         assert all(repr(float(v)) == v for v in line.split(","))
     assert stdout == ""
-    assert f"SpringMass: {DEFAULT_SOLVER}, " in stderr and " steps, " in stderr
-    assert "RHS and 0 Jacobian evaluations" in stderr
+    assert "SpringMass: auto -> dop853 (non-stiff: " in stderr and " steps, " in stderr
+    assert "RHS and 1 Jacobian evaluations" in stderr  # the stiffness estimate
     import matplotlib.image
 
     image = matplotlib.image.imread(str(png))
@@ -141,12 +141,14 @@ def test_solver_failure_leaves_no_csv(tmp_path: Path) -> None:
 
 
 def test_each_solver_runs() -> None:
-    assert set(SOLVER_CHOICES) == set(SOLVERS)
+    assert set(SOLVER_CHOICES) == {AUTO, *SOLVERS, *FIXED_STEP}
     for solver in SOLVER_CHOICES:
+        step = ["--step", "1e-3"] if solver in FIXED_STEP else []
         code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
-                                   "--vars", "spring.x")
+                                   "--vars", "spring.x", *step)
         assert code == 0, stderr
-        assert f"SpringMass: {solver}, " in stderr
+        shown = "auto -> dop853 (" if solver == AUTO else f"{solver},"
+        assert f"SpringMass: {shown}" in stderr
         if solver in ("radau", "bdf", "lsoda"):
             assert " 0 Jacobian" not in stderr
 

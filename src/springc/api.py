@@ -75,11 +75,14 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              parameters: Mapping[str, float] | None = None,
              outputs: Sequence[str] | None = None, backend: str = "python",
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
-             progress: TextIO | None = None) -> SimulationResult:
+             progress: TextIO | None = None, step: float | None = None
+             ) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
-    start 0, stop 10 s, 500 intervals, rtol 1e-6, atol rtol/1000.
+    start 0, stop 10 s, 500 intervals, rtol 1e-6, atol rtol/1000. ``solver`` is
+    ``"auto"`` (dop853 or radau from a stiffness estimate), a scipy method, or a
+    fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
     """
     values = dict(parameters or {})
@@ -92,5 +95,6 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
         structural = {k for k in values if k in model.structural}
         model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
-    options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress)
+    options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
+                                step)
     return simulate_model(model, options)

@@ -108,7 +108,8 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
 
 # ------------------------------------------------------------------ simulate, compile
 
-SOLVER_CHOICES = ("rk45", "dop853", "radau", "bdf", "lsoda")  # springc.simulation.SOLVERS
+SOLVER_CHOICES = ("auto", "rk45", "dop853", "radau", "bdf", "lsoda",  # simulation.SOLVERS
+                  "verlet", "symplectic-euler", "rk4")  # simulation.FIXED_STEP
 
 
 def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
@@ -159,7 +160,12 @@ def _single_threaded_blas() -> None:
 @click.option("--interval", type=float,
               help="Output interval [s] (default: experiment, else (stop-start)/500).")
 @click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
-              default="dop853", show_default=True, help="scipy solve_ivp method.")
+              default="auto", show_default=True,
+              help="auto: dop853 or radau from a stiffness estimate at the start (the "
+              "summary says why); a scipy solve_ivp method; or a fixed-step one "
+              "(verlet, symplectic-euler, rk4) with --step.")
+@click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
+              "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
               "Tolerance, else 1e-6).")
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
@@ -173,10 +179,15 @@ def _single_threaded_blas() -> None:
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, rtol: float | None,
-             atol: float | None, assignments: tuple[str, ...], output: str | None,
-             plot: str | None, quiet: bool) -> None:
+             step: float | None, atol: float | None, assignments: tuple[str, ...],
+             output: str | None, plot: str | None, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV) and/or a plot (PNG)."""
     values = _parse_set(assignments)
+    if solver.lower() in SOLVER_CHOICES[-3:] and step is None:
+        raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
+                               "needs --step H (e.g. --step 1e-3)")
+    if step is not None and not step > 0:
+        raise click.BadParameter(f"{step:g} is not positive", param_hint="--step")
     _single_threaded_blas()
     from .api import simulate as run
 
@@ -184,7 +195,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     result = run(files, model_name=model, libraries=libraries, backend=backend,
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress)
+                 parameters=values, progress=progress, step=step)
     if output:
         result.to_csv(output)
     elif not plot:
@@ -220,3 +231,129 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             f.write(compiled.source)
     else:
         click.echo(compiled.source, nl=False)
+
+
+# ------------------------------------------------------------------ tradeoff
+
+def _split(value: str | None) -> list[str]:
+    return [] if value is None else [w for w in value.replace(",", " ").split() if w]
+
+
+def _positive_list(ctx: click.Context, param: click.Parameter, value: str | None
+                   ) -> tuple[float, ...] | None:
+    if value is None:
+        return None
+    out = []
+    for word in _split(value):
+        try:
+            number = float(word)
+        except ValueError:
+            raise click.BadParameter(f"'{word}' is not a number") from None
+        if not 0 < number < float("inf"):
+            raise click.BadParameter(f"{word} is not positive")
+        out.append(number)
+    if not out:
+        raise click.BadParameter("the list is empty")
+    return tuple(out)
+
+
+def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
+                 ) -> tuple[str, ...] | None:
+    if value is None:
+        return None
+    from .tradeoff import available_solvers
+
+    names = tuple(w.lower() for w in _split(value))
+    known = available_solvers()
+    for name in names:
+        if name not in known:
+            raise click.BadParameter(f"unknown solver '{name}' (choose from "
+                                     f"{', '.join(known)})")
+    if not names:
+        raise click.BadParameter("the list is empty")
+    return names
+
+
+@main.command()
+@_model_options
+@_compile_options
+@click.option("--start", type=float, help="Start time [s] (default: experiment, else 0).")
+@click.option("--stop", type=float, help="Stop time [s] (default: experiment, else 10).")
+@click.option("--interval", type=float,
+              help="Output interval [s] (default: experiment, else (stop-start)/500).")
+@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
+              help="Set a parameter (repeatable); array sizes re-flatten the model.")
+@click.option("--solvers", callback=_solver_list, metavar="LIST",
+              help="Solvers to compare, e.g. 'dop853,radau' (default: rk45 dop853 radau "
+              "bdf lsoda and the fixed-step ones).")
+@click.option("--tolerances", callback=_positive_list, metavar="LIST",
+              help="rtol values of the adaptive solvers (atol = rtol/1000; default "
+              "1e-3 ... 1e-10).")
+@click.option("--steps", callback=_positive_list, metavar="LIST",
+              help="Step sizes [s] of the fixed-step solvers (default: the output "
+              "interval divided by 2, 4, ..., 256).")
+@click.option("--max-error", "targets", callback=_positive_list, metavar="LIST",
+              help="Errors to recommend a setting for (default 1e-4).")
+@click.option("--reference", type=click.Path(exists=True, dir_okay=False),
+              help="Reference trajectory CSV (as written by simulate -o) instead of a "
+              "tight solve.")
+@click.option("--save-reference", type=click.Path(dir_okay=False),
+              help="Write the reference trajectory as CSV (reusable with --reference).")
+@click.option("--repeats", type=click.IntRange(min=1), default=3, show_default=True,
+              help="Timed runs per setting (median); runs over 2 s are timed once.")
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
+              show_default=True, help="Seconds per run: a longer run is stopped and the "
+              "solver's tighter settings are skipped.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the table as CSV.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write the work-precision plot (PNG).")
+@click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
+@_guard
+def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
+             stop: float | None, interval: float | None, assignments: tuple[str, ...],
+             solvers: tuple[str, ...] | None, tolerances: tuple[float, ...] | None,
+             steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
+             reference: str | None, save_reference: str | None, repeats: int,
+             budget: float, output: str | None, plot: str | None, quiet: bool) -> None:
+    """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
+
+    The error of each run is measured on the output grid against REFERENCE, or against
+    a tight dop853 solve checked by a second method (VODE Adams). By default the states
+    are compared; --vars selects other variables.
+    """
+    values = _parse_set(assignments)
+    _single_threaded_blas()
+    from .api import compile_model
+    from .tradeoff import (
+        DEFAULT_TARGETS,
+        DEFAULT_TOLERANCES,
+        TradeoffOptions,
+        compare_states,
+        run_tradeoff,
+        summary,
+        write_table_csv,
+    )
+
+    compiled = compile_model(files, model, libraries=libraries, backend=backend,
+                             outputs=patterns or None, parameters=values,
+                             cache=not no_cache)
+    if not patterns:
+        compiled = compare_states(compiled)
+    rest = {k: v for k, v in values.items() if k not in compiled.structural}
+    options = TradeoffOptions(solvers, tolerances or DEFAULT_TOLERANCES, steps,
+                              targets or DEFAULT_TARGETS, reference, repeats, budget,
+                              start, stop, interval, rest, None if quiet else sys.stderr)
+    study = run_tradeoff(compiled, options)
+    click.echo(summary(study), nl=False)
+    if save_reference:
+        from .tradeoff_reference import write_reference
+
+        write_reference(study.reference, save_reference)
+    if output:
+        write_table_csv(study, output)
+    if plot:
+        from .tradeoff_plot import write_work_precision
+
+        write_work_precision(study, plot)

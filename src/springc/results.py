@@ -30,10 +30,12 @@ class SimulationStats:
     model_time: float  # seconds spent in the generated code
     compile_time: float
     cached: bool
+    reason: str = ""  # why --solver auto chose ``solver`` (empty: the user chose it)
 
     def summary(self, model: str) -> str:
-        """One line: solver, steps, evaluations, wall time."""
-        return (f"{model}: {self.solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
+        """One line: solver (``auto -> radau (why)``), steps, evaluations, wall time."""
+        solver = f"auto -> {self.solver} ({self.reason})" if self.reason else self.solver
+        return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s (model code {self.model_time:.3f} s; "
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)")

@@ -29,6 +29,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from . import solvers
 from .build import CompiledModel, check_parameter_names
 from .errors import Note, SimulationError
 from .results import SimulationResult, SimulationStats
@@ -36,10 +37,14 @@ from .results import SimulationResult, SimulationStats
 SOLVERS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
            "lsoda": "LSODA"}
 IMPLICIT = frozenset({"radau", "bdf", "lsoda"})
-DEFAULT_SOLVER = "dop853"
-"""An 8th-order explicit Runge-Kutta method: the spring-mass scenes are oscillatory
-and mostly non-stiff, where it takes far fewer steps than rk45 at tight tolerances;
-stiff scenes (strong damping, very stiff springs) want ``radau`` or ``bdf``."""
+FIXED_STEP = ("verlet", "symplectic-euler", "rk4")
+"""Fixed-step solvers (:mod:`springc.solvers`); they need ``SimulationOptions.step``."""
+AUTO = "auto"
+DEFAULT_SOLVER = AUTO
+"""``dop853`` (an 8th-order explicit Runge-Kutta method: the spring-mass scenes are
+oscillatory and mostly non-stiff, where it takes far fewer steps than rk45 at tight
+tolerances) or ``radau`` for stiff runs (strong damping, very stiff springs whose
+fast modes are at rest), chosen at the start state by :func:`springc.solvers.choose`."""
 
 DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
 DEFAULT_RTOL = 1e-6
@@ -60,6 +65,7 @@ class SimulationOptions:
     atol: float | None = None
     parameters: Mapping[str, float] = field(default_factory=dict)
     progress: TextIO | None = None
+    step: float | None = None  # fixed-step solvers only
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -140,6 +146,8 @@ def _fmt(t: float) -> str:
 
 
 def _remedy(solver: str) -> str:
+    if solver in FIXED_STEP:
+        return "reduce --step or use --solver radau"
     if solver in IMPLICIT:
         return ("check the parameters and start values near that time (a spring of zero "
                 "length? a mass of zero?), or try a tighter --rtol")
@@ -291,9 +299,9 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     """Integrate ``model`` and return the selected outputs on the output grid."""
     began = time.perf_counter()
     solver = options.solver.lower()
-    if solver not in SOLVERS:
+    if solver not in SOLVERS and solver not in FIXED_STEP and solver != AUTO:
         raise SimulationError(f"unknown solver '{options.solver}'",
-                              hint=f"choose one of {', '.join(SOLVERS)}")
+                              hint=f"choose one of {', '.join((AUTO, *SOLVERS, *FIXED_STEP))}")
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -313,7 +321,9 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             f"{len(grid)} output times x {len(model.outputs)} variables need "
             f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
             "use a larger --interval")
-    if getattr(model.module, "SWITCHABLE", False):
+    if solver in FIXED_STEP:
+        step = solvers.check_step(solver, options.step, start, stop, len(grid) - 1)
+    if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
         from .simulation_switching import simulate_switching_model
 
         return simulate_switching_model(model, solver, grid, rtol, atol,
@@ -322,13 +332,21 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
     problem = _Problem(model, p, solver, progress)
+    choice = None
     try:
         with np.errstate(all="ignore"):
             if not np.isfinite(x0).all():
                 raise _Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=_state_notes(problem.names, x0, None)))
-            states, steps = _integrate(problem, grid, x0, rtol, atol)
+            if solver == AUTO:
+                choice = solvers.choose_for(problem.jac, problem.rhs, x0, start, stop,
+                                            rtol, atol)
+                solver = problem.solver = choice.solver
+            if solver in FIXED_STEP:
+                states, steps = solvers.run_fixed(problem, grid, x0, step)
+            else:
+                states, steps = _integrate(problem, grid, x0, rtol, atol)
             outputs = _outputs(model, problem, grid, states)
     except _Stop as stop_:
         raise stop_.error from None
@@ -336,7 +354,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         progress.close()
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
-                            model.compile_time, model.cached)
+                            model.compile_time, model.cached,
+                            choice.reason if choice else "")
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs

@@ -1,0 +1,167 @@
+"""springc.solvers: position/velocity pairs, the auto choice, fixed-step runs and their
+failures (API and CLI)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import springc
+from springc.cli import main
+from springc.errors import SimulationError
+from springc.pipeline import flatten_files
+from springc.simplify import simplify
+from springc.solvers import choose, detect_pairs, pairs_from_ode
+
+ROOT = Path(__file__).resolve().parents[1]
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+SCENES = str(ROOT / "models" / "Scenes.mdl")
+
+MODELS = """
+model Harmonic
+  parameter Real k = 4;
+  parameter Real m = 1;
+  Real x(start = 1);
+  Real v(start = 0);
+equation
+  der(x) = v;
+  m * der(v) = -k * x;
+end Harmonic;
+
+model StiffPair "wall -k0- m1 -k- m2 -k0- wall: the stiff mode starts (and stays) at rest"
+  parameter Real k0 = 1;
+  parameter Real k = 1e8;
+  Real x1(start = 1);
+  Real x2(start = 1);
+  Real v1(start = 0);
+  Real v2(start = 0);
+equation
+  der(x1) = v1;
+  der(x2) = v2;
+  der(v1) = -k0 * x1 + k * (x2 - x1);
+  der(v2) = -k0 * x2 - k * (x2 - x1);
+end StiffPair;
+
+model Chained "der(a) = b, der(b) = c: b is not a velocity of a mechanical pair"
+  Real a(start = 1);
+  Real b(start = 0);
+  Real c(start = 0);
+equation
+  der(a) = b;
+  der(b) = c;
+  der(c) = -a;
+end Chained;
+"""
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory: pytest.TempPathFactory) -> str:
+    path = tmp_path_factory.mktemp("models") / "solvers.mdl"
+    path.write_text(MODELS)
+    return str(path)
+
+
+def _pairs_by_name(files: str, name: str) -> tuple[set[tuple[str, str]], set[tuple[str, str]]]:
+    compiled = springc.compile_model(files, name)
+    p = compiled.parameters()
+    x0 = np.asarray(compiled.module.start(p), dtype=float)
+    pairs = detect_pairs(compiled.module, p, x0, 0.0)
+    states = compiled.states
+    runtime = {(states[q], states[v]) for q, v in zip(pairs.positions, pairs.velocities)}
+    symbolic = set(pairs_from_ode(simplify(flatten_files([files], name)).ode))
+    return runtime, symbolic
+
+
+@pytest.mark.parametrize(("files", "name", "count"), [
+    (SEED, "SpringMass", 2), (SCENES, "Scenes.Oscillator", 2), (SCENES, "Scenes.Chain", 10),
+    (SCENES, "Scenes.Cloth", 200), (SCENES, "Scenes.Pendulum", 1)])
+def test_pairs_from_the_jacobian_match_the_ode(files: str, name: str, count: int) -> None:
+    runtime, symbolic = _pairs_by_name(files, name)
+    assert runtime == symbolic
+    assert len(runtime) == count
+
+
+def test_chains_of_derivatives_are_not_pairs(models: str) -> None:
+    runtime, symbolic = _pairs_by_name(models, "Chained")
+    assert runtime == symbolic == set()
+
+
+def test_auto_choice_on_linear_systems() -> None:
+    w = 1e3
+    osc = np.array([[0.0, 1.0], [-w * w, 0.0]])
+    x0 = np.array([1.0, 0.0])
+    # An excited fast oscillation must be resolved anyway: explicit.
+    excited = choose(osc, osc @ x0, x0, 10.0, 1e-6, 1e-9)
+    assert excited.solver == "dop853" and excited.reason.startswith("oscillatory")
+    assert excited.excited_radius == pytest.approx(w)
+    # The same system at rest is stiff: implicit.
+    rest = choose(osc, np.zeros(2), np.zeros(2), 10.0, 1e-6, 1e-9)
+    assert rest.solver == "radau"
+    assert rest.reason == ("stiff: fastest time scale 1/1e+03 s is 1e+04x shorter than "
+                           "the 10 s span")
+    # A fast mode that decays early in the span does not count.
+    damped = np.array([[0.0, 1.0], [-w * w, -2.5 * w]])
+    assert choose(damped, damped @ x0, x0, 10.0, 1e-6, 1e-9).solver == "radau"
+    # Slow: explicit.
+    slow = choose(osc / 1e3, osc @ x0 / 1e3, x0, 10.0, 1e-6, 1e-9)
+    assert slow.solver == "dop853" and slow.reason.startswith("non-stiff")
+
+
+def test_auto_summary_says_why(models: str) -> None:
+    result = springc.simulate(models, model_name="StiffPair", stop=1.0)
+    assert result.stats.solver == "radau"
+    assert result.stats.summary("StiffPair").startswith(
+        "StiffPair: auto -> radau (stiff: fastest time scale 1/1.41e+04 s is 1.41e+04x "
+        "shorter than the 1 s span), ")
+    chosen = springc.simulate(models, model_name="StiffPair", stop=1.0, solver="bdf")
+    assert chosen.stats.summary("StiffPair").startswith("StiffPair: bdf, ")
+
+
+@pytest.mark.parametrize("solver", ["verlet", "symplectic-euler", "rk4"])
+def test_fixed_step_solvers_against_the_closed_form(models: str, solver: str) -> None:
+    result = springc.simulate(models, model_name="Harmonic", stop=5.0, solver=solver,
+                              step=1e-3)
+    error = np.max(np.abs(result["x"] - np.cos(2.0 * result.time)))
+    bound = {"verlet": 2e-6, "symplectic-euler": 3e-3, "rk4": 3e-12}[solver]
+    assert error < bound
+    assert result.stats.steps == 5000 and result.stats.solver == solver
+
+
+def test_fixed_step_needs_a_step(models: str) -> None:
+    with pytest.raises(SimulationError, match="the fixed-step solver verlet needs a step"):
+        springc.simulate(models, model_name="Harmonic", solver="verlet")
+    with pytest.raises(SimulationError, match="more than 2e\\+07"):
+        springc.simulate(models, model_name="Harmonic", solver="verlet", step=1e-9)
+    with pytest.raises(SimulationError, match="the step must be positive and finite"):
+        springc.simulate(models, model_name="Harmonic", solver="rk4", step=float("inf"))
+
+
+def test_cli_fixed_step_usage_errors(models: str) -> None:
+    runner = CliRunner()
+    result = runner.invoke(main, ["simulate", models, "--model", "Harmonic", "--solver",
+                                  "verlet"])
+    assert result.exit_code == 2
+    assert "--solver verlet is a fixed-step solver and needs --step H" in result.output
+    result = runner.invoke(main, ["simulate", models, "--model", "Harmonic", "--solver",
+                                  "rk4", "--step", "-1"])
+    assert result.exit_code == 2 and "-1 is not positive" in result.output
+
+
+def test_unstable_step_fails_with_the_remedy_and_no_csv(models: str, tmp_path: Path) -> None:
+    out = tmp_path / "out.csv"
+    result = CliRunner().invoke(main, [
+        "simulate", models, "--model", "Harmonic", "--solver", "verlet", "--step", "1.5",
+        "--interval", "1.5", "--stop", "3000", "--set", "k=4", "-o", str(out)])
+    assert result.exit_code == 1, result.output
+    assert "error: der(v) is infinite at time " in result.output
+    assert "note: v = " in result.output
+    assert "help: reduce --step or use --solver radau" in result.output
+    assert list(tmp_path.iterdir()) == []
