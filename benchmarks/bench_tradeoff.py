@@ -1,0 +1,150 @@
+"""Benchmark: the setting ``springc tradeoff`` recommends vs scipy's default call.
+
+    PYTHONPATH=src python benchmarks/bench_tradeoff.py [--quick]
+
+For the seed (``models/SpringMass.mdl``) and the 50x50 cloth (``Scenes.Cloth``; 20x20
+with ``--quick``, which also measures fewer tolerances): the full tradeoff study
+(:mod:`springc.tradeoff`), then the fastest setting for max error 1e-4 against scipy's
+default ``solve_ivp(rhs, span, x0, t_eval=grid)`` (RK45, rtol 1e-3, atol 1e-6) on the
+same generated right-hand side, and against ``solve_ivp`` RK45 at the loosest rtol
+that reaches 1e-4. **Target:** the recommendation is at least 3x faster than scipy's
+default call at the same error, or the default call does not reach that error.
+``benchmarks/accuracy.py`` runs the same studies and writes ``docs/accuracy.md``.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as `springc simulate` does
+
+import argparse
+import importlib.util
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+import springc  # noqa: E402
+from springc.tradeoff import (  # noqa: E402
+    DEFAULT_TOLERANCES,
+    SCIPY_DEFAULT,
+    SCIPY_RK45,
+    Tradeoff,
+    TradeoffOptions,
+    compare_states,
+    run_tradeoff,
+)
+
+TARGET = 1e-4
+SPEEDUP = 3.0
+BACKEND = "numba" if importlib.util.find_spec("numba") else "python"
+QUICK_TOLERANCES = (1e-3, 1e-5, 1e-7, 1e-9)
+
+
+@dataclass(frozen=True)
+class Scene:
+    key: str
+    title: str
+    file: str
+    model: str | None
+    parameters: dict[str, float]
+
+
+def scenes(quick: bool) -> list[Scene]:
+    n = 20 if quick else 50
+    return [Scene("seed", "Seed (`models/SpringMass.mdl`)",
+                  str(ROOT / "models" / "SpringMass.mdl"), None, {}),
+            Scene("cloth", f"Cloth {n}x{n} (`Scenes.Cloth`, N = M = {n})",
+                  str(ROOT / "models" / "Scenes.mdl"), "Scenes.Cloth", {"N": n, "M": n})]
+
+
+def study(scene: Scene, quick: bool = False, budget: float = 30.0,
+          log: object = sys.stderr) -> tuple[Tradeoff, float]:
+    """The tradeoff study of ``scene`` (the states compared) and its total seconds."""
+    began = time.perf_counter()
+    model = springc.compile_model(scene.file, scene.model, parameters=scene.parameters,
+                                  backend=BACKEND)
+    print(f"{scene.key}: compiled in {time.perf_counter() - began:.1f} s "
+          f"({len(model.states)} states, {BACKEND} backend)", file=sys.stderr, flush=True)
+    began = time.perf_counter()
+    options = TradeoffOptions(tolerances=QUICK_TOLERANCES if quick else DEFAULT_TOLERANCES,
+                              targets=(TARGET,), budget=budget, log=log)  # type: ignore[arg-type]
+    result = run_tradeoff(compare_states(model), options)
+    return result, time.perf_counter() - began
+
+
+@dataclass(frozen=True)
+class Verdict:
+    recommended: str
+    seconds: float
+    error: float
+    default_seconds: float
+    default_error: float
+    matched: str  # "rtol 1e-08, 1.67 s" or why there is none
+    vs_default: float
+    vs_matched: float  # NaN: no matched run
+    met: bool
+
+    def cells(self) -> tuple[str, ...]:
+        reaches = ("reaches it" if self.default_error <= TARGET else "does not reach it")
+        vs_default = (f"{self.vs_default:.1f}x" if self.default_error <= TARGET
+                      else f"({self.vs_default:.1f}x, default not accurate)")
+        vs_matched = "" if self.vs_matched != self.vs_matched else f"{self.vs_matched:.1f}x"
+        return (self.recommended, f"{self.seconds:.3g} s", f"{self.error:.1e}",
+                f"{self.default_seconds:.3g} s, error {self.default_error:.1e} ({reaches})",
+                self.matched, vs_default, vs_matched, "yes" if self.met else "NO")
+
+
+HEADER = ("recommended for 1e-4", "time", "its error", "scipy default call",
+          "scipy RK45 reaching 1e-4", "vs default", "vs RK45 at same error",
+          "target met")
+
+
+def verdict(result: Tradeoff) -> Verdict:
+    good = [r for r in result.runs if r.ok and r.max_error <= TARGET]
+    default = next(b for b in result.baselines if b.solver == SCIPY_DEFAULT)
+    if not good or not default.ok:
+        return Verdict("none", float("nan"), float("nan"), default.wall_time,
+                       default.max_error, "", float("nan"), float("nan"), False)
+    best = min(good, key=lambda r: r.wall_time)
+    tightened = [b for b in result.baselines if b.solver == SCIPY_RK45]
+    match = next((b for b in tightened if b.ok and b.max_error <= TARGET), None)
+    matched = (f"rtol {match.value:.0e}: {match.wall_time:.3g} s" if match else
+               "none down to rtol " + (f"{tightened[-1].value:.0e}" if tightened else "?"))
+    speedup = default.wall_time / best.wall_time
+    met = default.max_error > TARGET or speedup >= SPEEDUP
+    return Verdict(f"{best.solver} at {best.label()}", best.wall_time, best.max_error,
+                   default.wall_time, default.max_error, matched, speedup,
+                   match.wall_time / best.wall_time if match else float("nan"), met)
+
+
+def markdown(rows: list[tuple[str, Verdict]]) -> str:
+    lines = ["| scene | " + " | ".join(HEADER) + " |",
+             "| --- | --- | ---: | ---: | --- | --- | ---: | ---: | --- |"]
+    lines += ["| " + " | ".join((name, *v.cells())) + " |" for name, v in rows]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="20x20 cloth, fewer tolerances")
+    parser.add_argument("--budget", type=float, default=30.0, help="seconds per run")
+    args = parser.parse_args()
+    rows = []
+    for scene in scenes(args.quick):
+        result, seconds = study(scene, args.quick, args.budget)
+        print(f"{scene.key}: study took {seconds:.0f} s", file=sys.stderr)
+        for line in result.recommendations():
+            print(f"{scene.key}: {line}", file=sys.stderr)
+        rows.append((scene.title, verdict(result)))
+    print(markdown(rows))
+    if not all(v.met for _, v in rows):
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()
