@@ -32,10 +32,9 @@ from springc.tradeoff import (
     REFERENCE_RTOL,
     REPEAT_LIMIT,
     SCALE_FLOOR,
-    format_table,
-    unresolved_note,
 )
 from springc.tradeoff_plot import write_work_precision
+from springc.tradeoff_table import format_table, unresolved_note
 
 DOCS = ROOT / "docs"
 EXTREMES = "## Extremes"

@@ -25,13 +25,12 @@ from springc.tradeoff import (
     TradeoffOptions,
     compare_states,
     fixed_step_solvers,
-    recommend,
     relative_errors,
     run_tradeoff,
     variable_scales,
-    write_table_csv,
 )
 from springc.tradeoff_plot import write_work_precision
+from springc.tradeoff_table import recommend, write_table_csv
 
 OSCILLATOR = """
 model Oscillator "x'' = -4 x: x = cos(2 t), v = -2 sin(2 t)"

@@ -332,9 +332,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         TradeoffOptions,
         compare_states,
         run_tradeoff,
-        summary,
-        write_table_csv,
     )
+    from .tradeoff_table import summary, write_table_csv
 
     compiled = compile_model(files, model, libraries=libraries, backend=backend,
                              outputs=patterns or None, parameters=values,
