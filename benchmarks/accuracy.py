@@ -40,7 +40,7 @@ DOCS = ROOT / "docs"
 EXTREMES = "## Extremes"
 COMMAND = "PYTHONPATH=src python benchmarks/accuracy.py"
 
-METHOD = f"""\
+METHOD = """\
 ## How it is measured
 
 `springc tradeoff FILE... [--solvers LIST] [--tolerances LIST] [--steps LIST]
@@ -50,19 +50,19 @@ its output with a reference on the output grid:
 
 - **Error**: variable *j* at output time *t_i* is off by
   `|y_j(t_i) - ref_j(t_i)| / scale_j`, where `scale_j` is the largest `|ref_j|` over
-  time, floored at {SCALE_FLOOR:g} times the largest scale among the compared
+  time, floored at {floor:g} times the largest scale among the compared
   variables of the same unit (a variable that stays near zero does not turn
   round-off into a large relative error). *max error* is the largest over times and
   variables, *RMS error* the root mean square over both. The states (positions and
   velocities) are compared.
-- **Reference**: springc's `dop853` at rtol {REFERENCE_RTOL:.0e} (atol rtol/1000),
+- **Reference**: springc's `dop853` at rtol {rtol:.0e} (atol rtol/1000),
   verified by scipy's VODE in Adams mode (a variable-order multistep method, no
   Jacobian) at the same tolerances on the same generated right-hand side; their
   difference is reported, and the reference is refused if it exceeds the target.
   Errors below about ten times that difference are not resolved.
 - **Time**: wall time of one simulation (integration and outputs, not compilation),
-  the median of 3 runs (runs over {REPEAT_LIMIT:g} s are timed once). A run over the
-  budget (30 s) is stopped and the solver's tighter settings are skipped.
+  the median of 3 runs (runs over {repeat:g} s are timed once). A run over the
+  budget ({budget:g} s) is stopped and the solver's tighter settings are skipped.
   Adaptive solvers use atol = rtol/1000, the ratio of scipy's defaults.
 - **scipy baselines**: `solve_ivp(rhs, span, x0, t_eval=grid)` with scipy's defaults
   (RK45, rtol 1e-3, atol 1e-6), `rhs` being the same generated function springc
@@ -94,7 +94,7 @@ def scene_section(title: str, key: str, result: object, seconds: float) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="20x20 cloth, fewer tolerances")
-    parser.add_argument("--budget", type=float, default=30.0, help="seconds per run")
+    parser.add_argument("--budget", type=float, default=20.0, help="seconds per run")
     args = parser.parse_args()
     sections, rows = [], []
     for scene in scenes(args.quick):
@@ -118,7 +118,8 @@ def main() -> None:
         "scipy's default `solve_ivp` call reaching the same error, or the default call "
         "does not reach it. The last columns compare with `solve_ivp` RK45 at the "
         "loosest rtol of the table that reaches 1e-4.", "",
-        bench.rstrip(), "", METHOD])
+        bench.rstrip(), "", METHOD.format(
+            floor=SCALE_FLOOR, rtol=REFERENCE_RTOL, repeat=REPEAT_LIMIT, budget=args.budget)])
     path = DOCS / "accuracy.md"
     old = path.read_text(encoding="utf-8") if path.exists() else ""
     tail = old[old.index(EXTREMES):] if EXTREMES in old else (

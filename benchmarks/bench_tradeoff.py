@@ -62,7 +62,7 @@ def scenes(quick: bool) -> list[Scene]:
                   str(ROOT / "models" / "Scenes.mdl"), "Scenes.Cloth", {"N": n, "M": n})]
 
 
-def study(scene: Scene, quick: bool = False, budget: float = 30.0,
+def study(scene: Scene, quick: bool = False, budget: float = 20.0,
           log: object = sys.stderr) -> tuple[Tradeoff, float]:
     """The tradeoff study of ``scene`` (the states compared) and its total seconds."""
     began = time.perf_counter()
@@ -132,7 +132,7 @@ def markdown(rows: list[tuple[str, Verdict]]) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="20x20 cloth, fewer tolerances")
-    parser.add_argument("--budget", type=float, default=30.0, help="seconds per run")
+    parser.add_argument("--budget", type=float, default=20.0, help="seconds per run")
     args = parser.parse_args()
     rows = []
     for scene in scenes(args.quick):
