@@ -247,7 +247,8 @@ def _setup(model: CompiledModel, options: TradeoffOptions) -> _Setup:
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     return _Setup(model, options, output_grid(start, stop, interval), atol / rtol, p,
-                  initial_state(model, p), tuple(units.get(n, "") for n in model.outputs))
+                  initial_state(model, p, start),
+                  tuple(units.get(n, "") for n in model.outputs))
 
 
 def warm_up(model: CompiledModel, p: np.ndarray, x0: np.ndarray) -> None:
