@@ -243,3 +243,20 @@ def test_cli_bad_reference_csv(oscillator: str, tmp_path: Path) -> None:
     short.write_text("time,x,v\n0.0,1.0,0.0\n")
     code, _, err = run_cli("tradeoff", oscillator, "--reference", str(short))
     assert code == 1 and "1 output times, the study's grid has 21" in err
+
+
+def test_budget_stops_runs(oscillator: str) -> None:
+    from springc.tradeoff import OverBudget, _Deadline
+
+    with pytest.raises(OverBudget):
+        _Deadline(0.0).write("progress")
+    _Deadline(60.0).write("progress")
+    # The scipy baselines check the budget every 64 RHS evaluations.
+    model = compare_states(springc.compile_model(oscillator))
+    study = run_tradeoff(model, TradeoffOptions(("dop853",), (1e-6,), repeats=1,
+                                                budget=1e-9))
+    assert study.runs[0].ok
+    # The default call needs fewer than 64 evaluations; RK45 at rtol 1e-6 does not.
+    assert [b.status for b in study.baselines] == ["ok", "over budget (> 1e-09 s)"]
+    assert recommend(study.runs, study.baselines, 1e-4).endswith(
+        "; scipy's RK45 does not reach it down to rtol 1e-06 (over budget (> 1e-09 s))")
