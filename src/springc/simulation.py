@@ -379,7 +379,13 @@ def _integrate(problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
     integrator = cls(problem.rhs, grid[0], x0, grid[-1], rtol=rtol, atol=atol, **kwargs)
     k, steps = 1, 0
     while k < len(grid):
-        message = integrator.step()
+        try:
+            message = integrator.step()
+        except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
+            if "infs or NaNs" not in str(err):
+                raise
+            raise _Stop(_solver_failure(problem, integrator, "the Newton matrix is not "
+                                        "finite (the Jacobian overflows)")) from None
         steps += 1
         if integrator.status == "failed":
             raise _Stop(_solver_failure(problem, integrator, message))
