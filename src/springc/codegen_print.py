@@ -13,6 +13,7 @@ helpers collected while printing, unsupported nodes refused explicitly.
 
 from __future__ import annotations
 
+import builtins
 import keyword
 import math
 import re
@@ -81,9 +82,19 @@ Stmt = Let | Load | Store | Raw | Loop | Block
 
 # ------------------------------------------------------------------ names
 
-_RESERVED = frozenset({"t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out",
-                       "abs", "min", "max", "float", "int", "range", "len", "bool",
-                       "values", "numba"}) | frozenset(keyword.kwlist)
+# Every identifier the module templates define or use (locals, loop variables, module
+# functions, constants and imports): model names must never shadow them.
+_RESERVED = frozenset({
+    "t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out", "abs", "min", "max",
+    "float", "int", "range", "len", "bool", "values", "numba", "scipy", "base64", "zlib",
+    "x0", "n", "i", "j", "k", "v", "ts", "given", "unknown", "name", "X",
+    "parameters", "start", "guesses", "rhs", "observed", "observed_grid", "jacobian",
+    "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
+    "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
+    "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
+    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "JAC_ROWS",
+    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR",
+}) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
 
 
 class Namer:
