@@ -41,3 +41,13 @@ def test_choice_and_reason() -> None:
 def test_non_finite_jacobian_goes_implicit() -> None:
     choice = choose_solver(np.array([[np.inf]]), span=1.0)
     assert choice.solver == "radau"
+
+
+def test_large_non_stiff_jacobian_is_decided_by_the_row_sum_bound() -> None:
+    n = 1000  # the chain above: row sums <= 4, so rho * T <= 40 without eigenvalues
+    k = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+    jac = sp.bmat([[None, sp.identity(n)], [-k.tocsr(), None]]).tocsr()
+    choice = choose_solver(jac, span=10.0)
+    assert choice.solver == "dop853"
+    assert choice.reason == ("non-stiff: spectral radius <= 4 1/s (row-sum bound) over "
+                             "10 s (rho*T <= 40 <= 2000)")

@@ -10,6 +10,7 @@ Jacobian), so the estimate costs a few dozen Jacobian-vector products.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,7 +60,17 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
 
 def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
                   explicit: str = "dop853", implicit: str = "radau") -> Choice:
-    """Pick ``explicit`` or ``implicit`` from ``rho * span`` and say why."""
+    """Pick ``explicit`` or ``implicit`` from ``rho * span`` and say why.
+
+    For large Jacobians the row-sum (Gershgorin) bound ``rho <= ||J||_inf`` is tried
+    first: when even the bound is not stiff, no eigenvalue computation is needed.
+    """
+    if jac.shape[0] > DENSE_LIMIT:
+        bound = _row_sum_bound(jac)
+        if math.isfinite(bound) and bound * abs(span) <= STIFF_THRESHOLD:
+            reason = (f"non-stiff: spectral radius <= {bound:.3g} 1/s (row-sum bound) over "
+                      f"{span:g} s (rho*T <= {bound * abs(span):.3g} <= {STIFF_THRESHOLD:g})")
+            return Choice(explicit, bound, bound * abs(span), reason)
     rho = spectral_radius(jac)
     stiffness = rho * abs(span)
     if not np.isfinite(stiffness):
@@ -72,3 +83,11 @@ def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
     reason = (f"non-stiff: spectral radius {rho:.3g} 1/s over {span:g} s "
               f"(rho*T = {stiffness:.3g} <= {STIFF_THRESHOLD:g})")
     return Choice(explicit, rho, stiffness, reason)
+
+
+def _row_sum_bound(jac: np.ndarray | sp.spmatrix) -> float:
+    """``||J||_inf``, an upper bound of the spectral radius."""
+    if sp.issparse(jac):
+        sums = np.asarray(abs(sp.csr_matrix(jac)).sum(axis=1)).ravel()
+        return float(np.max(sums, initial=0.0))
+    return float(np.max(np.abs(np.asarray(jac)).sum(axis=1), initial=0.0))
