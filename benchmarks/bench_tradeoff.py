@@ -3,8 +3,8 @@
     PYTHONPATH=src python benchmarks/bench_tradeoff.py [--quick]
 
 For the seed (``models/SpringMass.mdl``) and the 20x20 cloth (``Scenes.Cloth``): the
-full tradeoff study (:mod:`springc.tradeoff`); for the 50x50 cloth a reduced one
-(dop853 only; left out with ``--quick``, which also measures fewer tolerances). Then
+full tradeoff study (:mod:`springc.tradeoff`; ``--quick``: fewer tolerances); with
+``--full`` also a reduced one of the 50x50 cloth (dop853 only). Then
 the fastest setting for max error 1e-4 against scipy's default
 ``solve_ivp(rhs, span, x0, t_eval=grid)`` (RK45, rtol 1e-3, atol 1e-6) on the same
 generated right-hand side, and against ``solve_ivp`` RK45 at the loosest rtol that
@@ -59,16 +59,16 @@ class Scene:
     note: str = ""
 
 
-def scenes(quick: bool) -> list[Scene]:
-    """The seed and the 20x20 cloth with every solver; the 50x50 cloth (not with
-    ``--quick``) with dop853 only: one run there takes about a minute."""
+def scenes(quick: bool, full: bool = False) -> list[Scene]:
+    """The seed and the 20x20 cloth with every solver; with ``full``, the 50x50 cloth
+    with dop853 only: one run there takes about a minute."""
     tolerances = QUICK_TOLERANCES if quick else DEFAULT_TOLERANCES
     scenes_file = str(ROOT / "models" / "Scenes.mdl")
     out = [Scene("seed", "Seed (`models/SpringMass.mdl`)",
                  str(ROOT / "models" / "SpringMass.mdl"), None, {}, tolerances=tolerances),
            Scene("cloth20", "Cloth 20x20 (`Scenes.Cloth`, N = M = 20)", scenes_file,
                  "Scenes.Cloth", {"N": 20, "M": 20}, tolerances=tolerances)]
-    if not quick:
+    if full:
         out.append(Scene(
             "cloth50", "Cloth 50x50 (`Scenes.Cloth`, N = M = 50)", scenes_file,
             "Scenes.Cloth", {"N": 50, "M": 50}, ("dop853",), (1e-4, 1e-5, 1e-6, 1e-7, 1e-8),
@@ -149,11 +149,12 @@ def markdown(rows: list[tuple[str, Verdict]]) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
-                        help="no 50x50 cloth, fewer tolerances")
+                        help="fewer tolerances")
+    parser.add_argument("--full", action="store_true", help="add the 50x50 cloth")
     parser.add_argument("--budget", type=float, default=20.0, help="seconds per run")
     args = parser.parse_args()
     rows = []
-    for scene in scenes(args.quick):
+    for scene in scenes(args.quick, args.full):
         result, seconds = study(scene, args.budget)
         print(f"{scene.key}: study took {seconds:.0f} s", file=sys.stderr)
         for line in result.recommendations():

@@ -300,7 +300,8 @@ def scipy_outputs(model: CompiledModel, p: np.ndarray, grid: np.ndarray,
                   states: np.ndarray) -> np.ndarray:
     """The compared outputs (``model.outputs``) from states on the grid."""
     columns = {s: states[:, i] for i, s in enumerate(model.states)}
-    if any(n in set(model.observed) for n in model.outputs):
+    observed = set(model.observed)
+    if any(n in observed for n in model.outputs):
         z = np.asarray(model.module.guesses(p), dtype=float)
         obs = model.module.observed_grid(grid, np.ascontiguousarray(states), p, z)
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
