@@ -406,7 +406,8 @@ def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
              states: np.ndarray) -> np.ndarray:
     names = model.outputs
     columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
-    wanted = [o for o in model.observed if o in set(names)]
+    selected = set(names)
+    wanted = [o for o in model.observed if o in selected]
     if wanted:
         z = np.asarray(model.module.guesses(problem.p), dtype=float)
         try:
