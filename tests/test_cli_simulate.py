@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import csv
+import os
+import stat
 from pathlib import Path
 
 import numpy as np
@@ -177,3 +179,15 @@ def test_model_error_exit_code(tmp_path: Path) -> None:
     bad.write_text("model Bad\n  Real x;\nequation\n  der(x) = y;\nend Bad;\n")
     code, _, stderr = run("simulate", str(bad))
     assert code == 1 and "error:" in stderr
+
+
+def test_outputs_have_the_permissions_of_a_plain_file(tmp_path: Path) -> None:
+    mask = os.umask(0o022)
+    try:
+        out = tmp_path / "seed.csv"
+        result = CliRunner().invoke(main, ["simulate", SEED, "--stop", "0.1", "--quiet",
+                                           "-o", str(out)])
+    finally:
+        os.umask(mask)
+    assert result.exit_code == 0, result.output
+    assert stat.S_IMODE(out.stat().st_mode) == 0o644

@@ -89,11 +89,20 @@ def atomic_write(path: Path, mode: str) -> Iterator[IO[Any]]:
         with os.fdopen(fd, mode, **({"encoding": "utf-8", "newline": ""} if "b" not in mode
                                     else {})) as f:
             yield f
+        # mkstemp creates the file private (0600); give it the permissions a plain
+        # open() would have given (0666 less the umask).
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
