@@ -61,7 +61,7 @@ class Scene:
 
 def scenes(quick: bool, full: bool = False) -> list[Scene]:
     """The seed and the 20x20 cloth with every solver; with ``full``, the 50x50 cloth
-    with dop853 only: one run there takes about a minute."""
+    with dop853 only (its reference solves take about half a minute each)."""
     tolerances = QUICK_TOLERANCES if quick else DEFAULT_TOLERANCES
     scenes_file = str(ROOT / "models" / "Scenes.mdl")
     out = [Scene("seed", "Seed (`models/SpringMass.mdl`)",
@@ -72,10 +72,10 @@ def scenes(quick: bool, full: bool = False) -> list[Scene]:
         out.append(Scene(
             "cloth50", "Cloth 50x50 (`Scenes.Cloth`, N = M = 50)", scenes_file,
             "Scenes.Cloth", {"N": 50, "M": 50}, ("dop853",), (1e-4, 1e-5, 1e-6, 1e-7, 1e-8),
-            300.0, "A reduced study: every run of the 50x50 cloth takes about a minute on "
-            "the development VM, so only dop853 (what `--solver auto` picks for the cloth) "
-            "is measured, at rtol 1e-4 to 1e-8, with a 300 s budget per run. The full "
-            "comparison of the solvers is the 20x20 cloth's."))
+            300.0, "A reduced study: the 50x50 cloth's reference solves take about half a "
+            "minute on the development VM, so only dop853 (what `--solver auto` picks for "
+            "the cloth) is measured, at rtol 1e-4 to 1e-8, with a 300 s budget per run. "
+            "The full comparison of the solvers is the 20x20 cloth's."))
     return out
 
 
