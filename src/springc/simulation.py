@@ -32,6 +32,7 @@ import numpy as np
 from . import solvers
 from .build import CompiledModel, check_parameter_names
 from .errors import Note, SimulationError
+from .race import race
 from .results import SimulationResult, SimulationStats
 
 SOLVERS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
@@ -332,19 +333,23 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
     problem = _Problem(model, p, solver, progress)
-    choice = None
     try:
         with np.errstate(all="ignore"):
             if not np.isfinite(x0).all():
                 raise _Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=_state_notes(problem.names, x0, None)))
+            reason = ""
             if solver == AUTO:
-                choice = solvers.choose_for(problem.jac, problem.rhs, x0, start, stop,
-                                            rtol, atol)
+                choice = solvers.choose_for(problem.jac, x0, start, stop)
                 solver = problem.solver = choice.solver
+                reason = choice.reason
             if solver in FIXED_STEP:
                 states, steps = solvers.run_fixed(problem, grid, x0, step)
+            elif solver == solvers.RACE:
+                run = _Run(problem, grid, x0, rtol, atol)
+                solver, reason = race(run, start, x0, stop, reason)
+                states, steps = run.states, run.steps
             else:
                 states, steps = _integrate(problem, grid, x0, rtol, atol)
             outputs = _outputs(model, problem, grid, states)
@@ -354,8 +359,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         progress.close()
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
-                            model.compile_time, model.cached,
-                            choice.reason if choice else "")
+                            model.compile_time, model.cached, reason)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
@@ -367,39 +371,80 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
 def _integrate(problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
                atol: float) -> tuple[np.ndarray, int]:
     """The states on ``grid`` and the number of steps taken (solve_ivp's loop)."""
-    import scipy.integrate
+    run = _Run(problem, grid, x0, rtol, atol)
+    if len(x0):
+        run.advance(run.start(problem.solver, float(grid[0]), x0))
+    return run.states, run.steps
 
-    n = len(x0)
-    states = np.empty((len(grid), n))
-    states[0] = x0
-    if n == 0:
-        return states, 0
-    kwargs: dict[str, Any] = {"jac": problem.jac} if problem.solver in IMPLICIT else {}
-    cls = getattr(scipy.integrate, SOLVERS[problem.solver])
-    integrator = cls(problem.rhs, grid[0], x0, grid[-1], rtol=rtol, atol=atol, **kwargs)
-    k, steps = 1, 0
-    while k < len(grid):
-        try:
-            message = integrator.step()
-        except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
-            if "infs or NaNs" not in str(err):
-                raise
-            raise _Stop(_solver_failure(problem, integrator, "the Newton matrix is not "
-                                        "finite (the Jacobian overflows)")) from None
-        steps += 1
-        if integrator.status == "failed":
-            raise _Stop(_solver_failure(problem, integrator, message))
-        j = int(np.searchsorted(grid, integrator.t, side="right"))
-        if j > k:
-            dense = integrator.dense_output()
-            states[k:j] = dense(grid[k:j]).T
-            if grid[j - 1] == integrator.t:
-                states[j - 1] = integrator.y
-            k = j
-        if integrator.status == "finished" and k < len(grid):
-            states[k:] = integrator.y
-            break
-    return states, steps
+
+@dataclass(frozen=True)
+class Stretch:
+    """What :meth:`_Run.advance` measured: steps, wall time, last step sizes."""
+
+    steps: int
+    seconds: float
+    sizes: tuple[float, ...]
+
+
+class _Run:
+    """The output grid filled step by step, by one integrator after another (the
+    ``auto`` race of :mod:`springc.race` hands the state from one to the next)."""
+
+    failure = _Stop
+
+    def __init__(self, problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
+                 atol: float) -> None:
+        self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
+        self.states = np.empty((len(grid), len(x0)))
+        self.states[0] = x0
+        self.k, self.steps = 1, 0
+
+    @property
+    def done(self) -> bool:
+        return self.k >= len(self.grid)
+
+    def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
+              ) -> Any:
+        """A scipy integrator of ``solver`` from ``(t, y)`` to the end of the grid."""
+        import scipy.integrate
+
+        self.problem.solver = solver
+        kwargs: dict[str, Any] = {"jac": self.problem.jac} if solver in IMPLICIT else {}
+        if first_step is not None:
+            kwargs["first_step"] = min(first_step, float(self.grid[-1]) - t)
+        cls = getattr(scipy.integrate, SOLVERS[solver])
+        return cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol, atol=self.atol,
+                   **kwargs)
+
+    def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
+        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""
+        problem, grid, states = self.problem, self.grid, self.states
+        began, taken, sizes = time.perf_counter(), 0, []
+        while not self.done and taken != max_steps:
+            before = integrator.t
+            try:
+                message = integrator.step()
+            except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
+                if "infs or NaNs" not in str(err):
+                    raise
+                raise _Stop(_solver_failure(problem, integrator, "the Newton matrix is "
+                                            "not finite (the Jacobian overflows)")) from None
+            taken += 1
+            if integrator.status == "failed":
+                raise _Stop(_solver_failure(problem, integrator, message))
+            sizes.append(integrator.t - before)
+            j = int(np.searchsorted(grid, integrator.t, side="right"))
+            if j > self.k:
+                dense = integrator.dense_output()
+                states[self.k:j] = dense(grid[self.k:j]).T
+                if grid[j - 1] == integrator.t:
+                    states[j - 1] = integrator.y
+                self.k = j
+            if integrator.status == "finished" and not self.done:
+                states[self.k:] = integrator.y
+                self.k = len(grid)
+        self.steps += taken
+        return Stretch(taken, time.perf_counter() - began, tuple(sizes[-10:]))
 
 
 def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,

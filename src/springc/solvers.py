@@ -9,14 +9,13 @@ Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
   from the generated module: a state whose derivative depends structurally on one
   other state only, with slope 1 and no offset (:func:`detect_pairs`; on the ODE
   itself, :func:`pairs_from_ode` reads the ``der(q) := v`` steps directly).
-- **``auto``** (the default): explicit ``dop853`` or implicit ``radau`` from a cheap
-  stiffness estimate at the start state (:func:`choose`): the spectral radius ``rho``
-  of the analytic Jacobian times the span ``T`` (:mod:`springc.stiffness`). For
-  small systems (dense eigen-decomposition) the fast modes are also checked for
-  *excitation*: an undamped fast oscillation that is actually moving must be resolved
-  by any method, so the cheaper explicit steps win even when ``rho * T`` is large;
-  only fast modes that are at rest (or die out early in the span) make a problem
-  stiff.
+- **``auto``** (the default): ``dop853`` when a cheap stiffness estimate at the start
+  state is small: the spectral radius ``rho`` of the analytic Jacobian times the span
+  ``T`` (:mod:`springc.stiffness`, :func:`choose`). When it is large, the estimate
+  alone cannot tell: a stiff spring whose fast mode stays at rest costs an explicit
+  method nothing, an excited one costs every method, and per-step costs differ by
+  solver. So the two methods race for a few steps and the one whose projected
+  remaining cost is lower finishes the run (:mod:`springc.race`).
 """
 
 from __future__ import annotations
@@ -35,6 +34,7 @@ from .integrators import NonFiniteState, Pairs, integrate
 
 AUTO = "auto"
 EXPLICIT, IMPLICIT = "dop853", "radau"
+RACE = "race"
 MAX_FIXED_STEPS = 20_000_000
 """More fixed steps than this are refused up front (minutes of Python loop)."""
 FIXED_REMEDY = "reduce --step or use --solver radau"
@@ -104,68 +104,34 @@ def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -
 
 @dataclass(frozen=True)
 class AutoChoice:
-    """The solver ``auto`` picked and why (for the summary line)."""
+    """What ``auto`` decided at the start state and why (for the summary line):
+    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.race`)."""
 
     solver: str
     reason: str
     spectral_radius: float
-    excited_radius: float  # fastest mode that is excited and persists (= rho if unknown)
     span: float
 
 
-def _modal_excitation(jac: np.ndarray, f0: np.ndarray, span: float, tol: float
-                      ) -> float | None:
-    """Largest ``|lambda|`` among modes whose amplitude at the start exceeds ``tol``
-    and that do not die out before the end of ``span``; ``None`` if undecidable."""
-    try:
-        lam, vec = np.linalg.eig(jac)
-    except np.linalg.LinAlgError:
-        return None
-    if not np.all(np.isfinite(lam)) or np.linalg.cond(vec) > 1e10:
-        return None
-    coeff = np.linalg.solve(vec, f0.astype(complex))  # f0 = sum c_i lam_i v_i ...
-    size = np.abs(lam)
-    # ... so mode i's displacement from its equilibrium is c_i / lam_i (|v_i| = 1).
-    with np.errstate(divide="ignore", invalid="ignore"):
-        amplitude = np.where(size > 0, np.abs(coeff) / np.where(size > 0, size, 1.0), 0.0)
-    decay = np.minimum(lam.real, 0.0) * span
-    survives = amplitude * np.exp(np.maximum(decay, -700.0)) > tol
-    active = size[survives & (amplitude > tol)]
-    return float(active.max()) if active.size else 0.0
+def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
+    """``dop853`` if ``rho * span`` is small, else a race (``radau`` outright if the
+    Jacobian is not finite)."""
+    from .stiffness import choose_solver
 
-
-def choose(jac: np.ndarray | sp.spmatrix, f0: np.ndarray, x0: np.ndarray, span: float,
-           rtol: float, atol: float) -> AutoChoice:
-    """``dop853`` or ``radau`` for a run over ``span`` from ``x0`` (``f0 = rhs(x0)``)."""
-    from .stiffness import DENSE_LIMIT, STIFF_THRESHOLD, choose_solver
-
-    n = jac.shape[0]
-    if n == 0 or span <= 0:
-        return AutoChoice(EXPLICIT, "no dynamics to integrate", 0.0, 0.0, span)
+    if jac.shape[0] == 0 or span <= 0:
+        return AutoChoice(EXPLICIT, "no dynamics to integrate", 0.0, span)
     base = choose_solver(jac, span, EXPLICIT, IMPLICIT)
     rho = base.spectral_radius
-    if base.solver == EXPLICIT or not math.isfinite(rho) or n > DENSE_LIMIT \
-            or not np.all(np.isfinite(f0)):
-        return AutoChoice(base.solver, base.reason, rho, rho, span)
-    dense = jac.toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
-    tol = atol + rtol * float(np.max(np.abs(x0), initial=0.0))
-    excited = _modal_excitation(dense, f0, span, tol)
-    if excited is None or excited * span <= STIFF_THRESHOLD:
-        return AutoChoice(IMPLICIT, base.reason, rho, rho if excited is None else excited,
-                          span)
-    reason = (f"oscillatory: a fast mode (1/{excited:.3g} s) is excited and must be "
-              f"resolved over the {span:g} s span by any method; explicit steps are "
-              "cheaper")
-    return AutoChoice(EXPLICIT, reason, rho, excited, span)
+    if base.solver == EXPLICIT or not math.isfinite(base.stiffness):
+        return AutoChoice(base.solver, base.reason, rho, span)
+    return AutoChoice(RACE, base.reason, rho, span)
 
 
-def choose_for(jacobian: Callable[[float, np.ndarray], object],
-               rhs: Callable[[float, np.ndarray], np.ndarray], x0: np.ndarray,
-               start: float, stop: float, rtol: float, atol: float) -> AutoChoice:
-    """:func:`choose` with the generated Jacobian and RHS at the start state (their
-    failures there propagate: the integration would stop at the same point)."""
-    return choose(jacobian(start, x0), np.asarray(rhs(start, x0), dtype=float), x0,
-                  stop - start, rtol, atol)
+def choose_for(jacobian: Callable[[float, np.ndarray], object], x0: np.ndarray,
+               start: float, stop: float) -> AutoChoice:
+    """:func:`choose` with the generated Jacobian at the start state (its failures
+    there propagate: the integration would stop at the same point)."""
+    return choose(jacobian(start, x0), stop - start)  # type: ignore[arg-type]
 
 
 # ------------------------------------------------------------------ fixed step

@@ -31,6 +31,19 @@ equation
   der(v2) = -x2 - k * (x2 - x1);
 end StiffPair;
 
+model UnevenPair "wall -1- m1 -k- m2 -2- wall, unit masses: the stiff mode is excited (~1/k)"
+  parameter Real k = 1e8;
+  Real x1(start = 1);
+  Real x2(start = 1);
+  Real v1(start = 0);
+  Real v2(start = 0);
+equation
+  der(x1) = v1;
+  der(x2) = v2;
+  der(v1) = -x1 + k * (x2 - x1);
+  der(v2) = -2 * x2 - k * (x2 - x1);
+end UnevenPair;
+
 model Through "2D zero-rest-length spring to the origin: the mass passes through the anchor"
   parameter Real k = 100;
   parameter Real r = 1 "start position on the x axis";
@@ -78,6 +91,30 @@ def stiff_pair_expm(t: np.ndarray, k: float) -> np.ndarray:
     """x1 from the matrix exponential (checks :func:`stiff_pair` for moderate k)."""
     a = np.array([[0, 0, 1, 0], [0, 0, 0, 1], [-1 - k, k, 0, 0], [k, -1 - k, 0, 0]])
     return np.array([(scipy.linalg.expm(a * s) @ [1.0, 1.0, 0.0, 0.0])[0] for s in t])
+
+
+def uneven_pair(t: np.ndarray, k: float) -> np.ndarray:
+    """x1, x2, v1, v2 of UnevenPair (columns) by its two modes, free of cancellation.
+
+    Stiffness matrix ``[[1 + k, -k], [-k, 2 + k]]``: the large eigenvalue from the
+    quadratic formula (no cancellation), the small one as ``det / large``.
+    """
+    trace, det = 3 + 2 * k, 2 + 3 * k
+    large = (trace + np.sqrt(trace * trace - 4 * det)) / 2
+    out = np.zeros((len(t), 4))
+    for lam in (det / large, large):
+        shape = np.array([k, 1 + k - lam])
+        shape /= np.linalg.norm(shape)
+        weight, omega = shape @ [1.0, 1.0], np.sqrt(lam)
+        out[:, :2] += np.outer(np.cos(omega * t), shape * weight)
+        out[:, 2:] -= np.outer(omega * np.sin(omega * t), shape * weight)
+    return out
+
+
+def uneven_pair_expm(t: np.ndarray, k: float) -> np.ndarray:
+    """:func:`uneven_pair` from the matrix exponential (moderate k only)."""
+    a = np.array([[0, 0, 1, 0], [0, 0, 0, 1], [-1 - k, k, 0, 0], [k, -2 - k, 0, 0]])
+    return np.array([scipy.linalg.expm(a * s) @ [1.0, 1.0, 0.0, 0.0] for s in t])
 
 
 def big_chain(t: np.ndarray, n: int, k: float = 1.0) -> np.ndarray:
