@@ -32,6 +32,6 @@ def compiled(models_file: str, tmp_path_factory: pytest.TempPathFactory
     mp.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
     try:
         return {name: springc.compile_model(models_file, name)
-                for name in ("Harmonic", "StiffPair", "UnevenPair", "Through")}
+                for name in ("Harmonic", "StiffPair", "Through")}
     finally:
         mp.undo()

@@ -44,7 +44,7 @@ def test_auto_on_the_excited_stiff_mode(compiled: dict[str, CompiledModel], k: f
     # k = 1e8: the vibration's velocity (~5e-5) is above the tolerance, radau must
     # resolve its first periods too and dop853 stays cheaper; k = 1e12: it is below
     # the tolerance (~5e-7), radau steps over it while dop853 is held to 1/rho.
-    result = springc.simulate(compiled["UnevenPair"], parameters={"k": k}, stop=stop)
+    result = springc.simulate(compiled["StiffPair"], parameters={"k": k, "k2": 2.0}, stop=stop)
     assert result.stats.solver == solver
     positions = np.column_stack([result["x1"], result["x2"]])
     assert np.max(np.abs(positions - uneven_pair(result.time, k)[:, :2])) < BOUND
