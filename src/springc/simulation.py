@@ -23,6 +23,7 @@ import math
 import sys
 import time
 import traceback
+from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, TextIO
@@ -419,7 +420,8 @@ class _Run:
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""
         problem, grid, states = self.problem, self.grid, self.states
-        began, taken, sizes = time.perf_counter(), 0, []
+        began, taken = time.perf_counter(), 0
+        sizes: deque[float] = deque(maxlen=10)
         while not self.done and taken != max_steps:
             before = integrator.t
             try:
@@ -444,7 +446,7 @@ class _Run:
                 states[self.k:] = integrator.y
                 self.k = len(grid)
         self.steps += taken
-        return Stretch(taken, time.perf_counter() - began, tuple(sizes[-10:]))
+        return Stretch(taken, time.perf_counter() - began, tuple(sizes))
 
 
 def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
