@@ -115,9 +115,8 @@ def test_auto_keeps_the_explicit_method_while_the_fast_mode_rests(models: str) -
     result = springc.simulate(models, model_name="StiffPair", stop=1.0)
     assert result.stats.solver == "dop853"
     assert re.fullmatch(
-        r"StiffPair: auto -> dop853 \(stiff: fastest time scale 1/1\.41e\+04 s is "
-        r"1\.41e\+04x shorter than the 1 s span, but dop853 finished in \d+ steps: the "
-        r"fast modes stay at rest\), \d+ steps, .*", result.stats.summary("StiffPair"))
+        r"StiffPair: auto -> dop853 \(non-stiff: dop853 finished in (\d+) steps\), \1 "
+        r"steps, .*", result.stats.summary("StiffPair"))
     assert result.stats.steps <= race.EXPLICIT_PROBE
     assert np.max(np.abs(result["x1"] - np.cos(result.time))) < 1e-5
     chosen = springc.simulate(models, model_name="StiffPair", stop=1.0, solver="bdf")
@@ -151,7 +150,7 @@ def test_auto_falls_back_to_the_implicit_method_when_the_explicit_probe_fails(
     monkeypatch.setattr(simulation._Run, "advance", failing)
     result = springc.simulate(models, model_name="StiffPair", stop=1.0)
     assert result.stats.solver == "radau"
-    assert result.stats.reason.endswith("1 s span; dop853 failed in its first steps")
+    assert result.stats.reason == "dop853 failed in its first steps (overflow in a trial stage)"
     assert np.max(np.abs(result["x1"] - np.cos(result.time))) < 1e-5
 
 

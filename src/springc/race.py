@@ -1,42 +1,46 @@
-"""``--solver auto`` on a large stiffness estimate: a short race decides the solver.
-
-``rho * T`` large says an explicit method *could* be held to steps of ``1/rho`` for
-stability; whether it is depends on the run. A very stiff spring whose fast mode stays
-at rest (a symmetric pair, an equilibrium) costs ``dop853`` nothing; one whose fast
-mode is excited must be resolved by every method; and a ``radau`` step costs several
-``dop853`` steps. So both are measured on the model itself:
+"""``--solver auto``: explicit first, and a short race where the run proves long.
 
 1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps. If it finishes, or its current step
-   size leaves fewer than :data:`CHEAP_STEPS` steps to go, it finishes the run.
-2. Otherwise ``radau`` takes :data:`IMPLICIT_PROBE` steps from the start, and each
-   method's remaining cost is projected from its last step sizes and its measured
-   time per step. The cheaper one finishes the run from where its probe left off.
-   (``radau`` starts afresh rather than from ``dop853``'s state: a state reached at
-   the stability limit carries fast-mode noise that would hold ``radau``'s first
-   steps small and spoil its projection.)
+   size leaves at most :data:`CHEAP_STEPS` steps to go, it finishes the run: a short
+   run costs no stiffness estimate at all.
+2. Otherwise the stiffness estimate of :func:`springc.solvers.choose` (``rho * T``
+   from the analytic Jacobian at the current state) decides whether ``radau`` could
+   be cheaper. If not, ``dop853`` goes on.
+3. If it could, the estimate alone cannot tell: a very stiff spring whose fast mode
+   stays at rest costs ``dop853`` nothing, an excited one must be resolved by every
+   method, and a ``radau`` step costs several ``dop853`` steps. So ``radau`` takes
+   :data:`IMPLICIT_PROBE` steps from the start, each method's remaining cost is
+   projected from its last step sizes and its measured time per step, and the
+   cheaper one finishes the run from where its probe left off. (``radau`` starts
+   afresh rather than from ``dop853``'s state: a state reached at the stability
+   limit carries fast-mode noise that would hold ``radau``'s first steps small.)
 
-The probes are steps of the real run (the grid points they pass are kept), so the
-cost of deciding is bounded by the two probes: a few percent of any run long enough
-to matter. The projection is taken early, so it sees ``radau`` at its worst when a
-fast mode is excited above the tolerance (it must resolve the first oscillations
-before its damping removes them): the race then keeps ``dop853``, which resolves
-that vibration faithfully instead of damping it away. A failure inside the explicit probe
-(an overflow from an unstable step) hands the run to ``radau``; failures after the
+The probes are steps of the real run (the grid points they pass are kept), so
+deciding costs at most the two probes: a few percent of any run long enough to
+matter. The projection is taken early, so it sees ``radau`` at its worst when a fast
+mode is excited above the tolerance (it must resolve the first oscillations before
+its damping removes them): the race then keeps ``dop853``, which resolves that
+vibration instead of damping it away. A failure inside the explicit probe (an
+overflow from an unstable step) hands the run to ``radau``; if ``radau`` fails too,
+the explicit probe's error is reported (where the trouble began) with ``radau``'s as
+a note. Failures after the
 decision are the run's own.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
 
-from .solvers import EXPLICIT, IMPLICIT
+from .solvers import EXPLICIT, IMPLICIT, RACE, AutoChoice
 
 EXPLICIT_PROBE = 40
 IMPLICIT_PROBE = 20
-CHEAP_STEPS = 2000
-"""Explicit steps to go below which the implicit probe is not worth its cost."""
+CHEAP_STEPS = 500
+"""Explicit steps to go below which no estimate or implicit probe is worth its cost
+(about what ``rho * T <= 2000`` allows a stability-limited explicit method)."""
 
 
 class Stretch(Protocol):
@@ -56,29 +60,43 @@ class Run(Protocol):
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch: ...
 
+    def both_failed(self, first: Exception, second: Exception) -> Exception: ...
 
-def race(run: Run, t0: float, x0: np.ndarray, stop: float, stiffness: str
-         ) -> tuple[str, str]:
+
+def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
+         estimate: Callable[[float, np.ndarray], AutoChoice]) -> tuple[str, str]:
     """Integrate ``run`` to the end; the solver that finished and why.
 
-    ``stiffness`` is the estimate's own reason (``stiff: fastest time scale ...``).
+    ``estimate(t, x)`` is the stiffness estimate at a state (only called for long runs).
     """
     explicit = run.start(EXPLICIT, t0, x0)
     try:
         probe = run.advance(explicit, EXPLICIT_PROBE)
-    except run.failure:
+    except run.failure as failure:
         implicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
-        run.advance(implicit)
-        return IMPLICIT, f"{stiffness}; {EXPLICIT} failed in its first steps"
+        try:
+            run.advance(implicit)
+        except run.failure as again:
+            raise run.both_failed(failure, again) from None
+        return IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
     if run.done:
-        return EXPLICIT, (f"{stiffness}, but {EXPLICIT} finished in {probe.steps} steps: "
-                          "the fast modes stay at rest")
+        return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {probe.steps} steps"
     h_explicit = _step(probe)
     left = (stop - explicit.t) / h_explicit
     if left <= CHEAP_STEPS:
         run.advance(explicit)
-        return EXPLICIT, (f"{stiffness}, but {EXPLICIT}'s steps are not held to it "
-                          f"(~{left:.2g} steps to go): the fast modes stay at rest")
+        return EXPLICIT, f"non-stiff: {EXPLICIT} needs ~{left:.2g} more steps"
+    choice = estimate(float(explicit.t), np.array(explicit.y))
+    if choice.solver == RACE:
+        return _race(run, explicit, probe, h_explicit, t0, x0, stop, choice.reason)
+    if choice.solver == IMPLICIT:
+        explicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
+    run.advance(explicit)
+    return choice.solver, choice.reason
+
+
+def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
+          x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
     per_explicit = probe.seconds / probe.steps
     implicit = run.start(IMPLICIT, t0, x0)
     trial = run.advance(implicit, IMPLICIT_PROBE)

@@ -33,7 +33,7 @@ import numpy as np
 from . import solvers
 from .build import CompiledModel, check_parameter_names
 from .errors import Note, SimulationError
-from .race import race
+from .race import auto
 from .results import SimulationResult, SimulationStats
 
 SOLVERS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
@@ -341,17 +341,15 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                     f"the start values are not finite at time {start}",
                     notes=_state_notes(problem.names, x0, None)))
             reason = ""
-            if solver == AUTO:
-                choice = solvers.choose_for(problem.jac, x0, start, stop)
-                solver = problem.solver = choice.solver
-                reason = choice.reason
             if solver in FIXED_STEP:
                 states, steps = solvers.run_fixed(problem, grid, x0, step)
-            elif solver == solvers.RACE:
+            elif solver == AUTO and len(x0):
                 run = _Run(problem, grid, x0, rtol, atol)
-                solver, reason = race(run, start, x0, stop, reason)
+                solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
+                    problem.jac(t, x), stop - t))
                 states, steps = run.states, run.steps
             else:
+                solver = problem.solver = solvers.EXPLICIT if solver == AUTO else solver
                 states, steps = _integrate(problem, grid, x0, rtol, atol)
             outputs = _outputs(model, problem, grid, states)
     except _Stop as stop_:
@@ -416,6 +414,15 @@ class _Run:
         cls = getattr(scipy.integrate, SOLVERS[solver])
         return cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol, atol=self.atol,
                    **kwargs)
+
+    @staticmethod
+    def both_failed(first: _Stop, second: _Stop) -> _Stop:
+        """``first``'s error, with ``second`` (the implicit solver's retry) as a note."""
+        error = first.error
+        return _Stop(SimulationError(
+            error.message, notes=(*error.notes, Note(f"radau, tried next by auto, failed "
+                                                     f"too: {second.error.message}")),
+            hint=_remedy("radau")))
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""

@@ -9,19 +9,19 @@ Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
   from the generated module: a state whose derivative depends structurally on one
   other state only, with slope 1 and no offset (:func:`detect_pairs`; on the ODE
   itself, :func:`pairs_from_ode` reads the ``der(q) := v`` steps directly).
-- **``auto``** (the default): ``dop853`` when a cheap stiffness estimate at the start
-  state is small: the spectral radius ``rho`` of the analytic Jacobian times the span
-  ``T`` (:mod:`springc.stiffness`, :func:`choose`). When it is large, the estimate
-  alone cannot tell: a stiff spring whose fast mode stays at rest costs an explicit
-  method nothing, an excited one costs every method, and per-step costs differ by
-  solver. So the two methods race for a few steps and the one whose projected
-  remaining cost is lower finishes the run (:mod:`springc.race`).
+- **``auto``** (the default, run by :mod:`springc.race`): ``dop853`` unless a run
+  turns out long *and* a cheap stiffness estimate is large: the spectral radius
+  ``rho`` of the analytic Jacobian times the remaining span ``T``
+  (:mod:`springc.stiffness`, :func:`choose`). Even then the estimate alone cannot
+  tell: a stiff spring whose fast mode stays at rest costs an explicit method
+  nothing, an excited one costs every method, and per-step costs differ by solver;
+  so the two methods race for a few steps and the one whose projected remaining
+  cost is lower finishes the run.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -125,13 +125,6 @@ def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
     if base.solver == EXPLICIT or not math.isfinite(base.stiffness):
         return AutoChoice(base.solver, base.reason, rho, span)
     return AutoChoice(RACE, base.reason, rho, span)
-
-
-def choose_for(jacobian: Callable[[float, np.ndarray], object], x0: np.ndarray,
-               start: float, stop: float) -> AutoChoice:
-    """:func:`choose` with the generated Jacobian at the start state (its failures
-    there propagate: the integration would stop at the same point)."""
-    return choose(jacobian(start, x0), stop - start)  # type: ignore[arg-type]
 
 
 # ------------------------------------------------------------------ fixed step

@@ -27,7 +27,8 @@ def test_stiff_equilibrium_costs_nothing(compiled: dict[str, CompiledModel]) -> 
     # rho*T = 1e7 says stiff, but nothing moves: dop853 finishes in a few steps.
     result = springc.simulate(compiled["Harmonic"], parameters={"a": 0.0, "k": 1e12})
     assert result.stats.solver == "dop853" and not result.values.any()
-    assert result.stats.steps < 20 and "but dop853 finished in" in result.stats.reason
+    assert result.stats.steps < 20
+    assert result.stats.reason == f"non-stiff: dop853 finished in {result.stats.steps} steps"
 
 
 @pytest.mark.parametrize("solver", ["auto", "verlet"])
@@ -45,9 +46,10 @@ SET_CASES = [
     ("a=1e308", 1, "error: der(x) is NaN at time "),
     ("a=inf", 1, "error: the start values are not finite at time 0"),
     ("k=-1", 0, ""),  # an unstable spring: exponential growth, finite over 10 s
-    ("k=1e300", 1, "error: the radau solver failed at time 0: the Newton matrix is not "
-                   "finite (the Jacobian overflows)"),
-    ("m=1e-300", 1, "error: the radau solver failed at time 0: the Newton matrix"),
+    ("k=1e300", 1, "note: radau, tried next by auto, failed too: the radau solver failed "
+                   "at time 0: the Newton matrix is not finite (the Jacobian overflows)"),
+    ("m=1e-300", 1, "note: radau, tried next by auto, failed too: the radau solver failed "
+                    "at time 0: the Newton matrix"),
     ("m=1e300", 0, ""),  # a motionless mass
     ("k=abc", 2, "'abc' is not a number"),
 ]

@@ -2,7 +2,7 @@
 solver it picks; other solvers where they are still affordable.
 
 Two pairs: with even walls the stiff mode x2 - x1 stays exactly at rest, so the
-explicit method is never held to the stability limit and auto keeps it; with uneven
+explicit method is never held to the stability limit and finishes in a few steps; with uneven
 walls the stiff mode is excited at ~1/k, and auto's race decides (:mod:`springc.race`).
 """
 
@@ -29,12 +29,9 @@ def test_closed_forms_match_the_matrix_exponential() -> None:
 def test_auto_within_bound(compiled: dict[str, CompiledModel], k: float) -> None:
     result = springc.simulate(compiled["StiffPair"], parameters={"k": k})
     assert np.max(np.abs(result["x1"] - stiff_pair(result.time, k))) < BOUND
+    # rho*T up to 1.4e7, but dop853 is never held to 1/rho: no estimate is needed.
     assert result.stats.solver == "dop853"
-    if np.sqrt(1 + 2 * k) * 10 > 2000:
-        assert result.stats.reason.startswith("stiff: ")
-        assert "but dop853 finished in" in result.stats.reason
-    else:
-        assert result.stats.reason.startswith("non-stiff: ")
+    assert result.stats.reason == f"non-stiff: dop853 finished in {result.stats.steps} steps"
 
 
 @pytest.mark.parametrize(("k", "stop", "solver"),
