@@ -200,7 +200,7 @@ class Progress:
     def __init__(self, stream: TextIO | None, start: float, stop: float) -> None:
         self.stream, self.start, self.stop = stream, start, stop
         self.began = time.perf_counter()
-        self.next = self.began + 1.0
+        self.next = self.began + 1.0 if stream is not None else math.inf
         self.shown = False
 
     def update(self, t: float) -> None:
@@ -267,17 +267,20 @@ class _Problem:
             dx = self.mod.rhs(t, x, self.p, self.z)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise self._fail(err, t, x, "the derivatives") from err
-        self.model_time += time.perf_counter() - began
+        now = time.perf_counter()
+        self.model_time += now - began
         if self.z[-1] != 0.0:
             raise self._newton(t, x)
-        if not np.isfinite(dx).all():
+        # a sum is finite if every term is (a finite sum that overflows is checked again)
+        if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
             bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
             shown = ", ".join(f"der({n})" for n in bad[:3]) + (", ..." if len(bad) > 3 else "")
             what = "NaN" if np.isnan(dx).any() else "infinite"
             raise _Stop(SimulationError(
                 f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {_fmt(t)}",
                 notes=_state_notes(self.names, x, dx), hint=_remedy(self.solver)))
-        self.progress.update(t)
+        if now >= self.progress.next:
+            self.progress.update(t)
         return dx
 
     def jac(self, t: float, x: np.ndarray) -> Any:
