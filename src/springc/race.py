@@ -9,7 +9,8 @@
 3. If it could, the estimate alone cannot tell: a very stiff spring whose fast mode
    stays at rest costs ``dop853`` nothing, an excited one must be resolved by every
    method, and a ``radau`` step costs several ``dop853`` steps. So ``radau`` takes
-   :data:`IMPLICIT_PROBE` steps from the start, each method's remaining cost is
+   :data:`IMPLICIT_PROBE` steps from the start (fewer if they cost over
+   :data:`PROBE_BUDGET` of ``dop853``'s projected time), each method's remaining cost is
    projected from its last step sizes and its measured time per step, and the
    cheaper one finishes the run from where its probe left off. (``radau`` starts
    afresh rather than from ``dop853``'s state: a state reached at the stability
@@ -38,6 +39,9 @@ from .solvers import EXPLICIT, IMPLICIT, RACE, AutoChoice
 
 EXPLICIT_PROBE = 40
 IMPLICIT_PROBE = 20
+PROBE_BUDGET = 0.05
+"""The implicit probe stops early once it has cost this fraction of the explicit
+method's projected remaining time (a large scene's radau steps are dear)."""
 CHEAP_STEPS = 500
 """Explicit steps to go below which no estimate or implicit probe is worth its cost
 (about what ``rho * T <= 2000`` allows a stability-limited explicit method)."""
@@ -97,13 +101,16 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
 
 def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
           x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
-    per_explicit = probe.seconds / probe.steps
+    explicit_cost = (stop - explicit.t) / h_explicit * probe.seconds / probe.steps
     implicit = run.start(IMPLICIT, t0, x0)
-    trial = run.advance(implicit, IMPLICIT_PROBE)
-    if run.done:
-        return IMPLICIT, f"{stiffness}; {IMPLICIT} finished the run in its trial steps"
-    explicit_cost = (stop - explicit.t) / h_explicit * per_explicit
-    implicit_cost = (stop - implicit.t) / _step(trial) * trial.seconds / trial.steps
+    steps, seconds, sizes = 0, 0.0, []
+    while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
+        trial = run.advance(implicit, 1)
+        steps, seconds = steps + trial.steps, seconds + trial.seconds
+        sizes += trial.sizes
+        if run.done:
+            return IMPLICIT, f"{stiffness}; {IMPLICIT} finished the run in its trial steps"
+    implicit_cost = (stop - implicit.t) / float(np.median(sizes[-5:])) * seconds / steps
     measured = (f"measured: {IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
                 f"~{explicit_cost:.2g} s")
     if implicit_cost <= explicit_cost:

@@ -349,7 +349,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             elif solver == AUTO and len(x0):
                 run = _Run(problem, grid, x0, rtol, atol)
                 solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
-                    problem.jac(t, x), stop - t))
+                    problem.jac(t, x), stop - start))
                 states, steps = run.states, run.steps
             else:
                 solver = problem.solver = solvers.EXPLICIT if solver == AUTO else solver
