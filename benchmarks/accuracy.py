@@ -1,12 +1,13 @@
 """Regenerate ``docs/accuracy.md`` and its work-precision plots.
 
-    PYTHONPATH=src python benchmarks/accuracy.py [--quick] [--budget SECONDS]
+    PYTHONPATH=src python benchmarks/accuracy.py [--quick] [--full] [--extremes] [--budget S]
 
 Runs the tradeoff studies of ``bench_tradeoff.py`` (the seed and the 20x20 cloth with
 every solver (``--quick``: fewer tolerances; ``--full`` adds the 50x50 cloth with
 dop853), writes ``docs/accuracy-<scene>.png``, and rewrites ``docs/accuracy.md`` up to its
-``## Extremes`` section, which is kept as it is (it is maintained with
-``tests/extremes``). Prints the benchmark verdict as ``bench_tradeoff.py`` does.
+``## Extremes`` section. With ``--extremes`` the table of that section is re-measured
+too (``benchmarks/extremes.py``); its prose, which reads the figures, is kept and is
+maintained by hand. Prints the benchmark verdict as ``bench_tradeoff.py`` does.
 """
 
 from __future__ import annotations
@@ -97,12 +98,31 @@ def scene_section(title: str, key: str, result: object, seconds: float, note: st
     return "\n".join(lines)
 
 
+def replace_table(section: str, table: str) -> str:
+    """``section`` with its markdown table (the run of lines starting with ``|``)
+    replaced by ``table``; the prose around it is kept."""
+    lines = section.split("\n")
+    rows = [i for i, line in enumerate(lines) if line.startswith("|")]
+    if not rows:
+        return section.rstrip() + "\n\n" + table + "\n"
+    return "\n".join([*lines[:rows[0]], table, *lines[rows[-1] + 1:]])
+
+
+def extremes_table(quick: bool) -> str:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from extremes import table
+
+    return table(quick)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
                         help="fewer tolerances")
     parser.add_argument("--full", action="store_true", help="add the 50x50 cloth")
     parser.add_argument("--budget", type=float, default=20.0, help="seconds per run")
+    parser.add_argument("--extremes", action="store_true",
+                        help="also re-measure the Extremes table (about 15 minutes)")
     args = parser.parse_args()
     sections, rows = [], []
     for scene in scenes(args.quick, args.full):
@@ -120,7 +140,8 @@ def main() -> None:
         f"{' --full' if args.full else ''} on {date} "
         f"({platform.python_implementation()} {platform.python_version()}, "
         f"{BACKEND} backend, {os.cpu_count()} CPUs, load average {load:.1f} at the end); "
-        f"everything above `{EXTREMES}` is rewritten by it. Timings on a shared machine "
+        f"everything above `{EXTREMES}` is rewritten by it (with `--extremes`, that "
+        "section's table too). Timings on a shared machine "
         "vary by about 20 %.", "",
         "## Benchmark: the recommendation vs scipy's default `solve_ivp`", "",
         "Target: for max error 1e-4, the recommended setting is at least 3x faster than "
@@ -135,6 +156,8 @@ def main() -> None:
     heading = "\n" + EXTREMES + "\n"
     tail = old[old.index(heading) + 1:] if heading in old else (
         f"{EXTREMES}\n\n(see tests/extremes)\n")
+    if args.extremes:
+        tail = replace_table(tail, extremes_table(args.quick))
     path.write_text("\n".join([head, *sections, tail]).rstrip() + "\n", encoding="utf-8")
     print(f"wrote {path}", file=sys.stderr)
 

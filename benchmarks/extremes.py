@@ -131,7 +131,12 @@ def _positions_error(result: SimulationResult, k: float) -> float:
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv
+    print(table("--quick" in sys.argv))
+    sys.stdout.flush()
+
+
+def table(quick: bool = False) -> str:
+    """The markdown table of every case (also used by ``accuracy.py --extremes``)."""
     repeat = 1 if quick else 2
     os.environ.setdefault("SPRINGC_CACHE_DIR", tempfile.mkdtemp(prefix="springc-ext-"))
     path = Path(tempfile.mkdtemp()) / "extremes.mdl"
@@ -196,12 +201,10 @@ def main() -> None:
         rows += _rows(f"--set {name}={value:g}", harm, ["auto"], lambda r: 0.0, 1,
                       parameters=assignment)
 
-    print("| case | solver | max error (or the error) | time s | "
-          "auto / best (best at auto's error) |")
-    print("| --- | --- | --- | ---: | --- |")
-    for row in rows:
-        print("| " + " | ".join(row) + " |")
-    sys.stdout.flush()
+    lines = ["| case | solver | max error (or the error) | time s | "
+             "auto / best (best at auto's error) |", "| --- | --- | --- | ---: | --- |"]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
