@@ -308,6 +308,9 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
               help="Write the table as CSV.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write the work-precision plot (PNG).")
+@click.option("--energy", metavar="NAME",
+              help="Variable whose drift is reported per run (default: the only "
+              "variable in J, if any).")
 @click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
 @_guard
 def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -316,7 +319,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              solvers: tuple[str, ...] | None, tolerances: tuple[float, ...] | None,
              steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
              reference: str | None, save_reference: str | None, repeats: int,
-             budget: float, output: str | None, plot: str | None, quiet: bool) -> None:
+             budget: float, output: str | None, plot: str | None, energy: str | None,
+             quiet: bool) -> None:
     """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
 
     The error of each run is measured on the output grid against REFERENCE, or against
@@ -343,7 +347,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     rest = {k: v for k, v in values.items() if k not in compiled.structural}
     options = TradeoffOptions(solvers, tolerances or DEFAULT_TOLERANCES, steps,
                               targets or DEFAULT_TARGETS, reference, repeats, budget,
-                              start, stop, interval, rest, None if quiet else sys.stderr)
+                              start, stop, interval, rest, None if quiet else sys.stderr,
+                              energy)
     study = run_tradeoff(compiled, options)
     click.echo(summary(study), nl=False)
     if save_reference:

@@ -43,6 +43,7 @@ from . import simulation
 from .build import CompiledModel
 from .errors import SimulationError
 from .simulation import SimulationOptions, initial_state, output_grid, resolve, simulate_model
+from .tradeoff_energy import drift, energy_series, energy_variable
 
 ADAPTIVE = ("rk45", "dop853", "radau", "bdf", "lsoda")
 FIXED_STEP = ("verlet", "symplectic-euler", "rk4")
@@ -57,7 +58,7 @@ DEFAULT_BUDGET = 30.0
 SCIPY_DEFAULT, SCIPY_RK45 = "scipy-default", "scipy-rk45"
 CSV_COLUMNS = ("solver", "setting", "value", "wall_time_s", "repeats", "steps",
                "rhs_evaluations", "jacobian_evaluations", "max_error", "rms_error",
-               "status")
+               "status", "energy_drift")
 
 
 class TradeoffError(SimulationError):
@@ -80,6 +81,7 @@ class TradeoffOptions:
     interval: float | None = None
     parameters: Mapping[str, float] = field(default_factory=dict)
     log: TextIO | None = None
+    energy: str | None = None  # None: the only variable in J, if any
 
 
 @dataclass(frozen=True)
@@ -97,6 +99,7 @@ class Run:
     max_error: float
     rms_error: float
     status: str = "ok"
+    energy_drift: float = math.nan  # see springc.tradeoff_energy
 
     @property
     def ok(self) -> bool:
@@ -125,6 +128,7 @@ class Tradeoff:
     runs: tuple[Run, ...]
     baselines: tuple[Run, ...]
     targets: tuple[float, ...]
+    energy: str | None = None
 
     def recommendations(self) -> list[str]:
         """One line per target (:func:`springc.tradeoff_table.recommend`)."""
@@ -372,6 +376,8 @@ def run_tradeoff(model: CompiledModel, options: TradeoffOptions) -> Tradeoff:
         ref = tight_reference(setup, min(options.targets))
     scales = variable_scales(ref.values, setup.units)
     setup.log(f"reference: {ref.description}")
+    energy = energy_variable(model, options.energy)
+    with_energy = _energy_drift(setup, energy, ref)
     # Step 2: every solver, loosest setting first, until one is over budget.
     runs: list[Run] = []
     fixed = set(fixed_step_solvers())
@@ -388,25 +394,42 @@ def run_tradeoff(model: CompiledModel, options: TradeoffOptions) -> Tradeoff:
                 continue
             run, values = _springc_run(setup, solver, None if solver in fixed else value,
                                        value if solver in fixed else None)
-            run = _with_errors(run, values, ref, scales)
+            run = with_energy(_with_errors(run, values, ref, scales), values)
             runs.append(run)
             setup.log(_log_line(run))
             skip = run.status.startswith("over budget")
     # Step 3: scipy's default call, then RK45 tightened until it reaches the targets.
     base, values = _scipy_run(setup, None)
-    baselines = [_with_errors(base, values, ref, scales)]
+    baselines = [with_energy(_with_errors(base, values, ref, scales), values)]
     setup.log(_log_line(baselines[0]))
     goal = min(options.targets)
     if not (baselines[0].ok and baselines[0].max_error <= goal):
         for rtol in sorted((t for t in options.tolerances if t < 1e-3), reverse=True):
             run, values = _scipy_run(setup, rtol)
-            run = _with_errors(run, values, ref, scales)
+            run = with_energy(_with_errors(run, values, ref, scales), values)
             baselines.append(run)
             setup.log(_log_line(run))
             if not run.ok or run.max_error <= goal:
                 break
     return Tradeoff(model.name, len(model.states), ref, scales, tuple(runs),
-                    tuple(baselines), tuple(options.targets))
+                    tuple(baselines), tuple(options.targets), energy)
+
+
+def _energy_drift(setup: _Setup, energy: str | None, ref: Reference
+                  ) -> Callable[[Run, np.ndarray | None], Run]:
+    """A function adding the energy drift to a run (the identity without energy)."""
+    if energy is None:
+        return lambda run, values: run
+    model, p, grid = setup.model, setup.p, setup.grid
+    scale = float(np.max(np.abs(energy_series(model, p, grid, ref.values, energy))))
+
+    def add(run: Run, values: np.ndarray | None) -> Run:
+        if values is None or not run.ok:
+            return run
+        series = energy_series(model, p, grid, values, energy)
+        return dataclasses.replace(run, energy_drift=drift(series, scale))
+
+    return add
 
 
 def _log_line(run: Run) -> str:

@@ -74,7 +74,8 @@ def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
                      str(r.repeats), "" if r.steps < 0 else str(r.steps),
                      "" if r.rhs_evaluations < 0 else str(r.rhs_evaluations),
                      "" if r.jacobian_evaluations < 0 else str(r.jacobian_evaluations),
-                     num(r.max_error, ".3e"), num(r.rms_error, ".3e"), r.status))
+                     num(r.max_error, ".3e"), num(r.rms_error, ".3e"), r.status,
+                     num(r.energy_drift, ".3e")))
     return rows
 
 
@@ -89,6 +90,9 @@ def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
     """The table as aligned text (or a Markdown table)."""
     head = ("solver", "setting", "time s", "steps", "RHS", "Jacobians", "max error",
             "RMS error", "status")
+    energy = tradeoff.energy is not None
+    if energy:
+        head = (*head[:-1], f"{tradeoff.energy} drift", head[-1])
     body = []
     for r in (*tradeoff.runs, *tradeoff.baselines):
         ok = r.ok
@@ -97,13 +101,14 @@ def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
                      str(r.rhs_evaluations) if ok else "",
                      str(r.jacobian_evaluations) if ok else "",
                      f"{r.max_error:.1e}" if ok else "", f"{r.rms_error:.1e}" if ok else "",
-                     r.status))
+                     *([f"{r.energy_drift:.1e}" if ok else ""] if energy else []), r.status))
     if markdown:
-        right = "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"
+        right = "| --- | --- |" + " ---: |" * (len(head) - 3) + " --- |"
         return "\n".join(["| " + " | ".join(head) + " |", right,
                           *("| " + " | ".join(row) + " |" for row in body)]) + "\n"
     widths = [max(len(row[i]) for row in (head, *body)) for i in range(len(head))]
-    lines = ["  ".join(c.ljust(w) if i in (0, 1, 8) else c.rjust(w)
+    left = (0, 1, len(head) - 1)
+    lines = ["  ".join(c.ljust(w) if i in left else c.rjust(w)
                        for i, (c, w) in enumerate(zip(row, widths))).rstrip()
              for row in (head, *body)]
     return "\n".join(lines) + "\n"
