@@ -165,7 +165,7 @@ def write_png(result: SimulationResult, path: Path) -> None:
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
         shown = f"{title}: {len(columns)} variables" if many else title
-        ax.set_title(shown, fontsize=10, loc="left")
+        ax.set_title(shown, fontsize=10, loc="left", y=1.0)  # a fixed y: no bbox search
         if not many:
             ax.legend(fontsize=8, loc="upper right", ncol=min(3, len(columns)))
     if not panels:
@@ -175,4 +175,5 @@ def write_png(result: SimulationResult, path: Path) -> None:
     axes[-1, 0].set_xlabel("time [s]")
     fig.suptitle(f"{result.model}{note}", fontsize=11)
     with atomic_write(path, "wb") as f:
-        fig.savefig(f, format="png", dpi=100)
+        # zlib level 1: a third of the save time of the default 6, for a slightly larger file
+        fig.savefig(f, format="png", dpi=100, pil_kwargs={"compress_level": 1})
