@@ -194,3 +194,12 @@ def test_unstable_step_fails_with_the_remedy_and_no_csv(models: str, tmp_path: P
     assert "note: v = " in result.output
     assert "help: reduce --step or use --solver radau" in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_auto_without_states(tmp_path: Path) -> None:
+    path = tmp_path / "NoStates.mdl"
+    path.write_text("model NoStates\n  parameter Real a = 2;\n  Real y;\nequation\n"
+                    "  y = a * time;\nend NoStates;\n")
+    result = springc.simulate(str(path))
+    assert result.stats.reason == "no states to integrate" and result.stats.steps == 0
+    assert np.array_equal(result["y"], 2 * result.time)

@@ -352,7 +352,9 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                     problem.jac(t, x), stop - start))
                 states, steps = run.states, run.steps
             else:
-                solver = problem.solver = solvers.EXPLICIT if solver == AUTO else solver
+                if solver == AUTO:
+                    solver, reason = solvers.EXPLICIT, "no states to integrate"
+                problem.solver = solver
                 states, steps = _integrate(problem, grid, x0, rtol, atol)
             outputs = _outputs(model, problem, grid, states)
     except _Stop as stop_:
