@@ -1,6 +1,6 @@
 """Source files -> CompiledModel: flatten, simplify, generate, cache on disk, import.
 
-Generated modules are cached in ``$SPRINGC_CACHE_DIR``, else
+Generated modules are cached (the 200 most recently used) in ``$SPRINGC_CACHE_DIR``, else
 ``$XDG_CACHE_HOME/springc``, else ``~/.cache/springc``, keyed by the text of every
 file that could be loaded (the named files and all ``.mdl`` files of the library
 folders), the model name, the options, and the installed springc's own files. A warm
@@ -11,12 +11,14 @@ re-flattening the model with a modification (``extends M(N = 100)``).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import difflib
 import hashlib
 import importlib.util
 import os
 import re
+import shutil
 import sys
 import tempfile
 import time
@@ -138,6 +140,33 @@ def cache_dir() -> Path:
     return Path(base) / "springc"
 
 
+CACHE_ENTRIES = 200
+"""Generated modules kept in the cache; the least recently used beyond this are removed."""
+
+
+def _touch(path: Path) -> None:
+    """Mark a cache entry as used (its modification time orders the pruning)."""
+    with contextlib.suppress(OSError):  # a read-only cache still works
+        os.utime(path)
+
+
+def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]:
+    """Remove the least recently used entries beyond ``limit`` (never ``keep``)."""
+    limit = CACHE_ENTRIES if limit is None else limit
+    entries = []
+    for entry in folder.iterdir() if folder.is_dir() else ():
+        module = entry / "model.py"
+        try:
+            entries.append((module.stat().st_mtime, entry))
+        except OSError:  # not an entry (the "modified" folder) or being written
+            continue
+    entries.sort(reverse=True)
+    removed = [e for _, e in entries[limit:] if e.name != keep]
+    for entry in removed:
+        shutil.rmtree(entry, ignore_errors=True)
+    return removed
+
+
 def _library_folders(libraries: Sequence[str]) -> list[Path]:
     from .resources import models_dir
 
@@ -204,6 +233,7 @@ def compile_files(options: CompileOptions) -> CompiledModel:
     if options.cache:
         path = cache_dir() / key / "model.py"
         if path.exists():
+            _touch(path)
             module = _import(path, module_name)
             return CompiledModel(module, options, path, True, time.perf_counter() - began,
                                  _outputs(module, options))
@@ -212,6 +242,8 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         path = Path(tmp.name) / "model.py"
     generated = generate_source(options)
     _write_atomic(path, generated)
+    if options.cache:
+        prune_cache(cache_dir(), keep=key)
     module = _import(path, module_name)
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          _outputs(module, options), tmp)
