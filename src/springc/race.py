@@ -24,8 +24,7 @@ its damping removes them): the race then keeps ``dop853``, which resolves that
 vibration instead of damping it away. A failure inside the explicit probe (an
 overflow from an unstable step) hands the run to ``radau``; if ``radau`` fails too,
 the explicit probe's error is reported (where the trouble began) with ``radau``'s as
-a note. Failures after the
-decision are the run's own.
+a note. Failures after the decision are the run's own.
 """
 
 from __future__ import annotations
