@@ -1,0 +1,98 @@
+"""The decisions of ``--solver auto`` (springc.race) on a scripted step loop: which
+method finishes the run, after how many probe steps, and the reason given."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import pytest
+
+from springc import race
+from springc.solvers import AutoChoice
+
+
+@dataclass
+class Stretch:
+    steps: int
+    seconds: float
+    sizes: tuple[float, ...]
+
+
+@dataclass
+class Integrator:
+    solver: str
+    t: float
+    y: np.ndarray = field(default_factory=lambda: np.zeros(1))
+
+
+class Run:
+    """Each solver steps by a fixed size at a fixed cost per step, up to ``stop``."""
+
+    failure = RuntimeError
+
+    def __init__(self, step: dict[str, float], cost: dict[str, float], stop: float = 10.0
+                 ) -> None:
+        self.step, self.cost, self.stop = step, cost, stop
+        self.done = False
+        self.taken: dict[str, int] = {}
+
+    def start(self, solver: str, t: float, y: np.ndarray,
+              first_step: float | None = None) -> Integrator:
+        return Integrator(solver, t, y)
+
+    def advance(self, integrator: Integrator, max_steps: int | None = None) -> Stretch:
+        h = self.step[integrator.solver]
+        left = int(np.ceil((self.stop - integrator.t) / h - 1e-9))
+        steps = left if max_steps is None else min(max_steps, left)
+        integrator.t = min(self.stop, integrator.t + steps * h)
+        self.done = self.done or integrator.t >= self.stop
+        self.taken[integrator.solver] = self.taken.get(integrator.solver, 0) + steps
+        return Stretch(steps, steps * self.cost[integrator.solver], (h,) * min(steps, 10))
+
+    def both_failed(self, first: Exception, second: Exception) -> Exception:
+        return first
+
+
+def estimate(solver: str) -> object:
+    return lambda t, x: AutoChoice(solver, f"{solver} estimate", 1.0, 10.0)
+
+
+def _auto(run: Run, choice: str = race.RACE) -> tuple[str, str]:
+    return race.auto(run, 0.0, np.zeros(1), 10.0, estimate(choice))  # type: ignore[arg-type]
+
+
+def test_a_short_run_needs_no_estimate() -> None:
+    run = Run({"dop853": 0.5}, {"dop853": 1e-4})
+    assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 finished in 20 steps")
+    run = Run({"dop853": 0.1}, {"dop853": 1e-4})  # 100 steps: 60 left after the probe
+    assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 needs ~60 more steps")
+    assert run.taken == {"dop853": 100}
+
+
+@pytest.mark.parametrize("choice", ["dop853", "radau"])
+def test_a_long_run_follows_a_clear_estimate(choice: str) -> None:
+    run = Run({"dop853": 1e-3, "radau": 0.1}, {"dop853": 1e-4, "radau": 1e-3})
+    assert _auto(run, choice) == (choice, f"{choice} estimate")
+    assert run.done and set(run.taken) == ({"dop853"} | {choice})
+
+
+def test_the_race_picks_the_cheaper_projection() -> None:
+    # dop853 held to 1e-4 s steps (1e5 steps, 10 s); radau 0.05 s steps (200, 0.4 s).
+    run = Run({"dop853": 1e-4, "radau": 0.05}, {"dop853": 1e-4, "radau": 2e-3})
+    solver, reason = _auto(run)
+    assert solver == "radau" and run.taken["dop853"] == race.EXPLICIT_PROBE
+    assert reason == "race estimate; measured: radau ~0.36 s to go, dop853 ~10 s"
+    # radau held to small steps too, each dearer: dop853 goes on after radau's probe.
+    run = Run({"dop853": 1e-3, "radau": 1e-3}, {"dop853": 1e-4, "radau": 1e-3})
+    solver, reason = _auto(run)
+    assert solver == "dop853" and run.taken["radau"] == race.IMPLICIT_PROBE
+    assert reason == ("race estimate, but the fast modes must be resolved anyway; "
+                      "measured: radau ~10 s to go, dop853 ~1 s")
+
+
+def test_the_implicit_probe_stops_at_its_budget() -> None:
+    # dop853 projects ~1 s; each radau step costs 0.02 s, over the 0.05 s budget by 3.
+    run = Run({"dop853": 1e-3, "radau": 1e-3}, {"dop853": 1e-4, "radau": 0.02})
+    assert _auto(run)[0] == "dop853"
+    assert run.taken["radau"] == 3
