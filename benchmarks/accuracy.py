@@ -29,13 +29,13 @@ from bench_tradeoff import (
     study,
     verdict,
 )
-from springc.tradeoff import (
+from springc.tradeoff.study import (
     REFERENCE_RTOL,
     REPEAT_LIMIT,
     SCALE_FLOOR,
 )
-from springc.tradeoff_plot import write_work_precision
-from springc.tradeoff_table import format_table, unresolved_note
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import format_table, unresolved_note
 
 DOCS = ROOT / "docs"
 EXTREMES = "## Extremes"
@@ -80,7 +80,7 @@ its output with a reference on the output grid:
 
 
 def scene_section(title: str, key: str, result: object, seconds: float, note: str) -> str:
-    from springc.tradeoff import Tradeoff
+    from springc.tradeoff.study import Tradeoff
 
     assert isinstance(result, Tradeoff)
     ref = result.reference

@@ -26,9 +26,9 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from springc import load as loading
-from springc.flatten import flatten
-from springc.load import load
+from springc.parse import loader as loading
+from springc.flatten.flattener import flatten
+from springc.parse.loader import load
 
 CHAIN = [100, 1_000, 10_000]
 CLOTH = [(10, 10), (30, 30), (50, 50), (100, 100)]

@@ -20,9 +20,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from springc.pipeline import flatten_files
-from springc.simplify import simplify
-from springc.solve import COUNTERS, reset_counters
+from springc.pipeline.files import flatten_files
+from springc.simplify.passes import simplify
+from springc.simplify.isolate import COUNTERS, reset_counters
 
 ROOT = Path(__file__).resolve().parents[1]
 

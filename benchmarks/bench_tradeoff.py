@@ -3,7 +3,7 @@
     PYTHONPATH=src python benchmarks/bench_tradeoff.py [--quick]
 
 For the seed (``models/SpringMass.mdl``) and the 20x20 cloth (``Scenes.Cloth``): the
-full tradeoff study (:mod:`springc.tradeoff`; ``--quick``: fewer tolerances); with
+full tradeoff study (:mod:`springc.tradeoff.study`; ``--quick``: fewer tolerances); with
 ``--full`` also a reduced one of the 50x50 cloth (dop853 only). Then
 the fastest setting for max error 1e-4 against scipy's default
 ``solve_ivp(rhs, span, x0, t_eval=grid)`` (RK45, rtol 1e-3, atol 1e-6) on the same
@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import springc  # noqa: E402
-from springc.tradeoff import (  # noqa: E402
+from springc.tradeoff.study import (  # noqa: E402
     DEFAULT_TOLERANCES,
     SCIPY_DEFAULT,
     SCIPY_RK45,

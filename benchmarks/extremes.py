@@ -41,7 +41,7 @@ from extremes.cases import (  # noqa: E402
     uneven_pair,
 )
 from springc.errors import SpringcError  # noqa: E402
-from springc.results import SimulationResult  # noqa: E402
+from springc.simulation.results import SimulationResult  # noqa: E402
 
 ADAPTIVE = ("dop853", "rk45", "radau", "bdf", "lsoda")
 EXPLICIT = ("dop853", "rk45")

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from springc.balance import check_balance
+from springc.simplify.balance import check_balance
 from springc.errors import BalanceError
-from springc.flat import FlatModel
-from springc.pipeline import flatten_files
+from springc.ir.flat import FlatModel
+from springc.pipeline.files import flatten_files
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 import springc
-from springc import build
+from springc.pipeline import compiler as build
 
 MODEL = "model M{i}\n  Real x(start = {i});\nequation\n  der(x) = -x;\nend M{i};\n"
 

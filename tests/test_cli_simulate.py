@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from springc.cli import SOLVER_CHOICES, main
-from springc.simulation import AUTO, FIXED_STEP, SOLVERS
+from springc.simulation.runner import AUTO, FIXED_STEP, SOLVERS
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import springc
-from springc.codegen_print import Let, Namer, Raw, Store, function_lines
-from springc.expr import BinOp, Call, Const, If, Var
+from springc.codegen.printer import Let, Namer, Raw, Store, function_lines
+from springc.ir.expr import BinOp, Call, Const, If, Var
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -287,9 +287,9 @@ end SmallCloth;
 
 
 def _generated(files: list[str], model: str, **options: object):
-    from springc.codegen import CodegenOptions, generate
-    from springc.pipeline import flatten_files
-    from springc.simplify import simplify
+    from springc.codegen.generator import CodegenOptions, generate
+    from springc.pipeline.files import flatten_files
+    from springc.simplify.passes import simplify
 
     flat_model = flatten_files(files, model)
     system = simplify(flat_model).ode

@@ -6,12 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from springc import expr as x
+from springc.ir import expr as x
 from springc.errors import ErrorGroup, FlattenError, SpringcError, errors_of
-from springc.flat import FlatModel, Variable
-from springc.flatten import flatten
-from springc.load import load
-from springc.pipeline import flatten_files
+from springc.ir.flat import FlatModel, Variable
+from springc.flatten.flattener import flatten
+from springc.parse.loader import load
+from springc.pipeline.files import flatten_files
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,4 +1,4 @@
-"""``springc simulate`` honours initial equations (solved by springc.initialize)."""
+"""``springc simulate`` honours initial equations (solved by springc.simplify.initialize)."""
 
 from __future__ import annotations
 

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from springc.evaluate_ode import Evaluator
-from springc.initialize import InitializationError, conditions, initial_state
-from springc.pipeline import flatten_files
-from springc.simplify import simplify
+from springc.simplify.ode_eval import Evaluator
+from springc.simplify.initialize import InitializationError, conditions, initial_state
+from springc.pipeline.files import flatten_files
+from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,5 +1,5 @@
-"""Instance templates (springc.instance_templates) and direct connect references
-(springc.connections.direct_reference) give exactly the flat model of the general path."""
+"""Instance templates (springc.flatten.instance_templates) and direct connect references
+(springc.flatten.connections.direct_reference) give exactly the flat model of the general path."""
 
 from __future__ import annotations
 
@@ -7,12 +7,14 @@ from pathlib import Path
 
 import pytest
 
-from springc import connections, flat
-from springc import expr as x
-from springc import flatten as flattening
+from springc.flatten import connections
+
+from springc.ir import flat
+from springc.ir import expr as x
+from springc.flatten import flattener as flattening
 from springc.errors import FlattenError
-from springc.instance_templates import InstanceTemplates
-from springc.load import load
+from springc.flatten.instance_templates import InstanceTemplates
+from springc.parse.loader import load
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from springc.integrators import NonFiniteState, Pairs, integrate
+from springc.simulation.integrators import NonFiniteState, Pairs, integrate
 
 OMEGA = 2.0
 

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import springc
-from springc.parse import parse_text
+from springc.parse.parser import parse_text
 from springc.resources import grammar_path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -53,7 +53,7 @@ def test_grammar_loads_from_a_built_wheel(tmp_path: Path) -> None:
     )
     script = (
         "import pathlib, sys, springc\n"
-        "from springc.parse import parse_text\n"
+        "from springc.parse.parser import parse_text\n"
         "from springc.resources import grammar_path\n"
         "target = pathlib.Path(sys.argv[1]).resolve()\n"
         "assert pathlib.Path(springc.__file__).resolve().is_relative_to(target), springc.__file__\n"

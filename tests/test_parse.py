@@ -1,4 +1,4 @@
-"""Tests of springc.parse: syntax tree shapes, spans and the exact text of parse errors."""
+"""Tests of springc.parse.parser: syntax tree shapes, spans and the exact text of parse errors."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from springc.errors import ErrorGroup, LoadError, ParseError, Span, SpringcError, render_all
-from springc.parse import parse_expression, parse_file, parse_text
+from springc.parse.parser import parse_expression, parse_file, parse_text
 from springc.resources import models_dir
-from springc.syntax import (
+from springc.ir.syntax import (
     ArrayLit,
     Assign,
     Binary,

@@ -1,4 +1,4 @@
-"""The decisions of ``--solver auto`` (springc.race) on a scripted step loop: which
+"""The decisions of ``--solver auto`` (springc.simulation.race) on a scripted step loop: which
 method finishes the run, after how many probe steps, and the reason given."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pytest
 
-from springc import race
-from springc.solvers import AutoChoice
+from springc.simulation import race
+from springc.simulation.solvers import AutoChoice
 
 
 @dataclass

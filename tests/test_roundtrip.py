@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from springc.flat import FlatModel, format_flat
-from springc.pipeline import flatten_files
+from springc.ir.flat import FlatModel, format_flat
+from springc.pipeline.files import flatten_files
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = {

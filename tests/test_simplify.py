@@ -8,16 +8,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from springc import ode
-from springc.alias import eliminate_aliases
-from springc.causalize import causalize
+from springc.ir import ode
+from springc.simplify.alias import eliminate_aliases
+from springc.simplify.causalize import causalize
 from springc.errors import SimplifyError
-from springc.evaluate_ode import Evaluator, parameter_values
-from springc.expr import to_text
-from springc.lower import lower
-from springc.pipeline import flatten_files
-from springc.reduce import index_reduce
-from springc.simplify import simplify
+from springc.simplify.ode_eval import Evaluator, parameter_values
+from springc.ir.expr import to_text
+from springc.simplify.lower import lower
+from springc.pipeline.files import flatten_files
+from springc.simplify.index_reduction import index_reduce
+from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "models" / "Scenes.mdl"

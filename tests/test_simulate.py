@@ -13,7 +13,7 @@ import scipy.linalg
 
 import springc
 from springc.errors import SimulationError
-from springc.simulation import output_grid
+from springc.simulation.runner import output_grid
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -243,7 +243,7 @@ def test_numba_backend_simulates_like_python(models: str) -> None:
 def test_progress_bar_draws_and_clears() -> None:
     import io
 
-    from springc.simulation import Progress
+    from springc.simulation.runner import Progress
 
     stream = io.StringIO()
     bar = Progress(stream, 0.0, 10.0)
@@ -269,9 +269,9 @@ def test_progress_stream_receives_updates(models: str) -> None:
 
 
 def test_output_size_guard(monkeypatch: pytest.MonkeyPatch, models: str) -> None:
-    import springc.simulation
+    import springc.simulation.runner
 
-    monkeypatch.setattr(springc.simulation, "MAX_OUTPUT_BYTES", 1000)
+    monkeypatch.setattr(springc.simulation.runner, "MAX_OUTPUT_BYTES", 1000)
     with pytest.raises(SimulationError, match="output times") as info:
         springc.simulate(models, model_name="Harmonic")
     assert "--vars" in (info.value.hint or "")

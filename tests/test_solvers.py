@@ -1,4 +1,4 @@
-"""springc.solvers: position/velocity pairs, the auto choice, fixed-step runs and their
+"""springc.simulation.solvers: position/velocity pairs, the auto choice, fixed-step runs and their
 failures (API and CLI)."""
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ import pytest
 from click.testing import CliRunner
 
 import springc
-from springc import race
+from springc.simulation import race
 from springc.cli import main
 from springc.errors import SimulationError
-from springc.pipeline import flatten_files
-from springc.simplify import simplify
-from springc.solvers import choose, detect_pairs, pairs_from_ode
+from springc.pipeline.files import flatten_files
+from springc.simplify.passes import simplify
+from springc.simulation.solvers import choose, detect_pairs, pairs_from_ode
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -138,7 +138,7 @@ def test_auto_races_to_the_implicit_method_when_the_explicit_one_is_held(
 
 def test_auto_falls_back_to_the_implicit_method_when_the_explicit_probe_fails(
         models: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    from springc import simulation
+    from springc.simulation import runner as simulation
 
     real = simulation._Run.advance
 

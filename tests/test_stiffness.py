@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from springc.stiffness import STIFF_THRESHOLD, choose_solver, spectral_radius
+from springc.simulation.stiffness import STIFF_THRESHOLD, choose_solver, spectral_radius
 
 
 def oscillator_jacobian(k: float, m: float = 1.0) -> np.ndarray:

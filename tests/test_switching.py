@@ -11,13 +11,13 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from springc.evaluate_ode import parameter_values
-from springc.flat import FlatModel
-from springc.initialize import initial_state
-from springc.pipeline import flatten_files
-from springc.reduce import pivoted_choice
-from springc.simplify import simplify
-from springc.switching import (
+from springc.simplify.ode_eval import parameter_values
+from springc.ir.flat import FlatModel
+from springc.simplify.initialize import initial_state
+from springc.pipeline.files import flatten_files
+from springc.simplify.index_reduction import pivoted_choice
+from springc.simplify.passes import simplify
+from springc.simplify.state_choice import (
     THRESHOLD,
     EvaluatorFunctions,
     conditioning,

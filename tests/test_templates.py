@@ -1,4 +1,4 @@
-"""Equation templates (springc.templates): reused only where every instance of a class
+"""Equation templates (springc.flatten.equation_templates): reused only where every instance of a class
 has the same equations up to its prefix; otherwise each instance is flattened."""
 
 from __future__ import annotations
@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from springc import expr as x
-from springc.flat import format_equation
-from springc.pipeline import flatten_files
-from springc.templates import make_template, renamer
+from springc.ir import expr as x
+from springc.ir.flat import format_equation
+from springc.pipeline.files import flatten_files
+from springc.flatten.equation_templates import make_template, renamer
 
 
 def equations(tmp_path: Path, source: str) -> list[str]:
@@ -29,7 +29,7 @@ def test_renamer_swaps_the_instance_prefix() -> None:
 
 def test_no_template_when_a_variable_lies_outside_the_instance() -> None:
     from springc.errors import Span
-    from springc.flat import Equation, Origin
+    from springc.ir.flat import Equation, Origin
 
     span = Span("m.mdl", 1, 1, 1, 1)
     eq = Equation(x.Var("a.x"), x.Var("b.x"), span, Origin("equation", "a"))

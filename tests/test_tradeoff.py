@@ -14,7 +14,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.tradeoff import (
+from springc.tradeoff.study import (
     CSV_COLUMNS,
     SCIPY_DEFAULT,
     SCIPY_RK45,
@@ -29,8 +29,8 @@ from springc.tradeoff import (
     run_tradeoff,
     variable_scales,
 )
-from springc.tradeoff_plot import write_work_precision
-from springc.tradeoff_table import recommend, write_table_csv
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import recommend, write_table_csv
 
 OSCILLATOR = """
 model Oscillator "x'' = -4 x: x = cos(2 t), v = -2 sin(2 t)"
@@ -246,7 +246,7 @@ def test_cli_bad_reference_csv(oscillator: str, tmp_path: Path) -> None:
 
 
 def test_budget_stops_runs(oscillator: str) -> None:
-    from springc.tradeoff import OverBudget, _Deadline
+    from springc.tradeoff.study import OverBudget, _Deadline
 
     with pytest.raises(OverBudget):
         _Deadline(0.0).write("progress")

@@ -14,7 +14,7 @@ from click.testing import CliRunner
 import springc
 from springc.cli import main
 from springc.errors import SimulationError
-from springc.tradeoff import TradeoffOptions, compare_states, run_tradeoff
+from springc.tradeoff.study import TradeoffOptions, compare_states, run_tradeoff
 
 OSCILLATOR = """
 model Oscillator "x'' = -x, energy E = (v^2 + x^2)/2 = 1/2"

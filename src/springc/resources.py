@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-_PACKAGE = Path(__file__).resolve().parent
+#: The installed ``springc`` package folder (every subpackage lies below it).
+PACKAGE_ROOT = Path(__file__).resolve().parent
 
 
 def resource_dir(name: str) -> Path:
     """The folder ``name`` (``grammar`` or ``models``), wherever this install keeps it."""
-    for candidate in (_PACKAGE / name, _PACKAGE.parents[1] / name):
+    for candidate in (PACKAGE_ROOT / name, PACKAGE_ROOT.parents[1] / name):
         if candidate.is_dir():
             return candidate
     raise FileNotFoundError(f"springc installation is missing its '{name}' folder")

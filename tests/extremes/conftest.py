@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 
 from .cases import MODELS
 

@@ -11,7 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 from springc.cli import main
 from springc.errors import SimulationError
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 from springc.errors import SimulationError
 
 from .cases import harmonic

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 
 K = (2 * np.pi) ** 2  # period 1 s
 PERIODS = 10_000

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 
 from .cases import MASSES, harmonic
 

@@ -3,7 +3,7 @@ solver it picks; other solvers where they are still affordable.
 
 Two pairs: with even walls the stiff mode x2 - x1 stays exactly at rest, so the
 explicit method is never held to the stability limit and finishes in a few steps; with uneven
-walls the stiff mode is excited at ~1/k, and auto's race decides (:mod:`springc.race`).
+walls the stiff mode is excited at ~1/k, and auto's race decides (:mod:`springc.simulation.race`).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import springc
-from springc.build import CompiledModel
+from springc.pipeline.compiler import CompiledModel
 
 from .cases import STIFFNESSES, stiff_pair, stiff_pair_expm, uneven_pair, uneven_pair_expm
 

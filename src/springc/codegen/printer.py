@@ -1,0 +1,455 @@
+"""Statements of generated functions -> Python source lines, with shared subexpressions.
+
+The code generator (:mod:`springc.codegen`) describes each generated function as a
+list of small statements over flat names (:class:`Let`, :class:`Store`,
+:class:`Load`, :class:`Raw`, grouped in :class:`Block` and :class:`Loop`). This
+module removes statements whose results nobody uses, finds common subexpressions by
+hash-consing the frozen expression trees, and prints everything as Python that runs
+unchanged under plain CPython (``math``/numpy) and under ``numba.njit``.
+
+Printing follows sympy's printers: one ``_print_<Node>`` method per expression class,
+helpers collected while printing, unsupported nodes refused explicitly.
+"""
+
+from __future__ import annotations
+
+import builtins
+import keyword
+import math
+import re
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+
+from ..errors import SimulationError
+from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
+
+# ------------------------------------------------------------------ statements
+
+
+@dataclass
+class Let:
+    """``name = expr`` (``name`` a flat or internal name), with a trailing comment."""
+
+    name: str
+    expr: Expr
+    comment: str = ""
+
+
+@dataclass
+class Load:
+    """``name = source`` where ``source`` is Python text such as ``x[3]``."""
+
+    name: str
+    source: str
+    comment: str = ""
+
+
+@dataclass
+class Store:
+    """``target = expr`` where ``target`` is Python text such as ``dx[3]``."""
+
+    target: str
+    expr: Expr
+    comment: str = ""
+
+
+@dataclass
+class Raw:
+    """A line of Python that refers only to internal names (``_A1 = np.zeros(...)``)."""
+
+    text: str
+
+
+@dataclass
+class Loop:
+    """``header`` (e.g. ``for _it in range(50):``) with an indented body."""
+
+    header: str
+    body: list[Stmt]
+
+
+@dataclass
+class Block:
+    """Statements kept or dropped together (a linear or nonlinear system)."""
+
+    body: list[Stmt]
+    comment: str = ""
+    defines: set[str] = field(default_factory=set)
+    uses: set[str] = field(default_factory=set)
+
+
+Stmt = Let | Load | Store | Raw | Loop | Block
+
+# ------------------------------------------------------------------ names
+
+# Every identifier the module templates define or use (locals, loop variables, module
+# functions, constants and imports): model names must never shadow them.
+_RESERVED = frozenset({
+    "t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out", "abs", "min", "max",
+    "float", "int", "range", "len", "bool", "values", "numba", "scipy", "base64", "zlib",
+    "x0", "n", "i", "j", "k", "v", "ts", "given", "unknown", "name", "X",
+    "parameters", "start", "guesses", "rhs", "observed", "observed_grid", "jacobian",
+    "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
+    "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
+    "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
+    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "JAC_ROWS",
+    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR",
+}) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
+
+
+class Namer:
+    """Flat names -> Python identifiers: ``mass.pos[1]`` -> ``mass_pos_1``.
+
+    Internal names (starting with ``_``) are used verbatim; model names never start
+    with ``_`` once sanitized, so the two never collide.
+    """
+
+    def __init__(self) -> None:
+        self._ident: dict[str, str] = {}
+        self._used: set[str] = set(_RESERVED)
+
+    def __call__(self, name: str) -> str:
+        if name.startswith("_"):
+            return name
+        ident = self._ident.get(name)
+        if ident is None:
+            ident = self._fresh(name)
+            self._ident[name] = ident
+        return ident
+
+    def _fresh(self, name: str) -> str:
+        base = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_") or "v"
+        if base[0].isdigit():
+            base = "v_" + base
+        ident, n = base, 1
+        while ident in self._used:
+            n += 1
+            ident = f"{base}_{n}"
+        self._used.add(ident)
+        return ident
+
+
+# ------------------------------------------------------------------ dead code
+
+
+def uses_of(stmt: Stmt) -> set[str]:
+    """Flat and internal names read by ``stmt`` (minus those a block defines itself)."""
+    if isinstance(stmt, (Let, Store)):
+        return variables(stmt.expr)
+    if isinstance(stmt, (Load, Raw)):
+        return set()
+    body = stmt.body
+    used: set[str] = set()
+    for s in body:
+        used |= uses_of(s)
+    extra = stmt.uses if isinstance(stmt, Block) else set()
+    return (used - _defines_inside(body)) | extra
+
+
+def _defines_inside(body: Sequence[Stmt]) -> set[str]:
+    out: set[str] = set()
+    for s in body:
+        if isinstance(s, (Let, Load)):
+            out.add(s.name)
+        elif isinstance(s, (Loop, Block)):
+            out |= _defines_inside(s.body)
+    return out
+
+
+def defines_of(stmt: Stmt) -> set[str]:
+    if isinstance(stmt, (Let, Load)):
+        return {stmt.name}
+    if isinstance(stmt, Block):
+        return stmt.defines or _defines_inside(stmt.body)
+    if isinstance(stmt, Loop):
+        return _defines_inside(stmt.body)
+    return set()
+
+
+def prune(stmts: Sequence[Stmt]) -> list[Stmt]:
+    """Drop top-level statements whose results are never read (stores are kept)."""
+    live: set[str] = set()
+    kept: list[Stmt] = []
+    for stmt in reversed(stmts):
+        defines = defines_of(stmt)
+        if isinstance(stmt, (Let, Load, Block)) and not defines & live:
+            continue
+        live -= defines if isinstance(stmt, (Let, Load)) else set()
+        live |= uses_of(stmt)
+        kept.append(stmt)
+    kept.reverse()
+    return kept
+
+
+# ------------------------------------------------------------------ printing
+
+_PREC = {"or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
+         "+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
+_PY_OP = {"<>": "!=", "^": "**"}
+_MATH = {"sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh",
+         "tanh", "exp", "log", "log10", "floor", "ceil"}
+_BUILTIN = {"abs", "min", "max"}
+_TRANSPARENT = {"noEvent": 0, "smooth": 1, "homotopy": 0}
+
+HELPERS = {
+    "_sign": "def _sign(a):\n    return 1.0 if a > 0 else (-1.0 if a < 0 else 0.0)\n",
+    "_mod": "def _mod(a, b):\n    return a - math.floor(a / b) * b\n",
+    "_div": "def _div(a, b):\n    return float(math.trunc(a / b))\n",
+}
+_HELPER_OF = {"sign": "_sign", "mod": "_mod", "div": "_div", "integer": "math.floor",
+              "rem": "math.fmod"}
+
+
+class CodegenError(SimulationError):
+    """The model uses something the code generator cannot translate."""
+
+
+def _trivial(e: Expr) -> bool:
+    return isinstance(e, (Const, Var, Time)) or (
+        isinstance(e, Neg) and isinstance(e.arg, (Const, Var)))
+
+
+class FunctionWriter:
+    """Prints one function body; shares subexpressions that occur more than once.
+
+    Counting walks every statement's expressions once, on canonical (hash-consed)
+    node ids, and never descends into the branches of ``if``-expressions, so shared
+    values are only hoisted where they are evaluated anyway. A shared value is
+    assigned to a temporary right before its first use; it is forgotten when a
+    variable it reads is reassigned or when the loop that computed it ends.
+    """
+
+    def __init__(self, namer: Callable[[str], str], helpers: set[str],
+                 indent: str = "    ") -> None:
+        self.name = namer
+        self.helpers = helpers
+        self.lines: list[str] = []
+        self._canon: dict[int, tuple[int, Expr]] = {}
+        self._keys: dict[tuple[object, ...], int] = {}
+        self._count: list[int] = []
+        self._temps: dict[int, str] = {}
+        self._temp_vars: dict[int, set[str]] = {}
+        self._scopes: list[set[int]] = [set()]
+        self._in_branch = 0
+        self._indent = indent
+
+    # Step 1: canonical ids and use counts.
+    def _id(self, e: Expr) -> int:
+        hit = self._canon.get(id(e))
+        if hit is not None:
+            return hit[0]
+        if isinstance(e, Const):
+            key: tuple[object, ...] = ("C", type(e.value).__name__, repr(e.value))
+        elif isinstance(e, Var):
+            key = ("V", e.name)
+        elif isinstance(e, Time):
+            key = ("T",)
+        elif isinstance(e, (Neg, Not)):
+            key = (type(e).__name__, self._id(e.arg))
+        elif isinstance(e, BinOp):
+            key = ("B", e.op, self._id(e.left), self._id(e.right))
+        elif isinstance(e, Call):
+            key = ("F", e.name, *(self._id(a) for a in e.args))
+        elif isinstance(e, If):
+            key = ("I", self._id(e.cond), self._id(e.then), self._id(e.otherwise))
+        else:
+            raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+        cid = self._keys.get(key)
+        if cid is None:
+            cid = len(self._count)
+            self._keys[key] = cid
+            self._count.append(0)
+        self._canon[id(e)] = (cid, e)
+        return cid
+
+    def _visit(self, e: Expr) -> None:
+        stack = [e]
+        while stack:
+            node = stack.pop()
+            cid = self._id(node)
+            self._count[cid] += 1
+            if self._count[cid] > 1:
+                continue
+            if isinstance(node, If):
+                stack.append(node.cond)
+            elif isinstance(node, BinOp):
+                stack += (node.left, node.right)
+            elif isinstance(node, (Neg, Not)):
+                stack.append(node.arg)
+            elif isinstance(node, Call):
+                stack.extend(node.args)
+
+    def count(self, stmts: Sequence[Stmt]) -> None:
+        for e in _exprs(stmts):
+            self._visit(e)
+
+    # Step 2: printing.
+    def write(self, stmts: Sequence[Stmt]) -> None:
+        for stmt in stmts:
+            self._stmt(stmt)
+
+    def _emit(self, text: str, comment: str = "") -> None:
+        line = self._indent + text
+        if comment:
+            line += "  # " + comment.replace("\n", " ")
+        self.lines.append(line)
+
+    def _stmt(self, stmt: Stmt) -> None:
+        if isinstance(stmt, Let):
+            cid = self._id(stmt.expr)
+            if (self._count[cid] > 1 and cid not in self._temps
+                    and not _trivial(stmt.expr)):
+                # The whole right-hand side is shared: the variable itself holds it.
+                text, _ = self._print(stmt.expr)
+                self._reassigned(stmt.name)
+                ident = self.name(stmt.name)
+                self._emit(f"{ident} = {text}", stmt.comment)
+                self._remember(cid, ident, stmt.expr)
+                return
+            text = self.expr(stmt.expr)
+            self._reassigned(stmt.name)
+            self._emit(f"{self.name(stmt.name)} = {text}", stmt.comment)
+        elif isinstance(stmt, Load):
+            self._reassigned(stmt.name)
+            self._emit(f"{self.name(stmt.name)} = {stmt.source}", stmt.comment)
+        elif isinstance(stmt, Store):
+            self._emit(f"{stmt.target} = {self.expr(stmt.expr)}", stmt.comment)
+        elif isinstance(stmt, Raw):
+            for line in stmt.text.splitlines():
+                self._emit(line)
+        elif isinstance(stmt, Block):
+            if stmt.comment:
+                self._emit("# " + stmt.comment)
+            self.write(stmt.body)
+        else:
+            for name in _defines_inside(stmt.body):
+                self._reassigned(name)
+            self._emit(stmt.header)
+            outer = self._indent
+            self._indent += "    "
+            self._scopes.append(set())
+            self.write(stmt.body)
+            for cid in self._scopes.pop():
+                self._temps.pop(cid, None)
+            self._indent = outer
+
+    def _reassigned(self, name: str) -> None:
+        ident = self.name(name)
+        stale = [cid for cid, names in self._temp_vars.items()
+                 if cid in self._temps and (name in names or self._temps[cid] == ident)]
+        for cid in stale:
+            del self._temps[cid]
+
+    def _remember(self, cid: int, name: str, e: Expr) -> None:
+        self._temps[cid] = name
+        self._temp_vars[cid] = variables(e)
+        self._scopes[-1].add(cid)
+
+    def expr(self, e: Expr, outer: int = 0) -> str:
+        """Python text of ``e``; shared subexpressions become temporaries."""
+        text, prec = self._shared(e)
+        return f"({text})" if prec < outer else text
+
+    def _shared(self, e: Expr) -> tuple[str, int]:
+        cid = self._id(e)
+        if cid in self._temps:
+            return self._temps[cid], 9
+        text, prec = self._print(e)
+        if self._count[cid] > 1 and not _trivial(e) and not self._in_branch:
+            name = f"_c{cid}"
+            self._emit(f"{name} = {text}")
+            self._remember(cid, name, e)
+            return name, 9
+        return text, prec
+
+    def _print(self, e: Expr) -> tuple[str, int]:
+        method = getattr(self, "_print_" + type(e).__name__, None)
+        if method is None:
+            raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+        return method(e)
+
+    def _print_Const(self, e: Const) -> tuple[str, int]:
+        v = e.value
+        if isinstance(v, bool):
+            return ("True" if v else "False"), 9
+        if isinstance(v, float) and not math.isfinite(v):
+            text = "math.nan" if math.isnan(v) else ("math.inf" if v > 0 else "-math.inf")
+        else:
+            text = repr(v)
+        return text, (7 if text.startswith("-") else 9)
+
+    def _print_Var(self, e: Var) -> tuple[str, int]:
+        return self.name(e.name), 9
+
+    def _print_Time(self, e: Time) -> tuple[str, int]:
+        return "t", 9
+
+    def _print_Neg(self, e: Neg) -> tuple[str, int]:
+        return "-" + self.expr(e.arg, 7), 7
+
+    def _print_Not(self, e: Not) -> tuple[str, int]:
+        return "not " + self.expr(e.arg, 3), 3
+
+    def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
+        op = e.op
+        if op == "^" and not _integer_power(e.right):
+            return f"math.pow({self.expr(e.left)}, {self.expr(e.right)})", 9
+        prec = _PREC[op]
+        if op == "^":
+            left, right = self.expr(e.left, 9), self.expr(e.right, 9)
+        elif prec == 4:
+            left, right = self.expr(e.left, 5), self.expr(e.right, 5)
+        else:
+            left, right = self.expr(e.left, prec), self.expr(e.right, prec + 1)
+        return f"{left} {_PY_OP.get(op, op)} {right}", prec
+
+    def _print_Call(self, e: Call) -> tuple[str, int]:
+        name = e.name
+        if name in _TRANSPARENT:
+            return self._shared(e.args[_TRANSPARENT[name]])
+        args = ", ".join(self.expr(a) for a in e.args)
+        if name in _MATH:
+            return f"math.{name}({args})", 9
+        if name in _BUILTIN:
+            return f"{name}({args})", 9
+        if name in _HELPER_OF:
+            helper = _HELPER_OF[name]
+            if helper.startswith("_"):
+                self.helpers.add(helper)
+            return f"{helper}({args})", 9
+        raise CodegenError(f"cannot generate code for the function '{name}'")
+
+    def _print_If(self, e: If) -> tuple[str, int]:
+        cond = self.expr(e.cond, 1)
+        self._in_branch += 1
+        try:
+            then, other = self.expr(e.then, 1), self.expr(e.otherwise, 1)
+        finally:
+            self._in_branch -= 1
+        return f"{then} if {cond} else {other}", 0
+
+
+def _integer_power(e: Expr) -> bool:
+    value = e.arg.value if isinstance(e, Neg) and isinstance(e.arg, Const) else (
+        e.value if isinstance(e, Const) else None)
+    return (isinstance(value, int) and not isinstance(value, bool)) or (
+        isinstance(value, float) and value.is_integer() and abs(value) < 64)
+
+
+def _exprs(stmts: Sequence[Stmt]) -> Iterator[Expr]:
+    for s in stmts:
+        if isinstance(s, (Let, Store)):
+            yield s.expr
+        elif isinstance(s, (Loop, Block)):
+            yield from _exprs(s.body)
+
+
+def function_lines(namer: Callable[[str], str], helpers: set[str], stmts: Sequence[Stmt],
+                   indent: str = "    ", writer_class: type[FunctionWriter] | None = None
+                   ) -> list[str]:
+    """The indented body of a function computing ``stmts`` (after dead-code removal)."""
+    writer = (writer_class or FunctionWriter)(namer, helpers, indent)
+    kept = prune(stmts)
+    writer.count(kept)
+    writer.write(kept)
+    return writer.lines

@@ -1,0 +1,461 @@
+"""Large systems -> loops over groups of same-shaped assignments (the vector layout).
+
+Input: the explicit assignments of an ode.ODE (chains, cloths: thousands of them);
+output: the bodies of ``rhs``, ``jacobian_values`` and ``observed`` whose size grows
+with the number of distinct *shapes* of assignment, not with the number of masses.
+
+Every assignment ``v := e`` becomes a shape (``e`` with each variable replaced by a
+slot ``$0, $1, ...``) and operands (the array and index each slot reads: states
+``x``, parameters ``p``, intermediate values ``w``, derivatives ``dx``). Assignments
+of equal shape whose operands are ready at the same dependency level form a group;
+members are ordered by their subscripts (``s[2]`` before ``s[10]``), so the
+indices of chains and grids advance by constant strides. A run of members with
+constant strides becomes one loop (numba) or one slice expression (numpy); other
+members read their indices from the table ``_I``.
+
+The Jacobian is forward-mode over the same groups: each loop also stores the partial
+derivatives of its shape in ``D``, and a precomputed tape of multiply-adds
+``G[target] += D[partial] * G[source]`` (``G[0] = 1``) accumulates the gradient
+entries; ``jacobian_values`` gathers them in CSC order.
+"""
+
+from __future__ import annotations
+
+import base64
+import re
+import zlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar
+
+import numpy as np
+
+from .printer import CodegenError, FunctionWriter, Store, function_lines
+from ..errors import Span
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
+
+if TYPE_CHECKING:
+    from .generator import _Model
+
+VECTOR_THRESHOLD = 300
+"""Systems with at least this many explicit assignments use the vector layout."""
+MIN_RUN = 8
+"""Shorter runs of constant strides go to the index table instead of a loop."""
+
+_ARRAY = {"x": "x", "p": "p", "w": "w", "d": "dx", "c": "_F"}
+
+
+@dataclass
+class _Assignment:
+    name: str
+    shape: Expr
+    slots: list[str]  # the variable read by each slot
+    kinds: tuple[str, ...]
+    level: int
+    comment: str
+    out: tuple[str, int] = ("w", -1)
+    operands: list[tuple[str, int]] = field(default_factory=list)
+
+
+@dataclass
+class _Run:
+    members: list[_Assignment]  # in loop order (row-major for 2-D runs)
+    access: list[Callable[[str], str]]  # per slot (0: output, k + 1: slot k): "q" -> text
+    dims: list[int]  # loop sizes: [] (one member), [count] or [rows, columns]
+
+
+_SUBSCRIPT = re.compile(r"\[([0-9, ]+)\]")
+
+
+def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
+    """Members' loop order: by name pattern, then a trailing vector component
+    (``pos[2]`` in ``p[3,4].pos[2]``), then the other subscripts in order."""
+    groups = [tuple(int(i) for i in g.split(",")) for g in _SUBSCRIPT.findall(name)]
+    component = groups.pop() if len(groups) > 1 else ()
+    return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
+
+
+def _shape(e: Expr, slots: list[str]) -> Expr:
+    if isinstance(e, Var):
+        slots.append(e.name)
+        return Var(f"${len(slots) - 1}")
+    if isinstance(e, (Const, Time)):
+        return e
+    if isinstance(e, (Neg, Not)):
+        return type(e)(_shape(e.arg, slots))
+    if isinstance(e, BinOp):
+        return BinOp(e.op, _shape(e.left, slots), _shape(e.right, slots))
+    if isinstance(e, Call):
+        return Call(e.name, tuple(_shape(a, slots) for a in e.args))
+    if isinstance(e, If):
+        return If(_shape(e.cond, slots), _shape(e.then, slots), _shape(e.otherwise, slots))
+    raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+
+
+def encode_floats(values: Sequence[float]) -> str:
+    """Python text of a float64 array (exact): compressed base64."""
+    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.float64).tobytes(), 6))
+    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
+            "dtype=np.float64).copy()")
+
+
+def encode_strings(values: Sequence[str]) -> str:
+    """Python text of a tuple of strings (compressed when long)."""
+    if len(values) <= 32:
+        return repr(tuple(values))
+    data = base64.b64encode(zlib.compress("\n".join(values).encode(), 6))
+    return f"tuple(zlib.decompress(base64.b64decode({data.decode()!r})).decode().split('\\n'))"
+
+
+def encode_ints(values: Sequence[int]) -> str:
+    """Python text of an int64 array: a literal when short, else compressed base64."""
+    if len(values) <= 32:
+        return f"np.array({list(values)!r}, dtype=np.int64)"
+    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.int64).tobytes(), 6))
+    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
+            "dtype=np.int64).copy()")
+
+
+class NumpyWriter(FunctionWriter):
+    """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
+
+    _UFUNC: ClassVar[dict[str, str]] = {
+        "asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
+        "min": "minimum", "max": "maximum", "rem": "fmod", "integer": "floor"}
+    _SAME: ClassVar[set[str]] = {
+        "sqrt", "sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "log", "log10", "abs",
+        "sign", "mod", "floor", "ceil"}
+
+    def _print_Call(self, e: Call) -> tuple[str, int]:
+        if e.name in ("noEvent", "smooth", "homotopy"):
+            return super()._print_Call(e)
+        args = ", ".join(self.expr(a) for a in e.args)
+        if e.name == "div":
+            return f"np.trunc(np.divide({args}))", 9
+        if e.name in self._SAME:
+            return f"np.{e.name}({args})", 9
+        if e.name in self._UFUNC:
+            return f"np.{self._UFUNC[e.name]}({args})", 9
+        raise CodegenError(f"cannot generate code for the function '{e.name}'")
+
+    def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
+        if e.op in ("and", "or"):
+            fn = "logical_and" if e.op == "and" else "logical_or"
+            return f"np.{fn}({self.expr(e.left)}, {self.expr(e.right)})", 9
+        if e.op == "^":
+            return f"np.power({self.expr(e.left)}, {self.expr(e.right)})", 9
+        return super()._print_BinOp(e)
+
+    def _print_Not(self, e: Not) -> tuple[str, int]:
+        return f"np.logical_not({self.expr(e.arg)})", 9
+
+    def _print_If(self, e: If) -> tuple[str, int]:
+        return (f"np.where({self.expr(e.cond)}, {self.expr(e.then)}, "
+                f"{self.expr(e.otherwise)})", 9)
+
+
+class VectorLayout:
+    """The grouped form of a system of explicit assignments, for one backend."""
+
+    def __init__(self, m: _Model, statements: Sequence[tuple[str, Expr, Span]],
+                 numba: bool, table_name: str = "_I", lift_constants: bool = False) -> None:
+        self.m, self.numba, self.table_name = m, numba, table_name
+        self.table: list[int] = []
+        self.floats: list[float] = []
+        self.location: dict[str, tuple[str, int]] = {}
+        self.location.update({s: ("x", i) for i, s in enumerate(m.states)})
+        self.location.update({q: ("p", i) for i, q in enumerate(m.params)})
+        self.location.update({d: ("d", i) for i, d in enumerate(m.derivatives)})
+        self.assignments: dict[str, _Assignment] = {}
+        for name, e, span in statements:
+            slots: list[str] = []
+            if lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
+                # Constant values become data (_F), so they group whatever their value.
+                slots.append(f"#{len(self.floats)}")
+                self.location[slots[0]] = ("c", len(self.floats))
+                self.floats.append(float(e.value))
+                shape: Expr = Var("$0")
+            else:
+                shape = _shape(e, slots)
+            for v in slots:
+                if v not in self.location and v not in self.assignments:
+                    raise CodegenError(f"'{name}' reads '{v}', which nothing computes",
+                                       hint="this is a bug in springc")
+            level = 1 + max((self.assignments[v].level for v in slots
+                             if v in self.assignments), default=0)
+            kinds = tuple(self._kind(v) for v in slots)
+            comment = f"{name} := {to_text(e)}  {span.file}:{span.line}"
+            self.assignments[name] = _Assignment(name, shape, slots, kinds, level, comment)
+        # Intermediate values get slots of w group by group, in natural name order.
+        self.w_names: list[str] = []
+        for group in self._groups(list(self.assignments.values())):
+            for a in group:
+                if a.name in self.location:
+                    a.out = self.location[a.name]
+                else:
+                    a.out = ("w", len(self.w_names))
+                    self.location[a.name] = a.out
+                    self.w_names.append(a.name)
+        for a in self.assignments.values():
+            a.operands = [self.location[v] for v in a.slots]
+
+    def _kind(self, name: str) -> str:
+        if name in self.location:
+            return self.location[name][0]
+        return "d" if name in self.m.derivative_set else "w"
+
+    @staticmethod
+    def _groups(assignments: list[_Assignment]) -> list[list[_Assignment]]:
+        groups: dict[tuple[object, ...], list[_Assignment]] = {}
+        for a in assignments:
+            groups.setdefault((a.level, a.shape, a.kinds), []).append(a)
+        ordered = sorted(groups.values(), key=lambda g: g[0].level)
+        return [sorted(g, key=lambda a: _order(a.name)) for g in ordered]
+
+    def needed(self, targets: Sequence[str]) -> list[_Assignment]:
+        """The assignments that ``targets`` depend on."""
+        seen: set[str] = set()
+        stack = [t for t in targets if t in self.assignments]
+        while stack:
+            name = stack.pop()
+            if name in seen:
+                continue
+            seen.add(name)
+            stack += [v for v in self.assignments[name].slots if v in self.assignments]
+        return [a for a in self.assignments.values() if a.name in seen]
+
+    # ------------------------------------------------------------ runs
+
+    def _index(self, values: Sequence[int]) -> int:
+        offset = len(self.table)
+        self.table.extend(values)
+        return offset
+
+    def _runs(self, group: list[_Assignment]) -> list[_Run]:
+        """Loops over ``group``: affine runs (merged into 2-D blocks when rows repeat
+        with a constant offset) for numba; one slice or one gather for numpy."""
+        matrix = np.array([[a.out[1]] + [o[1] for o in a.operands] for a in group],
+                          dtype=np.int64).reshape(len(group), -1)
+        arrays = [_ARRAY[group[0].out[0]]] + [_ARRAY[k] for k in group[0].kinds]
+        spans: list[tuple[int, int]] = []  # maximal runs of constant strides
+        i = 0
+        while i < len(group):
+            j = i + 1
+            if j < len(group):
+                stride = matrix[j] - matrix[i]
+                if (stride >= 0).all() and stride[0] > 0:
+                    while j < len(group) and (matrix[j] - matrix[j - 1] == stride).all():
+                        j += 1
+            spans.append((i, j))
+            i = j
+        if len(spans) == 1:
+            i, j = spans[0]
+            step = matrix[1] - matrix[0] if j - i > 1 else matrix[0] * 0
+            return [self._affine(group, matrix[0], [(j - i, step)], arrays)]
+        if not self.numba:
+            return [self._tabled(group, matrix, arrays)]
+        runs: list[_Run] = []
+        table = [t for i, j in spans if j - i < MIN_RUN for t in range(i, j)]
+        spans = [(i, j) for i, j in spans if j - i >= MIN_RUN]
+        k = 0
+        while k < len(spans):
+            i, j = spans[k]
+            step = matrix[i + 1] - matrix[i]
+            # Step 2: rows of equal length and stride, each offset by the same amount.
+            rows = 1
+            while k + rows < len(spans):
+                a, b = spans[k + rows]
+                if (b - a != j - i or not (matrix[a + 1] - matrix[a] == step).all()
+                        or not (matrix[a] - matrix[spans[k + rows - 1][0]]
+                                == matrix[spans[k + 1][0]] - matrix[i]).all()):
+                    break
+                rows += 1
+            members = [m for lo, hi in spans[k:k + rows] for m in group[lo:hi]]
+            dims = [(j - i, step)] if rows == 1 else [
+                (rows, matrix[spans[k + 1][0]] - matrix[i]), (j - i, step)]
+            runs.append(self._affine(members, matrix[i], dims, arrays))
+            k += rows
+        if table:
+            runs.append(self._tabled([group[t] for t in table], matrix[table], arrays))
+        return runs
+
+    def _affine(self, members: list[_Assignment], start: np.ndarray,
+                dims: list[tuple[int, np.ndarray]], arrays: list[str]) -> _Run:
+        n = len(members)
+        loops = ["_r", "_q"][-len(dims):]
+        sizes = [count for count, _ in dims]
+
+        def access(array: str, slot: int) -> Callable[[str], str]:
+            a = int(start[slot])
+            if n == 1:
+                return lambda q: f"{array}[{a}]"
+            if self.numba:
+                terms = [str(a)] if a else []
+                for var, (_, stride) in zip(loops, dims):
+                    s = int(stride[slot])
+                    if s:
+                        terms.append(var if s == 1 else f"{s} * {var}")
+                text = " + ".join(terms) or "0"
+                return lambda q: f"{array}[{text}]"
+            s = int(dims[0][1][slot])  # numpy: one dimension (see _runs)
+            if s == 0:
+                return lambda q: f"{array}[{a}]"
+            stop = a + s * (n - 1) + 1
+            return lambda q: f"{array}[{a}:{stop}{'' if s == 1 else f':{s}'}]"
+
+        return _Run(members, [access(arr, k) for k, arr in enumerate(arrays)],
+                    sizes if n > 1 else [])
+
+    def _tabled(self, members: list[_Assignment], matrix: np.ndarray,
+                arrays: list[str]) -> _Run:
+        n = len(members)
+
+        def access(array: str, column: np.ndarray) -> Callable[[str], str]:
+            offset = self._index(column.tolist())
+            t = self.table_name
+            if self.numba:
+                return lambda q: f"{array}[{t}[{offset} + {q}]]"
+            return lambda q: f"{array}[{t}[{offset}:{offset + n}]]"
+
+        return _Run(members, [access(arr, matrix[:, k]) for k, arr in enumerate(arrays)],
+                    [n] if n > 1 else [])
+
+    # ------------------------------------------------------------ printing
+
+    def _loop(self, run: _Run, stores: list[tuple[Callable[[str], str], Expr]],
+              helpers: set[str], lines: list[str]) -> None:
+        """``stores`` of (target access, expression over slots) for every member."""
+        first = run.members[0]
+        count = len(run.members)
+        lines.append(f"    # {count} x {first.comment}" if count > 1 else
+                     f"    # {first.comment}")
+        looped = self.numba and count > 1
+        names = {f"${k}": acc("_q") for k, acc in enumerate(run.access[1:])}
+        stmts = [Store(target("_q"), e) for target, e in stores]
+        indent = "    "
+        if looped:
+            for var, size in zip(["_r", "_q"][-len(run.dims):], run.dims):
+                lines.append(f"{indent}for {var} in range({size}):")
+                indent += "    "
+        writer = None if self.numba else NumpyWriter
+        lines += function_lines(lambda n: names.get(n, n), helpers, stmts, indent, writer)
+
+    def _arrays(self, needed: Sequence[_Assignment]) -> list[str]:
+        kinds = {a.out[0] for a in needed} | {k for a in needed for k in a.kinds}
+        lines = []
+        if "w" in kinds:
+            lines.append(f"    w = np.empty({max(1, len(self.w_names))})")
+        if "d" in kinds:
+            lines.append(f"    dx = np.empty({len(self.m.states)})")
+        return lines
+
+    def body(self, targets: Sequence[str], helpers: set[str],
+             after_level: Sequence[str] = ()) -> list[str]:
+        """Statements computing ``targets`` (and what they read) into ``w``/``dx``;
+        ``after_level`` lines run after each dependency level."""
+        needed = self.needed(targets)
+        lines = self._arrays(needed)
+        level = None
+        for group in self._groups(needed):
+            if level is not None and group[0].level != level:
+                lines += after_level
+            level = group[0].level
+            for run in self._runs(group):
+                self._loop(run, [(run.access[0], run.members[0].shape)], helpers, lines)
+        return lines + list(after_level)
+
+    def jacobian_body(self, helpers: set[str]) -> tuple[list[str], list[tuple[int, int]]]:
+        """Primal values, partials ``D``, the tape into ``G``, then ``jv`` in CSC order."""
+        lines = self._arrays(self.needed(self.m.derivatives))
+        partial_index: dict[tuple[str, int], int] = {}
+        nd = 0
+        order: list[_Assignment] = []
+        for group in self._groups(self.needed(self.m.derivatives)):
+            shape = group[0].shape
+            partials = [(k, diff(shape, f"${k}")) for k in range(len(group[0].slots))
+                        if group[0].kinds[k] in ("x", "w", "d")]
+            partials = [(k, pd) for k, pd in partials if pd != ZERO]
+            for run in self._runs(group):
+                stores: list[tuple[Callable[[str], str], Expr]] = [(run.access[0], shape)]
+                for k, pd in partials:
+                    base = nd
+                    nd += len(run.members)
+                    for q, a in enumerate(run.members):
+                        partial_index[(a.name, k)] = base + q
+                    stores.append((self._d_access(base, run.dims), pd))
+                self._loop(run, stores, helpers, lines)
+                order += run.members
+        # The tape: gradient entries per variable, multiply-adds ordered by level.
+        entries: dict[str, dict[int, int]] = {s: {j: 0} for j, s in enumerate(self.m.states)}
+        ops: list[tuple[int, int, int, int]] = []
+        count = 1
+        for a in sorted(order, key=lambda a: a.level):
+            mine = entries.setdefault(a.name, {})
+            for k, v in enumerate(a.slots):
+                d = partial_index.get((a.name, k))
+                if d is None:
+                    continue
+                for j, src in entries.get(v, {}).items():
+                    if j not in mine:
+                        mine[j] = count
+                        count += 1
+                    ops.append((a.level, mine[j], d, src))
+        pattern = sorted(((row, col, e) for row, der in enumerate(self.m.derivatives)
+                          for col, e in entries.get(der, {}).items()),
+                         key=lambda r: (r[1], r[0]))
+        lines += [f"    G = np.zeros({count})", "    G[0] = 1.0"]
+        lines += self._tape(ops)
+        offset = self._index([e for _, _, e in pattern])
+        lines.append(f"    jv = G[_I[{offset}:{offset + len(pattern)}]]")
+        lines.insert(0, f"    D = np.empty({max(1, nd)})")
+        return lines, [(r, c) for r, c, _ in pattern]
+
+    def _d_access(self, base: int, dims: list[int]) -> Callable[[str], str]:
+        if not dims:
+            return lambda q: f"D[{base}]"
+        if not self.numba:
+            return lambda q: f"D[{base}:{base + int(np.prod(dims))}]"
+        if len(dims) == 2:
+            return lambda q: f"D[{base} + {dims[1]} * _r + _q]"
+        return lambda q: f"D[{base} + _q]"
+
+    def _tape(self, ops: list[tuple[int, int, int, int]]) -> list[str]:
+        if not ops:
+            return []
+        t = self._index([o[1] for o in ops])
+        d = self._index([o[2] for o in ops])
+        s = self._index([o[3] for o in ops])
+        if self.numba:
+            return ["    # chain rule: G[target] += D[partial] * G[source], by level",
+                    f"    for _e in range({len(ops)}):",
+                    f"        G[_I[{t} + _e]] += D[_I[{d} + _e]] * G[_I[{s} + _e]]"]
+        lines = ["    # chain rule: G[target] += D[partial] * G[source], level by level"]
+        start = 0
+        levels = [o[0] for o in ops]
+        while start < len(ops):
+            end = start
+            while end < len(ops) and levels[end] == levels[start]:
+                end += 1
+            lines.append(f"    G += np.bincount(_I[{t + start}:{t + end}], "
+                         f"weights=D[_I[{d + start}:{d + end}]] * G[_I[{s + start}:{s + end}]],"
+                         f" minlength=G.shape[0])")
+            start = end
+        return lines
+
+    def gather(self, names: Sequence[str]) -> list[str]:
+        """``out`` holding ``names`` (computed by :meth:`body`)."""
+        w = [self.location[n] for n in names]
+        lines = [f"    out = np.empty({len(names)})"]
+        for kind in ("w", "d", "x", "p"):
+            pos = [i for i, (k, _) in enumerate(w) if k == kind]
+            if not pos:
+                continue
+            src = self._index([w[i][1] for i in pos])
+            dst = self._index(pos)
+            if self.numba:
+                lines += [f"    for _q in range({len(pos)}):",
+                          f"        out[_I[{dst} + _q]] = {_ARRAY[kind]}[_I[{src} + _q]]"]
+            else:
+                lines.append(f"    out[_I[{dst}:{dst + len(pos)}]] = "
+                             f"{_ARRAY[kind]}[_I[{src}:{src + len(pos)}]]")
+        return lines

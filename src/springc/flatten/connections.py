@@ -1,0 +1,244 @@
+"""Connection sets (Modelica chapter 9.2): from ``connect`` statements to equations.
+
+Set members are scalar connector variables tagged inside or outside: a connector
+reached through a sub-component (``spring.flange_a``) is inside, a connector of the
+model that writes the ``connect`` (``flange_a``) is outside. Each set gives equal
+potentials and a zero sum of flows (outside flows counted negative); flow variables of
+connectors that are connected nowhere are set to zero.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..ir import expr as x
+from ..ir import flat
+from ..ir import syntax as s
+from ..errors import FlattenError, Note
+from .scope import ClassScope, LocalScope, Primitive
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+
+Key = tuple[str, bool]  # (flat variable name, outside)
+
+
+@dataclass(frozen=True, slots=True)
+class Leaf:
+    relative: str
+    name: str
+    flow: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Link:
+    """Why a member joined its set: the connect statement, its owner and its text."""
+
+    span: s.Span
+    owner: str
+    text: str
+
+
+def connector_leaves(scope: ClassScope) -> list[Leaf]:
+    """Scalar non-parameter variables of a connector, in declaration order."""
+    cached = getattr(scope, "_leaves", None)
+    if cached is not None:
+        return cached
+    leaves: list[Leaf] = []
+    cut = len(scope.prefix) + 1
+    for _, member in scope.all_members():
+        if isinstance(member, Primitive):
+            if member.variability in ("parameter", "constant"):
+                continue
+            names = [member.names] if isinstance(member.names, str) else list(member.names.flat)
+            leaves += [Leaf(n[cut:], n, member.flow) for n in names]
+        else:
+            for item in (member.flat if isinstance(member, np.ndarray) else [member]):
+                leaves += [Leaf(leaf.name[cut:], leaf.name, leaf.flow)
+                           for leaf in connector_leaves(item)]
+    scope._leaves = leaves  # type: ignore[attr-defined]
+    # What must match for two connectors to be connected: names and flow prefixes.
+    scope._signature = tuple((leaf.relative, leaf.flow) for leaf in leaves)  # type: ignore
+    return leaves
+
+
+def direct_reference(ref: s.Ref, where: Any) -> ClassScope | None:
+    """``p[i - 1, j].flange`` inside ``for`` loops, resolved by indexing the arrays of
+    components directly; None (use the general evaluator) for anything else. Valid
+    because the general evaluator gives the same instance for such a reference: the
+    components exist (the walk created them), the subscripts are integers computed
+    from loop indices and literals, and an index out of range goes the general way,
+    which reports it."""
+    indices: dict[str, Any] = {}
+    while type(where) is LocalScope:
+        for name, value in where.names.items():
+            indices.setdefault(name, value)
+        where = where.parent
+    current: Any = where
+    for part in ref.parts:
+        if type(current) is not ClassScope or part.name in indices \
+                or part.name not in current.view.components:
+            return None
+        current = current.member(part.name)
+        if part.subscripts:
+            if type(current) is not np.ndarray or current.ndim != len(part.subscripts):
+                return None
+            position = []
+            for sub, size in zip(part.subscripts, current.shape):
+                k = _integer(sub, indices)
+                if k is None or not 1 <= k <= size:
+                    return None
+                position.append(k - 1)
+            current = current[tuple(position)]
+    return current if type(current) is ClassScope else None
+
+
+def _integer(e: s.Expr, indices: dict[str, Any]) -> int | None:
+    """An integer subscript made of literals, loop indices, ``+`` and ``-``; else None."""
+    kind = type(e)
+    if kind is s.Number:
+        return e.value if type(e.value) is int else None  # type: ignore[union-attr]
+    if kind is s.Ref:
+        if len(e.parts) != 1 or e.parts[0].subscripts:  # type: ignore[union-attr]
+            return None
+        found = indices.get(e.parts[0].name)  # type: ignore[union-attr]
+        if type(found) is x.Const and type(found.value) is int:
+            return found.value
+        return None
+    if kind is s.Binary and e.op in ("+", "-"):  # type: ignore[union-attr]
+        left = _integer(e.left, indices)  # type: ignore[union-attr]
+        right = _integer(e.right, indices)  # type: ignore[union-attr]
+        if left is None or right is None:
+            return None
+        return left + right if e.op == "+" else left - right  # type: ignore[union-attr]
+    return None
+
+
+class ConnectionSets:
+    def __init__(self) -> None:
+        self.parent: dict[Key, Key] = {}
+        self.flow: dict[Key, bool] = {}
+        self.link: dict[Key, Link] = {}
+
+    def _find(self, key: Key) -> Key:
+        root = key
+        while self.parent[root] != root:
+            root = self.parent[root]
+        while self.parent[key] != root:
+            self.parent[key], key = root, self.parent[key]
+        return root
+
+    def _add(self, key: Key, flow: bool, link: Link) -> None:
+        if key not in self.parent:
+            self.parent[key] = key
+            self.flow[key] = flow
+            self.link[key] = link
+
+    def connect(self, ev: Evaluator, eq: s.Connect, where: Any, owner: ClassScope) -> None:
+        """Record ``connect(a, b)``; both sides may be arrays of connectors."""
+        sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
+        (left_shape, left, left_out), (right_shape, right, right_out) = sides
+        if left_shape != right_shape:
+            raise FlattenError(
+                f"cannot connect arrays of {len(left)} and {len(right)} connectors",
+                eq.span, hint="connect arrays of connectors of the same size")
+        for ca, cb in zip(left, right):
+            self._pair(ca, cb, left_out, right_out, eq, owner)
+
+    def _connectors(self, ev: Evaluator, ref: s.Ref, where: Any, owner: ClassScope
+                    ) -> tuple[tuple[int, ...], list[Any], bool]:
+        """The connectors a reference denotes: their array shape (a single connector
+        counts as an array of one), the connectors in order, and whether they are
+        outside connectors of ``owner``."""
+        value = direct_reference(ref, where)
+        if value is None:
+            value = ev.reference(ref, where)
+        if isinstance(value, ClassScope):  # the common case, without numpy
+            shape, items = (1,), [value]
+        else:
+            array = np.atleast_1d(np.asarray(value, dtype=object))
+            shape, items = array.shape, list(array.flat)
+        if not items or not all(isinstance(c, ClassScope) and c.kind == "connector"
+                                for c in items):
+            raise FlattenError(f"'{ref.dotted}' is not a connector", ref.span,
+                               hint="connect(...) joins connectors, such as flanges")
+        head = ref.parts[0].name
+        outside = owner.has_member(head) and isinstance(owner.member(head), (ClassScope,
+                                                                            np.ndarray)) \
+            and all(c.outer is owner for c in items)
+        return shape, items, outside
+
+    def _pair(self, ca: ClassScope, cb: ClassScope, out_a: bool, out_b: bool,
+              eq: s.Connect, owner: ClassScope) -> None:
+        leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
+        if ca._signature != cb._signature:  # type: ignore[attr-defined]
+            raise FlattenError(
+                f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
+                f"({cb.entry.full_name}) do not match", eq.span,
+                [Note(f"'{ca.entry.full_name}' has {_describe_leaves(leaves_a)}",
+                      ca.entry.defn.span),
+                 Note(f"'{cb.entry.full_name}' has {_describe_leaves(leaves_b)}",
+                      cb.entry.defn.span)],
+                "connect connectors with the same variables (names, sizes and flow "
+                "prefixes)")
+        link = Link(eq.span, owner.prefix, f"connect({ca.prefix}, {cb.prefix})")
+        for p, q in zip(leaves_a, leaves_b):
+            ka, kb = (p.name, out_a), (q.name, out_b)
+            self._add(ka, p.flow, link)
+            self._add(kb, q.flow, link)
+            ra, rb = self._find(ka), self._find(kb)
+            if ra != rb:
+                self.parent[rb] = ra
+
+    def equations(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
+        """Equations of all sets (in order of first connection), then zero flows."""
+        sets: dict[Key, list[Key]] = {}
+        for key in self.parent:
+            sets.setdefault(self._find(key), []).append(key)
+        out: list[flat.Equation] = []
+        for members in sets.values():
+            first = self.link[members[0]]
+            if self.flow[members[0]]:
+                out.append(self._flow_sum(members, first))
+            else:
+                out += [flat.Equation(x.Var(members[0][0]), x.Var(k[0]), self.link[k].span,
+                                      flat.Origin("connect", self.link[k].owner,
+                                                  self.link[k].text))
+                        for k in members[1:]]
+        out += self._unconnected(scopes, top)
+        return out
+
+    def _flow_sum(self, members: list[Key], first: Link) -> flat.Equation:
+        total: x.Expr = x.ZERO
+        for name, outside in members:
+            total = x.sub(total, x.Var(name)) if outside else x.add(total, x.Var(name))
+        names = ", ".join(("-" if o else "") + n for n, o in members)
+        return flat.Equation(total, x.ZERO, first.span,
+                             flat.Origin("flow", first.owner, f"sum of {{{names}}}"))
+
+    def _unconnected(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
+        out = []
+        for scope in scopes:
+            if scope.kind != "connector" or (scope.outer is not None
+                                             and scope.outer.kind == "connector"):
+                continue
+            at_top = scope.outer is top
+            for leaf in connector_leaves(scope):
+                if not leaf.flow:
+                    continue
+                if (leaf.name, False) in self.parent or (at_top and (leaf.name, True)
+                                                         in self.parent):
+                    continue
+                out.append(flat.Equation(x.Var(leaf.name), x.ZERO, scope.span,
+                                         flat.Origin("unconnected", scope.outer.prefix
+                                                     if scope.outer else "",
+                                                     f"{scope.prefix} is not connected")))
+        return out
+
+
+def _describe_leaves(leaves: list[Leaf]) -> str:
+    """``s, flow f``: the scalar variables of a connector, relative to it."""
+    return ", ".join(("flow " if p.flow else "") + p.relative for p in leaves) or "no variables"

@@ -1,0 +1,122 @@
+"""Equation templates: flatten a class's equations once, then rename them per instance.
+
+Input: the flat equations of the first instance of a class. Output: the same equations
+for any further instance of that class, with the instance prefix swapped
+(``sv[1,1].len`` -> ``sv[7,3].len``). A cloth has 40,000 springs of four kinds; each
+spring's equations differ only in these names as long as evaluating them did not depend
+on the instance's parameter values. :func:`reusable` decides that for a class (no
+parameter value was read, no connections, array sizes that are literals, no constants);
+anything else is flattened instance by instance as before.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ..ir import expr as x
+from ..ir import flat
+from ..ir import syntax as s
+from .scope import ClassView, ViewComponent
+
+if TYPE_CHECKING:
+    from .flattener import Flattener
+
+
+@dataclass(frozen=True)
+class Template:
+    """The equations of one instance (``prefix``) of a class, ready to be renamed."""
+
+    prefix: str
+    equations: tuple[flat.Equation, ...]
+
+    def instantiate(self, prefix: str) -> list[flat.Equation]:
+        """The equations of the instance named ``prefix``."""
+        rename = renamer(self.prefix, prefix)
+        return [flat.Equation(rename(eq.lhs), rename(eq.rhs), eq.span,
+                              flat.Origin(eq.origin.kind, prefix, eq.origin.detail))
+                for eq in self.equations]
+
+
+def make_template(prefix: str, equations: list[flat.Equation]) -> Template | None:
+    """A template from an instance's equations, or None if some variable lies outside
+    the instance (then renaming by prefix would be wrong)."""
+    inside = prefix + "."
+    for eq in equations:
+        for side in (eq.lhs, eq.rhs):
+            if not all(n.startswith(inside) for n in x.variables(side)):
+                return None
+    return Template(prefix, tuple(equations))
+
+
+def reusable(flattener: Flattener, view: ClassView) -> bool:
+    """Whether every instance of ``view`` has the same equations up to its prefix, as
+    far as the class's text shows: only equalities (loops and ifs of them), no
+    constants (their values may be modified per instance) and literal array sizes, in
+    the class and in all its components. Parameter reads are checked by the caller."""
+    found = flattener.reusable_views.get(id(view))
+    if found is None:
+        flattener.reusable_views[id(view)] = False  # a class containing itself
+        found = _equations_only(eq.equation for eq in view.equations) \
+            and _equations_only(eq.equation for eq in view.initial_equations) \
+            and all(_component_reusable(flattener, comp) for comp in view.components.values())
+        flattener.reusable_views[id(view)] = found
+    return found
+
+
+def fixed_shape(flattener: Flattener, comp: ViewComponent,
+                class_ok: Callable[[ClassView], bool]) -> bool:
+    """Literal sizes and no constants: ``comp`` has the same members in every instance
+    (for a component of class type, when ``class_ok`` accepts its class)."""
+    declared = flattener.declared_type(comp)
+    rtype = declared.rtype
+    if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]):
+        return False
+    if rtype.entry is None:
+        return True
+    return rtype.entry.defn.kind not in ("function", "package") \
+        and class_ok(flattener.view(rtype.entry))
+
+
+def _component_reusable(flattener: Flattener, comp: ViewComponent) -> bool:
+    return fixed_shape(flattener, comp, lambda view: reusable(flattener, view))
+
+
+def _equations_only(equations: Iterable[s.Equation]) -> bool:
+    for eq in equations:
+        if isinstance(eq, s.ForEquation):
+            if not _equations_only(eq.body):
+                return False
+        elif isinstance(eq, s.IfEquation):
+            if not all(_equations_only(body) for _, body in eq.branches) \
+                    or not _equations_only(eq.otherwise):
+                return False
+        elif not isinstance(eq, s.Equality):
+            return False
+    return True
+
+
+def renamer(old: str, new: str) -> Callable[[x.Expr], x.Expr]:
+    """A function that renames the variables ``old.*`` to ``new.*`` in an expression."""
+    cut = len(old)
+    names: dict[str, x.Var] = {}
+
+    def rename(e: x.Expr) -> x.Expr:
+        kind = type(e)
+        if kind is x.Var:
+            found = names.get(e.name)  # type: ignore[union-attr]
+            if found is None:
+                found = names[e.name] = x.Var(new + e.name[cut:])  # type: ignore[union-attr]
+            return found
+        if kind is x.BinOp:
+            return x.BinOp(e.op, rename(e.left), rename(e.right))  # type: ignore[union-attr]
+        if kind is x.Const or kind is x.Time:
+            return e
+        if kind is x.Call:
+            return x.Call(e.name, tuple(rename(a) for a in e.args))  # type: ignore[union-attr]
+        if kind is x.If:
+            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))  # type: ignore
+        return kind(rename(e.arg))  # type: ignore[union-attr, call-arg]  # Neg, Not, Der
+
+    return rename

@@ -1,0 +1,409 @@
+"""Evaluate syntax expressions in an instance scope: syntax.Expr -> arrays.Value.
+
+Variables and parameters become :class:`~springc.expr.Var` of their flat names,
+constants and loop indices are folded, arrays follow Modelica semantics. Structural
+values (array sizes, ranges, subscripts, ``if``-equation conditions) are reduced to
+numbers through the parameters' bindings with :meth:`Evaluator.constant`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import arrays as a
+from ..ir import expr as x
+from ..ir import syntax as s
+from .builtins import CONSTANTS, Builtins
+from ..errors import FlattenError, Note
+from .scope import ClassScope, LocalScope, Primitive
+from ..parse.loader import ClassEntry
+
+if TYPE_CHECKING:
+    from .flattener import Flattener
+
+UNSUPPORTED_CALLS = {
+    "pre", "edge", "change", "initial", "terminal", "reinit", "sample", "hold",
+    "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
+    "delay", "spatialDistribution", "cardinality", "inStream", "actualStream",
+    "getInstanceName", "String", "assert", "terminate",
+}
+
+
+# Scalar expression types, and the builders that arrays.add & co. apply to two scalars.
+_SCALARS = frozenset({x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If})
+_ARITHMETIC = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
+
+
+class Evaluator:
+    """Evaluates expressions for one flattening run (it shares the flattener's caches)."""
+
+    def __init__(self, flattener: Flattener) -> None:
+        self.flattener = flattener
+        self.no_event = 0
+        self.builtins = Builtins(self)
+        # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
+        # outlives the evaluator, so ids are not reused).
+        self.uses_end: dict[int, bool] = {}
+
+    # ------------------------------------------------------------ entry points
+
+    def value(self, e: s.Expr, scope: Any) -> a.Value:
+        method = getattr(self, "_" + type(e).__name__)
+        return method(e, scope)
+
+    def scalar(self, e: s.Expr, scope: Any) -> x.Expr:
+        v = self.value(e, scope)
+        if a.is_array(v) or isinstance(v, str):
+            raise FlattenError(f"expected a scalar, found {self.describe(v)}", e.span)
+        return v  # type: ignore[return-value]
+
+    def constant(self, e: s.Expr, scope: Any, what: str,
+                 hint: str = "use parameters and constants with values here") -> Any:
+        """Numeric value (number or numpy array) of a parameter expression."""
+        v = self.value(e, scope)
+        try:
+            return self.fold(v)
+        except KeyError as missing:
+            raise FlattenError(
+                f"{what} must be a parameter expression, but it depends on "
+                f"{missing.args[0]}", e.span, hint=hint) from None
+        except (ArithmeticError, ValueError, TypeError) as err:
+            raise FlattenError(f"cannot evaluate {what}: {err}", e.span) from None
+
+    def integer(self, e: s.Expr, scope: Any, what: str) -> int:
+        v = self.constant(e, scope, what)
+        if isinstance(v, (np.ndarray, bool)) or v != int(v):
+            raise FlattenError(f"{what} must be an integer, found {v!r}", e.span)
+        return int(v)
+
+    def fold(self, v: a.Value) -> Any:
+        """Evaluate a value numerically through parameter bindings (KeyError if not)."""
+        if isinstance(v, str):
+            return v
+        if a.is_array(v):
+            out = np.empty(v.shape, dtype=object)
+            for idx, item in np.ndenumerate(v):
+                out[idx] = self.fold(item)
+            return out
+        return x.evaluate(v, self.flattener.parameter_values)
+
+    def describe(self, v: Any) -> str:
+        if isinstance(v, str):
+            return "a string"
+        if isinstance(v, (ClassScope, ClassEntry)) or (a.is_array(v) and v.size and
+                                                     isinstance(v.flat[0], ClassScope)):
+            return "a component"
+        return f"an array of size {a.describe_shape(a.shape(v))}" if a.is_array(v) \
+            else "a scalar"
+
+    # ----------------------------------------------------------------- literals
+
+    def _Number(self, e: s.Number, scope: Any) -> a.Value:
+        return x.Const(e.value)
+
+    def _Bool(self, e: s.Bool, scope: Any) -> a.Value:
+        return x.Const(e.value)
+
+    def _String(self, e: s.String, scope: Any) -> a.Value:
+        return e.value
+
+    def _ArrayLit(self, e: s.ArrayLit, scope: Any) -> a.Value:
+        return self._stack([self.value(i, scope) for i in e.items], e.span)
+
+    def _stack(self, values: list[a.Value], span: s.Span) -> a.Value:
+        try:
+            return a.stack(values)
+        except ValueError as err:
+            raise FlattenError(str(err), span) from None
+
+    def _MatrixLit(self, e: s.MatrixLit, scope: Any) -> a.Value:
+        rows = []
+        for row in e.rows:
+            parts = [self._as_matrix(self.value(i, scope)) for i in row]
+            if len({p.shape[0] for p in parts}) > 1:
+                raise FlattenError("rows of a matrix constructor differ in size", e.span)
+            rows.append(np.concatenate(parts, axis=1))
+        if len({r.shape[1] for r in rows}) > 1:
+            raise FlattenError("columns of a matrix constructor differ in size", e.span)
+        return np.concatenate(rows, axis=0)
+
+    @staticmethod
+    def _as_matrix(v: a.Value) -> np.ndarray:
+        if not a.is_array(v):
+            return a.make_array([v], (1, 1))
+        return v.reshape(-1, 1) if v.ndim == 1 else v
+
+    def _Range(self, e: s.Range, scope: Any) -> a.Value:
+        start = self.constant(e.start, scope, "a range bound")
+        stop = self.constant(e.stop, scope, "a range bound")
+        step = self.constant(e.step, scope, "a range step") if e.step else 1
+        if step == 0:
+            raise FlattenError("the step of a range must not be zero", e.span)
+        count = max(0, math.floor((stop - start) / step + 1e-10) + 1)
+        values = [start + i * step for i in range(count)]
+        if all(isinstance(v, int) for v in (start, step)):
+            values = [int(v) for v in values]
+        return a.make_array([x.Const(v) for v in values])
+
+    def _Colon(self, e: s.Colon, scope: Any) -> a.Value:
+        raise FlattenError("':' is only allowed as a subscript", e.span)
+
+    def _End(self, e: s.End, scope: Any) -> a.Value:
+        end = getattr(scope, "end_value", None)
+        if end is None:
+            raise FlattenError("'end' is only allowed inside a subscript", e.span)
+        return x.Const(end)
+
+    # ------------------------------------------------------------------ operators
+
+    def _Unary(self, e: s.Unary, scope: Any) -> a.Value:
+        v = self.value(e.operand, scope)
+        self._numeric(v, e.operand.span)
+        if e.op == "-":
+            return a.elementwise(x.neg, v)
+        if e.op == "+":
+            return v
+        return a.elementwise(lambda b: x.Const(not b.value) if isinstance(b, x.Const)
+                             else x.Not(b), v)
+
+    def _numeric(self, v: Any, span: s.Span) -> None:
+        if isinstance(v, (str, ClassScope)) or (
+                a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
+            raise FlattenError(f"expected a number, found {self.describe(v)}", span)
+
+    def _Binary(self, e: s.Binary, scope: Any) -> a.Value:
+        left = self.value(e.left, scope)
+        right = self.value(e.right, scope)
+        scalar = _ARITHMETIC.get(e.op)
+        if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
+            return scalar(left, right)  # the common case: no sizes to check
+        self._numeric(left, e.left.span)
+        self._numeric(right, e.right.span)
+        op = e.op
+        try:
+            if op == "+":
+                return a.add(left, right)
+            if op == "-":
+                return a.sub(left, right)
+            if op == "*":
+                return a.mul(left, right)
+            if op == "/":
+                return a.div(left, right)
+            if op == "^":
+                return a.power(left, right)
+            if op.startswith("."):
+                return a.elementwise(a.scalar_op(op[1:]), left, right)
+            if a.is_array(left) or a.is_array(right):
+                raise ValueError(f"'{op}' needs scalar operands")
+        except ValueError as err:
+            raise FlattenError(str(err), e.span,
+                               hint="check the sizes of both operands") from None
+        result = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
+        if op in x.RELATIONS and not isinstance(result, x.Const):
+            self._check_event(result, e.span)
+        return result
+
+    def _check_event(self, relation: x.Expr, span: s.Span) -> None:
+        if self.no_event or self.flattener.is_parameter_expression(relation):
+            return
+        raise FlattenError(
+            "relations on variables generate events, which are not supported yet",
+            span, hint="if the expression is continuous across the switch, wrap it in "
+            "noEvent(...)")
+
+    def _IfExpr(self, e: s.IfExpr, scope: Any) -> a.Value:
+        result = self.value(e.otherwise, scope)
+        for cond_expr, then_expr in reversed(e.branches):
+            cond = self.scalar(cond_expr, scope)
+            if isinstance(cond, x.Const):
+                if cond.value:
+                    result = self.value(then_expr, scope)
+                continue
+            then = self.value(then_expr, scope)
+            if a.shape(then) != a.shape(result):
+                raise FlattenError("branches of an if-expression differ in size", e.span)
+            if not self.no_event and not self.flattener.is_parameter_expression(cond):
+                self._check_event(cond, cond_expr.span)
+            result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
+        return result
+
+    # ------------------------------------------------------------------ references
+
+    def _Ref(self, e: s.Ref, scope: Any) -> a.Value:
+        v = self.reference(e, scope)
+        if isinstance(v, (ClassEntry, ClassScope)) or (
+                a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
+            raise FlattenError(f"'{e.dotted}' is a component or class, not a value", e.span,
+                               hint="refer to one of its variables, e.g. "
+                               f"'{e.dotted}.<name>'")
+        return v
+
+    def reference(self, e: s.Ref, scope: Any) -> Any:
+        """Follow a component reference; the result may be a scope or array of scopes."""
+        first = e.parts[0]
+        if first.name == "Modelica" and e.dotted in CONSTANTS:
+            return x.Const(CONSTANTS[e.dotted])
+        current = scope.lookup(first.name, first.span)
+        current = self._subscript(current, first, scope)
+        for part in e.parts[1:]:
+            current = self._select(current, part, scope, e)
+        return current
+
+    def _select(self, current: Any, part: s.RefPart, scope: Any, ref: s.Ref) -> Any:
+        if isinstance(current, ClassEntry):
+            found = self.flattener.class_member(current, part.name, part.span)
+            return self._subscript(found, part, scope)
+        if isinstance(current, ClassScope):
+            if not current.has_member(part.name):
+                self._no_member(current, part)
+            return self._subscript(current.member(part.name, part.span), part, scope)
+        if a.is_array(current) and current.size and isinstance(current.flat[0], ClassScope):
+            items = [self._select(c, part, scope, ref) for c in current.flat]
+            inner = a.shape(items[0])
+            out = np.empty(current.shape + inner, dtype=object)
+            for idx, item in zip(np.ndindex(current.shape), items):
+                out[idx] = item
+            return out
+        raise FlattenError(f"'{part.name}' cannot be selected from a value", part.span)
+
+    def _no_member(self, owner: ClassScope, part: s.RefPart) -> None:
+        import difflib
+
+        close = difflib.get_close_matches(part.name, list(owner.view.components), 1)
+        hint = f"did you mean '{close[0]}'?" if close else None
+        raise FlattenError(
+            f"'{owner.prefix}' (of class '{owner.entry.full_name}') has no element "
+            f"'{part.name}'", part.span,
+            [Note(f"class '{owner.entry.full_name}' is defined here", owner.entry.defn.span)],
+            hint)
+
+    def member_value(self, member: Any) -> Any:
+        return member.value if isinstance(member, Primitive) else member
+
+    def _subscript(self, current: Any, part: s.RefPart, scope: Any) -> Any:
+        value = self.member_value(current)
+        if not part.subscripts:
+            return value
+        dims = a.shape(value)
+        if len(part.subscripts) > len(dims):
+            raise FlattenError(f"'{part.name}' has {len(dims)} dimension(s) but "
+                               f"{len(part.subscripts)} subscript(s) are given", part.span)
+        index = tuple(self._index(sub, dims[k], scope, part)
+                      for k, sub in enumerate(part.subscripts))
+        result = value[index]
+        if isinstance(result, np.ndarray) and result.ndim == 0:
+            return result.item()
+        return result
+
+    def _index(self, sub: s.Expr, size: int, scope: Any, part: s.RefPart) -> Any:
+        if isinstance(sub, s.Colon):
+            return slice(None)
+        uses_end = self.uses_end.get(id(sub))
+        if uses_end is None:
+            uses_end = self.uses_end[id(sub)] = _uses_end(sub)
+        if uses_end:
+            scope = LocalScope({}, scope)
+            scope.end_value = size  # type: ignore[attr-defined]
+        v = self._loop_index(sub, scope)
+        if v is None:
+            v = self.constant(sub, scope, "a subscript")
+        values = list(v.flat) if isinstance(v, np.ndarray) else [v]
+        for i in values:
+            if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
+                raise FlattenError(
+                    f"index {i} is out of range for '{part.name}' of size {size}"
+                    + _loop_context(scope), sub.span,
+                    hint=f"subscripts of '{part.name}' run from 1 to {size}")
+        if isinstance(v, np.ndarray):
+            return np.array([int(i) - 1 for i in values], dtype=int)
+        return int(v) - 1
+
+    @staticmethod
+    def _loop_index(sub: s.Expr, scope: Any) -> Any:
+        """The value of a subscript that names a for-loop index (``p[i]``), the most
+        common subscript, without the general evaluator; None for any other."""
+        if type(sub) is not s.Ref or len(sub.parts) != 1 or sub.parts[0].subscripts:
+            return None
+        part = sub.parts[0]
+        while type(scope) is LocalScope:
+            if part.name in scope.names:
+                found = scope.names[part.name]
+                return found.value if type(found) is x.Const else None
+            scope = scope.parent
+        return None
+
+    # ------------------------------------------------------------------ calls
+
+    def _Call(self, e: s.Call, scope: Any) -> a.Value:
+        name = e.func.dotted
+        if name in UNSUPPORTED_CALLS:
+            raise FlattenError(f"`{name}` is not supported yet", e.func.span,
+                               hint="springc supports a subset of Modelica; see the "
+                               "\"Later\" list in LANGUAGE.md")
+        handler = self.builtins.lookup(name, scope)
+        if handler is not None:
+            return handler(e, scope)
+        entry = self.flattener.resolve_function(e.func, scope)
+        from .functions import call_function
+
+        args = [self.value(arg, scope) for arg in e.args]
+        named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
+        return call_function(self, entry, args, named, e)
+
+    def _Comprehension(self, e: s.Comprehension, scope: Any) -> a.Value:
+        return self._stack(list(self.iterate(e.body, e.indices, scope)), e.span)
+
+    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Any):
+        """Values of ``body`` for every combination of the iterators (first outermost)."""
+        ranges = [self.range_values(i, scope) for i in indices]
+        for combo in itertools.product(*ranges):
+            local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
+            yield self.value(body, local)
+
+    def range_values(self, index: s.ForIndex, scope: Any) -> list[x.Expr]:
+        if index.range is None:
+            raise FlattenError(f"the range of '{index.name}' must be given "
+                               f"('for {index.name} in 1:N')", index.span)
+        v = self.value(index.range, scope)
+        if not a.is_array(v) or v.ndim != 1:
+            raise FlattenError("a for-loop range must be a vector", index.range.span)
+        return [x.Const(self._plain(self.fold_at(item, index.range))) for item in v]
+
+    def fold_at(self, v: a.Value, e: s.Expr) -> Any:
+        try:
+            return self.fold(v)
+        except KeyError as missing:
+            raise FlattenError(f"a for-loop range must be a parameter expression, but it "
+                               f"depends on {missing.args[0]}", e.span) from None
+
+    @staticmethod
+    def _plain(v: Any) -> Any:
+        return int(v) if isinstance(v, float) and v.is_integer() else v
+
+
+def _uses_end(e: Any) -> bool:
+    """Whether a subscript expression contains ``end`` (which needs the dimension's
+    size in scope)."""
+    if isinstance(e, s.End):
+        return True
+    if isinstance(e, tuple):
+        return any(_uses_end(item) for item in e)
+    fields = getattr(e, "__dataclass_fields__", None)
+    if fields is None or isinstance(e, s.Span):
+        return False
+    return any(_uses_end(getattr(e, name)) for name in fields)
+
+
+def _loop_context(scope: Any) -> str:
+    """`` (with i = 3)``: the values of the enclosing for-loop indices, if any."""
+    values: list[str] = []
+    while isinstance(scope, LocalScope):
+        values = [f"{k} = {v.value}" for k, v in scope.names.items()
+                  if isinstance(v, x.Const) and isinstance(v.value, (int, np.integer))
+                  and not isinstance(v.value, bool)] + values
+        scope = scope.parent
+    return f" (with {', '.join(values)})" if values else ""

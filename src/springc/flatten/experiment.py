@@ -1,0 +1,42 @@
+"""The ``experiment`` annotation of the simulated model: simulation defaults."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ..ir import flat
+from ..ir import syntax as s
+from ..errors import FlattenError
+from .scope import ClassScope
+from ..parse.loader import ClassEntry
+
+if TYPE_CHECKING:
+    from .flattener import Flattener
+
+_FIELDS = {"StartTime": "start", "StopTime": "stop", "Interval": "interval",
+           "Tolerance": "tolerance"}
+
+
+def experiment_of(flattener: Flattener, entry: ClassEntry, top: ClassScope) -> flat.Experiment:
+    """Read ``annotation(experiment(StartTime, StopTime, Interval, Tolerance))``."""
+    annotation = entry.defn.annotation
+    if annotation is None:
+        return flat.Experiment()
+    values: dict[str, float] = {}
+    for arg in annotation.arguments:
+        if arg.path != ("experiment",) or arg.modification is None:
+            continue
+        for item in arg.modification.arguments:
+            key = _FIELDS.get(".".join(item.path))
+            if key is None or item.modification is None or item.modification.value is None:
+                continue
+            value = _number(flattener, item.modification.value, top)
+            values[key] = value
+    return flat.Experiment(**values)
+
+
+def _number(flattener: Flattener, e: s.Expr, top: ClassScope) -> float:
+    value = flattener.evaluator.constant(e, top, "an experiment setting")
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
+        raise FlattenError("experiment settings must be numbers", e.span)
+    return float(value)

@@ -1,0 +1,177 @@
+"""User-defined functions, inlined by executing their algorithm symbolically.
+
+Input: a function class and argument values. Output: the value of its first output.
+Assignments update an environment of values; ``for`` loops over parameter ranges are
+unrolled; an ``if`` whose condition is not a constant runs both branches and merges
+the assigned values with ``if``-expressions. The flat model therefore contains no
+function calls besides the scalar built-ins.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import arrays as a
+from ..ir import expr as x
+from ..ir import syntax as s
+from ..errors import FlattenError, Note
+from ..parse.loader import ClassEntry
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+
+MAX_DEPTH = 50
+
+
+@dataclass(eq=False)
+class FunctionScope:
+    """Variables of one function call, over the function's package (for constants)."""
+
+    names: dict[str, Any]
+    parent: Any
+    entry: ClassEntry
+
+    def lookup(self, name: str, span: s.Span) -> Any:
+        if name not in self.names:
+            return self.parent.lookup(name, span)
+        value = self.names[name]
+        if value is None:
+            raise FlattenError(f"'{name}' is used before it is assigned", span)
+        return value
+
+
+def call_function(ev: Evaluator, entry: ClassEntry, args: list[a.Value],
+                  named: dict[str, tuple[a.Value, s.Span]], call: s.Call) -> a.Value:
+    depth = getattr(ev, "call_depth", 0)
+    if depth > MAX_DEPTH:
+        raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
+                           call.span, hint="recursive functions are not supported")
+    view = ev.flattener.view(entry)
+    comps = [c.decl for c in view.components.values()]
+    inputs = [c for c in comps if c.causality == "input"]
+    outputs = [c for c in comps if c.causality == "output"]
+    if not outputs:
+        raise FlattenError(f"function '{entry.full_name}' has no output", call.span)
+    if len(args) > len(inputs):
+        raise FlattenError(f"'{entry.full_name}' takes {len(inputs)} input(s), "
+                           f"{len(args)} given", call.span,
+                           [Note("function defined here", entry.defn.span)])
+    package = ev.flattener.package_scope(entry.parent or entry)
+    scope = FunctionScope({}, package, entry)
+    given = dict(zip((c.name for c in inputs), args))
+    for name, (value, span) in named.items():
+        if name not in {c.name for c in inputs}:
+            raise FlattenError(f"'{entry.full_name}' has no input '{name}'", span)
+        if name in given:
+            raise FlattenError(f"input '{name}' is given twice", span)
+        given[name] = value
+    ev.call_depth = depth + 1  # type: ignore[attr-defined]
+    try:
+        for comp in comps:
+            _declare(ev, scope, comp, given, call)
+        _run(ev, entry.defn.algorithm, scope)
+        result = scope.names[outputs[0].name]
+    finally:
+        ev.call_depth = depth  # type: ignore[attr-defined]
+    if result is None:
+        raise FlattenError(f"output '{outputs[0].name}' of '{entry.full_name}' is never "
+                           "assigned", call.span, [Note("declared here", outputs[0].span)])
+    return result
+
+
+def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
+             given: dict[str, a.Value], call: s.Call) -> None:
+    if comp.name in given:
+        scope.names[comp.name] = given[comp.name]
+        return
+    mod = comp.modification
+    if mod is not None and mod.value is not None:
+        scope.names[comp.name] = ev.value(mod.value, scope)
+        return
+    if comp.causality == "input":
+        raise FlattenError(f"input '{comp.name}' is missing in this call", call.span,
+                           [Note("declared here", comp.span)])
+    dims = [d for d in comp.type_dims + comp.dims]
+    if dims:
+        sizes = tuple(ev.integer(d, scope, "an array size") for d in dims)
+        out = np.empty(sizes, dtype=object)
+        out.fill(x.ZERO)
+        scope.names[comp.name] = out
+    else:
+        scope.names[comp.name] = None
+
+
+def _run(ev: Evaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
+    for stmt in body:
+        if isinstance(stmt, s.Assign):
+            _assign(ev, stmt, scope)
+        elif isinstance(stmt, s.ForStatement):
+            _for(ev, stmt, stmt.indices, scope)
+        else:
+            _if(ev, stmt, scope)
+
+
+def _for(ev: Evaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
+         scope: FunctionScope) -> None:
+    index, rest = indices[0], indices[1:]
+    for value in ev.range_values(index, scope):
+        scope.names[index.name] = value
+        if rest:
+            _for(ev, stmt, rest, scope)
+        else:
+            _run(ev, stmt.body, scope)
+    scope.names.pop(index.name, None)
+
+
+def _if(ev: Evaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
+    branches = list(stmt.branches)
+    if not branches:
+        _run(ev, stmt.otherwise, scope)
+        return
+    cond_expr, body = branches[0]
+    cond = ev.scalar(cond_expr, scope)
+    rest = s.IfStatement(tuple(branches[1:]), stmt.otherwise, stmt.span)
+    if isinstance(cond, x.Const):
+        _run(ev, body, scope) if cond.value else _if(ev, rest, scope)
+        return
+    before = dict(scope.names)
+    _run(ev, body, scope)
+    then_names = scope.names
+    scope.names = dict(before)
+    _if(ev, rest, scope)
+    for name, then_value in then_names.items():
+        other = scope.names.get(name)
+        if then_value is other or name not in before:
+            continue
+        if then_value is None or other is None:
+            raise FlattenError(f"'{name}' is assigned in only one branch of this if-statement",
+                               stmt.span, hint="assign it before the if-statement too")
+        scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
+
+
+def _assign(ev: Evaluator, stmt: s.Assign, scope: FunctionScope) -> None:
+    if len(stmt.targets) != 1 or stmt.targets[0] is None:
+        raise FlattenError("assignments to several outputs are not supported yet", stmt.span)
+    target = stmt.targets[0]
+    value = ev.value(stmt.value, scope)
+    part = target.parts[0]
+    if len(target.parts) > 1 or part.name not in scope.names:
+        raise FlattenError(f"'{target.dotted}' is not a variable of this function",
+                           target.span)
+    if not part.subscripts:
+        scope.names[part.name] = value
+        return
+    current = scope.names[part.name]
+    if not a.is_array(current):
+        raise FlattenError(f"'{part.name}' is not an array", part.span)
+    updated = current.copy()
+    index = tuple(slice(None) if isinstance(sub, s.Colon) else
+                  ev.integer(sub, scope, "a subscript") - 1 for sub in part.subscripts)
+    try:
+        updated[index] = value
+    except (IndexError, ValueError) as err:
+        raise FlattenError(f"cannot assign to '{target.dotted}': {err}", stmt.span) from None
+    scope.names[part.name] = updated

@@ -1,0 +1,248 @@
+"""Instantiation of components while flattening, as methods of
+:class:`~springc.flatten.Flattener`.
+
+Input: a component declaration seen from an instance (:class:`ClassScope`) and the
+modifications that reach it. Output: a :class:`Primitive` (with its binding equations
+and parameter bindings recorded), a :class:`ClassScope`, or an array of them.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from . import arrays as a
+from ..ir import expr as x
+from ..ir import flat
+from ..ir import syntax as s
+from ..errors import FlattenError, Note
+from .scope import ClassScope, ClassView, Primitive, ResolvedType, ViewComponent, instance_mod
+from .modification import Mod, ModValue, each, from_syntax, merge_all, select
+from .variables import check_attribute_mods
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+    from .flattener import ParameterValues
+
+
+class Instantiation:
+    """Member instantiation; mixed into the Flattener, which provides the caches and
+    the lookup methods (``view``, ``resolve_type``, ``package_scope``)."""
+
+    evaluator: Evaluator
+    parameter_values: ParameterValues
+    equations: list[flat.Equation]
+    mod_values: dict[tuple[int, int], tuple[Any, a.Value]]
+    declared_types: dict[int, Declared]
+
+    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
+        decl = comp.decl
+        declared = self.declared_type(comp)
+        rtype = declared.rtype
+        name = scope.flat_name(decl.name)
+        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
+        own = from_syntax(decl.modification, scope)
+        if outer is None and own is None and len(declared.type_mods) <= 1:
+            mod = declared.type_mods[0] if declared.type_mods else None  # nothing to merge
+        else:
+            mod = merge_all([outer, own, *declared.type_mods], name)
+        if decl.final and outer is not None:
+            raise FlattenError(f"'{name}' is final and cannot be "
+                               "modified", outer.span, [Note("declared final here",
+                                                              decl.span)])
+        dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
+        if rtype.primitive is not None:
+            return self._primitive(scope, decl, rtype, mod, dims, name)
+        assert rtype.entry is not None
+        if rtype.entry.defn.kind in ("function", "package"):
+            raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
+                               "cannot be instantiated", decl.type_name.span)
+        view = self.view(rtype.entry)
+        if not dims:
+            return self._class_scope(name, view, mod, decl, scope)
+        if mod is not None:
+            self._check_array_mod(mod, dims, name, "")
+        out = np.empty(dims, dtype=object)
+        for idx in np.ndindex(dims):
+            sub = tuple(i + 1 for i in idx)
+            out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
+                                         select(mod, sub), decl, scope)
+        return out
+
+    def _check_array_mod(self, mod: Mod, dims: tuple[int, ...], name: str, path: str
+                         ) -> None:
+        """Values (without ``each``) modifying an array of components must start with
+        the array's sizes: ``Mass m[3](s0 = {1, 2, 3})``."""
+        if mod.each:
+            return
+        if mod.value is not None:
+            value = self.mod_value(mod.value)
+            if not isinstance(value, str) and a.shape(value)[:len(dims)] != dims:
+                raise FlattenError(
+                    f"the value of '{path or name}' has size {a.describe_shape(a.shape(value))}, "
+                    f"but '{name}' is an array of components of size "
+                    f"{a.describe_shape(dims)}", mod.value.span,
+                    hint="give one value per element, or use `each` to give every element "
+                    "the same value")
+        for key, child in mod.children.items():
+            self._check_array_mod(child, dims, name, f"{path}.{key}" if path else key)
+
+    def declared_type(self, comp: ViewComponent) -> Declared:
+        """The resolved type of a declaration and its type modifiers, computed once."""
+        key = id(comp)
+        found = self.declared_types.get(key)
+        if found is None:
+            rtype = self.resolve_type(comp.decl.type_name, comp.defined_in)
+            # A type's own modifications apply to every element of an array of that type.
+            mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
+                    for m, e in rtype.mods]
+            found = self.declared_types[key] = Declared(comp, rtype, mods,
+                                                        _literal_dims(comp.decl, rtype))
+        return found
+
+    def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
+                     parent: ClassScope) -> ClassScope:
+        scope = ClassScope(self, name, view, None, decl.span, parent)
+        if mod is not None or view.extends_mods:
+            scope.mod = instance_mod(mod, view, scope)
+        if scope.mod is not None:
+            for key, child in scope.mod.children.items():
+                if key not in view.components:
+                    self._unknown_target(key, child, view, name)
+            if scope.mod.value is not None:
+                raise FlattenError(f"'{name}' is a component of class "
+                                   f"'{view.entry.full_name}' and cannot be given a value",
+                                   scope.mod.value.span)
+        return scope
+
+    def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
+        import difflib
+
+        close = difflib.get_close_matches(key, list(view.components), 1)
+        raise FlattenError(
+            f"'{name}' (of class '{view.entry.full_name}') has no element '{key}' to modify",
+            child.span, [Note(f"class '{view.entry.full_name}' is defined here",
+                              view.entry.defn.span)],
+            f"did you mean '{close[0]}'?" if close else
+            f"the elements of '{view.entry.full_name}' are: "
+            + ", ".join(view.components))
+
+    def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType
+              ) -> tuple[int, ...]:
+        exprs = [(d, scope) for d in decl.dims + decl.type_dims]
+        exprs += [(d, self.package_scope(e.parent or e)) for d, e in rtype.dims]
+        dims = []
+        for d, where in exprs:
+            if isinstance(d, s.Colon):
+                raise FlattenError("the size of this dimension must be given ('[:]' is only "
+                                   "allowed for function inputs)", d.span)
+            n = self.evaluator.integer(d, where, "an array size")
+            if n < 0:
+                raise FlattenError(f"array size must not be negative, found {n}", d.span)
+            dims.append(n)
+        return tuple(dims)
+
+    def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
+                   mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
+        variability = decl.variability or rtype.prefixes[0] or (
+            "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous")
+        causality = decl.causality or rtype.prefixes[1]
+        check_attribute_mods(mod, rtype.primitive, name)
+        name_list = _element_names(name, dims)
+        names = a.make_array(name_list, dims) if dims else name
+        binding = self._binding(mod, dims, name, decl)
+        if variability == "constant":
+            if binding is None:
+                raise FlattenError(f"constant '{name}' needs a value", decl.span)
+            value = self.evaluator.fold(binding)
+            value = a.elementwise(lambda v: x.Const(v), value) if a.is_array(value) \
+                else x.Const(value)
+        else:
+            value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
+        prim = Primitive(names, value, decl, variability, causality,
+                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+        if variability in ("parameter", "constant"):
+            for n, b in zip(a.scalars(names), _binding_scalars(binding, dims)):  # type: ignore
+                self.parameter_values.bindings[n] = b
+        else:
+            prim_binding = binding
+            self._binding_equations(scope, prim, prim_binding)
+        return prim
+
+    def _binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
+                 ) -> a.Value | None:
+        if mod is None or mod.value is None:
+            return None
+        value = self.mod_value(mod.value)
+        if isinstance(value, str):
+            raise FlattenError(f"'{name}' cannot be given a string", mod.value.span)
+        if a.shape(value) != dims:
+            raise FlattenError(
+                f"'{name}' has size {a.describe_shape(dims)} but is given a value of size "
+                f"{a.describe_shape(a.shape(value))}", mod.value.span,
+                [Note("declared here", decl.span)],
+                "make the sizes agree, or use `each` to give every element the same value")
+        return value
+
+    def mod_value(self, mv: ModValue) -> a.Value:
+        """Evaluate a modification value where it was written, then pick the element."""
+        key = (id(mv.expr), id(mv.scope))
+        cached = self.mod_values.get(key)
+        if cached is None:
+            cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
+        value = cached[1]
+        for i in mv.index:
+            if not a.is_array(value) or value.shape[0] < i:
+                raise FlattenError(
+                    "the value of this modification is not an array matching the array "
+                    "of components it modifies", mv.span,
+                    hint="use `each` to give every element the same value")
+            value = value[i - 1]
+        return value
+
+    def _binding_equations(self, scope: ClassScope, prim: Primitive,
+                           binding: a.Value | None) -> None:
+        if binding is None:
+            return
+        origin = flat.Origin("binding", scope.prefix, prim.decl.name)
+        span = prim.mod.value.span if prim.mod and prim.mod.value else prim.decl.span
+        for v, b in zip(a.scalars(prim.value), a.scalars(binding)):
+            self.equations.append(flat.Equation(v, b, span, origin))
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What a component declaration contributes independently of the instance: its
+    resolved type, the type's modifications, and its sizes when they are literals."""
+
+    comp: ViewComponent  # kept alive: declared_types is keyed by its id
+    rtype: ResolvedType
+    type_mods: list[Mod | None]
+    dims: tuple[int, ...] | None
+
+
+def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | None:
+    """The sizes of a declaration if all are integer literals (``pos[2]``), else None."""
+    exprs = [*decl.dims, *decl.type_dims, *(d for d, _ in rtype.dims)]
+    if all(isinstance(d, s.Number) and type(d.value) is int for d in exprs):
+        return tuple(d.value for d in exprs)  # type: ignore[union-attr]
+    return None
+
+
+def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
+    """The flat names of the elements of ``name`` in row-major order (``x[1,2]``)."""
+    if not dims:
+        return [name]
+    if len(dims) == 1:
+        return [f"{name}[{i}]" for i in range(1, dims[0] + 1)]
+    indices = itertools.product(*(range(1, n + 1) for n in dims))
+    return [f"{name}[{','.join(map(str, idx))}]" for idx in indices]
+
+
+def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:
+    if binding is None:
+        return [None] * int(np.prod(dims, dtype=int))
+    return a.scalars(binding)

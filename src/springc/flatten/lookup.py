@@ -1,0 +1,221 @@
+"""Class lookup while flattening: type names, short class definitions, functions,
+package constants and global names, as methods of :class:`~springc.flatten.Flattener`.
+
+Input: references written in a class (``P.Mass``, ``Units.Length``, ``sin``) and the
+class they are written in. Output: class entries, resolved types or values. Also
+:func:`select_model`, which picks the class to flatten from a class tree.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from ..ir import expr as x
+from ..ir import syntax as s
+from .builtins import CONSTANTS
+from ..errors import FlattenError, Note
+from .scope import PRIMITIVES, ClassScope, ClassView, ResolvedType, build_view
+from ..parse.loader import ClassEntry, ClassTree, lookup_class, member_class
+from .modification import Mod, from_syntax
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+
+
+class ClassLookup:
+    """Class and name lookup; mixed into the Flattener, which provides the caches."""
+
+    tree: ClassTree
+    views: dict[int, ClassView]
+    package_scopes: dict[int, ClassScope]
+    evaluator: Evaluator
+
+    def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
+        found = self.views.get(id(entry))
+        if found is None:
+            found = self.views[id(entry)] = build_view(entry, self, seen)
+        return found
+
+    def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None
+                      ) -> ClassEntry:
+        for part in ref.parts:
+            if part.subscripts:
+                raise FlattenError("a class name cannot have subscripts", part.span)
+        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span)
+
+    def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
+        """Follow short class definitions down to a primitive type or a full class."""
+        name = ref.dotted
+        dims: list[tuple[s.Expr, Any]] = []
+        mods: list[tuple[s.Modification, ClassEntry]] = []
+        prefixes = ("", "", False)
+        if name in PRIMITIVES and lookup_class(name, scope) is None:
+            return ResolvedType(name, None, (), (), prefixes)
+        if name in ("String", "StateSelect") or name.startswith("Modelica."):
+            raise FlattenError(f"the type `{name}` is not supported yet", ref.span,
+                               hint="use Real, Integer, Boolean or classes of your own")
+        entry = self.resolve_class(ref, scope)
+        for _ in range(100):
+            short = entry.defn.short
+            if short is None:
+                return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
+            if short.modification is not None:
+                mods.append((short.modification, entry))
+            dims += [(d, entry) for d in short.dims]
+            prefixes = (prefixes[0] or short.variability, prefixes[1] or short.causality,
+                        prefixes[2] or short.flow)
+            base = short.base.dotted
+            if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
+                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes)
+            entry = self.resolve_class(short.base, entry.parent or entry)
+        raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
+
+    def follow_short(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:
+        """``model M2 = M(k = 2)``: the full class behind a short definition, and the
+        modifications met on the way (outermost first)."""
+        mods: list[Mod | None] = []
+        seen = 0
+        while entry.defn.short is not None and seen < 100:
+            short = entry.defn.short
+            if short.dims:
+                raise FlattenError("a model defined as an array is not supported", short.span)
+            mods.append(from_syntax(short.modification, self.package_scope(entry.parent
+                                                                            or entry)))
+            entry = self.resolve_class(short.base, entry.parent or entry)
+            seen += 1
+        if entry.defn.short is not None:
+            raise FlattenError(f"'{entry.full_name}' is defined in terms of itself",
+                               entry.defn.span)
+        return entry, mods
+
+    def find_function(self, name: str, scope: Any) -> ClassEntry | None:
+        entry = lookup_class(name, scope.entry)
+        return entry if entry is not None and entry.defn.kind == "function" else None
+
+    def resolve_function(self, ref: s.Ref, scope: Any) -> ClassEntry:
+        if lookup_class(ref.parts[0].name, scope.entry) is None:
+            import difflib
+
+            close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
+            raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
+                               hint=f"did you mean '{close[0]}'?" if close else
+                               "define it as a `function`, or load the file that defines it")
+        entry = self.resolve_class(ref, scope.entry)
+        if entry.defn.kind != "function":
+            raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
+                               ref.span, [Note("defined here", entry.defn.span)])
+        return entry
+
+    def class_member(self, entry: ClassEntry, name: str, span: s.Span) -> Any:
+        """``P.c``: a nested class or a constant of a package."""
+        nested = member_class(entry, name)
+        if nested is not None:
+            return nested
+        package = self.package_scope(entry)
+        if package.has_member(name):
+            return package.member(name, span)
+        raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
+
+    def package_scope(self, entry: ClassEntry) -> ClassScope:
+        scope = self.package_scopes.get(id(entry))
+        if scope is None:
+            view = self.view(entry)
+            scope = ClassScope(self, entry.full_name, view, None, entry.defn.span)
+            self.package_scopes[id(entry)] = scope
+        return scope
+
+    def lookup_global(self, name: str, entry: ClassEntry, span: s.Span) -> Any:
+        """A name not declared in the instance: time, a constant of an enclosing class,
+        a class (for dotted references), or a built-in constant."""
+        if name == "time":
+            return x.TIME
+        enclosing: ClassEntry | None = entry
+        while enclosing is not None:
+            view = self.view(enclosing) if enclosing.parent is not None else None
+            if view is not None and name in view.components and enclosing is not entry:
+                decl = view.components[name].decl
+                if decl.variability != "constant":
+                    raise FlattenError(
+                        f"'{name}' belongs to the enclosing class '{enclosing.full_name}'; "
+                        "only its constants are visible here", span,
+                        [Note("declared here", decl.span)])
+                return self.package_scope(enclosing).member(name, span)
+            enclosing = enclosing.parent
+        found = lookup_class(name, entry)
+        if found is not None:
+            return found
+        if name in CONSTANTS:
+            return x.Const(CONSTANTS[name])
+        raise FlattenError(f"undefined name '{name}'", span,
+                           hint="declare it, or check the spelling")
+
+
+def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
+    """The class to flatten: ``model`` by dotted name, else the last model of the last
+    user file."""
+    if model is not None:
+        parts = model.split(".")
+        entry: ClassEntry | None = tree.root
+        for part in parts:
+            entry = entry.classes.get(part) if entry is not None else None
+        if entry is None:
+            raise FlattenError(f"no class named '{model}' is loaded",
+                               hint=_model_hint(tree, model))
+        if entry.defn.kind not in ("model", "block", "class"):
+            inner = [e.full_name for e in entry.classes.values()
+                     if e.defn.kind in ("model", "block", "class")]
+            raise FlattenError(f"'{model}' is a {entry.defn.kind}, not a model",
+                               hint=("its models are: " + ", ".join(inner)) if inner
+                               else "give the dotted name of a model")
+        return entry
+    user_files = [f for f in tree.files if _from_user(tree, f)]
+    for stored in reversed(user_files):
+        for defn in reversed(stored.classes):
+            if defn.kind in ("model", "block", "class"):
+                return _entry_of(tree, stored, defn)
+    nested = [name for f in user_files for d in f.classes
+              for name in _models_below(_entry_of(tree, f, d))]
+    raise FlattenError("no model found in the given files",
+                       hint=f"choose a model with --model, e.g. --model {nested[0]}" if nested
+                       else "name a file that defines a model, or use --model")
+
+
+def _models_below(entry: ClassEntry) -> list[str]:
+    """Dotted names of the models nested in ``entry`` (depth first)."""
+    found = []
+    for inner in entry.classes.values():
+        if inner.defn.kind in ("model", "block", "class"):
+            found.append(inner.full_name)
+        found += _models_below(inner)
+    return found
+
+
+def _model_hint(tree: ClassTree, model: str) -> str:
+    import difflib
+
+    names: list[str] = []
+    pending = list(tree.root.classes.values())
+    while pending:
+        entry = pending.pop()
+        if entry.defn.kind in ("model", "block", "class"):
+            names.append(entry.full_name)
+        pending += entry.classes.values()
+    close = difflib.get_close_matches(model, sorted(names), 3, 0.8)
+    if close:
+        return "did you mean " + " or ".join(f"'{n}'" for n in close) + "?"
+    return "give the dotted name of a model in the loaded files, e.g. --model Scenes.Chain"
+
+
+def _from_user(tree: ClassTree, stored: s.StoredDefinition) -> bool:
+    package = tree.root
+    for part in stored.within or ():
+        package = package.classes.get(part, package)
+    return any(package.classes.get(d.name) is not None and package.classes[d.name].from_user
+               and package.classes[d.name].defn is d for d in stored.classes)
+
+
+def _entry_of(tree: ClassTree, stored: s.StoredDefinition, defn: s.ClassDef) -> ClassEntry:
+    package = tree.root
+    for part in stored.within or ():
+        package = package.classes[part]
+    return package.classes[defn.name]

@@ -1,0 +1,121 @@
+"""The simplified system: states, the steps that compute their derivatives, observed.
+
+Produced by :mod:`springc.simplify`. ``steps`` run in order and compute every
+algebraic variable and every state derivative (named ``der(x)``) from the states,
+the parameters and ``time``: explicit assignments, linear systems, and torn nonlinear
+systems solved by Newton's method with an analytic Jacobian.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from . import dae
+from ..errors import Span
+from .expr import Expr, to_text
+
+
+@dataclass(frozen=True, slots=True)
+class Assign:
+    """``name := expr``, solved from the equation at ``span``."""
+
+    name: str
+    expr: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class LinearBlock:
+    """Solve ``matrix @ names = rhs``; ``matrix`` entries ``(row, col, expr)``, sparse."""
+
+    names: tuple[str, ...]
+    matrix: tuple[tuple[int, int, Expr], ...]
+    rhs: tuple[Expr, ...]
+    spans: tuple[Span, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class NonlinearBlock:
+    """Newton iteration on ``tearing`` variables: ``inner`` computes the other block
+    variables from them, then ``residuals`` must vanish. ``sensitivities`` compute
+    ``d(inner)/d(tearing)`` (names ``d(a)/d(t)``) and ``jacobian`` holds
+    ``(row, col, expr)`` of d(residual)/d(tearing) in terms of them."""
+
+    tearing: tuple[str, ...]
+    inner: tuple[Assign, ...]
+    residuals: tuple[Expr, ...]
+    sensitivities: tuple[Assign, ...]
+    jacobian: tuple[tuple[int, int, Expr], ...]
+    spans: tuple[Span, ...]
+
+
+Step = Assign | LinearBlock | NonlinearBlock
+
+
+@dataclass(frozen=True, slots=True)
+class State:
+    name: str
+    derivative: str
+    start: Expr | None
+    fixed: bool
+    nominal: Expr | None
+    unit: str | None
+    span: Span
+
+
+@dataclass(frozen=True)
+class ODE:
+    name: str
+    states: tuple[State, ...]
+    steps: tuple[Step, ...]
+    observed: tuple[Assign, ...]
+    parameters: tuple[dae.Parameter, ...]
+    dae: dae.DAE
+
+    def step_names(self) -> list[str]:
+        """Every name computed by the steps, in order."""
+        out: list[str] = []
+        for step in self.steps:
+            if isinstance(step, Assign):
+                out.append(step.name)
+            elif isinstance(step, LinearBlock):
+                out += step.names
+            else:
+                out += step.tearing + tuple(a.name for a in step.inner)
+        return out
+
+    def observed_names(self) -> list[str]:
+        """Algebraic variables the user can ask for (derivative variables excluded)."""
+        computed = [n for n in self.step_names() if not n.startswith("der(")]
+        return computed + [a.name for a in self.observed]
+
+
+def _step_text(step: Step) -> list[str]:
+    if isinstance(step, Assign):
+        return [f"  {step.name} := {to_text(step.expr)}"]
+    if isinstance(step, LinearBlock):
+        return [f"  linear system for {', '.join(step.names)} "
+                f"({len(step.names)} unknowns, {len(step.matrix)} non-zeros)"]
+    lines = [f"  nonlinear system, tearing {', '.join(step.tearing)}:"]
+    lines += [f"    {a.name} := {to_text(a.expr)}" for a in step.inner]
+    lines += [f"    0 = {to_text(r)}" for r in step.residuals]
+    return lines
+
+
+def format_ode(ode: ODE) -> str:
+    """``springc flatten --simplify``: states, evaluation order and observed variables."""
+    observed = ode.observed_names()
+    lines = [f"model {ode.name}: {len(ode.states)} states, {len(observed)} observed, "
+             f"{len(ode.parameters)} parameters"]
+    lines.append("states:")
+    lines += [f"  {s.name}" + (f" (start {to_text(s.start)}"
+                               f"{', fixed' if s.fixed else ''})" if s.start is not None
+                               else "") for s in ode.states]
+    lines.append("evaluation order:")
+    for step in ode.steps:
+        lines += _step_text(step)
+    if ode.observed:
+        lines.append("aliases:")
+        lines += [f"  {a.name} = {to_text(a.expr)}" for a in ode.observed]
+    lines.append(f"observed: {', '.join(observed) if observed else '(none)'}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,355 @@
+"""The typed syntax tree produced by :mod:`springc.parse`.
+
+Every node is a frozen dataclass carrying the :class:`~springc.errors.Span` of the text
+it came from. Names are plain strings; dotted names are tuples of strings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import Span
+
+# ---------------------------------------------------------------- expressions
+
+
+@dataclass(frozen=True, slots=True)
+class Number:
+    """A numeric literal: ``int`` for ``1``, ``float`` for ``1.0`` or ``1e3``."""
+
+    value: int | float
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Bool:
+    value: bool
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class String:
+    """A string literal (only legal in attributes such as ``unit`` and in annotations)."""
+
+    value: str
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class RefPart:
+    """One segment of a component reference: ``pos[i]`` in ``ms[3].pos[i]``."""
+
+    name: str
+    subscripts: tuple[Expr, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Ref:
+    """A component or class reference such as ``ms[i].flange.f`` or ``Modelica.Constants.pi``."""
+
+    parts: tuple[RefPart, ...]
+    span: Span
+
+    @property
+    def dotted(self) -> str:
+        return ".".join(p.name for p in self.parts)
+
+
+@dataclass(frozen=True, slots=True)
+class Colon:
+    """The ``:`` subscript selecting a whole dimension."""
+
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class End:
+    """``end`` inside a subscript: the size of that dimension."""
+
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Unary:
+    """``op`` is ``"-"``, ``"+"`` or ``"not"``."""
+
+    op: str
+    operand: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Binary:
+    """``op`` is one of ``+ - * / ^ .+ .- .* ./ .^ < <= > >= == <> and or``."""
+
+    op: str
+    left: Expr
+    right: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class IfExpr:
+    """``if c1 then e1 elseif c2 then e2 else e3``."""
+
+    branches: tuple[tuple[Expr, Expr], ...]
+    otherwise: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class NamedArg:
+    name: str
+    value: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Call:
+    """A function call, including built-ins such as ``der(x)`` and ``sum(v)``."""
+
+    func: Ref
+    args: tuple[Expr, ...]
+    named: tuple[NamedArg, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ForIndex:
+    """``i in 1:N``; ``range`` is ``None`` for the implicit-range form ``for i loop``."""
+
+    name: str
+    range: Expr | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Comprehension:
+    """``{e for i in r}`` or the argument of ``sum(e for i in r)``."""
+
+    body: Expr
+    indices: tuple[ForIndex, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ArrayLit:
+    """``{a, b, c}``."""
+
+    items: tuple[Expr, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class MatrixLit:
+    """``[a, b; c, d]``: rows of horizontally concatenated expressions."""
+
+    rows: tuple[tuple[Expr, ...], ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Range:
+    """``start:stop`` or ``start:step:stop``."""
+
+    start: Expr
+    step: Expr | None
+    stop: Expr
+    span: Span
+
+
+Expr = (
+    Number | Bool | String | Ref | Colon | End | Unary | Binary | IfExpr | Call
+    | Comprehension | ArrayLit | MatrixLit | Range
+)
+
+# -------------------------------------------------------------- modifications
+
+
+@dataclass(frozen=True, slots=True)
+class Modification:
+    """``(arg, ...) = value``; either part may be absent."""
+
+    arguments: tuple[ElementModification, ...]
+    value: Expr | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ElementModification:
+    """``each final a.b(c = 1) = 2 "description"``; ``path`` is the dotted target."""
+
+    path: tuple[str, ...]
+    modification: Modification | None
+    each: bool
+    final: bool
+    span: Span
+
+
+# ------------------------------------------------------------------- elements
+
+
+@dataclass(frozen=True, slots=True)
+class Component:
+    """One declared component; ``Real a, b;`` yields two of these.
+
+    ``variability`` is ``""``, ``"parameter"``, ``"constant"`` or ``"discrete"``;
+    ``causality`` is ``""``, ``"input"`` or ``"output"``. ``type_dims`` are the
+    dimensions written on the type (``Real[2] x``), ``dims`` those on the name.
+    """
+
+    name: str
+    type_name: Ref
+    type_dims: tuple[Expr, ...]
+    dims: tuple[Expr, ...]
+    modification: Modification | None
+    variability: str
+    causality: str
+    flow: bool
+    final: bool
+    protected: bool
+    description: str
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Extends:
+    base: Ref
+    modification: Modification | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Import:
+    """``import A.B.C;`` (``names=("C",)``, alias ``None``), ``import D = A.B.C;``
+    (alias ``"D"``), ``import A.B.*;`` (``wildcard``), ``import A.B.{C, D};`` (``names``).
+    ``path`` is the package part, without the imported names."""
+
+    path: tuple[str, ...]
+    names: tuple[str, ...]
+    alias: str | None
+    wildcard: bool
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ShortDef:
+    """The right-hand side of ``type Force = Real(unit = "N")`` or ``model M2 = M(k = 2)``.
+
+    ``variability``/``causality``/``flow`` are base prefixes such as in
+    ``connector RealInput = input Real``.
+    """
+
+    base: Ref
+    dims: tuple[Expr, ...]
+    modification: Modification | None
+    variability: str
+    causality: str
+    flow: bool
+    span: Span
+
+
+# ------------------------------------------------------------------ equations
+
+
+@dataclass(frozen=True, slots=True)
+class Equality:
+    lhs: Expr
+    rhs: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Connect:
+    a: Ref
+    b: Ref
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ForEquation:
+    indices: tuple[ForIndex, ...]
+    body: tuple[Equation, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class IfEquation:
+    branches: tuple[tuple[Expr, tuple[Equation, ...]], ...]
+    otherwise: tuple[Equation, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class CallEquation:
+    """A call standing as an equation, such as ``assert(...)``."""
+
+    call: Call
+    span: Span
+
+
+Equation = Equality | Connect | ForEquation | IfEquation | CallEquation
+
+# ----------------------------------------------------------------- statements
+
+
+@dataclass(frozen=True, slots=True)
+class Assign:
+    """``target := value``; ``(a, b) := f(x)`` has several targets (``None`` for a gap)."""
+
+    targets: tuple[Ref | None, ...]
+    value: Expr
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class IfStatement:
+    branches: tuple[tuple[Expr, tuple[Statement, ...]], ...]
+    otherwise: tuple[Statement, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ForStatement:
+    indices: tuple[ForIndex, ...]
+    body: tuple[Statement, ...]
+    span: Span
+
+
+Statement = Assign | IfStatement | ForStatement
+
+# -------------------------------------------------------------------- classes
+
+
+@dataclass(frozen=True, slots=True)
+class ClassDef:
+    """A class of any kind (``model``, ``connector``, ``record``, ``package``, ``type``,
+    ``function``, ``block``, ``class``). A short definition has ``short`` set and no
+    elements. ``annotation`` keeps the class annotation (for ``experiment``)."""
+
+    name: str
+    kind: str
+    partial: bool
+    encapsulated: bool
+    description: str
+    elements: tuple[Element, ...]
+    equations: tuple[Equation, ...]
+    initial_equations: tuple[Equation, ...]
+    algorithm: tuple[Statement, ...]
+    short: ShortDef | None
+    annotation: Modification | None
+    protected: bool
+    span: Span
+
+
+Element = Component | Extends | Import | ClassDef
+
+
+@dataclass(frozen=True, slots=True)
+class StoredDefinition:
+    """One parsed file: an optional ``within`` path and its top-level classes."""
+
+    file: str
+    within: tuple[str, ...] | None
+    classes: tuple[ClassDef, ...]

@@ -1,0 +1,140 @@
+"""lark tokens and rule positions -> spans, names and located errors: what every rule group
+of :mod:`springc.build_syntax` shares.
+
+:class:`RuleBase` holds the builder's state (file, collected errors, ``end``s awaiting a
+subscript) and the helpers the rule methods call; the intermediate results defined here
+(:class:`Rejected`, :class:`Subs`, :class:`ClassMod`, :class:`Annotation`) pass between rules
+of different groups and never leave the builder.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from lark import Token
+
+from ..errors import Note, ParseError, Span
+from ..ir.syntax import ElementModification, End, Expr, Modification, Ref, RefPart
+
+LATER = "springc supports a subset of Modelica; see the \"Later\" list in LANGUAGE.md"
+
+KEYWORDS = frozenset(
+    [
+        "algorithm", "and", "annotation", "block", "break", "class", "connect", "connector",
+        "constant", "constrainedby", "der", "discrete", "each", "else", "elseif", "elsewhen",
+        "encapsulated", "end", "enumeration", "equation", "expandable", "extends", "external",
+        "false", "final", "flow", "for", "function", "if", "import", "impure", "in", "initial",
+        "inner", "input", "loop", "model", "not", "operator", "or", "outer", "output", "package",
+        "parameter", "partial", "protected", "public", "pure", "record", "redeclare",
+        "replaceable", "return", "stream", "then", "true", "type", "when", "while", "within",
+    ]
+)
+# `der` and `initial` are also called as ordinary functions (see the grammar).
+_FUNCTION_WORDS = frozenset({"der", "initial"})
+
+_ESCAPES = {"'": "'", '"': '"', "?": "?", "\\": "\\", "a": "\a", "b": "\b", "f": "\f",
+            "n": "\n", "r": "\r", "t": "\t", "v": "\v"}
+_ESCAPE = re.compile(r"\\(.)", re.S)
+
+
+# ------------------------------------------- intermediate results shared by rule groups
+
+
+@dataclass(frozen=True, slots=True)
+class Rejected:
+    """Stands in for an unsupported construct; its error is already recorded."""
+
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Subs:
+    """Array subscripts ``[...]``."""
+
+    items: tuple[Expr, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class ClassMod:
+    """A class modification ``(...)``."""
+
+    arguments: tuple[ElementModification, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Annotation:
+    modification: Modification
+
+
+# ------------------------------------------------------------------- helpers
+
+
+def tokens(children: list) -> list[Token]:
+    return [c for c in children if isinstance(c, Token)]
+
+
+def of(children: list, kind: type):
+    """The first child of type ``kind``, or ``None``."""
+    return next((c for c in children if isinstance(c, kind)), None)
+
+
+def join(a: Span, b: Span) -> Span:
+    return Span(a.file, a.line, a.column, b.end_line, b.end_column)
+
+
+class RuleBase:
+    """State and helpers of the rule methods (see :class:`springc.build_syntax.SyntaxBuilder`)."""
+
+    file: str
+    errors: list[ParseError]
+    _loose_ends: list[End]  # `end`s not yet known to sit in a subscript
+
+    def _span(self, meta) -> Span:
+        return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
+
+    def _tspan(self, tok: Token) -> Span:
+        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
+
+    def _kw(self, meta, word: str) -> Span:
+        """The span of the keyword ``word`` that starts the rule at ``meta``."""
+        return Span(self.file, meta.line, meta.column, meta.line, meta.column + len(word))
+
+    def _error(self, message: str, span: Span, hint: str | None = None,
+               notes: Iterable[Note] = ()) -> None:
+        self.errors.append(ParseError(message, span, notes, hint))
+
+    def _reject(self, what: str, span: Span, hint: str | None = LATER) -> Rejected:
+        self._error(f"{what} not supported yet", span, hint)
+        return Rejected(span)
+
+    def _ident(self, tok: Token, function: bool = False) -> str:
+        """The name written by ``tok`` (without quotes); reserved words are errors,
+        except ``der``/``initial`` as the ``function`` name of a call."""
+        if tok.startswith("'"):
+            return self._unescape(tok[1:-1], tok)
+        if tok in KEYWORDS and not (function and tok in _FUNCTION_WORDS):
+            self._error(f"'{tok}' is a reserved word and cannot be used as a name",
+                        self._tspan(tok))
+        return str(tok)
+
+    def _ref(self, toks: tuple[Token, ...]) -> Ref:
+        parts = tuple(RefPart(self._ident(t), (), self._tspan(t)) for t in toks)
+        return Ref(parts, join(parts[0].span, parts[-1].span))
+
+    def _unescape(self, body: str, token: Token) -> str:
+        """Resolve Modelica's escapes (``\\n``, ``\\"``, ...) in a string or quoted name."""
+        if "\\" not in body:
+            return body
+
+        def one(m: re.Match) -> str:
+            if m.group(1) in _ESCAPES:
+                return _ESCAPES[m.group(1)]
+            self._error(f"invalid escape '\\{m.group(1)}'", self._tspan(token),
+                        hint="Modelica knows \\' \\\" \\? \\\\ \\a \\b \\f \\n \\r \\t \\v")
+            return m.group(1)
+
+        return _ESCAPE.sub(one, body)

@@ -1,0 +1,214 @@
+"""Stored-definition and class rules -> :class:`springc.syntax.StoredDefinition` and
+:class:`springc.syntax.ClassDef`.
+
+:class:`ClassRules` has one method per rule of ``grammar/modelica.lark`` for the file
+(``within``, top-level classes), class definitions (long, short, ``enumeration``,
+``class extends``) and their sections; a class's sections are sorted into elements,
+equations and algorithms here, and unsupported class kinds and sections become located
+``... not supported yet`` errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from lark import Token
+
+from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
+from .rules_elements import causality, variability
+from ..errors import Note, Span
+from ..ir.syntax import ClassDef, Component, Element, Modification, ShortDef, StoredDefinition
+
+
+@dataclass(frozen=True, slots=True)
+class _Within:
+    path: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class _Section:
+    """A composition section: ``kind`` is public, protected, equation,
+    initial equation, algorithm, initial algorithm or external."""
+
+    kind: str
+    items: tuple
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class _Spec:
+    """The part of a class definition after its prefixes."""
+
+    name: Token
+    description: str
+    sections: tuple[_Section, ...]
+    short: ShortDef | None
+    annotation: Modification | None
+    end_name: Token | None
+
+
+def _section_rule(kind: str):
+    """The rule method for a section that starts with the keyword(s) ``kind``."""
+
+    def method(self: RuleBase, meta, ch) -> _Section:
+        items = [i for c in ch for i in (c if isinstance(c, tuple) else (c,))]
+        return _Section(kind, tuple(items), self._kw(meta, kind.split()[0]))
+
+    return method
+
+
+def _merge_annotations(first: Modification | None,
+                       more: tuple[Modification, ...]) -> Modification | None:
+    mods = ([first] if first else []) + list(more)
+    if len(mods) <= 1:
+        return mods[0] if mods else None
+    return Modification(tuple(a for m in mods for a in m.arguments), None, mods[0].span)
+
+
+class ClassRules(RuleBase):
+    """The rules of the stored definition, class definitions and sections."""
+
+    # ----------------------------------------------------------- stored definition
+
+    def start(self, meta, ch):
+        within = of(ch, _Within)
+        classes = tuple(c for c in ch if isinstance(c, ClassDef))
+        return StoredDefinition(self.file, within.path if within else None, classes)
+
+    def expression_start(self, meta, ch):
+        return ch[0]
+
+    def within_clause(self, meta, ch):
+        return _Within(tuple(self._ident(t) for t in ch[0]) if ch else ())
+
+    def top_class(self, meta, ch):
+        return ch[-1]
+
+    # ----------------------------------------------------------------- classes
+
+    def class_prefixes(self, meta, ch):
+        return [t for c in ch for t in (c if isinstance(c, list) else [c])]
+
+    def class_kind(self, meta, ch):
+        return list(ch)
+
+    def class_definition(self, meta, ch):
+        prefixes, spec = ch
+        if isinstance(spec, Rejected):
+            return spec
+        words = [str(t) for t in prefixes]
+        for tok in prefixes:
+            if tok in ("operator", "expandable", "impure"):
+                kind = {"operator": "`operator` classes are",
+                        "expandable": "`expandable` connectors are",
+                        "impure": "`impure` functions are"}[tok]
+                self._reject(kind, self._tspan(tok))
+        kind = words[-1]
+        name = self._ident(spec.name)
+        span = self._span(meta)
+        if spec.end_name is not None and spec.end_name != spec.name:
+            head = Span(self.file, meta.line, meta.column, spec.name.end_line,
+                        spec.name.end_column)
+            self._error(f"class '{name}' ends with 'end {spec.end_name}'",
+                        self._tspan(spec.end_name),
+                        hint=f"write 'end {spec.name};'",
+                        notes=[Note(f"class '{name}' starts here", head)])
+        body = self._body(spec.sections, kind)
+        return ClassDef(
+            name=name, kind=kind, partial="partial" in words,
+            encapsulated="encapsulated" in words, description=spec.description,
+            elements=body["elements"], equations=body["equation"],
+            initial_equations=body["initial equation"], algorithm=body["algorithm"],
+            short=spec.short,
+            annotation=_merge_annotations(spec.annotation, body["annotations"]),
+            protected=False, span=span,
+        )
+
+    def _body(self, sections: tuple[_Section, ...], kind: str) -> dict:
+        body: dict = {"elements": [], "equation": [], "initial equation": [], "algorithm": [],
+                      "annotations": []}
+        for section in sections:
+            if section.kind == "algorithm" and kind != "function":
+                self._reject("`algorithm` sections outside functions are", section.span,
+                             hint="use equations; springc accepts `algorithm` only in "
+                                  "functions (see the \"Later\" list in LANGUAGE.md)")
+            elif section.kind == "initial algorithm":
+                self._reject("`initial algorithm` sections are", section.span)
+            elif section.kind == "external":
+                self._reject("`external` functions are", section.span)
+            elif section.kind in ("equation", "initial equation") and kind == "function":
+                self._error(f"a function cannot have an `{section.kind}` section", section.span,
+                            hint="compute the outputs in an `algorithm` section")
+            for item in section.items:
+                if isinstance(item, Annotation):
+                    body["annotations"].append(item.modification)
+                elif isinstance(item, Rejected):
+                    continue
+                elif section.kind in ("public", "protected"):
+                    if section.kind == "protected" and isinstance(item, Component | ClassDef):
+                        item = replace(item, protected=True)
+                    body["elements"].append(item)
+                elif section.kind in body:
+                    body[section.kind].append(item)
+        return {k: tuple(v) for k, v in body.items()}
+
+    def long_class(self, meta, ch):
+        name, description, sections, end_name = ch
+        return _Spec(name, description, sections, None, None, end_name)
+
+    def extends_class(self, meta, ch):
+        return self._reject("`class extends` definitions are", self._kw(meta, "extends"))
+
+    def short_class(self, meta, ch):
+        name, prefixes, base = ch[0], ch[1], ch[2]
+        dims = of(ch, Subs)
+        mod = of(ch, ClassMod)
+        comment = ch[-1]
+        words = [str(t) for t in prefixes]
+        short = ShortDef(
+            base=base, dims=dims.items if dims else (),
+            modification=Modification(mod.arguments, None, mod.span) if mod else None,
+            variability=variability(words), causality=causality(words),
+            flow="flow" in words, span=join(base.span, self._span(meta)),
+        )
+        return _Spec(name, comment.description, (), short, comment.annotation, None)
+
+    def enum_class(self, meta, ch):
+        keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
+        return self._reject("`enumeration` types are", self._tspan(keyword))
+
+    def enum_body(self, meta, ch):
+        return None
+
+    enum_literal = enum_body
+
+    def composition(self, meta, ch):
+        elements = [i for c in ch if not isinstance(c, _Section) for i in c]
+        first = _Section("public", tuple(elements), self._span(meta) if not meta.empty
+                         else Span(self.file, 1, 1, 1, 1))
+        return (first, *(c for c in ch if isinstance(c, _Section)))
+
+    def element_item(self, meta, ch):
+        item = ch[0]
+        return (item,) if isinstance(item, Element | Annotation | Rejected) else tuple(item)
+
+    def equation_item(self, meta, ch):
+        return ch[0]
+
+    statement_item = equation_item
+
+    public_section = _section_rule("public")
+    protected_section = _section_rule("protected")
+    equation_section = _section_rule("equation")
+    initial_equation_section = _section_rule("initial equation")
+    algorithm_section = _section_rule("algorithm")
+    initial_algorithm_section = _section_rule("initial algorithm")
+
+    def external_part(self, meta, ch):
+        return _Section("external", (), self._kw(meta, "external"))
+
+    def external_clause(self, meta, ch):
+        return None
+
+    def external_call(self, meta, ch):
+        return None

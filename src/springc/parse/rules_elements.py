@@ -1,0 +1,200 @@
+"""Element and modification rules -> :mod:`springc.syntax` elements (``Component``,
+``Import``, ``Extends``) and ``Modification``s.
+
+:class:`ElementRules` has one method per rule of ``grammar/modelica.lark`` for
+declarations, imports, ``extends`` clauses, modifications and comments; unsupported
+prefixes and forms (``inner``/``outer``, ``redeclare``, ``replaceable``, ``stream``,
+conditional components, ``:=`` bindings) become located ``... not supported yet`` errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from lark import Token
+
+from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, of
+from ..errors import Span
+from ..ir.syntax import (
+    ClassDef,
+    Component,
+    ElementModification,
+    Expr,
+    Extends,
+    Import,
+    Modification,
+    Ref,
+)
+
+
+@dataclass(frozen=True, slots=True)
+class _Comment:
+    description: str
+    annotation: Modification | None
+
+
+@dataclass(frozen=True, slots=True)
+class _Decl:
+    name: str
+    dims: tuple[Expr, ...]
+    modification: Modification | None
+    description: str
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class _Clause:
+    prefixes: tuple[str, ...]
+    type_name: Ref
+    type_dims: tuple[Expr, ...]
+    declarations: tuple[_Decl, ...]
+
+
+def variability(words: list[str]) -> str:
+    """``parameter``, ``constant``, ``discrete`` or ``""``, from a list of prefixes."""
+    return next((w for w in words if w in ("parameter", "constant", "discrete")), "")
+
+
+def causality(words: list[str]) -> str:
+    """``input``, ``output`` or ``""``, from a list of prefixes."""
+    return next((w for w in words if w in ("input", "output")), "")
+
+
+class ElementRules(RuleBase):
+    """The rules of element declarations, imports, extends clauses and modifications."""
+
+    # ---------------------------------------------------------------- elements
+
+    def declaration_element(self, meta, ch):
+        prefixes, item = ch[0], ch[1]
+        words = [str(t) for t in prefixes]
+        for tok in prefixes:
+            if tok in ("redeclare", "replaceable"):
+                self._reject(f"`{tok}` is", self._tspan(tok))
+            elif tok in ("inner", "outer"):
+                self._reject(f"`{tok}` elements are", self._tspan(tok))
+        if len(ch) > 2 and "replaceable" not in words:
+            self._reject("`constrainedby` is", ch[2])
+        if isinstance(item, ClassDef | Rejected):
+            return [item]
+        words += list(item.prefixes)
+        return [
+            Component(
+                name=d.name, type_name=item.type_name, type_dims=item.type_dims, dims=d.dims,
+                modification=d.modification, variability=variability(words),
+                causality=causality(words), flow="flow" in words, final="final" in words,
+                protected=False, description=d.description, span=d.span,
+            )
+            for d in item.declarations
+        ]
+
+    def element_prefixes(self, meta, ch):
+        return list(ch)
+
+    def type_prefix(self, meta, ch):
+        for tok in ch:
+            if tok == "stream":
+                self._reject("`stream` connectors are", self._tspan(tok))
+        return list(ch)
+
+    def constraining_clause(self, meta, ch):
+        return self._kw(meta, "constrainedby")
+
+    def import_alias(self, meta, ch):
+        alias, path = ch[0], ch[1]
+        names = tuple(self._ident(t) for t in path)
+        return Import(names[:-1], names[-1:], self._ident(alias), False, self._span(meta))
+
+    def import_single(self, meta, ch):
+        names = tuple(self._ident(t) for t in ch[0])
+        return Import(names[:-1], names[-1:], None, False, self._span(meta))
+
+    def import_wildcard(self, meta, ch):
+        names = tuple(self._ident(t) for t in ch[0])
+        return Import(names, (), None, True, self._span(meta))
+
+    def import_list(self, meta, ch):
+        path = tuple(self._ident(t) for t in ch[0])
+        names = tuple(self._ident(t) for t in ch[1:] if isinstance(t, Token))
+        return Import(path, names, None, False, self._span(meta))
+
+    def extends_clause(self, meta, ch):
+        mod = of(ch, ClassMod)
+        modification = Modification(mod.arguments, None, mod.span) if mod else None
+        return Extends(ch[0], modification, self._span(meta))
+
+    def component_clause(self, meta, ch):
+        prefixes, type_name = ch[0], ch[1]
+        dims = of(ch, Subs)
+        decls = tuple(c for c in ch if isinstance(c, _Decl))
+        return _Clause(tuple(str(t) for t in prefixes), type_name,
+                       dims.items if dims else (), decls)
+
+    def type_specifier(self, meta, ch):
+        return self._ref(ch[0])
+
+    def global_type_specifier(self, meta, ch):
+        self._reject("global names (`.A.B`) are", self._kw(meta, "."))
+        return self._ref(ch[0])
+
+    def component_declaration(self, meta, ch):
+        dims = of(ch, Subs)
+        comment = ch[-1]
+        return _Decl(self._ident(ch[0]), dims.items if dims else (), of(ch, Modification),
+                     comment.description, self._span(meta))
+
+    def condition_attribute(self, meta, ch):
+        return self._reject("conditional components (`... if condition`) are",
+                            self._kw(meta, "if"))
+
+    # ------------------------------------------------------------ modifications
+
+    def modification(self, meta, ch):
+        mod = of(ch, ClassMod)
+        value = ch[-1] if not isinstance(ch[-1], ClassMod) else None
+        return Modification(mod.arguments if mod else (), value, self._span(meta))
+
+    def assign_modification(self, meta, ch):
+        self._reject("`:=` in a declaration is", self._kw(meta, ":="),
+                     hint="use '=' for a binding")
+        return Modification((), ch[0], self._span(meta))
+
+    def class_modification(self, meta, ch):
+        args = tuple(c for c in ch if isinstance(c, ElementModification))
+        return ClassMod(args, self._span(meta))
+
+    def element_modification(self, meta, ch):
+        flags = {t.type for t in ch if isinstance(t, Token)}
+        path = next(c for c in ch if isinstance(c, tuple))
+        return ElementModification(
+            path=tuple(self._ident(t) for t in path), modification=of(ch, Modification),
+            each="EACH" in flags, final="FINAL" in flags, span=self._span(meta),
+        )
+
+    def element_replaceable(self, meta, ch):
+        return Rejected(self._span(meta))
+
+    def replaceable_body(self, meta, ch):
+        return self._reject("`replaceable` is", self._kw(meta, "replaceable"))
+
+    def element_redeclaration(self, meta, ch):
+        return self._reject("`redeclare` is", self._kw(meta, "redeclare"))
+
+    def short_class_definition(self, meta, ch):
+        return Rejected(self._span(meta))
+
+    def component_clause1(self, meta, ch):
+        return Rejected(self._span(meta))
+
+    def component_declaration1(self, meta, ch):
+        return Rejected(self._span(meta))
+
+    def annotation_clause(self, meta, ch):
+        return Annotation(Modification(ch[0].arguments, None, self._span(meta)))
+
+    def comment(self, meta, ch):
+        annotation = of(ch, Annotation)
+        return _Comment(ch[0], annotation.modification if annotation else None)
+
+    def description(self, meta, ch):
+        return "".join(self._unescape(t[1:-1], t) for t in ch)

@@ -1,0 +1,124 @@
+"""Equation and statement rules -> :mod:`springc.syntax` equations and statements.
+
+:class:`EquationRules` has one method per equation or statement rule of
+``grammar/modelica.lark``; the constructs of LANGUAGE.md's "Later" list among them
+(``when``, ``while``, ``break``, ``return``, call statements) become located
+``... not supported yet`` errors.
+"""
+
+from __future__ import annotations
+
+from .rules_base import Rejected, RuleBase, join
+from ..ir.syntax import (
+    Assign,
+    Call,
+    CallEquation,
+    Connect,
+    Equality,
+    ForEquation,
+    ForIndex,
+    ForStatement,
+    IfEquation,
+    IfStatement,
+    Ref,
+)
+
+
+class EquationRules(RuleBase):
+    """The equation and statement rules."""
+
+    def equation(self, meta, ch):
+        return ch[0]
+
+    def equations(self, meta, ch):
+        return tuple(c for c in ch if not isinstance(c, Rejected))
+
+    statements = equations
+
+    def simple_equation(self, meta, ch):
+        span = self._span(meta)
+        if len(ch) == 2:
+            return Equality(ch[0], ch[1], span)
+        if isinstance(ch[0], Call):
+            return CallEquation(ch[0], span)
+        self._error("this expression is not an equation", span,
+                    hint="write 'lhs = rhs'; only a function call may stand alone")
+        return Rejected(span)
+
+    def _branches(self, meta, ch, make):
+        branches = [(ch[0], ch[1])]
+        otherwise: tuple = ()
+        for extra in ch[2:]:
+            if extra[0] == "elseif":
+                branches.append((extra[1], extra[2]))
+            else:
+                otherwise = extra[1]
+        return make(tuple(branches), otherwise, self._span(meta))
+
+    def if_equation(self, meta, ch):
+        return self._branches(meta, ch, IfEquation)
+
+    def if_statement(self, meta, ch):
+        return self._branches(meta, ch, IfStatement)
+
+    def elseif_equation(self, meta, ch):
+        return ("elseif", ch[0], ch[1])
+
+    elseif_statement = elseif_equation
+
+    def else_equation(self, meta, ch):
+        return ("else", ch[0])
+
+    else_statement = else_equation
+
+    def for_equation(self, meta, ch):
+        return ForEquation(ch[0], ch[1], self._span(meta))
+
+    def for_statement(self, meta, ch):
+        return ForStatement(ch[0], ch[1], self._span(meta))
+
+    def connect_clause(self, meta, ch):
+        return Connect(ch[0], ch[1], self._span(meta))
+
+    def when_equation(self, meta, ch):
+        return self._reject("`when` equations are", self._kw(meta, "when"))
+
+    def for_indices(self, meta, ch):
+        return tuple(ch)
+
+    def for_index(self, meta, ch):
+        return ForIndex(self._ident(ch[0]), ch[1] if len(ch) > 1 else None, self._span(meta))
+
+    # --------------------------------------------------------------- statements
+
+    def statement(self, meta, ch):
+        return ch[0]
+
+    def assign_statement(self, meta, ch):
+        return Assign((ch[0],), ch[1], self._span(meta))
+
+    def call_statement(self, meta, ch):
+        return self._reject("call statements (`f(x);`) are", self._span(meta))
+
+    def multi_assign(self, meta, ch):
+        *targets, func, args = ch
+        for target in targets:
+            if target is not None and not isinstance(target, Ref):
+                self._error("only a component reference can be assigned to", target.span)
+        call = Call(func, args.args, args.named, join(func.span, self._span(meta)))
+        return Assign(tuple(targets), call, self._span(meta))
+
+    def output_item(self, meta, ch):
+        return ch[0] if ch else None
+
+    def break_statement(self, meta, ch):
+        return self._reject("`break` statements are", self._span(meta))
+
+    def return_statement(self, meta, ch):
+        return self._reject("`return` statements are", self._span(meta))
+
+    def while_statement(self, meta, ch):
+        return self._reject("`while` loops are", self._kw(meta, "while"))
+
+    def when_statement(self, meta, ch):
+        return self._reject("`when` statements are", self._kw(meta, "when"))

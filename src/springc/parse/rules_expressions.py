@@ -1,0 +1,248 @@
+"""Expression rules -> :mod:`springc.syntax` expressions (``Expr``), with operator precedence.
+
+:class:`ExpressionRules` has one method per expression rule of ``grammar/modelica.lark``;
+the grammar leaves binary and unary operators as a flat ``operand (op operand)*`` list
+that :class:`Precedence` turns into a tree.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from lark import Token
+
+from .rules_base import RuleBase, Subs, join, of
+from ..ir.syntax import (
+    ArrayLit,
+    Binary,
+    Bool,
+    Call,
+    Colon,
+    Comprehension,
+    End,
+    Expr,
+    IfExpr,
+    MatrixLit,
+    NamedArg,
+    Number,
+    Range,
+    Ref,
+    RefPart,
+    String,
+    Unary,
+)
+
+_RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
+_ADDITIVE = frozenset({"+", "-", ".+", ".-"})
+_MULTIPLICATIVE = frozenset({"*", "/", ".*", "./"})
+_POWER = frozenset({"^", ".^"})
+
+
+@dataclass(frozen=True, slots=True)
+class Args:
+    """The arguments of a call (also read by ``(a, b) := f(x)`` statements)."""
+
+    args: tuple[Expr, ...]
+    named: tuple[NamedArg, ...]
+
+
+class ExpressionRules(RuleBase):
+    """The expression rules: literals, references, calls, arrays, operators."""
+
+    def if_expression(self, meta, ch):
+        pairs = tuple((ch[i], ch[i + 1]) for i in range(0, len(ch) - 1, 2))
+        return IfExpr(pairs, ch[-1], self._span(meta))
+
+    def range(self, meta, ch):
+        step = ch[1] if len(ch) == 3 else None
+        return Range(ch[0], step, ch[-1], self._span(meta))
+
+    def operation(self, meta, ch):
+        return Precedence(self, ch).build()
+
+    def number(self, meta, ch):
+        text = str(ch[0])
+        value = int(text) if text.isdigit() else float(text)
+        return Number(value, self._span(meta))
+
+    def string(self, meta, ch):
+        return String(self._unescape(ch[0][1:-1], ch[0]), self._span(meta))
+
+    def true(self, meta, ch):
+        return Bool(True, self._span(meta))
+
+    def false(self, meta, ch):
+        return Bool(False, self._span(meta))
+
+    def call(self, meta, ch):
+        func, args = ch
+        return Call(func, args.args, args.named, self._span(meta))
+
+    def subscripted(self, meta, ch):
+        self._reject("subscripts on a parenthesized expression (`(e)[i]`) are",
+                     self._span(meta))
+        return ch[0]
+
+    def tuple(self, meta, ch):
+        self._reject("output lists (`(a, b)`) outside `(a, b) := f(x)` are", self._span(meta))
+        return next((c for c in ch if c is not None), Bool(False, self._span(meta)))
+
+    def matrix(self, meta, ch):
+        return MatrixLit(tuple(ch), self._span(meta))
+
+    def matrix_row(self, meta, ch):
+        return tuple(ch)
+
+    def array(self, meta, ch):
+        return ArrayLit(tuple(ch), self._span(meta))
+
+    def array_comprehension(self, meta, ch):
+        return Comprehension(ch[0], ch[1], self._span(meta))
+
+    def component_reference(self, meta, ch):
+        first = ch[0]
+        if first == "end" and len(ch) == 1:
+            end = End(self._span(meta))
+            self._loose_ends.append(end)
+            return end
+        subs = ch[1] if len(ch) > 1 and isinstance(ch[1], Subs) else None
+        head = self._tspan(first)
+        if subs:
+            head = join(head, subs.span)
+        parts = (RefPart(self._ident(first, len(ch) == 1), subs.items if subs else (), head),
+                 *(c for c in ch if isinstance(c, RefPart)))
+        return Ref(parts, self._span(meta))
+
+    def global_reference(self, meta, ch):
+        self._reject("global names (`.A.B`) are", self._kw(meta, "."))
+        return self.component_reference(meta, ch)
+
+    def ref_part(self, meta, ch):
+        subs = of(ch, Subs)
+        return RefPart(self._ident(ch[0]), subs.items if subs else (), self._span(meta))
+
+    def array_subscripts(self, meta, ch):
+        span = self._span(meta)
+        if self._loose_ends:  # those inside these brackets are where they belong
+            inside = (span.line, span.column), (span.end_line, span.end_column)
+            self._loose_ends = [e for e in self._loose_ends
+                                if not inside[0] <= (e.span.line, e.span.column) < inside[1]]
+        return Subs(tuple(ch), span)
+
+    def colon(self, meta, ch):
+        return Colon(self._span(meta))
+
+    def function_call_args(self, meta, ch):
+        named = tuple(c for c in ch if isinstance(c, NamedArg))
+        args = tuple(c for c in ch if not isinstance(c, NamedArg))
+        seen_named = False
+        for c in ch:
+            seen_named = seen_named or isinstance(c, NamedArg)
+            if seen_named and not isinstance(c, NamedArg):
+                self._error("positional argument after a named argument", c.span)
+                break
+        return Args(args, named)
+
+    def call_comprehension(self, meta, ch):
+        body, indices = ch
+        return Args((Comprehension(body, indices, join(body.span, indices[-1].span)),), ())
+
+    def named_argument(self, meta, ch):
+        return NamedArg(self._ident(ch[0]), ch[1], self._span(meta))
+
+    def name(self, meta, ch):
+        return (ch[0],) if len(ch) == 1 else (*ch[0], ch[1])
+
+
+
+class Precedence:
+    """Builds the tree of a flat ``operand (op operand)*`` list by Modelica precedence.
+
+    Follows appendix A: ``expr: or; or: and {or and}; and: not {and not};
+    not: [not] rel; rel: arith [relop arith]; arith: [addop] term {addop term};
+    term: factor {mulop factor}; factor: primary [^ primary]``.
+    """
+
+    def __init__(self, owner: RuleBase, items: list) -> None:
+        self.owner, self.items, self.i = owner, items, 0
+
+    def build(self) -> Expr:
+        result = self.or_()
+        if self.i < len(self.items):
+            tok = self.items[self.i]
+            hint = ("comparisons cannot be chained; combine them with `and`"
+                    if tok in _RELATIONS else
+                    "'^' is not associative; add parentheses: (a^b)^c or a^(b^c)")
+            self.owner._error(f"unexpected '{tok}'", self.owner._tspan(tok), hint=hint)
+        return result
+
+    def _take(self, ops: frozenset[str]) -> Token | None:
+        if self.i < len(self.items):
+            item = self.items[self.i]
+            if isinstance(item, Token) and item in ops:
+                self.i += 1
+                return item
+        return None
+
+    def _binary(self, left: Expr, op: Token, right: Expr) -> Binary:
+        return Binary(str(op), left, right, join(left.span, right.span))
+
+    def or_(self) -> Expr:
+        left = self.and_()
+        while op := self._take(frozenset({"or"})):
+            left = self._binary(left, op, self.and_())
+        return left
+
+    def and_(self) -> Expr:
+        left = self.not_()
+        while op := self._take(frozenset({"and"})):
+            left = self._binary(left, op, self.not_())
+        return left
+
+    def not_(self) -> Expr:
+        if op := self._take(frozenset({"not"})):
+            operand = self.relation()
+            return Unary("not", operand, join(self.owner._tspan(op), operand.span))
+        return self.relation()
+
+    def relation(self) -> Expr:
+        left = self.arithmetic()
+        if op := self._take(_RELATIONS):
+            left = self._binary(left, op, self.arithmetic())
+        return left
+
+    def arithmetic(self) -> Expr:
+        if sign := self._take(_ADDITIVE):
+            operand = self.term()
+            left: Expr = Unary(str(sign), operand, join(self.owner._tspan(sign), operand.span))
+        else:
+            left = self.term()
+        while op := self._take(_ADDITIVE):
+            left = self._binary(left, op, self.term())
+        return left
+
+    def term(self) -> Expr:
+        left = self.factor()
+        while op := self._take(_MULTIPLICATIVE):
+            left = self._binary(left, op, self.factor())
+        return left
+
+    def factor(self) -> Expr:
+        base = self.primary()
+        if op := self._take(_POWER):
+            return self._binary(base, op, self.primary())
+        return base
+
+    def primary(self) -> Expr:
+        item = self.items[self.i]
+        self.i += 1
+        if not isinstance(item, Token):
+            return item
+        example = "a and (not b)" if item == "not" else f"a * ({item}b)"
+        self.owner._error(
+            f"unexpected '{item}'", self.owner._tspan(item),
+            hint=f"a unary '{item}' may only start an expression or an operand of a "
+                 f"comparison; put it in parentheses, e.g. {example}",
+        )
+        return self.primary()
+

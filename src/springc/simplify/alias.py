@@ -1,0 +1,216 @@
+"""Alias and trivial-equation elimination: dae.DAE -> (dae.DAE, aliases, warnings).
+
+An equation ``a = b``, ``a = -b`` (``a + b = 0``) or ``a = p`` (a constant or parameter
+expression) removes one unknown. Chains are followed with a signed union-find; in each
+class the kept variable is the one with a fixed start value, then the strongest
+``stateSelect``, then one that appears differentiated, then the first declared.
+Eliminated variables become observed: ``a = ±kept`` or ``a = value``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from ..ir import dae
+from ..ir import expr as x
+from ..errors import Note
+from .lower import differentiate
+from .isolate import free_variables
+
+_SELECT_RANK = {"never": 0, "avoid": 1, "default": 2, "prefer": 3, "always": 4}
+
+
+@dataclass(frozen=True, slots=True)
+class Alias:
+    """An eliminated unknown and its value: ``sign * kept`` or a parameter expression."""
+
+    name: str
+    value: x.Expr
+    equation: dae.Residual
+
+
+@dataclass(frozen=True)
+class AliasResult:
+    dae: dae.DAE
+    aliases: tuple[Alias, ...]
+    warnings: tuple[Note, ...]
+
+
+def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
+           rest: list[tuple[int, x.Expr]]) -> bool:
+    """Split ``e`` into ±unknown terms and a remainder free of unknowns."""
+    if isinstance(e, x.BinOp) and e.op in "+-":
+        return (_terms(e.left, sign, unknowns, out, rest)
+                and _terms(e.right, sign if e.op == "+" else -sign, unknowns, out, rest))
+    if isinstance(e, x.Neg):
+        return _terms(e.arg, -sign, unknowns, out, rest)
+    if isinstance(e, x.Var) and e.name in unknowns:
+        out.append((sign, e.name))
+        return len(out) <= 2
+    if any(n in unknowns or n.startswith("der(") for n in free_variables(e)) or any(
+            isinstance(n, x.Time) for n in x.walk(e)):
+        return False
+    rest.append((sign, e))
+    return True
+
+
+def _classify(r: dae.Residual, unknowns: set[str]
+              ) -> tuple[str, str, int, x.Expr] | None:
+    """``(a, b, sign, 0)`` for ``a = sign*b``, ``(a, "", 0, value)`` for ``a = value``."""
+    if sum(n in unknowns for n in r.variables) > 2 or any(
+            n.startswith("der(") for n in r.variables):
+        return None
+    terms: list[tuple[int, str]] = []
+    rest: list[tuple[int, x.Expr]] = []
+    if not _terms(r.expr, 1, unknowns, terms, rest):
+        return None
+    if len(terms) == 2 and not rest and terms[0][1] != terms[1][1]:
+        (sa, a), (sb, b) = terms
+        return a, b, -sa * sb, x.ZERO
+    if len(terms) == 1:
+        (sa, a), = terms
+        value: x.Expr = x.ZERO
+        for sign, term in rest:
+            value = x.add(value, term) if sign == 1 else x.sub(value, term)
+        return a, "", 0, value if sa == -1 else x.neg(value)
+    return None
+
+
+def eliminate_aliases(system: dae.DAE) -> AliasResult:
+    """Remove alias and trivial equations; see the module docstring."""
+    unknowns = {u.name: u for u in system.unknowns}
+    order = {u.name: i for i, u in enumerate(system.unknowns)}
+    names = set(unknowns)
+    # Step 1: classify equations and join alias classes (signed union-find).
+    parent: dict[str, tuple[str, int]] = {}
+    value_of: dict[str, tuple[x.Expr, dae.Residual]] = {}
+    members_eq: dict[str, dae.Residual] = {}
+    kept: list[dae.Residual] = []
+
+    def find(a: str) -> tuple[str, int]:
+        sign = 1
+        while a in parent:
+            a, s = parent[a]
+            sign *= s
+        return a, sign
+
+    for r in system.equations:
+        found = _classify(r, names)
+        if found is None:
+            kept.append(r)
+            continue
+        a, b, sign, value = found
+        ra, sa = find(a)
+        if not b:
+            if ra in value_of:
+                kept.append(r)  # a second value for the class: leave it to the checks
+                continue
+            value_of[ra] = (x.neg(value) if sa == -1 else value, r)
+            continue
+        rb, sb = find(b)
+        if ra == rb or (ra in value_of and rb in value_of):
+            kept.append(r)
+            continue
+        # a = sign*b, a = sa*ra, b = sb*rb  =>  rb = sa*sign*sb * ra
+        parent[rb] = (ra, sa * sign * sb)
+        members_eq[rb] = r
+        if rb in value_of:
+            v, eq = value_of.pop(rb)
+            value_of[ra] = (x.neg(v) if sa * sign * sb == -1 else v, eq)
+
+    # Step 2: pick the kept variable of each class and express the others through it.
+    classes: dict[str, list[tuple[str, int]]] = {}
+    for name in unknowns:
+        root, sign = find(name)
+        classes.setdefault(root, []).append((name, sign))
+    mapping: dict[str, x.Expr] = {}
+    aliases: list[Alias] = []
+    warnings: list[Note] = []
+    new_unknowns: dict[str, dae.Unknown] = {}
+    differentiated = set(system.differentiated)
+    for root, members in classes.items():
+        if root in value_of:
+            value, eq = value_of[root]
+            for name, sign in members:
+                mapping[name] = x.neg(value) if sign == -1 else value
+                aliases.append(Alias(name, mapping[name], members_eq.get(name, eq)))
+            continue
+        if len(members) == 1:
+            continue
+        rep, rep_sign = max(members, key=lambda m: _priority(unknowns[m[0]], differentiated,
+                                                             order))
+        warnings += _start_conflicts(members, rep, rep_sign, unknowns)
+        for name, sign in members:
+            if name == rep:
+                continue
+            rel = sign * rep_sign  # name = rel * rep
+            mapping[name] = x.Var(rep) if rel == 1 else x.neg(x.Var(rep))
+            aliases.append(Alias(name, mapping[name], members_eq.get(name) or
+                                 members_eq.get(root) or system.equations[0]))
+        new_unknowns[rep] = _inherit_start(unknowns[rep], members, rep_sign, unknowns)
+
+    # Step 3: substitute into the remaining equations (derivatives too).
+    der_map: dict[str, x.Expr] = {}
+
+    def varying(name: str) -> bool:
+        return name in names or name.startswith("der(")
+
+    for name, value in mapping.items():
+        if name in differentiated:
+            der_map[dae.der_name(name)] = differentiate(value, varying)
+            differentiated.update(v for v in free_variables(value) if v in names)
+    full = {**mapping, **der_map}
+    value_vars = {name: free_variables(value) for name, value in full.items()}
+
+    def rewrite(r: dae.Residual) -> dae.Residual:
+        used = [n for n in r.variables if n in full]
+        if not used:
+            return r
+        names = set(r.variables).difference(used).union(*(value_vars[n] for n in used))
+        return replace(r, expr=x.substitute(r.expr, full), variables=frozenset(names))
+
+    equations = tuple(rewrite(r) for r in kept)
+    initial = tuple(rewrite(r) for r in system.initial_equations)
+    remaining = tuple(new_unknowns.get(u.name, u) for u in system.unknowns
+                      if u.name not in mapping)
+    differentiated -= set(mapping)
+    reduced = replace(system, unknowns=remaining, equations=equations,
+                      initial_equations=initial, differentiated=frozenset(differentiated))
+    return AliasResult(reduced, tuple(aliases), tuple(warnings))
+
+
+def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]
+              ) -> tuple[int, int, int, int]:
+    return (int(u.fixed and u.start is not None), _SELECT_RANK[u.state_select],
+            int(u.name in differentiated), -order[u.name])
+
+
+def _start_conflicts(members: list[tuple[str, int]], rep: str, rep_sign: int,
+                     unknowns: dict[str, dae.Unknown]) -> list[Note]:
+    seen: dict[float, str] = {}
+    for name, sign in members:
+        start = unknowns[name].start
+        if isinstance(start, x.Const):
+            seen.setdefault(float(start.value) * sign * rep_sign, name)
+    if len(seen) <= 1:
+        return []
+    listing = ", ".join(f"{name} = {value:g}" for value, name in seen.items())
+    return [Note(f"aliases of '{rep}' have conflicting start values ({listing}); "
+                 f"'{rep}' keeps its own", unknowns[rep].span)]
+
+
+def _inherit_start(rep: dae.Unknown, members: list[tuple[str, int]], rep_sign: int,
+                   unknowns: dict[str, dae.Unknown]) -> dae.Unknown:
+    """A kept variable without a start value takes a member's (fixed ones first)."""
+    if rep.start is not None:
+        return rep
+    candidates = sorted((m for m in members if unknowns[m[0]].start is not None),
+                        key=lambda m: not unknowns[m[0]].fixed)
+    if not candidates:
+        return rep
+    name, sign = candidates[0]
+    start = unknowns[name].start
+    assert start is not None
+    rel = sign * rep_sign
+    return replace(rep, start=start if rel == 1 else x.neg(start),
+                   fixed=rep.fixed or unknowns[name].fixed)

@@ -1,0 +1,151 @@
+"""Balance check of a flat model: flat.FlatModel -> Balance, or a BalanceError.
+
+Counts scalar unknowns and equations and matches them (``der(x)`` counts as ``x``,
+as before index reduction). When the counts differ or no complete matching exists,
+the Dulmage-Mendelsohn decomposition names exactly the variables left undetermined
+and the equations that over-determine others, each with its location and instance.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..ir import expr as x
+from ..ir import flat
+from ..errors import BalanceError, Note
+from ..structure import dulmage_mendelsohn, maximum_matching
+
+MAX_NOTES = 20
+
+
+@dataclass(frozen=True)
+class Balance:
+    model: str
+    unknowns: int
+    equations: int
+    parameters: int
+    parameter_arrays: int
+
+    def summary(self) -> str:
+        arrays = (f", {self.parameter_arrays} parameter array"
+                  f"{'s' if self.parameter_arrays != 1 else ''}") if self.parameter_arrays else ""
+        return (f"{self.model}: {_count(self.unknowns, 'unknown')}, "
+                f"{_count(self.equations, 'equation')}, "
+                f"{_count(self.parameters, 'parameter')}{arrays}: balanced")
+
+
+def incidence(model: flat.FlatModel) -> list[list[int]]:
+    """For each equation, the indices (into ``model.unknowns``) of the unknowns it uses."""
+    index = {v.name: i for i, v in enumerate(model.unknowns)}
+    rows = []
+    for eq in model.equations:
+        names = x.variables(eq.lhs) | x.variables(eq.rhs)
+        rows.append(sorted(index[n] for n in names if n in index))
+    return rows
+
+
+def count_parameters(model: flat.FlatModel) -> tuple[int, int]:
+    """Scalar parameters declared as scalars, and parameter arrays (counted once each)."""
+    scalars, arrays = 0, set()
+    for v in model.parameters:
+        if v.name.endswith("]"):
+            arrays.add(v.name[: v.name.rindex("[")])
+        else:
+            scalars += 1
+    return scalars, len(arrays)
+
+
+def check_balance(model: flat.FlatModel) -> Balance:
+    unknowns = model.unknowns
+    rows = incidence(model)
+    matching = maximum_matching(rows, len(unknowns))
+    n_eq, n_var = len(model.equations), len(unknowns)
+    if n_eq == n_var and matching.is_perfect:
+        return Balance(model.name, n_var, n_eq, *count_parameters(model))
+    parts = dulmage_mendelsohn(rows, n_var, matching)
+    notes: list[Note] = []
+    for eqs, var_ids in _blocks(rows, parts.under_equations, parts.under_variables):
+        names = _names(unknowns, var_ids)
+        for i in var_ids:
+            v = unknowns[i]
+            where = f" (in {v.component})" if v.component else ""
+            text = (f"'{v.name}'{where} appears in no equation" if not eqs else
+                    f"'{v.name}'{where} is left undetermined: {_count(len(eqs), 'equation')}"
+                    f" for the {_count(len(var_ids), 'unknown')} {names}")
+            notes.append(Note(text, v.span))
+    for eqs, var_ids in _blocks(rows, parts.over_equations, parts.over_variables):
+        names = _names(unknowns, var_ids)
+        for i in eqs:
+            eq = model.equations[i]
+            where = f" in {eq.origin.component}" if eq.origin.component else ""
+            text = f"{x.to_text(eq.lhs)} = {x.to_text(eq.rhs)}"
+            kind = _KINDS.get(eq.origin.kind, eq.origin.kind)
+            notes.append(Note(f"{kind}{where} `{text}` " + (
+                f"is one of {len(eqs)} equations for only "
+                f"{_count(len(var_ids), 'unknown')} {names}" if var_ids else
+                "involves no unknown"), eq.span))
+    if len(notes) > MAX_NOTES:
+        notes = [*notes[:MAX_NOTES], Note(f"... and {len(notes) - MAX_NOTES} more")]
+    raise BalanceError(_headline(model.name, n_var, n_eq, parts), model.span, notes,
+                       _hint(parts))
+
+
+def _blocks(rows: list[list[int]], eqs: tuple[int, ...], var_ids: tuple[int, ...]
+            ) -> list[tuple[list[int], list[int]]]:
+    """Split a part of the Dulmage-Mendelsohn decomposition into its connected pieces
+    (equations, variables), so that each note counts only what is related to it."""
+    parent: dict[tuple[str, int], tuple[str, int]] = {}
+
+    def find(k: tuple[str, int]) -> tuple[str, int]:
+        while parent.setdefault(k, k) != k:
+            k = parent[k]
+        return k
+
+    in_part = set(var_ids)
+    for i in eqs:
+        for j in rows[i]:
+            if j in in_part:
+                parent[find(("e", i))] = find(("v", j))
+    pieces: dict[tuple[str, int], tuple[list[int], list[int]]] = {}
+    for i in eqs:
+        pieces.setdefault(find(("e", i)), ([], []))[0].append(i)
+    for j in var_ids:
+        pieces.setdefault(find(("v", j)), ([], []))[1].append(j)
+    return sorted(pieces.values(), key=lambda p: (min(p[1], default=-1), min(p[0], default=-1)))
+
+
+_KINDS = {"binding": "binding equation", "connect": "connection equation",
+          "flow": "flow-sum equation", "unconnected": "unconnected-flow equation",
+          "initial": "initial equation"}
+
+
+def _count(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _names(unknowns: tuple[flat.Variable, ...], indices: list[int]) -> str:
+    """``'x', 'y'`` (the first six, then ``...``)."""
+    names = ", ".join(f"'{unknowns[i].name}'" for i in indices[:6])
+    return names + (", ..." if len(indices) > 6 else "")
+
+
+def _headline(name: str, n_var: int, n_eq: int, parts: object) -> str:
+    counts = f"{_count(n_var, 'unknown')}, {_count(n_eq, 'equation')}"
+    if n_var > n_eq:
+        return f"model '{name}' is under-determined: {counts}"
+    if n_eq > n_var:
+        return f"model '{name}' is over-determined: {counts}"
+    return f"model '{name}' is structurally singular: {counts}, but they do not match"
+
+
+def _hint(parts: object) -> str:
+    under = getattr(parts, "under_variables", ())
+    over = getattr(parts, "over_equations", ())
+    advice = []
+    if under:
+        advice.append("add an equation for each undetermined variable, or give it a "
+                      "binding (`Real x = ...`) or make it a parameter")
+    if over:
+        advice.append("remove the redundant equations (as many as there are surplus "
+                      "equations), or turn a parameter they constrain into an unknown")
+    return "; ".join(advice)

@@ -1,0 +1,192 @@
+"""Initialization: ode.ODE + parameter values -> consistent initial states.
+
+The initial problem (Modelica 8.6) is built from ``fixed = true`` start values and
+``initial equation`` sections:
+
+1. A state with a fixed start value takes it.
+2. The *conditions* are the initial equations and the fixed start values of
+   variables that are not states (algebraic variables, dummy derivatives); each is a
+   residual evaluated by running the ODE's steps (:class:`~springc.evaluate_ode.Evaluator`).
+3. The conditions choose which of the other states they determine: the columns of
+   their Jacobian with respect to those states (at the start values) picked by
+   QR with column pivoting. States not chosen keep their ``start`` (default 0), as
+   Modelica tools do when the problem is underdetermined.
+4. The chosen states are solved with ``scipy.optimize.root`` from their start values.
+
+Values the steps compute (algebraic variables, and the derivatives chosen as dummies
+by index reduction) are consistent by construction, since the steps are run.
+More conditions than free states, or conditions that do not determine the states
+(a singular Jacobian), are an :class:`InitializationError` naming the user's
+variables and equations with their locations.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..ir import expr as x
+from ..ir import ode
+from ..errors import Note, SimulationError, Span, SpringcError
+from .ode_eval import Evaluator, parameter_values, start_values
+
+
+class InitializationError(SpringcError):
+    """The initial problem is over- or under-determined, or has no solution."""
+
+
+@dataclass(frozen=True, slots=True)
+class Condition:
+    """One equation of the initial problem: ``residual = 0`` (user text at ``span``)."""
+
+    text: str
+    residual: x.Expr
+    span: Span | None
+
+
+@dataclass(frozen=True)
+class InitialInfo:
+    """What initialization found: ``values`` holds every parameter, state, algebraic
+    variable and derivative at ``t0``, ``observed`` the aliases; ``solved`` the states
+    determined by the conditions, ``fixed`` those with a fixed start, ``defaulted`` the
+    states that took their start value; ``residual`` the largest condition residual."""
+
+    values: dict[str, float]
+    observed: dict[str, float]
+    conditions: tuple[Condition, ...]
+    solved: tuple[str, ...]
+    fixed: tuple[str, ...]
+    defaulted: tuple[str, ...]
+    residual: float
+
+
+def conditions(model: ode.ODE) -> tuple[Condition, ...]:
+    """The conditions of step 2 of the module docstring."""
+    state_names = {s.name for s in model.states}
+    out = [Condition(r.describe(), r.expr, r.span) for r in model.dae.initial_equations]
+    for u in model.dae.unknowns:
+        if u.fixed and u.start is not None and u.name not in state_names:
+            out.append(Condition(f"{u.name} = {x.to_text(u.start)} (fixed start value)",
+                                 x.sub(x.Var(u.name), u.start), u.span))
+    return tuple(out)
+
+
+def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
+                  t0: float = 0.0, tol: float = 1e-9) -> tuple[np.ndarray, InitialInfo]:
+    """Consistent initial values of ``model.states`` (in that order) at ``t0``.
+
+    ``parameters`` overrides parameter values (others come from their bindings).
+    Raises :class:`InitializationError` (over-/under-determined, no convergence).
+    """
+    params = parameter_values(model.parameters, parameters)
+    evaluator = Evaluator(model, params)
+    starts = start_values(model.dae.unknowns, params)
+    x0 = np.array([starts.get(s.name, 0.0) for s in model.states])
+    fixed = [i for i, s in enumerate(model.states) if s.fixed and s.start is not None]
+    free = [i for i, s in enumerate(model.states) if i not in set(fixed)]
+    conds = conditions(model)
+
+    def residuals(z: np.ndarray, chosen: list[int]) -> np.ndarray:
+        trial = x0.copy()
+        trial[chosen] = z
+        env = evaluator.values(t0, trial)
+        return np.array([float(x.evaluate(c.residual, env, t0)) for c in conds])  # type: ignore
+
+    chosen: list[int] = []
+    if conds:
+        _check_evaluable(model, conds, evaluator, x0, t0)
+        if len(conds) > len(free):
+            raise _overdetermined(model, conds, fixed, free)
+        chosen = _choose_states(model, conds, free, x0, lambda z, c: residuals(z, c))
+        x0[chosen] = _solve(model, conds, chosen, x0, lambda z: residuals(z, chosen), tol)
+    env = evaluator.values(t0, x0)
+    worst = max((abs(float(x.evaluate(c.residual, env, t0))) for c in conds),  # type: ignore
+                default=0.0)
+    names = [s.name for s in model.states]
+    info = InitialInfo(env, evaluator.observed(env, t0), conds,
+                       tuple(names[i] for i in chosen), tuple(names[i] for i in fixed),
+                       tuple(names[i] for i in free if i not in chosen), worst)
+    return x0, info
+
+
+def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Evaluator,
+                     x0: np.ndarray, t0: float) -> None:
+    env = evaluator.values(t0, x0)
+    for c in conds:
+        try:
+            x.evaluate(c.residual, env, t0)
+        except KeyError as err:
+            raise InitializationError(
+                f"the initial equation uses {err}, which the simplified model does not "
+                f"compute", c.span, [], "initial equations may use variables and the "
+                "derivatives of variables that appear differentiated in the model") from None
+
+
+def _choose_states(model: ode.ODE, conds: tuple[Condition, ...], free: list[int],
+                   x0: np.ndarray, residuals) -> list[int]:  # type: ignore[no-untyped-def]
+    """Step 3: the free states the conditions determine (QR with column pivoting on a
+    finite-difference Jacobian at the start values)."""
+    import scipy.linalg
+
+    base = residuals(x0[free], free)
+    jac = np.zeros((len(conds), len(free)))
+    for j in range(len(free)):
+        z = x0[free].copy()
+        h = 1e-7 * max(1.0, abs(z[j]))
+        z[j] += h
+        jac[:, j] = (residuals(z, free) - base) / h
+    _, r, perm = scipy.linalg.qr(jac, pivoting=True, mode="economic")
+    diag = np.abs(np.diag(r))
+    rank = int(np.sum(diag > 1e-6 * max(1.0, diag[0] if diag.size else 1.0)))
+    if rank < len(conds):
+        raise _singular(model, conds, jac, rank)
+    return sorted(free[j] for j in perm[:len(conds)])
+
+
+def _solve(model: ode.ODE, conds: tuple[Condition, ...], chosen: list[int], x0: np.ndarray,
+           residuals, tol: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """Step 4: Newton-type solve (MINPACK hybrid) from the start values."""
+    import scipy.optimize
+
+    def safe(z: np.ndarray) -> np.ndarray:
+        try:
+            return residuals(z)
+        except (SimulationError, ArithmeticError, ValueError):
+            return np.full(len(conds), 1e10)
+
+    result = scipy.optimize.root(safe, x0[chosen], method="hybr", options={"xtol": 1e-12})
+    if not np.all(np.abs(safe(result.x)) <= tol * (1 + np.abs(x0[chosen]).max())):
+        lsq = scipy.optimize.least_squares(safe, x0[chosen], xtol=1e-14, ftol=1e-14)
+        if np.all(np.abs(safe(lsq.x)) <= tol * (1 + np.abs(lsq.x).max())):
+            return lsq.x
+        names = ", ".join(f"'{model.states[i].name}'" for i in chosen)
+        raise InitializationError(
+            f"the initial equations have no solution near the start values of {names}",
+            conds[0].span, [Note(f"condition: {c.text}", c.span) for c in conds[:10]],
+            "check the initial equations and start values for consistency")
+    return result.x
+
+
+def _overdetermined(model: ode.ODE, conds: tuple[Condition, ...], fixed: list[int],
+                    free: list[int]) -> InitializationError:
+    notes = [Note(f"condition: {c.text}", c.span) for c in conds[:10]]
+    notes += [Note(f"'{model.states[i].name}' has a fixed start value", model.states[i].span)
+              for i in fixed[:10]]
+    return InitializationError(
+        f"the initialization problem is over-determined: {len(conds)} initial conditions "
+        f"for {len(free)} state(s) without a fixed start value", model.dae.span, notes,
+        "remove an initial equation or a `fixed = true`")
+
+
+def _singular(model: ode.ODE, conds: tuple[Condition, ...], jac: np.ndarray, rank: int
+              ) -> InitializationError:
+    weak = [c for c, row in zip(conds, jac) if not np.any(np.abs(row) > 1e-9)] or list(conds)
+    notes = [Note(f"condition: {c.text}", c.span) for c in weak[:10]]
+    return InitializationError(
+        f"the initialization problem is singular: {len(conds)} initial conditions "
+        f"determine only {rank} state(s) (some are redundant or constrain variables "
+        f"already fixed)", weak[0].span, notes,
+        "remove the redundant initial equations or `fixed = true` attributes")
+

@@ -1,0 +1,96 @@
+"""Lower the flat model to a DAE: flat.FlatModel -> dae.DAE.
+
+Equations become residuals ``lhs - rhs``; ``der`` of an expression is expanded by
+the chain rule, and ``der(x)`` becomes the derivative variable ``der(x)``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from ..ir import dae, flat
+from ..ir import expr as x
+from ..errors import Note, SimplifyError
+from .isolate import COUNTERS, free_variables
+
+
+def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
+    """Replace ``der(expr)`` by derivative variables (``der(x)`` for ``der(x)``);
+    ``varying(name)`` is false for parameters, whose derivative is zero."""
+    if isinstance(e, x.Der):
+        arg = e.arg
+        if isinstance(arg, x.Var):
+            return x.Var(dae.der_name(arg.name)) if varying(arg.name) else x.ZERO
+        inner = lower_derivatives(arg, varying)
+        return lower_derivatives(x.time_derivative(inner, varying), varying)
+    if isinstance(e, (x.Const, x.Var, x.Time)):
+        return e
+    if isinstance(e, x.BinOp):
+        left, right = lower_derivatives(e.left, varying), lower_derivatives(e.right, varying)
+        return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
+    if isinstance(e, (x.Neg, x.Not)):
+        arg = lower_derivatives(e.arg, varying)
+        return e if arg is e.arg else type(e)(arg)
+    if isinstance(e, x.Call):
+        return x.Call(e.name, tuple(lower_derivatives(a, varying) for a in e.args))
+    if isinstance(e, x.If):
+        return x.If(lower_derivatives(e.cond, varying), lower_derivatives(e.then, varying),
+                    lower_derivatives(e.otherwise, varying))
+    raise TypeError(f"not an expression: {e!r}")
+
+
+def differentiate(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
+    """d/dt of a lowered expression, again in terms of derivative variables."""
+    COUNTERS["diff"] += 1
+    return lower_derivatives(x.time_derivative(e, varying), varying)
+
+
+def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual:
+    lhs = lower_derivatives(eq.lhs, varying) if _has_der(eq.lhs) else eq.lhs
+    rhs = lower_derivatives(eq.rhs, varying) if _has_der(eq.rhs) else eq.rhs
+    residual = x.sub(lhs, rhs)
+    return dae.Residual(residual, eq.span, eq.origin, eq, frozenset(free_variables(residual)))
+
+
+def _has_der(e: x.Expr) -> bool:
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        kind = type(node)
+        if kind is x.Der:
+            return True
+        if kind is x.BinOp:
+            stack += (node.left, node.right)  # type: ignore[union-attr]
+        elif kind is not x.Var and kind is not x.Const:
+            stack.extend(x.children(node))
+    return False
+
+
+def lower(model: flat.FlatModel) -> dae.DAE:
+    """Build the DAE of a flat model (continuous unknowns only, for now)."""
+    discrete = [v for v in model.unknowns if v.variability == "discrete"]
+    if discrete:
+        raise SimplifyError(
+            "discrete variables (Integer, Boolean or `discrete`) are not supported yet",
+            discrete[0].span, [Note(f"'{v.name}' is declared here", v.span)
+                               for v in discrete[1:6]],
+            "declare them as parameters if they do not change during the simulation")
+    unknowns = tuple(
+        dae.Unknown(v.name, v.attributes.start, bool(v.attributes.fixed),
+                    v.attributes.nominal, v.attributes.state_select or "default",
+                    v.attributes.unit, v.component, v.span)
+        for v in model.unknowns)
+    parameters = tuple(dae.Parameter(v.name, v.binding, v.attributes.start, v.span)
+                       for v in model.parameters)
+    names = {u.name for u in unknowns}
+
+    def varying(name: str) -> bool:
+        return name in names or name.startswith("der(")
+
+    equations = tuple(_residual(eq, varying) for eq in model.equations)
+    initial = tuple(_residual(eq, varying) for eq in model.initial_equations)
+    differentiated = frozenset(
+        n[4:-1] for r in equations + initial for n in r.variables
+        if n.startswith("der(") and n[4:-1] in names)
+    return dae.DAE(model.name, unknowns, parameters, equations, initial, model.experiment,
+                   model.span, differentiated)

@@ -1,0 +1,169 @@
+"""Reference evaluation of an ode.ODE: parameters, start values and the right-hand side.
+
+A slow but simple interpreter over :func:`springc.expr.evaluate`, used by
+initialization, by state selection (numeric checks at start values) and by tests as
+an independent check of generated code. ``Evaluator.rhs(t, x)`` runs ``ode.steps`` in
+order: assignments, linear systems (dense, or sparse LU when large) and torn
+nonlinear systems (Newton on the tearing variables with the analytic Jacobian,
+starting from the previous solution, or from start values the first time).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+
+from ..ir import dae, ode
+from ..ir import expr as x
+from ..errors import Note, SimplifyError, SimulationError
+
+SPARSE_FROM = 50
+"""Linear systems with at least this many unknowns are solved with sparse LU."""
+
+
+def parameter_values(parameters: Iterable[dae.Parameter],
+                     overrides: Mapping[str, float] | None = None) -> dict[str, float]:
+    """Numeric values of all parameters: ``overrides``, else the binding, else the
+    start value, else 0; bindings may refer to other parameters (in any order)."""
+    params = {p.name: p for p in parameters}
+    values: dict[str, float] = dict(overrides or {})
+    active: set[str] = set()
+
+    def value(name: str) -> float:
+        if name in values:
+            return values[name]
+        p = params[name]
+        if name in active:
+            raise SimplifyError(f"the binding of parameter '{name}' depends on itself", p.span)
+        active.add(name)
+        e = p.binding if p.binding is not None else p.start
+        values[name] = 0.0 if e is None else evaluate_with(e, value)
+        active.discard(name)
+        return values[name]
+
+    for name in params:
+        value(name)
+    return values
+
+
+class _Lazy(dict):  # type: ignore[type-arg]
+    def __init__(self, lookup):  # type: ignore[no-untyped-def]
+        super().__init__()
+        self.lookup = lookup
+
+    def __missing__(self, key: str) -> float:
+        self[key] = result = self.lookup(key)
+        return result
+
+
+def evaluate_with(e: x.Expr, lookup, time: float = 0.0) -> float:  # type: ignore[no-untyped-def]
+    """Evaluate ``e``, asking ``lookup(name)`` for each variable it needs."""
+    return float(x.evaluate(e, _Lazy(lookup), time))  # type: ignore[arg-type]
+
+
+def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
+                 ) -> dict[str, float]:
+    """The start value of every unknown (0 when not given), from parameter values."""
+    out = {}
+    for u in unknowns:
+        try:
+            out[u.name] = 0.0 if u.start is None else float(x.evaluate(u.start, params))
+        except KeyError as err:
+            raise SimplifyError(f"the start value of '{u.name}' must be a parameter "
+                                f"expression, but it uses {err}", u.span) from None
+    return out
+
+
+class Evaluator:
+    """Evaluates the steps of ``model`` for given parameter values.
+
+    ``guess`` (by name) overrides the start values as the first Newton guess of the
+    tearing variables: after a switch of states, the current values keep Newton on the
+    branch the simulation is on (e.g. the sign of a coordinate solved from a length).
+    """
+
+    def __init__(self, model: ode.ODE, params: Mapping[str, float],
+                 newton_tol: float = 1e-10, max_iterations: int = 50,
+                 guess: Mapping[str, float] | None = None) -> None:
+        self.model = model
+        self.params = dict(params)
+        self.names = [s.name for s in model.states]
+        self.derivatives = [s.derivative for s in model.states]
+        self.guess = start_values(model.dae.unknowns, self.params)
+        self.guess.update(guess or {})
+        self.newton_tol = newton_tol
+        self.max_iterations = max_iterations
+
+    def values(self, t: float, states: Iterable[float]) -> dict[str, float]:
+        """All parameters, states and step variables at time ``t``."""
+        env: dict[str, float] = dict(self.params)
+        env.update(zip(self.names, (float(v) for v in states)))
+        for step in self.model.steps:
+            if isinstance(step, ode.Assign):
+                env[step.name] = float(x.evaluate(step.expr, env, t))  # type: ignore
+            elif isinstance(step, ode.LinearBlock):
+                self._linear(step, env, t)
+            else:
+                self._newton(step, env, t)
+        return env
+
+    def rhs(self, t: float, states: Iterable[float]) -> np.ndarray:
+        """The state derivatives, in the order of ``model.states``."""
+        env = self.values(t, states)
+        return np.array([env[d] for d in self.derivatives])
+
+    def observed(self, env: Mapping[str, float], t: float = 0.0) -> dict[str, float]:
+        """The eliminated aliases, from a ``values`` result."""
+        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}  # type: ignore
+
+    def _linear(self, step: ode.LinearBlock, env: dict[str, float], t: float) -> None:
+        n = len(step.names)
+        rows = [r for r, _, _ in step.matrix]
+        cols = [c for _, c, _ in step.matrix]
+        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]  # type: ignore
+        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])  # type: ignore
+        try:
+            if n >= SPARSE_FROM:
+                from scipy.sparse import csc_matrix
+                from scipy.sparse.linalg import spsolve
+                solution = spsolve(csc_matrix((data, (rows, cols)), shape=(n, n)), b)
+                if not np.all(np.isfinite(solution)):
+                    raise np.linalg.LinAlgError
+            else:
+                a = np.zeros((n, n))
+                np.add.at(a, (rows, cols), data)
+                solution = np.linalg.solve(a, b)
+        except np.linalg.LinAlgError:
+            raise SimulationError(
+                f"the linear system for {', '.join(step.names[:6])} is singular at t = {t:g}",
+                step.spans[0] if step.spans else None,
+                [Note("equation of the system", s) for s in step.spans[1:6]]) from None
+        env.update(zip(step.names, solution.tolist()))
+
+    def _newton(self, step: ode.NonlinearBlock, env: dict[str, float], t: float) -> None:
+        z = np.array([self.guess.get(n, 0.0) for n in step.tearing])
+        n = len(z)
+        for _ in range(self.max_iterations):
+            env.update(zip(step.tearing, z.tolist()))
+            for a in step.inner + step.sensitivities:
+                env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
+            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])  # type: ignore
+            jac = np.zeros((n, n))
+            for i, j, e in step.jacobian:
+                jac[i, j] = float(x.evaluate(e, env, t))  # type: ignore
+            try:
+                dz = np.linalg.solve(jac, -f)
+            except np.linalg.LinAlgError:
+                break
+            z = z + dz
+            if np.max(np.abs(dz)) <= self.newton_tol * (1 + np.max(np.abs(z))):
+                env.update(zip(step.tearing, z.tolist()))
+                for a in step.inner:
+                    env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
+                self.guess.update(zip(step.tearing, z.tolist()))
+                return
+        raise SimulationError(
+            f"the nonlinear system for {', '.join(step.tearing)} did not converge at "
+            f"t = {t:g}", step.spans[0] if step.spans else None,
+            [Note("equation of the system", s) for s in step.spans[1:6]])

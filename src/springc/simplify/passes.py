@@ -1,0 +1,74 @@
+"""Structural simplification: flat.FlatModel -> ode.ODE.
+
+The pipeline is a short list of passes, each in its own module:
+
+1. ``lower`` (:mod:`springc.lower`): residual equations and derivative variables;
+2. ``eliminate_aliases`` (:mod:`springc.alias`): ``a = ±b`` and ``a = p`` removed;
+3. ``index_reduce`` (:mod:`springc.reduce`): Pantelides and dummy derivatives;
+4. ``causalize`` (:mod:`springc.causalize`): matching, BLT, solved blocks.
+"""
+
+from __future__ import annotations
+
+import gc
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+from ..ir import flat, ode
+from .alias import eliminate_aliases
+from .causalize import causalize
+from ..errors import Note
+from .lower import lower
+from .index_reduction import DummyBlock, index_reduce
+
+
+@dataclass(frozen=True)
+class Simplified:
+    """The ODE, warnings of the passes, and the blocks of the dummy-derivative choice
+    (what :mod:`springc.switching` monitors; empty when no index reduction was done)."""
+
+    ode: ode.ODE
+    warnings: tuple[Note, ...]
+    blocks: tuple[DummyBlock, ...] = field(default=())
+
+
+def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Simplified:
+    """Run the passes of the module docstring on ``model``.
+
+    ``at``: values of variables (by name; derivatives as ``der(x)``) at which the
+    states are chosen: each dummy-derivative block is then the best-conditioned
+    choice there (:func:`springc.reduce.pivoted_choice`), instead of the default
+    priority choice checked at the start values. Used to switch states during a
+    simulation (:mod:`springc.switching`).
+
+    The cyclic garbage collector is paused meanwhile: the passes allocate millions of
+    small acyclic nodes, and its full collections, each scanning the whole (large)
+    flat model, made the run superlinear in the model size.
+    """
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        return _simplify(model, at)
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
+    system = lower(model)
+    aliased = eliminate_aliases(system)
+    reduced = index_reduce(aliased.dae, at)
+    steps = causalize(reduced)
+    unknowns = {u.name: u for u in aliased.dae.unknowns}
+    states = []
+    for state, derivative in reduced.states:
+        name = reduced.names[state]
+        u = unknowns.get(name)
+        states.append(ode.State(name, reduced.names[derivative],
+                                u.start if u else None, bool(u and u.fixed),
+                                u.nominal if u else None, u.unit if u else None,
+                                u.span if u else model.span))
+    observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
+    result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
+                     aliased.dae.parameters, aliased.dae)
+    return Simplified(result, aliased.warnings, reduced.blocks)

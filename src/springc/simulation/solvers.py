@@ -1,0 +1,172 @@
+"""Solver choice and fixed-step runs: generated module + start state -> solver / states.
+
+Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
+
+- **Fixed-step scene integrators** (``springc.simulation.FIXED_STEP``): ``verlet`` (velocity Verlet)
+  and ``symplectic-euler`` (semi-implicit Euler) for second-order mechanical systems,
+  and the classical ``rk4``, run by :mod:`springc.integrators` with ``--step H``.
+  The position/velocity pairs they need (``der(q) = v`` with ``v`` a state) are found
+  from the generated module: a state whose derivative depends structurally on one
+  other state only, with slope 1 and no offset (:func:`detect_pairs`; on the ODE
+  itself, :func:`pairs_from_ode` reads the ``der(q) := v`` steps directly).
+- **``auto``** (the default, run by :mod:`springc.race`): ``dop853`` unless a run
+  turns out long *and* a cheap stiffness estimate is large: the spectral radius
+  ``rho`` of the analytic Jacobian times the remaining span ``T``
+  (:mod:`springc.stiffness`, :func:`choose`). Even then the estimate alone cannot
+  tell: a stiff spring whose fast mode stays at rest costs an explicit method
+  nothing, an excited one costs every method, and per-step costs differ by solver;
+  so the two methods race for a few steps and the one whose projected remaining
+  cost is lower finishes the run.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import Note, SimulationError
+from .integrators import NonFiniteState, Pairs, integrate
+
+AUTO = "auto"
+EXPLICIT, IMPLICIT = "dop853", "radau"
+RACE = "race"
+MAX_FIXED_STEPS = 20_000_000
+"""More fixed steps than this are refused up front (minutes of Python loop)."""
+FIXED_REMEDY = "reduce --step or use --solver radau"
+
+
+# ------------------------------------------------------------------ pairs
+
+def pairs_from_ode(system: object) -> list[tuple[str, str]]:
+    """``(q, v)`` for every step ``der(q) := v`` of an :class:`springc.ode.ODE` where
+    ``v`` is a state too."""
+    from ..ir.expr import Var
+    from ..ir.ode import Assign
+
+    states = {s.name for s in system.states}  # type: ignore[attr-defined]
+    out = []
+    for step in system.steps:  # type: ignore[attr-defined]
+        if (isinstance(step, Assign) and step.name.startswith("der(")
+                and isinstance(step.expr, Var) and step.expr.name in states):
+            q = step.name[4:-1]
+            if q in states:
+                out.append((q, step.expr.name))
+    return _disjoint(out)
+
+
+def _disjoint(pairs: list[tuple[str, str]] | list[tuple[int, int]]) -> list:
+    """Drop chains (``der(a) = b``, ``der(b) = c``): a state is a position or a
+    velocity, not both."""
+    positions = {q for q, _ in pairs}
+    velocities = {v for _, v in pairs}
+    return [(q, v) for q, v in pairs if v not in positions and q not in velocities]
+
+
+def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -> Pairs:
+    """Position/velocity pairs of a generated module, from its Jacobian sparsity.
+
+    Row ``i`` qualifies if its only structural non-zero is column ``j != i`` and
+    ``rhs_i == x_j`` at the start and at a perturbed state and time.
+    """
+    rows = np.asarray(module.JAC_ROWS, dtype=np.int64)
+    cols = np.asarray(module.JAC_COLS, dtype=np.int64)
+    n = len(x0)
+    if n == 0:
+        return Pairs.of([])
+    count = np.bincount(rows, minlength=n)
+    col_of = np.full(n, -1, dtype=np.int64)
+    col_of[rows] = cols
+    candidates = [(i, int(col_of[i])) for i in np.flatnonzero(count == 1)
+                  if col_of[i] != i]
+    if not candidates:
+        return Pairs.of([])
+    rng = np.random.default_rng(0)
+    probe = x0 + (0.1 + np.abs(x0)) * rng.uniform(0.01, 0.02, n)
+    checks = []
+    for t, x in ((t0, x0), (t0 + 0.5, probe)):
+        try:
+            with np.errstate(all="ignore"):
+                z = np.asarray(module.guesses(p), dtype=float)
+                checks.append((np.asarray(module.rhs(t, x, p, z), dtype=float), x))
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+            continue
+    good = [(q, v) for q, v in candidates
+            if checks and all(d[q] == x[v] for d, x in checks)]
+    return Pairs.of(_disjoint(good))
+
+
+# ------------------------------------------------------------------ auto
+
+@dataclass(frozen=True)
+class AutoChoice:
+    """What ``auto`` decided at the start state and why (for the summary line):
+    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.race`)."""
+
+    solver: str
+    reason: str
+    spectral_radius: float
+    span: float
+
+
+def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
+    """``dop853`` if ``rho * span`` is small, else a race (``radau`` outright if the
+    Jacobian is not finite)."""
+    from .stiffness import choose_solver
+
+    if jac.shape[0] == 0 or span <= 0:
+        return AutoChoice(EXPLICIT, "no dynamics to integrate", 0.0, span)
+    base = choose_solver(jac, span, EXPLICIT, IMPLICIT)
+    rho = base.spectral_radius
+    if base.solver == EXPLICIT or not math.isfinite(base.stiffness):
+        return AutoChoice(base.solver, base.reason, rho, span)
+    return AutoChoice(RACE, base.reason, rho, span)
+
+
+# ------------------------------------------------------------------ fixed step
+
+def check_step(solver: str, step: float | None, start: float, stop: float,
+               intervals: int) -> float:
+    """The step of a fixed-step run, validated; errors name the option."""
+    if step is None:
+        raise SimulationError(f"the fixed-step solver {solver} needs a step size",
+                              hint="pass --step H (e.g. a twentieth of the fastest "
+                              "period), or use --solver auto")
+    if not (math.isfinite(step) and step > 0):
+        raise SimulationError(f"the step must be positive and finite, not {step:g}",
+                              hint="pass --step H with H > 0")
+    steps = intervals + (stop - start) / step
+    if steps > MAX_FIXED_STEPS:
+        raise SimulationError(f"--step {step:g} over {stop - start:g} s takes {steps:.3g} "
+                              f"steps, more than {MAX_FIXED_STEPS:.0e}",
+                              hint="use a larger --step, a shorter span, or an adaptive "
+                              "solver (--solver auto)")
+    return float(step)
+
+
+def run_fixed(problem: Any, grid: np.ndarray, x0: np.ndarray, step: float
+              ) -> tuple[np.ndarray, int]:
+    """The states on ``grid`` and the number of steps of ``problem.solver``.
+
+    ``problem`` is the simulation's wrapper (``rhs``, ``mod``, ``p``, ``names``): a
+    non-finite derivative stops the run at that step (its ``rhs`` check); a state
+    that overflows stops it at the next output time, naming the states at fault.
+    """
+    if len(x0) == 0:
+        return np.tile(x0, (len(grid), 1)), 0
+    pairs = detect_pairs(problem.mod, problem.p, x0, float(grid[0]))
+    try:
+        result = integrate(problem.solver, problem.rhs, grid, x0, step, pairs)
+    except NonFiniteState as err:
+        names = [problem.names[i] for i in err.indices]
+        notes = [Note(f"{name} is not finite") for name in names[:4]]
+        if len(names) > 4:
+            notes.append(Note(f"... and {len(names) - 4} more states"))
+        raise SimulationError(f"the states became non-finite by time {err.time:.9g} "
+                              f"({problem.solver}, --step {step:g})", notes=notes,
+                              hint=FIXED_REMEDY) from None
+    return result.x, result.steps
