@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-import springc.pipeline.files
+import springc.pipeline
 from springc.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,7 +40,7 @@ def test_model_error_goes_to_stderr_with_exit_1(tmp_path: Path) -> None:
 
 
 def test_internal_error_exit_3_without_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(springc.pipeline.files, "flatten_files", _crash)
+    monkeypatch.setattr(springc.pipeline, "flatten_files", _crash)
     code, out, err = run("check", SEED)
     assert (code, out) == (3, "")
     assert err == ("internal error: ZeroDivisionError: boom\n"
@@ -49,7 +49,7 @@ def test_internal_error_exit_3_without_traceback(monkeypatch: pytest.MonkeyPatch
 
 
 def test_internal_error_traceback_with_debug(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(springc.pipeline.files, "flatten_files", _crash)
+    monkeypatch.setattr(springc.pipeline, "flatten_files", _crash)
     code, _, err = run("--debug", "flatten", SEED)
     assert code == 3
     assert err.startswith("Traceback (most recent call last):\n")

@@ -14,15 +14,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import TextIO
 
-from .pipeline.compiler import (
+from .pipeline import (
     CompiledModel,
     CompileOptions,
     check_parameter_names,
     compile_files,
     modification_value,
 )
-from .simulation.results import SimulationResult
-from .simulation.runner import DEFAULT_SOLVER, SimulationOptions, simulate_model
+from .simulation import DEFAULT_SOLVER, SimulationOptions, SimulationResult, simulate_model
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 

@@ -77,12 +77,12 @@ def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...
             origins: bool, as_json: bool, simplified: bool) -> None:
     """Print the flat model of FILES as Modelica text (or JSON)."""
     from .ir.flat import format_flat, to_json_dict
-    from .pipeline.files import flatten_files
+    from .pipeline import flatten_files
 
     flat_model = flatten_files(files, model, libraries)
     if simplified:
         from .ir.ode import format_ode
-        from .simplify.passes import simplify
+        from .simplify import simplify
 
         result = simplify(flat_model)
         click.echo(format_ode(result.ode), nl=False)
@@ -100,8 +100,8 @@ def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...
 @_guard
 def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...]) -> None:
     """Check that a model flattens and is balanced; print a one-line summary."""
-    from .simplify.balance import check_balance
-    from .pipeline.files import flatten_files
+    from .pipeline import flatten_files
+    from .simplify import check_balance
 
     click.echo(check_balance(flatten_files(files, model, libraries)).summary())
 
@@ -199,7 +199,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if output:
         result.to_csv(output)
     elif not plot:
-        from .simulation.results import write_csv
+        from .simulation import write_csv
 
         write_csv(result, sys.stdout)
     if plot:
@@ -218,14 +218,14 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              backend: str, patterns: tuple[str, ...], no_cache: bool,
              output: str | None) -> None:
     """Generate a standalone Python module (numpy/scipy, or numba) for a model."""
-    from .pipeline.compiler import CompileOptions, compile_files
+    from .pipeline import CompileOptions, compile_files
 
     compiled = compile_files(CompileOptions(files, model, libraries, backend,
                                             patterns or None, (), not no_cache))
     if output:
         from pathlib import Path
 
-        from .simulation.results import atomic_write
+        from .simulation import atomic_write
 
         with atomic_write(Path(output), "w") as f:
             f.write(compiled.source)
@@ -261,7 +261,7 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
                  ) -> tuple[str, ...] | None:
     if value is None:
         return None
-    from .tradeoff.study import available_solvers
+    from .tradeoff import available_solvers
 
     names = tuple(w.lower() for w in _split(value))
     known = available_solvers()
@@ -330,14 +330,15 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     values = _parse_set(assignments)
     _single_threaded_blas()
     from .api import compile_model
-    from .tradeoff.study import (
+    from .tradeoff import (
         DEFAULT_TARGETS,
         DEFAULT_TOLERANCES,
         TradeoffOptions,
         compare_states,
         run_tradeoff,
+        summary,
+        write_table_csv,
     )
-    from .tradeoff.report import summary, write_table_csv
 
     compiled = compile_model(files, model, libraries=libraries, backend=backend,
                              outputs=patterns or None, parameters=values,
@@ -352,12 +353,12 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     study = run_tradeoff(compiled, options)
     click.echo(summary(study), nl=False)
     if save_reference:
-        from .tradeoff.reference import write_reference
+        from .tradeoff import write_reference
 
         write_reference(study.reference, save_reference)
     if output:
         write_table_csv(study, output)
     if plot:
-        from .tradeoff.plot import write_work_precision
+        from .tradeoff import write_work_precision
 
         write_work_precision(study, plot)

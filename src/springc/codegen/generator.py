@@ -21,7 +21,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ..errors import Span
 from ..ir import flat, ode
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
 from .jacobian import jacobian_statements
 from .module_text import (
     _comment,
@@ -46,8 +48,6 @@ from .vector import (
     VECTOR_THRESHOLD,
     VectorLayout,
 )
-from ..errors import Span
-from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
 
 BACKENDS = ("python", "numba")
 NEWTON_ITERATIONS = 50

@@ -18,8 +18,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..ir import ode
-from .printer import Block, CodegenError, Let, Load, Raw, Stmt, Store
 from ..ir.expr import ONE, ZERO, BinOp, Const, Expr, Neg, Var, add, diff, mul, neg, sub, variables
+from .printer import Block, CodegenError, Let, Load, Raw, Stmt, Store
 
 Grad = dict[int, Expr]
 

@@ -11,7 +11,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from ..errors import Span
 from ..ir import dae
+from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
+from ..simplify import conditions as initial_conditions
 from .printer import HELPERS, CodegenError, Let, Namer, Raw, Stmt, Store, function_lines
 from .vector import (
     VECTOR_THRESHOLD,
@@ -20,9 +23,6 @@ from .vector import (
     encode_ints,
     encode_strings,
 )
-from ..errors import Span
-from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
-from ..simplify.initialize import conditions as initial_conditions
 
 if TYPE_CHECKING:
     from .generator import CodegenOptions, _Model

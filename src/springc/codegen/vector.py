@@ -30,9 +30,9 @@ from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from .printer import CodegenError, FunctionWriter, Store, function_lines
 from ..errors import Span
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
+from .printer import CodegenError, FunctionWriter, Store, function_lines
 
 if TYPE_CHECKING:
     from .generator import _Model

@@ -1,1 +1,7 @@
-"""springc.flatten."""
+"""Flatten: ``parse.ClassTree`` -> ``ir.flat.FlatModel`` (modifications, inheritance,
+arrays, connections, functions)."""
+
+from .flattener import flatten
+from .lookup import select_model
+
+__all__ = ["flatten", "select_model"]

@@ -13,10 +13,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import arrays as a
+from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import syntax as s
-from ..errors import FlattenError
+from . import arrays as a
 
 if TYPE_CHECKING:
     from .evaluate import Evaluator

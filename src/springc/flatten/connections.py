@@ -14,10 +14,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from ..errors import FlattenError, Note
 from .scope import ClassScope, LocalScope, Primitive
 
 if TYPE_CHECKING:

@@ -9,16 +9,16 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from . import arrays as a
+from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
-from ..errors import FlattenError
-from .scope import ClassScope, LocalScope
+from . import arrays as a
 from .equation_templates import Template, make_template, reusable
+from .scope import ClassScope, LocalScope
 
 if TYPE_CHECKING:
-    from .connections import ConnectionSets
     from ..errors import SpringcError
+    from .connections import ConnectionSets
     from .evaluate import Evaluator
     from .flattener import ParameterValues
 

@@ -14,13 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import arrays as a
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import syntax as s
+from ..parse import ClassEntry
+from . import arrays as a
 from .builtins import CONSTANTS, Builtins
-from ..errors import FlattenError, Note
 from .scope import ClassScope, LocalScope, Primitive
-from ..parse.loader import ClassEntry
 
 if TYPE_CHECKING:
     from .flattener import Flattener

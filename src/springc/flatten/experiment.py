@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
-from ..errors import FlattenError
+from ..parse import ClassEntry
 from .scope import ClassScope
-from ..parse.loader import ClassEntry
 
 if TYPE_CHECKING:
     from .flattener import Flattener

@@ -14,20 +14,20 @@ from typing import Any
 
 import numpy as np
 
-from . import arrays as a
+from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from ..ir import expr as x
 from ..ir import flat
+from ..parse import ClassTree
+from . import arrays as a
 from .connections import ConnectionSets
+from .equation_templates import Template
 from .equations import EquationFlattening
-from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from .evaluate import Evaluator
-from .scope import ClassScope, ClassView, Primitive, instance_mod
 from .instance_templates import InstanceTemplates
 from .instantiate import Declared, Instantiation
-from ..parse.loader import ClassTree
 from .lookup import ClassLookup, select_model
 from .modification import Mod, merge_all
-from .equation_templates import Template
+from .scope import ClassScope, ClassView, Primitive, instance_mod
 from .variables import attributes_of
 
 __all__ = ["Declared", "Flattener", "ParameterValues", "flatten", "select_model"]

@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import arrays as a
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import syntax as s
-from ..errors import FlattenError, Note
-from ..parse.loader import ClassEntry
+from ..parse import ClassEntry
+from . import arrays as a
 
 if TYPE_CHECKING:
     from .evaluate import Evaluator

@@ -24,13 +24,13 @@ from dataclasses import dataclass, fields
 from itertools import islice
 from typing import TYPE_CHECKING, Any
 
-from . import arrays as a
+from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import flat
-from ..errors import FlattenError
-from .scope import ClassScope, ClassView, Primitive, ViewComponent
-from .modification import Mod
+from . import arrays as a
 from .equation_templates import fixed_shape, renamer
+from .modification import Mod
+from .scope import ClassScope, ClassView, Primitive, ViewComponent
 
 if TYPE_CHECKING:
     from .flattener import Flattener

@@ -14,13 +14,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import arrays as a
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from ..errors import FlattenError, Note
-from .scope import ClassScope, ClassView, Primitive, ResolvedType, ViewComponent, instance_mod
+from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
+from .scope import ClassScope, ClassView, Primitive, ResolvedType, ViewComponent, instance_mod
 from .variables import check_attribute_mods
 
 if TYPE_CHECKING:

@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import syntax as s
+from ..parse import ClassEntry, ClassTree, lookup_class, member_class
 from .builtins import CONSTANTS
-from ..errors import FlattenError, Note
-from .scope import PRIMITIVES, ClassScope, ClassView, ResolvedType, build_view
-from ..parse.loader import ClassEntry, ClassTree, lookup_class, member_class
 from .modification import Mod, from_syntax
+from .scope import PRIMITIVES, ClassScope, ClassView, ResolvedType, build_view
 
 if TYPE_CHECKING:
     from .evaluate import Evaluator

@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from ..ir import syntax as s
 from ..errors import FlattenError, Note, Span
+from ..ir import syntax as s
 
 
 @dataclass(frozen=True, slots=True)

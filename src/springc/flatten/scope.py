@@ -14,9 +14,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..ir import syntax as s
 from ..errors import FlattenError, FollowUpError, Note
-from ..parse.loader import ClassEntry
+from ..ir import syntax as s
+from ..parse import ClassEntry
 from .modification import Mod, from_syntax, merge_all
 
 if TYPE_CHECKING:

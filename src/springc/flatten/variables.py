@@ -11,13 +11,13 @@ import itertools
 from collections.abc import Iterator
 from typing import TYPE_CHECKING, Any
 
-from . import arrays as a
+from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from ..errors import FlattenError
-from .scope import ClassScope, Primitive
+from . import arrays as a
 from .modification import Mod, select
+from .scope import ClassScope, Primitive
 
 if TYPE_CHECKING:
     from .flattener import Flattener

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from . import flat
 from ..errors import Span
+from . import flat
 from .expr import Expr, to_text
 
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from . import dae
 from ..errors import Span
+from . import dae
 from .expr import Expr, to_text
 
 

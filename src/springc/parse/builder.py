@@ -21,13 +21,13 @@ from typing import Any
 
 from lark import Tree
 
+from ..errors import ErrorGroup, ParseError
+from ..ir.syntax import End
 from .rules_base import KEYWORDS, LATER
 from .rules_classes import ClassRules
 from .rules_elements import ElementRules
 from .rules_equations import EquationRules
 from .rules_expressions import ExpressionRules
-from ..errors import ErrorGroup, ParseError
-from ..ir.syntax import End
 
 __all__ = ["KEYWORDS", "LATER", "SyntaxBuilder", "build"]
 

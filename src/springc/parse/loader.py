@@ -14,10 +14,10 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..ir import syntax as s
 from ..errors import ErrorGroup, FlattenError, LoadError, Note, SpringcError
-from .parser import parse_file
+from ..ir import syntax as s
 from ..resources import models_dir
+from .parser import parse_file
 
 
 @dataclass(eq=False)

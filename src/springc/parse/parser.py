@@ -20,10 +20,10 @@ from pathlib import Path
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from .builder import build
 from ..errors import LoadError, ParseError, Span
-from ..resources import grammar_path
 from ..ir.syntax import Expr, StoredDefinition
+from ..resources import grammar_path
+from .builder import build
 
 __all__ = ["parse_expression", "parse_file", "parse_text"]
 

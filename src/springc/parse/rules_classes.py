@@ -14,10 +14,10 @@ from dataclasses import dataclass, replace
 
 from lark import Token
 
-from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
-from .rules_elements import causality, variability
 from ..errors import Note, Span
 from ..ir.syntax import ClassDef, Component, Element, Modification, ShortDef, StoredDefinition
+from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
+from .rules_elements import causality, variability
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 from lark import Token
 
-from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, of
 from ..errors import Span
 from ..ir.syntax import (
     ClassDef,
@@ -25,6 +24,7 @@ from ..ir.syntax import (
     Modification,
     Ref,
 )
+from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, of
 
 
 @dataclass(frozen=True, slots=True)

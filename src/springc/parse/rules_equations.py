@@ -8,7 +8,6 @@
 
 from __future__ import annotations
 
-from .rules_base import Rejected, RuleBase, join
 from ..ir.syntax import (
     Assign,
     Call,
@@ -22,6 +21,7 @@ from ..ir.syntax import (
     IfStatement,
     Ref,
 )
+from .rules_base import Rejected, RuleBase, join
 
 
 class EquationRules(RuleBase):

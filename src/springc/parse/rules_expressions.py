@@ -11,7 +11,6 @@ from dataclasses import dataclass
 
 from lark import Token
 
-from .rules_base import RuleBase, Subs, join, of
 from ..ir.syntax import (
     ArrayLit,
     Binary,
@@ -31,6 +30,7 @@ from ..ir.syntax import (
     String,
     Unary,
 )
+from .rules_base import RuleBase, Subs, join, of
 
 _RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
 _ADDITIVE = frozenset({"+", "-", ".+", ".-"})

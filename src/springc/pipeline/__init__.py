@@ -1,1 +1,14 @@
-"""springc.pipeline."""
+"""Pipeline: source files -> ``CompiledModel`` (flatten, simplify, generate, cache, import)."""
+
+from .compiler import (
+    CompiledModel,
+    CompileOptions,
+    check_parameter_names,
+    compile_files,
+    derive_system,
+    modification_value,
+)
+from .files import flatten_files
+
+__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
+           "derive_system", "flatten_files", "modification_value"]

@@ -179,7 +179,7 @@ def _library_folders(libraries: Sequence[str]) -> list[Path]:
 
 def cache_key(options: CompileOptions) -> str:
     """A digest of everything the generated module depends on."""
-    from ..codegen.module_text import CODEGEN_VERSION
+    from ..codegen import CODEGEN_VERSION
 
     h = hashlib.sha256()
     h.update(repr((CODEGEN_VERSION, options.model, options.backend, options.outputs,
@@ -266,8 +266,8 @@ class Derived:
 
 def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
+    from ..simplify import simplify
     from .files import flatten_files
-    from ..simplify.passes import simplify
 
     files = list(options.files)
     model = options.model
@@ -290,7 +290,7 @@ def derive_system(options: CompileOptions) -> Derived:
 
 def generate_source(options: CompileOptions) -> str:
     """Flatten, simplify and generate the module text for ``options``."""
-    from ..codegen.generator import CodegenOptions, generate
+    from ..codegen import CodegenOptions, generate
 
     derived = derive_system(options)
     system, flat_model = derived.system, derived.flat_model

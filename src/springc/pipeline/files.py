@@ -14,7 +14,7 @@ from ..ir.flat import FlatModel
 def flatten_files(files: Sequence[str | Path], model: str | None = None,
                   libraries: Iterable[str | Path] = ()) -> FlatModel:
     """Load ``files`` (plus library folders) and flatten ``model`` (dotted name)."""
-    from ..flatten.flattener import flatten
-    from ..parse.loader import load
+    from ..flatten import flatten
+    from ..parse import load
 
     return flatten(load(files, libraries), model)

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ..errors import Note
 from ..ir import dae
 from ..ir import expr as x
-from ..errors import Note
-from .lower import differentiate
 from .isolate import free_variables
+from .lower import differentiate
 
 _SELECT_RANK = {"never": 0, "avoid": 1, "default": 2, "prefer": 3, "always": 4}
 

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..errors import BalanceError, Note
 from ..ir import expr as x
 from ..ir import flat
-from ..errors import BalanceError, Note
 from ..structure import dulmage_mendelsohn, maximum_matching
 
 MAX_NOTES = 20

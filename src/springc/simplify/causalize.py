@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ..errors import Note, SimplifyError
 from ..ir import expr as x
 from ..ir import ode
-from ..errors import Note, SimplifyError
+from ..structure import blt, dulmage_mendelsohn, maximum_matching, tear
 from .index_reduction import Reduced
 from .isolate import fold, free_variables, partial, solvable, solve_for
-from ..structure import blt, dulmage_mendelsohn, maximum_matching, tear
 
 
 def causalize(reduced: Reduced) -> list[ode.Step]:

@@ -20,12 +20,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import Note, SimplifyError
 from ..ir import dae
 from ..ir import expr as x
-from ..errors import Note, SimplifyError
-from .ode_eval import evaluate_with, parameter_values, start_values
-from .lower import differentiate
-from .isolate import free_variables, partial
 from ..structure import (
     NumericallySingular,
     StructurallySingular,
@@ -33,6 +30,9 @@ from ..structure import (
     pantelides,
     state_priority,
 )
+from .isolate import free_variables, partial
+from .lower import differentiate
+from .ode_eval import evaluate_with, parameter_values, start_values
 
 START_BONUS = 0.25
 """Priority added for a (non-fixed) start value: below the fixed-start bonus (0.5)."""

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import Note, SimulationError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import ode
-from ..errors import Note, SimulationError, Span, SpringcError
 from .ode_eval import Evaluator, parameter_values, start_values
 
 

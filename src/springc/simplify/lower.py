@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ..errors import Note, SimplifyError
 from ..ir import dae, flat
 from ..ir import expr as x
-from ..errors import Note, SimplifyError
 from .isolate import COUNTERS, free_variables
 
 

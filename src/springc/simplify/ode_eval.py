@@ -14,9 +14,9 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from ..errors import Note, SimplifyError, SimulationError
 from ..ir import dae, ode
 from ..ir import expr as x
-from ..errors import Note, SimplifyError, SimulationError
 
 SPARSE_FROM = 50
 """Linear systems with at least this many unknowns are solved with sparse LU."""

@@ -14,12 +14,12 @@ import gc
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from ..errors import Note
 from ..ir import flat, ode
 from .alias import eliminate_aliases
 from .causalize import causalize
-from ..errors import Note
-from .lower import lower
 from .index_reduction import DummyBlock, index_reduce
+from .lower import lower
 
 
 @dataclass(frozen=True)

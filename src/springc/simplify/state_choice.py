@@ -37,14 +37,14 @@ from typing import Protocol
 
 import numpy as np
 
+from ..errors import SimulationError
 from ..ir import expr as x
 from ..ir import flat, ode
-from ..errors import SimulationError
-from .ode_eval import Evaluator, parameter_values
-from .initialize import initial_state
 from .index_reduction import DummyBlock, pivoted_choice
-from .passes import simplify
+from .initialize import initial_state
 from .isolate import free_variables, partial
+from .ode_eval import Evaluator, parameter_values
+from .passes import simplify
 
 THRESHOLD = 0.2
 """Switch when the current choice is this much worse conditioned than the best one."""

@@ -30,9 +30,9 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from . import solvers
-from ..pipeline.compiler import CompiledModel, check_parameter_names
 from ..errors import Note, SimulationError
+from ..pipeline import CompiledModel, check_parameter_names
+from . import solvers
 from .race import auto
 from .results import SimulationResult, SimulationStats
 
@@ -123,8 +123,8 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
     """
     if not getattr(model.module, "INITIAL_CONDITIONS", 0):
         return np.asarray(model.module.start(p), dtype=float)
-    from ..pipeline.compiler import derive_system
-    from ..simplify.initialize import initial_state as solve_initial
+    from ..pipeline import derive_system
+    from ..simplify import initial_state as solve_initial
 
     system = derive_system(model.options).system
     values = dict(zip(model.parameter_names, (float(v) for v in p)))

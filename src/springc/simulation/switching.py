@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
-from ..pipeline.compiler import CompiledModel, derive_system
+from ..pipeline import CompiledModel, derive_system
+from ..simplify import simulate_switching
 from .results import SimulationResult, SimulationStats
-from ..simplify.state_choice import simulate_switching
 
 EXPLICIT_DEFAULT = "dop853"
 SCIPY_NAMES = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",

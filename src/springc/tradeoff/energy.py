@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..pipeline.compiler import CompiledModel
 from ..errors import SimulationError
+from ..pipeline import CompiledModel
 
 ENERGY_UNIT = "J"
 

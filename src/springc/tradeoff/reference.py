@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import Note, SimulationError
-from ..simulation.runner import simulate_model
+from ..simulation import simulate_model
 from .study import (
     REFERENCE_RTOL,
     Reference,
@@ -139,7 +139,7 @@ def write_reference(ref: Reference, path: str) -> None:
     ``--reference``."""
     from pathlib import Path
 
-    from ..simulation.results import atomic_write
+    from ..simulation import atomic_write
 
     with atomic_write(Path(path), "w") as f:
         writer = csv.writer(f, lineterminator="\n")

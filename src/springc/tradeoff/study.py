@@ -39,10 +39,10 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..simulation import runner as simulation
-from ..pipeline.compiler import CompiledModel
 from ..errors import SimulationError
-from ..simulation.runner import SimulationOptions, initial_state, output_grid, resolve, simulate_model
+from ..pipeline import CompiledModel
+from ..simulation import SimulationOptions, initial_state, output_grid, resolve, simulate_model
+from ..simulation import runner as simulation
 from .energy import drift, energy_series, energy_variable
 
 ADAPTIVE = ("rk45", "dop853", "radau", "bdf", "lsoda")
