@@ -29,13 +29,13 @@ from bench_tradeoff import (
     study,
     verdict,
 )
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import format_table, unresolved_note
 from springc.tradeoff.study import (
     REFERENCE_RTOL,
     REPEAT_LIMIT,
     SCALE_FLOOR,
 )
-from springc.tradeoff.plot import write_work_precision
-from springc.tradeoff.report import format_table, unresolved_note
 
 DOCS = ROOT / "docs"
 EXTREMES = "## Extremes"

@@ -26,8 +26,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from springc.parse import loader as loading
 from springc.flatten.flattener import flatten
+from springc.parse import loader as loading
 from springc.parse.loader import load
 
 CHAIN = [100, 1_000, 10_000]

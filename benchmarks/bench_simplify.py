@@ -21,8 +21,8 @@ import time
 from pathlib import Path
 
 from springc.pipeline.files import flatten_files
-from springc.simplify.passes import simplify
 from springc.simplify.isolate import COUNTERS, reset_counters
+from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[1]
 

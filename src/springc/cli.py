@@ -225,7 +225,7 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if output:
         from pathlib import Path
 
-        from .simulation import atomic_write
+        from .fileio import atomic_write
 
         with atomic_write(Path(output), "w") as f:
             f.write(compiled.source)

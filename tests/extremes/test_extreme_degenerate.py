@@ -11,9 +11,9 @@ import pytest
 from click.testing import CliRunner
 
 import springc
-from springc.pipeline.compiler import CompiledModel
 from springc.cli import main
 from springc.errors import SimulationError
+from springc.pipeline.compiler import CompiledModel
 
 
 @pytest.mark.parametrize("solver", ["auto", "dop853", "radau", "bdf", "verlet", "rk4"])

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import springc
-from springc.pipeline.compiler import CompiledModel
 from springc.errors import SimulationError
+from springc.pipeline.compiler import CompiledModel
 
 from .cases import harmonic
 

@@ -18,7 +18,7 @@ from springc.structure.dummy import (
     dummy_derivatives,
     state_priority,
 )
-from springc.structure.pantelides import IndexReduction, StructurallySingular, pantelides
+from springc.structure.index import IndexReduction, StructurallySingular, pantelides
 
 
 @dataclass(frozen=True)

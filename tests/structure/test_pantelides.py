@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import pytest
 
-from springc.structure.pantelides import (
+from springc.structure.index import (
     IndexReduction,
     StructurallySingular,
     pantelides,

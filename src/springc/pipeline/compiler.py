@@ -29,6 +29,7 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from ..errors import SimulationError
+from ..fileio import atomic_write
 from ..resources import PACKAGE_ROOT
 
 if TYPE_CHECKING:
@@ -214,14 +215,6 @@ def _import(path: Path, name: str) -> ModuleType:
     return module
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".py")
-    with os.fdopen(fd, "w", encoding="utf-8") as f:
-        f.write(text)
-    os.replace(tmp, path)
-
-
 # ------------------------------------------------------------------ compile
 
 def compile_files(options: CompileOptions) -> CompiledModel:
@@ -241,7 +234,9 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         tmp = tempfile.TemporaryDirectory(prefix="springc-")
         path = Path(tmp.name) / "model.py"
     generated = generate_source(options)
-    _write_atomic(path, generated)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path, "w") as f:
+        f.write(generated)
     if options.cache:
         prune_cache(cache_dir(), keep=key)
     module = _import(path, module_name)
@@ -312,7 +307,8 @@ def _wrapper_file(model: str, modifications: Sequence[tuple[str, str]]) -> Path:
     path = cache_dir() / "modified" / f"{digest}.mdl"
     if not path.exists():
         path.parent.mkdir(parents=True, exist_ok=True)
-        _write_atomic(path, text)
+        with atomic_write(path, "w") as f:
+            f.write(text)
     return path
 
 

@@ -3,9 +3,12 @@
 The package is ``simulation``, not ``simulate``: ``springc.simulate`` is the API function.
 """
 
-from .results import SimulationResult, atomic_write, write_csv
+from .results import SimulationResult, write_csv
 from .runner import (
     DEFAULT_SOLVER,
+    FIXED_STEP,
+    LSODA_LIMIT,
+    SOLVERS,
     SimulationOptions,
     initial_state,
     output_grid,
@@ -13,5 +16,6 @@ from .runner import (
     simulate_model,
 )
 
-__all__ = ["DEFAULT_SOLVER", "SimulationOptions", "SimulationResult", "atomic_write",
-           "initial_state", "output_grid", "resolve", "simulate_model", "write_csv"]
+__all__ = ["DEFAULT_SOLVER", "FIXED_STEP", "LSODA_LIMIT", "SOLVERS", "SimulationOptions",
+           "SimulationResult", "initial_state", "output_grid", "resolve", "simulate_model",
+           "write_csv"]

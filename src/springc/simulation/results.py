@@ -8,16 +8,15 @@ complete, so a failed run never leaves a CSV or PNG that looks complete.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import re
-import tempfile
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO
 
 import numpy as np
+
+from ..fileio import atomic_write
 
 
 @dataclass(frozen=True)
@@ -78,31 +77,6 @@ class SimulationResult:
     def __repr__(self) -> str:
         return (f"<SimulationResult {self.model}: {len(self.time)} times x "
                 f"{len(self.names)} variables, {self.stats.solver}>")
-
-
-@contextlib.contextmanager
-def atomic_write(path: Path, mode: str) -> Iterator[IO[Any]]:
-    """Write to a temporary file next to ``path``; rename it only on success."""
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, mode, **({"encoding": "utf-8", "newline": ""} if "b" not in mode
-                                    else {})) as f:
-            yield f
-        # mkstemp creates the file private (0600); give it the permissions a plain
-        # open() would have given (0666 less the umask).
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:

@@ -4,11 +4,11 @@ Input: an incidence (for each equation, the indices of the variables it contains
 Output: matchings, Dulmage-Mendelsohn parts, BLT blocks and tearings of loops.
 """
 
-from .blt import blt
 from .dummy import NumericallySingular, StateSelection, dummy_derivatives, state_priority
 from .graph import Incidence, biadjacency, to_incidence, transpose
+from .index import IndexReduction, StructurallySingular, pantelides
 from .matching import DMParts, Matching, dulmage_mendelsohn, maximum_matching, validate_matching
-from .pantelides import IndexReduction, StructurallySingular, pantelides
+from .sorting import blt
 from .tearing import Tearing, tear
 
 __all__ = [

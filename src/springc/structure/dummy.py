@@ -1,6 +1,6 @@
 """IndexReduction -> StateSelection: dummy derivatives (Mattsson and Söderlind, 1993).
 
-Input: the :class:`~springc.structure.pantelides.IndexReduction` of a DAE, a priority
+Input: the :class:`~springc.structure.index.IndexReduction` of a DAE, a priority
 per variable (see :func:`state_priority`) and an optional numeric check.
 Output: :class:`StateSelection`: the variables that stay states (their derivative is
 a true derivative), the derivatives turned into algebraic *dummy* derivatives, and
@@ -49,7 +49,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from .pantelides import NONE, IndexReduction, StructurallySingular
+from .index import NONE, IndexReduction, StructurallySingular
 
 ALWAYS = math.inf
 PREFER = 2.0

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..simulation import atomic_write
+from ..fileio import atomic_write
 from .study import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
 
 ERROR_FLOOR = 1e-16

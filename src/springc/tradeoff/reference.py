@@ -139,7 +139,7 @@ def write_reference(ref: Reference, path: str) -> None:
     ``--reference``."""
     from pathlib import Path
 
-    from ..simulation import atomic_write
+    from ..fileio import atomic_write
 
     with atomic_write(Path(path), "w") as f:
         writer = csv.writer(f, lineterminator="\n")

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..errors import Note
-from ..simulation import atomic_write
+from ..fileio import atomic_write
 from .study import CSV_COLUMNS, SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
 
 

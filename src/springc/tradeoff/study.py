@@ -41,12 +41,19 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
-from ..simulation import SimulationOptions, initial_state, output_grid, resolve, simulate_model
-from ..simulation import runner as simulation
+from ..simulation import (
+    FIXED_STEP,
+    LSODA_LIMIT,
+    SOLVERS,
+    SimulationOptions,
+    initial_state,
+    output_grid,
+    resolve,
+    simulate_model,
+)
 from .energy import drift, energy_series, energy_variable
 
 ADAPTIVE = ("rk45", "dop853", "radau", "bdf", "lsoda")
-FIXED_STEP = ("verlet", "symplectic-euler", "rk4")
 DEFAULT_TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 DEFAULT_STEP_DIVISIONS = (2, 4, 8, 16, 32, 64, 128, 256)
 """Default fixed steps: the output interval divided by these."""
@@ -148,12 +155,12 @@ def fixed_step_solvers() -> tuple[str, ...]:
     """The fixed-step methods the simulator offers (they need ``SimulationOptions.step``)."""
     if "step" not in {f.name for f in dataclasses.fields(SimulationOptions)}:
         return ()
-    offered = set(simulation.SOLVERS) | set(getattr(simulation, "FIXED_STEP", ()))
+    offered = set(SOLVERS) | set(FIXED_STEP)
     return tuple(s for s in FIXED_STEP if s in offered)
 
 
 def available_solvers() -> tuple[str, ...]:
-    return tuple(s for s in ADAPTIVE if s in simulation.SOLVERS) + fixed_step_solvers()
+    return tuple(s for s in ADAPTIVE if s in SOLVERS) + fixed_step_solvers()
 
 
 def check_solvers(names: Sequence[str]) -> tuple[str, ...]:
@@ -261,7 +268,7 @@ def warm_up(model: CompiledModel, p: np.ndarray, x0: np.ndarray) -> None:
     mod = model.module
     z = np.asarray(mod.guesses(p), dtype=float)
     for name in ("rhs", "jacobian", "jacobian_dense"):
-        if name == "jacobian_dense" and len(x0) > simulation.LSODA_LIMIT:
+        if name == "jacobian_dense" and len(x0) > LSODA_LIMIT:
             continue
         func = getattr(mod, name, None)
         if func is not None:

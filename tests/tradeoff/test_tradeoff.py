@@ -14,6 +14,8 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import recommend, write_table_csv
 from springc.tradeoff.study import (
     CSV_COLUMNS,
     SCIPY_DEFAULT,
@@ -29,8 +31,6 @@ from springc.tradeoff.study import (
     run_tradeoff,
     variable_scales,
 )
-from springc.tradeoff.plot import write_work_precision
-from springc.tradeoff.report import recommend, write_table_csv
 
 OSCILLATOR = """
 model Oscillator "x'' = -4 x: x = cos(2 t), v = -2 sin(2 t)"

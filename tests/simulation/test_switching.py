@@ -8,7 +8,7 @@ import numpy as np
 
 import springc
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 def test_rigid_pair_runs_through_the_switch_with_the_rod_length_kept() -> None:

@@ -10,7 +10,7 @@ import pytest
 from springc.ir.flat import FlatModel, format_flat
 from springc.pipeline.files import flatten_files
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = {
     "SpringMass": ("models/SpringMass.mdl", None),
     "SpringMassConnected": ("models/Scenes.mdl", "Scenes.SpringMassConnected"),

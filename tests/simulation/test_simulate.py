@@ -15,7 +15,7 @@ import springc
 from springc.errors import SimulationError
 from springc.simulation.runner import output_grid
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 SCENES = str(ROOT / "models" / "Scenes.mdl")
 

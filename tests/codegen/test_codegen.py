@@ -15,7 +15,7 @@ import springc
 from springc.codegen.printer import Let, Namer, Raw, Store, function_lines
 from springc.ir.expr import BinOp, Call, Const, If, Var
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 SCENES = str(ROOT / "models" / "Scenes.mdl")
 

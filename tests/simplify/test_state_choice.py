@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from springc.simplify.ode_eval import parameter_values
 from springc.ir.flat import FlatModel
-from springc.simplify.initialize import initial_state
 from springc.pipeline.files import flatten_files
 from springc.simplify.index_reduction import pivoted_choice
+from springc.simplify.initialize import initial_state
+from springc.simplify.ode_eval import parameter_values
 from springc.simplify.passes import simplify
 from springc.simplify.state_choice import (
     THRESHOLD,
@@ -28,7 +28,7 @@ from springc.simplify.state_choice import (
     switch,
 )
 
-SCENES = Path(__file__).resolve().parents[1] / "models" / "Scenes.mdl"
+SCENES = Path(__file__).resolve().parents[2] / "models" / "Scenes.mdl"
 G = 9.81
 
 

@@ -14,7 +14,7 @@ from click.testing import CliRunner
 from springc.cli import SOLVER_CHOICES, main
 from springc.simulation.runner import AUTO, FIXED_STEP, SOLVERS
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 SCENES = str(ROOT / "models" / "Scenes.mdl")
 

@@ -6,12 +6,12 @@ from pathlib import Path
 
 import pytest
 
-from springc.simplify.balance import check_balance
 from springc.errors import BalanceError
 from springc.ir.flat import FlatModel
 from springc.pipeline.files import flatten_files
+from springc.simplify.balance import check_balance
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def flat_of(tmp_path: Path, text: str) -> FlatModel:

@@ -12,7 +12,7 @@ import springc
 from springc.parse.parser import parse_text
 from springc.resources import grammar_path
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 TINY = "model Tiny\n  Real x(start = 1);\nequation\n  der(x) = -x;\nend Tiny;\n"
 
 

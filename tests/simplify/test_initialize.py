@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from springc.simplify.ode_eval import Evaluator
-from springc.simplify.initialize import InitializationError, conditions, initial_state
 from springc.pipeline.files import flatten_files
+from springc.simplify.initialize import InitializationError, conditions, initial_state
+from springc.simplify.ode_eval import Evaluator
 from springc.simplify.passes import simplify
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def compile_text(tmp_path: Path, text: str):

@@ -8,18 +8,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from springc.errors import SimplifyError
 from springc.ir import ode
+from springc.ir.expr import to_text
+from springc.pipeline.files import flatten_files
 from springc.simplify.alias import eliminate_aliases
 from springc.simplify.causalize import causalize
-from springc.errors import SimplifyError
-from springc.simplify.ode_eval import Evaluator, parameter_values
-from springc.ir.expr import to_text
-from springc.simplify.lower import lower
-from springc.pipeline.files import flatten_files
 from springc.simplify.index_reduction import index_reduce
+from springc.simplify.lower import lower
+from springc.simplify.ode_eval import Evaluator, parameter_values
 from springc.simplify.passes import simplify
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "models" / "Scenes.mdl"
 
 

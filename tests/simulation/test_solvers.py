@@ -11,14 +11,14 @@ import pytest
 from click.testing import CliRunner
 
 import springc
-from springc.simulation import race
 from springc.cli import main
 from springc.errors import SimulationError
 from springc.pipeline.files import flatten_files
 from springc.simplify.passes import simplify
+from springc.simulation import race
 from springc.simulation.solvers import choose, detect_pairs, pairs_from_ode
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 SCENES = str(ROOT / "models" / "Scenes.mdl")
 

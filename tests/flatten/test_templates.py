@@ -1,5 +1,6 @@
-"""Equation templates (springc.flatten.equation_templates): reused only where every instance of a class
-has the same equations up to its prefix; otherwise each instance is flattened."""
+"""Equation templates (springc.flatten.equation_templates): reused only where every
+instance of a class has the same equations up to its prefix; otherwise each instance
+is flattened."""
 
 from __future__ import annotations
 
@@ -7,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from springc.flatten.equation_templates import make_template, renamer
 from springc.ir import expr as x
 from springc.ir.flat import format_equation
 from springc.pipeline.files import flatten_files
-from springc.flatten.equation_templates import make_template, renamer
 
 
 def equations(tmp_path: Path, source: str) -> list[str]:

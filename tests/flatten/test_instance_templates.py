@@ -7,16 +7,15 @@ from pathlib import Path
 
 import pytest
 
-from springc.flatten import connections
-
-from springc.ir import flat
-from springc.ir import expr as x
-from springc.flatten import flattener as flattening
 from springc.errors import FlattenError
+from springc.flatten import connections
+from springc.flatten import flattener as flattening
 from springc.flatten.instance_templates import InstanceTemplates
+from springc.ir import expr as x
+from springc.ir import flat
 from springc.parse.loader import load
 
-MODELS = Path(__file__).resolve().parents[1] / "models"
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 # Per-element parameter values, an extends modification, a continuous variable with a
 # binding (binding equations), a start value naming a parameter, and an array whose

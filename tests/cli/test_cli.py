@@ -10,7 +10,7 @@ from click.testing import CliRunner
 import springc.pipeline
 from springc.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 
 
