@@ -16,6 +16,7 @@ from typing import Any
 import click
 
 from .errors import ErrorGroup, SpringcError, render_all
+from .simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
 
 EXIT_MODEL_ERROR = 1
 EXIT_USAGE = 2
@@ -108,10 +109,6 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
 
 # ------------------------------------------------------------------ simulate, compile
 
-SOLVER_CHOICES = ("auto", "rk45", "dop853", "radau", "bdf", "lsoda",  # simulation.SOLVERS
-                  "verlet", "symplectic-euler", "rk4")  # simulation.FIXED_STEP
-
-
 def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
     out: dict[str, float] = {}
     for item in values:
@@ -159,8 +156,8 @@ def _single_threaded_blas() -> None:
 @click.option("--stop", type=float, help="Stop time [s] (default: experiment, else 10).")
 @click.option("--interval", type=float,
               help="Output interval [s] (default: experiment, else (stop-start)/500).")
-@click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
-              default="auto", show_default=True,
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True,
               help="auto: dop853 or radau from a stiffness estimate at the start (the "
               "summary says why); a scipy solve_ivp method; or a fixed-step one "
               "(verlet, symplectic-euler, rk4) with --step.")
@@ -183,7 +180,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              output: str | None, plot: str | None, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV) and/or a plot (PNG)."""
     values = _parse_set(assignments)
-    if solver.lower() in SOLVER_CHOICES[-3:] and step is None:
+    if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
     if step is not None and not step > 0:

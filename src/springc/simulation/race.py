@@ -34,7 +34,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from .solvers import EXPLICIT, IMPLICIT, RACE, AutoChoice
+from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
+from .solvers import AutoChoice
 
 EXPLICIT_PROBE = 40
 IMPLICIT_PROBE = 20
@@ -76,12 +77,12 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
     try:
         probe = run.advance(explicit, EXPLICIT_PROBE)
     except run.failure as failure:
-        implicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
+        implicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
         try:
             run.advance(implicit)
         except run.failure as again:
             raise run.both_failed(failure, again) from None
-        return IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
+        return RACE_IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
     if run.done:
         return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {probe.steps} steps"
     h_explicit = _step(probe)
@@ -92,8 +93,8 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
     choice = estimate(float(explicit.t), np.array(explicit.y))
     if choice.solver == RACE:
         return _race(run, explicit, probe, h_explicit, t0, x0, stop, choice.reason)
-    if choice.solver == IMPLICIT:
-        explicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
+    if choice.solver == RACE_IMPLICIT:
+        explicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
     run.advance(explicit)
     return choice.solver, choice.reason
 
@@ -101,20 +102,21 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
 def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
           x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
     explicit_cost = (stop - explicit.t) / h_explicit * probe.seconds / probe.steps
-    implicit = run.start(IMPLICIT, t0, x0)
+    implicit = run.start(RACE_IMPLICIT, t0, x0)
     steps, seconds, sizes = 0, 0.0, []
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
         trial = run.advance(implicit, 1)
         steps, seconds = steps + trial.steps, seconds + trial.seconds
         sizes += trial.sizes
         if run.done:
-            return IMPLICIT, f"{stiffness}; {IMPLICIT} finished the run in its trial steps"
+            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
+                                   "trial steps")
     implicit_cost = (stop - implicit.t) / float(np.median(sizes[-5:])) * seconds / steps
-    measured = (f"measured: {IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
+    measured = (f"measured: {RACE_IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
                 f"~{explicit_cost:.2g} s")
     if implicit_cost <= explicit_cost:
         run.advance(implicit)
-        return IMPLICIT, f"{stiffness}; {measured}"
+        return RACE_IMPLICIT, f"{stiffness}; {measured}"
     run.advance(explicit)
     return EXPLICIT, (f"{stiffness}, but the fast modes must be resolved anyway; "
                       f"{measured}")

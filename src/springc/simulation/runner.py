@@ -35,18 +35,15 @@ from ..pipeline import CompiledModel, check_parameter_names
 from . import solvers
 from .race import auto
 from .results import SimulationResult, SimulationStats
-
-SOLVERS = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
-           "lsoda": "LSODA"}
-IMPLICIT = frozenset({"radau", "bdf", "lsoda"})
-FIXED_STEP = ("verlet", "symplectic-euler", "rk4")
-"""Fixed-step solvers (:mod:`springc.solvers`); they need ``SimulationOptions.step``."""
-AUTO = "auto"
-DEFAULT_SOLVER = AUTO
-"""``dop853`` (an 8th-order explicit Runge-Kutta method: the spring-mass scenes are
-oscillatory and mostly non-stiff, where it takes far fewer steps than rk45 at tight
-tolerances) or ``radau`` for stiff runs (strong damping, very stiff springs whose
-fast modes are at rest), chosen at the start state by :func:`springc.solvers.choose`."""
+from .solver_names import (
+    ALL_SOLVERS,
+    AUTO,
+    DEFAULT_SOLVER,
+    EXPLICIT,
+    FIXED_STEP,
+    IMPLICIT_SOLVERS,
+    SOLVERS,
+)
 
 DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
 DEFAULT_RTOL = 1e-6
@@ -150,7 +147,7 @@ def _fmt(t: float) -> str:
 def _remedy(solver: str) -> str:
     if solver in FIXED_STEP:
         return "reduce --step or use --solver radau"
-    if solver in IMPLICIT:
+    if solver in IMPLICIT_SOLVERS:
         return ("check the parameters and start values near that time (a spring of zero "
                 "length? a mass of zero?), or try a tighter --rtol")
     return "the system looks stiff or unstable: try --solver radau (or bdf)"
@@ -304,9 +301,9 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     """Integrate ``model`` and return the selected outputs on the output grid."""
     began = time.perf_counter()
     solver = options.solver.lower()
-    if solver not in SOLVERS and solver not in FIXED_STEP and solver != AUTO:
+    if solver not in ALL_SOLVERS:
         raise SimulationError(f"unknown solver '{options.solver}'",
-                              hint=f"choose one of {', '.join((AUTO, *SOLVERS, *FIXED_STEP))}")
+                              hint=f"choose one of {', '.join(ALL_SOLVERS)}")
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -353,7 +350,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 states, steps = run.states, run.steps
             else:
                 if solver == AUTO:
-                    solver, reason = solvers.EXPLICIT, "no states to integrate"
+                    solver, reason = EXPLICIT, "no states to integrate"
                 problem.solver = solver
                 states, steps = _integrate(problem, grid, x0, rtol, atol)
             outputs = _outputs(model, problem, grid, states)
@@ -413,7 +410,7 @@ class _Run:
         import scipy.integrate
 
         self.problem.solver = solver
-        kwargs: dict[str, Any] = {"jac": self.problem.jac} if solver in IMPLICIT else {}
+        kwargs: dict[str, Any] = {"jac": self.problem.jac} if solver in IMPLICIT_SOLVERS else {}
         if first_step is not None:
             kwargs["first_step"] = min(first_step, float(self.grid[-1]) - t)
         cls = getattr(scipy.integrate, SOLVERS[solver])

@@ -2,7 +2,7 @@
 
 Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
 
-- **Fixed-step scene integrators** (``springc.simulation.FIXED_STEP``): ``verlet`` (velocity Verlet)
+- **Fixed-step scene integrators** (``solver_names.FIXED_STEP``): ``verlet`` (velocity Verlet)
   and ``symplectic-euler`` (semi-implicit Euler) for second-order mechanical systems,
   and the classical ``rk4``, run by :mod:`springc.integrators` with ``--step H``.
   The position/velocity pairs they need (``der(q) = v`` with ``v`` a state) are found
@@ -31,10 +31,8 @@ import scipy.sparse as sp
 
 from ..errors import Note, SimulationError
 from .integrators import NonFiniteState, Pairs, integrate
+from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 
-AUTO = "auto"
-EXPLICIT, IMPLICIT = "dop853", "radau"
-RACE = "race"
 MAX_FIXED_STEPS = 20_000_000
 """More fixed steps than this are refused up front (minutes of Python loop)."""
 FIXED_REMEDY = "reduce --step or use --solver radau"
@@ -105,7 +103,7 @@ def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -
 @dataclass(frozen=True)
 class AutoChoice:
     """What ``auto`` decided at the start state and why (for the summary line):
-    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.race`)."""
+    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.simulation.race`)."""
 
     solver: str
     reason: str
@@ -120,7 +118,7 @@ def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
 
     if jac.shape[0] == 0 or span <= 0:
         return AutoChoice(EXPLICIT, "no dynamics to integrate", 0.0, span)
-    base = choose_solver(jac, span, EXPLICIT, IMPLICIT)
+    base = choose_solver(jac, span, EXPLICIT, RACE_IMPLICIT)
     rho = base.spectral_radius
     if base.solver == EXPLICIT or not math.isfinite(base.stiffness):
         return AutoChoice(base.solver, base.reason, rho, span)

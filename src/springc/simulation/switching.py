@@ -42,6 +42,7 @@ from ..simplify import (
     switch,
 )
 from .results import SimulationResult, SimulationStats
+from .solver_names import EXPLICIT, SOLVERS
 
 MAX_SWITCHES = 10_000
 
@@ -209,9 +210,6 @@ def _switch(model: flat.FlatModel, old: StateChoice, values: Mapping[str, float]
     return new
 
 
-EXPLICIT_DEFAULT = "dop853"
-SCIPY_NAMES = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
-               "lsoda": "LSODA"}
 
 
 def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray,
@@ -219,10 +217,10 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
                              ) -> SimulationResult:
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
-    method = solver if solver in SCIPY_NAMES else EXPLICIT_DEFAULT
+    method = solver if solver in SOLVERS else EXPLICIT
     flat_model = derive_system(model.options).flat_model
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
-                             rtol=rtol, atol=atol, method=SCIPY_NAMES[method],
+                             rtol=rtol, atol=atol, method=SOLVERS[method],
                              parameters=parameters)
     values = np.column_stack([run.values[name] for name in model.outputs])
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))
