@@ -279,3 +279,13 @@ def test_causalize_blocks_are_in_dependency_order(tmp_path: Path) -> None:
         assert computed.isdisjoint(known)
         known |= computed
     assert known == {"x", "y", "z", "w", "der(x)"}
+
+
+def test_derivative_names_are_built_and_read_by_one_pair_of_functions() -> None:
+    from springc.ir.dae import derivative_base, derivative_name, is_derivative
+
+    assert derivative_name("mass.v[1]") == "der(mass.v[1])"
+    assert derivative_base("der(mass.v[1])") == "mass.v[1]"
+    assert derivative_base(derivative_name(derivative_name("x"))) == "der(x)"
+    assert derivative_base("derivative") is None and derivative_base("der(x") is None
+    assert is_derivative("der(x)") and not is_derivative("x")

@@ -47,7 +47,7 @@ def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
     if isinstance(e, x.Var) and e.name in unknowns:
         out.append((sign, e.name))
         return len(out) <= 2
-    if any(n in unknowns or n.startswith("der(") for n in free_variables(e)) or any(
+    if any(n in unknowns or dae.is_derivative(n) for n in free_variables(e)) or any(
             isinstance(n, x.Time) for n in x.walk(e)):
         return False
     rest.append((sign, e))
@@ -58,7 +58,7 @@ def _classify(r: dae.Residual, unknowns: set[str]
               ) -> tuple[str, str, int, x.Expr] | None:
     """``(a, b, sign, 0)`` for ``a = sign*b``, ``(a, "", 0, value)`` for ``a = value``."""
     if sum(n in unknowns for n in r.variables) > 2 or any(
-            n.startswith("der(") for n in r.variables):
+            dae.is_derivative(n) for n in r.variables):
         return None
     terms: list[tuple[int, str]] = []
     rest: list[tuple[int, x.Expr]] = []
@@ -153,11 +153,11 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     der_map: dict[str, x.Expr] = {}
 
     def varying(name: str) -> bool:
-        return name in names or name.startswith("der(")
+        return name in names or dae.is_derivative(name)
 
     for name, value in mapping.items():
         if name in differentiated:
-            der_map[dae.der_name(name)] = differentiate(value, varying)
+            der_map[dae.derivative_name(name)] = differentiate(value, varying)
             differentiated.update(v for v in free_variables(value) if v in names)
     full = {**mapping, **der_map}
     value_vars = {name: free_variables(value) for name, value in full.items()}

@@ -75,10 +75,10 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
     pending = sorted({n for r in system.equations for n in r.variables
-                      if n.startswith("der(")}, key=lambda n: (len(n), n))
+                      if dae.is_derivative(n)}, key=lambda n: (len(n), n))
     for name in pending:
-        base = name[4:-1]
-        if base not in index:
+        base = dae.derivative_base(name)
+        if base is None or base not in index:
             raise SimplifyError(f"'{base}' is differentiated but is not an unknown",
                                 system.span)
         index[name] = len(names)
@@ -98,7 +98,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
                  for r in system.equations]
 
     def varying(name: str) -> bool:
-        return name in index or name.startswith("der(")
+        return name in index or dae.is_derivative(name)
 
     def hook(eq: int, var_derivative: Sequence[int]) -> list[int]:
         # Name the derivative variables Pantelides created, then differentiate.
@@ -107,7 +107,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
             if d != -1 and d >= len(names):
                 while len(names) <= d:
                     names.append("")
-                names[d] = dae.der_name(names[v])
+                names[d] = dae.derivative_name(names[v])
                 index[names[d]] = d
         new = differentiate(exprs[eq], varying)
         exprs.append(new)

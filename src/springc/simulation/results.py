@@ -17,6 +17,7 @@ from typing import IO
 import numpy as np
 
 from ..fileio import atomic_write
+from ..ir import dae
 
 
 @dataclass(frozen=True)
@@ -107,7 +108,9 @@ def _group(name: str, unit: str) -> tuple[str, str]:
     if unit:
         quantity = _QUANTITY.get(unit, unit)
         return quantity, f"{quantity} [{unit}]"
-    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1]).removeprefix("der(")
+    while (base := dae.derivative_base(name)) is not None:
+        name = base
+    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1])
     word = _WORDS.get(last, last)
     return word, word
 

@@ -31,6 +31,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import Note, SimulationError
+from ..ir.dae import derivative_name
 from ..pipeline import CompiledModel, check_parameter_names
 from . import solvers
 from .race import auto
@@ -163,7 +164,7 @@ def _state_notes(names: tuple[str, ...], x: np.ndarray, dx: np.ndarray | None,
         bad = [int(i) for i in np.argsort(-scale)[:limit]]
     elif not bad:
         bad = list(range(min(len(x), limit)))
-    notes = [Note(f"{names[i]} = {x[i]:.6g}" + (f", der({names[i]}) = {dx[i]:.6g}"
+    notes = [Note(f"{names[i]} = {x[i]:.6g}" + (f", {derivative_name(names[i])} = {dx[i]:.6g}"
                                                  if dx is not None else ""))
              for i in bad[:limit]]
     if len(bad) > limit:
@@ -271,7 +272,8 @@ class _Problem:
         # a sum is finite if every term is (a finite sum that overflows is checked again)
         if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
             bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
-            shown = ", ".join(f"der({n})" for n in bad[:3]) + (", ..." if len(bad) > 3 else "")
+            shown = ", ".join(derivative_name(n) for n in bad[:3])
+            shown += ", ..." if len(bad) > 3 else ""
             what = "NaN" if np.isnan(dx).any() else "infinite"
             raise _Stop(SimulationError(
                 f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {_fmt(t)}",

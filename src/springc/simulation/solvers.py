@@ -30,6 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import Note, SimulationError
+from ..ir import dae, ode
+from ..ir.expr import Var
 from .integrators import NonFiniteState, Pairs, integrate
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 
@@ -40,18 +42,15 @@ FIXED_REMEDY = "reduce --step or use --solver radau"
 
 # ------------------------------------------------------------------ pairs
 
-def pairs_from_ode(system: object) -> list[tuple[str, str]]:
+def pairs_from_ode(system: ode.ODE) -> list[tuple[str, str]]:
     """``(q, v)`` for every step ``der(q) := v`` of an :class:`springc.ode.ODE` where
     ``v`` is a state too."""
-    from ..ir.expr import Var
-    from ..ir.ode import Assign
-
-    states = {s.name for s in system.states}  # type: ignore[attr-defined]
+    states = {s.name for s in system.states}
     out = []
-    for step in system.steps:  # type: ignore[attr-defined]
-        if (isinstance(step, Assign) and step.name.startswith("der(")
-                and isinstance(step.expr, Var) and step.expr.name in states):
-            q = step.name[4:-1]
+    for step in system.steps:
+        if isinstance(step, ode.Assign) and isinstance(step.expr, Var) \
+                and step.expr.name in states:
+            q = dae.derivative_base(step.name)
             if q in states:
                 out.append((q, step.expr.name))
     return _disjoint(out)
