@@ -289,3 +289,23 @@ def test_derivative_names_are_built_and_read_by_one_pair_of_functions() -> None:
     assert derivative_base(derivative_name(derivative_name("x"))) == "der(x)"
     assert derivative_base("derivative") is None and derivative_base("der(x") is None
     assert is_derivative("der(x)") and not is_derivative("x")
+
+
+def test_alias_classes_keep_the_member_that_index_reduction_ranks_highest(
+        tmp_path: Path) -> None:
+    # One policy (structure.state_priority): stateSelect = prefer outranks a fixed start
+    # with the default stateSelect (2.0 against 1.5), as in the dummy-derivative choice.
+    text = """
+model P
+  Real x(start = 1, fixed = true);
+  Real y(stateSelect = StateSelect.prefer);
+equation
+  x = y;
+  der(y) = -y;
+end P;
+"""
+    result = eliminate_aliases(lower(flat(tmp_path, text)))
+    assert [u.name for u in result.dae.unknowns] == ["y"]
+    assert [(a.name, to_text(a.value)) for a in result.aliases] == [("x", "y")]
+    kept = result.dae.unknowns[0]
+    assert kept.fixed and to_text(kept.start) == "1"  # y inherits x's fixed start

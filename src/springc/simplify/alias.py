@@ -2,8 +2,9 @@
 
 An equation ``a = b``, ``a = -b`` (``a + b = 0``) or ``a = p`` (a constant or parameter
 expression) removes one unknown. Chains are followed with a signed union-find; in each
-class the kept variable is the one with a fixed start value, then the strongest
-``stateSelect``, then one that appears differentiated, then the first declared.
+class the kept variable is the one that ranks highest as a state
+(:func:`~springc.simplify.index_reduction.unknown_priority`: ``stateSelect``, a fixed
+start, a start value), then one that appears differentiated, then the first declared.
 Eliminated variables become observed: ``a = ±kept`` or ``a = value``.
 """
 
@@ -14,10 +15,9 @@ from dataclasses import dataclass, replace
 from ..errors import Note
 from ..ir import dae
 from ..ir import expr as x
+from .index_reduction import unknown_priority
 from .isolate import free_variables
 from .lower import differentiate
-
-_SELECT_RANK = {"never": 0, "avoid": 1, "default": 2, "prefer": 3, "always": 4}
 
 
 @dataclass(frozen=True, slots=True)
@@ -180,9 +180,8 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
 
 
 def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]
-              ) -> tuple[int, int, int, int]:
-    return (int(u.fixed and u.start is not None), _SELECT_RANK[u.state_select],
-            int(u.name in differentiated), -order[u.name])
+              ) -> tuple[float, int, int]:
+    return unknown_priority(u), int(u.name in differentiated), -order[u.name]
 
 
 def _start_conflicts(members: list[tuple[str, int]], rep: str, rep_sign: int,

@@ -121,7 +121,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
     except StructurallySingular as err:
         raise _singular(system, err, names) from None
     unknowns = {u.name: u for u in system.unknowns}
-    priority = [_priority(unknowns[n]) if n in unknowns else state_priority() for n in names]
+    priority = [unknown_priority(unknowns[n]) if n in unknowns else state_priority() for n in names]
     try:
         if at is None:
             check = _nonsingular_at_start(system, names, exprs)
@@ -140,9 +140,12 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
                    reduction.incidence, states, blocks)
 
 
-def _priority(u: dae.Unknown) -> float:
-    """``stateSelect`` and a fixed start rank first; any start value breaks ties, so
-    that a variable the user gave a start value stays a state when possible."""
+def unknown_priority(u: dae.Unknown) -> float:
+    """How strongly ``u`` should stay a state (the one ranking of simplify, built on
+    :func:`springc.structure.state_priority`; alias elimination keeps the member of
+    an alias class that ranks highest): ``stateSelect`` and a fixed start rank first;
+    any start value breaks ties, so that a variable the user gave a start value stays
+    a state when possible."""
     bonus = START_BONUS if u.start is not None and not u.fixed else 0.0
     return state_priority(u.state_select, u.fixed and u.start is not None) + bonus
 
