@@ -2,6 +2,9 @@
 
 The pipeline is a short list of passes, each in its own module:
 
+0. ``check_balance`` (:mod:`springc.simplify.balance`): as ``springc check`` does, so
+   that a missing or surplus equation is reported with its location, before the
+   structural passes would find it less clearly;
 1. ``lower`` (:mod:`springc.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.reduce`): Pantelides and dummy derivatives;
@@ -17,6 +20,7 @@ from dataclasses import dataclass, field
 from ..errors import Note
 from ..ir import flat, ode
 from .alias import eliminate_aliases
+from .balance import check_balance, dae_incidence
 from .causalize import causalize
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
@@ -56,6 +60,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
     system = lower(model)
+    check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)
     reduced = index_reduce(aliased.dae, at)
     steps = causalize(reduced)
