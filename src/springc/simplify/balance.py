@@ -16,8 +16,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import BalanceError, Note
-from ..ir import expr as x
 from ..ir import dae, flat
+from ..ir import expr as x
 from ..structure import dulmage_mendelsohn, maximum_matching
 
 MAX_NOTES = 20
