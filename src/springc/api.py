@@ -21,7 +21,14 @@ from .pipeline import (
     compile_files,
     modification_value,
 )
-from .simulation import DEFAULT_SOLVER, SimulationOptions, SimulationResult, simulate_model
+from .simulation import (
+    DEFAULT_MAX_STEPS,
+    DEFAULT_SOLVER,
+    DEFAULT_TIME_LIMIT,
+    SimulationOptions,
+    SimulationResult,
+    simulate_model,
+)
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 
@@ -74,7 +81,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              parameters: Mapping[str, float] | None = None,
              outputs: Sequence[str] | None = None, backend: str = "python",
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
-             progress: TextIO | None = None, step: float | None = None
+             progress: TextIO | None = None, step: float | None = None,
+             max_steps: int = DEFAULT_MAX_STEPS, time_limit: float = DEFAULT_TIME_LIMIT
              ) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
@@ -83,6 +91,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     ``"auto"`` (dop853 or radau from a stiffness estimate), a scipy method, or a
     fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
+    A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
+    seconds (defaults: 20,000,000 steps, one hour).
     """
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
@@ -95,5 +105,5 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
         model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
-                                step)
+                                step, max_steps, time_limit)
     return simulate_model(model, options)

@@ -168,6 +168,12 @@ def _single_threaded_blas() -> None:
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
 @click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
               help="Set a parameter (repeatable); array sizes re-flatten the model.")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Stop with an error after this many integrator steps (default "
+              "20,000,000).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Stop with an error after this many seconds of wall clock (default "
+              "3600).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Write the trajectory as CSV (default: stdout unless --plot).")
 @click.option("--plot", type=click.Path(dir_okay=False), help="Write a PNG plot.")
@@ -177,7 +183,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, rtol: float | None,
              step: float | None, atol: float | None, assignments: tuple[str, ...],
-             output: str | None, plot: str | None, quiet: bool) -> None:
+             max_steps: int | None, time_limit: float | None, output: str | None,
+             plot: str | None, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV) and/or a plot (PNG)."""
     values = _parse_set(assignments)
     if solver.lower() in FIXED_STEP and step is None:
@@ -192,7 +199,9 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     result = run(files, model_name=model, libraries=libraries, backend=backend,
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step)
+                 parameters=values, progress=progress, step=step,
+                 **({"max_steps": max_steps} if max_steps is not None else {}),
+                 **({"time_limit": time_limit} if time_limit is not None else {}))
     if output:
         result.to_csv(output)
     elif not plot:

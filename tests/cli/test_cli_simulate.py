@@ -148,7 +148,7 @@ def test_each_solver_runs() -> None:
     choices = tuple(solver_option.type.choices)  # type: ignore[attr-defined]
     assert choices == ALL_SOLVERS and set(choices) == {AUTO, *SOLVERS, *FIXED_STEP}
     for solver in choices:
-        step = ["--step", "1e-3"] if solver in FIXED_STEP else []
+        step = ["--step", "1e-4"] if solver in FIXED_STEP else []
         code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
                                    "--vars", "spring.x", *step)
         assert code == 0, stderr

@@ -19,7 +19,7 @@ from springc.pipeline.compiler import CompiledModel
 @pytest.mark.parametrize("solver", ["auto", "dop853", "radau", "bdf", "verlet", "rk4"])
 def test_exactly_at_equilibrium(compiled: dict[str, CompiledModel], solver: str) -> None:
     result = springc.simulate(compiled["Harmonic"], parameters={"a": 0.0}, solver=solver,
-                              step=0.1)
+                              step=0.01)
     assert not result.values.any()  # exactly zero, every output time
 
 
@@ -41,10 +41,10 @@ def test_zero_length_span(compiled: dict[str, CompiledModel], solver: str) -> No
 SET_CASES = [
     # (--set, exit code, text in the output)
     ("m=0", 1, "error: division by zero while computing der(v) ("),
-    ("m=nan", 1, "error: der(v) is NaN at time 0"),
-    ("k=inf", 1, "error: der(v) is infinite at time 0"),
+    ("m=nan", 1, "error: parameter 'm' = NaN: parameters must be finite numbers"),
+    ("k=inf", 1, "error: parameter 'k' = infinite: parameters must be finite numbers"),
     ("a=1e308", 1, "error: der(x) is NaN at time "),
-    ("a=inf", 1, "error: the start values are not finite at time 0"),
+    ("a=inf", 1, "error: parameter 'a' = infinite: parameters must be finite numbers"),
     ("k=-1", 0, ""),  # an unstable spring: exponential growth, finite over 10 s
     ("k=1e300", 1, "note: radau, tried next by auto, failed too: the radau solver failed "
                    "at time 0: the Newton matrix is not finite (the Jacobian overflows)"),

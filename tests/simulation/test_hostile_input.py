@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.errors import BalanceError, render
+from springc.errors import BalanceError, SimulationError, render
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED_TEXT = (ROOT / "models" / "SpringMass.mdl").read_text()
@@ -53,3 +53,127 @@ def test_simulate_names_a_surplus_equation(tmp_path: Path) -> None:
                              "7 unknowns, 8 equations\n")
     assert (f"{path}:9:3: note: equation in mass `mass.v[1] = 0` is one of 8 equations "
             "for only 7 unknowns") in output
+
+
+# ------------------------------------------------------------------ run limits
+
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+HARMONIC = """
+model Harmonic
+  parameter Real k = 4;
+  Real x(start = 1);
+  Real v(start = 0);
+equation
+  der(x) = v;
+  der(v) = -k * x;
+end Harmonic;
+"""
+
+
+def test_a_hopeless_stiffness_stops_with_the_time_the_stiffness_and_a_solver() -> None:
+    # k = 1e29: a period of 2e-14 s over 10 s. The projection stops the run within the
+    # first thousand steps instead of spending the whole step budget.
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(SEED, parameters={"spring.k": 1e29}, max_steps=2_000_000)
+    err = info.value
+    assert err.message.startswith("the simulation stopped at time ")
+    assert "far over the step limit (--max-steps 2000000)" in err.message
+    notes = [n.message for n in err.notes]
+    assert notes[0].startswith("reached time ") and " of 10 (" in notes[0]
+    # the spring's fast mode: rho = sqrt(k/m) = sqrt(1e29) = 3.16e14 1/s
+    assert "spectral radius of the Jacobian rho = 3.16e+14 1/s" in notes[1]
+    assert err.hint is not None and "radau" in err.hint
+
+
+def test_the_step_limit_and_the_time_limit_end_a_run_with_their_option(
+        tmp_path: Path) -> None:
+    path = tmp_path / "h.mdl"
+    path.write_text(HARMONIC)
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(path, solver="rk45", stop=1000.0, max_steps=500, cache=False)
+    assert "500 steps of rk45 reached the step limit (--max-steps 500)" in info.value.message
+    # rho = sqrt(k) = 2 for this oscillator; not stiff, so the advice is the limits
+    assert "rho = 2 1/s" in info.value.notes[1].message
+    assert info.value.hint is not None and info.value.hint.startswith(
+        "the run is long rather than stiff: raise --max-steps / --time-limit")
+    with pytest.raises(SimulationError, match=r"s of wall clock reached the time limit "
+                       r"\(--time-limit\)"):
+        springc.simulate(path, stop=1000.0, time_limit=1e-9, cache=False)
+    code, output = simulate_cli(str(path), "--max-steps", "0", "--no-cache")
+    assert code == 2 and "--max-steps" in output
+
+
+# ------------------------------------------------------------------ pendulum
+
+
+@pytest.mark.parametrize(("assignment", "expected"), [
+    ("L=0", f"{SCENES}:163:10: error: the start value of 'lambda' cannot be computed: "
+            "division by zero\n"),
+    ("g=nan", "error: parameter 'g' = NaN: parameters must be finite numbers\n"),
+    ("g=inf", "error: parameter 'g' = infinite: parameters must be finite numbers\n"),
+])
+def test_pendulum_with_a_degenerate_parameter(tmp_path: Path, assignment: str,
+                                              expected: str) -> None:
+    out = tmp_path / "out.csv"
+    code, output = simulate_cli(SCENES, "--model", "Scenes.Pendulum", "--set", assignment,
+                                "-o", str(out))
+    assert code == 1 and not out.exists()
+    assert output.startswith(expected)
+
+
+# ------------------------------------------------------------------ observed values
+
+OBSERVED = """
+model Obs
+  Real x(start = 0);
+  Real big;
+  Real root;
+equation
+  der(x) = 1;
+  big = 1e308 * x;
+  root = sqrt(OFFSET - x);
+end Obs;
+"""
+
+
+def test_an_infinite_observed_value_fails_where_it_happens(tmp_path: Path) -> None:
+    path = tmp_path / "obs.mdl"
+    path.write_text(OBSERVED.replace("OFFSET", "10"))
+    out = tmp_path / "out.csv"
+    code, output = simulate_cli(str(path), "--stop", "3", "--interval", "0.1", "-o",
+                                str(out), "--no-cache")
+    assert code == 1 and not out.exists()
+    # 1e308 * x overflows once x > 1.797...: the first output time after is 1.8
+    assert output.startswith("error: big is infinite at time 1.8\n")
+
+
+def test_an_observed_domain_error_is_reported_at_its_first_time(tmp_path: Path) -> None:
+    path = tmp_path / "obs.mdl"
+    path.write_text(OBSERVED.replace("OFFSET", "1.05"))
+    code, output = simulate_cli(str(path), "--stop", "3", "--interval", "0.1",
+                                "--vars", "root", "--no-cache")
+    assert code == 1
+    assert output.startswith(f"error: math domain error while computing root ({path}:9) "
+                             "at time 1.1\n")
+
+
+# ------------------------------------------------------------------ fixed step
+
+
+def test_a_step_longer_than_the_output_interval_is_refused(tmp_path: Path) -> None:
+    code, output = simulate_cli(SEED, "--solver", "verlet", "--step", "0.05", "-o",
+                                str(tmp_path / "out.csv"))
+    assert code == 1
+    assert output.startswith("error: --step 0.05 is longer than the output interval 0.02: "
+                             "the fixed-step solvers step to every output time\n")
+    assert "--interval 0.05" in output
+
+
+def test_a_step_that_does_not_divide_the_interval_is_shortened_and_says_so() -> None:
+    result = springc.simulate(SEED, solver="verlet", step=0.015, stop=1.0, interval=0.02)
+    assert result.stats.steps == 100  # 50 intervals of 0.02 s, two steps of 0.01 s each
+    assert result.stats.note == ("--step 0.015 does not divide the output interval 0.02; "
+                                 "verlet took steps of 0.01 s to land on every output time")
+    assert result.stats.summary("M").endswith("; note: " + result.stats.note)
+    exact = springc.simulate(SEED, solver="verlet", step=0.01, stop=1.0, interval=0.02)
+    assert exact.stats.note == "" and exact.stats.steps == 100

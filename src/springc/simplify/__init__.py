@@ -3,7 +3,7 @@ causalization), plus the balance check, the initial problem and state choice."""
 
 from .balance import check_balance
 from .initialize import conditions, initial_state
-from .ode_eval import Evaluator, parameter_values
+from .ode_eval import Evaluator, describe_failure, parameter_values
 from .passes import simplify
 from .state_choice import (
     THRESHOLD,
@@ -15,6 +15,19 @@ from .state_choice import (
     switch,
 )
 
-__all__ = ["THRESHOLD", "Evaluator", "StateChoice", "check_balance", "conditioning",
-           "conditions", "initial_state", "needs_switch", "parameter_values",
-           "select_states", "simplify", "state_vector", "switch"]
+__all__ = [
+    "THRESHOLD",
+    "Evaluator",
+    "StateChoice",
+    "check_balance",
+    "conditioning",
+    "conditions",
+    "describe_failure",
+    "initial_state",
+    "needs_switch",
+    "parameter_values",
+    "select_states",
+    "simplify",
+    "state_vector",
+    "switch",
+]

@@ -10,6 +10,7 @@ starting from the previous solution, or from start values the first time).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 
 import numpy as np
@@ -38,7 +39,13 @@ def parameter_values(parameters: Iterable[dae.Parameter],
             raise SimplifyError(f"the binding of parameter '{name}' depends on itself", p.span)
         active.add(name)
         e = p.binding if p.binding is not None else p.start
-        values[name] = 0.0 if e is None else evaluate_with(e, value)
+        try:
+            values[name] = 0.0 if e is None else evaluate_with(e, value)
+        except (ArithmeticError, ValueError) as err:
+            raise SimplifyError(f"the value of parameter '{name}' cannot be computed: "
+                                f"{describe_failure(err)}", p.span,
+                                hint="check the parameters its binding uses (--set)"
+                                ) from None
         active.discard(name)
         return values[name]
 
@@ -68,11 +75,28 @@ def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
     out = {}
     for u in unknowns:
         try:
-            out[u.name] = 0.0 if u.start is None else float(x.evaluate(u.start, params))
+            value = 0.0 if u.start is None else float(x.evaluate(u.start, params))
         except KeyError as err:
             raise SimplifyError(f"the start value of '{u.name}' must be a parameter "
                                 f"expression, but it uses {err}", u.span) from None
+        except (ArithmeticError, ValueError) as err:
+            raise SimplifyError(f"the start value of '{u.name}' cannot be computed: "
+                                f"{describe_failure(err)}", u.span,
+                                hint="check the parameters it uses (--set)") from None
+        if not math.isfinite(value):
+            raise SimplifyError(f"the start value of '{u.name}' is {value}", u.span,
+                                hint="check the parameters it uses (--set)")
+        out[u.name] = value
     return out
+
+
+def describe_failure(err: BaseException) -> str:
+    """``division by zero``, ``overflow`` or the error's own text."""
+    if isinstance(err, ZeroDivisionError):
+        return "division by zero"
+    if isinstance(err, OverflowError):
+        return "overflow"
+    return str(err) or type(err).__name__
 
 
 class Evaluator:

@@ -21,6 +21,7 @@ from .solver_names import (
 )
 
 if TYPE_CHECKING:
+    from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
     from .results import SimulationResult, write_csv
     from .runner import (
         LSODA_LIMIT,
@@ -31,10 +32,12 @@ if TYPE_CHECKING:
         simulate_model,
     )
 
-__all__ = ["ALL_SOLVERS", "AUTO", "DEFAULT_SOLVER", "FIXED_STEP", "IMPLICIT_SOLVERS",
-           "LSODA_LIMIT", "SOLVERS", "SimulationOptions", "SimulationResult",
-           "initial_state", "output_grid", "resolve", "simulate_model", "write_csv"]
+__all__ = ["ALL_SOLVERS", "AUTO", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT",
+           "FIXED_STEP", "IMPLICIT_SOLVERS", "LSODA_LIMIT", "SOLVERS", "SimulationOptions",
+           "SimulationResult", "initial_state", "output_grid", "resolve", "simulate_model",
+           "write_csv"]
 
+_LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
 _RESULTS = frozenset({"SimulationResult", "write_csv"})
 _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "output_grid",
                      "resolve", "simulate_model"})
@@ -42,6 +45,10 @@ _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "outpu
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
+    if name in _LIMITS:
+        from . import limits
+
+        return getattr(limits, name)
     if name in _RESULTS:
         from . import results
 

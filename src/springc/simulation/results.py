@@ -31,6 +31,7 @@ class SimulationStats:
     compile_time: float
     cached: bool
     reason: str = ""  # why --solver auto chose ``solver`` (empty: the user chose it)
+    note: str = ""  # what the run did differently from what was asked (e.g. the step)
 
     def summary(self, model: str) -> str:
         """One line: solver (``auto -> radau (why)``), steps, evaluations, wall time."""
@@ -38,7 +39,8 @@ class SimulationStats:
         return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s (model code {self.model_time:.3f} s; "
-                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)")
+                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
+                + (f"; note: {self.note}" if self.note else ""))
 
 
 @dataclass

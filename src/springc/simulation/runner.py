@@ -10,7 +10,9 @@ dense for small systems, ``scipy.sparse`` CSC beyond :data:`DENSE_JACOBIAN_LIMIT
 Defaults: start 0 s, stop 10 s, 500 output intervals, unless the model's
 ``experiment`` annotation says otherwise (its Interval applies even when the start or
 stop time is given); rtol 1e-6 (or the experiment's Tolerance),
-atol = rtol / 1000; solver :data:`DEFAULT_SOLVER`.
+atol = rtol / 1000; solver :data:`DEFAULT_SOLVER`; at most
+:data:`~springc.simulation.limits.DEFAULT_MAX_STEPS` steps and
+:data:`~springc.simulation.limits.DEFAULT_TIME_LIMIT` seconds (:mod:`.limits`).
 
 (The module is not named ``simulate``: ``springc.simulate`` is the API function, and a
 submodule of that name would replace it on the package once imported.)
@@ -33,7 +35,20 @@ import numpy as np
 from ..errors import Note, SimulationError
 from ..ir.dae import derivative_name
 from ..pipeline import CompiledModel, check_parameter_names
+from ..simplify import describe_failure as _kind
 from . import solvers
+from .limits import (
+    CHECK_EVERY,
+    DEFAULT_MAX_STEPS,
+    DEFAULT_TIME_LIMIT,
+    HOPELESS,
+    Limits,
+    OverLimit,
+    check_outputs,
+    check_parameters,
+    over_limit,
+    projected_steps,
+)
 from .race import auto
 from .results import SimulationResult, SimulationStats
 from .solver_names import (
@@ -66,6 +81,8 @@ class SimulationOptions:
     parameters: Mapping[str, float] = field(default_factory=dict)
     progress: TextIO | None = None
     step: float | None = None  # fixed-step solvers only
+    max_steps: int = DEFAULT_MAX_STEPS
+    time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -120,7 +137,13 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
     here, since the generated module holds only the ODE).
     """
     if not getattr(model.module, "INITIAL_CONDITIONS", 0):
-        return np.asarray(model.module.start(p), dtype=float)
+        try:
+            return np.asarray(model.module.start(p), dtype=float)
+        except (ArithmeticError, ValueError) as err:
+            where = _code_location(err, str(model.path))
+            raise SimulationError(
+                f"{_kind(err)} while computing the start value of {where or 'a state'}",
+                hint="check the parameters the start values use (--set)") from None
     from ..pipeline import derive_system
     from ..simplify import initial_state as solve_initial
 
@@ -225,7 +248,7 @@ class _Problem:
     """The generated functions wrapped for scipy: counting, timing, checking."""
 
     def __init__(self, model: CompiledModel, p: np.ndarray, solver: str,
-                 progress: Progress) -> None:
+                 progress: Progress, limits: Limits | None = None) -> None:
         mod = model.module
         self.model, self.mod, self.p, self.solver = model, mod, p, solver
         self.z = np.asarray(mod.guesses(p), dtype=float)
@@ -235,12 +258,12 @@ class _Problem:
         self.model_time = 0.0
         self.progress = progress
         self.t = 0.0
+        self.limits = limits = limits or Limits()
+        self.deadline = time.perf_counter() + limits.time_limit
 
     def _fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> _Stop:
         where = _code_location(err, self.path)
-        kind = {ZeroDivisionError: "division by zero", OverflowError: "overflow"}.get(
-            type(err), str(err) or type(err).__name__)
-        message = f"{kind} while computing {where or what} at time {_fmt(t)}"
+        message = f"{_kind(err)} while computing {where or what} at time {_fmt(t)}"
         if "singular" in str(err).lower():
             message = f"{where or 'a linear system'} is singular at time {_fmt(t)}"
         return _Stop(SimulationError(
@@ -267,6 +290,9 @@ class _Problem:
             raise self._fail(err, t, x, "the derivatives") from err
         now = time.perf_counter()
         self.model_time += now - began
+        if now > self.deadline:
+            raise OverLimit(f"{self.limits.time_limit:g} s of wall clock reached the time "
+                            "limit (--time-limit)", t, np.array(x), self.solver)
         if self.z[-1] != 0.0:
             raise self._newton(t, x)
         # a sum is finite if every term is (a finite sum that overflows is checked again)
@@ -281,6 +307,12 @@ class _Problem:
         if now >= self.progress.next:
             self.progress.update(t)
         return dx
+
+    def jacobian(self, t: float, x: np.ndarray) -> Any:
+        """The Jacobian for diagnostics: not counted, no failure checks."""
+        z = np.array(self.z)
+        return self.mod.jacobian_dense(t, x, self.p, z) if len(x) <= DENSE_JACOBIAN_LIMIT \
+            else self.mod.jacobian(t, x, self.p, z)
 
     def jac(self, t: float, x: np.ndarray) -> Any:
         self.njev += 1
@@ -306,6 +338,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     if solver not in ALL_SOLVERS:
         raise SimulationError(f"unknown solver '{options.solver}'",
                               hint=f"choose one of {', '.join(ALL_SOLVERS)}")
+    limits = Limits(options.max_steps, options.time_limit)
+    limits.validate()
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -325,17 +359,18 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             f"{len(grid)} output times x {len(model.outputs)} variables need "
             f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
             "use a larger --interval")
+    note = ""
     if solver in FIXED_STEP:
-        step = solvers.check_step(solver, options.step, start, stop, len(grid) - 1)
+        step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
+    p = parameter_vector(model, options.parameters)
     if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
         from .switching import simulate_switching_model
 
         return simulate_switching_model(model, solver, grid, rtol, atol,
-                                        dict(options.parameters))
-    p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
+                                        dict(options.parameters), limits)
     x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
-    problem = _Problem(model, p, solver, progress)
+    problem = _Problem(model, p, solver, progress, limits)
     try:
         with np.errstate(all="ignore"):
             if not np.isfinite(x0).all():
@@ -358,17 +393,32 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             outputs = _outputs(model, problem, grid, states)
     except _Stop as stop_:
         raise stop_.error from None
+    except OverLimit as over:
+        raise over_limit(over, start, stop, problem.jacobian) from None
     finally:
         progress.close()
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
-                            model.compile_time, model.cached, reason)
+                            model.compile_time, model.cached, reason, note)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
                             dict(zip(model.parameter_names, p.tolist())))
+
+
+def parameter_vector(model: CompiledModel, values: Mapping[str, float]) -> np.ndarray:
+    """The generated module's parameter vector with ``values``; every entry finite."""
+    try:
+        p = np.asarray(model.module.parameters(dict(values)), dtype=float)
+    except (ArithmeticError, ValueError) as err:
+        where = _code_location(err, str(model.path))
+        raise SimulationError(f"{_kind(err)} while computing the parameter "
+                              f"{where or 'values'}",
+                              hint="check the parameters its binding uses (--set)") from None
+    check_parameters(model.parameter_names, p)
+    return p
 
 
 def _integrate(problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
@@ -398,6 +448,7 @@ class _Run:
     def __init__(self, problem: _Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
                  atol: float) -> None:
         self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
+        self.limits = problem.limits
         self.states = np.empty((len(grid), len(x0)))
         self.states[0] = x0
         self.k, self.steps = 1, 0
@@ -428,6 +479,22 @@ class _Run:
                                                      f"too: {second.error.message}")),
             hint=_remedy("radau")))
 
+    def check_limits(self, integrator: Any, steps: int, sizes: deque[float]) -> None:
+        """Stop at ``max_steps``, or at once when the current step size would need
+        :data:`~springc.simulation.limits.HOPELESS` times as many."""
+        limit, t = self.limits.max_steps, float(integrator.t)
+        stop = float(self.grid[-1])
+        if steps >= limit and t < stop:
+            raise OverLimit(f"{steps} steps of {self.problem.solver} reached the step "
+                            f"limit (--max-steps {limit})", t, np.array(integrator.y),
+                            self.problem.solver)
+        projected = projected_steps(steps, t, stop, tuple(sizes))
+        if projected > HOPELESS * limit:
+            raise OverLimit(f"at its current step size ({float(np.median(sizes)):.3g} s) "
+                            f"{self.problem.solver} needs ~{projected:.3g} steps to the "
+                            f"stop time, far over the step limit (--max-steps {limit})",
+                            t, np.array(integrator.y), self.problem.solver)
+
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""
         problem, grid, states = self.problem, self.grid, self.states
@@ -446,6 +513,8 @@ class _Run:
             if integrator.status == "failed":
                 raise _Stop(_solver_failure(problem, integrator, message))
             sizes.append(integrator.t - before)
+            if taken % CHECK_EVERY == 0 or self.steps + taken >= self.limits.max_steps:
+                self.check_limits(integrator, self.steps + taken, sizes)
             j = int(np.searchsorted(grid, integrator.t, side="right"))
             if j > self.k:
                 dense = integrator.dense_output()
@@ -471,8 +540,7 @@ def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
         try:
             obs = model.module.observed_grid(grid, np.ascontiguousarray(states), problem.p, z)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
-            raise problem._fail(err, float(grid[-1]), states[-1], "an observed variable") \
-                from err
+            raise _first_failure(model, problem, grid, states, err) from err
         if z[-1] != 0.0:
             row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
             problem.z[-1] = z[-1]
@@ -481,7 +549,21 @@ def _outputs(model: CompiledModel, problem: _Problem, grid: np.ndarray,
     out = np.empty((len(grid), len(names)))
     for i, name in enumerate(names):
         out[:, i] = columns[name]
+    check_outputs(names, grid, out)
     return out
+
+
+def _first_failure(model: CompiledModel, problem: _Problem, grid: np.ndarray,
+                   states: np.ndarray, err: BaseException) -> _Stop:
+    """The failure of the observed variables at the first output time where it occurs
+    (``observed_grid`` raised for the whole grid)."""
+    z = np.asarray(model.module.guesses(problem.p), dtype=float)
+    for row in range(len(grid)):
+        try:
+            model.module.observed(float(grid[row]), states[row], problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as first:
+            return problem._fail(first, float(grid[row]), states[row], "an observed variable")
+    return problem._fail(err, float(grid[-1]), states[-1], "an observed variable")
 
 
 def _solver_failure(problem: _Problem, integrator: Any, message: str | None

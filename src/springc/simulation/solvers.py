@@ -35,8 +35,6 @@ from ..ir.expr import Var
 from .integrators import NonFiniteState, Pairs, integrate
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 
-MAX_FIXED_STEPS = 20_000_000
-"""More fixed steps than this are refused up front (minutes of Python loop)."""
 FIXED_REMEDY = "reduce --step or use --solver radau"
 
 
@@ -126,9 +124,15 @@ def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
 
 # ------------------------------------------------------------------ fixed step
 
-def check_step(solver: str, step: float | None, start: float, stop: float,
-               intervals: int) -> float:
-    """The step of a fixed-step run, validated; errors name the option."""
+def check_step(solver: str, step: float | None, grid: np.ndarray, max_steps: int
+               ) -> tuple[float, str]:
+    """The step of a fixed-step run, validated (errors name the option), and a note
+    when the run cannot take it exactly.
+
+    The fixed-step solvers land on every output time, so each output interval is
+    split into whole steps: a step longer than the interval is refused, and one that
+    does not divide it is shortened to the next divisor, which the note says.
+    """
     if step is None:
         raise SimulationError(f"the fixed-step solver {solver} needs a step size",
                               hint="pass --step H (e.g. a twentieth of the fastest "
@@ -136,13 +140,30 @@ def check_step(solver: str, step: float | None, start: float, stop: float,
     if not (math.isfinite(step) and step > 0):
         raise SimulationError(f"the step must be positive and finite, not {step:g}",
                               hint="pass --step H with H > 0")
-    steps = intervals + (stop - start) / step
-    if steps > MAX_FIXED_STEPS:
-        raise SimulationError(f"--step {step:g} over {stop - start:g} s takes {steps:.3g} "
-                              f"steps, more than {MAX_FIXED_STEPS:.0e}",
+    spans = np.diff(grid)
+    interval = float(spans[0])
+    if step > float(spans.max()) * (1 + 1e-9):
+        raise SimulationError(
+            f"--step {step:g} is longer than the output interval {interval:g}: the "
+            f"fixed-step solvers step to every output time",
+            hint=f"use a step that divides the interval (--step {interval:g} or smaller), "
+                 f"or an output interval that is a multiple of the step (--interval "
+                 f"{step:g})")
+    counts = np.maximum(1, np.ceil(spans / step - 1e-9))
+    steps = float(counts.sum())
+    if steps > max_steps:
+        raise SimulationError(f"--step {step:g} over {float(grid[-1] - grid[0]):g} s takes "
+                              f"{steps:.3g} steps, more than {max_steps:.0e} (--max-steps)",
                               hint="use a larger --step, a shorter span, or an adaptive "
                               "solver (--solver auto)")
-    return float(step)
+    taken = spans / counts
+    note = ""
+    if np.any(np.abs(taken - step) > 1e-9 * step):
+        note = (f"--step {step:g} does not divide the output interval {interval:g}; "
+                f"{solver} took steps of {float(taken.min()):.6g} s"
+                + (f" to {float(taken.max()):.6g} s" if taken.max() - taken.min()
+                   > 1e-9 * step else "") + " to land on every output time")
+    return float(step), note
 
 
 def run_fixed(problem: Any, grid: np.ndarray, x0: np.ndarray, step: float

@@ -11,6 +11,7 @@ Jacobian), so the estimate costs a few dozen Jacobian-vector products.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,21 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
         if not len(largest):
             return float(sp.linalg.norm(operator, np.inf))  # Gershgorin bound
     return float(np.max(np.abs(largest)))
+
+
+def numerical_jacobian(rhs: Callable[[float, np.ndarray], np.ndarray], t: float,
+                       y: np.ndarray) -> np.ndarray:
+    """Forward differences of ``rhs`` at ``(t, y)`` (for systems without an analytic
+    Jacobian, such as the switching driver's reference evaluator; small ones)."""
+    y = np.asarray(y, dtype=float)
+    f0 = np.asarray(rhs(t, y), dtype=float)
+    jac = np.empty((len(f0), len(y)))
+    for j in range(len(y)):
+        h = 1e-7 * max(1.0, abs(y[j]))
+        shifted = y.copy()
+        shifted[j] += h
+        jac[:, j] = (np.asarray(rhs(t, shifted), dtype=float) - f0) / h
+    return jac
 
 
 def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,

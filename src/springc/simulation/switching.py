@@ -19,9 +19,11 @@ used instead.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Protocol
 
 import numpy as np
@@ -41,8 +43,10 @@ from ..simplify import (
     state_vector,
     switch,
 )
+from .limits import Limits, OverLimit, check_outputs, over_limit
 from .results import SimulationResult, SimulationStats
 from .solver_names import EXPLICIT, SOLVERS
+from .stiffness import numerical_jacobian
 
 MAX_SWITCHES = 10_000
 
@@ -105,7 +109,8 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
                        rtol: float = 1e-6, atol: float = 1e-8, method: str = "DOP853",
                        parameters: Mapping[str, float] | None = None,
                        make_functions: MakeFunctions = EvaluatorFunctions,
-                       threshold: float = THRESHOLD) -> SwitchingResult:
+                       threshold: float = THRESHOLD, time_limit: float = math.inf
+                       ) -> SwitchingResult:
     """Simulate ``model`` over ``t_span`` with dynamic state selection.
 
     Starts with the default choice of states and consistent initial values
@@ -113,10 +118,13 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
     badly conditioned there), integrates with ``solve_ivp(method=...)`` until the
     conditioning event, switches (:func:`switch`), and restarts at the event time from
     the values there. Output at ``t_eval`` (default: every accepted step).
-    Raises :class:`SimulationError` when the integrator fails or a switch does not
-    improve the conditioning.
+    Raises :class:`SimulationError` when the integrator fails, a switch does not
+    improve the conditioning, or the run takes over ``time_limit`` seconds (the error
+    names the time reached and the stiffness there, from a difference Jacobian).
     """
     from scipy.integrate import solve_ivp
+
+    deadline = time.perf_counter() + time_limit
 
     t0, t1 = float(t_span[0]), float(t_span[1])
     choice = select_states(model)
@@ -139,9 +147,13 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         if requested is not None:
             later = (requested >= t) & (requested > times[-1] if times else True)
             segment = requested[later & (requested <= t1)]
-        rhs = _RejectingRhs(functions)
-        sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
-                        rtol=rtol, atol=atol, events=event if choice.blocks else None)
+        rhs = _RejectingRhs(functions, deadline, time_limit, method.lower())
+        try:
+            sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
+                            rtol=rtol, atol=atol, events=event if choice.blocks else None)
+        except OverLimit as over:
+            raise over_limit(over, t0, t1, partial(numerical_jacobian, functions.rhs)
+                             ) from None
         if sol.status == -1:
             cause = f" (last failure: {rhs.failure})" if rhs.failure else ""
             raise SimulationError(f"the integration failed at t = {sol.t[-1]:g}: "
@@ -173,11 +185,16 @@ class _RejectingRhs:
     trial stage that went past a singularity): solve_ivp's methods then reject the
     step and retry a smaller one, so the conditioning event gets its chance."""
 
-    def __init__(self, functions: Functions) -> None:
+    def __init__(self, functions: Functions, deadline: float = math.inf,
+                 time_limit: float = math.inf, solver: str = "") -> None:
         self.functions = functions
         self.failure: SimulationError | None = None
+        self.deadline, self.time_limit, self.solver = deadline, time_limit, solver
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        if time.perf_counter() > self.deadline:
+            raise OverLimit(f"{self.time_limit:g} s of wall clock reached the time limit "
+                            "(--time-limit)", t, np.array(y), self.solver)
         try:
             return self.functions.rhs(t, y)
         except SimulationError as err:
@@ -210,19 +227,19 @@ def _switch(model: flat.FlatModel, old: StateChoice, values: Mapping[str, float]
     return new
 
 
-
-
 def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray,
-                             rtol: float, atol: float, parameters: dict[str, float]
-                             ) -> SimulationResult:
+                             rtol: float, atol: float, parameters: dict[str, float],
+                             limits: Limits | None = None) -> SimulationResult:
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
     method = solver if solver in SOLVERS else EXPLICIT
     flat_model = derive_system(model.options).flat_model
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
                              rtol=rtol, atol=atol, method=SOLVERS[method],
-                             parameters=parameters)
+                             parameters=parameters,
+                             time_limit=(limits or Limits()).time_limit)
     values = np.column_stack([run.values[name] for name in model.outputs])
+    check_outputs(model.outputs, np.asarray(grid, dtype=float), values)
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))
     unit_of = dict(zip(model.states, getattr(model.module, "STATE_UNITS", ())))
     unit_of.update(zip(model.observed, units))
