@@ -82,7 +82,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              outputs: Sequence[str] | None = None, backend: str = "python",
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
              progress: TextIO | None = None, step: float | None = None,
-             max_steps: int = DEFAULT_MAX_STEPS, time_limit: float = DEFAULT_TIME_LIMIT
+             max_steps: int | None = None, time_limit: float | None = None
              ) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
@@ -92,7 +92,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
     A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
-    seconds (defaults: 20,000,000 steps, one hour).
+    seconds (``None``: 20,000,000 steps, one hour).
     """
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
@@ -105,5 +105,6 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
         model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
-                                step, max_steps, time_limit)
+                                step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
+                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit)
     return simulate_model(model, options)

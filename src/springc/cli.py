@@ -199,9 +199,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     result = run(files, model_name=model, libraries=libraries, backend=backend,
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step,
-                 **({"max_steps": max_steps} if max_steps is not None else {}),
-                 **({"time_limit": time_limit} if time_limit is not None else {}))
+                 parameters=values, progress=progress, step=step, max_steps=max_steps,
+                 time_limit=time_limit)
     if output:
         result.to_csv(output)
     elif not plot:

@@ -77,7 +77,7 @@ def fold(e: x.Expr) -> x.Expr:
                 return neg(left)
             return build(left, right)
         if isinstance(left, x.Const) and isinstance(right, x.Const):
-            return x.Const(x.evaluate(x.BinOp(e.op, left, right), {}))  # type: ignore
+            return x.Const(x.evaluate(x.BinOp(e.op, left, right), {}))
         return x.BinOp(e.op, left, right)
     if isinstance(e, x.Neg):
         return neg(fold(e.arg))
@@ -88,7 +88,8 @@ def fold(e: x.Expr) -> x.Expr:
         args = tuple(fold(a) for a in e.args)
         if all(isinstance(a, x.Const) for a in args) and e.name in x.MATH:
             try:
-                return x.Const(x.MATH[e.name](*(a.value for a in args)))  # type: ignore
+                values = [a.value for a in args if isinstance(a, x.Const)]
+                return x.Const(x.MATH[e.name](*values))
             except (ValueError, ZeroDivisionError, OverflowError):
                 pass
         return x.Call(e.name, args)

@@ -11,7 +11,7 @@ starting from the previous solution, or from start values the first time).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -54,8 +54,8 @@ def parameter_values(parameters: Iterable[dae.Parameter],
     return values
 
 
-class _Lazy(dict):  # type: ignore[type-arg]
-    def __init__(self, lookup):  # type: ignore[no-untyped-def]
+class _Lazy(dict[str, float]):
+    def __init__(self, lookup: Callable[[str], float]) -> None:
         super().__init__()
         self.lookup = lookup
 
@@ -64,9 +64,9 @@ class _Lazy(dict):  # type: ignore[type-arg]
         return result
 
 
-def evaluate_with(e: x.Expr, lookup, time: float = 0.0) -> float:  # type: ignore[no-untyped-def]
+def evaluate_with(e: x.Expr, lookup: Callable[[str], float], time: float = 0.0) -> float:
     """Evaluate ``e``, asking ``lookup(name)`` for each variable it needs."""
-    return float(x.evaluate(e, _Lazy(lookup), time))  # type: ignore[arg-type]
+    return float(x.evaluate(e, _Lazy(lookup), time))
 
 
 def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
@@ -125,7 +125,7 @@ class Evaluator:
         env.update(zip(self.names, (float(v) for v in states)))
         for step in self.model.steps:
             if isinstance(step, ode.Assign):
-                env[step.name] = float(x.evaluate(step.expr, env, t))  # type: ignore
+                env[step.name] = float(x.evaluate(step.expr, env, t))
             elif isinstance(step, ode.LinearBlock):
                 self._linear(step, env, t)
             else:
@@ -139,14 +139,14 @@ class Evaluator:
 
     def observed(self, env: Mapping[str, float], t: float = 0.0) -> dict[str, float]:
         """The eliminated aliases, from a ``values`` result."""
-        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}  # type: ignore
+        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}
 
     def _linear(self, step: ode.LinearBlock, env: dict[str, float], t: float) -> None:
         n = len(step.names)
         rows = [r for r, _, _ in step.matrix]
         cols = [c for _, c, _ in step.matrix]
-        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]  # type: ignore
-        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])  # type: ignore
+        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]
+        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])
         try:
             if n >= SPARSE_FROM:
                 from scipy.sparse import csc_matrix
@@ -171,11 +171,11 @@ class Evaluator:
         for _ in range(self.max_iterations):
             env.update(zip(step.tearing, z.tolist()))
             for a in step.inner + step.sensitivities:
-                env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
-            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])  # type: ignore
+                env[a.name] = float(x.evaluate(a.expr, env, t))
+            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])
             jac = np.zeros((n, n))
             for i, j, e in step.jacobian:
-                jac[i, j] = float(x.evaluate(e, env, t))  # type: ignore
+                jac[i, j] = float(x.evaluate(e, env, t))
             try:
                 dz = np.linalg.solve(jac, -f)
             except np.linalg.LinAlgError:
@@ -184,7 +184,7 @@ class Evaluator:
             if np.max(np.abs(dz)) <= self.newton_tol * (1 + np.max(np.abs(z))):
                 env.update(zip(step.tearing, z.tolist()))
                 for a in step.inner:
-                    env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
+                    env[a.name] = float(x.evaluate(a.expr, env, t))
                 self.guess.update(zip(step.tearing, z.tolist()))
                 return
         raise SimulationError(

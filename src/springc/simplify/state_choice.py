@@ -133,9 +133,9 @@ def state_vector(choice: StateChoice, values: Mapping[str, float]) -> np.ndarray
 
 def _evaluate(e: x.Expr, values: Mapping[str, float], time: float) -> float:
     try:
-        return float(x.evaluate(e, values, time))  # type: ignore[arg-type]
+        return float(x.evaluate(e, values, time))
     except KeyError:
-        return float(x.evaluate(e, _Defaulting(values), time))  # type: ignore[arg-type]
+        return float(x.evaluate(e, _Defaulting(values), time))
 
 
 class _Defaulting(dict):  # type: ignore[type-arg]

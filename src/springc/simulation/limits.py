@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -69,13 +70,13 @@ def projected_steps(taken: int, t: float, stop: float, sizes: Sequence[float]) -
 
 
 def over_limit(error: OverLimit, start: float, stop: float,
-               jacobian: Callable[[float, np.ndarray], object] | None) -> SimulationError:
+               jacobian: Callable[[float, np.ndarray], Any] | None) -> SimulationError:
     """The error of a run stopped by its limits: time, stiffness, a suggested solver."""
     rho = None
     if jacobian is not None:
         try:
             with np.errstate(all="ignore"):
-                rho = spectral_radius(jacobian(error.t, error.y))  # type: ignore[arg-type]
+                rho = spectral_radius(jacobian(error.t, error.y))
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             rho = None
     notes = [Note(f"reached time {error.t:.9g} of {stop:g} "

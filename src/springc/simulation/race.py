@@ -48,23 +48,33 @@ CHEAP_STEPS = 500
 
 
 class Stretch(Protocol):
-    steps: int
-    seconds: float
-    sizes: tuple[float, ...]
+    """What one stretch of steps measured (``springc.simulation.runner.Stretch``)."""
+
+    @property
+    def steps(self) -> int: ...
+
+    @property
+    def seconds(self) -> float: ...
+
+    @property
+    def sizes(self) -> tuple[float, ...]: ...
 
 
 class Run(Protocol):
-    """The simulation's step loop (``springc.simulation._Run``)."""
+    """The simulation's step loop (``springc.simulation.runner._Run``)."""
 
-    failure: type[Exception]
-    done: bool
+    @property
+    def failure(self) -> type[Exception]: ...
+
+    @property
+    def done(self) -> bool: ...
 
     def start(self, solver: str, t: float, y: np.ndarray,
               first_step: float | None = None) -> Any: ...
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch: ...
 
-    def both_failed(self, first: Exception, second: Exception) -> Exception: ...
+    def both_failed(self, first: Any, second: Any) -> Exception: ...
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -103,7 +113,8 @@ def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
           x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
     explicit_cost = (stop - explicit.t) / h_explicit * probe.seconds / probe.steps
     implicit = run.start(RACE_IMPLICIT, t0, x0)
-    steps, seconds, sizes = 0, 0.0, []
+    steps, seconds = 0, 0.0
+    sizes: list[float] = []
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
         trial = run.advance(implicit, 1)
         steps, seconds = steps + trial.steps, seconds + trial.seconds

@@ -306,7 +306,7 @@ class _Problem:
                 notes=_state_notes(self.names, x, dx), hint=_remedy(self.solver)))
         if now >= self.progress.next:
             self.progress.update(t)
-        return dx
+        return np.asarray(dx)
 
     def jacobian(self, t: float, x: np.ndarray) -> Any:
         """The Jacobian for diagnostics: not counted, no failure checks."""

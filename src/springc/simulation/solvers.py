@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -34,6 +34,8 @@ from ..ir import dae, ode
 from ..ir.expr import Var
 from .integrators import NonFiniteState, Pairs, integrate
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
+
+T = TypeVar("T")
 
 FIXED_REMEDY = "reduce --step or use --solver radau"
 
@@ -54,7 +56,7 @@ def pairs_from_ode(system: ode.ODE) -> list[tuple[str, str]]:
     return _disjoint(out)
 
 
-def _disjoint(pairs: list[tuple[str, str]] | list[tuple[int, int]]) -> list:
+def _disjoint(pairs: list[tuple[T, T]]) -> list[tuple[T, T]]:
     """Drop chains (``der(a) = b``, ``der(b) = c``): a state is a position or a
     velocity, not both."""
     positions = {q for q, _ in pairs}
@@ -90,7 +92,7 @@ def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -
                 checks.append((np.asarray(module.rhs(t, x, p, z), dtype=float), x))
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             continue
-    good = [(q, v) for q, v in candidates
+    good = [(int(q), v) for q, v in candidates
             if checks and all(d[q] == x[v] for d, x in checks)]
     return Pairs.of(_disjoint(good))
 

@@ -46,7 +46,7 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
     if n == 0:
         return 0.0
     if n <= DENSE_LIMIT:
-        dense = jac.toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
+        dense = sp.csr_matrix(jac).toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
         return float(np.max(np.abs(np.linalg.eigvals(dense))))
     operator = sp.csr_matrix(jac, dtype=float)
     try:

@@ -113,9 +113,11 @@ def augmenting_path(
     so deep paths need no recursion. On success, matching every pair of ``pairs``
     (left to right) flips the path and grows the matching by one.
     """
-    seen_left, seen_right = {root}, set()
+    seen_left: set[int] = {root}
+    seen_right: set[int] = set()
     left, right = [root], []
-    path, positions, via = [root], [0], []  # via[k]: the right vertex leading to path[k+1]
+    path, positions = [root], [0]
+    via: list[int] = []  # via[k]: the right vertex leading to path[k+1]
     while path:
         candidates, pos = neighbours(path[-1]), positions[-1]
         while pos < len(candidates):

@@ -236,10 +236,9 @@ class _Setup:
     def sim_options(self, solver: str, rtol: float | None = None, step: float | None = None,
                     progress: Any = None) -> SimulationOptions:
         o = self.options
-        extra = {"step": step} if step is not None else {}
         return SimulationOptions(o.start, o.stop, o.interval, solver, rtol,
                                  None if rtol is None else rtol * self.atol_ratio,
-                                 dict(o.parameters), progress, **extra)
+                                 dict(o.parameters), progress, step)
 
     def log(self, text: str) -> None:
         if self.options.log is not None:
