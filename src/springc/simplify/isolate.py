@@ -10,8 +10,6 @@ which the benchmark reports to show that it grows linearly with the model.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 from ..ir import expr as x
 
 _BUILD = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
@@ -99,10 +97,6 @@ def fold(e: x.Expr) -> x.Expr:
             return fold(e.then) if cond.value else fold(e.otherwise)
         return x.If(cond, fold(e.then), fold(e.otherwise))
     return e
-
-
-def substitute_fold(e: x.Expr, mapping: Mapping[str, x.Expr]) -> x.Expr:
-    return fold(x.substitute(e, mapping))
 
 
 _Split = tuple["x.Expr | None", x.Expr]

@@ -22,11 +22,10 @@ from __future__ import annotations
 
 import linecache
 import math
-import sys
 import time
 import traceback
 from collections import deque
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, TextIO
 
@@ -576,9 +575,3 @@ def _solver_failure(problem: _Problem, integrator: Any, message: str | None
     notes = [Note("fastest-changing states:"), *_state_notes(problem.names, x, dx)]
     return SimulationError(text, notes=notes, hint=_remedy(problem.solver))
 
-
-def print_summary(result: SimulationResult, stream: TextIO = sys.stderr) -> None:
-    stream.write(result.stats.summary(result.model) + "\n")
-
-
-ProgressStream = Callable[[], TextIO | None]
