@@ -177,3 +177,14 @@ def test_a_step_that_does_not_divide_the_interval_is_shortened_and_says_so() -> 
     assert result.stats.summary("M").endswith("; note: " + result.stats.note)
     exact = springc.simulate(SEED, solver="verlet", step=0.01, stop=1.0, interval=0.02)
     assert exact.stats.note == "" and exact.stats.steps == 100
+
+
+def test_a_zero_rod_length_is_located_not_an_internal_error(tmp_path: Path) -> None:
+    # RigidPair runs on the switching driver (reference evaluator): a division by zero
+    # in a step of the simplified system names the variable and its equation.
+    code, output = simulate_cli(SCENES, "--model", "Scenes.RigidPair", "--set", "rod.l=0",
+                                "-o", str(tmp_path / "out.csv"))
+    assert code == 1
+    planar = ROOT / "models" / "Planar.mdl"
+    assert output.startswith(f"{planar}:44:5: error: division by zero while computing "
+                             "p2.pos[1] at t = 0\n")

@@ -120,16 +120,27 @@ class Evaluator:
         self.max_iterations = max_iterations
 
     def values(self, t: float, states: Iterable[float]) -> dict[str, float]:
-        """All parameters, states and step variables at time ``t``."""
+        """All parameters, states and step variables at time ``t``; a step that leaves
+        the domain of an operation raises :class:`SimulationError` naming it."""
         env: dict[str, float] = dict(self.params)
         env.update(zip(self.names, (float(v) for v in states)))
         for step in self.model.steps:
-            if isinstance(step, ode.Assign):
-                env[step.name] = float(x.evaluate(step.expr, env, t))
-            elif isinstance(step, ode.LinearBlock):
-                self._linear(step, env, t)
-            else:
-                self._newton(step, env, t)
+            try:
+                if isinstance(step, ode.Assign):
+                    env[step.name] = float(x.evaluate(step.expr, env, t))
+                elif isinstance(step, ode.LinearBlock):
+                    self._linear(step, env, t)
+                else:
+                    self._newton(step, env, t)
+            except (ArithmeticError, ValueError) as err:
+                names = ([step.name] if isinstance(step, ode.Assign) else
+                         list(step.names) if isinstance(step, ode.LinearBlock) else
+                         list(step.tearing))
+                span = step.span if isinstance(step, ode.Assign) else step.spans[0]
+                raise SimulationError(
+                    f"{describe_failure(err)} while computing {', '.join(names[:4])} at "
+                    f"t = {t:g}", span, hint="the model leaves the domain of an operation "
+                    "there; check the parameters (--set) and start values") from None
         return env
 
     def rhs(self, t: float, states: Iterable[float]) -> np.ndarray:
