@@ -10,7 +10,7 @@ vetted numerically at the start values. With ``at`` (values of the variables, e.
 during a simulation) every block is instead chosen numerically at those values by
 :func:`pivoted_choice`: the best-conditioned columns within each priority class, so
 that the choice stays valid for a while (dynamic state selection,
-:mod:`springc.switching`).
+:mod:`springc.simplify.state_choice`).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps. If it finishes, or its current step
    size leaves at most :data:`CHEAP_STEPS` steps to go, it finishes the run: a short
    run costs no stiffness estimate at all.
-2. Otherwise the stiffness estimate of :func:`springc.solvers.choose` (``rho * T``
+2. Otherwise the stiffness estimate of :func:`springc.simulation.solvers.choose` (``rho * T``
    from the analytic Jacobian at the current state) decides whether ``radau`` could
    be cheaper. If not, ``dop853`` goes on.
 3. If it could, the estimate alone cannot tell: a very stiff spring whose fast mode
@@ -48,7 +48,7 @@ CHEAP_STEPS = 500
 
 
 class Stretch(Protocol):
-    """What one stretch of steps measured (``springc.simulation.runner.Stretch``)."""
+    """What one stretch of steps measured (``springc.simulation.steps.Stretch``)."""
 
     @property
     def steps(self) -> int: ...
@@ -61,7 +61,7 @@ class Stretch(Protocol):
 
 
 class Run(Protocol):
-    """The simulation's step loop (``springc.simulation.runner._Run``)."""
+    """The simulation's step loop (``springc.simulation.steps.StepLoop``)."""
 
     @property
     def failure(self) -> type[Exception]: ...

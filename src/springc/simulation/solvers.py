@@ -4,15 +4,15 @@ Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
 
 - **Fixed-step scene integrators** (``solver_names.FIXED_STEP``): ``verlet`` (velocity Verlet)
   and ``symplectic-euler`` (semi-implicit Euler) for second-order mechanical systems,
-  and the classical ``rk4``, run by :mod:`springc.integrators` with ``--step H``.
+  and the classical ``rk4``, run by :mod:`springc.simulation.integrators` with ``--step H``.
   The position/velocity pairs they need (``der(q) = v`` with ``v`` a state) are found
   from the generated module: a state whose derivative depends structurally on one
   other state only, with slope 1 and no offset (:func:`detect_pairs`; on the ODE
   itself, :func:`pairs_from_ode` reads the ``der(q) := v`` steps directly).
-- **``auto``** (the default, run by :mod:`springc.race`): ``dop853`` unless a run
+- **``auto``** (the default, run by :mod:`springc.simulation.race`): ``dop853`` unless a run
   turns out long *and* a cheap stiffness estimate is large: the spectral radius
   ``rho`` of the analytic Jacobian times the remaining span ``T``
-  (:mod:`springc.stiffness`, :func:`choose`). Even then the estimate alone cannot
+  (:mod:`springc.simulation.stiffness`, :func:`choose`). Even then the estimate alone cannot
   tell: a stiff spring whose fast mode stays at rest costs an explicit method
   nothing, an excited one costs every method, and per-step costs differ by solver;
   so the two methods race for a few steps and the one whose projected remaining

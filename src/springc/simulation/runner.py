@@ -1,0 +1,270 @@
+"""Simulation: CompiledModel + SimulationOptions -> SimulationResult.
+
+Options, the output grid ``t0, t0 + dt, ..., stop``, the start state, and the run:
+the step loop (:mod:`.steps`), ``auto``'s race (:mod:`.race`), the fixed-step
+solvers (:mod:`.solvers`), the switching driver (:mod:`.switching`), then the outputs.
+
+Defaults: start 0 s, stop 10 s, 500 output intervals, unless the model's
+``experiment`` annotation says otherwise (its Interval applies even when the start or
+stop time is given); rtol 1e-6 (or the experiment's Tolerance),
+atol = rtol / 1000; solver :data:`DEFAULT_SOLVER`; at most
+:data:`~springc.simulation.limits.DEFAULT_MAX_STEPS` steps and
+:data:`~springc.simulation.limits.DEFAULT_TIME_LIMIT` seconds (:mod:`.limits`).
+
+(The module is not named ``simulate``: ``springc.simulate`` is the API function, and a
+submodule of that name would replace it on the package once imported.)
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TextIO
+
+import numpy as np
+
+from ..errors import SimulationError
+from ..pipeline import CompiledModel, check_parameter_names
+from ..simplify import describe_failure as describe_failure
+from . import solvers
+from .failures import Stop, code_location, state_notes
+from .limits import (
+    DEFAULT_MAX_STEPS,
+    DEFAULT_TIME_LIMIT,
+    Limits,
+    OverLimit,
+    check_outputs,
+    check_parameters,
+    over_limit,
+)
+from .race import auto
+from .results import SimulationResult, SimulationStats
+from .solver_names import (
+    ALL_SOLVERS,
+    AUTO,
+    DEFAULT_SOLVER,
+    EXPLICIT,
+    FIXED_STEP,
+)
+from .steps import Problem, Progress, StepLoop, integrate
+
+DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
+DEFAULT_RTOL = 1e-6
+MAX_OUTPUT_BYTES = 4_000_000_000
+LSODA_LIMIT = 2000
+
+
+@dataclass(frozen=True)
+class SimulationOptions:
+    """``None`` means: from the experiment annotation, else the documented default."""
+
+    start: float | None = None
+    stop: float | None = None
+    interval: float | None = None
+    solver: str = DEFAULT_SOLVER
+    rtol: float | None = None
+    atol: float | None = None
+    parameters: Mapping[str, float] = field(default_factory=dict)
+    progress: TextIO | None = None
+    step: float | None = None  # fixed-step solvers only
+    max_steps: int = DEFAULT_MAX_STEPS
+    time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
+
+
+def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
+    """``start, start + interval, ..., stop``; the last point is ``stop`` exactly."""
+    if not (math.isfinite(start) and math.isfinite(stop)) or stop <= start:
+        raise SimulationError(f"the stop time {stop:g} must be after the start time "
+                              f"{start:g}")
+    if not interval > 0:
+        raise SimulationError(f"the output interval must be positive, not {interval:g}")
+    count = (stop - start) / interval
+    n = max(1, round(count)) if abs(count - round(count)) < 1e-9 * max(1.0, count) \
+        else math.ceil(count)
+    if n > 10_000_000:
+        raise SimulationError(f"{n} output intervals are too many",
+                              hint="use a larger --interval")
+    grid = start + interval * np.arange(n + 1, dtype=float)
+    grid[-1] = stop
+    return grid
+
+
+def resolve(model: CompiledModel, options: SimulationOptions) -> tuple[float, float, float,
+                                                                        float, float]:
+    """start, stop, interval, rtol, atol from options, experiment and defaults."""
+    exp = model.module.EXPERIMENT
+    start = _first(options.start, exp.get("start"), DEFAULT_START)
+    stop = _first(options.stop, exp.get("stop"), DEFAULT_STOP)
+    if options.interval is not None:
+        interval = options.interval
+    elif exp.get("interval") is not None:
+        interval = exp["interval"]
+    else:
+        interval = (stop - start) / DEFAULT_INTERVALS
+    rtol = _first(options.rtol, exp.get("tolerance"), DEFAULT_RTOL)
+    atol = _first(options.atol, None, rtol / 1000)
+    return start, stop, interval, rtol, atol
+
+
+def _first(*values: float | None) -> float:
+    for v in values:
+        if v is not None:
+            return float(v)
+    raise AssertionError("no default")
+
+
+def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.ndarray:
+    """The states at the start time.
+
+    States start at their ``start`` values, as Modelica tools do when nothing else
+    fixes them. A model with ``initial equation``s or fixed start values on variables
+    that are not states has an initial problem: it is solved by
+    :func:`springc.initialize.initial_state` on the simplified system (derived again
+    here, since the generated module holds only the ODE).
+    """
+    if not getattr(model.module, "INITIAL_CONDITIONS", 0):
+        try:
+            return np.asarray(model.module.start(p), dtype=float)
+        except (ArithmeticError, ValueError) as err:
+            where = code_location(err, str(model.path))
+            raise SimulationError(
+                f"{describe_failure(err)} while computing the start value of {where or 'a state'}",
+                hint="check the parameters the start values use (--set)") from None
+    from ..pipeline import derive_system
+    from ..simplify import initial_state as solve_initial
+
+    system = derive_system(model.options).system
+    values = dict(zip(model.parameter_names, (float(v) for v in p)))
+    x0, _info = solve_initial(system, values, t0)
+    order = {s.name: i for i, s in enumerate(system.states)}
+    return np.array([x0[order[name]] for name in model.states], dtype=float)
+
+
+def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
+                   ) -> SimulationResult:
+    """Integrate ``model`` and return the selected outputs on the output grid."""
+    began = time.perf_counter()
+    solver = options.solver.lower()
+    if solver not in ALL_SOLVERS:
+        raise SimulationError(f"unknown solver '{options.solver}'",
+                              hint=f"choose one of {', '.join(ALL_SOLVERS)}")
+    limits = Limits(options.max_steps, options.time_limit)
+    limits.validate()
+    start, stop, interval, rtol, atol = resolve(model, options)
+    grid = output_grid(start, stop, interval)
+    check_parameter_names(model, options.parameters)
+    structural = [n for n in options.parameters if n in model.structural]
+    if structural:
+        raise SimulationError(f"'{structural[0]}' is a structural parameter: changing it "
+                              "needs a new compilation",
+                              hint="pass it to compile_model(parameters=...) or use "
+                              "springc.simulate(files, parameters=...)")
+    n = len(model.states)
+    if solver == "lsoda" and n > LSODA_LIMIT:
+        raise SimulationError(f"lsoda uses dense Jacobians, too large for {n} states",
+                              hint="use --solver bdf or radau (sparse Jacobians)")
+    size = len(grid) * (len(model.outputs) + n) * 8
+    if size > MAX_OUTPUT_BYTES:
+        raise SimulationError(
+            f"{len(grid)} output times x {len(model.outputs)} variables need "
+            f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
+            "use a larger --interval")
+    note = ""
+    if solver in FIXED_STEP:
+        step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
+    p = parameter_vector(model, options.parameters)
+    if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
+        from .switching import simulate_switching_model
+
+        return simulate_switching_model(model, solver, grid, rtol, atol,
+                                        dict(options.parameters), limits)
+    x0 = initial_state(model, p, start)
+    progress = Progress(options.progress, start, stop)
+    problem = Problem(model, p, solver, progress, limits)
+    try:
+        with np.errstate(all="ignore"):
+            if not np.isfinite(x0).all():
+                raise Stop(SimulationError(
+                    f"the start values are not finite at time {start}",
+                    notes=state_notes(problem.names, x0, None)))
+            reason = ""
+            if solver in FIXED_STEP:
+                states, steps = solvers.run_fixed(problem, grid, x0, step)
+            elif solver == AUTO and len(x0):
+                run = StepLoop(problem, grid, x0, rtol, atol)
+                solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
+                    problem.jac(t, x), stop - start))
+                states, steps = run.states, run.steps
+            else:
+                if solver == AUTO:
+                    solver, reason = EXPLICIT, "no states to integrate"
+                problem.solver = solver
+                states, steps = integrate(problem, grid, x0, rtol, atol)
+            outputs = _outputs(model, problem, grid, states)
+    except Stop as stop_:
+        raise stop_.error from None
+    except OverLimit as over:
+        raise over_limit(over, start, stop, problem.jacobian) from None
+    finally:
+        progress.close()
+    stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
+                            time.perf_counter() - began, problem.model_time,
+                            model.compile_time, model.cached, reason, note)
+    units = dict(zip(model.states, model.module.STATE_UNITS))
+    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    names = model.outputs
+    return SimulationResult(model.name, grid, names, outputs,
+                            tuple(units.get(n, "") for n in names), stats,
+                            dict(zip(model.parameter_names, p.tolist())))
+
+
+def parameter_vector(model: CompiledModel, values: Mapping[str, float]) -> np.ndarray:
+    """The generated module's parameter vector with ``values``; every entry finite."""
+    try:
+        p = np.asarray(model.module.parameters(dict(values)), dtype=float)
+    except (ArithmeticError, ValueError) as err:
+        where = code_location(err, str(model.path))
+        raise SimulationError(f"{describe_failure(err)} while computing the parameter "
+                              f"{where or 'values'}",
+                              hint="check the parameters its binding uses (--set)") from None
+    check_parameters(model.parameter_names, p)
+    return p
+
+
+def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
+             states: np.ndarray) -> np.ndarray:
+    names = model.outputs
+    columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
+    selected = set(names)
+    wanted = [o for o in model.observed if o in selected]
+    if wanted:
+        z = np.asarray(model.module.guesses(problem.p), dtype=float)
+        try:
+            obs = model.module.observed_grid(grid, np.ascontiguousarray(states), problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise _first_failure(model, problem, grid, states, err) from err
+        if z[-1] != 0.0:
+            row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
+            problem.z[-1] = z[-1]
+            raise problem.newton_failure(float(grid[row]), states[row])
+        columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
+    out = np.empty((len(grid), len(names)))
+    for i, name in enumerate(names):
+        out[:, i] = columns[name]
+    check_outputs(names, grid, out)
+    return out
+
+
+def _first_failure(model: CompiledModel, problem: Problem, grid: np.ndarray,
+                   states: np.ndarray, err: BaseException) -> Stop:
+    """The failure of the observed variables at the first output time where it occurs
+    (``observed_grid`` raised for the whole grid)."""
+    z = np.asarray(model.module.guesses(problem.p), dtype=float)
+    for row in range(len(grid)):
+        try:
+            model.module.observed(float(grid[row]), states[row], problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as first:
+            return problem.fail(first, float(grid[row]), states[row], "an observed variable")
+    return problem.fail(err, float(grid[-1]), states[-1], "an observed variable")
