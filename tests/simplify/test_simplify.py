@@ -16,7 +16,7 @@ from springc.simplify.alias import eliminate_aliases
 from springc.simplify.causalize import causalize
 from springc.simplify.index_reduction import index_reduce
 from springc.simplify.lower import lower
-from springc.simplify.ode_eval import Evaluator, parameter_values
+from springc.simplify.ode_eval import OdeEvaluator, parameter_values
 from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -178,8 +178,8 @@ def test_springs_in_series_solve_a_linear_system(tmp_path: Path) -> None:
     assert len(linear) == 1 and len(linear[0]) >= 2
     # Numerically: equal tension in all springs, positions as for springs in series.
     params = parameter_values(model.parameters)
-    env = Evaluator(model, params).values(0.0, [3.5, 0.0])
-    env.update(Evaluator(model, params).observed(env))
+    env = OdeEvaluator(model, params).values(0.0, [3.5, 0.0])
+    env.update(OdeEvaluator(model, params).observed(env))
     f = [env[f"s[{i}].f"] for i in (1, 2, 3)]
     total = 0.5 / (1 / 10 + 1 / 20 + 1 / 30)  # stretch 0.5 over three springs
     assert f == pytest.approx([total] * 3, rel=1e-12)
@@ -231,7 +231,7 @@ def test_nonlinear_loop_is_torn(tmp_path: Path) -> None:
     step = torn[0]
     assert len(step.tearing) == 1 and len(step.residuals) == 1
     assert set(step.tearing) | {a.name for a in step.inner} == {"y", "z", "w"}
-    env = Evaluator(model, {}).values(0.0, [1.0])
+    env = OdeEvaluator(model, {}).values(0.0, [1.0])
     assert env["y"] + env["z"] ** 3 == pytest.approx(1.0, abs=1e-10)
     assert env["z"] == pytest.approx(np.cos(env["y"]) + 0.1 * env["y"] ** 2, abs=1e-10)
 

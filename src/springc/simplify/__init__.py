@@ -3,7 +3,7 @@ causalization), plus the balance check, the initial problem and state choice."""
 
 from .balance import check_balance
 from .initialize import conditions, initial_state
-from .ode_eval import Evaluator, describe_failure, parameter_values
+from .ode_eval import OdeEvaluator, describe_failure, parameter_values
 from .passes import simplify
 from .state_choice import (
     THRESHOLD,
@@ -17,7 +17,7 @@ from .state_choice import (
 
 __all__ = [
     "THRESHOLD",
-    "Evaluator",
+    "OdeEvaluator",
     "StateChoice",
     "check_balance",
     "conditioning",

@@ -6,7 +6,7 @@ The initial problem (Modelica 8.6) is built from ``fixed = true`` start values a
 1. A state with a fixed start value takes it.
 2. The *conditions* are the initial equations and the fixed start values of
    variables that are not states (algebraic variables, dummy derivatives); each is a
-   residual evaluated by running the ODE's steps (:class:`~springc.evaluate_ode.Evaluator`).
+   residual evaluated by running the ODE's steps (:class:`~springc.evaluate_ode.OdeEvaluator`).
 3. The conditions choose which of the other states they determine: the columns of
    their Jacobian with respect to those states (at the start values) picked by
    QR with column pivoting. States not chosen keep their ``start`` (default 0), as
@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import Note, SimulationError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import ode
-from .ode_eval import Evaluator, parameter_values, start_values
+from .ode_eval import OdeEvaluator, parameter_values, start_values
 
 
 class InitializationError(SpringcError):
@@ -81,7 +81,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     Raises :class:`InitializationError` (over-/under-determined, no convergence).
     """
     params = parameter_values(model.parameters, parameters)
-    evaluator = Evaluator(model, params)
+    evaluator = OdeEvaluator(model, params)
     starts = start_values(model.dae.unknowns, params)
     x0 = np.array([starts.get(s.name, 0.0) for s in model.states])
     fixed = [i for i, s in enumerate(model.states) if s.fixed and s.start is not None]
@@ -111,7 +111,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     return x0, info
 
 
-def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Evaluator,
+def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: OdeEvaluator,
                      x0: np.ndarray, t0: float) -> None:
     env = evaluator.values(t0, x0)
     for c in conds:

@@ -2,7 +2,7 @@
 
 A slow but simple interpreter over :func:`springc.expr.evaluate`, used by
 initialization, by state selection (numeric checks at start values) and by tests as
-an independent check of generated code. ``Evaluator.rhs(t, x)`` runs ``ode.steps`` in
+an independent check of generated code. ``OdeEvaluator.rhs(t, x)`` runs ``ode.steps`` in
 order: assignments, linear systems (dense, or sparse LU when large) and torn
 nonlinear systems (Newton on the tearing variables with the analytic Jacobian,
 starting from the previous solution, or from start values the first time).
@@ -99,7 +99,7 @@ def describe_failure(err: BaseException) -> str:
     return str(err) or type(err).__name__
 
 
-class Evaluator:
+class OdeEvaluator:
     """Evaluates the steps of ``model`` for given parameter values.
 
     ``guess`` (by name) overrides the start values as the first Newton guess of the

@@ -97,7 +97,7 @@ def conditioning(choice: StateChoice, values: Mapping[str, float], time: float =
     """How well the current states suit ``values`` (see step 2 of the module
     docstring): 1 for the best choice, towards 0 near its singularity; 1 when there is
     nothing to choose. ``values`` must hold the variables the ODE's steps compute
-    (e.g. :meth:`Evaluator.values`); names missing from it count as 0."""
+    (e.g. :meth:`OdeEvaluator.values`); names missing from it count as 0."""
     worst = 1.0
     for block in choice.blocks:
         jac = np.zeros((block.size, len(block.candidates)))

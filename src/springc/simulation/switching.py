@@ -33,7 +33,7 @@ from ..ir import flat
 from ..pipeline import CompiledModel, derive_system
 from ..simplify import (
     THRESHOLD,
-    Evaluator,
+    OdeEvaluator,
     StateChoice,
     conditioning,
     initial_state,
@@ -69,11 +69,11 @@ MakeFunctions = Callable[[StateChoice, Mapping[str, float], Mapping[str, float]]
 
 
 class EvaluatorFunctions:
-    """:class:`Functions` by the reference evaluator (:class:`springc.simplify.Evaluator`)."""
+    """:class:`Functions` by the reference evaluator (:class:`springc.simplify.OdeEvaluator`)."""
 
     def __init__(self, choice: StateChoice, parameters: Mapping[str, float],
                  guess: Mapping[str, float]) -> None:
-        self.evaluator = Evaluator(choice.ode, parameters, guess=guess)
+        self.evaluator = OdeEvaluator(choice.ode, parameters, guess=guess)
 
     def rhs(self, t: float, states: np.ndarray) -> np.ndarray:
         return self.evaluator.rhs(t, states)
