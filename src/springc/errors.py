@@ -83,6 +83,10 @@ class SimulationError(SpringcError):
     """The solver failed; the message names the time and the quantity at fault."""
 
 
+class CodegenError(SpringcError):
+    """The model uses something the code generator cannot translate."""
+
+
 class ErrorGroup(Exception):
     """Several independent errors reported together, in source order."""
 

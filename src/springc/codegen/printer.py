@@ -17,10 +17,10 @@ import builtins
 import keyword
 import math
 import re
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import SimulationError
+from ..errors import CodegenError
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
 
 # ------------------------------------------------------------------ statements
@@ -87,6 +87,7 @@ Stmt = Let | Load | Store | Raw | Loop | Block
 _RESERVED = frozenset({
     "t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out", "abs", "min", "max",
     "float", "int", "range", "len", "bool", "values", "numba", "scipy", "base64", "zlib",
+    "json", "fixed",
     "x0", "n", "i", "j", "k", "v", "ts", "given", "unknown", "name", "X",
     "parameters", "start", "guesses", "rhs", "observed", "observed_grid", "jacobian",
     "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
@@ -97,25 +98,40 @@ _RESERVED = frozenset({
 }) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
 
 
+# Internal names of the generated code (``_A3``, ``_r2_0``, ``_it``, ``_FS``): ASCII
+# identifiers that start with ``_``, used verbatim.
+_INTERNAL = re.compile(r"_[A-Za-z]+[0-9]*(?:_[0-9]+)?\Z")
+
+
+def escaped(text: str) -> str:
+    """``text`` as one line of ASCII that cannot end a comment or a docstring: control
+    and non-ASCII characters, backslashes and double quotes escaped as in a literal."""
+    return text.encode("unicode_escape").decode("ascii").replace('"', '\\"')
+
+
 class Namer:
     """Flat names -> Python identifiers: ``mass.pos[1]`` -> ``mass_pos_1``.
 
-    Internal names (starting with ``_``) are used verbatim; model names never start
-    with ``_`` once sanitized, so the two never collide.
+    Internal names (``_INTERNAL``) are used verbatim. Model names are sanitized into
+    ASCII identifiers that never start with ``_``, so the two never collide; a model
+    name that looks internal (Modelica allows ``_x``) is sanitized too.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, model_names: Iterable[str] = ()) -> None:
+        self.model_names = frozenset(model_names)
         self._ident: dict[str, str] = {}
         self._used: set[str] = set(_RESERVED)
 
     def __call__(self, name: str) -> str:
-        if name.startswith("_"):
-            return name
         ident = self._ident.get(name)
         if ident is None:
-            ident = self._fresh(name)
+            ident = name if self.internal(name) else self._fresh(name)
             self._ident[name] = ident
         return ident
+
+    def internal(self, name: str) -> bool:
+        """Whether ``name`` is one of the generator's own names (used verbatim)."""
+        return name not in self.model_names and _INTERNAL.match(name) is not None
 
     def _fresh(self, name: str) -> str:
         base = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_") or "v"
@@ -198,10 +214,6 @@ HELPERS = {
 }
 _HELPER_OF = {"sign": "_sign", "mod": "_mod", "div": "_div", "integer": "math.floor",
               "rem": "math.fmod"}
-
-
-class CodegenError(SimulationError):
-    """The model uses something the code generator cannot translate."""
 
 
 def _trivial(e: Expr) -> bool:
@@ -291,7 +303,7 @@ class FunctionWriter:
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
         if comment:
-            line += "  # " + comment.replace("\n", " ")
+            line += "  # " + escaped(comment)
         self.lines.append(line)
 
     def _stmt(self, stmt: Stmt) -> None:
@@ -319,7 +331,7 @@ class FunctionWriter:
                 self._emit(line)
         elif isinstance(stmt, Block):
             if stmt.comment:
-                self._emit("# " + stmt.comment)
+                self._emit("# " + escaped(stmt.comment))
             self.write(stmt.body)
         else:
             for name in _defines_inside(stmt.body):
@@ -363,7 +375,8 @@ class FunctionWriter:
         return text, prec
 
     def _print(self, e: Expr) -> tuple[str, int]:
-        method = getattr(self, "_print_" + type(e).__name__, None)
+        method: Callable[[Expr], tuple[str, int]] | None = getattr(
+            self, "_print_" + type(e).__name__, None)
         if method is None:
             raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
         return method(e)

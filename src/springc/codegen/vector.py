@@ -22,20 +22,19 @@ entries; ``jacobian_values`` gathers them in CSC order.
 from __future__ import annotations
 
 import base64
+import json
 import re
 import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
-from ..errors import Span
+from ..errors import CodegenError, Span
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
-from .printer import CodegenError, FunctionWriter, Store, function_lines
-
-if TYPE_CHECKING:
-    from .generator import _Model
+from .context import CodegenBug, CodegenContext
+from .printer import FunctionWriter, Store, escaped, function_lines
 
 VECTOR_THRESHOLD = 300
 """Systems with at least this many explicit assignments use the vector layout."""
@@ -100,11 +99,12 @@ def encode_floats(values: Sequence[float]) -> str:
 
 
 def encode_strings(values: Sequence[str]) -> str:
-    """Python text of a tuple of strings (compressed when long)."""
+    """Python text of a tuple of strings (compressed JSON when long: any character of a
+    name survives, including newlines)."""
     if len(values) <= 32:
         return repr(tuple(values))
-    data = base64.b64encode(zlib.compress("\n".join(values).encode(), 6))
-    return f"tuple(zlib.decompress(base64.b64decode({data.decode()!r})).decode().split('\\n'))"
+    data = base64.b64encode(zlib.compress(json.dumps(list(values)).encode(), 6))
+    return f"tuple(json.loads(zlib.decompress(base64.b64decode({data.decode()!r}))))"
 
 
 def encode_ints(values: Sequence[int]) -> str:
@@ -157,7 +157,7 @@ class NumpyWriter(FunctionWriter):
 class VectorLayout:
     """The grouped form of a system of explicit assignments, for one backend."""
 
-    def __init__(self, m: _Model, statements: Sequence[tuple[str, Expr, Span]],
+    def __init__(self, m: CodegenContext, statements: Sequence[tuple[str, Expr, Span]],
                  numba: bool, table_name: str = "_I", lift_constants: bool = False) -> None:
         self.m, self.numba, self.table_name = m, numba, table_name
         self.table: list[int] = []
@@ -179,8 +179,7 @@ class VectorLayout:
                 shape = _shape(e, slots)
             for v in slots:
                 if v not in self.location and v not in self.assignments:
-                    raise CodegenError(f"'{name}' reads '{v}', which nothing computes",
-                                       hint="this is a bug in springc")
+                    raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
             level = 1 + max((self.assignments[v].level for v in slots
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
@@ -327,8 +326,8 @@ class VectorLayout:
         """``stores`` of (target access, expression over slots) for every member."""
         first = run.members[0]
         count = len(run.members)
-        lines.append(f"    # {count} x {first.comment}" if count > 1 else
-                     f"    # {first.comment}")
+        comment = escaped(first.comment)
+        lines.append(f"    # {count} x {comment}" if count > 1 else f"    # {comment}")
         looped = self.numba and count > 1
         names = {f"${k}": acc("_q") for k, acc in enumerate(run.access[1:])}
         stmts = [Store(target("_q"), e) for target, e in stores]

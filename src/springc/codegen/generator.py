@@ -1,0 +1,190 @@
+"""Code generation: ode.ODE (+ flat.FlatModel) -> GeneratedModel (a Python module's text).
+
+The module runs with numpy and scipy only (plus numba for the ``numba`` backend) and
+exposes, over a state vector ``x``, a parameter vector ``p`` and Newton warm starts
+``z``: ``parameters(values)``, ``start(p)``, ``guesses(p)``, ``rhs(t, x, p, z)``,
+``jacobian_values``/``jacobian``/``jacobian_dense`` with the sparsity pattern
+(``JAC_ROWS``, ``JAC_COLS``; ``JAC_INDICES``, ``JAC_INDPTR`` in CSC order),
+``observed(t, x, p, z)`` and ``observed_grid(ts, X, p, z)`` for the requested observed
+variables only, and the names, units and experiment settings as constants.
+
+Every assignment carries a comment with its flat name and source ``file:line``;
+common subexpressions are shared (:mod:`.printer`); the Jacobian is analytic
+(:mod:`.jacobian`). Systems of thousands of explicit assignments (chains, cloths) use
+the vector layout of :mod:`.vector` instead, whose code grows with the number of
+distinct equation shapes; :mod:`.module_text` writes the rest of the module. Model text
+reaches the module only as ``repr`` literals, sanitized identifiers (``printer.Namer``)
+or escaped comments (``printer.escaped``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ..errors import CodegenError, Span
+from ..ir import flat, ode
+from ..ir.expr import Expr, Var, variables
+from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
+from .jacobian import jacobian_statements
+from .module_text import module_text, parameter_value, topological
+from .printer import Let, Namer, Raw, Store, function_lines
+from .vector import VECTOR_THRESHOLD, VectorLayout
+
+# ------------------------------------------------------------------ parameters
+
+
+def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) -> list[str]:
+    """Parameters that generated code cannot change: Integer and Boolean ones (they may
+    size arrays or pick equations) and those the flattener already evaluated away."""
+    used: set[str] = set()
+    for step in system.steps:
+        for e in _step_exprs(step):
+            used |= variables(e)
+    for a in system.observed:
+        used |= variables(a.expr)
+    for s in system.states:
+        if s.start is not None:
+            used |= variables(s.start)
+    for u in system.dae.unknowns:
+        if u.start is not None:
+            used |= variables(u.start)
+    by_name = {q.name: q for q in system.parameters}
+    for q in reversed(topological(system.parameters)):
+        if q.name in used:
+            used |= variables(parameter_value(q))
+    types = {v.name: v.type for v in flat_model.variables} if flat_model else {}
+    return [q.name for q in system.parameters
+            if q.name not in used or types.get(q.name, "Real") != "Real"
+            or q.name not in by_name]
+
+
+def _step_exprs(step: ode.Step) -> list[Expr]:
+    if isinstance(step, ode.Assign):
+        return [step.expr]
+    if isinstance(step, ode.LinearBlock):
+        return [e for _, _, e in step.matrix] + list(step.rhs)
+    return ([a.expr for a in step.inner] + list(step.residuals)
+            + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
+
+
+# ------------------------------------------------------------------ module
+
+
+def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
+             options: CodegenOptions | None = None) -> GeneratedModel:
+    """The Python module of ``system`` for ``options.backend`` (default options: the
+    python backend, every observed variable)."""
+    options = options or CodegenOptions()
+    if options.backend not in BACKENDS:
+        raise CodegenError(f"unknown backend '{options.backend}'",
+                           hint=f"choose one of {', '.join(BACKENDS)}")
+    m = CodegenContext(system, flat_model)
+    computed = system.step_names()
+    available = [n for n in system.observed_names()]
+    outputs = list(available if options.outputs is None else options.outputs)
+    available_set = set(available)
+    missing = [n for n in outputs if n not in available_set]
+    if missing:
+        raise CodegenError(f"'{missing[0]}' is not an observed variable of {system.name}")
+    _check_defined(m, computed)
+
+    namer = Namer(m.model_names)
+    helpers: set[str] = set()
+    numba = options.backend == "numba"
+    vector = options.vector
+    if vector is None:
+        vector = _vector_suits(system)
+    elif vector and not _vector_suits(system, 0):
+        raise CodegenError("the vector layout needs a system of explicit assignments only")
+    if vector:
+        layout = VectorLayout(m, _vector_statements(m, outputs), numba)
+        jac_lines, pattern = layout.jacobian_body(helpers)
+        bodies = [
+            ("rhs", "Time derivatives of the states at time t.",
+             layout.body(m.derivatives, helpers), "dx"),
+            ("jacobian_values", _JAC_DOC, jac_lines, "jv"),
+            ("observed", "The OBSERVED variables at time t.",
+             layout.body(outputs, helpers) + layout.gather(outputs), "out"),
+        ]
+        table: list[int] | None = layout.table
+    else:
+        bodies, pattern = _scalar_bodies(m, outputs, namer, helpers, numba)
+        table = None
+    structural = structural_parameters(system, flat_model)
+    source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
+                          table)
+    return GeneratedModel(system.name, source, options.backend, tuple(m.states),
+                          tuple(outputs), tuple(m.params), tuple(structural))
+
+
+_JAC_DOC = "Non-zeros of d(rhs)/dx in CSC order (JAC_INDICES, JAC_INDPTR)."
+
+
+def _vector_suits(system: ode.ODE, threshold: int = VECTOR_THRESHOLD) -> bool:
+    return (len(system.steps) >= threshold
+            and all(isinstance(s, ode.Assign) for s in system.steps))
+
+
+def _vector_statements(m: CodegenContext, outputs: Sequence[str]) -> list[tuple[str, Expr, Span]]:
+    statements = [(s.name, s.expr, s.span) for s in m.ode.steps if isinstance(s, ode.Assign)]
+    computed = {s[0] for s in statements}
+    wanted = [d for d in m.derivatives if d not in computed] + list(outputs)
+    for let in m.alias_stmts(wanted):
+        assert isinstance(let, Let)
+        statements.append((let.name, let.expr, m.aliases[let.name].span))
+    return statements
+
+
+def _scalar_bodies(m: CodegenContext, outputs: Sequence[str], namer: Namer, helpers: set[str],
+                   numba: bool) -> tuple[list[tuple[str, str, list[str], str]],
+                                         list[tuple[int, int]]]:
+    """Straight-line bodies: one statement per assignment, named locals."""
+    computed = m.ode.step_names()
+    steps, described = m.step_stmts()
+    loads = m.loads()
+    n = len(m.states)
+
+    rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
+    rhs.append(Raw(f"dx = np.empty({n})"))
+    rhs += [Store(f"dx[{i}]", Var(d), f"der({s})") for i, (s, d)
+            in enumerate(zip(m.states, m.derivatives))]
+
+    jac_body, pattern = jacobian_statements(
+        m.states, m.derivatives, described,
+        {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
+    jac = loads + steps + jac_body
+
+    obs = loads + steps + m.alias_stmts(outputs) + [Raw(f"out = np.empty({len(outputs)})")]
+    obs += [Store(f"out[{i}]", Var(name), name) for i, name in enumerate(outputs)]
+
+    functions = [
+        ("rhs", "Time derivatives of the states at time t.", rhs, "dx"),
+        ("jacobian_values", _JAC_DOC, jac, "jv"),
+        ("observed", "The OBSERVED variables at time t.", obs, "out"),
+    ]
+    # Plain Python computes fastest on Python floats, which also raise
+    # ZeroDivisionError or ValueError where they happen (springc names the line).
+    prologue = [] if numba else [Raw("x = x.tolist()\np = p.tolist()")]
+    bodies = [(fn, doc, function_lines(namer, helpers, prologue + stmts), ret)
+              for fn, doc, stmts, ret in functions]
+    return bodies, pattern
+
+
+def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
+    known = set(m.states) | set(m.params) | set(computed) | set(m.aliases)
+    for step in m.ode.steps:
+        inner = set()
+        if isinstance(step, ode.NonlinearBlock):
+            inner = {*step.tearing, *(s.name for s in step.sensitivities)}
+        for e in _step_exprs(step):
+            unknown = variables(e) - known - inner
+            if unknown:
+                name = sorted(unknown)[0]
+                raise CodegenBug(f"the simplified system reads '{name}' but nothing "
+                                 "computes it")
+    computed_set = set(computed)
+    for d in m.derivatives:
+        if d not in computed_set and d not in m.aliases:
+            raise CodegenBug(f"nothing computes {d}")
+
+
