@@ -27,7 +27,8 @@ from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
 from ..fileio import atomic_write
-from ..resources import PACKAGE_ROOT, grammar_path, models_dir
+from ..parse import library_folders
+from ..resources import PACKAGE_ROOT, grammar_path
 
 CACHE_ENTRIES = 200
 """Generated modules kept in the cache; the least recently used beyond this are removed."""
@@ -125,15 +126,6 @@ def springc_digest() -> bytes:
         h.update(hashlib.sha256(path.read_bytes()).digest())
     h.update(hashlib.sha256(grammar_path().read_bytes()).digest())
     return h.digest()
-
-
-def library_folders(libraries: Sequence[str]) -> list[Path]:
-    """The folders whose ``.mdl`` files a compilation may load (see ``parse.load``)."""
-    folders = [Path(p) for p in libraries]
-    env = os.environ.get("SPRINGC_PATH", "")
-    folders += [Path(p) for p in env.split(os.pathsep) if p]
-    folders.append(models_dir())
-    return folders
 
 
 def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
