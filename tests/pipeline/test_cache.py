@@ -197,3 +197,25 @@ def test_cache_key_follows_the_text_of_codegen_modules(tmp_path: Path) -> None:
     module.write_text(edited)
     os.utime(module, ns=(info.st_atime_ns, info.st_mtime_ns))
     assert key() != before
+
+
+def test_cache_write_failure_falls_back_to_a_temporary_folder(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    # As root every folder is writable: a read-only file system is simulated instead.
+    import springc.pipeline.compiler as compiler
+
+    def read_only(entry: Path, text: str) -> Path:
+        raise PermissionError(13, "Permission denied", str(entry))
+
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(folder))
+    monkeypatch.setattr(compiler, "write_entry", read_only)
+    model = tmp_path / "M1.mdl"
+    model.write_text(ONE)
+    compiled = springc.compile_model(str(model))
+    assert capsys.readouterr().err == (f"note: cannot write to the cache folder {folder} "
+                                       "(Permission denied); compiling in a temporary folder\n")
+    assert not compiled.path.is_relative_to(folder) and compiled.path.exists()
+    result = springc.simulate(compiled, stop=1.0, interval=0.5, rtol=1e-10, atol=1e-12)
+    assert abs(result["x"][-1] - np.exp(-1.0)) < 1e-7

@@ -20,13 +20,13 @@ import os
 import shutil
 import stat
 import sys
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from types import ModuleType
 from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
-from ..fileio import atomic_write
 from ..parse import library_folders
 from ..resources import PACKAGE_ROOT, grammar_path
 
@@ -43,7 +43,7 @@ class CacheUnusable(Exception):
 
 def note(text: str) -> None:
     """A one-line note on stderr (the cache never fails a compilation)."""
-    print(f"note: {text}", file=sys.stderr)
+    print("note: " + " ".join(text.splitlines()), file=sys.stderr)
 
 
 def cache_dir() -> Path:
@@ -176,15 +176,24 @@ def discard(entry: Path, reason: str) -> None:
 
 
 def write_entry(entry: Path, text: str) -> Path:
-    """Write ``text`` as the module of ``entry`` with its hash record; the module path."""
-    entry.mkdir(mode=0o700, exist_ok=True)
+    """Write ``text`` as the module of ``entry`` with its hash record; the module path.
+
+    Both files are written in a private temporary folder that is then renamed to
+    ``entry``, so a reader sees a complete entry or none. If another process wrote the
+    entry first, its entry is kept.
+    """
     data = text.encode("utf-8")
-    module = entry / MODULE_FILE
-    with atomic_write(module, "wb") as f:
-        f.write(data)
-    with atomic_write(entry / HASH_FILE, "w") as f:
-        f.write(hashlib.sha256(data).hexdigest() + "\n")
-    return module
+    new = Path(tempfile.mkdtemp(dir=entry.parent, prefix=".new-"))  # created 0700
+    try:
+        (new / MODULE_FILE).write_bytes(data)
+        (new / HASH_FILE).write_text(hashlib.sha256(data).hexdigest() + "\n",
+                                     encoding="ascii")
+        os.rename(new, entry)
+    except OSError:
+        shutil.rmtree(new, ignore_errors=True)
+        if not entry.is_dir():
+            raise
+    return entry / MODULE_FILE
 
 
 def import_module(data: bytes, path: Path, name: str) -> GeneratedModule:

@@ -71,6 +71,7 @@ class CompiledModel:
     compile_time: float
     outputs: tuple[str, ...] = field(default=())
     temporary: tempfile.TemporaryDirectory[str] | None = None
+    text: str = ""  # the module's text as verified and imported (``source``)
 
     @property
     def name(self) -> str:
@@ -94,7 +95,8 @@ class CompiledModel:
 
     @property
     def source(self) -> str:
-        return self.path.read_text(encoding="utf-8")
+        """The text of the imported module (not re-read from the cache file)."""
+        return self.text or self.path.read_text(encoding="utf-8")
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
         """The parameter vector with ``values`` (non-structural names) applied."""
@@ -185,24 +187,25 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             else:
                 touch(path)
                 return CompiledModel(module, options, path, True,
-                                     time.perf_counter() - began, outputs_of(module, options))
+                                     time.perf_counter() - began, outputs_of(module, options),
+                                     text=data.decode("utf-8"))
     generated = generate_source(options)
     temporary = None
-    try:
-        if folder is None:
-            raise CacheUnusable("no cache")
-        path = write_entry(folder / key, generated)
-        prune_cache(folder, keep=key)
-    except (CacheUnusable, OSError) as err:
-        if folder is not None:
-            note(f"cannot write to the cache folder {folder} ({err}); compiling in a "
-                 "temporary folder")
-        temporary = tempfile.TemporaryDirectory(prefix="springc-")
+    if folder is not None:
+        try:
+            path = write_entry(folder / key, generated)
+            prune_cache(folder, keep=key)
+        except OSError as err:
+            note(f"cannot write to the cache folder {folder} ({err.strerror or err}); "
+                 "compiling in a temporary folder")
+            folder = None
+    if folder is None:
+        temporary = tempfile.TemporaryDirectory(prefix="springc-")  # private (0700)
         path = Path(temporary.name) / "model.py"
         path.write_text(generated, encoding="utf-8")
     module = import_module(generated.encode("utf-8"), path, module_name)
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
-                         outputs_of(module, options), temporary)
+                         outputs_of(module, options), temporary, generated)
 
 
 def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, ...]:
