@@ -2,8 +2,9 @@
 context (names and lookups of one ``ir.ode.ODE``) that the generator hands to the
 Jacobian, vector-layout and module-text writers.
 
-Order of the codegen modules: ``printer <- context <- {jacobian, vector, module_text}
-<- generator``.
+Order of the codegen modules: ``statements <- printer``, ``statements <- context <-
+{jacobian, vector, module_text} <- generator`` (``vector`` and ``module_text`` print
+with ``printer``).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
-from .printer import Block, Let, Load, Loop, Raw, Stmt, Store
+from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 
 class CodegenBug(RuntimeError):

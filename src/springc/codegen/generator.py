@@ -27,7 +27,8 @@ from ..ir.expr import Expr, Var, variables
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
 from .jacobian import jacobian_statements
 from .module_text import module_text, parameter_value, topological
-from .printer import Let, Namer, Raw, Store, function_lines
+from .printer import function_lines
+from .statements import Let, Namer, Raw, Store
 from .vector import VECTOR_THRESHOLD, VectorLayout
 
 # ------------------------------------------------------------------ parameters

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from ..errors import CodegenError
 from ..ir import ode
 from ..ir.expr import ONE, ZERO, BinOp, Const, Expr, Neg, Var, add, diff, mul, neg, sub, variables
-from .printer import Block, Let, Load, Raw, Stmt, Store
+from .statements import Block, Let, Load, Raw, Stmt, Store
 
 Grad = dict[int, Expr]
 

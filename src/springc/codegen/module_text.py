@@ -1,6 +1,6 @@
 """Module text: the parts of a generated module around its functions.
 
-Input: the model description of :mod:`springc.codegen` and the printed bodies of
+Input: the :class:`.context.CodegenContext` of a system and the printed bodies of
 ``rhs``, ``jacobian_values`` and ``observed``; output: the module's source, with
 names, units, the experiment, the sparsity pattern, ``parameters(values)``,
 ``start(p)``, ``guesses(p)`` and the scipy.sparse wrappers of the Jacobian.
@@ -15,14 +15,10 @@ from ..ir import dae
 from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
 from ..simplify import conditions as initial_conditions
 from .context import CodegenContext, CodegenOptions, source_comment, source_location
-from .printer import HELPERS, Let, Namer, Raw, Stmt, Store, escaped, function_lines
-from .vector import (
-    VECTOR_THRESHOLD,
-    VectorLayout,
-    encode_floats,
-    encode_ints,
-    encode_strings,
-)
+from .encoding import encode_floats, encode_ints, encode_strings
+from .printer import HELPERS, function_lines
+from .statements import Let, Namer, Raw, Stmt, Store, escaped
+from .vector import VECTOR_THRESHOLD, VectorLayout
 
 CODEGEN_VERSION = 3
 
@@ -121,7 +117,7 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()
     kernel = table is not None and numba  # numba kernels take the index table _I
     if table is not None:
-        lines += ["", "# Indices of the vector layout (see springc.codegen_vector).",
+        lines += ["", "# Indices of the vector layout (see springc.codegen.vector).",
                   f"_I = {encode_ints(table) if table else 'np.zeros(1, dtype=np.int64)'}"]
     for fn, doc, body, ret in bodies:
         lines += ["", ""] + (["@_jit"] if numba else [])
@@ -215,7 +211,7 @@ def _parameters_vector(m: CodegenContext, helpers: set[str]) -> list[str]:
     start_body = [line.replace("_F[", "_FS[") for line in start_body]
     return [
         "",
-        "# Tables of parameters() and start() (see springc.codegen_vector).",
+        "# Tables of parameters() and start() (see springc.codegen.vector).",
         f"_IP = {encode_ints(params.table or [0])}",
         f"_IS = {encode_ints(starts.table or [0])}",
         f"_F = {encode_floats(floats or [0.0])}",

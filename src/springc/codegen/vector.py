@@ -21,20 +21,17 @@ entries; ``jacobian_values`` gathers them in CSC order.
 
 from __future__ import annotations
 
-import base64
-import json
 import re
-import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar
 
 import numpy as np
 
 from ..errors import CodegenError, Span
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
 from .context import CodegenBug, CodegenContext
-from .printer import FunctionWriter, Store, escaped, function_lines
+from .printer import NumpyWriter, function_lines
+from .statements import Store, escaped
 
 VECTOR_THRESHOLD = 300
 """Systems with at least this many explicit assignments use the vector layout."""
@@ -89,69 +86,6 @@ def _shape(e: Expr, slots: list[str]) -> Expr:
     if isinstance(e, If):
         return If(_shape(e.cond, slots), _shape(e.then, slots), _shape(e.otherwise, slots))
     raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
-
-
-def encode_floats(values: Sequence[float]) -> str:
-    """Python text of a float64 array (exact): compressed base64."""
-    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.float64).tobytes(), 6))
-    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
-            "dtype=np.float64).copy()")
-
-
-def encode_strings(values: Sequence[str]) -> str:
-    """Python text of a tuple of strings (compressed JSON when long: any character of a
-    name survives, including newlines)."""
-    if len(values) <= 32:
-        return repr(tuple(values))
-    data = base64.b64encode(zlib.compress(json.dumps(list(values)).encode(), 6))
-    return f"tuple(json.loads(zlib.decompress(base64.b64decode({data.decode()!r}))))"
-
-
-def encode_ints(values: Sequence[int]) -> str:
-    """Python text of an int64 array: a literal when short, else compressed base64."""
-    if len(values) <= 32:
-        return f"np.array({list(values)!r}, dtype=np.int64)"
-    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.int64).tobytes(), 6))
-    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
-            "dtype=np.int64).copy()")
-
-
-class NumpyWriter(FunctionWriter):
-    """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
-
-    _UFUNC: ClassVar[dict[str, str]] = {
-        "asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
-        "min": "minimum", "max": "maximum", "rem": "fmod", "integer": "floor"}
-    _SAME: ClassVar[set[str]] = {
-        "sqrt", "sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "log", "log10", "abs",
-        "sign", "mod", "floor", "ceil"}
-
-    def _print_Call(self, e: Call) -> tuple[str, int]:
-        if e.name in ("noEvent", "smooth", "homotopy"):
-            return super()._print_Call(e)
-        args = ", ".join(self.expr(a) for a in e.args)
-        if e.name == "div":
-            return f"np.trunc(np.divide({args}))", 9
-        if e.name in self._SAME:
-            return f"np.{e.name}({args})", 9
-        if e.name in self._UFUNC:
-            return f"np.{self._UFUNC[e.name]}({args})", 9
-        raise CodegenError(f"cannot generate code for the function '{e.name}'")
-
-    def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
-        if e.op in ("and", "or"):
-            fn = "logical_and" if e.op == "and" else "logical_or"
-            return f"np.{fn}({self.expr(e.left)}, {self.expr(e.right)})", 9
-        if e.op == "^":
-            return f"np.power({self.expr(e.left)}, {self.expr(e.right)})", 9
-        return super()._print_BinOp(e)
-
-    def _print_Not(self, e: Not) -> tuple[str, int]:
-        return f"np.logical_not({self.expr(e.arg)})", 9
-
-    def _print_If(self, e: If) -> tuple[str, int]:
-        return (f"np.where({self.expr(e.cond)}, {self.expr(e.then)}, "
-                f"{self.expr(e.otherwise)})", 9)
 
 
 class VectorLayout:
