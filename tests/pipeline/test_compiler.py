@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import random
+import re
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +17,7 @@ import springc
 from springc.cli import main
 from springc.errors import SpringcError
 from springc.pipeline import select_names
+from springc.pipeline.compiler import wildcard_match
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "models" / "Scenes.mdl"
@@ -38,6 +41,18 @@ def test_wildcards_match_like_a_shell() -> None:
     assert select_names(names, ["mass*pos*1*"]) == ["mass.pos[1]"]
     with pytest.raises(SpringcError, match=r"--vars 'mass\.\*\[3\]' matches no state"):
         select_names(names, ["mass.*[3]"])
+
+
+def test_wildcards_agree_with_a_backtracking_regex() -> None:
+    # The reference: each * as ".*", each ? as ".", everything else literal.
+    rng = random.Random(7)
+    for _ in range(3000):
+        name = "".join(rng.choice("ab.[1]") for _ in range(rng.randrange(0, 9)))
+        pattern = "".join(rng.choice("ab.[1]**?") for _ in range(rng.randrange(0, 7)))
+        regex = "".join(".*" if c == "*" else "." if c == "?" else re.escape(c)
+                        for c in pattern)
+        expected = re.fullmatch(regex, name, re.DOTALL) is not None
+        assert wildcard_match(pattern, name) == expected, (pattern, name)
 
 
 def test_many_wildcards_are_not_exponential() -> None:

@@ -47,11 +47,15 @@ def note(text: str) -> None:
 
 
 def cache_dir() -> Path:
-    """Where generated modules are kept."""
+    """Where generated modules are kept (:class:`CacheUnusable` without a home)."""
     if os.environ.get("SPRINGC_CACHE_DIR"):
         return Path(os.environ["SPRINGC_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "springc"
+    if os.environ.get("XDG_CACHE_HOME"):
+        return Path(os.environ["XDG_CACHE_HOME"]) / "springc"
+    try:
+        return Path.home() / ".cache" / "springc"
+    except RuntimeError as err:  # no HOME and no password entry
+        raise CacheUnusable(f"no home folder ({err})") from err
 
 
 def private_folder(folder: Path) -> Path:
