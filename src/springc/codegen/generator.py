@@ -28,7 +28,7 @@ from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, Gener
 from .jacobian import jacobian_statements
 from .module_text import module_text, parameter_value, topological
 from .printer import function_lines
-from .statements import Let, Namer, Raw, Store
+from .statements import Let, Namer, Raw, Store, reserved_name
 from .vector import VECTOR_THRESHOLD, VectorLayout
 
 # ------------------------------------------------------------------ parameters
@@ -88,6 +88,11 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     if missing:
         raise CodegenError(f"'{missing[0]}' is not an observed variable of {system.name}")
     _check_defined(m, computed)
+    reserved = reserved_name(m.model_names)
+    if reserved is not None:
+        raise CodegenError(f"the name '{reserved}' is reserved for springc's generated code",
+                           hint="rename the variable (names such as _r0_1, _d2_0, _done1 "
+                           "and _J3 are taken)")
 
     namer = Namer(m.model_names)
     helpers: set[str] = set()

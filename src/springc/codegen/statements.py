@@ -95,6 +95,15 @@ _RESERVED = frozenset({
 # Internal names of the generated code (``_A3``, ``_r2_0``, ``_it``, ``_FS``): ASCII
 # identifiers that start with ``_``, used verbatim.
 _INTERNAL = re.compile(r"_[A-Za-z]+[0-9]*(?:_[0-9]+)?\Z")
+# The internal names that statements bind through the namer (Newton residuals, steps,
+# convergence flags, pivots): a model variable of the same name would be the same
+# string in the statements, so such model names are refused (see reserved_name).
+_BOUND_INTERNAL = re.compile(r"_(?:r|d|done|J)[0-9]+(?:_[0-9]+)?\Z")
+
+
+def reserved_name(names: Iterable[str]) -> str | None:
+    """The first of ``names`` that the generated code binds itself, if any."""
+    return next((n for n in sorted(names) if _BOUND_INTERNAL.match(n)), None)
 
 
 def escaped(text: str) -> str:
