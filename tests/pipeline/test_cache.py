@@ -148,7 +148,9 @@ def test_unusable_cache_folder_falls_back_to_a_private_temporary_folder(
         reason = f"{folder} is not a folder"
     else:
         folder.mkdir(mode=0o700)
-        os.chown(folder, os.getuid() + 1, -1)  # the tests run as root or as a user
+        # The folder is ours; springc is made to run as the next user id instead.
+        uid = os.getuid()
+        monkeypatch.setattr(os, "getuid", lambda: uid + 1)
         reason = f"{folder} belongs to another user"
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(folder))
     model = tmp_path / "M1.mdl"
