@@ -97,3 +97,13 @@ def test_grid_times_at_step_ends_take_the_step_state(odes: SimpleNamespace) -> N
     np.testing.assert_allclose(run.states[1], ref.y[:, -1], rtol=1e-13, atol=1e-14)
     np.testing.assert_array_equal(run.states[0], x0)
     assert run.rhs_evaluations == ref.nfev + 3  # the one dense output of the last step
+
+
+def test_the_face_keeps_its_functions_after_the_kernels_load(odes: SimpleNamespace) -> None:
+    import springc.integrate as face
+
+    dop853(odes.oscillator, [0.0, 1.0], [1.0, 0.0], [2.0], np.zeros(0), rtol=1e-6, atol=1e-9)
+    face.fixed_step("rk4", odes.oscillator, [0.0, 1.0], [1.0, 0.0], [2.0], np.zeros(0),
+                    step=0.5)
+    # a kernel module named like a face function would replace it on import
+    assert face.dop853 is dop853 and face.fixed_step.__module__ == "springc.integrate.engine"

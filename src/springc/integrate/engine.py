@@ -61,7 +61,7 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     other summation order picks other early steps); without it, plain loops, about 1.5x
     faster on small systems, the same method within rounding.
     """
-    from .dop853 import dop853_run
+    from .dop853_kernel import dop853_run
 
     grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
     if not rtol > 0:
@@ -89,7 +89,7 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
     Same methods and results as ``springc.simulation``'s fixed-step integrators:
     ``pairs`` lists (position index, velocity index) with ``der(x[q]) = x[v]``.
     """
-    from .fixed_step import METHOD_CODES, fixed_step_run
+    from .fixed_step_kernel import METHOD_CODES, fixed_step_run
 
     if method not in METHOD_CODES:
         raise ValueError(f"unknown fixed-step method {method!r}; use one of "
