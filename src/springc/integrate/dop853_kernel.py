@@ -2,14 +2,18 @@
 
 The explicit Runge-Kutta method of Dormand and Prince, order 8 with 5th- and 3rd-order
 error estimates and a 7th-order dense output (Hairer, Norsett, Wanner, *Solving ODEs I*,
-Sec. II.10). The step-size controller, the error norm and the initial step follow
-``scipy.integrate.solve_ivp(method="DOP853")`` step for step, so that on the same problem
-and tolerances both take the same steps within rounding (the tests check this).
+Sec. II.10). The step-size controller, the error norm and the initial step are those of
+``scipy.integrate.solve_ivp(method="DOP853")``; with the ``blas`` flag the sums are
+scipy's too, and both runs agree bit for bit (the tests check this).
 
 The whole loop runs in numba: steps, error control, the dense output on the output
 grid and the observed variables at the output times. The model functions arrive as
 first-class function values, so this module is compiled once per machine (and cached
 on disk), whatever the model. Failures return a status code, never raise.
+
+numba keys its disk cache on this file's modification time only: the constants taken
+from ``dop853_tableau``, ``signatures`` and ``status`` are frozen into the cached code,
+so touch this file after editing those.
 """
 
 import math

@@ -6,6 +6,10 @@ tests check equality within rounding): each output interval is cut into
 and ``verlet`` (velocity Verlet, reusing the last acceleration) treat the
 (position, velocity) index pairs; other states advance with explicit Euler. ``rk4`` is the
 classical fourth-order method. Compiled once per machine, whatever the model.
+
+numba keys its disk cache on this file's modification time only: the constants taken
+from ``signatures`` and ``status`` are frozen into the cached code, so touch this file
+after editing those.
 """
 
 import math
