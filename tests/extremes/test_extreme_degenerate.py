@@ -33,7 +33,7 @@ def test_stiff_equilibrium_costs_nothing(compiled: dict[str, CompiledModel]) -> 
 
 @pytest.mark.parametrize("solver", ["auto", "verlet"])
 def test_zero_length_span(compiled: dict[str, CompiledModel], solver: str) -> None:
-    with pytest.raises(SimulationError, match=r"^the stop time 1 must be after the start "
+    with pytest.raises(SimulationError, match=r"^error: the stop time 1 must be after the start "
                        r"time 1$"):
         springc.simulate(compiled["Harmonic"], start=1.0, stop=1.0, solver=solver, step=0.1)
 

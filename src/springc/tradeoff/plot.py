@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 
 from ..fileio import atomic_write
-from .study import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
+from .model import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
 
 ERROR_FLOOR = 1e-16
 """Errors of exactly zero are drawn here (a log axis has no zero)."""
