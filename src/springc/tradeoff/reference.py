@@ -16,6 +16,7 @@ import math
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 
@@ -126,11 +127,16 @@ def read_reference(path: str, grid: np.ndarray, names: Sequence[str]) -> Referen
     return Reference(grid.copy(), tuple(names), values, f"{path} (not verified)", math.nan)
 
 
-def write_reference(ref: Reference, path: str) -> None:
+def write_reference_csv(ref: Reference, f: IO[str]) -> None:
     """The reference as CSV (header ``time,<names>``, full precision): reusable with
     ``--reference``."""
-    with atomic_write(Path(path), "w") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(["time", *ref.names])
-        for t, row in zip(ref.time.tolist(), ref.values.tolist()):
-            writer.writerow([repr(t), *map(repr, row)])
+    writer = csv.writer(f, lineterminator="\n")
+    writer.writerow(["time", *ref.names])
+    for t, row in zip(ref.time.tolist(), ref.values.tolist()):
+        writer.writerow([repr(t), *map(repr, row)])
+
+
+def write_reference(ref: Reference, path: str | Path) -> None:
+    """The reference as a CSV file (written atomically)."""
+    with atomic_write(path, "w") as f:
+        write_reference_csv(ref, f)

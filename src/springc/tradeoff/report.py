@@ -12,6 +12,7 @@ import csv
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import IO
 
 from ..errors import Note
 from ..fileio import atomic_write
@@ -84,11 +85,17 @@ def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
     return rows
 
 
+def write_table(tradeoff: Tradeoff, f: IO[str]) -> None:
+    """The table as CSV (:data:`CSV_COLUMNS`, then :func:`table_rows`)."""
+    writer = csv.writer(f, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    writer.writerows(table_rows(tradeoff))
+
+
 def write_table_csv(tradeoff: Tradeoff, path: str | Path) -> None:
-    with atomic_write(Path(path), "w") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(CSV_COLUMNS)
-        writer.writerows(table_rows(tradeoff))
+    """The table as a CSV file (written atomically)."""
+    with atomic_write(path, "w") as f:
+        write_table(tradeoff, f)
 
 
 def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
