@@ -305,3 +305,18 @@ def test_closed_stdout_pipe_exits_quietly(model: Path) -> None:
         code = proc.wait(timeout=120)
     assert err == b""
     assert code == 141  # 128 + SIGPIPE, as a tool killed by the closed pipe
+
+
+def test_flat_output_escapes_quoted_names_and_reads_back(tmp_path: Path) -> None:
+    model = tmp_path / "Q.mdl"
+    model.write_text("model Q\n  Real 'a\\'b'(start = 1);\n  Real 'c\"d\\\\e'(start = 2);\n"
+                     "equation\n  der('a\\'b') = -'a\\'b';\n  der('c\"d\\\\e') = 0;\nend Q;\n")
+    code, flat, err = run("flatten", model)
+    assert code == 0, err
+    assert flat == ("model Q\n  Real 'a\\'b'(start = 1);\n  Real 'c\"d\\\\e'(start = 2);\n"
+                    "equation\n  der('a\\'b') = -'a\\'b';\n  der('c\"d\\\\e') = 0;\nend Q;\n")
+    again = tmp_path / "Q2.mdl"
+    again.write_text(flat)
+    code, flat_again, err = run("flatten", again)
+    assert code == 0, err
+    assert flat_again == flat
