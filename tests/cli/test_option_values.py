@@ -143,3 +143,7 @@ def test_tradeoff_options_are_checked() -> None:
         TradeoffOptions(steps=(0.0,))
     with pytest.raises(UsageError, match=r"repeats must be an integer >= 1, not 0"):
         TradeoffOptions(repeats=0)
+    with pytest.raises(UsageError, match=r"^error: interval must be a finite number, not inf$"):
+        TradeoffOptions(interval=float("inf"))
+    with pytest.raises(UsageError, match=r"stop \(1\) must be after start \(2\)"):
+        TradeoffOptions(start=2.0, stop=1.0)

@@ -85,6 +85,18 @@ class TradeoffOptions:
                 and not math.isnan(self.budget)):
             raise UsageError(f"budget must be a positive number of seconds, not "
                              f"{self.budget!r}", option="budget")
+        for name in ("start", "stop", "interval"):
+            value = getattr(self, name)
+            if value is not None and not (isinstance(value, (int, float))
+                                          and math.isfinite(value)):
+                raise UsageError(f"{name} must be a finite number, not {value!r}",
+                                 option=name)
+        if self.interval is not None and not self.interval > 0:
+            raise UsageError(f"interval must be a finite number > 0, not {self.interval!r}",
+                             option="interval")
+        if self.start is not None and self.stop is not None and not self.stop > self.start:
+            raise UsageError(f"stop ({self.stop:g}) must be after start ({self.start:g})",
+                             option="stop")
 
 
 @dataclass(frozen=True)
