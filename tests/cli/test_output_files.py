@@ -18,6 +18,7 @@ import pytest
 from click.testing import CliRunner
 
 from springc.cli import main
+from springc.errors import UsageError
 
 MODEL = """
 model Decay
@@ -267,6 +268,7 @@ SIGTERM_SCRIPT = """
 import os, signal, sys
 import springc.simulation.results as results
 from springc.cli import main
+from springc.errors import UsageError
 
 def write_then_terminated(result, f):
     f.write("time,x\\n")
@@ -320,3 +322,15 @@ def test_flat_output_escapes_quoted_names_and_reads_back(tmp_path: Path) -> None
     code, flat_again, err = run("flatten", again)
     assert code == 0, err
     assert flat_again == flat
+
+
+def test_api_writers_choose_by_suffix(model: Path, tmp_path: Path) -> None:
+    import springc
+
+    result = springc.simulate(model, stop=1.0, interval=0.5)
+    with pytest.raises(UsageError, match=r"^error: plot .*p\.gif: the suffix must be one of "
+                                         r"\.png, \.svg, \.pdf"):
+        result.plot(tmp_path / "p.gif")
+    result.save(tmp_path / "r.csv")
+    assert (tmp_path / "r.csv").read_text().startswith("time,x\n0.0,1.0\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv"]

@@ -164,8 +164,8 @@ def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLi
     """Write the trajectory to ``output`` (CSV or MAT by suffix) and the plot to ``plot``
     (PNG, SVG or PDF): both are rendered before either is put in place, and files in
     ``protected`` (the inputs) are never replaced."""
-    kind = file_format(output, RESULT_FORMATS, "-o") if output is not None else None
-    plot_kind = file_format(plot, PLOT_FORMATS, "--plot") if plot is not None else None
+    kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
+    plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
     picture = render_plot(result, plot_kind) if plot_kind is not None else None
     with OutputSet(protected) as outputs:
         if output is not None:
