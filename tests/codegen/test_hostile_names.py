@@ -125,7 +125,7 @@ def test_model_name_cannot_close_the_docstring(tmp_path: Path,
     path = tmp_path / "m.mdl"
     path.write_text(f"model {name}\n  Real x(start = 1, fixed = true);\nequation\n"
                     f"  der(x) = -x;\nend {name};\n", encoding="utf-8")
-    out = tmp_path / "out.txt"
+    out = tmp_path / ("out.csv" if command == "simulate" else "out.py")
     run = CliRunner().invoke(main, [command, str(path), "-o", str(out)])
     assert run.exit_code == 0, run.output
     assert not marker.exists()
