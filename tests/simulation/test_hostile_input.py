@@ -106,19 +106,25 @@ def test_the_step_limit_and_the_time_limit_end_a_run_with_their_option(
 # ------------------------------------------------------------------ pendulum
 
 
-@pytest.mark.parametrize(("assignment", "expected"), [
-    ("L=0", f"{SCENES}:163:10: error: the start value of 'lambda' cannot be computed: "
-            "division by zero\n"),
-    ("g=nan", "error: parameter 'g' = NaN: parameters must be finite numbers\n"),
-    ("g=inf", "error: parameter 'g' = infinite: parameters must be finite numbers\n"),
-])
-def test_pendulum_with_a_degenerate_parameter(tmp_path: Path, assignment: str,
-                                              expected: str) -> None:
+def test_pendulum_with_a_zero_rod_length(tmp_path: Path) -> None:
     out = tmp_path / "out.csv"
-    code, output = simulate_cli(SCENES, "--model", "Scenes.Pendulum", "--set", assignment,
+    code, output = simulate_cli(SCENES, "--model", "Scenes.Pendulum", "--set", "L=0",
                                 "-o", str(out))
     assert code == 1 and not out.exists()
-    assert output.startswith(expected)
+    assert output.startswith(f"{SCENES}:163:10: error: the start value of 'lambda' cannot "
+                             "be computed: division by zero\n")
+
+
+def test_a_parameter_binding_that_overflows_is_named(tmp_path: Path) -> None:
+    # --set values are checked by the CLI (finite numbers); a binding computed from
+    # finite ones can still overflow: the run refuses it before starting.
+    path = tmp_path / "big.mdl"
+    path.write_text("model Big\n  parameter Real k = 1e200;\n  parameter Real c = k * k;\n"
+                    "  Real x(start = 1);\nequation\n  der(x) = -c * x;\nend Big;\n")
+    code, output = simulate_cli(str(path), "--no-cache")
+    assert code == 1
+    assert output.startswith("error: parameter 'c' = infinite: parameters must be finite "
+                             "numbers\n")
 
 
 # ------------------------------------------------------------------ observed values

@@ -22,7 +22,14 @@ from .solver_names import (
 
 if TYPE_CHECKING:
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
-    from .results import SimulationResult, write_csv
+    from .results import (
+        PLOT_FORMATS,
+        RESULT_FORMATS,
+        SimulationResult,
+        file_format,
+        save_outputs,
+        write_csv,
+    )
     from .runner import (
         LSODA_LIMIT,
         SimulationOptions,
@@ -33,12 +40,13 @@ if TYPE_CHECKING:
     )
 
 __all__ = ["ALL_SOLVERS", "AUTO", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT",
-           "FIXED_STEP", "IMPLICIT_SOLVERS", "LSODA_LIMIT", "SOLVERS", "SimulationOptions",
-           "SimulationResult", "initial_state", "output_grid", "resolve", "simulate_model",
-           "write_csv"]
+           "FIXED_STEP", "IMPLICIT_SOLVERS", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS",
+           "SOLVERS", "SimulationOptions", "SimulationResult", "file_format", "initial_state",
+           "output_grid", "resolve", "save_outputs", "simulate_model", "write_csv"]
 
 _LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
-_RESULTS = frozenset({"SimulationResult", "write_csv"})
+_RESULTS = frozenset({"PLOT_FORMATS", "RESULT_FORMATS", "SimulationResult", "file_format",
+                      "save_outputs", "write_csv"})
 _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "output_grid",
                      "resolve", "simulate_model"})
 
