@@ -27,7 +27,7 @@ from ..pipeline import CompiledModel
 from ..simplify import describe_failure
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
-from .solver_names import IMPLICIT_SOLVERS, SOLVERS
+from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
 
@@ -201,9 +201,9 @@ class StepLoop:
         """``first``'s error, with ``second`` (the implicit solver's retry) as a note."""
         error = first.error
         return Stop(SimulationError(
-            error.message, notes=(*error.notes, Note(f"radau, tried next by auto, failed "
+            error.message, notes=(*error.notes, Note(f"{RACE_IMPLICIT}, tried next by auto, failed "
                                                      f"too: {second.error.message}")),
-            hint=remedy("radau")))
+            hint=remedy(RACE_IMPLICIT)))
 
     def check_limits(self, integrator: Any, steps: int, sizes: deque[float]) -> None:
         """Stop at ``max_steps``, or at once when the current step size would need

@@ -18,6 +18,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import ArpackNoConvergence, eigs
 
+from .solver_names import EXPLICIT, RACE_IMPLICIT
+
 STIFF_THRESHOLD = 2000.0
 """``rho * T`` above which the implicit solver is chosen."""
 
@@ -75,7 +77,7 @@ def numerical_jacobian(rhs: Callable[[float, np.ndarray], np.ndarray], t: float,
 
 
 def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
-                  explicit: str = "dop853", implicit: str = "radau") -> Choice:
+                  explicit: str = EXPLICIT, implicit: str = RACE_IMPLICIT) -> Choice:
     """Pick ``explicit`` or ``implicit`` from ``rho * span`` and say why.
 
     For large Jacobians the row-sum (Gershgorin) bound ``rho <= ||J||_inf`` is tried
