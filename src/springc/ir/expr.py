@@ -42,17 +42,18 @@ def recursion_limit() -> int:
     """The recursion limit this thread's stack can afford (at least Python's current
     one): the stack size over 512 bytes a call, at most 20,000."""
     size = _DEFAULT_STACK
-    if threading.current_thread() is not threading.main_thread() and threading.stack_size():
-        size = threading.stack_size()
-    else:
-        try:
-            import resource
+    try:
+        import resource
 
-            soft = resource.getrlimit(resource.RLIMIT_STACK)[0]
-            if 0 < soft != resource.RLIM_INFINITY:
-                size = soft
-        except (ImportError, OSError, ValueError):
-            pass
+        soft = resource.getrlimit(resource.RLIMIT_STACK)[0]
+        if 0 < soft != resource.RLIM_INFINITY:
+            size = soft  # the main thread's, and the default of new threads
+    except (ImportError, OSError, ValueError):
+        pass
+    if threading.current_thread() is not threading.main_thread():
+        configured = threading.stack_size()
+        threading.stack_size(configured)  # reading it also set it (to 0): put it back
+        size = configured or size
     return max(sys.getrecursionlimit(), min(_RECURSION_CAP, size // _STACK_BYTES_PER_CALL))
 
 
