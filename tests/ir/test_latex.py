@@ -60,12 +60,12 @@ def test_seed_simplified_system_renders_in_evaluation_order() -> None:
 
 def test_sympy_expressions_equal_the_hand_derived_ones() -> None:
     flat = seed_flat()
-    k, l, xx, m = sympy.symbols("spring.k spring.l spring.x mass.m")
+    k, rest, xx, m = sympy.symbols("spring.k spring.l spring.x mass.m")
     for i in (1, 2):
         d, g = sympy.Symbol(f"spring.dir[{i}]"), sympy.Symbol(f"g[{i}]")
         eq = next(e for e in flat.equations if e.lhs == x.Der(x.Var(f"mass.v[{i}]")))
         assert to_sympy(eq.lhs) == sympy.Symbol(f"der(mass.v[{i}])")
-        assert sympy.simplify(to_sympy(eq.rhs) - (-k * d * (xx - l) / xx / m + g)) == 0
+        assert sympy.simplify(to_sympy(eq.rhs) - (-k * d * (xx - rest) / xx / m + g)) == 0
     d1, d2 = sympy.symbols("spring.dir[1] spring.dir[2]")
     eq = next(e for e in flat.equations if e.lhs == x.Var("spring.x"))
     assert to_sympy(eq.rhs) == sympy.sqrt(d1**2 + d2**2)
