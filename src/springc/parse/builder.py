@@ -2,8 +2,9 @@
 
 :class:`SyntaxBuilder` has one method per grammar rule (``grammar/modelica.lark``); each
 gets the rule's positions and its converted children and returns a :mod:`springc.syntax`
-node with its span. Constructs of LANGUAGE.md's "Later" list are turned into located
-``... not supported yet`` errors; all errors are collected and raised together.
+node with its span. Constructs of docs/language.md's "Not supported yet" list are turned
+into located ``... not supported yet`` errors; all errors are collected and raised
+together. Before that, :func:`check_depth` bounds the nesting (docs/language.md, "Limits").
 
 The rule methods live in one module per group of rules, combined here:
 
