@@ -14,7 +14,7 @@ from click.testing import CliRunner
 from springc.cli import main
 from springc.ir import expr as x
 from springc.ir.flat import format_flat_latex
-from springc.ir.latex import align, latex_name, to_latex, to_sympy
+from springc.ir.latex import NOTEBOOK_ROWS, align, latex_name, notebook, to_latex, to_sympy
 from springc.ir.ode import format_ode_latex
 from springc.pipeline import flatten_files
 from springc.simplify import simplify
@@ -93,6 +93,12 @@ def test_other_constructs() -> None:
     for _ in range(5000):  # conversion is iterative; sympy folds the sum
         deep = x.BinOp("+", deep, x.ONE)
     assert to_sympy(deep) == sympy.Symbol("a") + 5000
+
+
+def test_notebooks_get_text_for_large_models() -> None:
+    rows = [(x.Var(f"v{i}"), x.ONE, "") for i in range(NOTEBOOK_ROWS)]
+    assert notebook(rows) == "$$" + align(rows).strip().replace("{align}", "{aligned}") + "$$"
+    assert notebook([*rows, (x.Var("w"), x.ZERO, "")]) is None
 
 
 def test_flatten_latex_on_the_command_line() -> None:
