@@ -75,6 +75,8 @@ def test_names_are_readable_and_escaped() -> None:
     assert latex_name("mass.pos[1]") == r"\mathrm{mass.pos}_{1}"
     assert latex_name("der(mass.v[2])") == r"\dot{\mathrm{mass.v}}_{2}"
     assert latex_name("x") == "x"
+    assert latex_name("der(der(x))") == r"\ddot{x}"
+    assert latex_name("der(der(der(der(p[2]))))") == r"{p}^{(4)}_{2}"
     assert latex_name("ms[3].flange_a.f") == r"\mathrm{ms[3].flange\_a.f}"
     assert latex_name("a[1, 2]") == "a_{1,2}"
     assert latex_name("$\\{x}&") == r"\mathrm{\$\textbackslash{}\{x\}\&}"

@@ -27,6 +27,7 @@ NOTEBOOK_ROWS = 500
 text: converting and typesetting them would take minutes)."""
 
 _DERIVATIVE = re.compile(r"der\((.*)\)\Z", re.S)
+_DOTS = {1: r"\dot", 2: r"\ddot", 3: r"\dddot"}
 _LAST_SUBSCRIPT = re.compile(r"(.*?)\[([^\[\]]*)\]\Z", re.S)
 _LATEX_SPECIAL = {
     "\\": r"\textbackslash{}", "{": r"\{", "}": r"\}", "$": r"\$", "&": r"\&",
@@ -46,14 +47,17 @@ def _upright(text: str) -> str:
 
 def latex_name(name: str) -> str:
     """LaTeX for a flat name: ``mass.pos[1]`` -> ``\\mathrm{mass.pos}_{1}``,
-    ``der(mass.v[1])`` -> ``\\dot{\\mathrm{mass.v}}_{1}``, ``x`` -> ``x``."""
-    derivative = _DERIVATIVE.match(name)  # der(x): the name simplification gives x'
-    base = derivative.group(1) if derivative else name
+    ``der(mass.v[1])`` -> ``\\dot{\\mathrm{mass.v}}_{1}``, ``der(der(x))`` -> ``\\ddot{x}``,
+    ``x`` -> ``x``."""
+    order, base = 0, name  # der(x), der(der(x)): the names simplification gives x', x''
+    while derivative := _DERIVATIVE.match(base):
+        order, base = order + 1, derivative.group(1)
     indexed = _LAST_SUBSCRIPT.match(base)
     stem, index = (indexed.group(1), indexed.group(2)) if indexed else (base, None)
     text = _upright(stem) if stem else ""
-    if derivative:
-        text = r"\dot{" + text + "}"
+    if order:
+        text = (_DOTS[order] + "{" + text + "}" if order in _DOTS
+                else "{" + text + "}^{(" + str(order) + ")}")
     if index is not None:
         text += "_{" + _escape(index.replace(" ", "")) + "}"
     return text
