@@ -200,16 +200,17 @@ def invoke(*args: str, seconds: int = SECONDS_PER_RUN) -> tuple[int, str]:
 def run(command: str, path: Path) -> tuple[int, str]:
     """Exit code and output of ``springc COMMAND PATH``; a known finding counts as 1."""
     huge = HUGE.search(path.read_text()) is not None
-    try:  # F6 inputs get a shorter limit: they would all hang for the full one
-        code, output = invoke(command, str(path), seconds=5 if huge else SECONDS_PER_RUN)
+    seconds = 5 if huge else SECONDS_PER_RUN  # F6 inputs would all hang the full limit
+    try:
+        code, output = invoke(command, str(path), seconds=seconds)
+        if code == 3 and "\nTraceback" not in output:
+            debug_code, traceback = invoke("--debug", command, str(path), seconds=seconds)
+            if debug_code == 3 and known_finding(traceback):
+                return 1, f"known finding {known_finding(traceback)}"
     except Hang:
         if huge:
             return 1, "known finding F6"
         raise
-    if code == 3 and "\nTraceback" not in output:
-        debug_code, traceback = invoke("--debug", command, str(path))
-        if debug_code == 3 and known_finding(traceback):
-            return 1, f"known finding {known_finding(traceback)}"
     return code, output
 
 
