@@ -92,10 +92,12 @@ def test_the_limit_is_exact_and_counts_operators() -> None:
 def test_classes_nested_too_deeply_are_located() -> None:
     text = "".join(f"package P{i}\n" for i in range(800)) + "".join(
         f"end P{i};\n" for i in reversed(range(800)))
-    first = errors(text).splitlines()[0]
-    assert first.startswith("t.mo:")
-    assert first.endswith(": error: definitions and equations nested too deeply "
-                          "(depth 3001, limit 3000)")
+    lines = errors(text).splitlines()
+    assert lines[0].startswith("t.mo:")
+    assert lines[0].endswith(": error: definitions and equations nested too deeply "
+                             "(depth 3001, limit 3000)")
+    assert lines[-1] == ("help: nest classes, equations and modifications less; "
+                         "docs/language.md, \"Limits\", says how depth is counted")
 
 
 def test_a_run_of_stray_unary_operators_is_one_error() -> None:

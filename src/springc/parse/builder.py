@@ -145,7 +145,8 @@ def check_depth(tree: Tree[Token], file: str) -> None:
 def _too_deep(what: str, depth: int, node: Tree[Token], file: str) -> ParseError:
     meta = node.meta
     span = Span(file, meta.line, meta.column, meta.end_line, meta.end_column)
+    split = ("split it with intermediate variables (`Real s1 = a1 + a2 + ...;`)"
+             if what == "expression" else "nest classes, equations and modifications less")
     return ParseError(
         f"{what} nested too deeply (depth {depth}, limit {expr.MAX_DEPTH})", span,
-        hint="split it with intermediate variables (`Real s1 = a1 + a2 + ...;`); "
-             "docs/language.md, \"Limits\", says how depth is counted")
+        hint=f"{split}; docs/language.md, \"Limits\", says how depth is counted")
