@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.errors import SimulationError
+from springc.errors import SimulationError, UsageError
 from springc.pipeline.files import flatten_files
 from springc.simplify.passes import simplify
 from springc.simulation import race
@@ -169,7 +169,7 @@ def test_fixed_step_needs_a_step(models: str) -> None:
         springc.simulate(models, model_name="Harmonic", solver="verlet")
     with pytest.raises(SimulationError, match="more than 2e\\+07"):
         springc.simulate(models, model_name="Harmonic", solver="verlet", step=1e-9)
-    with pytest.raises(SimulationError, match="the step must be positive and finite"):
+    with pytest.raises(UsageError, match="step must be a finite number, not inf"):
         springc.simulate(models, model_name="Harmonic", solver="rk4", step=float("inf"))
 
 
@@ -181,7 +181,8 @@ def test_cli_fixed_step_usage_errors(models: str) -> None:
     assert "--solver verlet is a fixed-step solver and needs --step H" in result.output
     result = runner.invoke(main, ["simulate", models, "--model", "Harmonic", "--solver",
                                   "rk4", "--step", "-1"])
-    assert result.exit_code == 2 and "-1 is not positive" in result.output
+    assert result.exit_code == 2
+    assert "error: --step must be a finite number > 0, not -1.0" in result.output
 
 
 def test_unstable_step_fails_with_the_remedy_and_no_csv(models: str, tmp_path: Path) -> None:
