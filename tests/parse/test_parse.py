@@ -414,7 +414,7 @@ def test_when_is_not_supported() -> None:
         "t.mo:4:3: error: `when` equations are not supported yet\n"
         "    4 |   when x > 1 then\n"
         "      |   ^^^^\n"
-        'help: springc supports a subset of Modelica; see the "Later" list in LANGUAGE.md'
+        'help: springc supports a subset of Modelica; see "Not supported yet" in docs/language.md'
     )
 
 

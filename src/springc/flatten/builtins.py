@@ -1,4 +1,4 @@
-"""Built-in functions and constants of the language (LANGUAGE.md, "Built-ins").
+"""Built-in functions and constants of the language (docs/language.md, "Built-ins").
 
 Each handler takes the call's syntax and scope and returns a value; scalar math
 functions are vectorised over arrays as Modelica specifies (chapter 12.4.6).

@@ -76,8 +76,8 @@ class EquationFlattening:
         else:
             name = eq.call.func.dotted
             raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
-                               hint="springc supports a subset of Modelica; see the "
-                               "\"Later\" list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see "
+                               "\"Not supported yet\" in docs/language.md")
 
     def _if_condition(self, cond: s.Expr, where: Any) -> Any:
         """The value of an if-equation condition, which must be a parameter expression

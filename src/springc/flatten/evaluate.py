@@ -342,8 +342,8 @@ class Evaluator:
         name = e.func.dotted
         if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
-                               hint="springc supports a subset of Modelica; see the "
-                               "\"Later\" list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see "
+                               "\"Not supported yet\" in docs/language.md")
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)

@@ -6,9 +6,10 @@ The LALR grammar lives in ``grammar/modelica.lark`` (found by
 :class:`~springc.errors.Span`.
 
 Errors: lark's syntax errors become a :class:`~springc.errors.ParseError` at the offending
-token (``unexpected 'end', expected one of: ';', '('``). Constructs of LANGUAGE.md's
-"Later" list are parsed and then rejected by name (```when` equations are not supported
-yet``); all of them in a file are reported together as an :class:`~springc.errors.ErrorGroup`.
+token (``unexpected 'end', expected one of: ';', '('``). Constructs of docs/language.md's
+"Not supported yet" list are parsed and then rejected by name (```when` equations are not
+supported yet``); all of them in a file are reported together as an
+:class:`~springc.errors.ErrorGroup`.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ from lark import Token
 from ..errors import Note, ParseError, Span
 from ..ir.syntax import ElementModification, End, Expr, Modification, Ref, RefPart
 
-LATER = "springc supports a subset of Modelica; see the \"Later\" list in LANGUAGE.md"
+LATER = "springc supports a subset of Modelica; see \"Not supported yet\" in docs/language.md"
 
 KEYWORDS = frozenset(
     [

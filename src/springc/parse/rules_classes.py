@@ -131,7 +131,7 @@ class ClassRules(RuleBase):
             if section.kind == "algorithm" and kind != "function":
                 self._reject("`algorithm` sections outside functions are", section.span,
                              hint="use equations; springc accepts `algorithm` only in "
-                                  "functions (see the \"Later\" list in LANGUAGE.md)")
+                                  "functions (see \"Not supported yet\" in docs/language.md)")
             elif section.kind == "initial algorithm":
                 self._reject("`initial algorithm` sections are", section.span)
             elif section.kind == "external":

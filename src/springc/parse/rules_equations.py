@@ -1,7 +1,7 @@
 """Equation and statement rules -> :mod:`springc.syntax` equations and statements.
 
 :class:`EquationRules` has one method per equation or statement rule of
-``grammar/modelica.lark``; the constructs of LANGUAGE.md's "Later" list among them
+``grammar/modelica.lark``; the constructs of docs/language.md's "Not supported yet" list among them
 (``when``, ``while``, ``break``, ``return``, call statements) become located
 ``... not supported yet`` errors.
 """

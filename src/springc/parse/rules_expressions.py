@@ -244,5 +244,8 @@ class Precedence:
             hint=f"a unary '{item}' may only start an expression or an operand of a "
                  f"comparison; put it in parentheses, e.g. {example}",
         )
-        return self.primary()
+        while isinstance(item, Token):  # one error for a run such as `- - - 1`
+            item = self.items[self.i]
+            self.i += 1
+        return item
 
