@@ -7,31 +7,20 @@ appended to the Flattener's lists, and connections recorded in its connection se
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
-
 from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
+from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
-from .scope import ClassScope, LocalScope
-
-if TYPE_CHECKING:
-    from ..errors import SpringcError
-    from .connections import ConnectionSets
-    from .evaluate import Evaluator
-    from .flattener import ParameterValues
+from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
-class EquationFlattening:
+class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
 
-    evaluator: Evaluator
-    parameter_values: ParameterValues
     connections: ConnectionSets
-    equations: list[flat.Equation]
-    initial_equations: list[flat.Equation]
-    errors: list[SpringcError]
+    # Equation templates by (id of the ClassView, initial); None: not reusable.
     templates: dict[tuple[int, bool], Template | None]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
@@ -57,7 +46,7 @@ class EquationFlattening:
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
 
-    def equation(self, eq: s.Equation, where: Any, owner: ClassScope, initial: bool) -> None:
+    def equation(self, eq: s.Equation, where: Scope, owner: ClassScope, initial: bool) -> None:
         if isinstance(eq, s.Equality):
             self._equality(eq, where, owner, initial)
         elif isinstance(eq, s.Connect):
@@ -79,25 +68,25 @@ class EquationFlattening:
                                hint="springc supports a subset of Modelica; see the "
                                "\"Later\" list in LANGUAGE.md")
 
-    def _if_condition(self, cond: s.Expr, where: Any) -> Any:
+    def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression
         (a condition on variables would switch equations at events)."""
         self.evaluator.no_event += 1
         try:
-            return self.evaluator.constant(
+            return bool(self.evaluator.constant(
                 cond, where, "the condition of an if-equation",
                 "switching equations on a variable needs events, which are not supported "
                 "yet; for a continuous switch write one equation with an if-expression "
-                "inside noEvent(...)")
+                "inside noEvent(...)"))
         finally:
             self.evaluator.no_event -= 1
 
-    def _body(self, body: tuple[s.Equation, ...], where: Any, owner: ClassScope,
+    def _body(self, body: tuple[s.Equation, ...], where: Scope, owner: ClassScope,
               initial: bool) -> None:
         for eq in body:
             self.equation(eq, where, owner, initial)
 
-    def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Any,
+    def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Scope,
              owner: ClassScope, initial: bool) -> None:
         index, rest = indices[0], indices[1:]
         for value in self.evaluator.range_values(index, where):
@@ -107,7 +96,7 @@ class EquationFlattening:
             else:
                 self._body(eq.body, local, owner, initial)
 
-    def _equality(self, eq: s.Equality, where: Any, owner: ClassScope, initial: bool) -> None:
+    def _equality(self, eq: s.Equality, where: Scope, owner: ClassScope, initial: bool) -> None:
         lhs = self.evaluator.value(eq.lhs, where)
         rhs = self.evaluator.value(eq.rhs, where)
         if a.shape(lhs) != a.shape(rhs):

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import itertools
 import math
-from typing import TYPE_CHECKING, Any
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 
@@ -20,10 +21,8 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
-from .scope import ClassScope, LocalScope, Primitive
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .functions import call_function
+from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
     "pre", "edge", "change", "initial", "terminal", "reinit", "sample", "hold",
@@ -41,9 +40,10 @@ _ARITHMETIC = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
 class Evaluator:
     """Evaluates expressions for one flattening run (it shares the flattener's caches)."""
 
-    def __init__(self, flattener: Flattener) -> None:
+    def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
-        self.no_event = 0
+        self.no_event = 0  # > 0 inside noEvent(...) and smooth(...)
+        self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.builtins = Builtins(self)
         # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
         # outlives the evaluator, so ids are not reused).
@@ -51,17 +51,17 @@ class Evaluator:
 
     # ------------------------------------------------------------ entry points
 
-    def value(self, e: s.Expr, scope: Any) -> a.Value:
+    def value(self, e: s.Expr, scope: Scope) -> a.Value:
         method = getattr(self, "_" + type(e).__name__)
         return method(e, scope)
 
-    def scalar(self, e: s.Expr, scope: Any) -> x.Expr:
+    def scalar(self, e: s.Expr, scope: Scope) -> x.Expr:
         v = self.value(e, scope)
         if a.is_array(v) or isinstance(v, str):
             raise FlattenError(f"expected a scalar, found {self.describe(v)}", e.span)
         return v  # type: ignore[return-value]
 
-    def constant(self, e: s.Expr, scope: Any, what: str,
+    def constant(self, e: s.Expr, scope: Scope, what: str,
                  hint: str = "use parameters and constants with values here") -> Any:
         """Numeric value (number or numpy array) of a parameter expression."""
         v = self.value(e, scope)
@@ -74,7 +74,7 @@ class Evaluator:
         except (ArithmeticError, ValueError, TypeError) as err:
             raise FlattenError(f"cannot evaluate {what}: {err}", e.span) from None
 
-    def integer(self, e: s.Expr, scope: Any, what: str) -> int:
+    def integer(self, e: s.Expr, scope: Scope, what: str) -> int:
         v = self.constant(e, scope, what)
         if isinstance(v, (np.ndarray, bool)) or v != int(v):
             raise FlattenError(f"{what} must be an integer, found {v!r}", e.span)
@@ -102,16 +102,16 @@ class Evaluator:
 
     # ----------------------------------------------------------------- literals
 
-    def _Number(self, e: s.Number, scope: Any) -> a.Value:
+    def _Number(self, e: s.Number, scope: Scope) -> a.Value:
         return x.Const(e.value)
 
-    def _Bool(self, e: s.Bool, scope: Any) -> a.Value:
+    def _Bool(self, e: s.Bool, scope: Scope) -> a.Value:
         return x.Const(e.value)
 
-    def _String(self, e: s.String, scope: Any) -> a.Value:
+    def _String(self, e: s.String, scope: Scope) -> a.Value:
         return e.value
 
-    def _ArrayLit(self, e: s.ArrayLit, scope: Any) -> a.Value:
+    def _ArrayLit(self, e: s.ArrayLit, scope: Scope) -> a.Value:
         return self._stack([self.value(i, scope) for i in e.items], e.span)
 
     def _stack(self, values: list[a.Value], span: s.Span) -> a.Value:
@@ -120,7 +120,7 @@ class Evaluator:
         except ValueError as err:
             raise FlattenError(str(err), span) from None
 
-    def _MatrixLit(self, e: s.MatrixLit, scope: Any) -> a.Value:
+    def _MatrixLit(self, e: s.MatrixLit, scope: Scope) -> a.Value:
         rows = []
         for row in e.rows:
             parts = [self._as_matrix(self.value(i, scope)) for i in row]
@@ -137,7 +137,7 @@ class Evaluator:
             return a.make_array([v], (1, 1))
         return v.reshape(-1, 1) if v.ndim == 1 else v
 
-    def _Range(self, e: s.Range, scope: Any) -> a.Value:
+    def _Range(self, e: s.Range, scope: Scope) -> a.Value:
         start = self.constant(e.start, scope, "a range bound")
         stop = self.constant(e.stop, scope, "a range bound")
         step = self.constant(e.step, scope, "a range step") if e.step else 1
@@ -149,18 +149,18 @@ class Evaluator:
             values = [int(v) for v in values]
         return a.make_array([x.Const(v) for v in values])
 
-    def _Colon(self, e: s.Colon, scope: Any) -> a.Value:
+    def _Colon(self, e: s.Colon, scope: Scope) -> a.Value:
         raise FlattenError("':' is only allowed as a subscript", e.span)
 
-    def _End(self, e: s.End, scope: Any) -> a.Value:
-        end = getattr(scope, "end_value", None)
+    def _End(self, e: s.End, scope: Scope) -> a.Value:
+        end = scope.end_value if isinstance(scope, LocalScope) else None
         if end is None:
             raise FlattenError("'end' is only allowed inside a subscript", e.span)
         return x.Const(end)
 
     # ------------------------------------------------------------------ operators
 
-    def _Unary(self, e: s.Unary, scope: Any) -> a.Value:
+    def _Unary(self, e: s.Unary, scope: Scope) -> a.Value:
         v = self.value(e.operand, scope)
         self._numeric(v, e.operand.span)
         if e.op == "-":
@@ -175,7 +175,7 @@ class Evaluator:
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"expected a number, found {self.describe(v)}", span)
 
-    def _Binary(self, e: s.Binary, scope: Any) -> a.Value:
+    def _Binary(self, e: s.Binary, scope: Scope) -> a.Value:
         left = self.value(e.left, scope)
         right = self.value(e.right, scope)
         scalar = _ARITHMETIC.get(e.op)
@@ -215,7 +215,7 @@ class Evaluator:
             span, hint="if the expression is continuous across the switch, wrap it in "
             "noEvent(...)")
 
-    def _IfExpr(self, e: s.IfExpr, scope: Any) -> a.Value:
+    def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
         result = self.value(e.otherwise, scope)
         for cond_expr, then_expr in reversed(e.branches):
             cond = self.scalar(cond_expr, scope)
@@ -233,7 +233,7 @@ class Evaluator:
 
     # ------------------------------------------------------------------ references
 
-    def _Ref(self, e: s.Ref, scope: Any) -> a.Value:
+    def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
         if isinstance(v, (ClassEntry, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
@@ -242,7 +242,7 @@ class Evaluator:
                                f"'{e.dotted}.<name>'")
         return v
 
-    def reference(self, e: s.Ref, scope: Any) -> Any:
+    def reference(self, e: s.Ref, scope: Scope) -> Any:
         """Follow a component reference; the result may be a scope or array of scopes."""
         first = e.parts[0]
         if first.name == "Modelica" and e.dotted in CONSTANTS:
@@ -253,7 +253,7 @@ class Evaluator:
             current = self._select(current, part, scope, e)
         return current
 
-    def _select(self, current: Any, part: s.RefPart, scope: Any, ref: s.Ref) -> Any:
+    def _select(self, current: Any, part: s.RefPart, scope: Scope, ref: s.Ref) -> Any:
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -284,7 +284,7 @@ class Evaluator:
     def member_value(self, member: Any) -> Any:
         return member.value if isinstance(member, Primitive) else member
 
-    def _subscript(self, current: Any, part: s.RefPart, scope: Any) -> Any:
+    def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
         value = self.member_value(current)
         if not part.subscripts:
             return value
@@ -299,15 +299,14 @@ class Evaluator:
             return result.item()
         return result
 
-    def _index(self, sub: s.Expr, size: int, scope: Any, part: s.RefPart) -> Any:
+    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
         uses_end = self.uses_end.get(id(sub))
         if uses_end is None:
             uses_end = self.uses_end[id(sub)] = _uses_end(sub)
         if uses_end:
-            scope = LocalScope({}, scope)
-            scope.end_value = size  # type: ignore[attr-defined]
+            scope = LocalScope({}, scope, size)
         v = self._loop_index(sub, scope)
         if v is None:
             v = self.constant(sub, scope, "a subscript")
@@ -323,7 +322,7 @@ class Evaluator:
         return int(v) - 1
 
     @staticmethod
-    def _loop_index(sub: s.Expr, scope: Any) -> Any:
+    def _loop_index(sub: s.Expr, scope: Scope) -> Any:
         """The value of a subscript that names a for-loop index (``p[i]``), the most
         common subscript, without the general evaluator; None for any other."""
         if type(sub) is not s.Ref or len(sub.parts) != 1 or sub.parts[0].subscripts:
@@ -338,7 +337,7 @@ class Evaluator:
 
     # ------------------------------------------------------------------ calls
 
-    def _Call(self, e: s.Call, scope: Any) -> a.Value:
+    def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
         if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
@@ -348,23 +347,22 @@ class Evaluator:
         if handler is not None:
             return handler(e, scope)
         entry = self.flattener.resolve_function(e.func, scope)
-        from .functions import call_function
-
         args = [self.value(arg, scope) for arg in e.args]
         named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
         return call_function(self, entry, args, named, e)
 
-    def _Comprehension(self, e: s.Comprehension, scope: Any) -> a.Value:
+    def _Comprehension(self, e: s.Comprehension, scope: Scope) -> a.Value:
         return self._stack(list(self.iterate(e.body, e.indices, scope)), e.span)
 
-    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Any):
+    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
+                ) -> Iterator[a.Value]:
         """Values of ``body`` for every combination of the iterators (first outermost)."""
         ranges = [self.range_values(i, scope) for i in indices]
         for combo in itertools.product(*ranges):
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
 
-    def range_values(self, index: s.ForIndex, scope: Any) -> list[x.Expr]:
+    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
@@ -398,7 +396,7 @@ def _uses_end(e: Any) -> bool:
     return any(_uses_end(getattr(e, name)) for name in fields)
 
 
-def _loop_context(scope: Any) -> str:
+def _loop_context(scope: Scope) -> str:
     """`` (with i = 3)``: the values of the enclosing for-loop indices, if any."""
     values: list[str] = []
     while isinstance(scope, LocalScope):

@@ -8,9 +8,8 @@ turns ``connect`` statements into potential equalities and flow sums.
 from __future__ import annotations
 
 import gc
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
 
 import numpy as np
 
@@ -18,52 +17,19 @@ from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..parse import ClassTree
-from . import arrays as a
 from .connections import ConnectionSets
-from .equation_templates import Template
 from .equations import EquationFlattening
 from .evaluate import Evaluator
+from .experiment import experiment_of
 from .instance_templates import InstanceTemplates
-from .instantiate import Declared, Instantiation
+from .instantiate import Instantiation
 from .lookup import ClassLookup, select_model
-from .modification import Mod, merge_all
+from .modification import merge_all
+from .parameters import ParameterValues
 from .scope import ClassScope, ClassView, Primitive, instance_mod
 from .variables import attributes_of
 
-__all__ = ["Declared", "Flattener", "ParameterValues", "flatten", "select_model"]
-
-
-class ParameterValues(Mapping[str, Any]):
-    """Numeric values of parameters and constants, evaluated from bindings on demand."""
-
-    def __init__(self) -> None:
-        self.bindings: dict[str, x.Expr | None] = {}
-        self.cache: dict[str, Any] = {}
-        self.active: set[str] = set()
-        self.reads = 0  # how often a value was asked for (see templates.reusable)
-
-    def __getitem__(self, name: str) -> Any:
-        self.reads += 1
-        if name in self.cache:
-            return self.cache[name]
-        if name not in self.bindings:
-            raise KeyError(f"the variable '{name}'")
-        binding = self.bindings[name]
-        if binding is None or name in self.active:
-            raise KeyError(f"the parameter '{name}', which has no value")
-        self.active.add(name)
-        try:
-            value = x.evaluate(binding, self)
-        finally:
-            self.active.discard(name)
-        self.cache[name] = value
-        return value
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.bindings)
-
-    def __len__(self) -> int:
-        return len(self.bindings)
+__all__ = ["Flattener", "flatten"]
 
 
 class Flattener(ClassLookup, Instantiation, EquationFlattening):
@@ -81,15 +47,11 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
         self.errors: list[SpringcError] = []
-        # Evaluated modification values by (expression, scope); the scope is kept
-        # alive in the entry so that its id cannot be reused.
-        self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
-        self.declared_types: dict[int, Declared] = {}
-        self.attribute_cache: dict[tuple[tuple[str, int], ...],
-                                   tuple[tuple[Mod, ...], flat.Attributes]] = {}
-        self.reusable_views: dict[int, bool] = {}
-        # Equation templates by (id of the ClassView, initial); None: not reusable.
-        self.templates: dict[tuple[int, bool], Template | None] = {}
+        self.mod_values = {}
+        self.declared_types = {}
+        self.attribute_cache = {}
+        self.reusable_views = {}
+        self.templates = {}
         self.instance_templates = InstanceTemplates(self)
 
     # ----------------------------------------------------------------- queries
@@ -184,8 +146,6 @@ def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
         errs = flattener.errors
         raise errs[0] if len(errs) == 1 else ErrorGroup(errs)
     flattener.equations += flattener.connections.equations(scopes, top)
-    from .experiment import experiment_of
-
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
                           experiment_of(flattener, entry, top), entry.defn.span)

@@ -9,9 +9,6 @@ function calls besides the scalar built-ins.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
-
 import numpy as np
 
 from ..errors import FlattenError, Note
@@ -19,33 +16,14 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
-
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
+from .scope import ExpressionEvaluator, FunctionScope
 
 MAX_DEPTH = 50
 
 
-@dataclass(eq=False)
-class FunctionScope:
-    """Variables of one function call, over the function's package (for constants)."""
-
-    names: dict[str, Any]
-    parent: Any
-    entry: ClassEntry
-
-    def lookup(self, name: str, span: s.Span) -> Any:
-        if name not in self.names:
-            return self.parent.lookup(name, span)
-        value = self.names[name]
-        if value is None:
-            raise FlattenError(f"'{name}' is used before it is assigned", span)
-        return value
-
-
-def call_function(ev: Evaluator, entry: ClassEntry, args: list[a.Value],
+def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
                   named: dict[str, tuple[a.Value, s.Span]], call: s.Call) -> a.Value:
-    depth = getattr(ev, "call_depth", 0)
+    depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
                            call.span, hint="recursive functions are not supported")
@@ -68,21 +46,21 @@ def call_function(ev: Evaluator, entry: ClassEntry, args: list[a.Value],
         if name in given:
             raise FlattenError(f"input '{name}' is given twice", span)
         given[name] = value
-    ev.call_depth = depth + 1  # type: ignore[attr-defined]
+    ev.call_depth = depth + 1
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
         _run(ev, entry.defn.algorithm, scope)
         result = scope.names[outputs[0].name]
     finally:
-        ev.call_depth = depth  # type: ignore[attr-defined]
+        ev.call_depth = depth
     if result is None:
         raise FlattenError(f"output '{outputs[0].name}' of '{entry.full_name}' is never "
                            "assigned", call.span, [Note("declared here", outputs[0].span)])
     return result
 
 
-def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
+def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
              given: dict[str, a.Value], call: s.Call) -> None:
     if comp.name in given:
         scope.names[comp.name] = given[comp.name]
@@ -104,7 +82,7 @@ def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
         scope.names[comp.name] = None
 
 
-def _run(ev: Evaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
+def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
     for stmt in body:
         if isinstance(stmt, s.Assign):
             _assign(ev, stmt, scope)
@@ -114,7 +92,7 @@ def _run(ev: Evaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> 
             _if(ev, stmt, scope)
 
 
-def _for(ev: Evaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
+def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
          scope: FunctionScope) -> None:
     index, rest = indices[0], indices[1:]
     for value in ev.range_values(index, scope):
@@ -126,7 +104,7 @@ def _for(ev: Evaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
     scope.names.pop(index.name, None)
 
 
-def _if(ev: Evaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
+def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
     branches = list(stmt.branches)
     if not branches:
         _run(ev, stmt.otherwise, scope)
@@ -152,7 +130,7 @@ def _if(ev: Evaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
         scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
 
 
-def _assign(ev: Evaluator, stmt: s.Assign, scope: FunctionScope) -> None:
+def _assign(ev: ExpressionEvaluator, stmt: s.Assign, scope: FunctionScope) -> None:
     if len(stmt.targets) != 1 or stmt.targets[0] is None:
         raise FlattenError("assignments to several outputs are not supported yet", stmt.span)
     target = stmt.targets[0]

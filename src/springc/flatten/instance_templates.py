@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
 from itertools import islice
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..errors import FlattenError
 from ..ir import expr as x
@@ -30,10 +30,7 @@ from ..ir import flat
 from . import arrays as a
 from .equation_templates import fixed_shape, renamer
 from .modification import Mod
-from .scope import ClassScope, ClassView, Primitive, ViewComponent
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .scope import ClassScope, ClassView, FlattenContext, Primitive, ViewComponent
 
 Shape = tuple[Any, ...]
 
@@ -64,7 +61,7 @@ class Recording:
 class InstanceTemplates:
     """The instance templates of one flattening run, by (class view, modification shape)."""
 
-    def __init__(self, flattener: Flattener) -> None:
+    def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
         self.seen: dict[tuple[int, Shape], int] = {}  # instances met so far
         self.templates: dict[tuple[int, Shape], InstanceTemplate | None] = {}
@@ -166,8 +163,8 @@ class InstanceTemplates:
         outer: dict[str, x.Expr | None] = {}
         try:
             for name, prim in template.outer.items():
-                value = fl._binding(scope.mod.children[name], prim.dims,  # type: ignore
-                                    scope.flat_name(name), prim.decl)
+                value = fl.binding(scope.mod.children[name] if scope.mod else None,
+                                   prim.dims, scope.flat_name(name), prim.decl)
                 outer.update(zip(_scalar_names(prim, scope.prefix, template.scope.prefix),
                                  a.scalars(value)))
         except FlattenError:
@@ -191,7 +188,8 @@ class InstanceTemplates:
 
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         """The flat variables of a filled instance: the template's, renamed."""
-        template: InstanceTemplate = scope.template
+        template = scope.template
+        assert isinstance(template, InstanceTemplate)
         rename = renamer(template.scope.prefix, scope.prefix)
         cut, prefix = len(template.scope.prefix), scope.prefix
         bindings = self.flattener.parameter_values.bindings

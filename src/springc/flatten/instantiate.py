@@ -8,9 +8,8 @@ and parameter bindings recorded), a :class:`ClassScope`, or an array of them.
 
 from __future__ import annotations
 
+import difflib
 import itertools
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -20,25 +19,30 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
-from .scope import ClassScope, ClassView, Primitive, ResolvedType, ViewComponent, instance_mod
+from .scope import (
+    ClassScope,
+    ClassView,
+    Declared,
+    FlattenContext,
+    Member,
+    Primitive,
+    ResolvedType,
+    ViewComponent,
+    instance_mod,
+)
 from .variables import check_attribute_mods
 
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
-    from .flattener import ParameterValues
 
-
-class Instantiation:
+class Instantiation(FlattenContext):
     """Member instantiation; mixed into the Flattener, which provides the caches and
     the lookup methods (``view``, ``resolve_type``, ``package_scope``)."""
 
-    evaluator: Evaluator
-    parameter_values: ParameterValues
-    equations: list[flat.Equation]
-    mod_values: dict[tuple[int, int], tuple[Any, a.Value]]
+    # Evaluated modification values by (id of the expression, id of the scope); the
+    # scope is kept alive in the entry so that its id cannot be reused.
+    mod_values: dict[tuple[int, int], tuple[object, a.Value]]
     declared_types: dict[int, Declared]
 
-    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
+    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
         declared = self.declared_type(comp)
         rtype = declared.rtype
@@ -119,8 +123,6 @@ class Instantiation:
         return scope
 
     def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
-        import difflib
-
         close = difflib.get_close_matches(key, list(view.components), 1)
         raise FlattenError(
             f"'{name}' (of class '{view.entry.full_name}') has no element '{key}' to modify",
@@ -153,7 +155,7 @@ class Instantiation:
         check_attribute_mods(mod, rtype.primitive, name)
         name_list = _element_names(name, dims)
         names = a.make_array(name_list, dims) if dims else name
-        binding = self._binding(mod, dims, name, decl)
+        binding = self.binding(mod, dims, name, decl)
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)
@@ -172,7 +174,7 @@ class Instantiation:
             self._binding_equations(scope, prim, prim_binding)
         return prim
 
-    def _binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
+    def binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
                  ) -> a.Value | None:
         if mod is None or mod.value is None:
             return None
@@ -211,17 +213,6 @@ class Instantiation:
         span = prim.mod.value.span if prim.mod and prim.mod.value else prim.decl.span
         for v, b in zip(a.scalars(prim.value), a.scalars(binding)):
             self.equations.append(flat.Equation(v, b, span, origin))
-
-
-@dataclass(frozen=True)
-class Declared:
-    """What a component declaration contributes independently of the instance: its
-    resolved type, the type's modifications, and its sizes when they are literals."""
-
-    comp: ViewComponent  # kept alive: declared_types is keyed by its id
-    rtype: ResolvedType
-    type_mods: list[Mod | None]
-    dims: tuple[int, ...] | None
 
 
 def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | None:

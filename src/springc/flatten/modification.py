@@ -37,11 +37,6 @@ class Mod:
     final: bool = False
     span: Span | None = None
 
-    def child(self, name: str) -> Mod | None:
-        return self.children.get(name)
-
-
-EMPTY = Mod()
 
 
 def from_syntax(modification: s.Modification | None, scope: Any) -> Mod | None:
