@@ -52,7 +52,7 @@ def _section_rule(kind: str):
 
     def method(self: RuleBase, meta, ch) -> _Section:
         items = [i for c in ch for i in (c if isinstance(c, tuple) else (c,))]
-        return _Section(kind, tuple(items), self._kw(meta, kind.split()[0]))
+        return _Section(kind, tuple(items), self.keyword_span(meta, kind.split()[0]))
 
     return method
 
@@ -79,7 +79,7 @@ class ClassRules(RuleBase):
         return ch[0]
 
     def within_clause(self, meta, ch):
-        return _Within(tuple(self._ident(t) for t in ch[0]) if ch else ())
+        return _Within(tuple(self.ident(t) for t in ch[0]) if ch else ())
 
     def top_class(self, meta, ch):
         return ch[-1]
@@ -102,15 +102,15 @@ class ClassRules(RuleBase):
                 kind = {"operator": "`operator` classes are",
                         "expandable": "`expandable` connectors are",
                         "impure": "`impure` functions are"}[tok]
-                self._reject(kind, self._tspan(tok))
+                self.reject(kind, self.token_span(tok))
         kind = words[-1]
-        name = self._ident(spec.name)
-        span = self._span(meta)
+        name = self.ident(spec.name)
+        span = self.span_of(meta)
         if spec.end_name is not None and spec.end_name != spec.name:
             head = Span(self.file, meta.line, meta.column, spec.name.end_line,
                         spec.name.end_column)
-            self._error(f"class '{name}' ends with 'end {spec.end_name}'",
-                        self._tspan(spec.end_name),
+            self.error(f"class '{name}' ends with 'end {spec.end_name}'",
+                        self.token_span(spec.end_name),
                         hint=f"write 'end {spec.name};'",
                         notes=[Note(f"class '{name}' starts here", head)])
         body = self._body(spec.sections, kind)
@@ -129,15 +129,15 @@ class ClassRules(RuleBase):
                       "annotations": []}
         for section in sections:
             if section.kind == "algorithm" and kind != "function":
-                self._reject("`algorithm` sections outside functions are", section.span,
+                self.reject("`algorithm` sections outside functions are", section.span,
                              hint="use equations; springc accepts `algorithm` only in "
                                   "functions (see the \"Later\" list in LANGUAGE.md)")
             elif section.kind == "initial algorithm":
-                self._reject("`initial algorithm` sections are", section.span)
+                self.reject("`initial algorithm` sections are", section.span)
             elif section.kind == "external":
-                self._reject("`external` functions are", section.span)
+                self.reject("`external` functions are", section.span)
             elif section.kind in ("equation", "initial equation") and kind == "function":
-                self._error(f"a function cannot have an `{section.kind}` section", section.span,
+                self.error(f"a function cannot have an `{section.kind}` section", section.span,
                             hint="compute the outputs in an `algorithm` section")
             for item in section.items:
                 if isinstance(item, Annotation):
@@ -157,7 +157,7 @@ class ClassRules(RuleBase):
         return _Spec(name, description, sections, None, None, end_name)
 
     def extends_class(self, meta, ch):
-        return self._reject("`class extends` definitions are", self._kw(meta, "extends"))
+        return self.reject("`class extends` definitions are", self.keyword_span(meta, "extends"))
 
     def short_class(self, meta, ch):
         name, prefixes, base = ch[0], ch[1], ch[2]
@@ -169,13 +169,13 @@ class ClassRules(RuleBase):
             base=base, dims=dims.items if dims else (),
             modification=Modification(mod.arguments, None, mod.span) if mod else None,
             variability=variability(words), causality=causality(words),
-            flow="flow" in words, span=join(base.span, self._span(meta)),
+            flow="flow" in words, span=join(base.span, self.span_of(meta)),
         )
         return _Spec(name, comment.description, (), short, comment.annotation, None)
 
     def enum_class(self, meta, ch):
         keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
-        return self._reject("`enumeration` types are", self._tspan(keyword))
+        return self.reject("`enumeration` types are", self.token_span(keyword))
 
     def enum_body(self, meta, ch):
         return None
@@ -184,7 +184,7 @@ class ClassRules(RuleBase):
 
     def composition(self, meta, ch):
         elements = [i for c in ch if not isinstance(c, _Section) for i in c]
-        first = _Section("public", tuple(elements), self._span(meta) if not meta.empty
+        first = _Section("public", tuple(elements), self.span_of(meta) if not meta.empty
                          else Span(self.file, 1, 1, 1, 1))
         return (first, *(c for c in ch if isinstance(c, _Section)))
 
@@ -205,7 +205,7 @@ class ClassRules(RuleBase):
     initial_algorithm_section = _section_rule("initial algorithm")
 
     def external_part(self, meta, ch):
-        return _Section("external", (), self._kw(meta, "external"))
+        return _Section("external", (), self.keyword_span(meta, "external"))
 
     def external_clause(self, meta, ch):
         return None

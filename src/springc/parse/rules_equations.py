@@ -36,12 +36,12 @@ class EquationRules(RuleBase):
     statements = equations
 
     def simple_equation(self, meta, ch):
-        span = self._span(meta)
+        span = self.span_of(meta)
         if len(ch) == 2:
             return Equality(ch[0], ch[1], span)
         if isinstance(ch[0], Call):
             return CallEquation(ch[0], span)
-        self._error("this expression is not an equation", span,
+        self.error("this expression is not an equation", span,
                     hint="write 'lhs = rhs'; only a function call may stand alone")
         return Rejected(span)
 
@@ -53,7 +53,7 @@ class EquationRules(RuleBase):
                 branches.append((extra[1], extra[2]))
             else:
                 otherwise = extra[1]
-        return make(tuple(branches), otherwise, self._span(meta))
+        return make(tuple(branches), otherwise, self.span_of(meta))
 
     def if_equation(self, meta, ch):
         return self._branches(meta, ch, IfEquation)
@@ -72,22 +72,22 @@ class EquationRules(RuleBase):
     else_statement = else_equation
 
     def for_equation(self, meta, ch):
-        return ForEquation(ch[0], ch[1], self._span(meta))
+        return ForEquation(ch[0], ch[1], self.span_of(meta))
 
     def for_statement(self, meta, ch):
-        return ForStatement(ch[0], ch[1], self._span(meta))
+        return ForStatement(ch[0], ch[1], self.span_of(meta))
 
     def connect_clause(self, meta, ch):
-        return Connect(ch[0], ch[1], self._span(meta))
+        return Connect(ch[0], ch[1], self.span_of(meta))
 
     def when_equation(self, meta, ch):
-        return self._reject("`when` equations are", self._kw(meta, "when"))
+        return self.reject("`when` equations are", self.keyword_span(meta, "when"))
 
     def for_indices(self, meta, ch):
         return tuple(ch)
 
     def for_index(self, meta, ch):
-        return ForIndex(self._ident(ch[0]), ch[1] if len(ch) > 1 else None, self._span(meta))
+        return ForIndex(self.ident(ch[0]), ch[1] if len(ch) > 1 else None, self.span_of(meta))
 
     # --------------------------------------------------------------- statements
 
@@ -95,30 +95,30 @@ class EquationRules(RuleBase):
         return ch[0]
 
     def assign_statement(self, meta, ch):
-        return Assign((ch[0],), ch[1], self._span(meta))
+        return Assign((ch[0],), ch[1], self.span_of(meta))
 
     def call_statement(self, meta, ch):
-        return self._reject("call statements (`f(x);`) are", self._span(meta))
+        return self.reject("call statements (`f(x);`) are", self.span_of(meta))
 
     def multi_assign(self, meta, ch):
         *targets, func, args = ch
         for target in targets:
             if target is not None and not isinstance(target, Ref):
-                self._error("only a component reference can be assigned to", target.span)
-        call = Call(func, args.args, args.named, join(func.span, self._span(meta)))
-        return Assign(tuple(targets), call, self._span(meta))
+                self.error("only a component reference can be assigned to", target.span)
+        call = Call(func, args.args, args.named, join(func.span, self.span_of(meta)))
+        return Assign(tuple(targets), call, self.span_of(meta))
 
     def output_item(self, meta, ch):
         return ch[0] if ch else None
 
     def break_statement(self, meta, ch):
-        return self._reject("`break` statements are", self._span(meta))
+        return self.reject("`break` statements are", self.span_of(meta))
 
     def return_statement(self, meta, ch):
-        return self._reject("`return` statements are", self._span(meta))
+        return self.reject("`return` statements are", self.span_of(meta))
 
     def while_statement(self, meta, ch):
-        return self._reject("`while` loops are", self._kw(meta, "while"))
+        return self.reject("`while` loops are", self.keyword_span(meta, "while"))
 
     def when_statement(self, meta, ch):
-        return self._reject("`when` statements are", self._kw(meta, "when"))
+        return self.reject("`when` statements are", self.keyword_span(meta, "when"))

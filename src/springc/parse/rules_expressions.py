@@ -51,11 +51,11 @@ class ExpressionRules(RuleBase):
 
     def if_expression(self, meta, ch):
         pairs = tuple((ch[i], ch[i + 1]) for i in range(0, len(ch) - 1, 2))
-        return IfExpr(pairs, ch[-1], self._span(meta))
+        return IfExpr(pairs, ch[-1], self.span_of(meta))
 
     def range(self, meta, ch):
         step = ch[1] if len(ch) == 3 else None
-        return Range(ch[0], step, ch[-1], self._span(meta))
+        return Range(ch[0], step, ch[-1], self.span_of(meta))
 
     def operation(self, meta, ch):
         return Precedence(self, ch).build()
@@ -63,74 +63,74 @@ class ExpressionRules(RuleBase):
     def number(self, meta, ch):
         text = str(ch[0])
         value = int(text) if text.isdigit() else float(text)
-        return Number(value, self._span(meta))
+        return Number(value, self.span_of(meta))
 
     def string(self, meta, ch):
-        return String(self._unescape(ch[0][1:-1], ch[0]), self._span(meta))
+        return String(self.unescape(ch[0][1:-1], ch[0]), self.span_of(meta))
 
     def true(self, meta, ch):
-        return Bool(True, self._span(meta))
+        return Bool(True, self.span_of(meta))
 
     def false(self, meta, ch):
-        return Bool(False, self._span(meta))
+        return Bool(False, self.span_of(meta))
 
     def call(self, meta, ch):
         func, args = ch
-        return Call(func, args.args, args.named, self._span(meta))
+        return Call(func, args.args, args.named, self.span_of(meta))
 
     def subscripted(self, meta, ch):
-        self._reject("subscripts on a parenthesized expression (`(e)[i]`) are",
-                     self._span(meta))
+        self.reject("subscripts on a parenthesized expression (`(e)[i]`) are",
+                     self.span_of(meta))
         return ch[0]
 
     def tuple(self, meta, ch):
-        self._reject("output lists (`(a, b)`) outside `(a, b) := f(x)` are", self._span(meta))
-        return next((c for c in ch if c is not None), Bool(False, self._span(meta)))
+        self.reject("output lists (`(a, b)`) outside `(a, b) := f(x)` are", self.span_of(meta))
+        return next((c for c in ch if c is not None), Bool(False, self.span_of(meta)))
 
     def matrix(self, meta, ch):
-        return MatrixLit(tuple(ch), self._span(meta))
+        return MatrixLit(tuple(ch), self.span_of(meta))
 
     def matrix_row(self, meta, ch):
         return tuple(ch)
 
     def array(self, meta, ch):
-        return ArrayLit(tuple(ch), self._span(meta))
+        return ArrayLit(tuple(ch), self.span_of(meta))
 
     def array_comprehension(self, meta, ch):
-        return Comprehension(ch[0], ch[1], self._span(meta))
+        return Comprehension(ch[0], ch[1], self.span_of(meta))
 
     def component_reference(self, meta, ch):
         first = ch[0]
         if first == "end" and len(ch) == 1:
-            end = End(self._span(meta))
-            self._loose_ends.append(end)
+            end = End(self.span_of(meta))
+            self.loose_ends.append(end)
             return end
         subs = ch[1] if len(ch) > 1 and isinstance(ch[1], Subs) else None
-        head = self._tspan(first)
+        head = self.token_span(first)
         if subs:
             head = join(head, subs.span)
-        parts = (RefPart(self._ident(first, len(ch) == 1), subs.items if subs else (), head),
+        parts = (RefPart(self.ident(first, len(ch) == 1), subs.items if subs else (), head),
                  *(c for c in ch if isinstance(c, RefPart)))
-        return Ref(parts, self._span(meta))
+        return Ref(parts, self.span_of(meta))
 
     def global_reference(self, meta, ch):
-        self._reject("global names (`.A.B`) are", self._kw(meta, "."))
+        self.reject("global names (`.A.B`) are", self.keyword_span(meta, "."))
         return self.component_reference(meta, ch)
 
     def ref_part(self, meta, ch):
         subs = of(ch, Subs)
-        return RefPart(self._ident(ch[0]), subs.items if subs else (), self._span(meta))
+        return RefPart(self.ident(ch[0]), subs.items if subs else (), self.span_of(meta))
 
     def array_subscripts(self, meta, ch):
-        span = self._span(meta)
-        if self._loose_ends:  # those inside these brackets are where they belong
+        span = self.span_of(meta)
+        if self.loose_ends:  # those inside these brackets are where they belong
             inside = (span.line, span.column), (span.end_line, span.end_column)
-            self._loose_ends = [e for e in self._loose_ends
+            self.loose_ends = [e for e in self.loose_ends
                                 if not inside[0] <= (e.span.line, e.span.column) < inside[1]]
         return Subs(tuple(ch), span)
 
     def colon(self, meta, ch):
-        return Colon(self._span(meta))
+        return Colon(self.span_of(meta))
 
     def function_call_args(self, meta, ch):
         named = tuple(c for c in ch if isinstance(c, NamedArg))
@@ -139,7 +139,7 @@ class ExpressionRules(RuleBase):
         for c in ch:
             seen_named = seen_named or isinstance(c, NamedArg)
             if seen_named and not isinstance(c, NamedArg):
-                self._error("positional argument after a named argument", c.span)
+                self.error("positional argument after a named argument", c.span)
                 break
         return Args(args, named)
 
@@ -148,7 +148,7 @@ class ExpressionRules(RuleBase):
         return Args((Comprehension(body, indices, join(body.span, indices[-1].span)),), ())
 
     def named_argument(self, meta, ch):
-        return NamedArg(self._ident(ch[0]), ch[1], self._span(meta))
+        return NamedArg(self.ident(ch[0]), ch[1], self.span_of(meta))
 
     def name(self, meta, ch):
         return (ch[0],) if len(ch) == 1 else (*ch[0], ch[1])
@@ -173,7 +173,7 @@ class Precedence:
             hint = ("comparisons cannot be chained; combine them with `and`"
                     if tok in _RELATIONS else
                     "'^' is not associative; add parentheses: (a^b)^c or a^(b^c)")
-            self.owner._error(f"unexpected '{tok}'", self.owner._tspan(tok), hint=hint)
+            self.owner.error(f"unexpected '{tok}'", self.owner.token_span(tok), hint=hint)
         return result
 
     def _take(self, ops: frozenset[str]) -> Token | None:
@@ -202,7 +202,7 @@ class Precedence:
     def not_(self) -> Expr:
         if op := self._take(frozenset({"not"})):
             operand = self.relation()
-            return Unary("not", operand, join(self.owner._tspan(op), operand.span))
+            return Unary("not", operand, join(self.owner.token_span(op), operand.span))
         return self.relation()
 
     def relation(self) -> Expr:
@@ -214,7 +214,7 @@ class Precedence:
     def arithmetic(self) -> Expr:
         if sign := self._take(_ADDITIVE):
             operand = self.term()
-            left: Expr = Unary(str(sign), operand, join(self.owner._tspan(sign), operand.span))
+            left: Expr = Unary(str(sign), operand, join(self.owner.token_span(sign), operand.span))
         else:
             left = self.term()
         while op := self._take(_ADDITIVE):
@@ -239,8 +239,8 @@ class Precedence:
         if not isinstance(item, Token):
             return item
         example = "a and (not b)" if item == "not" else f"a * ({item}b)"
-        self.owner._error(
-            f"unexpected '{item}'", self.owner._tspan(item),
+        self.owner.error(
+            f"unexpected '{item}'", self.owner.token_span(item),
             hint=f"a unary '{item}' may only start an expression or an operand of a "
                  f"comparison; put it in parentheses, e.g. {example}",
         )
