@@ -149,8 +149,16 @@ class Builtins:
         (v,) = self._args(call, scope, 1)
         return x.Const(len(a.shape(v)))
 
-    def _dims(self, call: s.Call, scope: Scope, args: list[s.Expr]) -> tuple[int, ...]:
-        return tuple(self.ev.integer(arg, scope, "an array size") for arg in args)
+    def _dims(self, call: s.Call, scope: Scope, args: list[s.Expr], square: bool = False
+              ) -> tuple[int, ...]:
+        dims = tuple(self.ev.integer(arg, scope, "an array size") for arg in args)
+        for n in dims:
+            if n < 0:
+                raise FlattenError(f"array size must not be negative, found {n}", call.span)
+        count = math.prod(dims) ** (2 if square else 1)
+        self.ev.flattener.limits.check_size(count, f"the result of '{call.func.dotted}'",
+                                            call.span)
+        return dims
 
     def fill_value(self, value: int) -> Handler:
         def handler(call: s.Call, scope: Scope) -> a.Value:
@@ -169,7 +177,10 @@ class Builtins:
         return out
 
     def identity(self, call: s.Call, scope: Scope) -> a.Value:
-        (n,) = self._dims(call, scope, list(call.args))
+        if len(call.args) != 1:
+            raise FlattenError(f"'identity' takes 1 argument, {len(call.args)} given",
+                               call.span)
+        (n,) = self._dims(call, scope, list(call.args), square=True)
         return a.make_array([x.Const(int(i == j)) for i in range(n) for j in range(n)], (n, n))
 
     def cross(self, call: s.Call, scope: Scope) -> a.Value:
@@ -210,7 +221,9 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
         try:
             return x.Const(x.MATH[name](*(arg.value for arg in args)))  # type: ignore[union-attr]
         except (ValueError, ZeroDivisionError, OverflowError) as err:
-            raise ValueError(f"{name}{tuple(arg.value for arg in args)}: {err}") from None
+            text = f"{name}({', '.join(repr(arg.value) for arg in args)})"  # type: ignore[union-attr]
+            reason = "overflows" if isinstance(err, OverflowError) else f"is undefined ({err})"
+            raise ValueError(f"{text} {reason}") from None
     return x.Call(name, args)
 
 

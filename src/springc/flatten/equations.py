@@ -55,6 +55,8 @@ class EquationFlattening(FlattenContext):
                                    eq.span)
             self.connections.connect(self.evaluator, eq, where, owner)
         elif isinstance(eq, s.ForEquation):
+            if len(eq.indices) > 1:
+                self.evaluator.check_loop_nest(eq.indices, where)
             self._for(eq, eq.indices, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
             for cond, body in eq.branches:
@@ -89,7 +91,9 @@ class EquationFlattening(FlattenContext):
     def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Scope,
              owner: ClassScope, initial: bool) -> None:
         index, rest = indices[0], indices[1:]
-        for value in self.evaluator.range_values(index, where):
+        values = self.evaluator.range_values(index, where)
+        self.limits.add_iterations(len(values), index.span)
+        for value in values:
             local = LocalScope({index.name: value}, where)
             if rest:
                 self._for(eq, rest, local, owner, initial)

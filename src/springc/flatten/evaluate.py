@@ -76,7 +76,7 @@ class Evaluator:
 
     def integer(self, e: s.Expr, scope: Scope, what: str) -> int:
         v = self.constant(e, scope, what)
-        if isinstance(v, (np.ndarray, bool)) or v != int(v):
+        if isinstance(v, (np.ndarray, bool, str)) or not math.isfinite(v) or v != int(v):
             raise FlattenError(f"{what} must be an integer, found {v!r}", e.span)
         return int(v)
 
@@ -141,9 +141,14 @@ class Evaluator:
         start = self.constant(e.start, scope, "a range bound")
         stop = self.constant(e.stop, scope, "a range bound")
         step = self.constant(e.step, scope, "a range step") if e.step else 1
+        for bound in (start, stop, step):
+            if isinstance(bound, (np.ndarray, str)) or not math.isfinite(bound):
+                raise FlattenError(f"the bounds and step of a range must be finite numbers, "
+                                   f"found {bound!r}", e.span)
         if step == 0:
             raise FlattenError("the step of a range must not be zero", e.span)
         count = max(0, math.floor((stop - start) / step + 1e-10) + 1)
+        self.flattener.limits.check_size(count, "this range", e.span)
         values = [start + i * step for i in range(count)]
         if all(isinstance(v, int) for v in (start, step)):
             values = [int(v) for v in values]
@@ -358,9 +363,23 @@ class Evaluator:
                 ) -> Iterator[a.Value]:
         """Values of ``body`` for every combination of the iterators (first outermost)."""
         ranges = [self.range_values(i, scope) for i in indices]
+        self.flattener.limits.add_iterations(math.prod(len(r) for r in ranges),
+                                             indices[0].span)
         for combo in itertools.product(*ranges):
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
+
+    def check_loop_nest(self, indices: tuple[s.ForIndex, ...], scope: Scope) -> None:
+        """``for i in 1:n, j in 1:m``: refuse a nest whose iterations exceed the cap before
+        running any (ranges that use an outer index are left to the running count)."""
+        outer: set[str] = set()
+        count = 1
+        for index in indices:
+            if index.range is not None and not outer & _names_in(index.range):
+                count *= len(self.range_values(index, scope))
+            outer.add(index.name)
+        self.flattener.limits.check_size(count, "this loop nest", indices[0].span,
+                                         "iterations")
 
     def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
         if index.range is None:
@@ -394,6 +413,19 @@ def _uses_end(e: Any) -> bool:
     if fields is None or isinstance(e, s.Span):
         return False
     return any(_uses_end(getattr(e, name)) for name in fields)
+
+
+def _names_in(e: object) -> set[str]:
+    """The first names of the references in a syntax expression."""
+    if isinstance(e, s.Ref):
+        return {e.parts[0].name} | {n for p in e.parts for sub in p.subscripts
+                                    for n in _names_in(sub)}
+    if isinstance(e, tuple):
+        return {n for item in e for n in _names_in(item)}
+    fields = getattr(e, "__dataclass_fields__", None)
+    if fields is None or isinstance(e, s.Span):
+        return set()
+    return {n for name in fields for n in _names_in(getattr(e, name))}
 
 
 def _loop_context(scope: Scope) -> str:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
@@ -32,6 +34,8 @@ def experiment_of(flattener: FlattenContext, entry: ClassEntry, top: ClassScope)
 
 def _number(flattener: FlattenContext, e: s.Expr, top: ClassScope) -> float:
     value = flattener.evaluator.constant(e, top, "an experiment setting")
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
-        raise FlattenError("experiment settings must be numbers", e.span)
+    if not isinstance(value, (int, float)) or isinstance(value, bool) \
+            or not math.isfinite(value):
+        raise FlattenError(f"experiment settings must be finite numbers, found {value!r}",
+                           e.span)
     return float(value)

@@ -23,9 +23,10 @@ from .evaluate import Evaluator
 from .experiment import experiment_of
 from .instance_templates import InstanceTemplates
 from .instantiate import Instantiation
+from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .lookup import ClassLookup, select_model
 from .modification import merge_all
-from .parameters import ParameterValues
+from .parameters import ParameterValues, binding_errors
 from .scope import ClassScope, ClassView, Primitive, instance_mod
 from .variables import attributes_of
 
@@ -37,8 +38,9 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     the walk over instances. Class lookup (``lookup.py``), instantiation
     (``instantiate.py``) and equations (``equations.py``) are mixed in."""
 
-    def __init__(self, tree: ClassTree) -> None:
+    def __init__(self, tree: ClassTree, max_size: int = DEFAULT_MAX_SIZE) -> None:
         self.tree = tree
+        self.limits = Limits(max_size)
         self.views: dict[int, ClassView] = {}
         self.package_scopes: dict[int, ClassScope] = {}
         self.parameter_values = ParameterValues()
@@ -104,10 +106,15 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
                         yield from self.variables(item)
 
 
-def flatten(tree: ClassTree, model: str | None = None) -> flat.FlatModel:
-    """Flatten ``model`` (a dotted name; default: the last model of the last user file)."""
+def flatten(tree: ClassTree, model: str | None = None, max_size: int | None = None
+            ) -> flat.FlatModel:
+    """Flatten ``model`` (a dotted name; default: the last model of the last user file).
+
+    ``max_size`` caps the scalar variables of the flat model and the iterations of its
+    loops (default: ``$SPRINGC_MAX_SIZE``, else 10 million; see :mod:`.limits`)."""
+    cap = max_size_setting(max_size)
     with _gc_paused():
-        return _flatten(tree, model)
+        return _flatten(tree, model, cap)
 
 
 @contextmanager
@@ -124,9 +131,9 @@ def _gc_paused() -> Iterator[None]:
             gc.enable()
 
 
-def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
+def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatModel:
     entry = select_model(tree, model)
-    flattener = Flattener(tree)
+    flattener = Flattener(tree, max_size)
     base, mods = flattener.follow_short(entry)
     view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
@@ -140,6 +147,7 @@ def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
             flattener.equations_of(scope, initial=True)
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
+            flattener.errors += binding_errors(variables, flattener.parameter_values)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:

@@ -9,6 +9,8 @@ function calls besides the scalar built-ins.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import FlattenError, Note
@@ -75,6 +77,7 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
     dims = [d for d in comp.type_dims + comp.dims]
     if dims:
         sizes = tuple(ev.integer(d, scope, "an array size") for d in dims)
+        ev.flattener.limits.check_size(math.prod(sizes), f"'{comp.name}'", comp.span)
         out = np.empty(sizes, dtype=object)
         out.fill(x.ZERO)
         scope.names[comp.name] = out
@@ -87,6 +90,8 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
         if isinstance(stmt, s.Assign):
             _assign(ev, stmt, scope)
         elif isinstance(stmt, s.ForStatement):
+            if len(stmt.indices) > 1:
+                ev.check_loop_nest(stmt.indices, scope)
             _for(ev, stmt, stmt.indices, scope)
         else:
             _if(ev, stmt, scope)
@@ -95,7 +100,9 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
 def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
          scope: FunctionScope) -> None:
     index, rest = indices[0], indices[1:]
-    for value in ev.range_values(index, scope):
+    values = ev.range_values(index, scope)
+    ev.flattener.limits.add_iterations(len(values), index.span)
+    for value in values:
         scope.names[index.name] = value
         if rest:
             _for(ev, stmt, rest, scope)

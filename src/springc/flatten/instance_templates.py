@@ -169,6 +169,7 @@ class InstanceTemplates:
                                  a.scalars(value)))
         except FlattenError:
             return
+        fl.limits.add_scalars(len(template.variables), scope.prefix, scope.span)
         rename = renamer(template.scope.prefix, scope.prefix)
         cut = len(template.scope.prefix)
         _copy_members(template.scope, scope, rename, scope.prefix, cut)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import itertools
+import math
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
+from ..parse import ClassEntry
 from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .scope import (
@@ -58,12 +60,16 @@ class Instantiation(FlattenContext):
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
         dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
+        for n in dims:
+            self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
+        self.limits.add_scalars(math.prod(dims), name, decl.span)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name)
         assert rtype.entry is not None
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
                                "cannot be instantiated", decl.type_name.span)
+        self._check_containment(scope, rtype.entry, decl, name)
         view = self.view(rtype.entry)
         if not dims:
             return self._class_scope(name, view, mod, decl, scope)
@@ -75,6 +81,27 @@ class Instantiation(FlattenContext):
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _check_containment(self, scope: ClassScope, entry: ClassEntry, decl: s.Component,
+                           name: str) -> None:
+        """A component may not be of a class that (directly or through its components)
+        contains it: ``model A  A a; end A;`` would be infinitely large."""
+        chain: list[ClassScope] = []
+        outer: ClassScope | None = scope
+        while outer is not None:
+            chain.append(outer)
+            if outer.entry is entry:
+                path = " -> ".join(f"'{c.prefix}' ({c.entry.full_name})" if c.prefix
+                                   else f"the model ({c.entry.full_name})"
+                                   for c in reversed(chain))
+                raise FlattenError(
+                    f"'{name}' is of class '{entry.full_name}', which contains it: the "
+                    "model would be infinitely large", decl.span,
+                    [Note(f"the chain of components: {path} -> '{name}'"),
+                     Note(f"class '{entry.full_name}' is defined here", entry.defn.span)],
+                    "a class cannot contain a component of its own class, directly or "
+                    "through its components")
+            outer = outer.outer
 
     def _check_array_mod(self, mod: Mod, dims: tuple[int, ...], name: str, path: str
                          ) -> None:
@@ -159,7 +186,7 @@ class Instantiation(FlattenContext):
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)
-            value = self.evaluator.fold(binding)
+            value = self._constant_value(binding, name, mod)
             value = a.elementwise(lambda v: x.Const(v), value) if a.is_array(value) \
                 else x.Const(value)
         else:
@@ -173,6 +200,26 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
+
+    def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> a.Value:
+        """The numeric value of a constant's binding (a constant expression)."""
+        span = mod.value.span if mod is not None and mod.value is not None else None
+        try:
+            value = self.evaluator.fold(binding)
+        except KeyError as missing:
+            raise FlattenError(f"the value of constant '{name}' must be a constant "
+                               f"expression, but it depends on {missing.args[0]}", span,
+                               hint="use only constants and literals in the binding of a "
+                               "constant, or make it a parameter") from None
+        except (ArithmeticError, ValueError, TypeError) as err:
+            reason = "division by zero" if isinstance(err, ZeroDivisionError) else str(err)
+            raise FlattenError(f"cannot evaluate the value of constant '{name}': {reason}",
+                               span) from None
+        for item in (value.flat if isinstance(value, np.ndarray) else [value]):
+            if isinstance(item, float) and not math.isfinite(item):
+                raise FlattenError(f"the value of constant '{name}' is {item} (an "
+                                   "operation overflows or is undefined)", span)
+        return value
 
     def binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
                  ) -> a.Value | None:

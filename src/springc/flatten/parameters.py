@@ -1,18 +1,28 @@
-"""Numeric values of parameters and constants, evaluated from their bindings on demand.
+"""Numeric values of parameters and constants, evaluated from their bindings on demand,
+and the check of the parameters' bindings once the model is flat.
 
 Input: the flat binding of each parameter and constant (an ``ir.expr`` expression, or
 None). Output: numbers (or numpy arrays), cached, with cycles and missing values raised
-as ``KeyError`` naming the parameter.
+as ``KeyError`` naming the parameter; located errors for bindings that use variables,
+divide by zero or overflow.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+import math
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
+from ..errors import FlattenError, Span
 from ..ir import expr as x
+from ..ir import flat
 
-__all__ = ["ParameterValues"]
+__all__ = ["ParameterValues", "binding_errors"]
+
+VARIABILITY_HINT = ("a parameter's binding may only use parameters and constants (Modelica "
+                    "3.6, section 3.8): bind it to a parameter expression, or remove the "
+                    "`parameter` prefix to make it a variable with a binding equation")
+VALUE_HINT = "change the binding (or the parameters it uses) so that it has a finite value"
 
 
 class ParameterValues(Mapping[str, Any]):
@@ -46,3 +56,43 @@ class ParameterValues(Mapping[str, Any]):
 
     def __len__(self) -> int:
         return len(self.bindings)
+
+
+def binding_errors(variables: Iterable[flat.Variable], values: ParameterValues
+                   ) -> list[FlattenError]:
+    """The parameters whose binding uses something other than parameters and constants
+    (a variable, ``time``, a derivative), or whose value cannot be computed or is not
+    finite (division by zero, overflow); one error per declaration. A binding that
+    depends on a parameter without a value is left alone."""
+    errors: list[FlattenError] = []
+    reported: set[Span] = set()
+    for v in variables:
+        if v.variability != "parameter" or v.binding is None or v.span in reported:
+            continue
+        error = _binding_error(v, v.binding, values)
+        if error is not None:
+            reported.add(v.span)
+            errors.append(error)
+    return errors
+
+
+def _binding_error(v: flat.Variable, binding: x.Expr, values: ParameterValues
+                   ) -> FlattenError | None:
+    outside = [n for n in x.variables(binding) if n not in values.bindings]
+    if outside or any(isinstance(n, (x.Der, x.Time)) for n in x.walk(binding)):
+        what = f"the variable '{outside[0]}'" if outside else "time or a derivative"
+        return FlattenError(f"parameter '{v.name}' is bound to an expression that uses "
+                            f"{what}, which is not a parameter or constant", v.span,
+                            hint=VARIABILITY_HINT)
+    try:
+        value = values[v.name]
+    except KeyError:  # a parameter without a value: it is given one at simulation
+        return None
+    except (ArithmeticError, ValueError, TypeError) as err:
+        reason = "division by zero" if isinstance(err, ZeroDivisionError) else str(err)
+        return FlattenError(f"cannot evaluate the binding of parameter '{v.name}': {reason}",
+                            v.span, hint=VALUE_HINT)
+    if isinstance(value, (int, float)) and not math.isfinite(value):
+        return FlattenError(f"the binding of parameter '{v.name}' evaluates to {value} (an "
+                            "operation overflows or is undefined)", v.span, hint=VALUE_HINT)
+    return None

@@ -26,6 +26,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
 
@@ -258,6 +259,8 @@ class ExpressionEvaluator(Protocol):
 
     def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]: ...
 
+    def check_loop_nest(self, indices: tuple[s.ForIndex, ...], scope: Scope) -> None: ...
+
 
 class FlattenContext(Protocol):
     """What the flattening helpers call on the driver
@@ -266,6 +269,7 @@ class FlattenContext(Protocol):
 
     parameter_values: ParameterValues
     evaluator: ExpressionEvaluator
+    limits: Limits
     errors: list[SpringcError]
     equations: list[flat.Equation]
     initial_equations: list[flat.Equation]

@@ -7,6 +7,7 @@ that :class:`Precedence` turns into a tree.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from lark import Token
@@ -62,8 +63,15 @@ class ExpressionRules(RuleBase):
 
     def number(self, meta, ch):
         text = str(ch[0])
-        value = int(text) if text.isdigit() else float(text)
-        return Number(value, self.span_of(meta))
+        span = self.span_of(meta)
+        value: int | float = float(text)
+        if not math.isfinite(value):
+            self.error(f"the number {text} is too large", span,
+                       hint="numbers must be below about 1.8e308 (the largest double)")
+            value = 0.0
+        elif text.isdigit():
+            value = int(text)
+        return Number(value, span)
 
     def string(self, meta, ch):
         return String(self.unescape(ch[0][1:-1], ch[0]), self.span_of(meta))
