@@ -118,10 +118,12 @@ class Builtins:
         return self.ev.value(call.args[0], scope)
 
     def sum(self, call: s.Call, scope: Scope) -> a.Value:
-        return reduce(x.add, self._elements(call, scope), x.ZERO)
+        zero: x.Expr = x.ZERO
+        return reduce(x.add, self._elements(call, scope), zero)
 
     def product(self, call: s.Call, scope: Scope) -> a.Value:
-        return reduce(x.mul, self._elements(call, scope), x.ONE)
+        one: x.Expr = x.ONE
+        return reduce(x.mul, self._elements(call, scope), one)
 
     def min_max(self, call: s.Call, scope: Scope) -> a.Value:
         name = call.func.dotted
@@ -185,7 +187,8 @@ class Builtins:
 
     def cross(self, call: s.Call, scope: Scope) -> a.Value:
         u, v = self._args(call, scope, 2)
-        if a.shape(u) != (3,) or a.shape(v) != (3,):
+        if not isinstance(u, np.ndarray) or not isinstance(v, np.ndarray) \
+                or u.shape != (3,) or v.shape != (3,):
             raise FlattenError("'cross' needs two vectors of size 3", call.span)
         comps = [x.sub(x.mul(u[(i + 1) % 3], v[(i + 2) % 3]),
                        x.mul(u[(i + 2) % 3], v[(i + 1) % 3])) for i in range(3)]
@@ -193,13 +196,13 @@ class Builtins:
 
     def transpose(self, call: s.Call, scope: Scope) -> a.Value:
         (m,) = self._args(call, scope, 1)
-        if len(a.shape(m)) < 2:
+        if not isinstance(m, np.ndarray) or m.ndim < 2:
             raise FlattenError("'transpose' needs a matrix", call.span)
         return np.swapaxes(m, 0, 1)
 
     def norm(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
-        if len(a.shape(v)) != 1:
+        if not isinstance(v, np.ndarray) or v.ndim != 1:
             raise FlattenError("'norm' needs a vector", call.span)
         return _call("sqrt", (a.dot(v, v),))
 

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
@@ -27,7 +27,7 @@ Key = tuple[str, bool]  # (flat variable name, outside)
 class Link:
     """Why a member joined its set: the connect statement, its owner and its text."""
 
-    span: s.Span
+    span: Span
     owner: str
     text: str
 

@@ -99,20 +99,19 @@ def renamer(old: str, new: str) -> Callable[[x.Expr], x.Expr]:
     names: dict[str, x.Var] = {}
 
     def rename(e: x.Expr) -> x.Expr:
-        kind = type(e)
-        if kind is x.Var:
-            found = names.get(e.name)  # type: ignore[union-attr]
+        if isinstance(e, x.Var):
+            found = names.get(e.name)
             if found is None:
-                found = names[e.name] = x.Var(new + e.name[cut:])  # type: ignore[union-attr]
+                found = names[e.name] = x.Var(new + e.name[cut:])
             return found
-        if kind is x.BinOp:
-            return x.BinOp(e.op, rename(e.left), rename(e.right))  # type: ignore[union-attr]
-        if kind is x.Const or kind is x.Time:
+        if isinstance(e, x.BinOp):
+            return x.BinOp(e.op, rename(e.left), rename(e.right))
+        if isinstance(e, (x.Const, x.Time)):
             return e
-        if kind is x.Call:
-            return x.Call(e.name, tuple(rename(a) for a in e.args))  # type: ignore[union-attr]
-        if kind is x.If:
-            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))  # type: ignore
-        return kind(rename(e.arg))  # type: ignore[union-attr, call-arg]  # Neg, Not, Der
+        if isinstance(e, x.Call):
+            return x.Call(e.name, tuple(rename(a) for a in e.args))
+        if isinstance(e, x.If):
+            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))
+        return type(e)(rename(e.arg))  # Neg, Not, Der
 
     return rename

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterator
-from typing import Any
+from collections.abc import Callable, Iterator
+from typing import Any, cast
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
@@ -52,7 +52,7 @@ class Evaluator:
     # ------------------------------------------------------------ entry points
 
     def value(self, e: s.Expr, scope: Scope) -> a.Value:
-        method = getattr(self, "_" + type(e).__name__)
+        method: Callable[[s.Expr, Scope], a.Value] = getattr(self, "_" + type(e).__name__)
         return method(e, scope)
 
     def scalar(self, e: s.Expr, scope: Scope) -> x.Expr:
@@ -89,6 +89,7 @@ class Evaluator:
             for idx, item in np.ndenumerate(v):
                 out[idx] = self.fold(item)
             return out
+        assert not isinstance(v, np.ndarray)
         return x.evaluate(v, self.flattener.parameter_values)
 
     def describe(self, v: Any) -> str:
@@ -114,7 +115,7 @@ class Evaluator:
     def _ArrayLit(self, e: s.ArrayLit, scope: Scope) -> a.Value:
         return self._stack([self.value(i, scope) for i in e.items], e.span)
 
-    def _stack(self, values: list[a.Value], span: s.Span) -> a.Value:
+    def _stack(self, values: list[a.Value], span: Span) -> a.Value:
         try:
             return a.stack(values)
         except ValueError as err:
@@ -175,7 +176,7 @@ class Evaluator:
         return a.elementwise(lambda b: x.Const(not b.value) if isinstance(b, x.Const)
                              else x.Not(b), v)
 
-    def _numeric(self, v: Any, span: s.Span) -> None:
+    def _numeric(self, v: Any, span: Span) -> None:
         if isinstance(v, (str, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"expected a number, found {self.describe(v)}", span)
@@ -185,7 +186,8 @@ class Evaluator:
         right = self.value(e.right, scope)
         scalar = _ARITHMETIC.get(e.op)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
-            return scalar(left, right)  # the common case: no sizes to check
+            # the common case: no sizes to check
+            return scalar(cast(x.Expr, left), cast(x.Expr, right))
         self._numeric(left, e.left.span)
         self._numeric(right, e.right.span)
         op = e.op
@@ -212,7 +214,7 @@ class Evaluator:
             self._check_event(result, e.span)
         return result
 
-    def _check_event(self, relation: x.Expr, span: s.Span) -> None:
+    def _check_event(self, relation: x.Expr, span: Span) -> None:
         if self.no_event or self.flattener.is_parameter_expression(relation):
             return
         raise FlattenError(
@@ -245,7 +247,8 @@ class Evaluator:
             raise FlattenError(f"'{e.dotted}' is a component or class, not a value", e.span,
                                hint="refer to one of its variables, e.g. "
                                f"'{e.dotted}.<name>'")
-        return v
+        value: a.Value = v
+        return value
 
     def reference(self, e: s.Ref, scope: Scope) -> Any:
         """Follow a component reference; the result may be a scope or array of scopes."""
@@ -410,7 +413,7 @@ def _uses_end(e: Any) -> bool:
     if isinstance(e, tuple):
         return any(_uses_end(item) for item in e)
     fields = getattr(e, "__dataclass_fields__", None)
-    if fields is None or isinstance(e, s.Span):
+    if fields is None or isinstance(e, Span):
         return False
     return any(_uses_end(getattr(e, name)) for name in fields)
 
@@ -423,7 +426,7 @@ def _names_in(e: object) -> set[str]:
     if isinstance(e, tuple):
         return {n for item in e for n in _names_in(item)}
     fields = getattr(e, "__dataclass_fields__", None)
-    if fields is None or isinstance(e, s.Span):
+    if fields is None or isinstance(e, Span):
         return set()
     return {n for name in fields for n in _names_in(getattr(e, name))}
 

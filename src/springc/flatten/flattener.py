@@ -27,7 +27,7 @@ from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .lookup import ClassLookup, select_model
 from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
-from .scope import ClassScope, ClassView, Primitive, instance_mod
+from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
 from .variables import attributes_of
 
 __all__ = ["Flattener", "flatten"]
@@ -44,7 +44,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.views: dict[int, ClassView] = {}
         self.package_scopes: dict[int, ClassScope] = {}
         self.parameter_values = ParameterValues()
-        self.evaluator = Evaluator(self)
+        self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
@@ -24,7 +24,7 @@ MAX_DEPTH = 50
 
 
 def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
-                  named: dict[str, tuple[a.Value, s.Span]], call: s.Call) -> a.Value:
+                  named: dict[str, tuple[a.Value, Span]], call: s.Call) -> a.Value:
     depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
@@ -53,7 +53,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         for comp in comps:
             _declare(ev, scope, comp, given, call)
         _run(ev, entry.defn.algorithm, scope)
-        result = scope.names[outputs[0].name]
+        result: a.Value | None = scope.names[outputs[0].name]
     finally:
         ev.call_depth = depth
     if result is None:

@@ -24,6 +24,8 @@ from dataclasses import dataclass, fields
 from itertools import islice
 from typing import Any
 
+import numpy as np
+
 from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import flat
@@ -165,6 +167,8 @@ class InstanceTemplates:
             for name, prim in template.outer.items():
                 value = fl.binding(scope.mod.children[name] if scope.mod else None,
                                    prim.dims, scope.flat_name(name), prim.decl)
+                if value is None:
+                    raise FlattenError(f"'{scope.flat_name(name)}' has no value")
                 outer.update(zip(_scalar_names(prim, scope.prefix, template.scope.prefix),
                                  a.scalars(value)))
         except FlattenError:
@@ -249,12 +253,14 @@ def _copy_scope(source: ClassScope, outer: ClassScope, rename: Callable[[x.Expr]
 
 def _copy_primitive(prim: Primitive, rename: Callable[[x.Expr], x.Expr], prefix: str,
                     cut: int) -> Primitive:
-    if prim.dims:
-        names: Any = a.make_array([prefix + n[cut:] for n in prim.names.flat],  # type: ignore
-                                  prim.dims)
-        value = a.make_array([rename(v) for v in prim.value.flat], prim.dims)
+    names: np.ndarray | str
+    value: a.Value
+    if isinstance(prim.names, np.ndarray):
+        names = a.make_array([prefix + n[cut:] for n in prim.names.flat], prim.dims)
+        value = a.make_array([rename(v) for v in a.scalars(prim.value)], prim.dims)
     else:
-        names, value = prefix + prim.names[cut:], rename(prim.value)  # type: ignore[index]
+        names = prefix + prim.names[cut:]
+        value = rename(a.scalars(prim.value)[0])
     return Primitive(names, value, prim.decl, prim.variability, prim.causality, prim.flow,
                      prim.type, prim.mod, prim.dims)
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import difflib
 import itertools
 import math
+from typing import Any
 
 import numpy as np
 
@@ -194,15 +195,16 @@ class Instantiation(FlattenContext):
         prim = Primitive(names, value, decl, variability, causality,
                          decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
         if variability in ("parameter", "constant"):
-            for n, b in zip(a.scalars(names), _binding_scalars(binding, dims)):  # type: ignore
+            for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b
         else:
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
 
-    def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> a.Value:
-        """The numeric value of a constant's binding (a constant expression)."""
+    def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
+        """The numeric value of a constant's binding (a constant expression): a number,
+        or a numpy array of numbers."""
         span = mod.value.span if mod is not None and mod.value is not None else None
         try:
             value = self.evaluator.fold(binding)
@@ -242,7 +244,7 @@ class Instantiation(FlattenContext):
         cached = self.mod_values.get(key)
         if cached is None:
             cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
-        value = cached[1]
+        value: a.Value = cached[1]
         for i in mv.index:
             if not a.is_array(value) or value.shape[0] < i:
                 raise FlattenError(
@@ -265,9 +267,8 @@ class Instantiation(FlattenContext):
 def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | None:
     """The sizes of a declaration if all are integer literals (``pos[2]``), else None."""
     exprs = [*decl.dims, *decl.type_dims, *(d for d, _ in rtype.dims)]
-    if all(isinstance(d, s.Number) and type(d.value) is int for d in exprs):
-        return tuple(d.value for d in exprs)  # type: ignore[union-attr]
-    return None
+    sizes = [d.value for d in exprs if isinstance(d, s.Number) and type(d.value) is int]
+    return tuple(int(n) for n in sizes) if len(sizes) == len(exprs) else None
 
 
 def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
@@ -282,5 +283,5 @@ def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
 
 def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:
     if binding is None:
-        return [None] * int(np.prod(dims, dtype=int))
-    return a.scalars(binding)
+        return [None] * math.prod(dims)
+    return list(a.scalars(binding))

@@ -11,7 +11,7 @@ from __future__ import annotations
 import difflib
 from typing import Any
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
@@ -109,7 +109,7 @@ class ClassLookup(FlattenContext):
                                ref.span, [Note("defined here", entry.defn.span)])
         return entry
 
-    def class_member(self, entry: ClassEntry, name: str, span: s.Span) -> Any:
+    def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
         """``P.c``: a nested class or a constant of a package."""
         nested = member_class(entry, name)
         if nested is not None:
@@ -127,7 +127,7 @@ class ClassLookup(FlattenContext):
             self.package_scopes[id(entry)] = scope
         return scope
 
-    def lookup_global(self, name: str, entry: ClassEntry, span: s.Span) -> Any:
+    def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any:
         """A name not declared in the instance: time, a constant of an enclosing class,
         a class (for dotted references), or a built-in constant."""
         if name == "time":

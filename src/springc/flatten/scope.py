@@ -20,7 +20,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import FlattenError, FollowUpError, Note, SpringcError
+from ..errors import FlattenError, FollowUpError, Note, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
@@ -96,7 +96,7 @@ class ClassScope:
     prefix: str
     view: ClassView
     mod: Mod | None
-    span: s.Span
+    span: Span
     outer: ClassScope | None = None
     members: dict[str, Member] = field(default_factory=dict)
     in_progress: dict[str, None] = field(default_factory=dict)  # ordered: a chain
@@ -122,7 +122,7 @@ class ClassScope:
     def has_member(self, name: str) -> bool:
         return name in self.view.components
 
-    def member(self, name: str, span: s.Span | None = None) -> Member:
+    def member(self, name: str, span: Span | None = None) -> Member:
         """The member ``name``, instantiating it on first use."""
         found = self.members.get(name)
         if found is not None:
@@ -151,7 +151,7 @@ class ClassScope:
         for name in self.view.components:
             yield name, self.member(name)
 
-    def lookup(self, name: str, span: s.Span) -> Any:
+    def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
             return self.member(name, span)
         return self.flattener.lookup_global(name, self.entry, span)
@@ -170,7 +170,7 @@ class LocalScope:
     def entry(self) -> ClassEntry:
         return self.parent.entry
 
-    def lookup(self, name: str, span: s.Span) -> Any:
+    def lookup(self, name: str, span: Span) -> Any:
         if name in self.names:
             return self.names[name]
         return self.parent.lookup(name, span)
@@ -185,7 +185,7 @@ class FunctionScope:
     parent: ClassScope
     entry: ClassEntry
 
-    def lookup(self, name: str, span: s.Span) -> Any:
+    def lookup(self, name: str, span: Span) -> Any:
         if name not in self.names:
             return self.parent.lookup(name, span)
         value = self.names[name]
@@ -237,9 +237,11 @@ class ExpressionEvaluator(Protocol):
     """What the flattening helpers call on the expression evaluator (``evaluate.py``)."""
 
     flattener: FlattenContext
-    builtins: BuiltinFunctions
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
     call_depth: int  # nesting of user-defined function calls being inlined
+
+    @property
+    def builtins(self) -> BuiltinFunctions: ...
 
     def value(self, e: s.Expr, scope: Scope) -> a.Value: ...
 
@@ -289,9 +291,9 @@ class FlattenContext(Protocol):
 
     def find_function(self, name: str, scope: Scope) -> ClassEntry | None: ...
 
-    def lookup_global(self, name: str, entry: ClassEntry, span: s.Span) -> Any: ...
+    def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any: ...
 
-    def class_member(self, entry: ClassEntry, name: str, span: s.Span) -> Any: ...
+    def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any: ...
 
     def package_scope(self, entry: ClassEntry) -> ClassScope: ...
 

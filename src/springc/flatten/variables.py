@@ -11,6 +11,8 @@ import itertools
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
+
 from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import flat
@@ -54,6 +56,7 @@ def attributes_of(flattener: FlattenContext, scope: ClassScope, prim: Primitive
     is_param = prim.variability == "parameter"
     for name, idx in zip(names, indices):
         mod = select(prim.mod, idx) if idx else prim.mod
+        assert isinstance(name, str)
         yield flat.Variable(
             name, prim.type, prim.variability, prim.causality, prim.flow,
             bindings.get(name) if is_param else None,
@@ -95,6 +98,9 @@ def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes
             if key != "quantity":
                 values["display_unit" if key == "displayUnit" else "unit"] = value
         elif key == "fixed":
+            if isinstance(value, (str, np.ndarray)):
+                raise FlattenError("the attribute 'fixed' must be a scalar Boolean",
+                                   child.value.span)
             values["fixed"] = bool(_fold(flattener, value, child, "'fixed'"))
         else:
             if isinstance(value, str):
