@@ -19,7 +19,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from lark import Tree
+from lark import Token, Tree
 
 from ..errors import ErrorGroup, ParseError
 from ..ir.syntax import End
@@ -32,13 +32,14 @@ from .rules_expressions import ExpressionRules
 __all__ = ["KEYWORDS", "LATER", "SyntaxBuilder", "build"]
 
 
-def build(tree: Tree, file: str) -> Any:
+def build(tree: Tree[Token], file: str) -> Any:
     """The syntax node of ``tree`` (a StoredDefinition, or an Expr for an expression);
     raises :class:`ParseError`, or :class:`ErrorGroup` if there are several errors."""
     builder = SyntaxBuilder(file)
     result = builder.convert(tree)
     if builder.errors:
-        errors = sorted(builder.errors, key=lambda e: (e.span.line, e.span.column))
+        errors = sorted(builder.errors,
+                        key=lambda e: (e.span.line, e.span.column) if e.span else (0, 0))
         raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
     return result
 
@@ -54,10 +55,10 @@ class SyntaxBuilder(ClassRules, ElementRules, EquationRules, ExpressionRules):
     def __init__(self, file: str) -> None:
         self.file = file
         self.errors: list[ParseError] = []
-        self._methods: dict[str, Callable[[Any, list], Any]] = {}
+        self._methods: dict[str, Callable[[Any, list[Any]], Any]] = {}
         self.loose_ends: list[End] = []  # `end`s not yet known to sit in a subscript
 
-    def convert(self, tree: Tree) -> Any:
+    def convert(self, tree: Tree[Token]) -> Any:
         """The syntax node for the whole ``tree``; problems are left in ``errors``."""
         result = self.transform(tree)
         for end in self.loose_ends:
@@ -65,7 +66,7 @@ class SyntaxBuilder(ClassRules, ElementRules, EquationRules, ExpressionRules):
                         end.span)
         return result
 
-    def transform(self, tree: Tree) -> Any:
+    def transform(self, tree: Tree[Token]) -> Any:
         children = [self.transform(c) if type(c) is Tree else c for c in tree.children]
         method = self._methods.get(tree.data)
         if method is None:  # every rule has a method: a missing one is a bug, not a skip

@@ -116,7 +116,9 @@ def parser_cache_file(grammar: Path) -> Path | None:
 def parse_text(text: str, file: str) -> StoredDefinition:
     """Parse the Modelica source ``text`` of ``file`` (used in spans only)."""
     tree = _parse(text, file, "start")
-    return build(tree, file)
+    stored = build(tree, file)
+    assert isinstance(stored, StoredDefinition)
+    return stored
 
 
 def parse_file(path: str | Path) -> StoredDefinition:
@@ -131,17 +133,19 @@ def parse_file(path: str | Path) -> StoredDefinition:
 def parse_expression(text: str, file: str = "<expr>") -> Expr:
     """Parse a single expression, e.g. the value of ``--set mass.m=2``."""
     tree = _parse(text, file, "expression_start")
-    return build(tree, file)
+    expression: Expr = build(tree, file)
+    return expression
 
 
-def _parse(text: str, file: str, start: str) -> Tree:
+def _parse(text: str, file: str, start: str) -> Tree[Token]:
     text = text.removeprefix("\ufeff")
     try:
         return _lark().parse(text, start=start)
     except _LexProblem as exc:
         tok = exc.token
         width = 2 if tok.startswith("/*") else 1
-        span = Span(file, tok.line, tok.column, tok.line, tok.column + width)
+        line, column = tok.line or 1, tok.column or 1
+        span = Span(file, line, column, line, column + width)
         raise ParseError(exc.message, span, hint=exc.hint) from None
     except UnexpectedInput as exc:
         raise _syntax_error(exc, text, file) from None
@@ -215,7 +219,7 @@ def _previous_token(text: str, before: int) -> Token | None:
 
 def _syntax_error(exc: UnexpectedInput, text: str, file: str) -> ParseError:
     if isinstance(exc, UnexpectedCharacters):
-        char = text[exc.pos_in_stream]
+        char = text[exc.pos_in_stream or 0]
         span = Span(file, exc.line, exc.column, exc.line, exc.column + 1)
         if char == "'":
             return ParseError("unterminated quoted identifier", span,

@@ -12,11 +12,15 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from lark import Token
+from lark.tree import Meta
 
 from ..errors import Note, ParseError, Span
 from ..ir.syntax import ElementModification, End, Expr, Modification, Ref, RefPart
+
+T = TypeVar("T")
 
 LATER = "springc supports a subset of Modelica; see the \"Later\" list in LANGUAGE.md"
 
@@ -73,11 +77,11 @@ class Annotation:
 # ------------------------------------------------------------------- helpers
 
 
-def tokens(children: list) -> list[Token]:
+def tokens(children: list[Any]) -> list[Token]:
     return [c for c in children if isinstance(c, Token)]
 
 
-def of(children: list, kind: type):
+def of(children: list[Any], kind: type[T]) -> T | None:
     """The first child of type ``kind``, or ``None``."""
     return next((c for c in children if isinstance(c, kind)), None)
 
@@ -93,13 +97,15 @@ class RuleBase:
     errors: list[ParseError]
     loose_ends: list[End]  # `end`s not yet known to sit in a subscript
 
-    def span_of(self, meta) -> Span:
+    def span_of(self, meta: Meta) -> Span:
         return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
 
     def token_span(self, tok: Token) -> Span:
-        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
+        # Tokens from the parser always carry positions (propagate_positions).
+        return Span(self.file, tok.line or 1, tok.column or 1, tok.end_line or 1,
+                    tok.end_column or 1)
 
-    def keyword_span(self, meta, word: str) -> Span:
+    def keyword_span(self, meta: Meta, word: str) -> Span:
         """The span of the keyword ``word`` that starts the rule at ``meta``."""
         return Span(self.file, meta.line, meta.column, meta.line, meta.column + len(word))
 
@@ -130,11 +136,11 @@ class RuleBase:
         if "\\" not in body:
             return body
 
-        def one(m: re.Match) -> str:
+        def one(m: re.Match[str]) -> str:
             if m.group(1) in _ESCAPES:
                 return _ESCAPES[m.group(1)]
             self.error(f"invalid escape '\\{m.group(1)}'", self.token_span(token),
                         hint="Modelica knows \\' \\\" \\? \\\\ \\a \\b \\f \\n \\r \\t \\v")
-            return m.group(1)
+            return str(m.group(1))
 
         return _ESCAPE.sub(one, body)

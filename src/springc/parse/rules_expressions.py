@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from lark import Token
+from lark.tree import Meta
 
 from ..ir.syntax import (
     ArrayLit,
@@ -50,18 +52,18 @@ class Args:
 class ExpressionRules(RuleBase):
     """The expression rules: literals, references, calls, arrays, operators."""
 
-    def if_expression(self, meta, ch):
+    def if_expression(self, meta: Meta, ch: list[Any]) -> IfExpr:
         pairs = tuple((ch[i], ch[i + 1]) for i in range(0, len(ch) - 1, 2))
         return IfExpr(pairs, ch[-1], self.span_of(meta))
 
-    def range(self, meta, ch):
+    def range(self, meta: Meta, ch: list[Any]) -> Range:
         step = ch[1] if len(ch) == 3 else None
         return Range(ch[0], step, ch[-1], self.span_of(meta))
 
-    def operation(self, meta, ch):
+    def operation(self, meta: Meta, ch: list[Any]) -> Any:
         return Precedence(self, ch).build()
 
-    def number(self, meta, ch):
+    def number(self, meta: Meta, ch: list[Any]) -> Number:
         text = str(ch[0])
         span = self.span_of(meta)
         value: int | float = float(text)
@@ -73,41 +75,41 @@ class ExpressionRules(RuleBase):
             value = int(text)
         return Number(value, span)
 
-    def string(self, meta, ch):
+    def string(self, meta: Meta, ch: list[Any]) -> String:
         return String(self.unescape(ch[0][1:-1], ch[0]), self.span_of(meta))
 
-    def true(self, meta, ch):
+    def true(self, meta: Meta, ch: list[Any]) -> Bool:
         return Bool(True, self.span_of(meta))
 
-    def false(self, meta, ch):
+    def false(self, meta: Meta, ch: list[Any]) -> Bool:
         return Bool(False, self.span_of(meta))
 
-    def call(self, meta, ch):
+    def call(self, meta: Meta, ch: list[Any]) -> Call:
         func, args = ch
         return Call(func, args.args, args.named, self.span_of(meta))
 
-    def subscripted(self, meta, ch):
+    def subscripted(self, meta: Meta, ch: list[Any]) -> Any:
         self.reject("subscripts on a parenthesized expression (`(e)[i]`) are",
                      self.span_of(meta))
         return ch[0]
 
-    def tuple(self, meta, ch):
+    def tuple(self, meta: Meta, ch: list[Any]) -> Any:
         self.reject("output lists (`(a, b)`) outside `(a, b) := f(x)` are", self.span_of(meta))
         return next((c for c in ch if c is not None), Bool(False, self.span_of(meta)))
 
-    def matrix(self, meta, ch):
+    def matrix(self, meta: Meta, ch: list[Any]) -> MatrixLit:
         return MatrixLit(tuple(ch), self.span_of(meta))
 
-    def matrix_row(self, meta, ch):
+    def matrix_row(self, meta: Meta, ch: list[Any]) -> Any:
         return tuple(ch)
 
-    def array(self, meta, ch):
+    def array(self, meta: Meta, ch: list[Any]) -> ArrayLit:
         return ArrayLit(tuple(ch), self.span_of(meta))
 
-    def array_comprehension(self, meta, ch):
+    def array_comprehension(self, meta: Meta, ch: list[Any]) -> Comprehension:
         return Comprehension(ch[0], ch[1], self.span_of(meta))
 
-    def component_reference(self, meta, ch):
+    def component_reference(self, meta: Meta, ch: list[Any]) -> Any:
         first = ch[0]
         if first == "end" and len(ch) == 1:
             end = End(self.span_of(meta))
@@ -121,15 +123,15 @@ class ExpressionRules(RuleBase):
                  *(c for c in ch if isinstance(c, RefPart)))
         return Ref(parts, self.span_of(meta))
 
-    def global_reference(self, meta, ch):
+    def global_reference(self, meta: Meta, ch: list[Any]) -> Any:
         self.reject("global names (`.A.B`) are", self.keyword_span(meta, "."))
         return self.component_reference(meta, ch)
 
-    def ref_part(self, meta, ch):
+    def ref_part(self, meta: Meta, ch: list[Any]) -> RefPart:
         subs = of(ch, Subs)
         return RefPart(self.ident(ch[0]), subs.items if subs else (), self.span_of(meta))
 
-    def array_subscripts(self, meta, ch):
+    def array_subscripts(self, meta: Meta, ch: list[Any]) -> Subs:
         span = self.span_of(meta)
         if self.loose_ends:  # those inside these brackets are where they belong
             inside = (span.line, span.column), (span.end_line, span.end_column)
@@ -137,10 +139,10 @@ class ExpressionRules(RuleBase):
                                 if not inside[0] <= (e.span.line, e.span.column) < inside[1]]
         return Subs(tuple(ch), span)
 
-    def colon(self, meta, ch):
+    def colon(self, meta: Meta, ch: list[Any]) -> Colon:
         return Colon(self.span_of(meta))
 
-    def function_call_args(self, meta, ch):
+    def function_call_args(self, meta: Meta, ch: list[Any]) -> Args:
         named = tuple(c for c in ch if isinstance(c, NamedArg))
         args = tuple(c for c in ch if not isinstance(c, NamedArg))
         seen_named = False
@@ -151,14 +153,14 @@ class ExpressionRules(RuleBase):
                 break
         return Args(args, named)
 
-    def call_comprehension(self, meta, ch):
+    def call_comprehension(self, meta: Meta, ch: list[Any]) -> Args:
         body, indices = ch
         return Args((Comprehension(body, indices, join(body.span, indices[-1].span)),), ())
 
-    def named_argument(self, meta, ch):
+    def named_argument(self, meta: Meta, ch: list[Any]) -> NamedArg:
         return NamedArg(self.ident(ch[0]), ch[1], self.span_of(meta))
 
-    def name(self, meta, ch):
+    def name(self, meta: Meta, ch: list[Any]) -> Any:
         return (ch[0],) if len(ch) == 1 else (*ch[0], ch[1])
 
 
@@ -171,7 +173,7 @@ class Precedence:
     term: factor {mulop factor}; factor: primary [^ primary]``.
     """
 
-    def __init__(self, owner: RuleBase, items: list) -> None:
+    def __init__(self, owner: RuleBase, items: list[Any]) -> None:
         self.owner, self.items, self.i = owner, items, 0
 
     def build(self) -> Expr:
@@ -245,7 +247,8 @@ class Precedence:
         item = self.items[self.i]
         self.i += 1
         if not isinstance(item, Token):
-            return item
+            operand: Expr = item
+            return operand
         example = "a and (not b)" if item == "not" else f"a * ({item}b)"
         self.owner.error(
             f"unexpected '{item}'", self.owner.token_span(item),
