@@ -31,7 +31,6 @@ from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
-UNSUPPORTED_TYPES = {"String": "`String` variables", "StateSelect": None}
 
 
 @dataclass(frozen=True)
