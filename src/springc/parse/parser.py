@@ -221,6 +221,11 @@ def _syntax_error(exc: UnexpectedInput, text: str, file: str) -> ParseError:
     if isinstance(exc, UnexpectedCharacters):
         char = text[exc.pos_in_stream or 0]
         span = Span(file, exc.line, exc.column, exc.line, exc.column + 1)
+        position = exc.pos_in_stream or 0
+        if text.startswith("''", position):
+            return ParseError("empty quoted identifier", Span(file, exc.line, exc.column,
+                                                             exc.line, exc.column + 2),
+                              hint="a quoted identifier has at least one character: 'x'")
         if char == "'":
             return ParseError("unterminated quoted identifier", span,
                               hint="a quoted identifier ends with ' on the same line")

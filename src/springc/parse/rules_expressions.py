@@ -68,7 +68,8 @@ class ExpressionRules(RuleBase):
         span = self.span_of(meta)
         value: int | float = float(text)
         if not math.isfinite(value):
-            self.error(f"the number {text} is too large", span,
+            shown = text if len(text) <= 24 else f"{text[:12]}... ({len(text)} characters)"
+            self.error(f"the number {shown} is too large", span,
                        hint="numbers must be below about 1.8e308 (the largest double)")
             value = 0.0
         elif text.isdigit():
