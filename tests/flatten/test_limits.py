@@ -84,3 +84,27 @@ def test_loop_iterations_count_against_the_cap(tmp_path: Path) -> None:
     with pytest.raises(FlattenError) as err:
         flatten(tree, "L", max_size=3)
     assert err.value.message == "this range has 4 elements, more than the limit of 3"
+
+
+def test_loops_below_the_cap_one_by_one_are_counted_together(tmp_path: Path) -> None:
+    path = tmp_path / "two.mdl"
+    path.write_text("model T\n  Real a;\n  Real b;\nequation\n  for i in 1:3 loop\n    a = i;\n"
+                    "  end for;\n  for j in 1:3 loop\n    b = j;\n  end for;\nend T;\n")
+    tree = load([path])
+    assert len(flatten(tree, "T", max_size=6).equations) == 6
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "T", max_size=5)
+    assert err.value.message == ("the loops of this model run more than 5 iterations in all "
+                                 "(this loop crosses the limit)")
+    assert err.value.span is not None and err.value.span.line == 8
+
+
+def test_a_nest_is_refused_before_it_runs(tmp_path: Path) -> None:
+    path = tmp_path / "nest.mdl"
+    path.write_text("model N\n  Real a;\nequation\n  for i in 1:3 loop\n    for j in 1:2 loop\n"
+                    "      a = i + j;\n    end for;\n  end for;\nend N;\n")
+    tree = load([path])
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "N", max_size=5)
+    assert err.value.message == "this loop nest has 6 iterations, more than the limit of 5"
+    assert err.value.span is not None and err.value.span.line == 4

@@ -13,6 +13,7 @@ from ..ir import syntax as s
 from . import arrays as a
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
+from .loops import check_loop_nest
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
@@ -55,8 +56,8 @@ class EquationFlattening(FlattenContext):
                                    eq.span)
             self.connections.connect(self.evaluator, eq, where, owner)
         elif isinstance(eq, s.ForEquation):
-            if len(eq.indices) > 1:
-                self.evaluator.check_loop_nest(eq.indices, where)
+            if not isinstance(where, LocalScope):  # the outermost loop of a nest
+                check_loop_nest(self.evaluator, eq, where)
             self._for(eq, eq.indices, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
             for cond, body in eq.branches:

@@ -372,18 +372,6 @@ class Evaluator:
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
 
-    def check_loop_nest(self, indices: tuple[s.ForIndex, ...], scope: Scope) -> None:
-        """``for i in 1:n, j in 1:m``: refuse a nest whose iterations exceed the cap before
-        running any (ranges that use an outer index are left to the running count)."""
-        outer: set[str] = set()
-        count = 1
-        for index in indices:
-            if index.range is not None and not outer & _names_in(index.range):
-                count *= len(self.range_values(index, scope))
-            outer.add(index.name)
-        self.flattener.limits.check_size(count, "this loop nest", indices[0].span,
-                                         "iterations")
-
     def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
@@ -416,19 +404,6 @@ def _uses_end(e: Any) -> bool:
     if fields is None or isinstance(e, Span):
         return False
     return any(_uses_end(getattr(e, name)) for name in fields)
-
-
-def _names_in(e: object) -> set[str]:
-    """The first names of the references in a syntax expression."""
-    if isinstance(e, s.Ref):
-        return {e.parts[0].name} | {n for p in e.parts for sub in p.subscripts
-                                    for n in _names_in(sub)}
-    if isinstance(e, tuple):
-        return {n for item in e for n in _names_in(item)}
-    fields = getattr(e, "__dataclass_fields__", None)
-    if fields is None or isinstance(e, Span):
-        return set()
-    return {n for name in fields for n in _names_in(getattr(e, name))}
 
 
 def _loop_context(scope: Scope) -> str:

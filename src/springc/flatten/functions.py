@@ -18,6 +18,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .loops import check_loop_nest
 from .scope import ExpressionEvaluator, FunctionScope
 
 MAX_DEPTH = 50
@@ -52,6 +53,9 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        for stmt in entry.defn.algorithm:
+            if isinstance(stmt, s.ForStatement):
+                check_loop_nest(ev, stmt, scope)
         _run(ev, entry.defn.algorithm, scope)
         result: a.Value | None = scope.names[outputs[0].name]
     finally:
@@ -90,8 +94,6 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
         if isinstance(stmt, s.Assign):
             _assign(ev, stmt, scope)
         elif isinstance(stmt, s.ForStatement):
-            if len(stmt.indices) > 1:
-                ev.check_loop_nest(stmt.indices, scope)
             _for(ev, stmt, stmt.indices, scope)
         else:
             _if(ev, stmt, scope)

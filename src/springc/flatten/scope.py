@@ -260,8 +260,6 @@ class ExpressionEvaluator(Protocol):
 
     def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]: ...
 
-    def check_loop_nest(self, indices: tuple[s.ForIndex, ...], scope: Scope) -> None: ...
-
 
 class FlattenContext(Protocol):
     """What the flattening helpers call on the driver
