@@ -21,7 +21,7 @@ class ModValue:
     as when ``Mass ms[3](m = {1, 2, 3})`` gives ``ms[2]`` the value ``m = 2``."""
 
     expr: s.Expr
-    scope: Any
+    scope: Any  # the scope.ClassScope it is written in (scope.py imports this module)
     index: tuple[int, ...] = ()
 
     @property
