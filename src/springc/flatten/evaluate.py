@@ -22,6 +22,7 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
 from .functions import call_function
+from .parameters import check_powers
 from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
@@ -90,6 +91,9 @@ class Evaluator:
                 out[idx] = self.fold(item)
             return out
         assert not isinstance(v, np.ndarray)
+        if type(v) is x.Const:
+            return v.value
+        check_powers(v, self.flattener.parameter_values)
         return x.evaluate(v, self.flattener.parameter_values)
 
     def describe(self, v: Any) -> str:

@@ -17,7 +17,7 @@ from ..errors import FlattenError, Span
 from ..ir import expr as x
 from ..ir import flat
 
-__all__ = ["ParameterValues", "binding_errors"]
+__all__ = ["MAX_INTEGER_EXPONENT", "ParameterValues", "binding_errors", "check_powers"]
 
 VARIABILITY_HINT = ("a parameter's binding may only use parameters and constants (Modelica "
                     "3.6, section 3.8): bind it to a parameter expression, or remove the "
@@ -45,6 +45,7 @@ class ParameterValues(Mapping[str, Any]):
             raise KeyError(f"the parameter '{name}', which has no value")
         self.active.add(name)
         try:
+            check_powers(binding, self)
             value = x.evaluate(binding, self)
         finally:
             self.active.discard(name)
@@ -56,6 +57,26 @@ class ParameterValues(Mapping[str, Any]):
 
     def __len__(self) -> int:
         return len(self.bindings)
+
+
+#: Integer powers beyond this exponent are refused: Python computes ``10 ^ 10^9`` exactly,
+#: a number of a billion digits, which takes hours (Modelica's ``^`` is a Real power).
+MAX_INTEGER_EXPONENT = 4096
+
+
+def check_powers(e: x.Expr, values: Mapping[str, Any]) -> None:
+    """Raise OverflowError for an integer power in ``e`` whose exact value would be huge;
+    inner powers are checked before the operands that contain them are evaluated."""
+    if not isinstance(e, x.BinOp) or e.op != "^":
+        for child in x.children(e):
+            check_powers(child, values)
+        return
+    check_powers(e.left, values)
+    check_powers(e.right, values)
+    base, exponent = x.evaluate(e.left, values), x.evaluate(e.right, values)
+    if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
+            and abs(exponent) > MAX_INTEGER_EXPONENT:
+        raise OverflowError(f"{base} ^ {exponent} is too large")
 
 
 def binding_errors(variables: Iterable[flat.Variable], values: ParameterValues
