@@ -139,13 +139,15 @@ class Builtins:
         if len(call.args) == 1:
             (v,) = self._args(call, scope, 1)
             return a.make_array([x.Const(d) for d in a.shape(v)])
-        v, dim = self._args(call, scope, 2)
-        k = self.ev.fold(dim)
+        if len(call.args) != 2 or call.named:
+            self._args(call, scope, 2)  # reports the wrong arguments
+        v = self.ev.value(call.args[0], scope)
+        k = self.ev.integer(call.args[1], scope, "the dimension of 'size'")
         dims = a.shape(v)
         if not 1 <= k <= len(dims):
             raise FlattenError(f"dimension {k} does not exist: the array has {len(dims)}",
                                call.args[1].span)
-        return x.Const(dims[int(k) - 1])
+        return x.Const(dims[k - 1])
 
     def ndims(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)

@@ -7,6 +7,8 @@ appended to the Flattener's lists, and connections recorded in its connection se
 
 from __future__ import annotations
 
+import numpy as np
+
 from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
@@ -76,13 +78,18 @@ class EquationFlattening(FlattenContext):
         (a condition on variables would switch equations at events)."""
         self.evaluator.no_event += 1
         try:
-            return bool(self.evaluator.constant(
+            value = self.evaluator.constant(
                 cond, where, "the condition of an if-equation",
                 "switching equations on a variable needs events, which are not supported "
                 "yet; for a continuous switch write one equation with an if-expression "
-                "inside noEvent(...)"))
+                "inside noEvent(...)")
         finally:
             self.evaluator.no_event -= 1
+        if not isinstance(value, bool | int | float | np.bool_):
+            kind = "a string" if isinstance(value, str) else "an array"
+            raise FlattenError(f"the condition of an if-equation must be a scalar Boolean, "
+                               f"found {kind}", cond.span)
+        return bool(value)
 
     def _body(self, body: tuple[s.Equation, ...], where: Scope, owner: ClassScope,
               initial: bool) -> None:

@@ -78,7 +78,7 @@ class Evaluator:
     def integer(self, e: s.Expr, scope: Scope, what: str) -> int:
         v = self.constant(e, scope, what)
         if isinstance(v, (np.ndarray, bool, str)) or not math.isfinite(v) or v != int(v):
-            raise FlattenError(f"{what} must be an integer, found {v!r}", e.span)
+            raise FlattenError(f"{what} must be an integer, found {_shown(v)}", e.span)
         return int(v)
 
     def fold(self, v: a.Value) -> Any:
@@ -149,7 +149,7 @@ class Evaluator:
         for bound in (start, stop, step):
             if isinstance(bound, (np.ndarray, str)) or not math.isfinite(bound):
                 raise FlattenError(f"the bounds and step of a range must be finite numbers, "
-                                   f"found {bound!r}", e.span)
+                                   f"found {_shown(bound)}", e.span)
         if step == 0:
             raise FlattenError("the step of a range must not be zero", e.span)
         count = max(0, math.floor((stop - start) / step + 1e-10) + 1)
@@ -408,6 +408,11 @@ def _uses_end(e: Any) -> bool:
     if fields is None or isinstance(e, Span):
         return False
     return any(_uses_end(getattr(e, name)) for name in fields)
+
+
+def _shown(value: object) -> str:
+    """A value for a message: ``'a'``, ``1.5``, or ``an array`` (not numpy's repr)."""
+    return "an array" if isinstance(value, np.ndarray) else repr(value)
 
 
 def _loop_context(scope: Scope) -> str:

@@ -36,6 +36,7 @@ def _number(flattener: FlattenContext, e: s.Expr, top: ClassScope) -> float:
     value = flattener.evaluator.constant(e, top, "an experiment setting")
     if not isinstance(value, (int, float)) or isinstance(value, bool) \
             or not math.isfinite(value):
-        raise FlattenError(f"experiment settings must be finite numbers, found {value!r}",
+        shown = "an array" if hasattr(value, "shape") else repr(value)
+        raise FlattenError(f"experiment settings must be finite numbers, found {shown}",
                            e.span)
     return float(value)
