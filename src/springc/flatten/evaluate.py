@@ -324,7 +324,9 @@ class Evaluator:
             v = self.constant(sub, scope, "a subscript")
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
         for i in values:
-            if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
+            if isinstance(i, bool | str) or not math.isfinite(i) or i != int(i):
+                raise FlattenError(f"a subscript must be an integer, found {i!r}", sub.span)
+            if not 1 <= i <= size:
                 raise FlattenError(
                     f"index {i} is out of range for '{part.name}' of size {size}"
                     + _loop_context(scope), sub.span,

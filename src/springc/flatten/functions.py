@@ -81,6 +81,9 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
     dims = [d for d in comp.type_dims + comp.dims]
     if dims:
         sizes = tuple(ev.integer(d, scope, "an array size") for d in dims)
+        if any(n < 0 for n in sizes):
+            raise FlattenError(f"array size must not be negative, found {min(sizes)}",
+                               comp.span)
         ev.flattener.limits.check_size(math.prod(sizes), f"'{comp.name}'", comp.span)
         out = np.empty(sizes, dtype=object)
         out.fill(x.ZERO)
