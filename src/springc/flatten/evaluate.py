@@ -8,6 +8,7 @@ numbers through the parameters' bindings with :meth:`Evaluator.constant`.
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import math
 from collections.abc import Callable, Iterator
@@ -283,8 +284,6 @@ class Evaluator:
         raise FlattenError(f"'{part.name}' cannot be selected from a value", part.span)
 
     def _no_member(self, owner: ClassScope, part: s.RefPart) -> None:
-        import difflib
-
         close = difflib.get_close_matches(part.name, list(owner.view.components), 1)
         hint = f"did you mean '{close[0]}'?" if close else None
         raise FlattenError(

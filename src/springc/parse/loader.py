@@ -9,6 +9,7 @@ over later ones, like ``MODELICAPATH``.
 
 from __future__ import annotations
 
+import difflib
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -168,8 +169,6 @@ def _imported(entry: ClassEntry, name: str) -> ClassEntry | None:
 
 
 def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
-    import difflib
-
     visible: set[str] = set()
     entry: ClassEntry | None = scope
     while entry is not None:
