@@ -29,13 +29,13 @@ from bench_tradeoff import (
     study,
     verdict,
 )
-from springc.tradeoff.plot import write_work_precision
-from springc.tradeoff.report import format_table, unresolved_note
-from springc.tradeoff.study import (
+from springc.tradeoff.model import (
     REFERENCE_RTOL,
     REPEAT_LIMIT,
     SCALE_FLOOR,
 )
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import format_table, recommendations, unresolved_note
 
 DOCS = ROOT / "docs"
 EXTREMES = "## Extremes"
@@ -51,7 +51,7 @@ METHOD = """\
 
 `springc tradeoff FILE... [--solvers LIST] [--tolerances LIST] [--steps LIST]
 [--max-error LIST] [--reference ref.csv] [-o table.csv] [--plot wp.png]` (the
-module is `src/springc/tradeoff.py`) runs every solver at every setting and compares
+package is `src/springc/tradeoff/`) runs every solver at every setting and compares
 its output with a reference on the output grid:
 
 - **Error**: variable *j* at output time *t_i* is off by
@@ -80,7 +80,7 @@ its output with a reference on the output grid:
 
 
 def scene_section(title: str, key: str, result: object, seconds: float, note: str) -> str:
-    from springc.tradeoff.study import Tradeoff
+    from springc.tradeoff.model import Tradeoff
 
     assert isinstance(result, Tradeoff)
     ref = result.reference
@@ -90,7 +90,7 @@ def scene_section(title: str, key: str, result: object, seconds: float, note: st
              f"to {ref.time[-1]:g} s; the study took {seconds / 60:.1f} minutes.", "",
              *([note, ""] if note else []),
              f"Reference: {ref.description}.", "",
-             *(f"**{line}**" for line in result.recommendations()), "",
+             *(f"**{line}**" for line in recommendations(result)), "",
              format_table(result, markdown=True).rstrip(), ""]
     if unresolved is not None:
         lines += [f"Note: {unresolved.message}.", ""]

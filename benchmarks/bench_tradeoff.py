@@ -30,15 +30,15 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
 import springc  # noqa: E402
-from springc.tradeoff.study import (  # noqa: E402
+from springc.tradeoff import (  # noqa: E402
     DEFAULT_TOLERANCES,
-    SCIPY_DEFAULT,
-    SCIPY_RK45,
     Tradeoff,
     TradeoffOptions,
     compare_states,
+    recommendations,
     run_tradeoff,
 )
+from springc.tradeoff.model import SCIPY_DEFAULT, SCIPY_RK45  # noqa: E402
 
 TARGET = 1e-4
 SPEEDUP = 3.0
@@ -157,7 +157,7 @@ def main() -> None:
     for scene in scenes(args.quick, args.full):
         result, seconds = study(scene, args.budget)
         print(f"{scene.key}: study took {seconds:.0f} s", file=sys.stderr)
-        for line in result.recommendations():
+        for line in recommendations(result):
             print(f"{scene.key}: {line}", file=sys.stderr)
         rows.append((scene.title, verdict(result)))
     print(markdown(rows))

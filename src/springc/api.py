@@ -9,11 +9,13 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import TextIO
 
+from .errors import UsageError
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -21,9 +23,82 @@ from .pipeline import (
     compile_files,
     modification_value,
 )
-from .simulation import DEFAULT_SOLVER, SimulationOptions, SimulationResult, simulate_model
+from .simulation import (
+    DEFAULT_MAX_STEPS,
+    DEFAULT_SOLVER,
+    DEFAULT_TIME_LIMIT,
+    SimulationOptions,
+    SimulationResult,
+    simulate_model,
+)
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
+
+INTEGER_LIMIT = 2**31 - 1
+"""The largest magnitude of a value given to an Integer parameter (32-bit, as Modelica
+tools use)."""
+
+API_NAMES = {"start": "start", "stop": "stop", "interval": "interval", "rtol": "rtol",
+             "atol": "atol", "step": "step", "parameters": "parameters"}
+"""How :func:`check_run_values` names each value: the keywords of :func:`simulate`."""
+
+
+def _number(value: object, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise UsageError(f"{name} must be a number, not {value!r}", option=name)
+    return float(value)
+
+
+def check_run_values(start: float | None = None, stop: float | None = None,
+                     interval: float | None = None, rtol: float | None = None,
+                     atol: float | None = None, step: float | None = None,
+                     parameters: Mapping[str, float] | None = None,
+                     names: Mapping[str, str] = API_NAMES) -> None:
+    """Refuse values no run can use, before any work, with a :class:`UsageError` naming
+    the value as ``names`` spells it (the command line passes its option names).
+
+    Times must be finite, ``stop`` after ``start``; ``interval`` and ``step`` finite and
+    positive; ``rtol`` in (0, 1); ``atol`` finite and positive; parameter values finite.
+    """
+    def finite(value: float | None, key: str) -> float | None:
+        if value is None:
+            return None
+        number = _number(value, names[key])
+        if not math.isfinite(number):
+            raise UsageError(f"{names[key]} must be a finite number, not {number!r}",
+                             option=names[key])
+        return number
+
+    first, last = finite(start, "start"), finite(stop, "stop")
+    if first is not None and last is not None and not last > first:
+        raise UsageError(f"{names['stop']} ({last:g}) must be after {names['start']} "
+                         f"({first:g})", option=names["stop"])
+    for key, value in (("interval", interval), ("step", step), ("atol", atol)):
+        number = finite(value, key)
+        if number is not None and not number > 0:
+            raise UsageError(f"{names[key]} must be a finite number > 0, not {number!r}",
+                             option=names[key])
+    if rtol is not None:
+        number = _number(rtol, names["rtol"])
+        if not 0 < number < 1:
+            raise UsageError(f"{names['rtol']} must be a finite number in (0, 1), not "
+                             f"{number!r}", option=names["rtol"])
+    for name, value in (parameters or {}).items():
+        number = _number(value, f"the value of {name}")
+        if not math.isfinite(number):
+            raise UsageError(f"{names['parameters']}: the value of '{name}' must be a "
+                             f"finite number, not {number!r}", option=names["parameters"])
+
+
+def _check_integers(model: CompiledModel, values: Mapping[str, float]) -> None:
+    """Integer parameters take whole numbers of at most :data:`INTEGER_LIMIT`."""
+    types = dict(zip(model.module.PARAMETERS, getattr(model.module, "PARAMETER_TYPES", ())))
+    for name, value in values.items():
+        if types.get(name) == "Integer" and not (
+                abs(value) <= INTEGER_LIMIT and float(value) == int(value)):
+            raise UsageError(f"'{name}' is an Integer parameter: {value!r} is not a whole "
+                             f"number of magnitude at most {INTEGER_LIMIT}",
+                             option="parameters")
 
 
 def _files(files: Files) -> tuple[str, ...]:
@@ -44,6 +119,7 @@ def compile_model(files: Files, model: str | None = None, *,
     which re-flattens the model; other parameters are inputs of the generated code
     and are better passed to :func:`simulate`.
     """
+    check_run_values(parameters=parameters)
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
                              backend, tuple(outputs) if outputs is not None else None,
                              (), cache)
@@ -53,6 +129,7 @@ def compile_model(files: Files, model: str | None = None, *,
     # (all outputs: the selection may name variables that only the modified one has).
     base = compile_files(replace(options, outputs=None))
     check_parameter_names(base, parameters)
+    _check_integers(base, parameters)
     structural = {k: v for k, v in parameters.items() if k in base.structural}
     if not structural:
         return compile_files(options)
@@ -74,7 +151,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              parameters: Mapping[str, float] | None = None,
              outputs: Sequence[str] | None = None, backend: str = "python",
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
-             progress: TextIO | None = None, step: float | None = None
+             progress: TextIO | None = None, step: float | None = None,
+             max_steps: int | None = None, time_limit: float | None = None
              ) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
@@ -83,7 +161,10 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     ``"auto"`` (dop853 or radau from a stiffness estimate), a scipy method, or a
     fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
+    A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
+    seconds (``None``: 20,000,000 steps, one hour).
     """
+    check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
         model = compile_model(model, model_name, libraries=libraries, backend=backend,
@@ -91,9 +172,11 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
         structural = {k for k, v in model.options.modifications}
     else:
         check_parameter_names(model, values)
+        _check_integers(model, values)
         structural = {k for k in values if k in model.structural}
         model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
-                                step)
+                                step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
+                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit)
     return simulate_model(model, options)

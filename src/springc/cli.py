@@ -1,25 +1,55 @@
-"""Command-line interface: click options -> library calls -> text on stdout.
+"""Command-line interface: click options -> checked values and frozen options objects ->
+library calls -> text on stdout.
 
-Exit codes: 0 success, 1 model errors (diagnostics on stderr), 2 usage errors,
-3 internal errors (traceback only with ``--debug``).
+Exit codes: 0 success, 1 model errors (diagnostics on stderr), 2 usage errors (a bad
+option value, an output file springc refuses to write), 3 internal errors (traceback
+only with ``--debug``); 130 after Ctrl-C, 143 after SIGTERM, 141 when stdout is a pipe
+closed early (``springc simulate m.mdl | head -1``), quietly. Unfinished output files
+are removed in every case (:mod:`springc.fileio`).
 """
 
 from __future__ import annotations
 
 import functools
 import json
+import os
+import signal
 import sys
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from types import FrameType
 from typing import Any
 
 import click
 
-from .errors import ErrorGroup, SpringcError, render_all
+from .errors import ErrorGroup, OutputError, SpringcError, UsageError, render_all
+from .simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
 
 EXIT_MODEL_ERROR = 1
 EXIT_USAGE = 2
 EXIT_INTERNAL = 3
+EXIT_BROKEN_PIPE = 128 + signal.SIGPIPE
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+
+CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
+             "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}
+"""How the checks of :func:`springc.api.check_run_values` name the options."""
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM ends the run as an exception, so that unfinished outputs are removed."""
+    raise SystemExit(128 + signum)
+
+
+def _silence_stdout() -> None:
+    """After a closed pipe: send what is left in stdout's buffer nowhere."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass  # stdout is not a real file (a test runner's buffer)
+    finally:
+        os.close(devnull)
 
 
 def _guard(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -30,10 +60,19 @@ def _guard(func: Callable[..., Any]) -> Callable[..., Any]:
         debug = click.get_current_context().find_root().params.get("debug", False)
         try:
             return func(*args, **kwargs)
+        except UsageError as err:
+            click.echo(str(err), err=True)
+            sys.exit(EXIT_USAGE)
         except (SpringcError, ErrorGroup) as err:
             click.echo(render_all(err), err=True)
             sys.exit(EXIT_MODEL_ERROR)
-        except (click.exceptions.Exit, click.ClickException, KeyboardInterrupt):
+        except KeyboardInterrupt:
+            click.echo("interrupted", err=True)
+            sys.exit(EXIT_INTERRUPTED)
+        except BrokenPipeError:
+            _silence_stdout()
+            sys.exit(EXIT_BROKEN_PIPE)
+        except (click.exceptions.Exit, click.ClickException):
             raise
         except Exception as err:
             if debug:
@@ -64,6 +103,11 @@ def _model_options(func: Callable[..., Any]) -> Callable[..., Any]:
 @click.version_option(package_name="springc")
 def main(debug: bool) -> None:
     """springc: compile and simulate spring-mass models written in a Modelica subset."""
+    try:
+        if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
+            signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:
+        pass  # not the main thread: leave signals alone
 
 
 @main.command()
@@ -108,10 +152,6 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
 
 # ------------------------------------------------------------------ simulate, compile
 
-SOLVER_CHOICES = ("auto", "rk45", "dop853", "radau", "bdf", "lsoda",  # simulation.SOLVERS
-                  "verlet", "symplectic-euler", "rk4")  # simulation.FIXED_STEP
-
-
 def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
     out: dict[str, float] = {}
     for item in values:
@@ -128,6 +168,42 @@ def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
             raise click.BadParameter(f"'{text}' is not a number (in '{item}')",
                                      param_hint="--set") from None
     return out
+
+
+def _check_outputs(outputs: Sequence[tuple[str, str | None, dict[str, str] | None]],
+                   protected: Sequence[str]) -> None:
+    """Refuse, before any work, outputs that cannot be written: ``(option, path,
+    formats by suffix or None)``; a UsageError names the option."""
+    from .fileio import check_distinct, check_target
+    from .simulation import file_format
+
+    given = [(option, path, formats) for option, path, formats in outputs if path]
+    try:
+        for option, path, formats in given:
+            if formats is not None:
+                file_format(path, formats, option)
+            try:
+                check_target(path, protected)
+            except OutputError as err:
+                raise UsageError(f"{option}: {err.message}", option=option,
+                                 hint=err.hint) from None
+        check_distinct((option, path) for option, path, _ in given)
+    except OutputError as err:
+        raise UsageError(err.message, hint=err.hint) from None
+
+
+def _run_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """The options of a run shared by ``simulate`` and ``tradeoff``."""
+    func = click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
+                        help="Set a parameter (repeatable); array sizes re-flatten the "
+                        "model.")(func)
+    func = click.option("--interval", type=float,
+                        help="Output interval [s] (default: experiment, else "
+                        "(stop-start)/500).")(func)
+    func = click.option("--stop", type=float,
+                        help="Stop time [s] (default: experiment, else 10).")(func)
+    return click.option("--start", type=float,
+                        help="Start time [s] (default: experiment, else 0).")(func)
 
 
 def _compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -155,12 +231,9 @@ def _single_threaded_blas() -> None:
 @main.command()
 @_model_options
 @_compile_options
-@click.option("--start", type=float, help="Start time [s] (default: experiment, else 0).")
-@click.option("--stop", type=float, help="Stop time [s] (default: experiment, else 10).")
-@click.option("--interval", type=float,
-              help="Output interval [s] (default: experiment, else (stop-start)/500).")
-@click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
-              default="auto", show_default=True,
+@_run_options
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True,
               help="auto: dop853 or radau from a stiffness estimate at the start (the "
               "summary says why); a scipy solve_ivp method; or a fixed-step one "
               "(verlet, symplectic-euler, rk4) with --step.")
@@ -169,41 +242,51 @@ def _single_threaded_blas() -> None:
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
               "Tolerance, else 1e-6).")
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
-@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
-              help="Set a parameter (repeatable); array sizes re-flatten the model.")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Stop with an error after this many integrator steps (default "
+              "20,000,000).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Stop with an error after this many seconds of wall clock (default "
+              "3600).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
-              help="Write the trajectory as CSV (default: stdout unless --plot).")
-@click.option("--plot", type=click.Path(dir_okay=False), help="Write a PNG plot.")
+              help="Write the trajectory: .csv, or .mat (the MATLAB v4 result layout of "
+              "OpenModelica and Dymola); default: CSV on stdout unless --plot.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write a plot: .png, .svg or .pdf.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
 @_guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, rtol: float | None,
              step: float | None, atol: float | None, assignments: tuple[str, ...],
-             output: str | None, plot: str | None, quiet: bool) -> None:
-    """Simulate a model and write its trajectory (CSV) and/or a plot (PNG)."""
+             max_steps: int | None, time_limit: float | None, output: str | None,
+             plot: str | None, quiet: bool) -> None:
+    """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
+    from .api import check_run_values
+    from .simulation import PLOT_FORMATS, RESULT_FORMATS
+
     values = _parse_set(assignments)
-    if solver.lower() in SOLVER_CHOICES[-3:] and step is None:
+    if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
-    if step is not None and not step > 0:
-        raise click.BadParameter(f"{step:g} is not positive", param_hint="--step")
+    check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
+    _check_outputs([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
+                   files)
     _single_threaded_blas()
     from .api import simulate as run
+    from .simulation import save_outputs, write_csv
 
     progress = None if quiet or not sys.stderr.isatty() else sys.stderr
     result = run(files, model_name=model, libraries=libraries, backend=backend,
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step)
-    if output:
-        result.to_csv(output)
-    elif not plot:
-        from .simulation import write_csv
-
+                 parameters=values, progress=progress, step=step, max_steps=max_steps,
+                 time_limit=time_limit)
+    if output or plot:
+        save_outputs(result, output, plot, files)
+    else:
         write_csv(result, sys.stdout)
-    if plot:
-        result.plot(plot)
+        sys.stdout.flush()
     if not quiet:
         click.echo(result.stats.summary(result.model), err=True)
 
@@ -220,14 +303,13 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     """Generate a standalone Python module (numpy/scipy, or numba) for a model."""
     from .pipeline import CompileOptions, compile_files
 
+    _check_outputs([("-o", output, None)], files)
     compiled = compile_files(CompileOptions(files, model, libraries, backend,
                                             patterns or None, (), not no_cache))
     if output:
-        from pathlib import Path
-
         from .fileio import atomic_write
 
-        with atomic_write(Path(output), "w") as f:
+        with atomic_write(output, "w", files) as f:
             f.write(compiled.source)
     else:
         click.echo(compiled.source, nl=False)
@@ -277,12 +359,7 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @main.command()
 @_model_options
 @_compile_options
-@click.option("--start", type=float, help="Start time [s] (default: experiment, else 0).")
-@click.option("--stop", type=float, help="Stop time [s] (default: experiment, else 10).")
-@click.option("--interval", type=float,
-              help="Output interval [s] (default: experiment, else (stop-start)/500).")
-@click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
-              help="Set a parameter (repeatable); array sizes re-flatten the model.")
+@_run_options
 @click.option("--solvers", callback=_solver_list, metavar="LIST",
               help="Solvers to compare, e.g. 'dop853,radau' (default: rk45 dop853 radau "
               "bdf lsoda and the fixed-step ones).")
@@ -305,9 +382,9 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
               show_default=True, help="Seconds per run: a longer run is stopped and the "
               "solver's tighter settings are skipped.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
-              help="Write the table as CSV.")
+              help="Write the table as CSV (.csv).")
 @click.option("--plot", type=click.Path(dir_okay=False),
-              help="Write the work-precision plot (PNG).")
+              help="Write the work-precision plot: .png, .svg or .pdf.")
 @click.option("--energy", metavar="NAME",
               help="Variable whose drift is reported per run (default: the only "
               "variable in J, if any).")
@@ -327,7 +404,14 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
     are compared; --vars selects other variables.
     """
+    from .api import check_run_values
+    from .simulation import PLOT_FORMATS
+
     values = _parse_set(assignments)
+    check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
+    inputs = (*files, *([reference] if reference else []))
+    _check_outputs([("-o", output, {".csv": "csv"}), ("--plot", plot, PLOT_FORMATS),
+                    ("--save-reference", save_reference, {".csv": "csv"})], inputs)
     _single_threaded_blas()
     from .api import compile_model
     from .tradeoff import (
@@ -336,8 +420,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         TradeoffOptions,
         compare_states,
         run_tradeoff,
+        save_study,
         summary,
-        write_table_csv,
     )
 
     compiled = compile_model(files, model, libraries=libraries, backend=backend,
@@ -346,19 +430,11 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if not patterns:
         compiled = compare_states(compiled)
     rest = {k: v for k, v in values.items() if k not in compiled.structural}
-    options = TradeoffOptions(solvers, tolerances or DEFAULT_TOLERANCES, steps,
-                              targets or DEFAULT_TARGETS, reference, repeats, budget,
-                              start, stop, interval, rest, None if quiet else sys.stderr,
-                              energy)
+    options = TradeoffOptions(
+        solvers=solvers, tolerances=tolerances or DEFAULT_TOLERANCES, steps=steps,
+        targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
+        budget=budget, start=start, stop=stop, interval=interval, parameters=rest,
+        log=None if quiet else sys.stderr, energy=energy)
     study = run_tradeoff(compiled, options)
     click.echo(summary(study), nl=False)
-    if save_reference:
-        from .tradeoff import write_reference
-
-        write_reference(study.reference, save_reference)
-    if output:
-        write_table_csv(study, output)
-    if plot:
-        from .tradeoff import write_work_precision
-
-        write_work_precision(study, plot)
+    save_study(study, table=output, plot=plot, reference=save_reference, protected=inputs)

@@ -49,6 +49,24 @@ class SpringcError(Exception):
         self.notes = tuple(notes)
         self.hint = hint
 
+    def __str__(self) -> str:
+        """The rendered text, as the command line shows it (location, notes, help)."""
+        return render(self)
+
+
+class UsageError(SpringcError):
+    """A value given to springc (a command-line option or an API argument) that it
+    cannot use; ``option`` names it. The command line exits with code 2."""
+
+    def __init__(self, message: str, *, option: str | None = None,
+                 notes: Iterable[Note] = (), hint: str | None = None) -> None:
+        super().__init__(message, None, notes, hint)
+        self.option = option
+
+
+class OutputError(SpringcError):
+    """An output file that springc refuses to write or cannot write."""
+
 
 class ParseError(SpringcError):
     """Lexical or syntax error, or a construct that is not supported yet."""
@@ -83,12 +101,19 @@ class SimulationError(SpringcError):
     """The solver failed; the message names the time and the quantity at fault."""
 
 
+class CodegenError(SpringcError):
+    """The model uses something the code generator cannot translate."""
+
+
 class ErrorGroup(Exception):
     """Several independent errors reported together, in source order."""
 
     def __init__(self, errors: Iterable[SpringcError]) -> None:
         self.errors = tuple(errors)
         super().__init__(f"{len(self.errors)} errors")
+
+    def __str__(self) -> str:
+        return render_all(self)
 
 
 def errors_of(exc: SpringcError | ErrorGroup) -> tuple[SpringcError, ...]:

@@ -1,35 +1,184 @@
-"""Writing files safely: one atomic writer for every output springc produces."""
+"""Writing files safely: one writer for every file springc produces.
+
+The policy, for every output (``-o``, ``--plot``, ``--save-reference``, the cache):
+
+- **What may be replaced.** Only a regular file, or a name that does not exist yet.
+  Folders, devices, FIFOs and sockets are refused, and so are the run's input files
+  (``protected``) and files without any write permission bit (read-only files are
+  honoured even when springc runs as root).
+- **Symbolic links are followed**, as ``cp`` and a shell's ``>`` follow them: the file
+  the link points to is replaced (the same checks apply to it) and the link itself
+  stays a link. Replacing the link by a plain file would silently cut it.
+- **Nothing half-written.** Data goes to a temporary file (``.NAME.XXXX.part``) in the
+  target's folder, created exclusively (never through a link) with the permissions
+  ``open()`` would give (0666 less the umask; a replaced file keeps its mode). Only a
+  complete file is renamed over the target. On any error, ``KeyboardInterrupt`` or
+  ``SystemExit`` (the command line turns SIGTERM into one) the temporary file is
+  removed.
+- **All or nothing.** :class:`OutputSet` renders several outputs to their temporary
+  files and renames them only once every one is complete, so a failing plot never
+  leaves a fresh CSV next to a stale PNG.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import os
-import tempfile
-from collections.abc import Iterator
+import secrets
+import stat
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
+from .errors import OutputError
+
+PathLike = str | os.PathLike[str]
+
+
+def real_target(path: PathLike) -> Path:
+    """The file that writing ``path`` would replace (symbolic links followed)."""
+    return Path(os.path.realpath(os.fspath(path)))
+
+
+def _writable(mode: int) -> bool:
+    return bool(mode & (stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH))
+
+
+def _same_file(a: Path, b: PathLike) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_target(path: PathLike, protected: Iterable[PathLike] = ()) -> Path:
+    """The real path that writing ``path`` would replace, after the checks of the module
+    text; :class:`~springc.errors.OutputError` names ``path`` and the reason."""
+    shown = os.fspath(path)
+    if not shown:
+        raise OutputError("the output file name is empty")
+    real = real_target(path)
+    folder = real.parent
+    try:
+        folder_mode = folder.stat().st_mode
+    except OSError:
+        raise OutputError(f"cannot write '{shown}': the folder '{folder}' does not exist",
+                          hint="create the folder first, or choose another path") from None
+    if not stat.S_ISDIR(folder_mode):
+        raise OutputError(f"cannot write '{shown}': '{folder}' is not a folder")
+    if not (_writable(folder_mode) and os.access(folder, os.W_OK | os.X_OK)):
+        raise OutputError(f"cannot write '{shown}': the folder '{folder}' is read-only")
+    try:
+        st = real.stat()
+    except FileNotFoundError:
+        return real
+    except OSError as err:
+        raise OutputError(f"cannot write '{shown}': {err.strerror}") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise OutputError(f"cannot write '{shown}': it is a folder")
+    if not stat.S_ISREG(st.st_mode):
+        raise OutputError(f"refusing to write '{shown}': it is not a regular file (a "
+                          "device, FIFO or socket)",
+                          hint="springc writes its outputs to regular files only")
+    if not (_writable(st.st_mode) and os.access(real, os.W_OK)):
+        raise OutputError(f"cannot write '{shown}': the file is read-only",
+                          hint="make it writable (chmod u+w) or choose another path")
+    for source in protected:
+        if _same_file(real, source):
+            raise OutputError(f"refusing to write '{shown}': it is an input of this run "
+                              f"('{os.fspath(source)}')",
+                              hint="choose another output path")
+    return real
+
+
+def check_distinct(paths: Iterable[tuple[str, PathLike]]) -> None:
+    """Refuse two outputs of one run that name the same file: ``(option, path)`` pairs
+    (links followed, hard links caught once the file exists)."""
+    seen: list[tuple[str, Path]] = []
+    for option, path in paths:
+        real = real_target(path)
+        for other, other_real in seen:
+            if real == other_real or _same_file(real, other_real):
+                raise OutputError(f"{other} and {option} name the same file "
+                                  f"'{os.fspath(path)}'",
+                                  hint="give each output its own file")
+        seen.append((option, real))
+
+
+@dataclass
+class _Staged:
+    target: Path
+    temporary: Path
+    mode: int
+
+
+class OutputSet:
+    """Outputs written together (see the module text): open each with :meth:`open`;
+    leaving the ``with`` block renames them all, or, on an error, removes them all."""
+
+    def __init__(self, protected: Iterable[PathLike] = ()) -> None:
+        self.protected = tuple(protected)
+        self.staged: list[_Staged] = []
+
+    def __enter__(self) -> OutputSet:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, *rest: object) -> None:
+        if kind is not None:
+            self.discard()
+            return
+        try:
+            for item in self.staged:
+                # the target may have changed since it was checked: check again
+                check_target(item.target, self.protected)
+                try:
+                    os.chmod(item.temporary, item.mode)
+                    os.replace(item.temporary, item.target)
+                except OSError as err:
+                    raise OutputError(f"cannot write '{item.target}': {err.strerror}") \
+                        from None
+        except BaseException:
+            self.discard()
+            raise
+        self.staged.clear()
+
+    def discard(self) -> None:
+        """Remove every temporary file not renamed yet."""
+        for item in self.staged:
+            with contextlib.suppress(OSError):
+                os.unlink(item.temporary)
+        self.staged.clear()
+
+    @contextlib.contextmanager
+    def open(self, path: PathLike, mode: str) -> Iterator[IO[Any]]:
+        """A file to write ``path``'s content to (``"w"``: UTF-8 text, ``"wb"``: bytes)."""
+        target = check_target(path, self.protected)
+        try:
+            old_mode = stat.S_IMODE(target.stat().st_mode)
+        except FileNotFoundError:
+            old_mode = None
+        temporary = target.parent / f".{target.name}.{secrets.token_hex(4)}.part"
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+        try:
+            fd = os.open(temporary, flags, 0o666)  # the umask applies, as for open()
+        except OSError as err:
+            raise OutputError(f"cannot write '{os.fspath(path)}': {err.strerror}") from None
+        mode_now = old_mode if old_mode is not None else stat.S_IMODE(os.fstat(fd).st_mode)
+        item = _Staged(target, temporary, mode_now)
+        self.staged.append(item)
+        binary = "b" in mode
+        try:
+            with (os.fdopen(fd, "wb") if binary else
+                  os.fdopen(fd, "w", encoding="utf-8", newline="")) as f:
+                yield f
+        except OSError as err:
+            raise OutputError(f"cannot write '{os.fspath(path)}': {err.strerror}") from None
+
 
 @contextlib.contextmanager
-def atomic_write(path: Path, mode: str) -> Iterator[IO[Any]]:
-    """Write to a temporary file next to ``path``; rename it only on success."""
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, mode, **({"encoding": "utf-8", "newline": ""} if "b" not in mode
-                                    else {})) as f:
-            yield f
-        # mkstemp creates the file private (0600); give it the permissions a plain
-        # open() would have given (0666 less the umask).
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+def atomic_write(path: PathLike, mode: str, protected: Iterable[PathLike] = ()
+                 ) -> Iterator[IO[Any]]:
+    """Write ``path`` through a temporary file next to it; rename only on success."""
+    with OutputSet(protected) as outputs, outputs.open(path, mode) as f:
+        yield f

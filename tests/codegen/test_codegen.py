@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import springc
-from springc.codegen.printer import Let, Namer, Raw, Store, function_lines
+from springc.codegen.printer import function_lines
+from springc.codegen.statements import Let, Namer, Raw, Store
 from springc.ir.expr import BinOp, Call, Const, If, Var
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -12,7 +12,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.errors import SimulationError
+from springc.errors import SimulationError, UsageError
 from springc.pipeline.files import flatten_files
 from springc.simplify.passes import simplify
 from springc.simulation import race
@@ -138,16 +138,16 @@ def test_auto_races_to_the_implicit_method_when_the_explicit_one_is_held(
 
 def test_auto_falls_back_to_the_implicit_method_when_the_explicit_probe_fails(
         models: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    from springc.simulation import runner as simulation
+    from springc.simulation import steps
 
-    real = simulation._Run.advance
+    real = steps.StepLoop.advance
 
     def failing(run: object, integrator: object, max_steps: int | None = None) -> object:
         if type(integrator).__name__ == "DOP853":
-            raise simulation._Stop(SimulationError("overflow in a trial stage"))
+            raise steps.Stop(SimulationError("overflow in a trial stage"))
         return real(run, integrator, max_steps)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(simulation._Run, "advance", failing)
+    monkeypatch.setattr(steps.StepLoop, "advance", failing)
     result = springc.simulate(models, model_name="StiffPair", stop=1.0)
     assert result.stats.solver == "radau"
     assert result.stats.reason == "dop853 failed in its first steps (overflow in a trial stage)"
@@ -169,7 +169,7 @@ def test_fixed_step_needs_a_step(models: str) -> None:
         springc.simulate(models, model_name="Harmonic", solver="verlet")
     with pytest.raises(SimulationError, match="more than 2e\\+07"):
         springc.simulate(models, model_name="Harmonic", solver="verlet", step=1e-9)
-    with pytest.raises(SimulationError, match="the step must be positive and finite"):
+    with pytest.raises(UsageError, match="step must be a finite number, not inf"):
         springc.simulate(models, model_name="Harmonic", solver="rk4", step=float("inf"))
 
 
@@ -181,7 +181,8 @@ def test_cli_fixed_step_usage_errors(models: str) -> None:
     assert "--solver verlet is a fixed-step solver and needs --step H" in result.output
     result = runner.invoke(main, ["simulate", models, "--model", "Harmonic", "--solver",
                                   "rk4", "--step", "-1"])
-    assert result.exit_code == 2 and "-1 is not positive" in result.output
+    assert result.exit_code == 2
+    assert "error: --step must be a finite number > 0, not -1.0" in result.output
 
 
 def test_unstable_step_fails_with_the_remedy_and_no_csv(models: str, tmp_path: Path) -> None:

@@ -14,9 +14,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.tradeoff.plot import write_work_precision
-from springc.tradeoff.report import recommend, write_table_csv
-from springc.tradeoff.study import (
+from springc.tradeoff.model import (
     CSV_COLUMNS,
     SCIPY_DEFAULT,
     SCIPY_RK45,
@@ -25,12 +23,11 @@ from springc.tradeoff.study import (
     Tradeoff,
     TradeoffError,
     TradeoffOptions,
-    compare_states,
-    fixed_step_solvers,
-    relative_errors,
-    run_tradeoff,
-    variable_scales,
 )
+from springc.tradeoff.plot import write_work_precision
+from springc.tradeoff.report import recommend, write_table_csv
+from springc.tradeoff.setup import relative_errors, variable_scales
+from springc.tradeoff.study import compare_states, fixed_step_solvers, run_tradeoff
 
 OSCILLATOR = """
 model Oscillator "x'' = -4 x: x = cos(2 t), v = -2 sin(2 t)"
@@ -246,11 +243,12 @@ def test_cli_bad_reference_csv(oscillator: str, tmp_path: Path) -> None:
 
 
 def test_budget_stops_runs(oscillator: str) -> None:
-    from springc.tradeoff.study import OverBudget, _Deadline
+    from springc.tradeoff.model import OverBudget
+    from springc.tradeoff.setup import Deadline
 
     with pytest.raises(OverBudget):
-        _Deadline(0.0).write("progress")
-    _Deadline(60.0).write("progress")
+        Deadline(0.0).write("progress")
+    Deadline(60.0).write("progress")
     # The scipy baselines check the budget every 64 RHS evaluations.
     model = compare_states(springc.compile_model(oscillator))
     study = run_tradeoff(model, TradeoffOptions(("dop853",), (1e-6,), repeats=1,

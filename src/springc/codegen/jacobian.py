@@ -17,9 +17,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ..errors import CodegenError
 from ..ir import ode
 from ..ir.expr import ONE, ZERO, BinOp, Const, Expr, Neg, Var, add, diff, mul, neg, sub, variables
-from .printer import Block, CodegenError, Let, Load, Raw, Stmt, Store
+from .statements import Block, Let, Load, Raw, Stmt, Store
 
 Grad = dict[int, Expr]
 
@@ -142,9 +143,9 @@ class JacobianBuilder:
             body.append(Raw(f"_J{index} = np.zeros(({k}, {k}))"))
             body += [Store(f"_J{index}[{i}, {j}]", e) for (i, j), e in entries.items()]
             body.append(Raw(f"_R{index} = np.zeros(({k}, {len(order)}))"))
-            for i, g in enumerate(residual_grads):
-                body += [Store(f"_R{index}[{i}, {c}]", g[j]) for c, j in enumerate(order)
-                         if j in g]
+            for i, residual in enumerate(residual_grads):
+                body += [Store(f"_R{index}[{i}, {c}]", residual[j])
+                         for c, j in enumerate(order) if j in residual]
             body.append(Raw(f"_S{index} = np.linalg.solve(_J{index}, _R{index})"))
             for i, t in enumerate(block.tearing):
                 grad = {}

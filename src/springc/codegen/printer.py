@@ -1,11 +1,9 @@
-"""Statements of generated functions -> Python source lines, with shared subexpressions.
+"""Statements of generated functions (:mod:`.statements`) -> Python source lines.
 
-The code generator (:mod:`springc.codegen`) describes each generated function as a
-list of small statements over flat names (:class:`Let`, :class:`Store`,
-:class:`Load`, :class:`Raw`, grouped in :class:`Block` and :class:`Loop`). This
-module removes statements whose results nobody uses, finds common subexpressions by
-hash-consing the frozen expression trees, and prints everything as Python that runs
-unchanged under plain CPython (``math``/numpy) and under ``numba.njit``.
+After dead-code removal (``statements.prune``) this module finds common
+subexpressions by hash-consing the frozen expression trees, and prints everything as
+Python that runs unchanged under plain CPython (``math``/numpy) and under
+``numba.njit``.
 
 Printing follows sympy's printers: one ``_print_<Node>`` method per expression class,
 helpers collected while printing, unsupported nodes refused explicitly.
@@ -13,173 +11,24 @@ helpers collected while printing, unsupported nodes refused explicitly.
 
 from __future__ import annotations
 
-import builtins
-import keyword
 import math
-import re
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field
+from typing import ClassVar
 
-from ..errors import SimulationError
+from ..errors import CodegenError
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
-
-# ------------------------------------------------------------------ statements
-
-
-@dataclass
-class Let:
-    """``name = expr`` (``name`` a flat or internal name), with a trailing comment."""
-
-    name: str
-    expr: Expr
-    comment: str = ""
-
-
-@dataclass
-class Load:
-    """``name = source`` where ``source`` is Python text such as ``x[3]``."""
-
-    name: str
-    source: str
-    comment: str = ""
-
-
-@dataclass
-class Store:
-    """``target = expr`` where ``target`` is Python text such as ``dx[3]``."""
-
-    target: str
-    expr: Expr
-    comment: str = ""
-
-
-@dataclass
-class Raw:
-    """A line of Python that refers only to internal names (``_A1 = np.zeros(...)``)."""
-
-    text: str
-
-
-@dataclass
-class Loop:
-    """``header`` (e.g. ``for _it in range(50):``) with an indented body."""
-
-    header: str
-    body: list[Stmt]
-
-
-@dataclass
-class Block:
-    """Statements kept or dropped together (a linear or nonlinear system)."""
-
-    body: list[Stmt]
-    comment: str = ""
-    defines: set[str] = field(default_factory=set)
-    uses: set[str] = field(default_factory=set)
-
-
-Stmt = Let | Load | Store | Raw | Loop | Block
-
-# ------------------------------------------------------------------ names
-
-# Every identifier the module templates define or use (locals, loop variables, module
-# functions, constants and imports): model names must never shadow them.
-_RESERVED = frozenset({
-    "t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out", "abs", "min", "max",
-    "float", "int", "range", "len", "bool", "values", "numba", "scipy", "base64", "zlib",
-    "x0", "n", "i", "j", "k", "v", "ts", "given", "unknown", "name", "X",
-    "parameters", "start", "guesses", "rhs", "observed", "observed_grid", "jacobian",
-    "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
-    "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
-    "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
-    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "JAC_ROWS",
-    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR",
-}) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
-
-
-class Namer:
-    """Flat names -> Python identifiers: ``mass.pos[1]`` -> ``mass_pos_1``.
-
-    Internal names (starting with ``_``) are used verbatim; model names never start
-    with ``_`` once sanitized, so the two never collide.
-    """
-
-    def __init__(self) -> None:
-        self._ident: dict[str, str] = {}
-        self._used: set[str] = set(_RESERVED)
-
-    def __call__(self, name: str) -> str:
-        if name.startswith("_"):
-            return name
-        ident = self._ident.get(name)
-        if ident is None:
-            ident = self._fresh(name)
-            self._ident[name] = ident
-        return ident
-
-    def _fresh(self, name: str) -> str:
-        base = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_") or "v"
-        if base[0].isdigit():
-            base = "v_" + base
-        ident, n = base, 1
-        while ident in self._used:
-            n += 1
-            ident = f"{base}_{n}"
-        self._used.add(ident)
-        return ident
-
-
-# ------------------------------------------------------------------ dead code
-
-
-def uses_of(stmt: Stmt) -> set[str]:
-    """Flat and internal names read by ``stmt`` (minus those a block defines itself)."""
-    if isinstance(stmt, (Let, Store)):
-        return variables(stmt.expr)
-    if isinstance(stmt, (Load, Raw)):
-        return set()
-    body = stmt.body
-    used: set[str] = set()
-    for s in body:
-        used |= uses_of(s)
-    extra = stmt.uses if isinstance(stmt, Block) else set()
-    return (used - _defines_inside(body)) | extra
-
-
-def _defines_inside(body: Sequence[Stmt]) -> set[str]:
-    out: set[str] = set()
-    for s in body:
-        if isinstance(s, (Let, Load)):
-            out.add(s.name)
-        elif isinstance(s, (Loop, Block)):
-            out |= _defines_inside(s.body)
-    return out
-
-
-def defines_of(stmt: Stmt) -> set[str]:
-    if isinstance(stmt, (Let, Load)):
-        return {stmt.name}
-    if isinstance(stmt, Block):
-        return stmt.defines or _defines_inside(stmt.body)
-    if isinstance(stmt, Loop):
-        return _defines_inside(stmt.body)
-    return set()
-
-
-def prune(stmts: Sequence[Stmt]) -> list[Stmt]:
-    """Drop top-level statements whose results are never read (stores are kept)."""
-    live: set[str] = set()
-    kept: list[Stmt] = []
-    for stmt in reversed(stmts):
-        defines = defines_of(stmt)
-        if isinstance(stmt, (Let, Load, Block)) and not defines & live:
-            continue
-        live -= defines if isinstance(stmt, (Let, Load)) else set()
-        live |= uses_of(stmt)
-        kept.append(stmt)
-    kept.reverse()
-    return kept
-
+from .statements import (
+    Block,
+    Let,
+    Load,
+    Loop,
+    Raw,
+    Stmt,
+    Store,
+    defines_inside,
+    escaped,
+    prune,
+)
 
 # ------------------------------------------------------------------ printing
 
@@ -198,10 +47,6 @@ HELPERS = {
 }
 _HELPER_OF = {"sign": "_sign", "mod": "_mod", "div": "_div", "integer": "math.floor",
               "rem": "math.fmod"}
-
-
-class CodegenError(SimulationError):
-    """The model uses something the code generator cannot translate."""
 
 
 def _trivial(e: Expr) -> bool:
@@ -291,7 +136,7 @@ class FunctionWriter:
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
         if comment:
-            line += "  # " + comment.replace("\n", " ")
+            line += "  # " + escaped(comment)
         self.lines.append(line)
 
     def _stmt(self, stmt: Stmt) -> None:
@@ -319,10 +164,10 @@ class FunctionWriter:
                 self._emit(line)
         elif isinstance(stmt, Block):
             if stmt.comment:
-                self._emit("# " + stmt.comment)
+                self._emit("# " + escaped(stmt.comment))
             self.write(stmt.body)
         else:
-            for name in _defines_inside(stmt.body):
+            for name in defines_inside(stmt.body):
                 self._reassigned(name)
             self._emit(stmt.header)
             outer = self._indent
@@ -363,7 +208,8 @@ class FunctionWriter:
         return text, prec
 
     def _print(self, e: Expr) -> tuple[str, int]:
-        method = getattr(self, "_print_" + type(e).__name__, None)
+        method: Callable[[Expr], tuple[str, int]] | None = getattr(
+            self, "_print_" + type(e).__name__, None)
         if method is None:
             raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
         return method(e)
@@ -453,3 +299,41 @@ def function_lines(namer: Callable[[str], str], helpers: set[str], stmts: Sequen
     writer.count(kept)
     writer.write(kept)
     return writer.lines
+
+
+class NumpyWriter(FunctionWriter):
+    """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
+
+    _UFUNC: ClassVar[dict[str, str]] = {
+        "asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
+        "min": "minimum", "max": "maximum", "rem": "fmod", "integer": "floor"}
+    _SAME: ClassVar[set[str]] = {
+        "sqrt", "sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "log", "log10", "abs",
+        "sign", "mod", "floor", "ceil"}
+
+    def _print_Call(self, e: Call) -> tuple[str, int]:
+        if e.name in ("noEvent", "smooth", "homotopy"):
+            return super()._print_Call(e)
+        args = ", ".join(self.expr(a) for a in e.args)
+        if e.name == "div":
+            return f"np.trunc(np.divide({args}))", 9
+        if e.name in self._SAME:
+            return f"np.{e.name}({args})", 9
+        if e.name in self._UFUNC:
+            return f"np.{self._UFUNC[e.name]}({args})", 9
+        raise CodegenError(f"cannot generate code for the function '{e.name}'")
+
+    def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
+        if e.op in ("and", "or"):
+            fn = "logical_and" if e.op == "and" else "logical_or"
+            return f"np.{fn}({self.expr(e.left)}, {self.expr(e.right)})", 9
+        if e.op == "^":
+            return f"np.power({self.expr(e.left)}, {self.expr(e.right)})", 9
+        return super()._print_BinOp(e)
+
+    def _print_Not(self, e: Not) -> tuple[str, int]:
+        return f"np.logical_not({self.expr(e.arg)})", 9
+
+    def _print_If(self, e: If) -> tuple[str, int]:
+        return (f"np.where({self.expr(e.cond)}, {self.expr(e.then)}, "
+                f"{self.expr(e.otherwise)})", 9)

@@ -21,21 +21,17 @@ entries; ``jacobian_values`` gathers them in CSC order.
 
 from __future__ import annotations
 
-import base64
 import re
-import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
-from ..errors import Span
+from ..errors import CodegenError, Span
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
-from .printer import CodegenError, FunctionWriter, Store, function_lines
-
-if TYPE_CHECKING:
-    from .generator import _Model
+from .context import CodegenBug, CodegenContext
+from .printer import NumpyWriter, function_lines
+from .statements import Store, escaped
 
 VECTOR_THRESHOLD = 300
 """Systems with at least this many explicit assignments use the vector layout."""
@@ -92,72 +88,10 @@ def _shape(e: Expr, slots: list[str]) -> Expr:
     raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
 
 
-def encode_floats(values: Sequence[float]) -> str:
-    """Python text of a float64 array (exact): compressed base64."""
-    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.float64).tobytes(), 6))
-    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
-            "dtype=np.float64).copy()")
-
-
-def encode_strings(values: Sequence[str]) -> str:
-    """Python text of a tuple of strings (compressed when long)."""
-    if len(values) <= 32:
-        return repr(tuple(values))
-    data = base64.b64encode(zlib.compress("\n".join(values).encode(), 6))
-    return f"tuple(zlib.decompress(base64.b64decode({data.decode()!r})).decode().split('\\n'))"
-
-
-def encode_ints(values: Sequence[int]) -> str:
-    """Python text of an int64 array: a literal when short, else compressed base64."""
-    if len(values) <= 32:
-        return f"np.array({list(values)!r}, dtype=np.int64)"
-    data = base64.b64encode(zlib.compress(np.asarray(values, dtype=np.int64).tobytes(), 6))
-    return (f"np.frombuffer(zlib.decompress(base64.b64decode({data.decode()!r})), "
-            "dtype=np.int64).copy()")
-
-
-class NumpyWriter(FunctionWriter):
-    """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
-
-    _UFUNC: ClassVar[dict[str, str]] = {
-        "asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
-        "min": "minimum", "max": "maximum", "rem": "fmod", "integer": "floor"}
-    _SAME: ClassVar[set[str]] = {
-        "sqrt", "sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "log", "log10", "abs",
-        "sign", "mod", "floor", "ceil"}
-
-    def _print_Call(self, e: Call) -> tuple[str, int]:
-        if e.name in ("noEvent", "smooth", "homotopy"):
-            return super()._print_Call(e)
-        args = ", ".join(self.expr(a) for a in e.args)
-        if e.name == "div":
-            return f"np.trunc(np.divide({args}))", 9
-        if e.name in self._SAME:
-            return f"np.{e.name}({args})", 9
-        if e.name in self._UFUNC:
-            return f"np.{self._UFUNC[e.name]}({args})", 9
-        raise CodegenError(f"cannot generate code for the function '{e.name}'")
-
-    def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
-        if e.op in ("and", "or"):
-            fn = "logical_and" if e.op == "and" else "logical_or"
-            return f"np.{fn}({self.expr(e.left)}, {self.expr(e.right)})", 9
-        if e.op == "^":
-            return f"np.power({self.expr(e.left)}, {self.expr(e.right)})", 9
-        return super()._print_BinOp(e)
-
-    def _print_Not(self, e: Not) -> tuple[str, int]:
-        return f"np.logical_not({self.expr(e.arg)})", 9
-
-    def _print_If(self, e: If) -> tuple[str, int]:
-        return (f"np.where({self.expr(e.cond)}, {self.expr(e.then)}, "
-                f"{self.expr(e.otherwise)})", 9)
-
-
 class VectorLayout:
     """The grouped form of a system of explicit assignments, for one backend."""
 
-    def __init__(self, m: _Model, statements: Sequence[tuple[str, Expr, Span]],
+    def __init__(self, m: CodegenContext, statements: Sequence[tuple[str, Expr, Span]],
                  numba: bool, table_name: str = "_I", lift_constants: bool = False) -> None:
         self.m, self.numba, self.table_name = m, numba, table_name
         self.table: list[int] = []
@@ -179,8 +113,7 @@ class VectorLayout:
                 shape = _shape(e, slots)
             for v in slots:
                 if v not in self.location and v not in self.assignments:
-                    raise CodegenError(f"'{name}' reads '{v}', which nothing computes",
-                                       hint="this is a bug in springc")
+                    raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
             level = 1 + max((self.assignments[v].level for v in slots
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
@@ -327,8 +260,8 @@ class VectorLayout:
         """``stores`` of (target access, expression over slots) for every member."""
         first = run.members[0]
         count = len(run.members)
-        lines.append(f"    # {count} x {first.comment}" if count > 1 else
-                     f"    # {first.comment}")
+        comment = escaped(first.comment)
+        lines.append(f"    # {count} x {comment}" if count > 1 else f"    # {comment}")
         looped = self.numba and count > 1
         names = {f"${k}": acc("_q") for k, acc in enumerate(run.access[1:])}
         stmts = [Store(target("_q"), e) for target, e in stores]

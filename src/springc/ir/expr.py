@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,7 +91,7 @@ MATH: dict[str, Callable[..., float]] = {
     "noEvent": lambda x: x, "smooth": lambda p, x: x, "homotopy": lambda a, s: a,
 }
 
-_BINARY: dict[str, Callable[[object, object], object]] = {
+_BINARY: dict[str, Callable[[Any, Any], Any]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
     "/": lambda a, b: a / b, "^": lambda a, b: a**b,
     "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
@@ -154,7 +155,7 @@ def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
     raise TypeError(f"not an expression: {e!r}")
 
 
-def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> object:
+def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> Any:
     """Numeric value of ``e``; raises ``KeyError`` for a variable missing from ``env``."""
     if isinstance(e, Const):
         return e.value

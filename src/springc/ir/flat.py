@@ -123,9 +123,16 @@ class FlatModel:
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
+_Q_ESCAPES = {"\\": "\\\\", "'": "\\'", "\n": "\\n", "\r": "\\r", "\t": "\\t",
+              "\a": "\\a", "\b": "\\b", "\f": "\\f", "\v": "\\v"}
+
+
 def quote(name: str) -> str:
-    """A flat name as a Modelica identifier: ``mass.pos[1]`` becomes ``'mass.pos[1]'``."""
-    return name if _IDENT.match(name) else "'" + name.replace("'", "\\'") + "'"
+    """A flat name as a Modelica identifier: ``mass.pos[1]`` becomes ``'mass.pos[1]'``;
+    ``\\``, ``'`` and control characters are escaped as Q-IDENT's S-ESCAPE says."""
+    if _IDENT.match(name):
+        return name
+    return "'" + "".join(_Q_ESCAPES.get(c, c) for c in name) + "'"
 
 
 def _expr(e: Expr) -> str:

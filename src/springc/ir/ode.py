@@ -86,7 +86,7 @@ class ODE:
 
     def observed_names(self) -> list[str]:
         """Algebraic variables the user can ask for (derivative variables excluded)."""
-        computed = [n for n in self.step_names() if not n.startswith("der(")]
+        computed = [n for n in self.step_names() if not dae.is_derivative(n)]
         return computed + [a.name for a in self.observed]
 
 

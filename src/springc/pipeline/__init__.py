@@ -6,9 +6,12 @@ from .compiler import (
     check_parameter_names,
     compile_files,
     derive_system,
+    generate_source,
     modification_value,
+    select_names,
 )
 from .files import flatten_files
 
 __all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
-           "derive_system", "flatten_files", "modification_value"]
+           "derive_system", "flatten_files", "generate_source", "modification_value",
+           "select_names"]

@@ -1,40 +1,44 @@
 """Source files -> CompiledModel: flatten, simplify, generate, cache on disk, import.
 
-Generated modules are cached (the 200 most recently used) in ``$SPRINGC_CACHE_DIR``, else
-``$XDG_CACHE_HOME/springc``, else ``~/.cache/springc``, keyed by the text of every
-file that could be loaded (the named files and all ``.mdl`` files of the library
-folders), the model name, the options, and the installed springc's own files. A warm
-hit imports the module without flattening anything. Structural parameters (Integer or
-Boolean ones, and those the flattener evaluated, such as array sizes) are set by
-re-flattening the model with a modification (``extends M(N = 100)``).
+Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
+could be loaded, the model name, the options and springc's own code; verified by a
+recorded hash before import). A warm hit imports the module without flattening
+anything. Structural parameters (Integer or Boolean ones, and those the flattener
+evaluated, such as array sizes) are set by re-flattening the selected class with a
+modification (``extends M(N = 100)``), in the same class tree as the user's files.
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import difflib
-import hashlib
-import importlib.util
-import os
 import re
-import shutil
-import sys
 import tempfile
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import ModuleType
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
+from ..codegen import CodegenOptions, GeneratedModule, generate
 from ..errors import SimulationError
-from ..fileio import atomic_write
-from ..resources import PACKAGE_ROOT
-
-if TYPE_CHECKING:
-    from ..ir import flat, ode
-
+from ..flatten import flatten, select_model
+from ..ir import flat, ode, syntax
+from ..parse import ClassEntry, ClassTree, load, parse_text
+from ..simplify import simplify
+from .cache import (
+    CacheUnusable,
+    cache_dir,
+    cache_key,
+    discard,
+    import_module,
+    note,
+    private_folder,
+    prune_cache,
+    read_entry,
+    touch,
+    write_entry,
+)
 
 
 @dataclass(frozen=True)
@@ -57,15 +61,17 @@ class CompileOptions:
 
 @dataclass
 class CompiledModel:
-    """A generated module, imported, with the options that produced it."""
+    """A generated module, imported, with the options that produced it; ``temporary``
+    keeps the private folder of an uncached module alive as long as the model."""
 
-    module: ModuleType
+    module: GeneratedModule
     options: CompileOptions
     path: Path
     cached: bool
     compile_time: float
     outputs: tuple[str, ...] = field(default=())
-    _tmp: Any = None
+    temporary: tempfile.TemporaryDirectory[str] | None = None
+    text: str = ""  # the module's text as verified and imported (``source``)
 
     @property
     def name(self) -> str:
@@ -89,7 +95,8 @@ class CompiledModel:
 
     @property
     def source(self) -> str:
-        return self.path.read_text(encoding="utf-8")
+        """The text of the imported module (not re-read from the cache file)."""
+        return self.text or self.path.read_text(encoding="utf-8")
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
         """The parameter vector with ``values`` (non-structural names) applied."""
@@ -99,24 +106,46 @@ class CompiledModel:
 
 # ------------------------------------------------------------------ selection
 
-def _pattern(text: str) -> re.Pattern[str]:
-    parts = (".*" if c == "*" else "." if c == "?" else re.escape(c) for c in text)
-    return re.compile("".join(parts) + r"\Z")
+
+def wildcard_match(pattern: str, name: str) -> bool:
+    """Whether ``name`` matches ``pattern`` (``*``: any run, ``?``: one character; no
+    other special characters, so ``x[1]`` is literal). Linear in the number of ``*``:
+    each segment between stars is found at its leftmost place, never backtracked."""
+    first, *middle = [_segment(part) for part in pattern.split("*")]
+    if not middle:
+        return first.fullmatch(name) is not None
+    last = middle.pop()
+    head = first.match(name)
+    if head is None:
+        return False
+    pos = head.end()
+    end = len(name) - (len(pattern.rsplit("*", 1)[1]))
+    if end < pos or last.fullmatch(name, end) is None:
+        return False
+    for segment in middle:
+        found = segment.search(name, pos, end)
+        if found is None:
+            return False
+        pos = found.end()
+    return True
+
+
+def _segment(text: str) -> re.Pattern[str]:
+    return re.compile("".join("." if c == "?" else re.escape(c) for c in text), re.DOTALL)
 
 
 def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> list[str]:
     """``candidates`` matching any of ``patterns`` (all when ``None``), in model order."""
     if patterns is None:
         return list(candidates)
-    compiled = [(p, _pattern(p)) for p in patterns]
-    for text, rx in compiled:
-        if not any(rx.match(c) for c in candidates):
+    for text in patterns:
+        if not any(wildcard_match(text, c) for c in candidates):
             close = difflib.get_close_matches(text, candidates, 3)
             raise SimulationError(
                 f"--vars '{text}' matches no state or observed variable",
                 hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
                       "use flat names such as 'mass.pos[1]', with * and ? as wildcards"))
-    return [c for c in candidates if any(rx.match(c) for _, rx in compiled)]
+    return [c for c in candidates if any(wildcard_match(p, c) for p in patterns)]
 
 
 def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) -> None:
@@ -131,120 +160,56 @@ def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) ->
                       "parameters are named by their flat names, e.g. 'spring.k'"))
 
 
-# ------------------------------------------------------------------ cache
-
-def cache_dir() -> Path:
-    """Where generated modules are kept."""
-    if os.environ.get("SPRINGC_CACHE_DIR"):
-        return Path(os.environ["SPRINGC_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "springc"
-
-
-CACHE_ENTRIES = 200
-"""Generated modules kept in the cache; the least recently used beyond this are removed."""
-
-
-def _touch(path: Path) -> None:
-    """Mark a cache entry as used (its modification time orders the pruning)."""
-    with contextlib.suppress(OSError):  # a read-only cache still works
-        os.utime(path)
-
-
-def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]:
-    """Remove the least recently used entries beyond ``limit`` (never ``keep``)."""
-    limit = CACHE_ENTRIES if limit is None else limit
-    entries = []
-    for entry in folder.iterdir() if folder.is_dir() else ():
-        module = entry / "model.py"
-        try:
-            entries.append((module.stat().st_mtime, entry))
-        except OSError:  # not an entry (the "modified" folder) or being written
-            continue
-    entries.sort(reverse=True)
-    removed = [e for _, e in entries[limit:] if e.name != keep]
-    for entry in removed:
-        shutil.rmtree(entry, ignore_errors=True)
-    return removed
-
-
-def _library_folders(libraries: Sequence[str]) -> list[Path]:
-    from ..resources import models_dir
-
-    folders = [Path(p) for p in libraries]
-    env = os.environ.get("SPRINGC_PATH", "")
-    folders += [Path(p) for p in env.split(os.pathsep) if p]
-    folders.append(models_dir())
-    return folders
-
-
-def cache_key(options: CompileOptions) -> str:
-    """A digest of everything the generated module depends on."""
-    from ..codegen import CODEGEN_VERSION
-
-    h = hashlib.sha256()
-    h.update(repr((CODEGEN_VERSION, options.model, options.backend, options.outputs,
-                   options.modifications)).encode())
-    for f in sorted(PACKAGE_ROOT.glob("**/*.py")):
-        st = f.stat()
-        h.update(f"{f.relative_to(PACKAGE_ROOT)}:{st.st_size}:{st.st_mtime_ns}".encode())
-    sources = [Path(f) for f in options.files]
-    for folder in _library_folders(options.libraries):
-        if folder.is_dir():
-            sources += sorted(folder.glob("**/*.mdl"))
-    for path in sources:
-        h.update(str(path.resolve()).encode() + b"\0")
-        try:
-            h.update(hashlib.sha256(path.read_bytes()).digest())
-        except OSError:
-            h.update(b"missing")
-    return h.hexdigest()[:24]
-
-
-def _import(path: Path, name: str) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    # numba's on-disk cache finds the module again by name when loading.
-    sys.modules[name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[name]
-        raise
-    return module
-
-
 # ------------------------------------------------------------------ compile
+
 
 def compile_files(options: CompileOptions) -> CompiledModel:
     """The compiled model for ``options``: from the cache, or generated now."""
     began = time.perf_counter()
-    key = cache_key(options)
+    folder = None
+    if options.cache:
+        try:
+            folder = private_folder(cache_dir())
+        except CacheUnusable as err:
+            note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
+    settings = (options.model, options.backend, options.outputs, options.modifications)
+    key = cache_key(settings, options.files, options.libraries)
     module_name = f"springc_model_{key}"
-    tmp = None
-    if options.cache:
-        path = cache_dir() / key / "model.py"
-        if path.exists():
-            _touch(path)
-            module = _import(path, module_name)
-            return CompiledModel(module, options, path, True, time.perf_counter() - began,
-                                 _outputs(module, options))
-    else:
-        tmp = tempfile.TemporaryDirectory(prefix="springc-")
-        path = Path(tmp.name) / "model.py"
+    if folder is not None:
+        entry = folder / key
+        data = read_entry(entry)
+        if data is not None:
+            path = entry / "model.py"
+            try:
+                module = import_module(data, path, module_name)
+            except Exception as err:  # a damaged entry: regenerate it
+                discard(entry, f"does not import ({type(err).__name__}: {err})")
+            else:
+                touch(path)
+                return CompiledModel(module, options, path, True,
+                                     time.perf_counter() - began, outputs_of(module, options),
+                                     text=data.decode("utf-8"))
     generated = generate_source(options)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_write(path, "w") as f:
-        f.write(generated)
-    if options.cache:
-        prune_cache(cache_dir(), keep=key)
-    module = _import(path, module_name)
+    temporary = None
+    if folder is not None:
+        try:
+            path = write_entry(folder / key, generated)
+            prune_cache(folder, keep=key)
+        except OSError as err:
+            note(f"cannot write to the cache folder {folder} ({err.strerror or err}); "
+                 "compiling in a temporary folder")
+            folder = None
+    if folder is None:
+        temporary = tempfile.TemporaryDirectory(prefix="springc-")  # private (0700)
+        path = Path(temporary.name) / "model.py"
+        path.write_text(generated, encoding="utf-8")
+    module = import_module(generated.encode("utf-8"), path, module_name)
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
-                         _outputs(module, options), tmp)
+                         outputs_of(module, options), temporary, generated)
 
 
-def _outputs(module: ModuleType, options: CompileOptions) -> tuple[str, ...]:
+def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, ...]:
+    """The names ``options.outputs`` selects among the module's states and observed."""
     return tuple(select_names(tuple(module.STATES) + tuple(module.OBSERVED),
                               options.outputs))
 
@@ -259,57 +224,67 @@ class Derived:
     switchable: bool
 
 
+WRAPPER_FILE = "<springc: structural parameters>"
+"""The file name of the class that applies ``--set`` values of structural parameters."""
+
+
 def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
-    from ..simplify import simplify
-    from .files import flatten_files
-
-    files = list(options.files)
+    tree = load(list(options.files), options.libraries)
     model = options.model
     base = None
     if options.modifications:
-        base = flatten_files(files, model, options.libraries)
-        files.append(str(_wrapper_file(base.name, options.modifications)))
-        model = "SpringcModified"
-    flat_model = flatten_files(files, model, options.libraries)
+        entry = select_model(tree, model)
+        base = flatten(tree, model)
+        model = _add_wrapper(tree, entry, options.modifications)
+    flat_model = flatten(tree, model)
     simplified = simplify(flat_model)
     system = simplified.ode
     switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
     if base is not None:
-        # Keep the simulated model's name and experiment (annotations are not inherited).
+        # Keep the simulated model's name, location and experiment (annotations are
+        # not inherited).
         system = dataclasses.replace(
             system, name=base.name,
-            dae=dataclasses.replace(system.dae, experiment=base.experiment))
+            dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
     return Derived(system, flat_model, switchable)
+
+
+def _add_wrapper(tree: ClassTree, entry: ClassEntry,
+                 modifications: Sequence[tuple[str, str]]) -> str:
+    """Add to ``tree`` a model extending the class ``entry`` with ``modifications``;
+    its name. The base is named by its path from the root, each part quoted, so the
+    class of the user's file is used even where a library class has the same dotted
+    name (a flattened file's ``model 'Scenes.Chain'``)."""
+    path = []
+    scope: ClassEntry | None = entry
+    while scope is not None and scope.parent is not None:
+        path.append(flat.quote(scope.name))
+        scope = scope.parent
+    declared = {e.name for e in entry.defn.elements if isinstance(e, syntax.Component)}
+    targets = {name: flat.quote(name) if name in declared
+               else ".".join(map(flat.quote, name.split("."))) for name, _ in modifications}
+    mods = ", ".join(f"{targets[name]} = {value}" for name, value in modifications)
+    wrapper = "SpringcModified"
+    while wrapper in tree.root.classes:
+        wrapper += "_"
+    text = (f"model {wrapper}\n  extends {'.'.join(reversed(path))}({mods});\n"
+            f"end {wrapper};\n")
+    errors = tree.add(parse_text(text, WRAPPER_FILE), override=True)
+    if errors:
+        raise errors[0]
+    return wrapper
 
 
 def generate_source(options: CompileOptions) -> str:
     """Flatten, simplify and generate the module text for ``options``."""
-    from ..codegen import CodegenOptions, generate
-
     derived = derive_system(options)
     system, flat_model = derived.system, derived.flat_model
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)
-    source = generate(system, flat_model, CodegenOptions(options.backend, observed)).source
-    # Index reduction left a choice of states that may turn singular during the run:
-    # the simulator then switches states (springc.simulation_switching).
-    return source + f"\nSWITCHABLE = {derived.switchable}\n"
-
-
-def _wrapper_file(model: str, modifications: Sequence[tuple[str, str]]) -> Path:
-    mods = ", ".join(f"{name} = {value}" for name, value in modifications)
-    text = (f'model SpringcModified "{model} with structural parameters set by springc"\n'
-            f"  extends {model}({mods});\n"
-            "end SpringcModified;\n")
-    digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-    path = cache_dir() / "modified" / f"{digest}.mdl"
-    if not path.exists():
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_write(path, "w") as f:
-            f.write(text)
-    return path
+    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable)
+    return generate(system, flat_model, codegen).source
 
 
 def modification_value(model: CompiledModel, name: str, value: float) -> str:
@@ -319,7 +294,7 @@ def modification_value(model: CompiledModel, name: str, value: float) -> str:
             f"'{name}' is a structural parameter (it was evaluated while flattening) and "
             "an array element cannot be modified on its own",
             hint="change the whole array in the model, or bind it to a scalar parameter")
-    types = dict(zip(model.module.PARAMETERS, getattr(model.module, "PARAMETER_TYPES", ())))
+    types = dict(zip(model.module.PARAMETERS, model.module.PARAMETER_TYPES))
     kind = types.get(name, "Real")
     if kind == "Boolean":
         return "true" if value else "false"

@@ -8,13 +8,12 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
+from ..flatten import flatten
 from ..ir.flat import FlatModel
+from ..parse import load
 
 
 def flatten_files(files: Sequence[str | Path], model: str | None = None,
                   libraries: Iterable[str | Path] = ()) -> FlatModel:
     """Load ``files`` (plus library folders) and flatten ``model`` (dotted name)."""
-    from ..flatten import flatten
-    from ..parse import load
-
     return flatten(load(files, libraries), model)

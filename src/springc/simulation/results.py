@@ -1,22 +1,45 @@
-"""Simulation results: SimulationResult -> CSV text file, PNG plot, summary line.
+"""Simulation results: SimulationResult -> CSV or MAT file, PNG/SVG/PDF plot, summary.
 
-The CSV has a header ``time`` then the flat names, one row per output time, every
-number written with ``repr`` (the shortest text that reads back as the same float).
-Files are written to a temporary file in the target folder and renamed only when
-complete, so a failed run never leaves a CSV or PNG that looks complete.
+The CSV has a header ``time`` then the flat names (quoted as RFC 4180 says when they
+hold a comma, a quote or a line break), one row per output time, every number written
+with ``repr`` (the shortest text that reads back as the same float). The MAT file is
+the MATLAB v4 result layout of OpenModelica and Dymola (see :func:`write_mat`).
+
+The writer is chosen by the file's suffix (:data:`RESULT_FORMATS`, :data:`PLOT_FORMATS`);
+:func:`save_outputs` renders every requested file before any is renamed into place
+(:class:`springc.fileio.OutputSet`), so a failed plot never leaves a new CSV behind.
 """
 
 from __future__ import annotations
 
+import csv
+import io
 import os
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
 import numpy as np
 
-from ..fileio import atomic_write
+from ..errors import OutputError, UsageError
+from ..fileio import OutputSet, PathLike, atomic_write
+from ..ir import dae
+
+RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
+"""Suffix -> trajectory format of ``simulate -o``."""
+PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+"""Suffix -> plot format of ``--plot``."""
+
+
+def file_format(path: PathLike, formats: dict[str, str], option: str) -> str:
+    """The format of ``path`` from its suffix; a UsageError naming ``option`` if unknown."""
+    suffix = Path(os.fspath(path)).suffix.lower()
+    if suffix not in formats:
+        raise UsageError(f"{option} {os.fspath(path)}: the suffix must be one of "
+                         f"{', '.join(formats)} (it chooses the format)", option=option)
+    return formats[suffix]
 
 
 @dataclass(frozen=True)
@@ -30,6 +53,7 @@ class SimulationStats:
     compile_time: float
     cached: bool
     reason: str = ""  # why --solver auto chose ``solver`` (empty: the user chose it)
+    note: str = ""  # what the run did differently from what was asked (e.g. the step)
 
     def summary(self, model: str) -> str:
         """One line: solver (``auto -> radau (why)``), steps, evaluations, wall time."""
@@ -37,7 +61,8 @@ class SimulationStats:
         return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s (model code {self.model_time:.3f} s; "
-                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)")
+                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
+                + (f"; note: {self.note}" if self.note else ""))
 
 
 @dataclass
@@ -68,11 +93,17 @@ class SimulationResult:
         return out
 
     def to_csv(self, path: str | os.PathLike[str]) -> None:
-        with atomic_write(Path(path), "w") as f:
+        """Write the trajectory as CSV (whatever the suffix)."""
+        with atomic_write(path, "w") as f:
             write_csv(self, f)
 
+    def save(self, path: str | os.PathLike[str]) -> None:
+        """Write the trajectory as CSV or MAT, by the suffix of ``path``."""
+        save_outputs(self, path, None)
+
     def plot(self, path: str | os.PathLike[str]) -> None:
-        write_png(self, Path(path))
+        """Plot the outputs to a PNG, SVG or PDF file, by the suffix of ``path``."""
+        save_outputs(self, None, path)
 
     def __repr__(self) -> str:
         return (f"<SimulationResult {self.model}: {len(self.time)} times x "
@@ -81,13 +112,74 @@ class SimulationResult:
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
     """Header ``time,<names>`` then one row per output time, full precision."""
-    f.write(",".join(["time", *(_csv_field(n) for n in result.names)]) + "\n")
+    csv.writer(f, lineterminator="\n").writerow(["time", *result.names])
     table = np.column_stack([result.time, result.values]).tolist()
     f.writelines(",".join(map(repr, row)) + "\n" for row in table)
 
 
-def _csv_field(name: str) -> str:
-    return f'"{name}"' if any(c in name for c in ',"\n') else name
+def _char_matrix(texts: list[str]) -> np.ndarray:
+    """Strings as the columns of a character matrix (the ``binTrans`` orientation)."""
+    width = max(1, *map(len, texts))
+    return np.ascontiguousarray(np.array([list(t.ljust(width)) for t in texts]).T)
+
+
+def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
+    """The MATLAB v4 result file of OpenModelica and Dymola (``Aclass`` = Atrajectory,
+    1.1, binTrans), as DyMat, OMPython and Dymola read it:
+
+    - ``name``, ``description``: one column of characters per variable, ``time`` first;
+      the description is the unit in brackets;
+    - ``dataInfo`` (4 x variables, int32): data block, 1-based row in that block
+      (negative: negated), interpolation 0, extrapolation -1 (0 for parameters);
+    - ``data_1``: the parameters, one row each (``time`` first), at start and stop;
+    - ``data_2``: the trajectories, one row each (``time`` first), one column per time.
+    """
+    from scipy.io import savemat
+
+    params = sorted(result.parameters.items())
+    names = ["time", *(n for n, _ in params), *result.names]
+    units = dict(zip(result.names, result.units))
+    descriptions = ["Time in [s]", *("" for _ in params),
+                    *(f"[{units[n]}]" if units.get(n) else "" for n in result.names)]
+    info = [(0, 1, 0, -1)]
+    info += [(1, i + 2, 0, 0) for i in range(len(params))]
+    info += [(2, i + 2, 0, -1) for i in range(len(result.names))]
+    span = [float(result.time[0]), float(result.time[-1])] if len(result.time) else [0, 0]
+    data_1 = np.array([span, *([v, v] for _, v in params)], dtype=float)
+    data_2 = np.vstack([result.time, np.asarray(result.values, dtype=float).T])
+    try:
+        matrices = {"Aclass": np.array(["Atrajectory", "1.1", "", "binTrans"]),
+                    "name": _char_matrix(names),
+                    "description": _char_matrix(descriptions)}
+        for text in (*names, *descriptions):
+            text.encode("latin-1")
+    except UnicodeEncodeError:
+        raise OutputError(f"{result.model}: a name or unit is not Latin-1 text, which the "
+                          "MAT v4 format cannot store",
+                          hint="write the trajectory as .csv (UTF-8) instead") from None
+    matrices.update({"dataInfo": np.ascontiguousarray(np.array(info, dtype=np.int32).T),
+                     "data_1": data_1, "data_2": np.ascontiguousarray(data_2)})
+    savemat(f, matrices, format="4")
+
+
+def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLike | None,
+                 protected: Iterable[PathLike] = ()) -> None:
+    """Write the trajectory to ``output`` (CSV or MAT by suffix) and the plot to ``plot``
+    (PNG, SVG or PDF): both are rendered before either is put in place, and files in
+    ``protected`` (the inputs) are never replaced."""
+    kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
+    plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
+    picture = render_plot(result, plot_kind) if plot_kind is not None else None
+    with OutputSet(protected) as outputs:
+        if output is not None:
+            with outputs.open(output, "w" if kind == "csv" else "wb") as f:
+                if kind == "csv":
+                    write_csv(result, f)
+                else:
+                    write_mat(result, f)
+        if plot is not None and picture is not None:
+            with outputs.open(plot, "wb") as f:
+                f.write(picture)
 
 
 # ------------------------------------------------------------------ plotting
@@ -102,18 +194,26 @@ MAX_PANELS = 8
 MAX_LEGEND = 12
 
 
+def plain_text(text: str) -> str:
+    """``text`` as matplotlib shows it literally: a ``$`` would start mathtext."""
+    return text.replace("$", r"\$")
+
+
 def _group(name: str, unit: str) -> tuple[str, str]:
     """(panel title, y label) of a variable: by unit if declared, else by its last name."""
     if unit:
         quantity = _QUANTITY.get(unit, unit)
         return quantity, f"{quantity} [{unit}]"
-    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1]).removeprefix("der(")
+    while (base := dae.derivative_base(name)) is not None:
+        name = base
+    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1])
     word = _WORDS.get(last, last)
     return word, word
 
 
-def write_png(result: SimulationResult, path: Path) -> None:
-    """Plot the outputs, one panel per quantity (positions, velocities, forces, ...)."""
+def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
+    """Plot the outputs, one panel per quantity (positions, velocities, forces, ...), as
+    the bytes of a ``kind`` (png, svg, pdf) file. Names and units are shown literally."""
     # A Figure with the Agg canvas directly: no pyplot, so the user's matplotlib
     # backend (a notebook's, say) is left alone.
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -134,12 +234,12 @@ def write_png(result: SimulationResult, path: Path) -> None:
     for ax, (title, (label, columns)) in zip(axes[:, 0], panels):
         many = len(columns) > MAX_LEGEND
         for i in columns:
-            ax.plot(result.time, result.values[:, i], label=result.names[i],
+            ax.plot(result.time, result.values[:, i], label=plain_text(result.names[i]),
                     linewidth=0.6 if many else 1.2, alpha=0.6 if many else 1.0)
-        ax.set_ylabel(label)
+        ax.set_ylabel(plain_text(label))
         ax.grid(True, alpha=0.3)
         shown = f"{title}: {len(columns)} variables" if many else title
-        ax.set_title(shown, fontsize=10, loc="left", y=1.0)  # a fixed y: no bbox search
+        ax.set_title(plain_text(shown), fontsize=10, loc="left", y=1.0)  # a fixed y: no bbox search
         if not many:
             ax.legend(fontsize=8, loc="upper right", ncol=min(3, len(columns)))
     if not panels:
@@ -147,7 +247,11 @@ def write_png(result: SimulationResult, path: Path) -> None:
     omitted = len(groups) - len(panels)
     note = f" ({omitted} more groups not shown)" if omitted > 0 else ""
     axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(f"{result.model}{note}", fontsize=11)
-    with atomic_write(path, "wb") as f:
-        # zlib level 1: a third of the save time of the default 6, for a slightly larger file
-        fig.savefig(f, format="png", dpi=100, pil_kwargs={"compress_level": 1})
+    fig.suptitle(plain_text(f"{result.model}{note}"), fontsize=11)
+    buffer = io.BytesIO()
+    # zlib level 1: a third of the save time of the default 6, for a slightly larger file
+    if kind == "png":
+        fig.savefig(buffer, format=kind, dpi=100, pil_kwargs={"compress_level": 1})
+    else:
+        fig.savefig(buffer, format=kind, dpi=100)
+    return buffer.getvalue()

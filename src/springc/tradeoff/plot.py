@@ -1,14 +1,17 @@
-"""Work-precision plot: Tradeoff -> PNG (max error against wall time and against RHS
-evaluations, log-log, one line per solver, scipy's default call as a star)."""
+"""Work-precision plot: Tradeoff -> PNG, SVG or PDF (max error against wall time and
+against RHS evaluations, log-log, one line per solver, scipy's default call as a star)."""
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
 from ..fileio import atomic_write
-from .study import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
+from .model import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
 
+PLOT_KINDS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+"""Suffix -> format of the plot file."""
 ERROR_FLOOR = 1e-16
 """Errors of exactly zero are drawn here (a log axis has no zero)."""
 
@@ -20,7 +23,17 @@ def _points(runs: list[Run], x: str) -> tuple[list[float], list[float]]:
 
 
 def write_work_precision(tradeoff: Tradeoff, path: str | Path) -> None:
-    """Two panels: max error vs wall time, max error vs RHS evaluations."""
+    """The plot of :func:`render_work_precision` in the format of ``path``'s suffix
+    (PNG for an unknown one), written atomically."""
+    picture = render_work_precision(tradeoff, PLOT_KINDS.get(Path(path).suffix.lower(),
+                                                             "png"))
+    with atomic_write(path, "wb") as f:
+        f.write(picture)
+
+
+def render_work_precision(tradeoff: Tradeoff, kind: str = "png") -> bytes:
+    """Two panels, max error vs wall time and vs RHS evaluations, as ``kind`` bytes
+    (png, svg, pdf). The model's name is shown literally (a ``$`` is no mathtext)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -61,7 +74,9 @@ def write_work_precision(tradeoff: Tradeoff, path: str | Path) -> None:
     axes[0].set_ylabel("max relative error on the output grid")
     axes[0].legend(fontsize=7, loc="lower left")
     targets = ", ".join(f"{t:.0e}" for t in tradeoff.targets)
-    fig.suptitle(f"{tradeoff.model}: work-precision ({tradeoff.states} states; dashed: "
+    model = tradeoff.model.replace("$", r"\$")  # shown literally, not as mathtext
+    fig.suptitle(f"{model}: work-precision ({tradeoff.states} states; dashed: "
                  f"target {targets}; dotted: reference agreement)", fontsize=10)
-    with atomic_write(Path(path), "wb") as f:
-        fig.savefig(f, format="png", dpi=100)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format=kind, dpi=100)
+    return buffer.getvalue()

@@ -1,7 +1,7 @@
 """References for :mod:`springc.tradeoff`: a user CSV, or a tight solve verified by a
 second method -> Reference.
 
-The tight reference is springc's ``dop853`` at rtol :data:`~springc.tradeoff.REFERENCE_RTOL`
+The tight reference is springc's ``dop853`` at rtol :data:`~springc.tradeoff.model.REFERENCE_RTOL`
 (atol in the same ratio to rtol as the simulator's default); the check is scipy's
 VODE in Adams mode (variable order up to 12, functional iteration: no Jacobian, so
 it suits models of any size) on the same generated right-hand side at the same
@@ -15,26 +15,19 @@ import csv
 import math
 import time
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from pathlib import Path
+from typing import IO
 
 import numpy as np
 
 from ..errors import Note, SimulationError
+from ..fileio import atomic_write
 from ..simulation import simulate_model
-from .study import (
-    REFERENCE_RTOL,
-    Reference,
-    TradeoffError,
-    relative_errors,
-    scipy_outputs,
-    variable_scales,
-)
-
-if TYPE_CHECKING:
-    from .study import _Setup
+from .model import REFERENCE_RTOL, Reference, TradeoffError
+from .setup import StudySetup, relative_errors, scipy_outputs, variable_scales
 
 
-def _adams(setup: _Setup, rtol: float, atol: float) -> np.ndarray:
+def _adams(setup: StudySetup, rtol: float, atol: float) -> np.ndarray:
     """The states on the grid by VODE Adams (raises SimulationError if it fails)."""
     from scipy.integrate import ode
 
@@ -55,7 +48,7 @@ def _adams(setup: _Setup, rtol: float, atol: float) -> np.ndarray:
     return states
 
 
-def tight_reference(setup: _Setup, target: float, rtol: float = REFERENCE_RTOL
+def tight_reference(setup: StudySetup, target: float, rtol: float = REFERENCE_RTOL
                     ) -> Reference:
     """dop853 at ``rtol``, checked by VODE Adams; refused if they differ by more than
     ``target`` (the smallest error the study is asked about)."""
@@ -134,15 +127,16 @@ def read_reference(path: str, grid: np.ndarray, names: Sequence[str]) -> Referen
     return Reference(grid.copy(), tuple(names), values, f"{path} (not verified)", math.nan)
 
 
-def write_reference(ref: Reference, path: str) -> None:
+def write_reference_csv(ref: Reference, f: IO[str]) -> None:
     """The reference as CSV (header ``time,<names>``, full precision): reusable with
     ``--reference``."""
-    from pathlib import Path
+    writer = csv.writer(f, lineterminator="\n")
+    writer.writerow(["time", *ref.names])
+    for t, row in zip(ref.time.tolist(), ref.values.tolist()):
+        writer.writerow([repr(t), *map(repr, row)])
 
-    from ..fileio import atomic_write
 
-    with atomic_write(Path(path), "w") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(["time", *ref.names])
-        for t, row in zip(ref.time.tolist(), ref.values.tolist()):
-            writer.writerow([repr(t), *map(repr, row)])
+def write_reference(ref: Reference, path: str | Path) -> None:
+    """The reference as a CSV file (written atomically)."""
+    with atomic_write(path, "w") as f:
+        write_reference_csv(ref, f)

@@ -12,10 +12,11 @@ import csv
 import math
 from collections.abc import Sequence
 from pathlib import Path
+from typing import IO
 
 from ..errors import Note
 from ..fileio import atomic_write
-from .study import CSV_COLUMNS, SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
+from .model import CSV_COLUMNS, SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
 
 
 def _times(seconds: float, other: float) -> str:
@@ -61,6 +62,11 @@ def recommend(runs: Sequence[Run], baselines: Sequence[Run], target: float) -> s
     return text
 
 
+def recommendations(tradeoff: Tradeoff) -> list[str]:
+    """One line per target of the study (:func:`recommend`)."""
+    return [recommend(tradeoff.runs, tradeoff.baselines, t) for t in tradeoff.targets]
+
+
 # ------------------------------------------------------------------ table
 
 def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
@@ -68,7 +74,7 @@ def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
     def num(x: float, fmt: str) -> str:
         return "" if not math.isfinite(x) else format(x, fmt)
 
-    rows = []
+    rows: list[tuple[str, ...]] = []
     for r in (*tradeoff.runs, *tradeoff.baselines):
         rows.append((r.solver, r.setting, repr(r.value), num(r.wall_time, ".6g"),
                      str(r.repeats), "" if r.steps < 0 else str(r.steps),
@@ -79,17 +85,23 @@ def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
     return rows
 
 
+def write_table(tradeoff: Tradeoff, f: IO[str]) -> None:
+    """The table as CSV (:data:`CSV_COLUMNS`, then :func:`table_rows`)."""
+    writer = csv.writer(f, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    writer.writerows(table_rows(tradeoff))
+
+
 def write_table_csv(tradeoff: Tradeoff, path: str | Path) -> None:
-    with atomic_write(Path(path), "w") as f:
-        writer = csv.writer(f, lineterminator="\n")
-        writer.writerow(CSV_COLUMNS)
-        writer.writerows(table_rows(tradeoff))
+    """The table as a CSV file (written atomically)."""
+    with atomic_write(path, "w") as f:
+        write_table(tradeoff, f)
 
 
 def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
     """The table as aligned text (or a Markdown table)."""
-    head = ("solver", "setting", "time s", "steps", "RHS", "Jacobians", "max error",
-            "RMS error", "status")
+    head: tuple[str, ...] = ("solver", "setting", "time s", "steps", "RHS", "Jacobians",
+                             "max error", "RMS error", "status")
     energy = tradeoff.energy is not None
     if energy:
         head = (*head[:-1], f"{tradeoff.energy} drift", head[-1])
@@ -123,7 +135,7 @@ def summary(tradeoff: Tradeoff) -> str:
     note = unresolved_note(tradeoff)
     if note is not None:
         lines += [f"note: {note.message}", ""]
-    return "\n".join(lines + tradeoff.recommendations()) + "\n"
+    return "\n".join(lines + recommendations(tradeoff)) + "\n"
 
 
 def unresolved_note(tradeoff: Tradeoff) -> Note | None:

@@ -1,0 +1,208 @@
+"""The shared vocabulary of code generation: options, the generated model, and the
+context (names and lookups of one ``ir.ode.ODE``) that the generator hands to the
+Jacobian, vector-layout and module-text writers.
+
+Order of the codegen modules: ``statements <- printer``, ``statements <- context <-
+{jacobian, vector, module_text} <- generator`` (``vector`` and ``module_text`` print
+with ``printer``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from ..errors import Span
+from ..ir import flat, ode
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
+from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
+
+
+class CodegenBug(RuntimeError):
+    """An internal invariant of the code generator failed: a bug in springc, not in the
+    model (the CLI reports it as an internal error, exit code 3)."""
+
+
+def source_location(span: Span) -> str:
+    """``file:line`` of ``span``, for comments (escaped when printed)."""
+    return f"{span.file}:{span.line}"
+
+
+def source_comment(name: str, span: Span) -> str:
+    """The comment of an assignment: its flat name and where it comes from."""
+    return f"{name}  {source_location(span)}"
+
+
+BACKENDS = ("python", "numba")
+NEWTON_ITERATIONS = 50
+NEWTON_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True)
+class CodegenOptions:
+    """``outputs``: observed variables to generate (``None``: all of them);
+    ``vector``: loops over groups of same-shaped assignments (large systems);
+    ``switchable``: index reduction left a choice of states that may turn singular
+    during a run (the module says so; the simulator then switches states)."""
+
+    backend: str = "python"
+    outputs: tuple[str, ...] | None = None
+    vector: bool | None = None  # None: by size (vector.VECTOR_THRESHOLD)
+    switchable: bool = False
+
+
+@dataclass(frozen=True)
+class GeneratedModel:
+    """The text of a generated module and what it contains."""
+
+    name: str
+    source: str
+    backend: str
+    states: tuple[str, ...]
+    observed: tuple[str, ...]
+    parameters: tuple[str, ...]
+    structural: tuple[str, ...]
+
+
+class CodegenContext:
+    """The system being generated: names and lookups shared by the generated functions
+    and the module text (the parts of codegen below the generator take it)."""
+
+    def __init__(self, system: ode.ODE, flat_model: flat.FlatModel | None) -> None:
+        self.ode = system
+        self.states = [s.name for s in system.states]
+        self.derivatives = [s.derivative for s in system.states]
+        self.params = [q.name for q in system.parameters]
+        self.param_set = set(self.params)
+        self.derivative_set = set(self.derivatives)
+        self.aliases = {a.name: a for a in system.observed}
+        self.variables = {v.name: v for v in flat_model.variables} if flat_model else {}
+        self.unknowns = {u.name: u for u in system.dae.unknowns}
+        # Every name the model defines: the namer sanitizes them all (see printer.Namer).
+        self.model_names = {*self.states, *self.derivatives, *self.params,
+                            *system.step_names(), *self.aliases, *self.unknowns,
+                            *self.variables}
+        self.guess_slots: dict[str, int] = {}
+        for step in system.steps:
+            if isinstance(step, ode.NonlinearBlock):
+                for t in step.tearing:
+                    self.guess_slots[t] = len(self.guess_slots)
+
+    def source_files(self) -> list[str]:
+        """The model's own file, then the other files its variables come from."""
+        model_file = self.ode.dae.span.file
+        others = {s.span.file for s in self.ode.states} | {
+            q.span.file for q in self.ode.parameters}
+        return [model_file, *sorted(others - {model_file})]
+
+    def loads(self) -> list[Stmt]:
+        out: list[Stmt] = [Load(n, f"p[{i}]", n) for i, n in enumerate(self.params)]
+        out += [Load(n, f"x[{i}]", n) for i, n in enumerate(self.states)]
+        return out
+
+    def newton_systems(self) -> dict[int, tuple[str, ...]]:
+        """Failure flag value -> tearing variables of that torn system."""
+        return {i + 1: step.tearing for i, step in enumerate(self.ode.steps)
+                if isinstance(step, ode.NonlinearBlock)}
+
+    def type(self, name: str) -> str:
+        v = self.variables.get(name)
+        return v.type if v is not None else "Real"
+
+    def unit(self, name: str) -> str:
+        v = self.variables.get(name)
+        if v is not None and v.attributes.unit:
+            return v.attributes.unit
+        u = self.unknowns.get(name)
+        return (u.unit or "") if u is not None else ""
+
+    # -------------------------------------------------------------- primal
+
+    def step_stmts(self) -> tuple[list[Stmt], list[tuple[ode.Step, int, str]]]:
+        stmts: list[Stmt] = []
+        described: list[tuple[ode.Step, int, str]] = []
+        for index, step in enumerate(self.ode.steps):
+            if isinstance(step, ode.Assign):
+                comment = source_comment(step.name, step.span)
+                stmts.append(Let(step.name, step.expr, comment))
+            elif isinstance(step, ode.LinearBlock):
+                comment = block_comment("linear system for", step.names, step.spans)
+                stmts.append(self._linear(step, index, comment))
+            else:
+                comment = block_comment("nonlinear system, tearing", step.tearing,
+                                        step.spans)
+                stmts.append(self._nonlinear(step, index, comment))
+            described.append((step, index, comment))
+        return stmts, described
+
+    def _linear(self, block: ode.LinearBlock, index: int, comment: str) -> Stmt:
+        n = len(block.names)
+        body: list[Stmt] = [Raw(f"_A{index} = np.zeros(({n}, {n}))")]
+        body += [Store(f"_A{index}[{i}, {j}]", e) for i, j, e in block.matrix]
+        body.append(Raw(f"_b{index} = np.empty({n})"))
+        body += [Store(f"_b{index}[{i}]", e) for i, e in enumerate(block.rhs)]
+        body.append(Raw(f"_y{index} = np.linalg.solve(_A{index}, _b{index})"))
+        body += [Load(name, f"_y{index}[{k}]", name) for k, name in enumerate(block.names)]
+        return Block(body, comment, {*block.names, f"_A{index}"})
+
+    def _nonlinear(self, block: ode.NonlinearBlock, index: int, comment: str) -> Stmt:
+        k = len(block.tearing)
+        slots = [self.guess_slots[t] for t in block.tearing]
+        body: list[Stmt] = [Load(t, f"float(z[{s}])", f"{t} (warm start)")
+                            for t, s in zip(block.tearing, slots)]
+        body.append(Raw(f"_ok{index} = False\n_done{index} = False"))
+        loop: list[Stmt] = [Let(a.name, a.expr, source_comment(a.name, a.span))
+                            for a in block.inner]
+        loop += [Let(f"_r{index}_{i}", r, "residual") for i, r in enumerate(block.residuals)]
+        loop.append(Raw(f"if _done{index}:\n    _ok{index} = True\n    break"))
+        loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
+        entries = {(i, j): e for i, j, e in block.jacobian}
+        if k == 1:
+            pivot = entries.get((0, 0), ZERO)
+            loop.append(Let(f"_d{index}_0", BinOp("/", Var(f"_r{index}_0"), pivot)))
+        else:
+            loop.append(Raw(f"_J{index} = np.zeros(({k}, {k}))"))
+            loop += [Store(f"_J{index}[{i}, {j}]", e) for (i, j), e in entries.items()]
+            loop.append(Raw(f"_R{index} = np.empty({k})"))
+            loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
+            loop.append(Raw(f"_D{index} = np.linalg.solve(_J{index}, _R{index})"))
+            loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
+        done: Expr | None = None
+        for i, t in enumerate(block.tearing):
+            loop.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
+            small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
+                          mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
+            done = small if done is None else BinOp("and", done, small)
+        assert done is not None
+        loop.append(Let(f"_done{index}", done))
+        body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))
+        body.append(Raw(f"if not _ok{index}:\n    z[{len(self.guess_slots)}] = "
+                        f"{float(index + 1)}"))
+        body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
+        names = {*block.tearing, *(a.name for a in block.inner),
+                 *(s.name for s in block.sensitivities)}
+        return Block(body, comment, names)
+
+    def alias_stmts(self, names: Sequence[str]) -> list[Stmt]:
+        """Lets for the aliases among ``names`` and the aliases they read, in order."""
+        out: list[Stmt] = []
+        done: set[str] = set()
+
+        def visit(name: str) -> None:
+            if name in done or name not in self.aliases:
+                return
+            done.add(name)
+            a = self.aliases[name]
+            for v in sorted(variables(a.expr)):
+                visit(v)
+            out.append(Let(name, a.expr, f"{name} (alias)  {source_location(a.span)}"))
+
+        for n in names:
+            visit(n)
+        return out
+
+
+def block_comment(kind: str, names: Sequence[str], spans: Sequence[Span]) -> str:
+    shown = ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")
+    where = ", ".join(sorted({source_location(s) for s in spans})[:4])
+    return f"{kind} {shown}  {where}"

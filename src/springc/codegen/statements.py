@@ -1,0 +1,202 @@
+"""The statements of generated functions, the names they use, and dead-code removal.
+
+The code generator describes each generated function as a list of small statements
+over flat names (:class:`Let`, :class:`Store`, :class:`Load`, :class:`Raw`, grouped in
+:class:`Block` and :class:`Loop`); :mod:`.printer` prints them. Model names become
+Python identifiers only through :class:`Namer` and reach comments only through
+:func:`escaped`: model text is data, never code.
+"""
+
+from __future__ import annotations
+
+import builtins
+import keyword
+import re
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+from ..ir.expr import Expr, variables
+
+# ------------------------------------------------------------------ statements
+
+
+@dataclass
+class Let:
+    """``name = expr`` (``name`` a flat or internal name), with a trailing comment."""
+
+    name: str
+    expr: Expr
+    comment: str = ""
+
+
+@dataclass
+class Load:
+    """``name = source`` where ``source`` is Python text such as ``x[3]``."""
+
+    name: str
+    source: str
+    comment: str = ""
+
+
+@dataclass
+class Store:
+    """``target = expr`` where ``target`` is Python text such as ``dx[3]``."""
+
+    target: str
+    expr: Expr
+    comment: str = ""
+
+
+@dataclass
+class Raw:
+    """A line of Python that refers only to internal names (``_A1 = np.zeros(...)``)."""
+
+    text: str
+
+
+@dataclass
+class Loop:
+    """``header`` (e.g. ``for _it in range(50):``) with an indented body."""
+
+    header: str
+    body: list[Stmt]
+
+
+@dataclass
+class Block:
+    """Statements kept or dropped together (a linear or nonlinear system)."""
+
+    body: list[Stmt]
+    comment: str = ""
+    defines: set[str] = field(default_factory=set)
+    uses: set[str] = field(default_factory=set)
+
+
+Stmt = Let | Load | Store | Raw | Loop | Block
+
+# ------------------------------------------------------------------ names
+
+# Every identifier the module templates define or use (locals, loop variables, module
+# functions, constants and imports): model names must never shadow them.
+_RESERVED = frozenset({
+    "t", "x", "p", "z", "dx", "jv", "np", "math", "njit", "out", "abs", "min", "max",
+    "float", "int", "range", "len", "bool", "values", "numba", "scipy", "base64", "zlib",
+    "json", "fixed",
+    "x0", "n", "i", "j", "k", "v", "ts", "given", "unknown", "name", "X",
+    "parameters", "start", "guesses", "rhs", "observed", "observed_grid", "jacobian",
+    "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
+    "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
+    "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
+    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "JAC_ROWS",
+    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR",
+}) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
+
+
+# Internal names of the generated code (``_A3``, ``_r2_0``, ``_it``, ``_FS``): ASCII
+# identifiers that start with ``_``, used verbatim.
+_INTERNAL = re.compile(r"_[A-Za-z]+[0-9]*(?:_[0-9]+)?\Z")
+# The internal names that statements bind through the namer (Newton residuals, steps,
+# convergence flags, pivots): a model variable of the same name would be the same
+# string in the statements, so such model names are refused (see reserved_name).
+_BOUND_INTERNAL = re.compile(r"_(?:r|d|done|J)[0-9]+(?:_[0-9]+)?\Z")
+
+
+def reserved_name(names: Iterable[str]) -> str | None:
+    """The first of ``names`` that the generated code binds itself, if any."""
+    return next((n for n in sorted(names) if _BOUND_INTERNAL.match(n)), None)
+
+
+def escaped(text: str) -> str:
+    """``text`` as one line of ASCII that cannot end a comment or a docstring: control
+    and non-ASCII characters, backslashes and double quotes escaped as in a literal."""
+    return text.encode("unicode_escape").decode("ascii").replace('"', '\\"')
+
+
+class Namer:
+    """Flat names -> Python identifiers: ``mass.pos[1]`` -> ``mass_pos_1``.
+
+    Internal names (``_INTERNAL``) are used verbatim. Model names are sanitized into
+    ASCII identifiers that never start with ``_``, so the two never collide; a model
+    name that looks internal (Modelica allows ``_x``) is sanitized too.
+    """
+
+    def __init__(self, model_names: Iterable[str] = ()) -> None:
+        self.model_names = frozenset(model_names)
+        self._ident: dict[str, str] = {}
+        self._used: set[str] = set(_RESERVED)
+
+    def __call__(self, name: str) -> str:
+        ident = self._ident.get(name)
+        if ident is None:
+            ident = name if self.internal(name) else self._fresh(name)
+            self._ident[name] = ident
+        return ident
+
+    def internal(self, name: str) -> bool:
+        """Whether ``name`` is one of the generator's own names (used verbatim)."""
+        return name not in self.model_names and _INTERNAL.match(name) is not None
+
+    def _fresh(self, name: str) -> str:
+        base = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_") or "v"
+        if base[0].isdigit():
+            base = "v_" + base
+        ident, n = base, 1
+        while ident in self._used:
+            n += 1
+            ident = f"{base}_{n}"
+        self._used.add(ident)
+        return ident
+
+
+# ------------------------------------------------------------------ dead code
+
+
+def uses_of(stmt: Stmt) -> set[str]:
+    """Flat and internal names read by ``stmt`` (minus those a block defines itself)."""
+    if isinstance(stmt, (Let, Store)):
+        return variables(stmt.expr)
+    if isinstance(stmt, (Load, Raw)):
+        return set()
+    body = stmt.body
+    used: set[str] = set()
+    for s in body:
+        used |= uses_of(s)
+    extra = stmt.uses if isinstance(stmt, Block) else set()
+    return (used - defines_inside(body)) | extra
+
+
+def defines_inside(body: Sequence[Stmt]) -> set[str]:
+    """Names bound anywhere inside ``body`` (nested loops and blocks included)."""
+    out: set[str] = set()
+    for s in body:
+        if isinstance(s, (Let, Load)):
+            out.add(s.name)
+        elif isinstance(s, (Loop, Block)):
+            out |= defines_inside(s.body)
+    return out
+
+
+def defines_of(stmt: Stmt) -> set[str]:
+    """Names ``stmt`` makes available to the statements after it."""
+    if isinstance(stmt, (Let, Load)):
+        return {stmt.name}
+    if isinstance(stmt, Block):
+        return stmt.defines or defines_inside(stmt.body)
+    if isinstance(stmt, Loop):
+        return defines_inside(stmt.body)
+    return set()
+
+
+def prune(stmts: Sequence[Stmt]) -> list[Stmt]:
+    """Drop top-level statements whose results are never read (stores are kept)."""
+    live: set[str] = set()
+    kept: list[Stmt] = []
+    for stmt in reversed(stmts):
+        defines = defines_of(stmt)
+        if isinstance(stmt, (Let, Load, Block)) and not defines & live:
+            continue
+        live -= defines if isinstance(stmt, (Let, Load)) else set()
+        live |= uses_of(stmt)
+        kept.append(stmt)
+    kept.reverse()
+    return kept

@@ -1,0 +1,36 @@
+"""Compiled integration loops: no Python per step (imports nothing from springc).
+
+Input: a model's numba functions ``rhs(t, x, p, z) -> dx`` (and optionally
+``observed(t, x, p, z) -> y``), an output grid, start states, parameters ``p`` and the
+work array ``z``. Output: a :class:`Run` with the states (and observed variables) on the
+grid, step counts and a :class:`Status`.
+
+The step loop, error control, dense output on the grid and the observed variables all
+run in numba. The model functions are passed as first-class function values
+(``numba.types.FunctionType``), so the kernels compile once per machine and load from
+numba's disk cache afterwards; a new model only compiles its own functions.
+
+How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
+
+    from springc.integrate import Status, dop853, fixed_step
+    run = dop853(mod.rhs, grid, x0, p, z, rtol=rtol, atol=atol, observed=mod.observed)
+    run = fixed_step("verlet", mod.rhs, grid, x0, p, z, step=h, pairs=[(0, 2), (1, 3)])
+    if not run.ok:   # build the message from run.status, run.failure_time/_state
+        ...
+
+- ``dop853`` takes the same steps as ``scipy.integrate.solve_ivp(method="DOP853")``
+  within rounding (same controller, error norm and initial step) and fills the grid from
+  the 7th-order dense output (a grid time equal to a step's end gets that step's state).
+- ``fixed_step`` runs ``euler``, ``symplectic-euler``, ``verlet`` or ``rk4`` exactly as
+  ``springc.simulation``'s integrators do.
+- Failures never raise inside the loop: :class:`Status` says what happened
+  (step too small, NaN/inf derivative or state, max steps, the model's failure flag
+  ``z[-1]``) and the run carries the time and the state where it happened.
+- Bad arguments (a grid that does not increase, a function that is not jitted or
+  returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
+"""
+
+from .engine import FIXED_STEP_METHODS, Run, dop853, fixed_step
+from .status import Status
+
+__all__ = ["FIXED_STEP_METHODS", "Run", "Status", "dop853", "fixed_step"]

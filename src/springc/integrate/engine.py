@@ -1,0 +1,156 @@
+"""The Python side of the compiled loops: checked arguments in, a :class:`Run` out.
+
+numba is an optional dependency of springc, so the kernels (which compile, or load from
+numba's on-disk cache, when their module is imported) are imported on first use only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .status import Status
+
+ModelFunction = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+FIXED_STEP_METHODS = ("euler", "symplectic-euler", "verlet", "rk4")
+
+
+@dataclass(frozen=True)
+class Run:
+    """The outcome of a compiled run on an output grid.
+
+    ``states[k]`` (and ``observed[k]``) hold the solution at ``t[k]`` for ``k < filled``;
+    later rows are NaN. Unless ``status`` is SUCCESS, ``failure_time`` and
+    ``failure_state`` say where the run stopped (see :class:`Status`).
+    """
+
+    status: Status
+    t: np.ndarray
+    states: np.ndarray  # (len(t), n_states)
+    observed: np.ndarray  # (len(t), n_observed)
+    filled: int
+    accepted_steps: int
+    rejected_steps: int
+    rhs_evaluations: int
+    failure_time: float
+    failure_state: np.ndarray
+
+    @property
+    def ok(self) -> bool:
+        """Whether the run reached the end of the grid."""
+        return self.status == Status.SUCCESS
+
+
+def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
+           atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
+           max_step: float = np.inf, first_step: float | None = None,
+           max_steps: int = 0, scipy_arithmetic: bool = True) -> Run:
+    """Integrate ``x' = rhs(t, x, p, z)`` with compiled DOP853 on the output ``grid``.
+
+    ``rhs`` and ``observed`` are numba-jitted functions ``f(t, x, p, z) -> array`` (the
+    generated module's ``rhs`` and ``observed``); ``z`` is the model's work array and is
+    updated in place. ``first_step`` None selects the initial step as scipy does;
+    ``max_steps`` (accepted and rejected steps) 0 is no limit.
+
+    With ``scipy_arithmetic`` the weighted sums go through the BLAS calls numpy makes, so
+    the run equals ``solve_ivp(method="DOP853")`` on the same tolerances bit for bit
+    (same steps, same states; the error estimate of tiny steps is rounding noise, so any
+    other summation order picks other early steps); without it, plain loops, about 1.5x
+    faster on small systems, the same method within rounding.
+    """
+    from .dop853_kernel import dop853_run
+
+    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
+    if not rtol > 0:
+        raise ValueError(f"rtol must be positive, got {rtol!r}")
+    atol_ = np.array(np.broadcast_to(np.asarray(atol, dtype=float), x0_.shape))
+    if not (atol_ >= 0).all():
+        raise ValueError("atol must not be negative")
+    if first_step is not None and not 0 < first_step <= grid_[-1] - grid_[0]:
+        raise ValueError(f"first_step must be positive and within the interval, "
+                         f"got {first_step!r}")
+    if not max_step > 0:
+        raise ValueError(f"max_step must be positive, got {max_step!r}")
+    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
+    result = dop853_run(rhs_, observed_, n_observed, grid_, x0_, p_, z_, float(rtol), atol_,
+                        float(max_step), float(first_step or 0.0), int(max_steps),
+                        bool(scipy_arithmetic))
+    return _run(grid_, result)
+
+
+def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *,
+               step: float, pairs: Sequence[tuple[int, int]] = (),
+               observed: ModelFunction | None = None) -> Run:
+    """Integrate with a fixed-step method of :data:`FIXED_STEP_METHODS`, compiled.
+
+    Same methods and results as ``springc.simulation``'s fixed-step integrators:
+    ``pairs`` lists (position index, velocity index) with ``der(x[q]) = x[v]``.
+    """
+    from .fixed_step_kernel import METHOD_CODES, fixed_step_run
+
+    if method not in METHOD_CODES:
+        raise ValueError(f"unknown fixed-step method {method!r}; use one of "
+                         f"{FIXED_STEP_METHODS}")
+    if not (step > 0 and np.isfinite(step)):
+        raise ValueError(f"the step must be positive, got {step!r}")
+    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
+    positions = np.array([q for q, _ in pairs], dtype=np.int64)
+    velocities = np.array([v for _, v in pairs], dtype=np.int64)
+    if pairs and not (min(positions.min(), velocities.min()) >= 0
+                      and max(positions.max(), velocities.max()) < x0_.size):
+        raise ValueError("a pair index is outside the state vector")
+    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
+    result = fixed_step_run(METHOD_CODES[method], rhs_, observed_, n_observed, grid_, x0_,
+                            p_, z_, float(step), positions, velocities)
+    return _run(grid_, result)
+
+
+def _vectors(grid: Any, x0: Any, p: Any, z: Any
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    # copies: the kernels take writable contiguous arrays (and never see the caller's)
+    grid_ = np.array(grid, dtype=float)
+    if grid_.ndim != 1 or grid_.size == 0 or not np.isfinite(grid_).all() \
+            or (np.diff(grid_) <= 0).any():
+        raise ValueError("the output grid must be a non-empty, finite, strictly "
+                         "increasing 1-D array")
+    x0_ = np.array(x0, dtype=float).ravel()
+    if not isinstance(z, np.ndarray) or z.dtype != np.float64 or z.ndim != 1 \
+            or not z.flags.c_contiguous or not z.flags.writeable:
+        raise ValueError("z must be a writable contiguous 1-D float64 array (it is updated "
+                         "in place)")
+    return grid_, x0_, np.array(p, dtype=float).ravel(), z
+
+
+def _functions(rhs: ModelFunction, observed: ModelFunction | None, grid: np.ndarray,
+               x0: np.ndarray, p: np.ndarray, z: np.ndarray
+               ) -> tuple[ModelFunction, ModelFunction, int]:
+    """The model functions checked once from Python (on a copy of z), and the observed count.
+
+    The kernels do no bounds checks, so a function whose result has the wrong length
+    is refused here rather than read past its end.
+    """
+    from numba.core.dispatcher import Dispatcher
+
+    from .models import no_observed
+
+    for name, f in (("rhs", rhs), ("observed", observed)):
+        if f is not None and not isinstance(f, Dispatcher):
+            raise TypeError(f"{name} must be a numba-jitted function, got {type(f).__name__}")
+    size = np.asarray(rhs(grid[0], x0, p, z.copy())).shape
+    if size != x0.shape:
+        raise ValueError(f"rhs returns shape {size} for {x0.size} states")
+    if observed is None:
+        return rhs, no_observed, 0
+    n_observed = np.asarray(observed(grid[0], x0, p, z.copy())).size
+    return rhs, observed, n_observed
+
+
+def _run(grid: np.ndarray, result: tuple[Any, ...]) -> Run:
+    status, states, observed, filled, accepted, rejected, nfev, t_fail, x_fail = result
+    states[filled:] = np.nan
+    observed[filled:] = np.nan
+    return Run(Status(status), grid, states, observed, int(filled), int(accepted),
+               int(rejected), int(nfev), float(t_fail), x_fail)

@@ -1,0 +1,27 @@
+"""numba types of the model functions the kernels call through a function pointer.
+
+A model function has the signature of the generated module's ``rhs``:
+``f(t: float, x: float64[::1], p: float64[::1], z: float64[::1]) -> float64[::1]``.
+The kernels take it as a first-class function value (``types.FunctionType``), so they are
+compiled once (and cached on disk) for every model, not once per model.
+"""
+
+from collections.abc import Callable
+
+import numpy as np
+from numba import types
+
+#: a model function as Python sees it (a numba dispatcher)
+ModelFunction = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+#: what the kernels return, as Python sees it (see RUN_RESULT)
+RunTuple = tuple[int, np.ndarray, np.ndarray, int, int, int, int, float, np.ndarray]
+
+VECTOR = types.float64[::1]
+MATRIX = types.float64[:, ::1]
+MODEL_FUNCTION_SIGNATURE = VECTOR(types.float64, VECTOR, VECTOR, VECTOR)
+MODEL_FUNCTION = types.FunctionType(MODEL_FUNCTION_SIGNATURE)
+
+#: status, states (grid x n), observed (grid x m), rows filled, accepted steps,
+#: rejected steps, right-hand-side evaluations, failure time, failure state
+RUN_RESULT = types.Tuple((types.int64, MATRIX, MATRIX, types.int64,  # type: ignore[no-untyped-call]
+                          types.int64, types.int64, types.int64, types.float64, VECTOR))

@@ -1,0 +1,221 @@
+"""The on-disk cache of generated modules: where it lives, its key, verified reads.
+
+Entries live in ``$SPRINGC_CACHE_DIR``, else ``$XDG_CACHE_HOME/springc``, else
+``~/.cache/springc``: one folder per key holding ``model.py`` and ``model.sha256``, the
+SHA-256 of the module recorded when it was written. The cache folder is private (created
+0700, whatever the umask). A module is imported only from the bytes whose hash matched
+the record: an edited, planted, truncated or unreadable entry is regenerated with a
+one-line note on stderr, never executed. A cache folder that cannot be used (not a
+folder, not writable, owned by another user) gives a note, and the model is compiled
+in a private temporary folder instead. The least recently used entries beyond
+``CACHE_ENTRIES`` are removed when a new one is written.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import os
+import shutil
+import stat
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from types import ModuleType
+from typing import cast
+
+from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
+from ..parse import library_folders
+from ..resources import PACKAGE_ROOT, grammar_path
+
+CACHE_ENTRIES = 200
+"""Generated modules kept in the cache; the least recently used beyond this are removed."""
+
+MODULE_FILE = "model.py"
+HASH_FILE = "model.sha256"
+
+
+class CacheUnusable(Exception):
+    """The cache folder cannot hold entries (the reason is the message)."""
+
+
+def note(text: str) -> None:
+    """A one-line note on stderr (the cache never fails a compilation)."""
+    print("note: " + " ".join(text.splitlines()), file=sys.stderr)
+
+
+def cache_dir() -> Path:
+    """Where generated modules are kept (:class:`CacheUnusable` without a home)."""
+    if os.environ.get("SPRINGC_CACHE_DIR"):
+        return Path(os.environ["SPRINGC_CACHE_DIR"])
+    if os.environ.get("XDG_CACHE_HOME"):
+        return Path(os.environ["XDG_CACHE_HOME"]) / "springc"
+    try:
+        return Path.home() / ".cache" / "springc"
+    except RuntimeError as err:  # no HOME and no password entry
+        raise CacheUnusable(f"no home folder ({err})") from err
+
+
+def private_folder(folder: Path) -> Path:
+    """``folder``, created 0700 (missing parents too) and checked: a folder of this user
+    that no one else may write. Raises :class:`CacheUnusable` otherwise."""
+    missing = []
+    parent = folder
+    while not parent.exists() and parent != parent.parent:
+        missing.append(parent)
+        parent = parent.parent
+    try:
+        for path in reversed(missing):
+            path.mkdir(mode=0o700)  # the umask only removes bits: 0700 stays 0700
+        info = folder.stat()
+    except OSError as err:
+        raise CacheUnusable(f"cannot create {folder}: {err.strerror or err}") from err
+    if not stat.S_ISDIR(info.st_mode):
+        raise CacheUnusable(f"{folder} is not a folder")
+    if info.st_uid != os.getuid():
+        raise CacheUnusable(f"{folder} belongs to another user")
+    if info.st_mode & 0o077:
+        # Readable or writable by others (an older springc, or a umask of 000): make
+        # it private; entries written while others could write are not trusted.
+        writable = bool(info.st_mode & 0o022)
+        try:
+            os.chmod(folder, 0o700)
+        except OSError as err:
+            raise CacheUnusable(f"cannot make {folder} private: {err.strerror}") from err
+        if writable:
+            note(f"the cache folder {folder} was writable by others: it is private now "
+                 "and its entries were removed")
+            for entry in folder.iterdir():
+                if (entry / MODULE_FILE).exists():
+                    shutil.rmtree(entry, ignore_errors=True)
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise CacheUnusable(f"{folder} is not writable")
+    return folder
+
+
+def touch(path: Path) -> None:
+    """Mark a cache entry as used (its modification time orders the pruning)."""
+    with contextlib.suppress(OSError):  # a read-only cache still works
+        os.utime(path)
+
+
+def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]:
+    """Remove the least recently used entries beyond ``limit`` (never ``keep``)."""
+    limit = CACHE_ENTRIES if limit is None else limit
+    entries = []
+    for entry in folder.iterdir() if folder.is_dir() else ():
+        try:
+            entries.append(((entry / MODULE_FILE).stat().st_mtime, entry))
+        except OSError:  # not an entry, or being written
+            continue
+    entries.sort(reverse=True)
+    removed = [e for _, e in entries[limit:] if e.name != keep]
+    for entry in removed:
+        shutil.rmtree(entry, ignore_errors=True)
+    return removed
+
+
+# ------------------------------------------------------------------ key
+
+
+@functools.cache
+def springc_digest() -> bytes:
+    """SHA-256 of the text of every module below ``PACKAGE_ROOT`` and of the grammar:
+    any change to springc's code moves every key."""
+    h = hashlib.sha256()
+    for path in sorted(PACKAGE_ROOT.glob("**/*.py")):
+        h.update(str(path.relative_to(PACKAGE_ROOT)).encode() + b"\0")
+        h.update(hashlib.sha256(path.read_bytes()).digest())
+    h.update(hashlib.sha256(grammar_path().read_bytes()).digest())
+    return h.digest()
+
+
+def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
+    """A digest of everything a generated module depends on: ``settings`` (by ``repr``:
+    model, backend, outputs, modifications), the text of ``files`` and of every ``.mdl``
+    file of the library folders, and springc's own code."""
+    h = hashlib.sha256()
+    h.update(repr((CODEGEN_VERSION, settings)).encode())
+    h.update(springc_digest())
+    sources = [Path(f) for f in files]
+    for folder in library_folders(libraries):
+        if folder.is_dir():
+            sources += sorted(folder.glob("**/*.mdl"))
+    for path in sources:
+        h.update(str(path.resolve()).encode() + b"\0")
+        try:
+            h.update(hashlib.sha256(path.read_bytes()).digest())
+        except OSError:
+            h.update(b"missing")
+    return h.hexdigest()[:24]
+
+
+# ------------------------------------------------------------------ entries
+
+
+def read_entry(entry: Path) -> bytes | None:
+    """The module text of ``entry`` if its hash matches the record; ``None`` (with a
+    note, the entry removed) if the entry is damaged or was changed; ``None`` silently
+    if there is no entry."""
+    module, record = entry / MODULE_FILE, entry / HASH_FILE
+    if not module.exists() and not record.exists():
+        return None
+    try:
+        data = module.read_bytes()
+        expected = record.read_text(encoding="ascii").strip()
+    except (OSError, UnicodeDecodeError):
+        expected, data = "", b""
+    if hashlib.sha256(data).hexdigest() != expected:
+        discard(entry, "does not match its recorded hash")
+        return None
+    return data
+
+
+def discard(entry: Path, reason: str) -> None:
+    """Remove a damaged cache entry, saying so on stderr."""
+    note(f"cache entry {entry} {reason}; regenerating it")
+    shutil.rmtree(entry, ignore_errors=True)
+
+
+def write_entry(entry: Path, text: str) -> Path:
+    """Write ``text`` as the module of ``entry`` with its hash record; the module path.
+
+    Both files are written in a private temporary folder that is then renamed to
+    ``entry``, so a reader sees a complete entry or none. If another process wrote the
+    entry first, its entry is kept.
+    """
+    data = text.encode("utf-8")
+    new = Path(tempfile.mkdtemp(dir=entry.parent, prefix=".new-"))  # created 0700
+    try:
+        (new / MODULE_FILE).write_bytes(data)
+        (new / HASH_FILE).write_text(hashlib.sha256(data).hexdigest() + "\n",
+                                     encoding="ascii")
+        os.rename(new, entry)
+    except OSError:
+        shutil.rmtree(new, ignore_errors=True)
+        if not entry.is_dir():
+            raise
+    return entry / MODULE_FILE
+
+
+def import_module(data: bytes, path: Path, name: str) -> GeneratedModule:
+    """Execute the module text ``data`` (already verified) as module ``name`` located at
+    ``path``; raises ``ImportError`` if it is not a complete generated module."""
+    module = ModuleType(name)
+    module.__file__ = str(path)
+    code = compile(data, str(path), "exec")
+    # numba's on-disk cache finds the module again by name when loading.
+    sys.modules[name] = module
+    try:
+        exec(code, module.__dict__)
+    except BaseException:
+        del sys.modules[name]
+        raise
+    missing = MODULE_NAMES - set(vars(module))
+    if missing:
+        del sys.modules[name]
+        raise ImportError(f"{path} is not a generated module of this springc: it does "
+                          f"not define {sorted(missing)[0]}")
+    return cast(GeneratedModule, module)

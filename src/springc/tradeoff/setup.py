@@ -1,0 +1,146 @@
+"""The setting of a study: CompiledModel + TradeoffOptions -> StudySetup (the output
+grid, parameters, start state, units), and the measures shared by the runs and the
+reference: the per-variable scales, the relative errors, the compared outputs of a
+scipy solve, and the deadline that stops a run over budget.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TextIO
+
+import numpy as np
+
+from ..pipeline import CompiledModel
+from ..simulation import (
+    LSODA_LIMIT,
+    SimulationOptions,
+    initial_state,
+    output_grid,
+    resolve,
+)
+from .model import SCALE_FLOOR, OverBudget, TradeoffOptions
+
+# ------------------------------------------------------------------ errors
+
+def variable_scales(values: np.ndarray, units: Sequence[str]) -> np.ndarray:
+    """``max |value|`` over time per column, floored per unit at
+    :data:`SCALE_FLOOR` times the largest peak of that unit (see :mod:`.study`)."""
+    peak = np.max(np.abs(values), axis=0) if len(values) else np.zeros(len(units))
+    scales = peak.copy()
+    for unit in set(units):
+        cols = np.array([u == unit for u in units])
+        floor = SCALE_FLOOR * float(np.max(peak[cols]))
+        scales[cols] = np.maximum(peak[cols], floor)
+    scales[~(scales > 0)] = 1.0  # all zero (or NaN): compare absolutely
+    return scales
+
+
+def relative_errors(values: np.ndarray, reference: np.ndarray,
+                    scales: np.ndarray) -> tuple[float, float]:
+    """(max, RMS) of ``|values - reference| / scales`` over times and variables."""
+    err = np.abs(values - reference) / scales
+    if err.size == 0:
+        return 0.0, 0.0
+    if not np.isfinite(err).all():
+        return math.inf, math.inf
+    return float(err.max()), float(np.sqrt(np.mean(err * err)))
+
+
+# ------------------------------------------------------------------ budget
+
+class Deadline:
+    """A progress stream that ends the run: ``simulate_model`` writes progress to it
+    about ten times a second once a run has taken a second, and past the deadline the
+    write raises :class:`OverBudget` (a time limit in SimulationOptions would be
+    cleaner)."""
+
+    def __init__(self, seconds: float) -> None:
+        self.end = time.perf_counter() + seconds
+
+    def check(self) -> None:
+        if time.perf_counter() > self.end:
+            raise OverBudget
+
+    def write(self, text: str) -> int:
+        self.check()
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+# ------------------------------------------------------------------ the study
+
+@dataclass(frozen=True)
+class StudySetup:
+    """What every run of a study shares: the model, the options, the output grid, the
+    parameter vector ``p``, the start state ``x0`` and the units of the compared outputs."""
+
+    model: CompiledModel
+    options: TradeoffOptions
+    grid: np.ndarray
+    atol_ratio: float
+    p: np.ndarray
+    x0: np.ndarray
+    units: tuple[str, ...]
+
+    def sim_options(self, solver: str, rtol: float | None = None, step: float | None = None,
+                    progress: TextIO | Deadline | None = None) -> SimulationOptions:
+        """The simulator's options for one run (atol in the study's ratio to rtol)."""
+        o = self.options
+        return SimulationOptions(o.start, o.stop, o.interval, solver, rtol,
+                                 None if rtol is None else rtol * self.atol_ratio,
+                                 dict(o.parameters), progress,  # type: ignore[arg-type]
+                                 step)
+
+    def log(self, text: str) -> None:
+        """A line on the study's log stream, if any."""
+        if self.options.log is not None:
+            self.options.log.write(text + "\n")
+            self.options.log.flush()
+
+
+def study_setup(model: CompiledModel, options: TradeoffOptions) -> StudySetup:
+    """The setup of a study of ``model``: times and tolerances resolved as the simulator
+    resolves them (options, then the experiment annotation, then the defaults)."""
+    base = SimulationOptions(options.start, options.stop, options.interval,
+                             parameters=dict(options.parameters))
+    start, stop, interval, rtol, atol = resolve(model, base)
+    p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
+    units = dict(zip(model.states, model.module.STATE_UNITS))
+    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    return StudySetup(model, options, output_grid(start, stop, interval), atol / rtol, p,
+                      initial_state(model, p, start),
+                      tuple(units.get(n, "") for n in model.outputs))
+
+
+def warm_up(model: CompiledModel, p: np.ndarray, x0: np.ndarray) -> None:
+    """Call the generated functions once, so that just-in-time compilation (numba)
+    is not timed as part of the first run that needs them."""
+    mod = model.module
+    z = np.asarray(mod.guesses(p), dtype=float)
+    for name in ("rhs", "jacobian", "jacobian_dense"):
+        if name == "jacobian_dense" and len(x0) > LSODA_LIMIT:
+            continue
+        func = getattr(mod, name, None)
+        if func is not None:
+            func(0.0, x0, p, z)
+    if model.observed:
+        mod.observed_grid(np.zeros(1), np.ascontiguousarray(x0[None, :]), p, z)
+
+
+def scipy_outputs(model: CompiledModel, p: np.ndarray, grid: np.ndarray,
+                  states: np.ndarray) -> np.ndarray:
+    """The compared outputs (``model.outputs``) from states on the grid."""
+    columns = {s: states[:, i] for i, s in enumerate(model.states)}
+    observed = set(model.observed)
+    if any(n in observed for n in model.outputs):
+        z = np.asarray(model.module.guesses(p), dtype=float)
+        obs = model.module.observed_grid(grid, np.ascontiguousarray(states), p, z)
+        columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
+    return np.column_stack([columns[n] for n in model.outputs]) if model.outputs \
+        else np.empty((len(grid), 0))
