@@ -564,3 +564,11 @@ def test_numbers_beyond_the_double_range_are_errors() -> None:
         ("the number 2E400 is too large", Span("t.mo", 2, 20, 2, 25))]
     number = parse_expression("1" + "0" * 300)  # an integer literal in range stays exact
     assert isinstance(number, Number) and number.value == 10**300
+
+
+def test_end_cannot_be_called() -> None:
+    assert error_text("model A\n  Real x[end(2)];\nend A;") == (
+        "t.mo:2:10: error: 'end' cannot be called\n"
+        "    2 |   Real x[end(2)];\n"
+        "      |          ^^^\n"
+        "help: call a function by its name, e.g. size(x, 1)")

@@ -87,6 +87,10 @@ class ExpressionRules(RuleBase):
 
     def call(self, meta: Meta, ch: list[Any]) -> Call:
         func, args = ch
+        if not isinstance(func, Ref):  # `end(...)`: the grammar reads `end` as a reference
+            self.error(f"'{type(func).__name__.lower()}' cannot be called", func.span,
+                       hint="call a function by its name, e.g. size(x, 1)")
+            func = Ref((RefPart("end", (), func.span),), func.span)
         return Call(func, args.args, args.named, self.span_of(meta))
 
     def subscripted(self, meta: Meta, ch: list[Any]) -> Any:
