@@ -59,13 +59,13 @@ class SyntaxBuilder(ClassRules, ElementRules, EquationRules, ExpressionRules):
         self.file = file
         self.errors: list[ParseError] = []
         self._methods: dict[str, Callable[[Any, list[Any]], Any]] = {}
-        self._loose_ends: list[End] = []  # `end`s not yet known to sit in a subscript
+        self.loose_ends: list[End] = []  # `end`s not yet known to sit in a subscript
 
     def convert(self, tree: Tree[Token]) -> Any:
         """The syntax node for the whole ``tree``; problems are left in ``errors``."""
         result = self.transform(tree)
-        for end in self._loose_ends:
-            self._error("`end` may only be used inside array subscripts such as x[end]",
+        for end in self.loose_ends:
+            self.error("`end` may only be used inside array subscripts such as x[end]",
                         end.span)
         return result
 
