@@ -152,42 +152,11 @@ def limits(seconds: int, memory: int) -> Iterator[None]:
         signal.signal(signal.SIGALRM, previous)
 
 
-# Findings outside the fuzzer's area, excluded until their fixes land: remove each entry
-# then. An entry matches exactly one reproducer class: the exception an internal error
-# (exit 3) raised and the springc function it was raised in (from the --debug traceback).
-KNOWN = {
-    # F1: a range with a bound that is not finite: `x = 1:1e309;` (OverflowError),
-    #     `x = 1:(1e309 - 1e309);` (ValueError: cannot convert float NaN to integer);
-    # F2: a range with an array bound: `x = {1, 2}:3;` (TypeError)
-    ("flatten/evaluate.py", "_Range", "OverflowError"): "F1",
-    ("flatten/evaluate.py", "_Range", "ValueError"): "F1",
-    ("flatten/evaluate.py", "_Range", "TypeError"): "F2",
-    # F3: an if-equation whose condition is an array: `if {1, 2} then ... end if;`,
-    #     `if 2:1 then ... end if;` (ValueError: truth value of an array is ambiguous)
-    ("flatten/equations.py", "equation", "ValueError"): "F3",
-    # F4: an infinite array size: `Real x[1e309];` (OverflowError)
-    ("flatten/evaluate.py", "integer", "OverflowError"): "F4",
-}
-# F5: a huge array (`Real x[1000000000];`) has no size cap yet: it fails with
-# MemoryError under the fuzzer's memory limit (and takes all memory without it).
-KNOWN_ANYWHERE = {"MemoryError": "F5"}
-
-# F6: a loop or array of a billion (`for i in 1:1000000000 loop`) runs past the time
-# limit: there is no cap on loop iterations yet. A hang counts as F6 only if the input
-# has such a number.
+# Inputs with numbers of a million or more may run loops up to the size cap (two
+# million iterations, flatten/limits.py), which takes longer than the time limit on a
+# loaded machine: they get a short limit, and running out of it is not a failure.
 HUGE = re.compile(r"(?<![.\w])[1-9][0-9]{6,}(?![.\w])")
 
-FRAME = re.compile(r'File "[^"]*springc/([^"]+)", line \d+, in (\w+)')
-
-
-def known_finding(traceback: str) -> str | None:
-    """The finding whose class the internal error of ``traceback`` belongs to."""
-    frames = FRAME.findall(traceback)
-    last = traceback.strip().splitlines()[-1] if traceback.strip() else ""
-    kind = last.split(":")[0]
-    if kind in KNOWN_ANYWHERE:
-        return KNOWN_ANYWHERE[kind]
-    return KNOWN.get((*frames[-1], kind)) if frames else None
 
 
 def invoke(*args: str, seconds: int = SECONDS_PER_RUN) -> tuple[int, str]:
@@ -198,20 +167,14 @@ def invoke(*args: str, seconds: int = SECONDS_PER_RUN) -> tuple[int, str]:
 
 
 def run(command: str, path: Path) -> tuple[int, str]:
-    """Exit code and output of ``springc COMMAND PATH``; a known finding counts as 1."""
+    """Exit code and output of ``springc COMMAND PATH``."""
     huge = HUGE.search(path.read_text()) is not None
-    seconds = 5 if huge else SECONDS_PER_RUN  # F6 inputs would all hang the full limit
     try:
-        code, output = invoke(command, str(path), seconds=seconds)
-        if code == 3 and "\nTraceback" not in output:
-            debug_code, traceback = invoke("--debug", command, str(path), seconds=seconds)
-            if debug_code == 3 and known_finding(traceback):
-                return 1, f"known finding {known_finding(traceback)}"
+        return invoke(command, str(path), seconds=5 if huge else SECONDS_PER_RUN)
     except Hang:
         if huge:
-            return 1, "known finding F6"
+            return 1, "a loop within the size cap outlasted the short time limit"
         raise
-    return code, output
 
 
 @settings(max_examples=EXAMPLES, derandomize=not RANDOM, deadline=None, database=None,
