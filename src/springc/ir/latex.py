@@ -19,7 +19,6 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from . import expr as x
-from .dae import derivative_name
 
 __all__ = ["NOTEBOOK_ROWS", "align", "latex_name", "notebook", "to_latex", "to_sympy"]
 
@@ -125,7 +124,7 @@ class _Converter:
             return self.time
         if isinstance(e, x.Der):
             if isinstance(e.arg, x.Var):
-                return self.symbol(derivative_name(e.arg.name))
+                return self.symbol(x.to_text(e))  # der(name), as the DAE names it
             return sp.Derivative(args[0], self.time, evaluate=False)
         if isinstance(e, x.Neg):
             return -args[0]
