@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import TextIO
 
 from .errors import UsageError
+from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -109,6 +110,7 @@ def _files(files: Files) -> tuple[str, ...]:
     return tuple(os.fspath(f) for f in files)
 
 
+@recursion_room()  # expressions up to ir.expr.MAX_DEPTH deep (docs/language.md, "Limits")
 def compile_model(files: Files, model: str | None = None, *,
                   libraries: Sequence[str | os.PathLike[str]] = (), backend: str = "python",
                   outputs: Sequence[str] | None = None,
@@ -146,6 +148,7 @@ def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
     return compile_files(replace(options or compiled.options, modifications=mods))
 
 
+@recursion_room()
 def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              start: float | None = None, stop: float | None = None,
              interval: float | None = None, solver: str = DEFAULT_SOLVER,

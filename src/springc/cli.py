@@ -23,6 +23,7 @@ from typing import Any
 import click
 
 from .errors import ErrorGroup, OutputError, SpringcError, UsageError, render_all
+from .ir.expr import recursion_room
 from .simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, FIXED_STEP
 
 EXIT_MODEL_ERROR = 1
@@ -59,7 +60,8 @@ def _guard(func: Callable[..., Any]) -> Callable[..., Any]:
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         debug = click.get_current_context().find_root().params.get("debug", False)
         try:
-            return func(*args, **kwargs)
+            with recursion_room():  # expressions up to ir.expr.MAX_DEPTH deep
+                return func(*args, **kwargs)
         except UsageError as err:
             click.echo(str(err), err=True)
             sys.exit(EXIT_USAGE)
@@ -116,25 +118,31 @@ def main(debug: bool) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the flat model as JSON.")
 @click.option("--simplify", "simplified", is_flag=True,
               help="Print the simplified system: states, evaluation order, observed.")
+@click.option("--latex", "as_latex", is_flag=True,
+              help="Print the equations (with --simplify: the evaluation order) as LaTeX.")
 @_guard
 def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
-            origins: bool, as_json: bool, simplified: bool) -> None:
-    """Print the flat model of FILES as Modelica text (or JSON)."""
-    from .ir.flat import format_flat, to_json_dict
+            origins: bool, as_json: bool, simplified: bool, as_latex: bool) -> None:
+    """Print the flat model of FILES as Modelica text (or JSON, or LaTeX)."""
+    from .ir.flat import format_flat, format_flat_latex, to_json_dict
     from .pipeline import flatten_files
 
+    if as_latex and as_json:
+        raise click.UsageError("--latex and --json cannot be combined")
     flat_model = flatten_files(files, model, libraries)
     if simplified:
-        from .ir.ode import format_ode
+        from .ir.ode import format_ode, format_ode_latex
         from .simplify import simplify
 
         result = simplify(flat_model)
-        click.echo(format_ode(result.ode), nl=False)
+        click.echo((format_ode_latex if as_latex else format_ode)(result.ode), nl=False)
         for note in result.warnings:
             click.echo(f"{note.span}: warning: {note.message}" if note.span
                        else f"warning: {note.message}", err=True)
     elif as_json:
         click.echo(json.dumps(to_json_dict(flat_model), indent=1))
+    elif as_latex:
+        click.echo(format_flat_latex(flat_model), nl=False)
     else:
         click.echo(format_flat(flat_model, origins), nl=False)
 
