@@ -39,6 +39,8 @@ start with ten times the budget (at most 11 % repeated work), so that a run whos
 size is hopeless stops early and the wall-clock limit is checked between attempts.
 (The kernel counts rejected steps too; its budget is raised by them, so that the step
 limit counts accepted steps, as scipy's loop does.)"""
+FIXED_CHUNK = 200_000
+"""Steps of a fixed-step stretch between two checks of the wall clock."""
 SCIPY_COLLAPSE = "Required step size is less than spacing between numbers."
 """scipy's message for the same failure (the step loop words both alike)."""
 
@@ -142,21 +144,42 @@ def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step:
                        ) -> tuple[np.ndarray, int, float]:
     """The states on ``grid``, the steps and the loop's seconds of a fixed-step run of
     ``problem.solver``, compiled (the same arithmetic and errors as
-    :func:`springc.simulation.solvers.run_fixed`)."""
+    :func:`springc.simulation.solvers.run_fixed`).
+
+    The grid is run in stretches of about :data:`FIXED_CHUNK` steps, each from the
+    state the last one reached (the methods restart exactly at an output time; verlet
+    evaluates the derivative there again, the same value up to the rounding of a
+    time-dependent model's clock), with the wall-clock limit and the progress bar
+    between stretches.
+    """
     from springc.integrate import fixed_step
 
     if len(x0) == 0:
         return np.tile(x0, (len(grid), 1)), 0, 0.0
     pairs = detect_pairs(problem.mod, problem.p, x0, float(grid[0]))
+    index_pairs = list(zip(pairs.positions.tolist(), pairs.velocities.tolist()))
+    counts = np.maximum(1, np.ceil(np.diff(grid) / step - 1e-9))
+    ends = np.searchsorted(np.cumsum(counts), FIXED_CHUNK * np.arange(1, counts.sum()
+                                                                     // FIXED_CHUNK + 2))
+    states = np.empty((len(grid), len(x0)))
+    states[0] = x0
     began = time.perf_counter()
-    run = fixed_step(problem.solver, problem.mod.rhs, grid, x0, problem.p, problem.z,
-                     step=step, pairs=list(zip(pairs.positions.tolist(),
-                                               pairs.velocities.tolist())))
-    seconds = time.perf_counter() - began
-    problem.nfev += run.rhs_evaluations
-    if not run.ok:
-        raise failure(problem, run, problem.solver, step=step)
-    return run.states, run.accepted_steps, seconds
+    first, steps = 0, 0
+    for end in sorted({*(min(int(e) + 1, len(grid) - 1) for e in ends), len(grid) - 1}):
+        if end <= first:
+            continue
+        run = fixed_step(problem.solver, problem.mod.rhs, grid[first:end + 1],
+                         states[first], problem.p, problem.z, step=step, pairs=index_pairs)
+        problem.nfev += run.rhs_evaluations
+        steps += run.accepted_steps
+        if not run.ok:
+            raise failure(problem, run, problem.solver, step=step)
+        states[first + 1:end + 1] = run.states[1:]
+        first = end
+        if end < len(grid) - 1 and time.perf_counter() > problem.deadline:
+            raise time_limit_reached(problem, run)
+        problem.progress.update(float(grid[end]))
+    return states, steps, time.perf_counter() - began
 
 
 def time_limit_reached(problem: Problem, run: Run) -> OverLimit:
