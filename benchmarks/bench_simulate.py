@@ -8,7 +8,12 @@
     cache, against the interpreter + numpy + scipy.integrate import floor:
     target warm under 1.5 s;
 (c) the 10,000-mass chain (2,000 with --quick) with BDF and the sparse analytic
-    Jacobian: wall time and the share spent in springc's generated code vs scipy.
+    Jacobian: wall time and the share spent in springc's generated code vs scipy;
+(d) the seed, warm, in process: ``springc.simulate`` on the compiled engine (numba
+    loops of springc.integrate) against the scipy engine on the same numba module and
+    on the python backend (the scipy engine's default), and the first run's compile
+    time in a fresh process: numba's cache empty (kernels and model functions compile)
+    and with the kernels cached (a new model compiles its own functions only).
 """
 
 from __future__ import annotations
@@ -109,10 +114,73 @@ def bench_large_chain(n: int) -> None:
           f"({'cached' if model.cached else 'cold'}); {s.summary(result.model)}", flush=True)
 
 
+def best_run(repeats: int, **keywords: object) -> tuple[float, object]:
+    """The smallest wall time of ``repeats`` simulate calls (after a warm-up) and a result."""
+    result = springc.simulate(**keywords)  # type: ignore[arg-type]
+    times = []
+    for _ in range(repeats):
+        began = time.perf_counter()
+        springc.simulate(**keywords)  # type: ignore[arg-type]
+        times.append(time.perf_counter() - began)
+    return min(times), result
+
+
+FIRST_RUN = """
+import sys, time
+began = time.perf_counter()
+import springc
+result = springc.simulate(sys.argv[1], engine="compiled")
+print(time.perf_counter() - began, result.stats.wall_time, result.stats.engine)
+"""
+
+
+def first_run(env: dict[str, str]) -> tuple[float, float]:
+    """Seconds of a fresh process's import + simulate, and of simulate alone."""
+    out = subprocess.run([sys.executable, "-c", FIRST_RUN, SEED], check=True, env=env,
+                         capture_output=True, text=True).stdout.split()
+    assert out[2] == "compiled", out
+    return float(out[0]), float(out[1])
+
+
+def bench_engines(repeats: int) -> None:
+    numba_model = springc.compile_model(SEED, backend="numba")
+    python_model = springc.compile_model(SEED)
+    compiled, run = best_run(repeats, model=numba_model, engine="compiled")
+    scipy_numba, _ = best_run(repeats, model=numba_model, engine="scipy")
+    scipy_python, _ = best_run(repeats, model=python_model, engine="scipy")
+    steps = run.stats.steps  # type: ignore[attr-defined]
+    rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
+                 f"scipy engine, numba module {scipy_numba * 1e3:.0f} ms",
+                 f"{scipy_numba / compiled:.0f}x faster", f"{steps} steps"))
+    rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
+                 f"scipy engine, python module {scipy_python * 1e3:.0f} ms",
+                 f"{scipy_python / compiled:.0f}x faster", "(the scipy engine's default)"))
+    # --solver dop853: no auto probe (40 scipy steps) and no stiffness estimate
+    direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="compiled")
+    scipy_direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="scipy")
+    rows.append(("(d) seed in process, warm, --solver dop853 compiled",
+                 f"{direct * 1e3:.1f} ms", f"scipy engine {scipy_direct * 1e3:.0f} ms",
+                 f"{scipy_direct / direct:.0f}x faster", "same steps, same values"))
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, SPRINGC_CACHE_DIR=str(Path(tmp) / "springc"),
+                   NUMBA_CACHE_DIR=str(Path(tmp) / "numba"), PYTHONPATH=str(ROOT / "src"))
+        cold_total, cold_run = first_run(env)
+        env["SPRINGC_CACHE_DIR"] = str(Path(tmp) / "springc2")  # a new model, kernels cached
+        model_total, model_run = first_run(env)
+        warm_total, warm_run = first_run(env)  # both cached
+    rows.append(("(d) seed first run, fresh process, numba cache empty",
+                 f"{cold_total:.1f} s", f"simulate call {cold_run:.1f} s", "",
+                 "kernels + model compile"))
+    rows.append(("(d) seed first run, kernels cached, new model", f"{model_total:.1f} s",
+                 f"simulate call {model_run:.1f} s", "", "model functions compile"))
+    rows.append(("(d) seed, fresh process, everything cached", f"{warm_total:.1f} s",
+                 f"simulate call {warm_run:.2f} s", "", "import + cache loads"))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller scenes")
-    parser.add_argument("--only", default="abc", help="which benchmarks, e.g. 'bc'")
+    parser.add_argument("--only", default="abcd", help="which benchmarks, e.g. 'bc'")
     args = parser.parse_args()
     quick, only = args.quick, args.only
 
@@ -132,6 +200,9 @@ def main() -> None:
     if "c" in only:
         print("(c) large chain", flush=True)
         bench_large_chain(2000 if quick else 10000)
+    if "d" in only:
+        print("(d) compiled engine vs scipy engine", flush=True)
+        bench_engines(3 if quick else 10)
     header: Row = ("benchmark", "springc", "baseline (same run)", "ratio", "target")
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(5)]
     print()

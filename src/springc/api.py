@@ -25,11 +25,13 @@ from .pipeline import (
     modification_value,
 )
 from .simulation import (
+    DEFAULT_ENGINE,
     DEFAULT_MAX_STEPS,
     DEFAULT_SOLVER,
     DEFAULT_TIME_LIMIT,
     SimulationOptions,
     SimulationResult,
+    choose_engine,
     simulate_model,
 )
 
@@ -152,11 +154,11 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              interval: float | None = None, solver: str = DEFAULT_SOLVER,
              rtol: float | None = None, atol: float | None = None,
              parameters: Mapping[str, float] | None = None,
-             outputs: Sequence[str] | None = None, backend: str = "python",
+             outputs: Sequence[str] | None = None, backend: str | None = None,
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
              progress: TextIO | None = None, step: float | None = None,
-             max_steps: int | None = None, time_limit: float | None = None
-             ) -> SimulationResult:
+             max_steps: int | None = None, time_limit: float | None = None,
+             engine: str = DEFAULT_ENGINE) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -165,15 +167,24 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
     A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
-    seconds (``None``: 20,000,000 steps, one hour).
+    seconds (``None``: 20,000,000 steps, one hour). ``engine`` runs the steps:
+    ``"compiled"`` (numba loops of :mod:`springc.integrate` for dop853, auto's dop853
+    and the fixed-step solvers), ``"scipy"`` (scipy's solvers stepped from Python), or
+    ``"auto"``: compiled where numba is importable and the solver has a compiled loop.
+    ``backend`` (files only) defaults to ``"numba"`` for the compiled engine, else
+    ``"python"``.
     """
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
-        model = compile_model(model, model_name, libraries=libraries, backend=backend,
+        chosen = choose_engine(engine, str(solver).lower(), backend, "engine", "backend")
+        model = compile_model(model, model_name, libraries=libraries,
+                              backend=backend or ("numba" if chosen == "compiled"
+                                                  else "python"),
                               outputs=outputs, cache=cache, parameters=values)
         structural = {k for k, v in model.options.modifications}
     else:
+        choose_engine(engine, str(solver).lower(), model.module.BACKEND, "engine", "backend")
         check_parameter_names(model, values)
         _check_integers(model, values)
         structural = {k for k in values if k in model.structural}
@@ -181,5 +192,6 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
                                 step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
-                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit)
+                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
+                                engine)
     return simulate_model(model, options)

@@ -24,7 +24,7 @@ import click
 
 from .errors import ErrorGroup, OutputError, SpringcError, UsageError, render_all
 from .ir.expr import recursion_room
-from .simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
+from .simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, FIXED_STEP
 
 EXIT_MODEL_ERROR = 1
 EXIT_USAGE = 2
@@ -221,8 +221,10 @@ def _compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
                         help="Output only these variables: flat names, * and ? as "
                         "wildcards (repeatable). Default: all states and observed.")(func)
     return click.option("--backend", type=click.Choice(["python", "numba"]),
-                        default="python", show_default=True,
-                        help="Generated code: plain Python/numpy, or numba-compiled.")(func)
+                        default=None,
+                        help="Generated code: plain Python/numpy, or numba-compiled "
+                        "(default: numba for simulate's compiled engine, else "
+                        "python).")(func)
 
 
 def _single_threaded_blas() -> None:
@@ -245,6 +247,11 @@ def _single_threaded_blas() -> None:
               help="auto: dop853 or radau from a stiffness estimate at the start (the "
               "summary says why); a scipy solve_ivp method; or a fixed-step one "
               "(verlet, symplectic-euler, rk4) with --step.")
+@click.option("--engine", type=click.Choice(ENGINES, case_sensitive=False),
+              default=DEFAULT_ENGINE, show_default=True,
+              help="compiled: numba loops (springc.integrate) for dop853, auto's dop853 "
+              "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; "
+              "auto: compiled where numba is installed and the solver has a loop.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
@@ -265,18 +272,20 @@ def _single_threaded_blas() -> None:
 @_guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
-             stop: float | None, interval: float | None, solver: str, rtol: float | None,
-             step: float | None, atol: float | None, assignments: tuple[str, ...],
-             max_steps: int | None, time_limit: float | None, output: str | None,
-             plot: str | None, quiet: bool) -> None:
+             stop: float | None, interval: float | None, solver: str, engine: str,
+             rtol: float | None, step: float | None, atol: float | None,
+             assignments: tuple[str, ...], max_steps: int | None,
+             time_limit: float | None, output: str | None, plot: str | None,
+             quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from .api import check_run_values
-    from .simulation import PLOT_FORMATS, RESULT_FORMATS
+    from .simulation import PLOT_FORMATS, RESULT_FORMATS, choose_engine
 
     values = _parse_set(assignments)
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
+    choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     _check_outputs([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
@@ -289,7 +298,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
                  parameters=values, progress=progress, step=step, max_steps=max_steps,
-                 time_limit=time_limit)
+                 time_limit=time_limit, engine=engine.lower())
     if output or plot:
         save_outputs(result, output, plot, files)
     else:
@@ -312,7 +321,7 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     from .pipeline import CompileOptions, compile_files
 
     _check_outputs([("-o", output, None)], files)
-    compiled = compile_files(CompileOptions(files, model, libraries, backend,
+    compiled = compile_files(CompileOptions(files, model, libraries, backend or "python",
                                             patterns or None, (), not no_cache))
     if output:
         from .fileio import atomic_write
@@ -432,7 +441,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         summary,
     )
 
-    compiled = compile_model(files, model, libraries=libraries, backend=backend,
+    compiled = compile_model(files, model, libraries=libraries, backend=backend or "python",
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     if not patterns:

@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from springc.cli import main
-from springc.simulation import ALL_SOLVERS, AUTO, FIXED_STEP, SOLVERS
+from springc.simulation import ALL_SOLVERS, AUTO, COMPILED_SOLVERS, FIXED_STEP, SOLVERS
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -57,7 +57,8 @@ def test_seed_csv_and_png(tmp_path: Path) -> None:
     for line in out.read_text().splitlines()[1:5]:
         assert all(repr(float(v)) == v for v in line.split(","))
     assert stdout == ""
-    assert "SpringMass: auto -> dop853 (non-stiff: " in stderr and " steps, " in stderr
+    assert "SpringMass: auto -> dop853 (compiled) (non-stiff: " in stderr
+    assert " steps, " in stderr
     assert "RHS and 1 Jacobian evaluations" in stderr  # the stiffness estimate
     import matplotlib.image
 
@@ -152,7 +153,8 @@ def test_each_solver_runs() -> None:
         code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
                                    "--vars", "spring.x", *step)
         assert code == 0, stderr
-        shown = "auto -> dop853 (" if solver == AUTO else f"{solver},"
+        engine = "compiled" if solver in COMPILED_SOLVERS else "scipy"
+        shown = "auto -> dop853 (" if solver == AUTO else f"{solver} ({engine}),"
         assert f"SpringMass: {shown}" in stderr
         if solver in ("radau", "bdf", "lsoda"):
             assert " 0 Jacobian" not in stderr

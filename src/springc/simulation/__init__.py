@@ -14,13 +14,17 @@ from typing import TYPE_CHECKING, Any
 from .solver_names import (
     ALL_SOLVERS,
     AUTO,
+    COMPILED_SOLVERS,
+    DEFAULT_ENGINE,
     DEFAULT_SOLVER,
+    ENGINES,
     FIXED_STEP,
     IMPLICIT_SOLVERS,
     SOLVERS,
 )
 
 if TYPE_CHECKING:
+    from .compiled import choose_engine
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
     from .results import (
         PLOT_FORMATS,
@@ -39,10 +43,11 @@ if TYPE_CHECKING:
         simulate_model,
     )
 
-__all__ = ["ALL_SOLVERS", "AUTO", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT",
-           "FIXED_STEP", "IMPLICIT_SOLVERS", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS",
-           "SOLVERS", "SimulationOptions", "SimulationResult", "file_format", "initial_state",
-           "output_grid", "resolve", "save_outputs", "simulate_model", "write_csv"]
+__all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE", "DEFAULT_MAX_STEPS",
+           "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT", "ENGINES", "FIXED_STEP", "IMPLICIT_SOLVERS",
+           "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS", "SOLVERS", "SimulationOptions",
+           "SimulationResult", "choose_engine", "file_format", "initial_state", "output_grid",
+           "resolve", "save_outputs", "simulate_model", "write_csv"]
 
 _LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
 _RESULTS = frozenset({"PLOT_FORMATS", "RESULT_FORMATS", "SimulationResult", "file_format",
@@ -53,6 +58,10 @@ _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "outpu
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
+    if name == "choose_engine":
+        from . import compiled
+
+        return compiled.choose_engine
     if name in _LIMITS:
         from . import limits
 

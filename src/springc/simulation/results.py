@@ -54,13 +54,18 @@ class SimulationStats:
     cached: bool
     reason: str = ""  # why --solver auto chose ``solver`` (empty: the user chose it)
     note: str = ""  # what the run did differently from what was asked (e.g. the step)
+    engine: str = "scipy"  # the step loop: "compiled" (springc.integrate) or "scipy"
+    loop_time: float = 0.0  # seconds in the compiled loop (model code included)
 
     def summary(self, model: str) -> str:
-        """One line: solver (``auto -> radau (why)``), steps, evaluations, wall time."""
-        solver = f"auto -> {self.solver} ({self.reason})" if self.reason else self.solver
+        """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
+        evaluations, wall time."""
+        solver = f"{self.solver} ({self.engine})"
+        solver = f"auto -> {solver} ({self.reason})" if self.reason else solver
+        inside = f"compiled loop {self.loop_time:.3f} s, " if self.loop_time else ""
         return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
-                f"{self.wall_time:.3f} s (model code {self.model_time:.3f} s; "
+                f"{self.wall_time:.3f} s ({inside}model code {self.model_time:.3f} s; "
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
                 + (f"; note: {self.note}" if self.note else ""))
 

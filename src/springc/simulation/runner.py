@@ -29,6 +29,7 @@ from ..errors import SimulationError
 from ..pipeline import CompiledModel, check_parameter_names
 from ..simplify import describe_failure as describe_failure
 from . import solvers
+from .compiled import COMPILED, SCIPY, choose_engine, finish_dop853, run_fixed_compiled
 from .failures import Stop, code_location, state_notes
 from .limits import (
     DEFAULT_MAX_STEPS,
@@ -44,6 +45,7 @@ from .results import SimulationResult, SimulationStats
 from .solver_names import (
     ALL_SOLVERS,
     AUTO,
+    DEFAULT_ENGINE,
     DEFAULT_SOLVER,
     EXPLICIT,
     FIXED_STEP,
@@ -71,6 +73,7 @@ class SimulationOptions:
     step: float | None = None  # fixed-step solvers only
     max_steps: int = DEFAULT_MAX_STEPS
     time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
+    engine: str = DEFAULT_ENGINE  # auto, compiled (springc.integrate) or scipy
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -152,6 +155,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                               hint=f"choose one of {', '.join(ALL_SOLVERS)}")
     limits = Limits(options.max_steps, options.time_limit)
     limits.validate()
+    engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -178,6 +182,11 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
         from .switching import simulate_switching_model
 
+        if options.engine == COMPILED:
+            raise SimulationError(f"{model.name} switches its states during the run, which "
+                                  "only the scipy engine does",
+                                  hint="use --engine scipy (or auto)")
+
         return simulate_switching_model(model, solver, grid, rtol, atol,
                                         dict(options.parameters), limits)
     x0 = initial_state(model, p, start)
@@ -190,18 +199,26 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
             reason = ""
-            if solver in FIXED_STEP:
+            compiled = engine == COMPILED
+            finish = finish_dop853 if compiled else None
+            loop_time = 0.0
+            if solver in FIXED_STEP and compiled:
+                states, steps, loop_time = run_fixed_compiled(problem, grid, x0, step)
+            elif solver in FIXED_STEP:
                 states, steps = solvers.run_fixed(problem, grid, x0, step)
             elif solver == AUTO and len(x0):
-                run = StepLoop(problem, grid, x0, rtol, atol)
+                run = StepLoop(problem, grid, x0, rtol, atol, finish)
                 solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
                     problem.jac(t, x), stop - start))
-                states, steps = run.states, run.steps
+                states, steps, loop_time = run.states, run.steps, run.loop_time
+                compiled = run.compiled_steps > 0
             else:
                 if solver == AUTO:
                     solver, reason = EXPLICIT, "no states to integrate"
                 problem.solver = solver
-                states, steps = integrate(problem, grid, x0, rtol, atol)
+                run = integrate(problem, grid, x0, rtol, atol, finish)
+                states, steps, loop_time = run.states, run.steps, run.loop_time
+                compiled = compiled and len(x0) > 0
             outputs = _outputs(model, problem, grid, states)
     except Stop as stop_:
         raise stop_.error from None
@@ -211,7 +228,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         progress.close()
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
-                            model.compile_time, model.cached, reason, note)
+                            model.compile_time, model.cached, reason, note,
+                            COMPILED if compiled else SCIPY, loop_time)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
@@ -249,6 +267,8 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
             row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
             problem.z[-1] = z[-1]
             raise problem.newton_failure(float(grid[row]), states[row])
+        if not np.isfinite(obs).all():
+            _locate_observed(model, problem, grid, states, obs)
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     out = np.empty((len(grid), len(names)))
     for i, name in enumerate(names):
@@ -268,3 +288,16 @@ def _first_failure(model: CompiledModel, problem: Problem, grid: np.ndarray,
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as first:
             return problem.fail(first, float(grid[row]), states[row], "an observed variable")
     return problem.fail(err, float(grid[-1]), states[-1], "an observed variable")
+
+
+def _locate_observed(model: CompiledModel, problem: Problem, grid: np.ndarray,
+                     states: np.ndarray, obs: np.ndarray) -> None:
+    """Raise the located error of a numba module's observed variables that are not
+    finite: the first output time up to the first non-finite row where the Python
+    semantics of the same code raise (as the python backend does)."""
+    last = int(np.flatnonzero(~np.isfinite(obs).all(axis=1))[0])
+    for row in range(last + 1):
+        located = problem.locate(model.module.observed, float(grid[row]), states[row],
+                                 "an observed variable")
+        if located is not None:
+            raise located

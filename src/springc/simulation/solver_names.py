@@ -31,3 +31,11 @@ RACE = "race"
 DEFAULT_SOLVER = AUTO
 ALL_SOLVERS = (AUTO, *SOLVERS, *FIXED_STEP)
 """Every name ``--solver`` and ``springc.simulate(solver=...)`` accept."""
+
+ENGINES = ("auto", "compiled", "scipy")
+"""Step loops ``--engine`` accepts: ``compiled`` (:mod:`springc.integrate`, numba, no
+Python per step), ``scipy`` (``scipy.integrate``'s solver classes stepped from Python),
+or ``auto``: compiled where numba is importable and the solver has a compiled loop."""
+DEFAULT_ENGINE = "auto"
+COMPILED_SOLVERS = (EXPLICIT, *FIXED_STEP)
+"""Solvers with a compiled loop (``auto`` too, where it settles on :data:`EXPLICIT`)."""

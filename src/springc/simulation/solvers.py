@@ -22,8 +22,8 @@ Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from types import ModuleType
 from typing import Any, TypeVar
 
 import numpy as np
@@ -64,7 +64,7 @@ def _disjoint(pairs: list[tuple[T, T]]) -> list[tuple[T, T]]:
     return [(q, v) for q, v in pairs if v not in positions and q not in velocities]
 
 
-def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -> Pairs:
+def detect_pairs(module: Any, p: np.ndarray, x0: np.ndarray, t0: float) -> Pairs:
     """Position/velocity pairs of a generated module, from its Jacobian sparsity.
 
     Row ``i`` qualifies if its only structural non-zero is column ``j != i`` and
@@ -182,11 +182,18 @@ def run_fixed(problem: Any, grid: np.ndarray, x0: np.ndarray, step: float
     try:
         result = integrate(problem.solver, problem.rhs, grid, x0, step, pairs)
     except NonFiniteState as err:
-        names = [problem.names[i] for i in err.indices]
-        notes = [Note(f"{name} is not finite") for name in names[:4]]
-        if len(names) > 4:
-            notes.append(Note(f"... and {len(names) - 4} more states"))
-        raise SimulationError(f"the states became non-finite by time {err.time:.9g} "
-                              f"({problem.solver}, --step {step:g})", notes=notes,
-                              hint=FIXED_REMEDY) from None
+        raise non_finite_states(problem, err.time, err.indices, step) from None
     return result.x, result.steps
+
+
+def non_finite_states(problem: Any, t: float, indices: Sequence[int] | np.ndarray,
+                      step: float) -> SimulationError:
+    """The error of a fixed-step run whose states ``indices`` are not finite at the
+    output time ``t``."""
+    names = [problem.names[i] for i in indices]
+    notes = [Note(f"{name} is not finite") for name in names[:4]]
+    if len(names) > 4:
+        notes.append(Note(f"... and {len(names) - 4} more states"))
+    return SimulationError(f"the states became non-finite by time {t:.9g} "
+                           f"({problem.solver}, --step {step:g})", notes=notes,
+                           hint=FIXED_REMEDY)

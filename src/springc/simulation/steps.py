@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TextIO
 
@@ -27,7 +28,7 @@ from ..pipeline import CompiledModel
 from ..simplify import describe_failure
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
-from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
+from .solver_names import EXPLICIT, IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
 
@@ -114,16 +115,48 @@ class Problem:
             raise self.newton_failure(t, x)
         # a sum is finite if every term is (a finite sum that overflows is checked again)
         if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
-            bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
-            shown = ", ".join(derivative_name(n) for n in bad[:3])
-            shown += ", ..." if len(bad) > 3 else ""
-            what = "NaN" if np.isnan(dx).any() else "infinite"
-            raise Stop(SimulationError(
-                f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {format_time(t)}",
-                notes=state_notes(self.names, x, dx), hint=remedy(self.solver)))
+            raise self.explain(t, np.asarray(x))
         if now >= self.progress.next:
             self.progress.update(t)
         return np.asarray(dx)
+
+    def non_finite(self, t: float, x: np.ndarray, dx: np.ndarray) -> Stop:
+        """The error of derivatives ``dx`` that are NaN or infinite at ``(t, x)``."""
+        bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
+        shown = ", ".join(derivative_name(n) for n in bad[:3])
+        shown += ", ..." if len(bad) > 3 else ""
+        what = "NaN" if np.isnan(dx).any() else "infinite"
+        return Stop(SimulationError(
+            f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {format_time(t)}",
+            notes=state_notes(self.names, x, dx), hint=remedy(self.solver)))
+
+    def locate(self, function: Any, t: float, x: np.ndarray, what: str) -> Stop | None:
+        """The error of ``function``'s Python original (``py_func`` of a numba function)
+        at ``(t, x)`` on Python floats, where it raises (a division by zero, a square
+        root of a negative number...), naming the line; ``None`` where it does not."""
+        original = getattr(function, "py_func", None)
+        if original is None:
+            return None
+        try:
+            with np.errstate(all="ignore"):
+                original(t, x.tolist(), self.p.tolist(), np.array(self.z))
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            return self.fail(err, t, x, what)
+        except TypeError:  # vectorised code needs arrays: no location then
+            return None
+        return None
+
+    def explain(self, t: float, x: np.ndarray) -> Stop:
+        """The error of a compiled evaluation at ``(t, x)`` that returned a non-finite
+        derivative: where the numba function has a Python original (``py_func``), it is
+        run on Python floats, as the python backend runs, so that an operation leaving
+        its domain is named with its source line; otherwise the derivatives at fault."""
+        located = self.locate(self.mod.rhs, t, x, "the derivatives")
+        if located is not None:
+            return located
+        with np.errstate(all="ignore"):
+            dx = np.asarray(self.mod.rhs(t, x, self.p, np.array(self.z)), dtype=float)
+        return self.non_finite(t, x, dx)
 
     def jacobian(self, t: float, x: np.ndarray) -> Any:
         """The Jacobian for diagnostics: not counted, no failure checks."""
@@ -148,12 +181,13 @@ class Problem:
 
 
 def integrate(problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
-               atol: float) -> tuple[np.ndarray, int]:
-    """The states on ``grid`` and the number of steps taken (solve_ivp's loop)."""
-    run = StepLoop(problem, grid, x0, rtol, atol)
+              atol: float, finish: Finish | None = None) -> StepLoop:
+    """The step loop run over ``grid`` (solve_ivp's loop; ``finish``: see
+    :class:`StepLoop`): its states on the grid and the number of steps taken."""
+    run = StepLoop(problem, grid, x0, rtol, atol, finish)
     if len(x0):
         run.advance(run.start(problem.solver, float(grid[0]), x0))
-    return run.states, run.steps
+    return run
 
 
 @dataclass(frozen=True)
@@ -165,6 +199,10 @@ class Stretch:
     sizes: tuple[float, ...]
 
 
+Finish = Callable[["StepLoop", Any], Stretch]
+"""``finish(loop, integrator)``: run ``integrator`` to the end of ``loop``'s grid."""
+
+
 class StepLoop:
     """The output grid filled step by step, by one integrator after another (the
     ``auto`` race of :mod:`springc.simulation.race` hands the state from one to the next)."""
@@ -172,12 +210,17 @@ class StepLoop:
     failure = Stop
 
     def __init__(self, problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
-                 atol: float) -> None:
+                 atol: float, finish: Finish | None = None) -> None:
         self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
         self.limits = problem.limits
         self.states = np.empty((len(grid), len(x0)))
         self.states[0] = x0
         self.k, self.steps = 1, 0
+        #: continues a DOP853 integrator to the end of the grid (the compiled engine's
+        #: :func:`springc.simulation.compiled.finish_dop853`); None: scipy steps on
+        self.finish = finish
+        self.compiled_steps = 0
+        self.loop_time = 0.0  # seconds in the compiled loop
 
     @property
     def done(self) -> bool:
@@ -222,7 +265,14 @@ class StepLoop:
                             t, np.array(integrator.y), self.problem.solver)
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
-        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""
+        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it.
+
+        A ``DOP853`` integrator run to the end on the compiled engine continues there
+        (the same steps, see :func:`springc.simulation.compiled.finish_dop853`).
+        """
+        if self.finish is not None and max_steps is None and not self.done \
+                and type(integrator).__name__ == SOLVERS[EXPLICIT]:
+            return self.finish(self, integrator)
         problem, grid, states = self.problem, self.grid, self.states
         began, taken = time.perf_counter(), 0
         sizes: deque[float] = deque(maxlen=10)
@@ -233,11 +283,13 @@ class StepLoop:
             except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
                 if "infs or NaNs" not in str(err):
                     raise
-                raise Stop(solver_failure(problem, integrator, "the Newton matrix is "
-                                            "not finite (the Jacobian overflows)")) from None
+                raise Stop(solver_failure(problem, float(integrator.t), np.asarray(integrator.y),
+                                          "the Newton matrix is not finite (the "
+                                          "Jacobian overflows)")) from None
             taken += 1
             if integrator.status == "failed":
-                raise Stop(solver_failure(problem, integrator, message))
+                raise Stop(solver_failure(problem, float(integrator.t),
+                                          np.asarray(integrator.y), message))
             sizes.append(integrator.t - before)
             if taken % CHECK_EVERY == 0 or self.steps + taken >= self.limits.max_steps:
                 self.check_limits(integrator, self.steps + taken, sizes)
@@ -255,9 +307,9 @@ class StepLoop:
         return Stretch(taken, time.perf_counter() - began, tuple(sizes))
 
 
-def solver_failure(problem: Problem, integrator: Any, message: str | None
-                    ) -> SimulationError:
-    t, x = float(integrator.t), np.asarray(integrator.y)
+def solver_failure(problem: Problem, t: float, x: np.ndarray, message: str | None
+                   ) -> SimulationError:
+    """The error of a solver that failed at ``(t, x)`` (its last accepted state)."""
     dx = np.asarray(problem.mod.rhs(t, x, problem.p, problem.z))
     collapse = message is not None and "step size" in message.lower()
     text = (f"the step size of {problem.solver} collapsed at time {format_time(t)}" if collapse

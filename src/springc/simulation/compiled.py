@@ -1,0 +1,211 @@
+"""The compiled engine: springc's runs on :mod:`springc.integrate` (numba, no Python per step).
+
+- :func:`choose_engine`: ``--engine auto|compiled|scipy`` and the solver -> the engine
+  of a run (``compiled`` needs numba, a solver with a compiled loop and the numba
+  backend's functions; errors name the option).
+- :func:`finish_dop853`: a scipy ``DOP853`` integrator of the step loop continued to the
+  end of the grid by the compiled DOP853, which takes the same steps (same state, same
+  next step size, same controller), so the run equals the scipy run bit for bit.
+- :func:`run_fixed_compiled`: the fixed-step solvers, compiled.
+
+Failures come back as :class:`springc.integrate.Status` codes and become the scipy
+path's errors here: the step size collapse, a non-finite derivative (located in the
+generated code where the Python semantics of the same function raise), a non-finite
+state, the model's Newton failure flag, and the step and time limits.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import UsageError
+from .failures import Stop
+from .limits import HOPELESS, OverLimit
+from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP
+from .solvers import detect_pairs, non_finite_states
+from .steps import Problem, StepLoop, Stretch, solver_failure
+
+if TYPE_CHECKING:
+    from springc.integrate import Run
+
+COMPILED, SCIPY = "compiled", "scipy"
+FIRST_CHUNK = 10_000
+"""Accepted steps of the first compiled attempt: a longer run is retried from the same
+start with ten times the budget (at most 11 % repeated work), so that a run whose step
+size is hopeless stops early and the wall-clock limit is checked between attempts.
+(The kernel counts rejected steps too; its budget is raised by them, so that the step
+limit counts accepted steps, as scipy's loop does.)"""
+FIXED_CHUNK = 200_000
+"""Steps of a fixed-step stretch between two checks of the wall clock."""
+SCIPY_COLLAPSE = "Required step size is less than spacing between numbers."
+"""scipy's message for the same failure (the step loop words both alike)."""
+
+
+def numba_available() -> bool:
+    """Whether numba can be imported (without importing it)."""
+    return importlib.util.find_spec("numba") is not None
+
+
+def choose_engine(engine: str, solver: str, backend: str | None = None,
+                  option: str = "--engine", backend_option: str = "--backend") -> str:
+    """:data:`COMPILED` or :data:`SCIPY` for a run of ``solver``.
+
+    ``backend`` is the generated module's backend if already chosen (``None``: springc
+    chooses, numba for the compiled engine). ``auto`` is compiled where numba is
+    importable, the solver has a compiled loop (``auto`` counts: it finishes on dop853
+    compiled) and the backend is not ``python``. A ``compiled`` request that cannot be
+    met is a :class:`UsageError` naming ``option``.
+    """
+    name = engine.lower() if isinstance(engine, str) else engine
+    if name not in ENGINES:
+        raise UsageError(f"{option} must be one of {', '.join(ENGINES)}, not {engine!r}",
+                         option=option)
+    has_loop = solver == AUTO or solver in COMPILED_SOLVERS
+    if name == SCIPY:
+        return SCIPY
+    if name == AUTO:
+        return COMPILED if has_loop and backend != "python" and numba_available() else SCIPY
+    if not has_loop:
+        raise UsageError(f"{option} compiled: the {solver} solver has no compiled loop",
+                         option=option,
+                         hint=f"use {option} scipy (or auto), or a solver with a compiled "
+                              f"loop: {', '.join((AUTO, *COMPILED_SOLVERS))}")
+    if not numba_available():
+        raise UsageError(f"{option} compiled needs numba, which is not installed",
+                         option=option, hint=f"install numba, or use {option} scipy")
+    if backend == "python":
+        raise UsageError(f"{option} compiled runs the numba backend's functions, not "
+                         f"{backend_option} python", option=option,
+                         hint=f"leave out {backend_option} (the compiled engine uses "
+                              f"numba), or use {option} scipy")
+    return COMPILED
+
+
+def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
+    """Continue the scipy ``DOP853`` ``integrator`` of ``loop`` to the end of the grid,
+    compiled: from its state with its next step size, filling the grid from ``loop.k``."""
+    from springc.integrate import Status, dop853
+
+    problem, grid = loop.problem, loop.grid
+    t, y = float(integrator.t), np.array(integrator.y)
+    rest = grid[loop.k:]
+    times = np.concatenate(([t], rest[rest > t]))
+    first = float(integrator.h_abs)
+    began = time.perf_counter()
+    allowed = loop.limits.max_steps - loop.steps  # accepted steps, as scipy's loop counts
+    budget = min(FIRST_CHUNK, allowed)
+    attempt = budget  # the kernel counts rejected steps too
+    while True:
+        run = dop853(problem.mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                     atol=loop.atol, first_step=min(first, float(times[-1] - t)),
+                     max_steps=max(attempt, 1))
+        problem.nfev += run.rhs_evaluations
+        if run.status != Status.MAX_STEPS:
+            break
+        if run.accepted_steps < budget:  # rejections used part of the attempt
+            attempt += budget - run.accepted_steps
+            continue
+        if budget >= allowed:
+            break
+        taken = run.accepted_steps
+        projected = loop.steps + taken * (float(grid[-1]) - t) / max(run.failure_time - t,
+                                                                     1e-300)
+        if projected > HOPELESS * loop.limits.max_steps:
+            raise OverLimit(f"at its current step size ({(run.failure_time - t) / taken:.3g} "
+                            f"s on average) {EXPLICIT} needs ~{projected:.3g} steps to the "
+                            f"stop time, far over the step limit (--max-steps "
+                            f"{loop.limits.max_steps})", run.failure_time,
+                            run.failure_state, EXPLICIT)
+        if time.perf_counter() > problem.deadline:
+            raise time_limit_reached(problem, run)
+        budget = min(10 * budget, allowed)
+        attempt = budget + run.rejected_steps
+    seconds = time.perf_counter() - began
+    loop.loop_time += seconds
+    loop.compiled_steps += run.accepted_steps
+    if not run.ok:
+        raise failure(problem, run, EXPLICIT, steps=loop.steps + run.accepted_steps,
+                      limit=loop.limits.max_steps)
+    if time.perf_counter() > problem.deadline:
+        raise time_limit_reached(problem, run)
+    filled = times[1:]
+    k = loop.k
+    loop.states[k:k + len(filled)] = run.states[1:]
+    loop.k = len(grid)
+    loop.steps += run.accepted_steps
+    return Stretch(run.accepted_steps, seconds, ())
+
+
+def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step: float
+                       ) -> tuple[np.ndarray, int, float]:
+    """The states on ``grid``, the steps and the loop's seconds of a fixed-step run of
+    ``problem.solver``, compiled (the same arithmetic and errors as
+    :func:`springc.simulation.solvers.run_fixed`).
+
+    The grid is run in stretches of about :data:`FIXED_CHUNK` steps, each from the
+    state the last one reached (the methods restart exactly at an output time; verlet
+    evaluates the derivative there again, the same value up to the rounding of a
+    time-dependent model's clock), with the wall-clock limit and the progress bar
+    between stretches.
+    """
+    from springc.integrate import fixed_step
+
+    if len(x0) == 0:
+        return np.tile(x0, (len(grid), 1)), 0, 0.0
+    pairs = detect_pairs(problem.mod, problem.p, x0, float(grid[0]))
+    index_pairs = list(zip(pairs.positions.tolist(), pairs.velocities.tolist()))
+    counts = np.maximum(1, np.ceil(np.diff(grid) / step - 1e-9))
+    ends = np.searchsorted(np.cumsum(counts), FIXED_CHUNK * np.arange(1, counts.sum()
+                                                                     // FIXED_CHUNK + 2))
+    states = np.empty((len(grid), len(x0)))
+    states[0] = x0
+    began = time.perf_counter()
+    first, steps = 0, 0
+    for end in sorted({*(min(int(e) + 1, len(grid) - 1) for e in ends), len(grid) - 1}):
+        if end <= first:
+            continue
+        run = fixed_step(problem.solver, problem.mod.rhs, grid[first:end + 1],
+                         states[first], problem.p, problem.z, step=step, pairs=index_pairs)
+        problem.nfev += run.rhs_evaluations
+        steps += run.accepted_steps
+        if not run.ok:
+            raise failure(problem, run, problem.solver, step=step)
+        states[first + 1:end + 1] = run.states[1:]
+        first = end
+        if end < len(grid) - 1 and time.perf_counter() > problem.deadline:
+            raise time_limit_reached(problem, run)
+        problem.progress.update(float(grid[end]))
+    return states, steps, time.perf_counter() - began
+
+
+def time_limit_reached(problem: Problem, run: Run) -> OverLimit:
+    """The error of a compiled run that passed the wall-clock limit."""
+    return OverLimit(f"{problem.limits.time_limit:g} s of wall clock reached the time "
+                     "limit (--time-limit)", run.failure_time, run.failure_state,
+                     problem.solver)
+
+
+def failure(problem: Problem, run: Run, solver: str, *, steps: int = 0, limit: int = 0,
+            step: float = 0.0) -> Exception:
+    """The error (``Stop`` or ``OverLimit``) of a compiled run that did not finish,
+    worded as the scipy path words it."""
+    from springc.integrate import Status
+
+    t, x = run.failure_time, np.asarray(run.failure_state)
+    problem.solver = solver
+    if run.status == Status.STEP_TOO_SMALL:
+        return Stop(solver_failure(problem, t, x, SCIPY_COLLAPSE))
+    if run.status == Status.NON_FINITE_DERIVATIVE:
+        return problem.explain(t, x)
+    if run.status == Status.MODEL_FAILED:
+        return problem.newton_failure(t, x)
+    if run.status == Status.MAX_STEPS:
+        return OverLimit(f"{steps} steps of {solver} reached the step limit (--max-steps "
+                         f"{limit})", t, x, solver)
+    if run.status == Status.NON_FINITE_STATE and solver in FIXED_STEP:
+        return Stop(non_finite_states(problem, t, np.flatnonzero(~np.isfinite(x)), step))
+    raise AssertionError(f"the compiled {solver} loop returned {run.status.name}")

@@ -1,0 +1,194 @@
+"""``engine="compiled"`` (springc.integrate) against ``engine="scipy"``: the same values on
+the output grid, the same failures, and the option checks."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import springc
+from springc.cli import main
+from springc.errors import SimulationError, UsageError
+from springc.simulation import write_csv
+
+ROOT = Path(__file__).resolve().parents[2]
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+SCENES = str(ROOT / "models" / "Scenes.mdl")
+MODELS = {"seed": (SEED, None), "chain": (SCENES, "Scenes.Chain")}
+
+FAILING = """
+model Blowup
+  Real x(start = 1);
+equation
+  der(x) = x * x;
+end Blowup;
+
+model Circle
+  Real x(start = 0);
+  Real y(start = -1);
+equation
+  der(x) = 1;
+  x^2 + y^2 = 1;
+end Circle;
+
+model DivZero
+  Real x(start = 1);
+  Real y;
+equation
+  y = 1 / (x - 1);
+  der(x) = y;
+end DivZero;
+
+model Overflow
+  parameter Real a = 1e308;
+  Real x(start = 1);
+equation
+  der(x) = a * x * 10 - a * x * 10;
+end Overflow;
+
+model Drift
+  Real x(start = 0);
+equation
+  der(x) = 1e308;
+end Drift;
+"""
+
+
+@pytest.fixture(scope="module")
+def failing(tmp_path_factory: pytest.TempPathFactory) -> str:
+    path = tmp_path_factory.mktemp("engine") / "failing.mdl"
+    path.write_text(FAILING)
+    return str(path)
+
+
+def csv_text(result: springc.SimulationResult) -> str:
+    out = io.StringIO()
+    write_csv(result, out)
+    return out.getvalue()
+
+
+@pytest.mark.parametrize("rtol", [1e-6, 1e-9])
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_compiled_dop853_equals_scipy(name: str, rtol: float) -> None:
+    files, model_name = MODELS[name]
+    model = springc.compile_model(files, model_name, backend="numba")
+    for solver in ("auto", "dop853"):
+        compiled = springc.simulate(model, solver=solver, rtol=rtol, engine="compiled")
+        scipy_run = springc.simulate(model, solver=solver, rtol=rtol, engine="scipy")
+        assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
+        assert compiled.stats.solver == scipy_run.stats.solver == "dop853"
+        assert compiled.stats.steps == scipy_run.stats.steps
+        # the same generated functions: the same steps and values, bit for bit
+        assert csv_text(compiled) == csv_text(scipy_run)
+    # the default: auto picks the compiled engine and the numba backend; against the
+    # scipy engine on the python backend (Python float arithmetic) within 1e-12
+    default = springc.simulate(files, model_name=model_name, rtol=rtol)
+    python = springc.simulate(files, model_name=model_name, rtol=rtol, engine="scipy")
+    assert default.stats.engine == "compiled" and python.stats.engine == "scipy"
+    assert default.names == python.names
+    scale = np.abs(python.values).max(axis=0)
+    assert (np.abs(default.values - python.values) <= 1e-12 * scale).all()
+
+
+@pytest.mark.parametrize("solver", ["verlet", "symplectic-euler", "rk4"])
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_compiled_fixed_step_equals_python_integrators(name: str, solver: str) -> None:
+    files, model_name = MODELS[name]
+    model = springc.compile_model(files, model_name, backend="numba")
+    compiled = springc.simulate(model, solver=solver, step=1e-3, stop=2.0, engine="compiled")
+    python = springc.simulate(model, solver=solver, step=1e-3, stop=2.0, engine="scipy")
+    assert compiled.stats.engine == "compiled" and python.stats.engine == "scipy"
+    assert compiled.stats.steps == python.stats.steps == 2000
+    scale = np.abs(python.values).max(axis=0)
+    assert (np.abs(compiled.values - python.values) <= 1e-13 * np.maximum(scale, 1.0)).all()
+
+
+FAILURES = [
+    # (model, simulate's keywords, the start of the message)
+    ("Blowup", {"solver": "dop853", "stop": 2.0}, "the step size of dop853 collapsed at time 1"),
+    ("Circle", {"stop": 3.0, "interval": 0.001},
+     "the nonlinear system for y did not converge at time 1"),
+    ("DivZero", {}, "division by zero while computing y ("),
+    ("Overflow", {"solver": "dop853"}, "der(x) is NaN at time 0"),
+    ("Blowup", {"solver": "rk4", "step": 0.01, "stop": 2.0, "interval": 0.01},
+     "der(x) is infinite at time 1.02\n"),
+    ("Drift", {"solver": "verlet", "step": 0.1, "stop": 3.0, "interval": 0.1},
+     "the states became non-finite by time 1.8 (verlet, --step 0.1)\n"),
+]
+
+
+@pytest.mark.parametrize(("model_name", "keywords", "message"), FAILURES,
+                         ids=[f"{m}-{k.get('solver', 'auto')}" for m, k, _ in FAILURES])
+def test_failures_read_as_on_the_scipy_engine(failing: str, model_name: str,
+                                              keywords: dict[str, object],
+                                              message: str) -> None:
+    errors = []
+    for engine in ("compiled", "scipy"):
+        with pytest.raises(SimulationError) as info:
+            springc.simulate(failing, model_name=model_name, engine=engine,
+                             **keywords)  # type: ignore[arg-type]
+        errors.append(str(info.value))
+    assert errors[0] == errors[1]
+    assert errors[0].startswith(f"error: {message}")
+
+
+def test_step_limit_counts_the_same_steps() -> None:
+    errors = []
+    for engine in ("compiled", "scipy"):
+        with pytest.raises(SimulationError) as info:
+            springc.simulate(SEED, solver="dop853", max_steps=100, engine=engine)
+        errors.append(str(info.value))
+    assert errors[0] == errors[1]
+    assert "100 steps of dop853 reached the step limit (--max-steps 100)" in errors[0]
+
+
+def test_hopeless_step_size_stops_the_compiled_loop() -> None:
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(SEED, solver="dop853", parameters={"spring.k": 1e29},
+                         engine="compiled")
+    assert "far over the step limit (--max-steps 20000000)" in info.value.message
+    assert info.value.hint == "the system is stiff: use --solver radau (or bdf)"
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    (["--engine", "compiled", "--solver", "radau"],
+     "error: --engine compiled: the radau solver has no compiled loop\n"),
+    (["--engine", "compiled", "--backend", "python"],
+     "error: --engine compiled runs the numba backend's functions, not --backend python\n"),
+])
+def test_compiled_requests_that_cannot_be_met_exit_2(arguments: list[str],
+                                                     message: str) -> None:
+    result = CliRunner().invoke(main, ["simulate", SEED, *arguments])
+    assert result.exit_code == 2 and result.output.startswith(message)
+
+
+def test_api_names_the_engine_argument() -> None:
+    model = springc.compile_model(SEED)  # python backend: no numba functions
+    with pytest.raises(UsageError, match="engine compiled runs the numba backend") as info:
+        springc.simulate(model, engine="compiled")
+    assert info.value.option == "engine"
+    with pytest.raises(UsageError, match="engine must be one of auto, compiled, scipy"):
+        springc.simulate(model, engine="fast")
+    assert springc.simulate(model, stop=0.5).stats.engine == "scipy"  # auto: scipy here
+
+
+def test_switching_models_are_refused_on_the_compiled_engine() -> None:
+    with pytest.raises(SimulationError, match="switches its states during the run, which "
+                                              "only the scipy engine does"):
+        springc.simulate(SCENES, model_name="Scenes.RigidPair", stop=0.1, engine="compiled")
+
+
+def test_fixed_step_stretches_join_exactly(monkeypatch: pytest.MonkeyPatch) -> None:
+    from springc.simulation import compiled as engine_module
+
+    model = springc.compile_model(SEED, backend="numba")
+    whole = springc.simulate(model, solver="verlet", step=1e-3, stop=2.0, engine="compiled")
+    monkeypatch.setattr(engine_module, "FIXED_CHUNK", 300)  # 2000 steps in 7 stretches
+    pieces = springc.simulate(model, solver="verlet", step=1e-3, stop=2.0, engine="compiled")
+    assert pieces.stats.steps == whole.stats.steps == 2000
+    # the seed's right-hand side does not read the clock: the same values, bit for bit
+    np.testing.assert_array_equal(pieces.values, whole.values)
