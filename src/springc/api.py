@@ -170,7 +170,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     seconds (``None``: 20,000,000 steps, one hour). ``engine`` runs the steps:
     ``"compiled"`` (numba loops of :mod:`springc.integrate` for dop853, auto's dop853
     and the fixed-step solvers), ``"scipy"`` (scipy's solvers stepped from Python), or
-    ``"auto"``: compiled where numba is importable and the solver has a compiled loop.
+    ``"auto"``: compiled for a module generated with the numba backend (where numba is
+    importable and the solver has a compiled loop), else scipy.
     ``backend`` (files only) defaults to ``"numba"`` for the compiled engine, else
     ``"python"``.
     """

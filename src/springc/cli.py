@@ -251,7 +251,7 @@ def _single_threaded_blas() -> None:
               default=DEFAULT_ENGINE, show_default=True,
               help="compiled: numba loops (springc.integrate) for dop853, auto's dop853 "
               "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; "
-              "auto: compiled where numba is installed and the solver has a loop.")
+              "auto: compiled for the numba backend (--backend numba), else scipy.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "

@@ -57,7 +57,7 @@ def test_seed_csv_and_png(tmp_path: Path) -> None:
     for line in out.read_text().splitlines()[1:5]:
         assert all(repr(float(v)) == v for v in line.split(","))
     assert stdout == ""
-    assert "SpringMass: auto -> dop853 (compiled) (non-stiff: " in stderr
+    assert "SpringMass: auto -> dop853 (scipy) (non-stiff: " in stderr
     assert " steps, " in stderr
     assert "RHS and 1 Jacobian evaluations" in stderr  # the stiffness estimate
     import matplotlib.image
@@ -150,12 +150,14 @@ def test_each_solver_runs() -> None:
     assert choices == ALL_SOLVERS and set(choices) == {AUTO, *SOLVERS, *FIXED_STEP}
     for solver in choices:
         step = ["--step", "1e-4"] if solver in FIXED_STEP else []
-        code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
-                                   "--vars", "spring.x", *step)
-        assert code == 0, stderr
-        engine = "compiled" if solver in COMPILED_SOLVERS else "scipy"
-        shown = "auto -> dop853 (" if solver == AUTO else f"{solver} ({engine}),"
-        assert f"SpringMass: {shown}" in stderr
+        for backend in ("python", "numba"):  # auto's engine: scipy, then compiled
+            code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
+                                  "--vars", "spring.x", "--backend", backend, *step)
+            assert code == 0, stderr
+            compiled = backend == "numba" and solver in COMPILED_SOLVERS
+            engine = "compiled" if compiled else "scipy"
+            shown = "auto -> dop853 (" if solver == AUTO else f"{solver} ({engine}),"
+            assert f"SpringMass: {shown}" in stderr
         if solver in ("radau", "bdf", "lsoda"):
             assert " 0 Jacobian" not in stderr
 

@@ -55,10 +55,13 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
     """:data:`COMPILED` or :data:`SCIPY` for a run of ``solver``.
 
     ``backend`` is the generated module's backend if already chosen (``None``: springc
-    chooses, numba for the compiled engine). ``auto`` is compiled where numba is
-    importable, the solver has a compiled loop (``auto`` counts: it finishes on dop853
-    compiled) and the backend is not ``python``. A ``compiled`` request that cannot be
-    met is a :class:`UsageError` naming ``option``.
+    chooses, numba for the compiled engine). ``auto`` is compiled where the module is
+    (or is asked to be) generated with the numba backend, numba is importable and the
+    solver has a compiled loop (``auto`` counts: it finishes on dop853 compiled).
+    Otherwise it is scipy: numba's first compilation of a model costs seconds, more
+    than a short run of the seed takes on scipy, so the compiled loop is what users
+    opt into with ``--backend numba`` or ``--engine compiled``. A ``compiled`` request
+    that cannot be met is a :class:`UsageError` naming ``option``.
     """
     name = engine.lower() if isinstance(engine, str) else engine
     if name not in ENGINES:
@@ -68,7 +71,7 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
     if name == SCIPY:
         return SCIPY
     if name == AUTO:
-        return COMPILED if has_loop and backend != "python" and numba_available() else SCIPY
+        return COMPILED if has_loop and backend == "numba" and numba_available() else SCIPY
     if not has_loop:
         raise UsageError(f"{option} compiled: the {solver} solver has no compiled loop",
                          option=option,
