@@ -515,7 +515,15 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
     from dataclasses import replace
 
-    study = run_study(compiled, replace(options, fixed=fixed), output, summary_file,
-                      resume, files, None if quiet else sys.stderr)
+    try:
+        study = run_study(compiled, replace(options, fixed=fixed), output, summary_file,
+                          resume, files, None if quiet else sys.stderr)
+    except (KeyboardInterrupt, SystemExit):
+        from .studies import partial_folder
+
+        if partial_folder(output).is_dir():
+            click.echo(f"note: finished runs are kept in {partial_folder(output)}; run "
+                       "the same command with --resume to continue", err=True)
+        raise
     if not quiet:
         click.echo(study.summary_line(), err=True)

@@ -67,3 +67,16 @@ def test_sweep_as_dataframe_is_the_study_table() -> None:
 def test_sweep_names_a_bad_argument() -> None:
     with pytest.raises(UsageError, match="as_ must be 'dataset' or 'dataframe'"):
         springc.sweep(SEED, params={"spring.k": [1.0]}, as_="table")
+
+
+def test_a_variable_named_like_a_fixed_column_is_quoted(tmp_path: Path) -> None:
+    path = tmp_path / "Control.mdl"
+    path.write_text("model Control\n  parameter Real gain = 2;\n  Real x(start = 0);\n"
+                    "  Real error = 1 - x;\nequation\n  der(x) = gain * error;\n"
+                    "end Control;\n")
+    frame = springc.sweep(str(path), params={"gain": [1.0, 2.0]}, stop=1.0,
+                          interval=0.5, workers=1, as_="dataframe")
+    assert frame.columns.tolist()[:5] == ["run", "time", "gain", "x", "'error'"]
+    assert frame["error"].isna().all()
+    assert np.allclose(frame["'error'"], np.exp(-frame["gain"] * frame["time"]),
+                       atol=1e-5)

@@ -226,15 +226,25 @@ class Shards:
     def paths(self) -> list[Path]:
         return sorted(self.folder.glob("shard-*" + SUFFIX))
 
-    def read(self) -> list[Any]:
-        """The tables of the shards written so far."""
+    def read(self, columns: list[str] | None = None) -> list[Any]:
+        """The tables of the shards written so far (only ``columns`` if given)."""
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        return [pq.read_table(path) for path in self.paths()]
+        tables = []
+        for path in self.paths():
+            try:
+                tables.append(pq.read_table(path, columns=columns))
+            except (OSError, pa.ArrowException) as err:
+                raise UsageError(f"the partial result {path} is damaged ({err})",
+                                 option="--resume", hint="remove that file (its runs are "
+                                 "run again) and resume") from None
+        return tables
 
     def done(self) -> set[int]:
         """The runs already in the shards."""
-        return {int(r) for table in self.read() for r in np.unique(table.column("run"))}
+        return {int(r) for table in self.read(["run"])
+                for r in np.unique(table.column("run"))}
 
     def write(self, table: Any) -> None:
         """Add ``table`` as a new shard (written to a temporary file, then renamed)."""
