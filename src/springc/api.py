@@ -13,7 +13,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from typing import TextIO
+from typing import Any, TextIO
 
 from .errors import UsageError
 from .pipeline import (
@@ -182,7 +182,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
           output: str | os.PathLike[str] | None = None, resume: bool = False,
           energy: str | None = None, libraries: Sequence[str | os.PathLike[str]] = (),
           backend: str = "python", cache: bool = True, progress: TextIO | None = None,
-          as_: str = "dataset") -> object:
+          as_: str = "dataset") -> Any:
     """Run a parameter study and return it as an ``xarray.Dataset`` (``as_="dataset"``:
     each output over ``run`` x ``time`` with ``units`` attributes, the swept parameters
     as coordinates on ``run``, ``status``/``error``/solver statistics per run) or a

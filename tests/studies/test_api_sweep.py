@@ -80,3 +80,14 @@ def test_a_variable_named_like_a_fixed_column_is_quoted(tmp_path: Path) -> None:
     assert frame["error"].isna().all()
     assert np.allclose(frame["'error'"], np.exp(-frame["gain"] * frame["time"]),
                        atol=1e-5)
+
+
+def test_a_structural_parameter_cannot_be_swept(tmp_path: Path) -> None:
+    path = tmp_path / "Decay.mdl"
+    path.write_text("model Decay\n  parameter Integer n = 2;\n  Real x(start = 1);\n"
+                    "equation\n  der(x) = -n * x;\nend Decay;\n")
+    with pytest.raises(UsageError) as caught:
+        springc.sweep(str(path), params={"n": [1, 2]})
+    assert caught.value.message == ("--param n: 'n' is a structural parameter (it changes "
+                                    "the equations); a study varies the others")
+    assert caught.value.hint == "run one study per value, with --set NAME=VALUE"

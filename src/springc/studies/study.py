@@ -44,7 +44,6 @@ from .store import (
 )
 
 ENERGY_UNIT = "J"
-INTEGER_LIMIT = 2**31 - 1
 
 
 @dataclass(frozen=True)
@@ -109,25 +108,16 @@ def parameter_table(options: StudyOptions) -> np.ndarray:
     return sample(options.parameters, options.samples, options.method, options.seed)
 
 
-def check_values(model: CompiledModel, names: Sequence[str], values: np.ndarray) -> None:
-    """Swept parameters must be parameters of ``model``, not structural, and Integer
-    ones take whole values."""
+def check_names(model: CompiledModel, names: Sequence[str]) -> None:
+    """Swept parameters must be parameters of ``model`` and not structural (Integer and
+    Boolean parameters, array sizes: they change the equations)."""
     check_parameter_names(model, dict.fromkeys(names, 0.0))
-    types = dict(zip(model.parameter_names, model.module.PARAMETER_TYPES))
-    for j, name in enumerate(names):
+    for name in names:
         if name in model.structural:
             raise UsageError(f"--param {name}: '{name}' is a structural parameter (it "
                              "changes the equations); a study varies the others",
                              option="--param",
                              hint="run one study per value, with --set NAME=VALUE")
-        column = values[:, j]
-        if types.get(name) in ("Integer", "Boolean") and not (
-                np.all(column == np.round(column)) and np.all(np.abs(column) <=
-                                                               INTEGER_LIMIT)):
-            bad = float(column[np.flatnonzero(column != np.round(column))[0]]) \
-                if np.any(column != np.round(column)) else float(column[0])
-            raise UsageError(f"--param {name}: '{name}' is an {types[name]} parameter: "
-                             f"{bad!r} is not a whole number", option="--param")
 
 
 def energy_variable(model: CompiledModel, requested: str | None) -> str | None:
@@ -178,9 +168,13 @@ def job_of(model: CompiledModel, options: StudyOptions) -> RunJob:
                   options.rtol, options.atol, options.step)
 
 
-def _engine(options: StudyOptions, job: RunJob, pending: Sequence[tuple[int, tuple[float,
-                                                                                      ...]]],
+Pending = Sequence[tuple[int, tuple[float, ...]]]
+
+
+def _engine(options: StudyOptions, job: RunJob, pending: Pending
             ) -> tuple[Iterator[list[Any]], int, str, Callable[[], None]]:
+    """The batches' results as they complete, the worker count, the engine's name,
+    and what to call at the end."""
     if options.scheduler is not None:
         client = connect(options.scheduler)
         workers = dask_workers(client)
@@ -207,7 +201,7 @@ def run_study(model: CompiledModel, options: StudyOptions, output: str | None = 
     began = time.perf_counter()
     values = parameter_table(options)
     names = tuple(s.name for s in options.parameters)
-    check_values(model, names, values)
+    check_names(model, names)
     for name, _ in options.fixed:
         if name in names:
             raise UsageError(f"'{name}' is both swept (--param) and fixed (--set)",
