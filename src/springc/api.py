@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import Any, TextIO
 
 from .errors import UsageError
+from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -23,7 +24,14 @@ from .pipeline import (
     compile_files,
     modification_value,
 )
-from .simulation import DEFAULT_SOLVER, SimulationOptions, SimulationResult, simulate_model
+from .simulation import (
+    DEFAULT_MAX_STEPS,
+    DEFAULT_SOLVER,
+    DEFAULT_TIME_LIMIT,
+    SimulationOptions,
+    SimulationResult,
+    simulate_model,
+)
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 
@@ -100,6 +108,7 @@ def _files(files: Files) -> tuple[str, ...]:
     return tuple(os.fspath(f) for f in files)
 
 
+@recursion_room()  # expressions up to ir.expr.MAX_DEPTH deep (docs/language.md, "Limits")
 def compile_model(files: Files, model: str | None = None, *,
                   libraries: Sequence[str | os.PathLike[str]] = (), backend: str = "python",
                   outputs: Sequence[str] | None = None,
@@ -137,6 +146,7 @@ def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
     return compile_files(replace(options or compiled.options, modifications=mods))
 
 
+@recursion_room()
 def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              start: float | None = None, stop: float | None = None,
              interval: float | None = None, solver: str = DEFAULT_SOLVER,
@@ -144,7 +154,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              parameters: Mapping[str, float] | None = None,
              outputs: Sequence[str] | None = None, backend: str = "python",
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
-             progress: TextIO | None = None, step: float | None = None
+             progress: TextIO | None = None, step: float | None = None,
+             max_steps: int | None = None, time_limit: float | None = None
              ) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
@@ -153,6 +164,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     ``"auto"`` (dop853 or radau from a stiffness estimate), a scipy method, or a
     fixed-step one (``"verlet"``, ``"symplectic-euler"``, ``"rk4"``) with ``step``.
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
+    A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
+    seconds (``None``: 20,000,000 steps, one hour).
     """
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
@@ -167,7 +180,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
         model = _with_structural(model, {k: values[k] for k in structural})
     rest = {k: v for k, v in values.items() if k not in structural}
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
-                                step)
+                                step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
+                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit)
     return simulate_model(model, options)
 
 
@@ -182,6 +196,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
           output: str | os.PathLike[str] | None = None, resume: bool = False,
           energy: str | None = None, libraries: Sequence[str | os.PathLike[str]] = (),
           backend: str = "python", cache: bool = True, progress: TextIO | None = None,
+          max_steps: int | None = None, time_limit: float | None = None,
           as_: str = "dataset") -> Any:
     """Run a parameter study and return it as an ``xarray.Dataset`` (``as_="dataset"``:
     each output over ``run`` x ``time`` with ``units`` attributes, the swept parameters
@@ -195,6 +210,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     core) or to the Dask scheduler at ``scheduler``. ``parameters`` are fixed values
     for every run. With ``output`` (``.parquet``), the study table and its summary
     (``.summary.parquet``) are written, and ``resume`` continues an interrupted study.
+    ``max_steps`` and ``time_limit`` bound each run as in :func:`simulate`.
     """
     from .studies import (
         StudyOptions,
@@ -226,7 +242,8 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     if target is not None:
         check_outputs(target, summary_path(target), protected, ("output", "output"))
     options = StudyOptions(specs, samples, method, seed, rest, start, stop, interval,
-                           solver, rtol, atol, step, workers, scheduler, energy)
+                           solver, rtol, atol, step, workers, scheduler, energy, max_steps,
+                           time_limit)
     study = run_study(compiled, options, target, resume=resume, protected=protected,
                       progress=progress)
     if as_ == "dataframe":

@@ -23,6 +23,8 @@ from typing import Any
 import click
 
 from .errors import ErrorGroup, OutputError, SpringcError, UsageError, render_all
+from .ir.expr import recursion_room
+from .simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
 
 EXIT_MODEL_ERROR = 1
 EXIT_USAGE = 2
@@ -58,7 +60,8 @@ def _guard(func: Callable[..., Any]) -> Callable[..., Any]:
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         debug = click.get_current_context().find_root().params.get("debug", False)
         try:
-            return func(*args, **kwargs)
+            with recursion_room():  # expressions up to ir.expr.MAX_DEPTH deep
+                return func(*args, **kwargs)
         except UsageError as err:
             click.echo(str(err), err=True)
             sys.exit(EXIT_USAGE)
@@ -115,25 +118,31 @@ def main(debug: bool) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the flat model as JSON.")
 @click.option("--simplify", "simplified", is_flag=True,
               help="Print the simplified system: states, evaluation order, observed.")
+@click.option("--latex", "as_latex", is_flag=True,
+              help="Print the equations (with --simplify: the evaluation order) as LaTeX.")
 @_guard
 def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
-            origins: bool, as_json: bool, simplified: bool) -> None:
-    """Print the flat model of FILES as Modelica text (or JSON)."""
-    from .ir.flat import format_flat, to_json_dict
+            origins: bool, as_json: bool, simplified: bool, as_latex: bool) -> None:
+    """Print the flat model of FILES as Modelica text (or JSON, or LaTeX)."""
+    from .ir.flat import format_flat, format_flat_latex, to_json_dict
     from .pipeline import flatten_files
 
+    if as_latex and as_json:
+        raise click.UsageError("--latex and --json cannot be combined")
     flat_model = flatten_files(files, model, libraries)
     if simplified:
-        from .ir.ode import format_ode
+        from .ir.ode import format_ode, format_ode_latex
         from .simplify import simplify
 
         result = simplify(flat_model)
-        click.echo(format_ode(result.ode), nl=False)
+        click.echo((format_ode_latex if as_latex else format_ode)(result.ode), nl=False)
         for note in result.warnings:
             click.echo(f"{note.span}: warning: {note.message}" if note.span
                        else f"warning: {note.message}", err=True)
     elif as_json:
         click.echo(json.dumps(to_json_dict(flat_model), indent=1))
+    elif as_latex:
+        click.echo(format_flat_latex(flat_model), nl=False)
     else:
         click.echo(format_flat(flat_model, origins), nl=False)
 
@@ -150,10 +159,6 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
 
 
 # ------------------------------------------------------------------ simulate, compile
-
-SOLVER_CHOICES = ("auto", "rk45", "dop853", "radau", "bdf", "lsoda",  # simulation.SOLVERS
-                  "verlet", "symplectic-euler", "rk4")  # simulation.FIXED_STEP
-
 
 def _parse_set(values: tuple[str, ...]) -> dict[str, float]:
     out: dict[str, float] = {}
@@ -235,8 +240,8 @@ def _single_threaded_blas() -> None:
 @_model_options
 @_compile_options
 @_run_options
-@click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
-              default="auto", show_default=True,
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True,
               help="auto: dop853 or radau from a stiffness estimate at the start (the "
               "summary says why); a scipy solve_ivp method; or a fixed-step one "
               "(verlet, symplectic-euler, rk4) with --step.")
@@ -245,6 +250,12 @@ def _single_threaded_blas() -> None:
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
               "Tolerance, else 1e-6).")
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Stop with an error after this many integrator steps (default "
+              "20,000,000).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Stop with an error after this many seconds of wall clock (default "
+              "3600).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Write the trajectory: .csv, or .mat (the MATLAB v4 result layout of "
               "OpenModelica and Dymola); default: CSV on stdout unless --plot.")
@@ -256,13 +267,14 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, rtol: float | None,
              step: float | None, atol: float | None, assignments: tuple[str, ...],
-             output: str | None, plot: str | None, quiet: bool) -> None:
+             max_steps: int | None, time_limit: float | None, output: str | None,
+             plot: str | None, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from .api import check_run_values
     from .simulation import PLOT_FORMATS, RESULT_FORMATS
 
     values = _parse_set(assignments)
-    if solver.lower() in SOLVER_CHOICES[-3:] and step is None:
+    if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
@@ -276,7 +288,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     result = run(files, model_name=model, libraries=libraries, backend=backend,
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step)
+                 parameters=values, progress=progress, step=step, max_steps=max_steps,
+                 time_limit=time_limit)
     if output or plot:
         save_outputs(result, output, plot, files)
     else:
@@ -456,12 +469,16 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
               help="Local worker processes (default: one per core).")
 @click.option("--scheduler", metavar="ADDRESS", help="Run on the Dask scheduler at "
               "ADDRESS (tcp://host:8786) instead of local processes.")
-@click.option("--solver", type=click.Choice(SOLVER_CHOICES, case_sensitive=False),
-              default="auto", show_default=True, help="As for simulate.")
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True, help="As for simulate.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers.")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
               "Tolerance, else 1e-6).")
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Integrator steps per run before it fails (as for simulate).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Seconds of wall clock per run before it fails (as for simulate).")
 @click.option("--energy", metavar="NAME", help="Variable whose drift the summary "
               "reports (default: the only selected variable in J, if any).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
@@ -478,7 +495,8 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           stop: float | None, interval: float | None, assignments: tuple[str, ...],
           params: tuple[str, ...], samples: int | None, method: str, seed: int,
           workers: int | None, scheduler: str | None, solver: str, step: float | None,
-          rtol: float | None, atol: float | None, energy: str | None, output: str,
+          rtol: float | None, atol: float | None, max_steps: int | None,
+          time_limit: float | None, energy: str | None, output: str,
           summary_file: str | None, resume: bool, quiet: bool) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
 
@@ -492,7 +510,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     from .studies import check_outputs, parse_parameter, summary_path
 
     values = _parse_set(assignments)
-    if solver.lower() in SOLVER_CHOICES[-3:] and step is None:
+    if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
     if workers is not None and scheduler is not None:
@@ -507,7 +525,8 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     from .studies import StudyOptions, parameter_table, run_study
 
     options = StudyOptions(specs, samples, method, seed, (), start, stop, interval,
-                           solver.lower(), rtol, atol, step, workers, scheduler, energy)
+                           solver.lower(), rtol, atol, step, workers, scheduler, energy,
+                           max_steps, time_limit)
     parameter_table(options)  # refuse bad specifications before compiling
     compiled = compile_model(files, model, libraries=libraries, backend=backend,
                              outputs=patterns or None, parameters=values,

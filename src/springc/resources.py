@@ -1,4 +1,5 @@
-"""Locate files shipped with springc: the grammar and the bundled model library.
+"""Locate files shipped with springc (the grammar and the bundled model library) and
+springc's per-user cache folder.
 
 In a built wheel they sit inside the package (``springc/grammar``, ``springc/models``);
 in a source checkout or editable install they are the repository's top-level folders.
@@ -6,6 +7,7 @@ in a source checkout or editable install they are the repository's top-level fol
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 #: The installed ``springc`` package folder (every subpackage lies below it).
@@ -26,3 +28,12 @@ def grammar_path() -> Path:
 
 def models_dir() -> Path:
     return resource_dir("models")
+
+
+def user_cache_dir() -> Path:
+    """springc's per-user cache folder: ``$SPRINGC_CACHE_DIR``, else
+    ``$XDG_CACHE_HOME/springc``, else ``~/.cache/springc``."""
+    if os.environ.get("SPRINGC_CACHE_DIR"):
+        return Path(os.environ["SPRINGC_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "springc"

@@ -19,7 +19,7 @@ from springc.pipeline.compiler import CompiledModel
 @pytest.mark.parametrize("solver", ["auto", "dop853", "radau", "bdf", "verlet", "rk4"])
 def test_exactly_at_equilibrium(compiled: dict[str, CompiledModel], solver: str) -> None:
     result = springc.simulate(compiled["Harmonic"], parameters={"a": 0.0}, solver=solver,
-                              step=0.1)
+                              step=0.01)
     assert not result.values.any()  # exactly zero, every output time
 
 

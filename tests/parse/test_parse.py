@@ -414,7 +414,7 @@ def test_when_is_not_supported() -> None:
         "t.mo:4:3: error: `when` equations are not supported yet\n"
         "    4 |   when x > 1 then\n"
         "      |   ^^^^\n"
-        'help: springc supports a subset of Modelica; see the "Later" list in LANGUAGE.md'
+        'help: springc supports a subset of Modelica; see "Not supported yet" in docs/language.md'
     )
 
 
@@ -546,3 +546,29 @@ def test_parse_file_reads_and_reports_unreadable(tmp_path: Path) -> None:
     assert stored.file == str(path) and stored.classes[0].span.file == str(path)
     with pytest.raises(LoadError, match="cannot read"):
         parse_file(tmp_path / "missing.mo")
+
+
+def test_empty_quoted_identifier_is_named_as_such() -> None:
+    assert error_text("model A Real ''; end A;") == (
+        "t.mo:1:14: error: empty quoted identifier\n"
+        "    1 | model A Real ''; end A;\n"
+        "      |              ^^\n"
+        "help: a quoted identifier has at least one character: 'x'")
+
+
+def test_numbers_beyond_the_double_range_are_errors() -> None:
+    with pytest.raises(ErrorGroup) as group:
+        parse_text("model A\n  Real x = 1e309 + 2E400;\nend A;", "t.mo")
+    assert [(e.message, e.span) for e in group.value.errors] == [
+        ("the number 1e309 is too large", Span("t.mo", 2, 12, 2, 17)),
+        ("the number 2E400 is too large", Span("t.mo", 2, 20, 2, 25))]
+    number = parse_expression("1" + "0" * 300)  # an integer literal in range stays exact
+    assert isinstance(number, Number) and number.value == 10**300
+
+
+def test_end_cannot_be_called() -> None:
+    assert error_text("model A\n  Real x[end(2)];\nend A;") == (
+        "t.mo:2:10: error: 'end' cannot be called\n"
+        "    2 |   Real x[end(2)];\n"
+        "      |          ^^^\n"
+        "help: call a function by its name, e.g. size(x, 1)")

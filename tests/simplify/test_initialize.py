@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 
 from springc.pipeline.files import flatten_files
 from springc.simplify.initialize import InitializationError, conditions, initial_state
-from springc.simplify.ode_eval import Evaluator
+from springc.simplify.ode_eval import OdeEvaluator
 from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -147,7 +147,7 @@ def test_pendulum_numerics() -> None:
     model = simplify(flatten_files([ROOT / "models" / "Scenes.mdl"], "Scenes.Pendulum")).ode
     x0, info = initial_state(model)
     params = {p.name: info.values[p.name] for p in model.parameters}
-    evaluator = Evaluator(model, params)
+    evaluator = OdeEvaluator(model, params)
     times = np.linspace(0, 10, 201)
     sol = solve_ivp(evaluator.rhs, (0, 10), x0, method="DOP853", rtol=1e-8, atol=1e-10,
                     t_eval=times)

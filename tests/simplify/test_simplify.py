@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from springc.errors import SimplifyError
+from springc.errors import BalanceError, SimplifyError
 from springc.ir import ode
 from springc.ir.expr import to_text
 from springc.pipeline.files import flatten_files
@@ -16,7 +16,7 @@ from springc.simplify.alias import eliminate_aliases
 from springc.simplify.causalize import causalize
 from springc.simplify.index_reduction import index_reduce
 from springc.simplify.lower import lower
-from springc.simplify.ode_eval import Evaluator, parameter_values
+from springc.simplify.ode_eval import OdeEvaluator, parameter_values
 from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -178,8 +178,8 @@ def test_springs_in_series_solve_a_linear_system(tmp_path: Path) -> None:
     assert len(linear) == 1 and len(linear[0]) >= 2
     # Numerically: equal tension in all springs, positions as for springs in series.
     params = parameter_values(model.parameters)
-    env = Evaluator(model, params).values(0.0, [3.5, 0.0])
-    env.update(Evaluator(model, params).observed(env))
+    env = OdeEvaluator(model, params).values(0.0, [3.5, 0.0])
+    env.update(OdeEvaluator(model, params).observed(env))
     f = [env[f"s[{i}].f"] for i in (1, 2, 3)]
     total = 0.5 / (1 / 10 + 1 / 20 + 1 / 30)  # stretch 0.5 over three springs
     assert f == pytest.approx([total] * 3, rel=1e-12)
@@ -231,7 +231,7 @@ def test_nonlinear_loop_is_torn(tmp_path: Path) -> None:
     step = torn[0]
     assert len(step.tearing) == 1 and len(step.residuals) == 1
     assert set(step.tearing) | {a.name for a in step.inner} == {"y", "z", "w"}
-    env = Evaluator(model, {}).values(0.0, [1.0])
+    env = OdeEvaluator(model, {}).values(0.0, [1.0])
     assert env["y"] + env["z"] ** 3 == pytest.approx(1.0, abs=1e-10)
     assert env["z"] == pytest.approx(np.cos(env["y"]) + 0.1 * env["y"] ** 2, abs=1e-10)
 
@@ -260,12 +260,18 @@ equation
   y^2 + z^2 = 1;
 end S;
 """
+    model = flat(tmp_path, text)
+    # Index reduction names them (simplify runs the balance check before, which does too).
     with pytest.raises(SimplifyError) as info:
-        simplify(flat(tmp_path, text))
+        index_reduce(eliminate_aliases(lower(model)).dae)
     err = info.value
-    assert "structurally singular" in str(err) or "do not determine" in str(err)
+    assert err.message.startswith("the system is structurally singular")
     texts = " ".join(n.message for n in err.notes)
     assert "x ^ 2 = 2" in texts and "sin(x) = 0.1" in texts
+    with pytest.raises(BalanceError) as balance:
+        simplify(model)
+    assert balance.value.message == ("model 'S' is structurally singular: 3 unknowns, "
+                                     "3 equations, but they do not match")
 
 
 def test_causalize_blocks_are_in_dependency_order(tmp_path: Path) -> None:
@@ -279,3 +285,33 @@ def test_causalize_blocks_are_in_dependency_order(tmp_path: Path) -> None:
         assert computed.isdisjoint(known)
         known |= computed
     assert known == {"x", "y", "z", "w", "der(x)"}
+
+
+def test_derivative_names_are_built_and_read_by_one_pair_of_functions() -> None:
+    from springc.ir.dae import derivative_base, derivative_name, is_derivative
+
+    assert derivative_name("mass.v[1]") == "der(mass.v[1])"
+    assert derivative_base("der(mass.v[1])") == "mass.v[1]"
+    assert derivative_base(derivative_name(derivative_name("x"))) == "der(x)"
+    assert derivative_base("derivative") is None and derivative_base("der(x") is None
+    assert is_derivative("der(x)") and not is_derivative("x")
+
+
+def test_alias_classes_keep_the_member_that_index_reduction_ranks_highest(
+        tmp_path: Path) -> None:
+    # One policy (structure.state_priority): stateSelect = prefer outranks a fixed start
+    # with the default stateSelect (2.0 against 1.5), as in the dummy-derivative choice.
+    text = """
+model P
+  Real x(start = 1, fixed = true);
+  Real y(stateSelect = StateSelect.prefer);
+equation
+  x = y;
+  der(y) = -y;
+end P;
+"""
+    result = eliminate_aliases(lower(flat(tmp_path, text)))
+    assert [u.name for u in result.dae.unknowns] == ["y"]
+    assert [(a.name, to_text(a.value)) for a in result.aliases] == [("x", "y")]
+    kept = result.dae.unknowns[0]
+    assert kept.fixed and to_text(kept.start) == "1"  # y inherits x's fixed start

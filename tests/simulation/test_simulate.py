@@ -243,7 +243,7 @@ def test_numba_backend_simulates_like_python(models: str) -> None:
 def test_progress_bar_draws_and_clears() -> None:
     import io
 
-    from springc.simulation.runner import Progress
+    from springc.simulation.steps import Progress
 
     stream = io.StringIO()
     bar = Progress(stream, 0.0, 10.0)

@@ -138,16 +138,16 @@ def test_auto_races_to_the_implicit_method_when_the_explicit_one_is_held(
 
 def test_auto_falls_back_to_the_implicit_method_when_the_explicit_probe_fails(
         models: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    from springc.simulation import runner as simulation
+    from springc.simulation import steps
 
-    real = simulation._Run.advance
+    real = steps.StepLoop.advance
 
     def failing(run: object, integrator: object, max_steps: int | None = None) -> object:
         if type(integrator).__name__ == "DOP853":
-            raise simulation._Stop(SimulationError("overflow in a trial stage"))
+            raise steps.Stop(SimulationError("overflow in a trial stage"))
         return real(run, integrator, max_steps)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(simulation._Run, "advance", failing)
+    monkeypatch.setattr(steps.StepLoop, "advance", failing)
     result = springc.simulate(models, model_name="StiffPair", stop=1.0)
     assert result.stats.solver == "radau"
     assert result.stats.reason == "dop853 failed in its first steps (overflow in a trial stage)"

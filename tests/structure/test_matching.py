@@ -190,3 +190,18 @@ def test_dm_parts_independent_of_chosen_maximum_matching() -> None:
 def test_dm_rejects_non_maximum_matching() -> None:
     with pytest.raises(ValueError, match="not maximum"):
         dulmage_mendelsohn([[0], [1]], 2, Matching.from_eq_to_var([0, -1], 2))
+
+
+def test_augmenting_path_flips_the_path_and_reports_what_it_visited() -> None:
+    from springc.structure.matching import UNMATCHED, augmenting_path
+
+    # left 0 - right {0, 1}; left 1 - right {0}; right 0 is matched to left 1 ...
+    neighbours = {0: [0], 1: [0, 1], 2: [1]}
+    mate = {0: 1}  # right 0 <- left 1
+    found = augmenting_path(0, neighbours.__getitem__, lambda r: mate.get(r, UNMATCHED))
+    assert found.pairs == ((0, 0), (1, 1))  # 0 takes right 0, 1 moves on to right 1
+    assert found.left == (0, 1) and found.right == (0, 1)
+    # ... and with right 1 excluded no path exists; the visited part is returned.
+    blocked = augmenting_path(0, neighbours.__getitem__, lambda r: mate.get(r, UNMATCHED),
+                              usable=lambda r: r != 1)
+    assert blocked.pairs == () and blocked.left == (0, 1) and blocked.right == (0,)

@@ -23,6 +23,7 @@ from collections.abc import Sequence
 
 from ..errors import CodegenError, Span
 from ..ir import flat, ode
+from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
 from .jacobian import jacobian_statements
@@ -152,7 +153,7 @@ def _scalar_bodies(m: CodegenContext, outputs: Sequence[str], namer: Namer, help
 
     rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
     rhs.append(Raw(f"dx = np.empty({n})"))
-    rhs += [Store(f"dx[{i}]", Var(d), f"der({s})") for i, (s, d)
+    rhs += [Store(f"dx[{i}]", Var(d), derivative_name(s)) for i, (s, d)
             in enumerate(zip(m.states, m.derivatives))]
 
     jac_body, pattern = jacobian_statements(

@@ -9,8 +9,9 @@ attaches the source location.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import reduce
+from typing import Any, TypeGuard
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from ..ir import expr as x
 Value = x.Expr | str | np.ndarray
 
 
-def is_array(v: object) -> bool:
+def is_array(v: object) -> TypeGuard[np.ndarray]:
     return isinstance(v, np.ndarray)
 
 
@@ -27,7 +28,7 @@ def shape(v: object) -> tuple[int, ...]:
     return v.shape if isinstance(v, np.ndarray) else ()
 
 
-def make_array(items: list, dims: tuple[int, ...] | None = None) -> np.ndarray:
+def make_array(items: Sequence[Any], dims: tuple[int, ...] | None = None) -> np.ndarray:
     """An object array from a flat list of scalars (``dims`` defaults to 1-D)."""
     out = np.empty(len(items), dtype=object)
     out[:] = items
@@ -64,6 +65,7 @@ def elementwise(f: Callable[..., x.Expr], *args: Value) -> Value:
         return f(*args)
     if len(args) == 1:
         (arg,) = args
+        assert isinstance(arg, np.ndarray)
         return make_array([f(item) for item in arg.flat], arg.shape)
     if any(d != dims[0] for d in dims):
         raise ValueError("element-wise operation on arrays of different sizes: "
@@ -94,14 +96,15 @@ def sub(a: Value, b: Value) -> Value:
 
 def dot(a: np.ndarray, b: np.ndarray) -> x.Expr:
     """Scalar product of two vectors of equal length."""
-    return reduce(x.add, (x.mul(p, q) for p, q in zip(a, b)), x.ZERO)
+    zero: x.Expr = x.ZERO
+    return reduce(x.add, (x.mul(p, q) for p, q in zip(a, b)), zero)
 
 
 def mul(a: Value, b: Value) -> Value:
     """``*``: scalar scaling, scalar product, matrix-vector and matrix products."""
-    sa, sb = shape(a), shape(b)
-    if not sa or not sb:
+    if not isinstance(a, np.ndarray) or not isinstance(b, np.ndarray):
         return elementwise(x.mul, a, b)
+    sa, sb = a.shape, b.shape
     if sa[-1] != sb[0] or len(sa) > 2 or len(sb) > 2:
         raise ValueError(f"operands of '*' do not fit: {_fmt(sa)} and {_fmt(sb)}")
     if len(sa) == 1 and len(sb) == 1:
@@ -139,10 +142,15 @@ def scalar_op(op: str) -> Callable[[x.Expr, x.Expr], x.Expr]:
 
 def _fold(op: str, a: x.Expr, b: x.Expr) -> x.Expr:
     if isinstance(a, x.Const) and isinstance(b, x.Const):
-        return x.Const(x.evaluate(x.BinOp(op, a, b), {}))
+        value = x.evaluate(x.BinOp(op, a, b), {})
+        assert isinstance(value, (bool, int, float))
+        return x.Const(value)
     return x.BinOp(op, a, b)
 
 
 def scalars(v: Value) -> list[x.Expr]:
     """All elements of ``v`` in row-major order (a scalar gives a one-element list)."""
-    return list(v.flat) if is_array(v) else [v]  # type: ignore[list-item]
+    if isinstance(v, np.ndarray):
+        return list(v.flat)
+    assert not isinstance(v, str), "a string has no scalar elements"
+    return [v]

@@ -1,4 +1,4 @@
-"""Built-in functions and constants of the language (LANGUAGE.md, "Built-ins").
+"""Built-in functions and constants of the language (docs/language.md, "Built-ins").
 
 Each handler takes the call's syntax and scope and returns a value; scalar math
 functions are vectorised over arrays as Modelica specifies (chapter 12.4.6).
@@ -7,9 +7,7 @@ functions are vectorised over arrays as Modelica specifies (chapter 12.4.6).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from functools import reduce
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,11 +15,7 @@ from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
-
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
-
-Handler = Callable[[s.Call, Any], a.Value]
+from .scope import ExpressionEvaluator, Handler, Scope
 
 SCALAR_FUNCTIONS = {
     "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1,
@@ -41,7 +35,7 @@ _ALIASES = {f"Modelica.Math.{n}": n for n in SCALAR_FUNCTIONS} | {
 
 
 class Builtins:
-    def __init__(self, evaluator: Evaluator) -> None:
+    def __init__(self, evaluator: ExpressionEvaluator) -> None:
         self.ev = evaluator
         self.table: dict[str, Handler] = {
             "der": self.der, "noEvent": self.no_event, "smooth": self.smooth,
@@ -54,7 +48,7 @@ class Builtins:
         for name in SCALAR_FUNCTIONS:
             self.table[name] = self.math
 
-    def lookup(self, name: str, scope: Any) -> Handler | None:
+    def lookup(self, name: str, scope: Scope) -> Handler | None:
         name = _ALIASES.get(name, name)
         handler = self.table.get(name)
         if handler is None or name != "norm":
@@ -64,7 +58,7 @@ class Builtins:
 
     # ------------------------------------------------------------------ helpers
 
-    def _args(self, call: s.Call, scope: Any, count: int | tuple[int, int]) -> list[a.Value]:
+    def _args(self, call: s.Call, scope: Scope, count: int | tuple[int, int]) -> list[a.Value]:
         lo, hi = (count, count) if isinstance(count, int) else count
         name = call.func.dotted
         if call.named:
@@ -76,7 +70,7 @@ class Builtins:
                                f"{len(call.args)} given", call.span)
         return [self.ev.value(arg, scope) for arg in call.args]
 
-    def _elements(self, call: s.Call, scope: Any) -> list[x.Expr]:
+    def _elements(self, call: s.Call, scope: Scope) -> list[x.Expr]:
         """The elements reduced by ``sum``/``product``/``min``/``max`` of one argument."""
         if len(call.args) == 1 and isinstance(call.args[0], s.Comprehension):
             comp = call.args[0]
@@ -87,11 +81,11 @@ class Builtins:
 
     # ---------------------------------------------------------------- handlers
 
-    def der(self, call: s.Call, scope: Any) -> a.Value:
+    def der(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
         return a.elementwise(lambda e: x.ZERO if isinstance(e, x.Const) else x.Der(e), v)
 
-    def math(self, call: s.Call, scope: Any) -> a.Value:
+    def math(self, call: s.Call, scope: Scope) -> a.Value:
         name = _ALIASES.get(call.func.dotted, call.func.dotted)
         args = self._args(call, scope, SCALAR_FUNCTIONS[name])
         try:
@@ -99,7 +93,7 @@ class Builtins:
         except ValueError as err:
             raise FlattenError(str(err), call.span) from None
 
-    def no_event(self, call: s.Call, scope: Any) -> a.Value:
+    def no_event(self, call: s.Call, scope: Scope) -> a.Value:
         self.ev.no_event += 1
         try:
             (v,) = self._args(call, scope, 1)
@@ -107,7 +101,7 @@ class Builtins:
             self.ev.no_event -= 1
         return a.elementwise(_keep_no_event, v)
 
-    def smooth(self, call: s.Call, scope: Any) -> a.Value:
+    def smooth(self, call: s.Call, scope: Scope) -> a.Value:
         self.ev.no_event += 1
         try:
             _, v = self._args(call, scope, 2)
@@ -115,7 +109,7 @@ class Builtins:
             self.ev.no_event -= 1
         return a.elementwise(_keep_no_event, v)
 
-    def homotopy(self, call: s.Call, scope: Any) -> a.Value:
+    def homotopy(self, call: s.Call, scope: Scope) -> a.Value:
         actual = next((n.value for n in call.named if n.name == "actual"), None)
         if actual is not None:
             return self.ev.value(actual, scope)
@@ -123,13 +117,15 @@ class Builtins:
             raise FlattenError("'homotopy' needs the argument 'actual'", call.span)
         return self.ev.value(call.args[0], scope)
 
-    def sum(self, call: s.Call, scope: Any) -> a.Value:
-        return reduce(x.add, self._elements(call, scope), x.ZERO)
+    def sum(self, call: s.Call, scope: Scope) -> a.Value:
+        zero: x.Expr = x.ZERO
+        return reduce(x.add, self._elements(call, scope), zero)
 
-    def product(self, call: s.Call, scope: Any) -> a.Value:
-        return reduce(x.mul, self._elements(call, scope), x.ONE)
+    def product(self, call: s.Call, scope: Scope) -> a.Value:
+        one: x.Expr = x.ONE
+        return reduce(x.mul, self._elements(call, scope), one)
 
-    def min_max(self, call: s.Call, scope: Any) -> a.Value:
+    def min_max(self, call: s.Call, scope: Scope) -> a.Value:
         name = call.func.dotted
         if len(call.args) == 2:
             args = self._args(call, scope, 2)
@@ -139,32 +135,42 @@ class Builtins:
             raise FlattenError(f"'{name}' of an empty array", call.span)
         return reduce(lambda p, q: _call(name, (p, q)), items)
 
-    def size(self, call: s.Call, scope: Any) -> a.Value:
+    def size(self, call: s.Call, scope: Scope) -> a.Value:
         if len(call.args) == 1:
             (v,) = self._args(call, scope, 1)
             return a.make_array([x.Const(d) for d in a.shape(v)])
-        v, dim = self._args(call, scope, 2)
-        k = self.ev.fold(dim)
+        if len(call.args) != 2 or call.named:
+            self._args(call, scope, 2)  # reports the wrong arguments
+        v = self.ev.value(call.args[0], scope)
+        k = self.ev.integer(call.args[1], scope, "the dimension of 'size'")
         dims = a.shape(v)
         if not 1 <= k <= len(dims):
             raise FlattenError(f"dimension {k} does not exist: the array has {len(dims)}",
                                call.args[1].span)
-        return x.Const(dims[int(k) - 1])
+        return x.Const(dims[k - 1])
 
-    def ndims(self, call: s.Call, scope: Any) -> a.Value:
+    def ndims(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
         return x.Const(len(a.shape(v)))
 
-    def _dims(self, call: s.Call, scope: Any, args: list[s.Expr]) -> tuple[int, ...]:
-        return tuple(self.ev.integer(arg, scope, "an array size") for arg in args)
+    def _dims(self, call: s.Call, scope: Scope, args: list[s.Expr], square: bool = False
+              ) -> tuple[int, ...]:
+        dims = tuple(self.ev.integer(arg, scope, "an array size") for arg in args)
+        for n in dims:
+            if n < 0:
+                raise FlattenError(f"array size must not be negative, found {n}", call.span)
+        count = math.prod(dims) ** (2 if square else 1)
+        self.ev.flattener.limits.check_size(count, f"the result of '{call.func.dotted}'",
+                                            call.span)
+        return dims
 
     def fill_value(self, value: int) -> Handler:
-        def handler(call: s.Call, scope: Any) -> a.Value:
+        def handler(call: s.Call, scope: Scope) -> a.Value:
             dims = self._dims(call, scope, list(call.args))
             return a.make_array([x.Const(value)] * math.prod(dims), dims)
         return handler
 
-    def fill(self, call: s.Call, scope: Any) -> a.Value:
+    def fill(self, call: s.Call, scope: Scope) -> a.Value:
         if not call.args:
             raise FlattenError("'fill' needs a value and sizes", call.span)
         v = self.ev.value(call.args[0], scope)
@@ -174,38 +180,42 @@ class Builtins:
             out[idx] = v
         return out
 
-    def identity(self, call: s.Call, scope: Any) -> a.Value:
-        (n,) = self._dims(call, scope, list(call.args))
+    def identity(self, call: s.Call, scope: Scope) -> a.Value:
+        if len(call.args) != 1:
+            raise FlattenError(f"'identity' takes 1 argument, {len(call.args)} given",
+                               call.span)
+        (n,) = self._dims(call, scope, list(call.args), square=True)
         return a.make_array([x.Const(int(i == j)) for i in range(n) for j in range(n)], (n, n))
 
-    def cross(self, call: s.Call, scope: Any) -> a.Value:
+    def cross(self, call: s.Call, scope: Scope) -> a.Value:
         u, v = self._args(call, scope, 2)
-        if a.shape(u) != (3,) or a.shape(v) != (3,):
+        if not isinstance(u, np.ndarray) or not isinstance(v, np.ndarray) \
+                or u.shape != (3,) or v.shape != (3,):
             raise FlattenError("'cross' needs two vectors of size 3", call.span)
         comps = [x.sub(x.mul(u[(i + 1) % 3], v[(i + 2) % 3]),
                        x.mul(u[(i + 2) % 3], v[(i + 1) % 3])) for i in range(3)]
         return a.make_array(comps)
 
-    def transpose(self, call: s.Call, scope: Any) -> a.Value:
+    def transpose(self, call: s.Call, scope: Scope) -> a.Value:
         (m,) = self._args(call, scope, 1)
-        if len(a.shape(m)) < 2:
+        if not isinstance(m, np.ndarray) or m.ndim < 2:
             raise FlattenError("'transpose' needs a matrix", call.span)
         return np.swapaxes(m, 0, 1)
 
-    def norm(self, call: s.Call, scope: Any) -> a.Value:
+    def norm(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
-        if len(a.shape(v)) != 1:
+        if not isinstance(v, np.ndarray) or v.ndim != 1:
             raise FlattenError("'norm' needs a vector", call.span)
         return _call("sqrt", (a.dot(v, v),))
 
-    def scalar(self, call: s.Call, scope: Any) -> a.Value:
+    def scalar(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
         items = a.scalars(v)
         if len(items) != 1:
             raise FlattenError("'scalar' needs an array with one element", call.span)
         return items[0]
 
-    def vector(self, call: s.Call, scope: Any) -> a.Value:
+    def vector(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)
         return a.make_array(a.scalars(v))
 
@@ -216,7 +226,9 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
         try:
             return x.Const(x.MATH[name](*(arg.value for arg in args)))  # type: ignore[union-attr]
         except (ValueError, ZeroDivisionError, OverflowError) as err:
-            raise ValueError(f"{name}{tuple(arg.value for arg in args)}: {err}") from None
+            text = f"{name}({', '.join(repr(arg.value) for arg in args)})"  # type: ignore[union-attr]
+            reason = "overflows" if isinstance(err, OverflowError) else f"is undefined ({err})"
+            raise ValueError(f"{text} {reason}") from None
     return x.Call(name, args)
 
 

@@ -10,43 +10,32 @@ connectors that are connected nowhere are set to zero.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from .scope import ClassScope, LocalScope, Primitive
-
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
+from .scope import ClassScope, ExpressionEvaluator, Leaf, LocalScope, Primitive, Scope
 
 Key = tuple[str, bool]  # (flat variable name, outside)
-
-
-@dataclass(frozen=True, slots=True)
-class Leaf:
-    relative: str
-    name: str
-    flow: bool
 
 
 @dataclass(frozen=True, slots=True)
 class Link:
     """Why a member joined its set: the connect statement, its owner and its text."""
 
-    span: s.Span
+    span: Span
     owner: str
     text: str
 
 
 def connector_leaves(scope: ClassScope) -> list[Leaf]:
     """Scalar non-parameter variables of a connector, in declaration order."""
-    cached = getattr(scope, "_leaves", None)
-    if cached is not None:
-        return cached
+    if scope.connector_leaves is not None:
+        return scope.connector_leaves
     leaves: list[Leaf] = []
     cut = len(scope.prefix) + 1
     for _, member in scope.all_members():
@@ -59,13 +48,12 @@ def connector_leaves(scope: ClassScope) -> list[Leaf]:
             for item in (member.flat if isinstance(member, np.ndarray) else [member]):
                 leaves += [Leaf(leaf.name[cut:], leaf.name, leaf.flow)
                            for leaf in connector_leaves(item)]
-    scope._leaves = leaves  # type: ignore[attr-defined]
-    # What must match for two connectors to be connected: names and flow prefixes.
-    scope._signature = tuple((leaf.relative, leaf.flow) for leaf in leaves)  # type: ignore
+    scope.connector_leaves = leaves
+    scope.connector_signature = tuple((leaf.relative, leaf.flow) for leaf in leaves)
     return leaves
 
 
-def direct_reference(ref: s.Ref, where: Any) -> ClassScope | None:
+def direct_reference(ref: s.Ref, where: Scope) -> ClassScope | None:
     """``p[i - 1, j].flange`` inside ``for`` loops, resolved by indexing the arrays of
     components directly; None (use the general evaluator) for anything else. Valid
     because the general evaluator gives the same instance for such a reference: the
@@ -137,7 +125,8 @@ class ConnectionSets:
             self.flow[key] = flow
             self.link[key] = link
 
-    def connect(self, ev: Evaluator, eq: s.Connect, where: Any, owner: ClassScope) -> None:
+    def connect(self, ev: ExpressionEvaluator, eq: s.Connect, where: Scope,
+                owner: ClassScope) -> None:
         """Record ``connect(a, b)``; both sides may be arrays of connectors."""
         sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
         (left_shape, left, left_out), (right_shape, right, right_out) = sides
@@ -148,7 +137,7 @@ class ConnectionSets:
         for ca, cb in zip(left, right):
             self._pair(ca, cb, left_out, right_out, eq, owner)
 
-    def _connectors(self, ev: Evaluator, ref: s.Ref, where: Any, owner: ClassScope
+    def _connectors(self, ev: ExpressionEvaluator, ref: s.Ref, where: Scope, owner: ClassScope
                     ) -> tuple[tuple[int, ...], list[Any], bool]:
         """The connectors a reference denotes: their array shape (a single connector
         counts as an array of one), the connectors in order, and whether they are
@@ -174,7 +163,7 @@ class ConnectionSets:
     def _pair(self, ca: ClassScope, cb: ClassScope, out_a: bool, out_b: bool,
               eq: s.Connect, owner: ClassScope) -> None:
         leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
-        if ca._signature != cb._signature:  # type: ignore[attr-defined]
+        if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
                 f"({cb.entry.full_name}) do not match", eq.span,

@@ -13,15 +13,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from .scope import ClassView, ViewComponent
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .scope import ClassView, FlattenContext, ViewComponent
 
 
 @dataclass(frozen=True)
@@ -50,7 +46,7 @@ def make_template(prefix: str, equations: list[flat.Equation]) -> Template | Non
     return Template(prefix, tuple(equations))
 
 
-def reusable(flattener: Flattener, view: ClassView) -> bool:
+def reusable(flattener: FlattenContext, view: ClassView) -> bool:
     """Whether every instance of ``view`` has the same equations up to its prefix, as
     far as the class's text shows: only equalities (loops and ifs of them), no
     constants (their values may be modified per instance) and literal array sizes, in
@@ -65,7 +61,7 @@ def reusable(flattener: Flattener, view: ClassView) -> bool:
     return found
 
 
-def fixed_shape(flattener: Flattener, comp: ViewComponent,
+def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
                 class_ok: Callable[[ClassView], bool]) -> bool:
     """Literal sizes and no constants: ``comp`` has the same members in every instance
     (for a component of class type, when ``class_ok`` accepts its class)."""
@@ -79,7 +75,7 @@ def fixed_shape(flattener: Flattener, comp: ViewComponent,
         and class_ok(flattener.view(rtype.entry))
 
 
-def _component_reusable(flattener: Flattener, comp: ViewComponent) -> bool:
+def _component_reusable(flattener: FlattenContext, comp: ViewComponent) -> bool:
     return fixed_shape(flattener, comp, lambda view: reusable(flattener, view))
 
 
@@ -103,20 +99,19 @@ def renamer(old: str, new: str) -> Callable[[x.Expr], x.Expr]:
     names: dict[str, x.Var] = {}
 
     def rename(e: x.Expr) -> x.Expr:
-        kind = type(e)
-        if kind is x.Var:
-            found = names.get(e.name)  # type: ignore[union-attr]
+        if isinstance(e, x.Var):
+            found = names.get(e.name)
             if found is None:
-                found = names[e.name] = x.Var(new + e.name[cut:])  # type: ignore[union-attr]
+                found = names[e.name] = x.Var(new + e.name[cut:])
             return found
-        if kind is x.BinOp:
-            return x.BinOp(e.op, rename(e.left), rename(e.right))  # type: ignore[union-attr]
-        if kind is x.Const or kind is x.Time:
+        if isinstance(e, x.BinOp):
+            return x.BinOp(e.op, rename(e.left), rename(e.right))
+        if isinstance(e, (x.Const, x.Time)):
             return e
-        if kind is x.Call:
-            return x.Call(e.name, tuple(rename(a) for a in e.args))  # type: ignore[union-attr]
-        if kind is x.If:
-            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))  # type: ignore
-        return kind(rename(e.arg))  # type: ignore[union-attr, call-arg]  # Neg, Not, Der
+        if isinstance(e, x.Call):
+            return x.Call(e.name, tuple(rename(a) for a in e.args))
+        if isinstance(e, x.If):
+            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))
+        return type(e)(rename(e.arg))  # Neg, Not, Der
 
     return rename

@@ -7,31 +7,23 @@ appended to the Flattener's lists, and connections recorded in its connection se
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+import numpy as np
 
 from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
+from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
-from .scope import ClassScope, LocalScope
-
-if TYPE_CHECKING:
-    from ..errors import SpringcError
-    from .connections import ConnectionSets
-    from .evaluate import Evaluator
-    from .flattener import ParameterValues
+from .loops import check_loop_nest
+from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
-class EquationFlattening:
+class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
 
-    evaluator: Evaluator
-    parameter_values: ParameterValues
     connections: ConnectionSets
-    equations: list[flat.Equation]
-    initial_equations: list[flat.Equation]
-    errors: list[SpringcError]
+    # Equation templates by (id of the ClassView, initial); None: not reusable.
     templates: dict[tuple[int, bool], Template | None]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
@@ -57,7 +49,7 @@ class EquationFlattening:
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
 
-    def equation(self, eq: s.Equation, where: Any, owner: ClassScope, initial: bool) -> None:
+    def equation(self, eq: s.Equation, where: Scope, owner: ClassScope, initial: bool) -> None:
         if isinstance(eq, s.Equality):
             self._equality(eq, where, owner, initial)
         elif isinstance(eq, s.Connect):
@@ -66,6 +58,8 @@ class EquationFlattening:
                                    eq.span)
             self.connections.connect(self.evaluator, eq, where, owner)
         elif isinstance(eq, s.ForEquation):
+            if not isinstance(where, LocalScope):  # the outermost loop of a nest
+                check_loop_nest(self.evaluator, eq, where)
             self._for(eq, eq.indices, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
             for cond, body in eq.branches:
@@ -76,38 +70,45 @@ class EquationFlattening:
         else:
             name = eq.call.func.dotted
             raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
-                               hint="springc supports a subset of Modelica; see the "
-                               "\"Later\" list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see "
+                               "\"Not supported yet\" in docs/language.md")
 
-    def _if_condition(self, cond: s.Expr, where: Any) -> Any:
+    def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression
         (a condition on variables would switch equations at events)."""
         self.evaluator.no_event += 1
         try:
-            return self.evaluator.constant(
+            value = self.evaluator.constant(
                 cond, where, "the condition of an if-equation",
                 "switching equations on a variable needs events, which are not supported "
                 "yet; for a continuous switch write one equation with an if-expression "
                 "inside noEvent(...)")
         finally:
             self.evaluator.no_event -= 1
+        if not isinstance(value, bool | int | float | np.bool_):
+            kind = "a string" if isinstance(value, str) else "an array"
+            raise FlattenError(f"the condition of an if-equation must be a scalar Boolean, "
+                               f"found {kind}", cond.span)
+        return bool(value)
 
-    def _body(self, body: tuple[s.Equation, ...], where: Any, owner: ClassScope,
+    def _body(self, body: tuple[s.Equation, ...], where: Scope, owner: ClassScope,
               initial: bool) -> None:
         for eq in body:
             self.equation(eq, where, owner, initial)
 
-    def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Any,
+    def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Scope,
              owner: ClassScope, initial: bool) -> None:
         index, rest = indices[0], indices[1:]
-        for value in self.evaluator.range_values(index, where):
+        values = self.evaluator.range_values(index, where)
+        self.limits.add_iterations(len(values), index.span)
+        for value in values:
             local = LocalScope({index.name: value}, where)
             if rest:
                 self._for(eq, rest, local, owner, initial)
             else:
                 self._body(eq.body, local, owner, initial)
 
-    def _equality(self, eq: s.Equality, where: Any, owner: ClassScope, initial: bool) -> None:
+    def _equality(self, eq: s.Equality, where: Scope, owner: ClassScope, initial: bool) -> None:
         lhs = self.evaluator.value(eq.lhs, where)
         rhs = self.evaluator.value(eq.rhs, where)
         if a.shape(lhs) != a.shape(rhs):

@@ -8,22 +8,23 @@ numbers through the parameters' bindings with :meth:`Evaluator.constant`.
 
 from __future__ import annotations
 
+import difflib
 import itertools
 import math
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Iterator
+from typing import Any, cast
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
-from .scope import ClassScope, LocalScope, Primitive
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .functions import call_function
+from .parameters import check_powers
+from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
     "pre", "edge", "change", "initial", "terminal", "reinit", "sample", "hold",
@@ -41,9 +42,10 @@ _ARITHMETIC = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
 class Evaluator:
     """Evaluates expressions for one flattening run (it shares the flattener's caches)."""
 
-    def __init__(self, flattener: Flattener) -> None:
+    def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
-        self.no_event = 0
+        self.no_event = 0  # > 0 inside noEvent(...) and smooth(...)
+        self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.builtins = Builtins(self)
         # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
         # outlives the evaluator, so ids are not reused).
@@ -51,17 +53,17 @@ class Evaluator:
 
     # ------------------------------------------------------------ entry points
 
-    def value(self, e: s.Expr, scope: Any) -> a.Value:
-        method = getattr(self, "_" + type(e).__name__)
+    def value(self, e: s.Expr, scope: Scope) -> a.Value:
+        method: Callable[[s.Expr, Scope], a.Value] = getattr(self, "_" + type(e).__name__)
         return method(e, scope)
 
-    def scalar(self, e: s.Expr, scope: Any) -> x.Expr:
+    def scalar(self, e: s.Expr, scope: Scope) -> x.Expr:
         v = self.value(e, scope)
         if a.is_array(v) or isinstance(v, str):
             raise FlattenError(f"expected a scalar, found {self.describe(v)}", e.span)
         return v  # type: ignore[return-value]
 
-    def constant(self, e: s.Expr, scope: Any, what: str,
+    def constant(self, e: s.Expr, scope: Scope, what: str,
                  hint: str = "use parameters and constants with values here") -> Any:
         """Numeric value (number or numpy array) of a parameter expression."""
         v = self.value(e, scope)
@@ -74,10 +76,10 @@ class Evaluator:
         except (ArithmeticError, ValueError, TypeError) as err:
             raise FlattenError(f"cannot evaluate {what}: {err}", e.span) from None
 
-    def integer(self, e: s.Expr, scope: Any, what: str) -> int:
+    def integer(self, e: s.Expr, scope: Scope, what: str) -> int:
         v = self.constant(e, scope, what)
-        if isinstance(v, (np.ndarray, bool)) or v != int(v):
-            raise FlattenError(f"{what} must be an integer, found {v!r}", e.span)
+        if isinstance(v, (np.ndarray, bool, str)) or not math.isfinite(v) or v != int(v):
+            raise FlattenError(f"{what} must be an integer, found {_shown(v)}", e.span)
         return int(v)
 
     def fold(self, v: a.Value) -> Any:
@@ -89,6 +91,10 @@ class Evaluator:
             for idx, item in np.ndenumerate(v):
                 out[idx] = self.fold(item)
             return out
+        assert not isinstance(v, np.ndarray)
+        if type(v) is x.Const:
+            return v.value
+        check_powers(v, self.flattener.parameter_values)
         return x.evaluate(v, self.flattener.parameter_values)
 
     def describe(self, v: Any) -> str:
@@ -102,25 +108,25 @@ class Evaluator:
 
     # ----------------------------------------------------------------- literals
 
-    def _Number(self, e: s.Number, scope: Any) -> a.Value:
+    def _Number(self, e: s.Number, scope: Scope) -> a.Value:
         return x.Const(e.value)
 
-    def _Bool(self, e: s.Bool, scope: Any) -> a.Value:
+    def _Bool(self, e: s.Bool, scope: Scope) -> a.Value:
         return x.Const(e.value)
 
-    def _String(self, e: s.String, scope: Any) -> a.Value:
+    def _String(self, e: s.String, scope: Scope) -> a.Value:
         return e.value
 
-    def _ArrayLit(self, e: s.ArrayLit, scope: Any) -> a.Value:
+    def _ArrayLit(self, e: s.ArrayLit, scope: Scope) -> a.Value:
         return self._stack([self.value(i, scope) for i in e.items], e.span)
 
-    def _stack(self, values: list[a.Value], span: s.Span) -> a.Value:
+    def _stack(self, values: list[a.Value], span: Span) -> a.Value:
         try:
             return a.stack(values)
         except ValueError as err:
             raise FlattenError(str(err), span) from None
 
-    def _MatrixLit(self, e: s.MatrixLit, scope: Any) -> a.Value:
+    def _MatrixLit(self, e: s.MatrixLit, scope: Scope) -> a.Value:
         rows = []
         for row in e.rows:
             parts = [self._as_matrix(self.value(i, scope)) for i in row]
@@ -137,30 +143,35 @@ class Evaluator:
             return a.make_array([v], (1, 1))
         return v.reshape(-1, 1) if v.ndim == 1 else v
 
-    def _Range(self, e: s.Range, scope: Any) -> a.Value:
+    def _Range(self, e: s.Range, scope: Scope) -> a.Value:
         start = self.constant(e.start, scope, "a range bound")
         stop = self.constant(e.stop, scope, "a range bound")
         step = self.constant(e.step, scope, "a range step") if e.step else 1
+        for bound in (start, stop, step):
+            if isinstance(bound, (np.ndarray, str)) or not math.isfinite(bound):
+                raise FlattenError(f"the bounds and step of a range must be finite numbers, "
+                                   f"found {_shown(bound)}", e.span)
         if step == 0:
             raise FlattenError("the step of a range must not be zero", e.span)
         count = max(0, math.floor((stop - start) / step + 1e-10) + 1)
+        self.flattener.limits.check_size(count, "this range", e.span)
         values = [start + i * step for i in range(count)]
         if all(isinstance(v, int) for v in (start, step)):
             values = [int(v) for v in values]
         return a.make_array([x.Const(v) for v in values])
 
-    def _Colon(self, e: s.Colon, scope: Any) -> a.Value:
+    def _Colon(self, e: s.Colon, scope: Scope) -> a.Value:
         raise FlattenError("':' is only allowed as a subscript", e.span)
 
-    def _End(self, e: s.End, scope: Any) -> a.Value:
-        end = getattr(scope, "end_value", None)
+    def _End(self, e: s.End, scope: Scope) -> a.Value:
+        end = scope.end_value if isinstance(scope, LocalScope) else None
         if end is None:
             raise FlattenError("'end' is only allowed inside a subscript", e.span)
         return x.Const(end)
 
     # ------------------------------------------------------------------ operators
 
-    def _Unary(self, e: s.Unary, scope: Any) -> a.Value:
+    def _Unary(self, e: s.Unary, scope: Scope) -> a.Value:
         v = self.value(e.operand, scope)
         self._numeric(v, e.operand.span)
         if e.op == "-":
@@ -170,17 +181,18 @@ class Evaluator:
         return a.elementwise(lambda b: x.Const(not b.value) if isinstance(b, x.Const)
                              else x.Not(b), v)
 
-    def _numeric(self, v: Any, span: s.Span) -> None:
+    def _numeric(self, v: Any, span: Span) -> None:
         if isinstance(v, (str, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"expected a number, found {self.describe(v)}", span)
 
-    def _Binary(self, e: s.Binary, scope: Any) -> a.Value:
+    def _Binary(self, e: s.Binary, scope: Scope) -> a.Value:
         left = self.value(e.left, scope)
         right = self.value(e.right, scope)
         scalar = _ARITHMETIC.get(e.op)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
-            return scalar(left, right)  # the common case: no sizes to check
+            # the common case: no sizes to check
+            return scalar(cast(x.Expr, left), cast(x.Expr, right))
         self._numeric(left, e.left.span)
         self._numeric(right, e.right.span)
         op = e.op
@@ -207,7 +219,7 @@ class Evaluator:
             self._check_event(result, e.span)
         return result
 
-    def _check_event(self, relation: x.Expr, span: s.Span) -> None:
+    def _check_event(self, relation: x.Expr, span: Span) -> None:
         if self.no_event or self.flattener.is_parameter_expression(relation):
             return
         raise FlattenError(
@@ -215,7 +227,7 @@ class Evaluator:
             span, hint="if the expression is continuous across the switch, wrap it in "
             "noEvent(...)")
 
-    def _IfExpr(self, e: s.IfExpr, scope: Any) -> a.Value:
+    def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
         result = self.value(e.otherwise, scope)
         for cond_expr, then_expr in reversed(e.branches):
             cond = self.scalar(cond_expr, scope)
@@ -233,16 +245,17 @@ class Evaluator:
 
     # ------------------------------------------------------------------ references
 
-    def _Ref(self, e: s.Ref, scope: Any) -> a.Value:
+    def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
         if isinstance(v, (ClassEntry, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"'{e.dotted}' is a component or class, not a value", e.span,
                                hint="refer to one of its variables, e.g. "
                                f"'{e.dotted}.<name>'")
-        return v
+        value: a.Value = v
+        return value
 
-    def reference(self, e: s.Ref, scope: Any) -> Any:
+    def reference(self, e: s.Ref, scope: Scope) -> Any:
         """Follow a component reference; the result may be a scope or array of scopes."""
         first = e.parts[0]
         if first.name == "Modelica" and e.dotted in CONSTANTS:
@@ -253,7 +266,7 @@ class Evaluator:
             current = self._select(current, part, scope, e)
         return current
 
-    def _select(self, current: Any, part: s.RefPart, scope: Any, ref: s.Ref) -> Any:
+    def _select(self, current: Any, part: s.RefPart, scope: Scope, ref: s.Ref) -> Any:
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -271,8 +284,6 @@ class Evaluator:
         raise FlattenError(f"'{part.name}' cannot be selected from a value", part.span)
 
     def _no_member(self, owner: ClassScope, part: s.RefPart) -> None:
-        import difflib
-
         close = difflib.get_close_matches(part.name, list(owner.view.components), 1)
         hint = f"did you mean '{close[0]}'?" if close else None
         raise FlattenError(
@@ -284,7 +295,7 @@ class Evaluator:
     def member_value(self, member: Any) -> Any:
         return member.value if isinstance(member, Primitive) else member
 
-    def _subscript(self, current: Any, part: s.RefPart, scope: Any) -> Any:
+    def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
         value = self.member_value(current)
         if not part.subscripts:
             return value
@@ -299,21 +310,22 @@ class Evaluator:
             return result.item()
         return result
 
-    def _index(self, sub: s.Expr, size: int, scope: Any, part: s.RefPart) -> Any:
+    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
         uses_end = self.uses_end.get(id(sub))
         if uses_end is None:
             uses_end = self.uses_end[id(sub)] = _uses_end(sub)
         if uses_end:
-            scope = LocalScope({}, scope)
-            scope.end_value = size  # type: ignore[attr-defined]
+            scope = LocalScope({}, scope, size)
         v = self._loop_index(sub, scope)
         if v is None:
             v = self.constant(sub, scope, "a subscript")
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
         for i in values:
-            if isinstance(i, bool) or i != int(i) or not 1 <= i <= size:
+            if isinstance(i, bool | str) or not math.isfinite(i) or i != int(i):
+                raise FlattenError(f"a subscript must be an integer, found {i!r}", sub.span)
+            if not 1 <= i <= size:
                 raise FlattenError(
                     f"index {i} is out of range for '{part.name}' of size {size}"
                     + _loop_context(scope), sub.span,
@@ -323,7 +335,7 @@ class Evaluator:
         return int(v) - 1
 
     @staticmethod
-    def _loop_index(sub: s.Expr, scope: Any) -> Any:
+    def _loop_index(sub: s.Expr, scope: Scope) -> Any:
         """The value of a subscript that names a for-loop index (``p[i]``), the most
         common subscript, without the general evaluator; None for any other."""
         if type(sub) is not s.Ref or len(sub.parts) != 1 or sub.parts[0].subscripts:
@@ -338,33 +350,34 @@ class Evaluator:
 
     # ------------------------------------------------------------------ calls
 
-    def _Call(self, e: s.Call, scope: Any) -> a.Value:
+    def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
         if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
-                               hint="springc supports a subset of Modelica; see the "
-                               "\"Later\" list in LANGUAGE.md")
+                               hint="springc supports a subset of Modelica; see "
+                               "\"Not supported yet\" in docs/language.md")
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
         entry = self.flattener.resolve_function(e.func, scope)
-        from .functions import call_function
-
         args = [self.value(arg, scope) for arg in e.args]
         named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
         return call_function(self, entry, args, named, e)
 
-    def _Comprehension(self, e: s.Comprehension, scope: Any) -> a.Value:
+    def _Comprehension(self, e: s.Comprehension, scope: Scope) -> a.Value:
         return self._stack(list(self.iterate(e.body, e.indices, scope)), e.span)
 
-    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Any):
+    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
+                ) -> Iterator[a.Value]:
         """Values of ``body`` for every combination of the iterators (first outermost)."""
         ranges = [self.range_values(i, scope) for i in indices]
+        self.flattener.limits.add_iterations(math.prod(len(r) for r in ranges),
+                                             indices[0].span)
         for combo in itertools.product(*ranges):
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
 
-    def range_values(self, index: s.ForIndex, scope: Any) -> list[x.Expr]:
+    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
@@ -393,12 +406,17 @@ def _uses_end(e: Any) -> bool:
     if isinstance(e, tuple):
         return any(_uses_end(item) for item in e)
     fields = getattr(e, "__dataclass_fields__", None)
-    if fields is None or isinstance(e, s.Span):
+    if fields is None or isinstance(e, Span):
         return False
     return any(_uses_end(getattr(e, name)) for name in fields)
 
 
-def _loop_context(scope: Any) -> str:
+def _shown(value: object) -> str:
+    """A value for a message: ``'a'``, ``1.5``, or ``an array`` (not numpy's repr)."""
+    return "an array" if isinstance(value, np.ndarray) else repr(value)
+
+
+def _loop_context(scope: Scope) -> str:
     """`` (with i = 3)``: the values of the enclosing for-loop indices, if any."""
     values: list[str] = []
     while isinstance(scope, LocalScope):

@@ -2,22 +2,19 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import math
 
 from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
-from .scope import ClassScope
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .scope import ClassScope, FlattenContext
 
 _FIELDS = {"StartTime": "start", "StopTime": "stop", "Interval": "interval",
            "Tolerance": "tolerance"}
 
 
-def experiment_of(flattener: Flattener, entry: ClassEntry, top: ClassScope) -> flat.Experiment:
+def experiment_of(flattener: FlattenContext, entry: ClassEntry, top: ClassScope) -> flat.Experiment:
     """Read ``annotation(experiment(StartTime, StopTime, Interval, Tolerance))``."""
     annotation = entry.defn.annotation
     if annotation is None:
@@ -35,8 +32,11 @@ def experiment_of(flattener: Flattener, entry: ClassEntry, top: ClassScope) -> f
     return flat.Experiment(**values)
 
 
-def _number(flattener: Flattener, e: s.Expr, top: ClassScope) -> float:
+def _number(flattener: FlattenContext, e: s.Expr, top: ClassScope) -> float:
     value = flattener.evaluator.constant(e, top, "an experiment setting")
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
-        raise FlattenError("experiment settings must be numbers", e.span)
+    if not isinstance(value, (int, float)) or isinstance(value, bool) \
+            or not math.isfinite(value):
+        shown = "an array" if hasattr(value, "shape") else repr(value)
+        raise FlattenError(f"experiment settings must be finite numbers, found {shown}",
+                           e.span)
     return float(value)

@@ -8,9 +8,8 @@ turns ``connect`` statements into potential equalities and flow sums.
 from __future__ import annotations
 
 import gc
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
 
 import numpy as np
 
@@ -18,52 +17,20 @@ from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..parse import ClassTree
-from . import arrays as a
 from .connections import ConnectionSets
-from .equation_templates import Template
 from .equations import EquationFlattening
 from .evaluate import Evaluator
+from .experiment import experiment_of
 from .instance_templates import InstanceTemplates
-from .instantiate import Declared, Instantiation
+from .instantiate import Instantiation
+from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .lookup import ClassLookup, select_model
-from .modification import Mod, merge_all
-from .scope import ClassScope, ClassView, Primitive, instance_mod
+from .modification import merge_all
+from .parameters import ParameterValues, binding_errors
+from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
 from .variables import attributes_of
 
-__all__ = ["Declared", "Flattener", "ParameterValues", "flatten", "select_model"]
-
-
-class ParameterValues(Mapping[str, Any]):
-    """Numeric values of parameters and constants, evaluated from bindings on demand."""
-
-    def __init__(self) -> None:
-        self.bindings: dict[str, x.Expr | None] = {}
-        self.cache: dict[str, Any] = {}
-        self.active: set[str] = set()
-        self.reads = 0  # how often a value was asked for (see templates.reusable)
-
-    def __getitem__(self, name: str) -> Any:
-        self.reads += 1
-        if name in self.cache:
-            return self.cache[name]
-        if name not in self.bindings:
-            raise KeyError(f"the variable '{name}'")
-        binding = self.bindings[name]
-        if binding is None or name in self.active:
-            raise KeyError(f"the parameter '{name}', which has no value")
-        self.active.add(name)
-        try:
-            value = x.evaluate(binding, self)
-        finally:
-            self.active.discard(name)
-        self.cache[name] = value
-        return value
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.bindings)
-
-    def __len__(self) -> int:
-        return len(self.bindings)
+__all__ = ["Flattener", "flatten"]
 
 
 class Flattener(ClassLookup, Instantiation, EquationFlattening):
@@ -71,25 +38,22 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     the walk over instances. Class lookup (``lookup.py``), instantiation
     (``instantiate.py``) and equations (``equations.py``) are mixed in."""
 
-    def __init__(self, tree: ClassTree) -> None:
+    def __init__(self, tree: ClassTree, max_size: int = DEFAULT_MAX_SIZE) -> None:
         self.tree = tree
+        self.limits = Limits(max_size)
         self.views: dict[int, ClassView] = {}
         self.package_scopes: dict[int, ClassScope] = {}
         self.parameter_values = ParameterValues()
-        self.evaluator = Evaluator(self)
+        self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
         self.errors: list[SpringcError] = []
-        # Evaluated modification values by (expression, scope); the scope is kept
-        # alive in the entry so that its id cannot be reused.
-        self.mod_values: dict[tuple[int, int], tuple[Any, a.Value]] = {}
-        self.declared_types: dict[int, Declared] = {}
-        self.attribute_cache: dict[tuple[tuple[str, int], ...],
-                                   tuple[tuple[Mod, ...], flat.Attributes]] = {}
-        self.reusable_views: dict[int, bool] = {}
-        # Equation templates by (id of the ClassView, initial); None: not reusable.
-        self.templates: dict[tuple[int, bool], Template | None] = {}
+        self.mod_values = {}
+        self.declared_types = {}
+        self.attribute_cache = {}
+        self.reusable_views = {}
+        self.templates = {}
         self.instance_templates = InstanceTemplates(self)
 
     # ----------------------------------------------------------------- queries
@@ -142,10 +106,15 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
                         yield from self.variables(item)
 
 
-def flatten(tree: ClassTree, model: str | None = None) -> flat.FlatModel:
-    """Flatten ``model`` (a dotted name; default: the last model of the last user file)."""
+def flatten(tree: ClassTree, model: str | None = None, max_size: int | None = None
+            ) -> flat.FlatModel:
+    """Flatten ``model`` (a dotted name; default: the last model of the last user file).
+
+    ``max_size`` caps the scalar variables of the flat model and the iterations of its
+    loops (default: ``$SPRINGC_MAX_SIZE``, else 10 million; see :mod:`.limits`)."""
+    cap = max_size_setting(max_size)
     with _gc_paused():
-        return _flatten(tree, model)
+        return _flatten(tree, model, cap)
 
 
 @contextmanager
@@ -162,9 +131,9 @@ def _gc_paused() -> Iterator[None]:
             gc.enable()
 
 
-def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
+def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatModel:
     entry = select_model(tree, model)
-    flattener = Flattener(tree)
+    flattener = Flattener(tree, max_size)
     base, mods = flattener.follow_short(entry)
     view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
@@ -178,14 +147,13 @@ def _flatten(tree: ClassTree, model: str | None) -> flat.FlatModel:
             flattener.equations_of(scope, initial=True)
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
+            flattener.errors += binding_errors(variables, flattener.parameter_values)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:
         errs = flattener.errors
         raise errs[0] if len(errs) == 1 else ErrorGroup(errs)
     flattener.equations += flattener.connections.equations(scopes, top)
-    from .experiment import experiment_of
-
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
                           experiment_of(flattener, entry, top), entry.defn.span)

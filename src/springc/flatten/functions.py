@@ -9,43 +9,24 @@ function calls besides the scalar built-ins.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+import math
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
-
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
+from .loops import check_loop_nest
+from .scope import ExpressionEvaluator, FunctionScope
 
 MAX_DEPTH = 50
 
 
-@dataclass(eq=False)
-class FunctionScope:
-    """Variables of one function call, over the function's package (for constants)."""
-
-    names: dict[str, Any]
-    parent: Any
-    entry: ClassEntry
-
-    def lookup(self, name: str, span: s.Span) -> Any:
-        if name not in self.names:
-            return self.parent.lookup(name, span)
-        value = self.names[name]
-        if value is None:
-            raise FlattenError(f"'{name}' is used before it is assigned", span)
-        return value
-
-
-def call_function(ev: Evaluator, entry: ClassEntry, args: list[a.Value],
-                  named: dict[str, tuple[a.Value, s.Span]], call: s.Call) -> a.Value:
-    depth = getattr(ev, "call_depth", 0)
+def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
+                  named: dict[str, tuple[a.Value, Span]], call: s.Call) -> a.Value:
+    depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
                            call.span, hint="recursive functions are not supported")
@@ -68,21 +49,24 @@ def call_function(ev: Evaluator, entry: ClassEntry, args: list[a.Value],
         if name in given:
             raise FlattenError(f"input '{name}' is given twice", span)
         given[name] = value
-    ev.call_depth = depth + 1  # type: ignore[attr-defined]
+    ev.call_depth = depth + 1
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        for stmt in entry.defn.algorithm:
+            if isinstance(stmt, s.ForStatement):
+                check_loop_nest(ev, stmt, scope)
         _run(ev, entry.defn.algorithm, scope)
-        result = scope.names[outputs[0].name]
+        result: a.Value | None = scope.names[outputs[0].name]
     finally:
-        ev.call_depth = depth  # type: ignore[attr-defined]
+        ev.call_depth = depth
     if result is None:
         raise FlattenError(f"output '{outputs[0].name}' of '{entry.full_name}' is never "
                            "assigned", call.span, [Note("declared here", outputs[0].span)])
     return result
 
 
-def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
+def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
              given: dict[str, a.Value], call: s.Call) -> None:
     if comp.name in given:
         scope.names[comp.name] = given[comp.name]
@@ -97,6 +81,10 @@ def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
     dims = [d for d in comp.type_dims + comp.dims]
     if dims:
         sizes = tuple(ev.integer(d, scope, "an array size") for d in dims)
+        if any(n < 0 for n in sizes):
+            raise FlattenError(f"array size must not be negative, found {min(sizes)}",
+                               comp.span)
+        ev.flattener.limits.check_size(math.prod(sizes), f"'{comp.name}'", comp.span)
         out = np.empty(sizes, dtype=object)
         out.fill(x.ZERO)
         scope.names[comp.name] = out
@@ -104,7 +92,7 @@ def _declare(ev: Evaluator, scope: FunctionScope, comp: s.Component,
         scope.names[comp.name] = None
 
 
-def _run(ev: Evaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
+def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
     for stmt in body:
         if isinstance(stmt, s.Assign):
             _assign(ev, stmt, scope)
@@ -114,10 +102,12 @@ def _run(ev: Evaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> 
             _if(ev, stmt, scope)
 
 
-def _for(ev: Evaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
+def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
          scope: FunctionScope) -> None:
     index, rest = indices[0], indices[1:]
-    for value in ev.range_values(index, scope):
+    values = ev.range_values(index, scope)
+    ev.flattener.limits.add_iterations(len(values), index.span)
+    for value in values:
         scope.names[index.name] = value
         if rest:
             _for(ev, stmt, rest, scope)
@@ -126,7 +116,7 @@ def _for(ev: Evaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
     scope.names.pop(index.name, None)
 
 
-def _if(ev: Evaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
+def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
     branches = list(stmt.branches)
     if not branches:
         _run(ev, stmt.otherwise, scope)
@@ -152,7 +142,7 @@ def _if(ev: Evaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
         scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
 
 
-def _assign(ev: Evaluator, stmt: s.Assign, scope: FunctionScope) -> None:
+def _assign(ev: ExpressionEvaluator, stmt: s.Assign, scope: FunctionScope) -> None:
     if len(stmt.targets) != 1 or stmt.targets[0] is None:
         raise FlattenError("assignments to several outputs are not supported yet", stmt.span)
     target = stmt.targets[0]

@@ -22,7 +22,9 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
 from itertools import islice
-from typing import TYPE_CHECKING, Any
+from typing import Any
+
+import numpy as np
 
 from ..errors import FlattenError
 from ..ir import expr as x
@@ -30,10 +32,7 @@ from ..ir import flat
 from . import arrays as a
 from .equation_templates import fixed_shape, renamer
 from .modification import Mod
-from .scope import ClassScope, ClassView, Primitive, ViewComponent
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .scope import ClassScope, ClassView, FlattenContext, Primitive, ViewComponent
 
 Shape = tuple[Any, ...]
 
@@ -64,7 +63,7 @@ class Recording:
 class InstanceTemplates:
     """The instance templates of one flattening run, by (class view, modification shape)."""
 
-    def __init__(self, flattener: Flattener) -> None:
+    def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
         self.seen: dict[tuple[int, Shape], int] = {}  # instances met so far
         self.templates: dict[tuple[int, Shape], InstanceTemplate | None] = {}
@@ -166,12 +165,15 @@ class InstanceTemplates:
         outer: dict[str, x.Expr | None] = {}
         try:
             for name, prim in template.outer.items():
-                value = fl._binding(scope.mod.children[name], prim.dims,  # type: ignore
-                                    scope.flat_name(name), prim.decl)
+                value = fl.binding(scope.mod.children[name] if scope.mod else None,
+                                   prim.dims, scope.flat_name(name), prim.decl)
+                if value is None:
+                    raise FlattenError(f"'{scope.flat_name(name)}' has no value")
                 outer.update(zip(_scalar_names(prim, scope.prefix, template.scope.prefix),
                                  a.scalars(value)))
         except FlattenError:
             return
+        fl.limits.add_scalars(len(template.variables), scope.prefix, scope.span)
         rename = renamer(template.scope.prefix, scope.prefix)
         cut = len(template.scope.prefix)
         _copy_members(template.scope, scope, rename, scope.prefix, cut)
@@ -191,7 +193,8 @@ class InstanceTemplates:
 
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         """The flat variables of a filled instance: the template's, renamed."""
-        template: InstanceTemplate = scope.template
+        template = scope.template
+        assert isinstance(template, InstanceTemplate)
         rename = renamer(template.scope.prefix, scope.prefix)
         cut, prefix = len(template.scope.prefix), scope.prefix
         bindings = self.flattener.parameter_values.bindings
@@ -250,12 +253,14 @@ def _copy_scope(source: ClassScope, outer: ClassScope, rename: Callable[[x.Expr]
 
 def _copy_primitive(prim: Primitive, rename: Callable[[x.Expr], x.Expr], prefix: str,
                     cut: int) -> Primitive:
-    if prim.dims:
-        names: Any = a.make_array([prefix + n[cut:] for n in prim.names.flat],  # type: ignore
-                                  prim.dims)
-        value = a.make_array([rename(v) for v in prim.value.flat], prim.dims)
+    names: np.ndarray | str
+    value: a.Value
+    if isinstance(prim.names, np.ndarray):
+        names = a.make_array([prefix + n[cut:] for n in prim.names.flat], prim.dims)
+        value = a.make_array([rename(v) for v in a.scalars(prim.value)], prim.dims)
     else:
-        names, value = prefix + prim.names[cut:], rename(prim.value)  # type: ignore[index]
+        names = prefix + prim.names[cut:]
+        value = rename(a.scalars(prim.value)[0])
     return Primitive(names, value, prim.decl, prim.variability, prim.causality, prim.flow,
                      prim.type, prim.mod, prim.dims)
 

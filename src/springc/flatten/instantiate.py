@@ -8,9 +8,10 @@ and parameter bindings recorded), a :class:`ClassScope`, or an array of them.
 
 from __future__ import annotations
 
+import difflib
 import itertools
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+import math
+from typing import Any
 
 import numpy as np
 
@@ -18,27 +19,33 @@ from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
+from ..parse import ClassEntry
 from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
-from .scope import ClassScope, ClassView, Primitive, ResolvedType, ViewComponent, instance_mod
+from .scope import (
+    ClassScope,
+    ClassView,
+    Declared,
+    FlattenContext,
+    Member,
+    Primitive,
+    ResolvedType,
+    ViewComponent,
+    instance_mod,
+)
 from .variables import check_attribute_mods
 
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
-    from .flattener import ParameterValues
 
-
-class Instantiation:
+class Instantiation(FlattenContext):
     """Member instantiation; mixed into the Flattener, which provides the caches and
     the lookup methods (``view``, ``resolve_type``, ``package_scope``)."""
 
-    evaluator: Evaluator
-    parameter_values: ParameterValues
-    equations: list[flat.Equation]
-    mod_values: dict[tuple[int, int], tuple[Any, a.Value]]
+    # Evaluated modification values by (id of the expression, id of the scope); the
+    # scope is kept alive in the entry so that its id cannot be reused.
+    mod_values: dict[tuple[int, int], tuple[object, a.Value]]
     declared_types: dict[int, Declared]
 
-    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Any:
+    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
         declared = self.declared_type(comp)
         rtype = declared.rtype
@@ -54,12 +61,16 @@ class Instantiation:
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
         dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
+        for n in dims:
+            self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
+        self.limits.add_scalars(math.prod(dims), name, decl.span)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name)
         assert rtype.entry is not None
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
                                "cannot be instantiated", decl.type_name.span)
+        self._check_containment(scope, rtype.entry, decl, name)
         view = self.view(rtype.entry)
         if not dims:
             return self._class_scope(name, view, mod, decl, scope)
@@ -71,6 +82,27 @@ class Instantiation:
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _check_containment(self, scope: ClassScope, entry: ClassEntry, decl: s.Component,
+                           name: str) -> None:
+        """A component may not be of a class that (directly or through its components)
+        contains it: ``model A  A a; end A;`` would be infinitely large."""
+        chain: list[ClassScope] = []
+        outer: ClassScope | None = scope
+        while outer is not None:
+            chain.append(outer)
+            if outer.entry is entry:
+                path = " -> ".join(f"'{c.prefix}' ({c.entry.full_name})" if c.prefix
+                                   else f"the model ({c.entry.full_name})"
+                                   for c in reversed(chain))
+                raise FlattenError(
+                    f"'{name}' is of class '{entry.full_name}', which contains it: the "
+                    "model would be infinitely large", decl.span,
+                    [Note(f"the chain of components: {path} -> '{name}'"),
+                     Note(f"class '{entry.full_name}' is defined here", entry.defn.span)],
+                    "a class cannot contain a component of its own class, directly or "
+                    "through its components")
+            outer = outer.outer
 
     def _check_array_mod(self, mod: Mod, dims: tuple[int, ...], name: str, path: str
                          ) -> None:
@@ -119,8 +151,6 @@ class Instantiation:
         return scope
 
     def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
-        import difflib
-
         close = difflib.get_close_matches(key, list(view.components), 1)
         raise FlattenError(
             f"'{name}' (of class '{view.entry.full_name}') has no element '{key}' to modify",
@@ -153,11 +183,11 @@ class Instantiation:
         check_attribute_mods(mod, rtype.primitive, name)
         name_list = _element_names(name, dims)
         names = a.make_array(name_list, dims) if dims else name
-        binding = self._binding(mod, dims, name, decl)
+        binding = self.binding(mod, dims, name, decl)
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)
-            value = self.evaluator.fold(binding)
+            value = self._constant_value(binding, name, mod)
             value = a.elementwise(lambda v: x.Const(v), value) if a.is_array(value) \
                 else x.Const(value)
         else:
@@ -165,14 +195,35 @@ class Instantiation:
         prim = Primitive(names, value, decl, variability, causality,
                          decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
         if variability in ("parameter", "constant"):
-            for n, b in zip(a.scalars(names), _binding_scalars(binding, dims)):  # type: ignore
+            for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b
         else:
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
 
-    def _binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
+    def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
+        """The numeric value of a constant's binding (a constant expression): a number,
+        or a numpy array of numbers."""
+        span = mod.value.span if mod is not None and mod.value is not None else None
+        try:
+            value = self.evaluator.fold(binding)
+        except KeyError as missing:
+            raise FlattenError(f"the value of constant '{name}' must be a constant "
+                               f"expression, but it depends on {missing.args[0]}", span,
+                               hint="use only constants and literals in the binding of a "
+                               "constant, or make it a parameter") from None
+        except (ArithmeticError, ValueError, TypeError) as err:
+            reason = "division by zero" if isinstance(err, ZeroDivisionError) else str(err)
+            raise FlattenError(f"cannot evaluate the value of constant '{name}': {reason}",
+                               span) from None
+        for item in (value.flat if isinstance(value, np.ndarray) else [value]):
+            if isinstance(item, float) and not math.isfinite(item):
+                raise FlattenError(f"the value of constant '{name}' is {item} (an "
+                                   "operation overflows or is undefined)", span)
+        return value
+
+    def binding(self, mod: Mod | None, dims: tuple[int, ...], name: str, decl: s.Component
                  ) -> a.Value | None:
         if mod is None or mod.value is None:
             return None
@@ -193,7 +244,7 @@ class Instantiation:
         cached = self.mod_values.get(key)
         if cached is None:
             cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
-        value = cached[1]
+        value: a.Value = cached[1]
         for i in mv.index:
             if not a.is_array(value) or value.shape[0] < i:
                 raise FlattenError(
@@ -213,23 +264,11 @@ class Instantiation:
             self.equations.append(flat.Equation(v, b, span, origin))
 
 
-@dataclass(frozen=True)
-class Declared:
-    """What a component declaration contributes independently of the instance: its
-    resolved type, the type's modifications, and its sizes when they are literals."""
-
-    comp: ViewComponent  # kept alive: declared_types is keyed by its id
-    rtype: ResolvedType
-    type_mods: list[Mod | None]
-    dims: tuple[int, ...] | None
-
-
 def _literal_dims(decl: s.Component, rtype: ResolvedType) -> tuple[int, ...] | None:
     """The sizes of a declaration if all are integer literals (``pos[2]``), else None."""
     exprs = [*decl.dims, *decl.type_dims, *(d for d, _ in rtype.dims)]
-    if all(isinstance(d, s.Number) and type(d.value) is int for d in exprs):
-        return tuple(d.value for d in exprs)  # type: ignore[union-attr]
-    return None
+    sizes = [d.value for d in exprs if isinstance(d, s.Number) and type(d.value) is int]
+    return tuple(int(n) for n in sizes) if len(sizes) == len(exprs) else None
 
 
 def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
@@ -244,5 +283,5 @@ def _element_names(name: str, dims: tuple[int, ...]) -> list[str]:
 
 def _binding_scalars(binding: a.Value | None, dims: tuple[int, ...]) -> list[x.Expr | None]:
     if binding is None:
-        return [None] * int(np.prod(dims, dtype=int))
-    return a.scalars(binding)
+        return [None] * math.prod(dims)
+    return list(a.scalars(binding))

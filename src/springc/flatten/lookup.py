@@ -8,27 +8,32 @@ class they are written in. Output: class entries, resolved types or values. Also
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+import difflib
+from typing import Any
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
-from .scope import PRIMITIVES, ClassScope, ClassView, ResolvedType, build_view
+from .scope import (
+    PRIMITIVES,
+    ClassScope,
+    ClassView,
+    FlattenContext,
+    ResolvedType,
+    Scope,
+    build_view,
+)
 
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
 
-
-class ClassLookup:
+class ClassLookup(FlattenContext):
     """Class and name lookup; mixed into the Flattener, which provides the caches."""
 
     tree: ClassTree
     views: dict[int, ClassView]
     package_scopes: dict[int, ClassScope]
-    evaluator: Evaluator
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
@@ -88,14 +93,12 @@ class ClassLookup:
                                entry.defn.span)
         return entry, mods
 
-    def find_function(self, name: str, scope: Any) -> ClassEntry | None:
+    def find_function(self, name: str, scope: Scope) -> ClassEntry | None:
         entry = lookup_class(name, scope.entry)
         return entry if entry is not None and entry.defn.kind == "function" else None
 
-    def resolve_function(self, ref: s.Ref, scope: Any) -> ClassEntry:
+    def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry:
         if lookup_class(ref.parts[0].name, scope.entry) is None:
-            import difflib
-
             close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else
@@ -106,7 +109,7 @@ class ClassLookup:
                                ref.span, [Note("defined here", entry.defn.span)])
         return entry
 
-    def class_member(self, entry: ClassEntry, name: str, span: s.Span) -> Any:
+    def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
         """``P.c``: a nested class or a constant of a package."""
         nested = member_class(entry, name)
         if nested is not None:
@@ -124,7 +127,7 @@ class ClassLookup:
             self.package_scopes[id(entry)] = scope
         return scope
 
-    def lookup_global(self, name: str, entry: ClassEntry, span: s.Span) -> Any:
+    def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any:
         """A name not declared in the instance: time, a constant of an enclosing class,
         a class (for dotted references), or a built-in constant."""
         if name == "time":
@@ -191,8 +194,6 @@ def _models_below(entry: ClassEntry) -> list[str]:
 
 
 def _model_hint(tree: ClassTree, model: str) -> str:
-    import difflib
-
     names: list[str] = []
     pending = list(tree.root.classes.values())
     while pending:

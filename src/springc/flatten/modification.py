@@ -21,7 +21,7 @@ class ModValue:
     as when ``Mass ms[3](m = {1, 2, 3})`` gives ``ms[2]`` the value ``m = 2``."""
 
     expr: s.Expr
-    scope: Any
+    scope: Any  # the scope.ClassScope it is written in (scope.py imports this module)
     index: tuple[int, ...] = ()
 
     @property
@@ -37,11 +37,6 @@ class Mod:
     final: bool = False
     span: Span | None = None
 
-    def child(self, name: str) -> Mod | None:
-        return self.children.get(name)
-
-
-EMPTY = Mod()
 
 
 def from_syntax(modification: s.Modification | None, scope: Any) -> Mod | None:
@@ -86,7 +81,9 @@ def merge(outer: Mod | None, inner: Mod | None, name: str = "") -> Mod | None:
             "remove this modification or the `final` prefix")
     children = dict(inner.children)
     for key, mod in outer.children.items():
-        children[key] = merge(mod, inner.children.get(key), f"{name}.{key}" if name else key)
+        merged = merge(mod, inner.children.get(key), f"{name}.{key}" if name else key)
+        assert merged is not None  # the outer one is not None
+        children[key] = merged
     value = outer.value if outer.value is not None else inner.value
     each = outer.each if outer.value is not None else inner.each
     return Mod(value, children, each, inner.final or outer.final, outer.span or inner.span)
@@ -97,7 +94,7 @@ def merge_all(mods: list[Mod | None], name: str = "") -> Mod | None:
     present = [m for m in mods if m is not None]
     if len(present) <= 1:
         return present[0] if present else None
-    result = present[-1]
+    result: Mod | None = present[-1]
     for mod in reversed(present[:-1]):
         result = merge(mod, result, name)
     return result

@@ -1,29 +1,36 @@
-"""Instances of classes while flattening: scopes, members and primitive variables.
+"""Instances of classes while flattening: scopes, members and primitive variables, and
+the Protocols through which the flattening helpers reach their driver.
 
 A :class:`ClassScope` is one instantiated component (or the simulated model itself):
 its flat prefix, its class, the modification that applies to it, and its members,
 created on first use so that parameters needed for array sizes are evaluated in
 dependency order. Inheritance is resolved once per class into a :class:`ClassView`.
+
+The helpers (lookup, instantiation, equations, evaluation, connections, templates) do
+not import the :class:`~springc.flatten.flattener.Flattener` or the evaluator; they take
+a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defined here
+(the pattern of mypy's ``semanal_shared``), so that the package has no import cycle.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import FlattenError, FollowUpError, Note
+from ..errors import FlattenError, FollowUpError, Note, Span, SpringcError
+from ..ir import expr as x
+from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
-from .modification import Mod, from_syntax, merge_all
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from . import arrays as a
+from .limits import Limits
+from .modification import Mod, ModValue, from_syntax, merge_all
+from .parameters import ParameterValues
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
-UNSUPPORTED_TYPES = {"String": "`String` variables", "StateSelect": None}
 
 
 @dataclass(frozen=True)
@@ -84,16 +91,21 @@ class Primitive:
 class ClassScope:
     """One instance of a class; ``prefix`` is its flat name (``""`` for the model)."""
 
-    flattener: Flattener
+    flattener: FlattenContext
     prefix: str
     view: ClassView
     mod: Mod | None
-    span: s.Span
+    span: Span
     outer: ClassScope | None = None
-    members: dict[str, Any] = field(default_factory=dict)
+    members: dict[str, Member] = field(default_factory=dict)
     in_progress: dict[str, None] = field(default_factory=dict)  # ordered: a chain
-    failed: dict[str, FlattenError] = field(default_factory=dict)
-    template: Any = None  # the InstanceTemplate this instance was copied from, if any
+    failed: dict[str, SpringcError] = field(default_factory=dict)
+    # The InstanceTemplate this instance was copied from, if any.
+    template: object | None = None
+    # Filled by connections.connector_leaves for a connector: its scalar variables, and
+    # what must match for two connectors to be connected (names and flow prefixes).
+    connector_leaves: list[Leaf] | None = None
+    connector_signature: tuple[tuple[str, bool], ...] = ()
 
     @property
     def entry(self) -> ClassEntry:
@@ -109,7 +121,7 @@ class ClassScope:
     def has_member(self, name: str) -> bool:
         return name in self.view.components
 
-    def member(self, name: str, span: s.Span | None = None) -> Any:
+    def member(self, name: str, span: Span | None = None) -> Member:
         """The member ``name``, instantiating it on first use."""
         found = self.members.get(name)
         if found is not None:
@@ -134,11 +146,11 @@ class ClassScope:
         self.members[name] = created
         return created
 
-    def all_members(self) -> Iterator[tuple[str, Any]]:
+    def all_members(self) -> Iterator[tuple[str, Member]]:
         for name in self.view.components:
             yield name, self.member(name)
 
-    def lookup(self, name: str, span: s.Span) -> Any:
+    def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
             return self.member(name, span)
         return self.flattener.lookup_global(name, self.entry, span)
@@ -146,22 +158,157 @@ class ClassScope:
 
 @dataclass(eq=False)
 class LocalScope:
-    """Loop indices (or function variables) over an enclosing scope."""
+    """Loop indices over an enclosing scope; inside a subscript that uses ``end``, also
+    the size of the subscripted dimension (``end_value``)."""
 
     names: dict[str, Any]
-    parent: Any
+    parent: Scope
+    end_value: int | None = None
 
     @property
     def entry(self) -> ClassEntry:
         return self.parent.entry
 
-    def lookup(self, name: str, span: s.Span) -> Any:
+    def lookup(self, name: str, span: Span) -> Any:
         if name in self.names:
             return self.names[name]
         return self.parent.lookup(name, span)
 
 
-def build_view(entry: ClassEntry, flattener: Flattener, seen: tuple[ClassEntry, ...] = ()
+@dataclass(eq=False)
+class FunctionScope:
+    """Variables of one function call, over the function's package (for constants);
+    None marks a variable not assigned yet."""
+
+    names: dict[str, Any]
+    parent: ClassScope
+    entry: ClassEntry
+
+    def lookup(self, name: str, span: Span) -> Any:
+        if name not in self.names:
+            return self.parent.lookup(name, span)
+        value = self.names[name]
+        if value is None:
+            raise FlattenError(f"'{name}' is used before it is assigned", span)
+        return value
+
+
+#: Where a name is looked up: an instance, loop indices over one, or a function call.
+Scope = ClassScope | LocalScope | FunctionScope
+#: A member of an instance: a primitive variable, a component, or an array of components.
+Member = Primitive | ClassScope | np.ndarray
+
+
+@dataclass(frozen=True, slots=True)
+class Leaf:
+    """A scalar variable of a connector: its name relative to the connector, its flat
+    name, and whether it is a flow variable."""
+
+    relative: str
+    name: str
+    flow: bool
+
+
+@dataclass(frozen=True)
+class Declared:
+    """What a component declaration contributes independently of the instance: its
+    resolved type, the type's modifications, and its sizes when they are literals."""
+
+    comp: ViewComponent  # kept alive: declared_types is keyed by its id
+    rtype: ResolvedType
+    type_mods: list[Mod | None]
+    dims: tuple[int, ...] | None
+
+
+Handler = Callable[[s.Call, Scope], a.Value]
+AttributeCache = dict[tuple[tuple[str, int], ...], tuple[tuple[Mod, ...], flat.Attributes]]
+
+
+class BuiltinFunctions(Protocol):
+    """The built-in functions of the language, by name."""
+
+    table: dict[str, Handler]
+
+    def lookup(self, name: str, scope: Scope) -> Handler | None: ...
+
+
+class ExpressionEvaluator(Protocol):
+    """What the flattening helpers call on the expression evaluator (``evaluate.py``)."""
+
+    flattener: FlattenContext
+    no_event: int  # > 0 inside noEvent(...) and smooth(...)
+    call_depth: int  # nesting of user-defined function calls being inlined
+
+    @property
+    def builtins(self) -> BuiltinFunctions: ...
+
+    def value(self, e: s.Expr, scope: Scope) -> a.Value: ...
+
+    def scalar(self, e: s.Expr, scope: Scope) -> x.Expr: ...
+
+    def constant(self, e: s.Expr, scope: Scope, what: str,
+                 hint: str = ...) -> Any: ...
+
+    def integer(self, e: s.Expr, scope: Scope, what: str) -> int: ...
+
+    def fold(self, v: a.Value) -> Any: ...
+
+    def reference(self, e: s.Ref, scope: Scope) -> Any: ...
+
+    def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
+                ) -> Iterator[a.Value]: ...
+
+    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]: ...
+
+
+class FlattenContext(Protocol):
+    """What the flattening helpers call on the driver
+    (:class:`~springc.flatten.flattener.Flattener`): its results so far, its caches,
+    and class lookup and instantiation."""
+
+    parameter_values: ParameterValues
+    evaluator: ExpressionEvaluator
+    limits: Limits
+    errors: list[SpringcError]
+    equations: list[flat.Equation]
+    initial_equations: list[flat.Equation]
+    attribute_cache: AttributeCache
+    reusable_views: dict[int, bool]
+
+    def report(self, err: FlattenError) -> None: ...
+
+    def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView: ...
+
+    def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None
+                      ) -> ClassEntry: ...
+
+    def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType: ...
+
+    def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry: ...
+
+    def find_function(self, name: str, scope: Scope) -> ClassEntry | None: ...
+
+    def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any: ...
+
+    def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any: ...
+
+    def package_scope(self, entry: ClassEntry) -> ClassScope: ...
+
+    def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member: ...
+
+    def declared_type(self, comp: ViewComponent) -> Declared: ...
+
+    def binding(self, mod: Mod | None, dims: tuple[int, ...], name: str,
+                decl: s.Component) -> a.Value | None: ...
+
+    def mod_value(self, mv: ModValue) -> a.Value: ...
+
+    def is_parameter_expression(self, e: x.Expr) -> bool: ...
+
+    def variables(self, scope: ClassScope) -> Iterator[flat.Variable]: ...
+
+
+def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEntry, ...] = ()
                ) -> ClassView:
     """Resolve ``extends`` clauses: base elements first, then the class's own."""
     if entry in seen:

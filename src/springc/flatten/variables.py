@@ -9,7 +9,9 @@ from __future__ import annotations
 import difflib
 import itertools
 from collections.abc import Iterator
-from typing import TYPE_CHECKING, Any
+from typing import Any
+
+import numpy as np
 
 from ..errors import FlattenError
 from ..ir import expr as x
@@ -17,10 +19,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .modification import Mod, select
-from .scope import ClassScope, Primitive
-
-if TYPE_CHECKING:
-    from .flattener import Flattener
+from .scope import ClassScope, FlattenContext, Primitive
 
 ATTRIBUTES = {
     "Real": ("start", "fixed", "nominal", "min", "max", "unit", "displayUnit", "stateSelect",
@@ -47,7 +46,7 @@ def check_attribute_mods(mod: Mod | None, primitive: str | None, name: str) -> N
             raise FlattenError(f"the attribute '{key}' has no elements to modify", child.span)
 
 
-def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
+def attributes_of(flattener: FlattenContext, scope: ClassScope, prim: Primitive
                   ) -> Iterator[flat.Variable]:
     """The flat variables of one primitive component."""
     names = [prim.names] if not prim.dims else list(prim.names.flat)  # type: ignore[union-attr]
@@ -57,6 +56,7 @@ def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
     is_param = prim.variability == "parameter"
     for name, idx in zip(names, indices):
         mod = select(prim.mod, idx) if idx else prim.mod
+        assert isinstance(name, str)
         yield flat.Variable(
             name, prim.type, prim.variability, prim.causality, prim.flow,
             bindings.get(name) if is_param else None,
@@ -64,7 +64,7 @@ def attributes_of(flattener: Flattener, scope: ClassScope, prim: Primitive
             prim.decl.span)
 
 
-def _attributes(flattener: Flattener, mod: Mod | None, name: str) -> flat.Attributes:
+def _attributes(flattener: FlattenContext, mod: Mod | None, name: str) -> flat.Attributes:
     """The attributes given by ``mod``, remembered per combination of attribute
     modification objects: a type's modifiers (``unit = "m"``) are objects shared by all
     its variables, also where a merge with a binding built a new ``mod`` around them."""
@@ -79,7 +79,7 @@ def _attributes(flattener: Flattener, mod: Mod | None, name: str) -> flat.Attrib
     return cached[1]
 
 
-def _evaluate(flattener: Flattener, mod: Mod, name: str) -> flat.Attributes:
+def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes:
     values: dict[str, Any] = {}
     for key, child in mod.children.items():
         if child.value is None:
@@ -98,6 +98,9 @@ def _evaluate(flattener: Flattener, mod: Mod, name: str) -> flat.Attributes:
             if key != "quantity":
                 values["display_unit" if key == "displayUnit" else "unit"] = value
         elif key == "fixed":
+            if isinstance(value, (str, np.ndarray)):
+                raise FlattenError("the attribute 'fixed' must be a scalar Boolean",
+                                   child.value.span)
             values["fixed"] = bool(_fold(flattener, value, child, "'fixed'"))
         else:
             if isinstance(value, str):
@@ -109,7 +112,7 @@ def _evaluate(flattener: Flattener, mod: Mod, name: str) -> flat.Attributes:
 _EMPTY = flat.Attributes()
 
 
-def _fold(flattener: Flattener, value: x.Expr, child: Mod, what: str) -> Any:
+def _fold(flattener: FlattenContext, value: x.Expr, child: Mod, what: str) -> Any:
     try:
         return flattener.evaluator.fold(value)
     except KeyError as missing:

@@ -1,8 +1,9 @@
 """The DAE: residual equations over unknowns and their derivatives.
 
-Produced by :mod:`springc.lower` from the flat model. Derivatives are ordinary
+Produced by :mod:`springc.simplify.lower` from the flat model. Derivatives are ordinary
 variables named ``der(x)`` (and ``der(der(x))`` after index reduction), so every
-structural algorithm sees one kind of unknown; ``derivative_of`` links them.
+structural algorithm sees one kind of unknown. :func:`derivative_name` and
+:func:`derivative_base` are the one way to build and read such names.
 """
 
 from __future__ import annotations
@@ -13,10 +14,25 @@ from ..errors import Span
 from . import flat
 from .expr import Expr, to_text
 
+DERIVATIVE_PREFIX = "der("
 
-def der_name(name: str) -> str:
+
+def derivative_name(name: str) -> str:
     """The name of the derivative variable of ``name``: ``der(x)``."""
-    return f"der({name})"
+    return f"{DERIVATIVE_PREFIX}{name})"
+
+
+def derivative_base(name: str) -> str | None:
+    """``x`` for the derivative variable ``der(x)`` (``der(x)`` for ``der(der(x))``);
+    None when ``name`` is not a derivative variable."""
+    if name.startswith(DERIVATIVE_PREFIX) and name.endswith(")"):
+        return name[len(DERIVATIVE_PREFIX):-1]
+    return None
+
+
+def is_derivative(name: str) -> bool:
+    """Is ``name`` a derivative variable (``der(x)``)?"""
+    return derivative_base(name) is not None
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,15 +1,73 @@
 """Scalar expressions of the flat model and later stages.
 
 A deliberately small, fast tree: flattening builds hundreds of thousands of these, so
-they are plain frozen dataclasses rather than sympy objects. Symbolic work that needs
-a computer-algebra system converts to sympy on demand (:mod:`springc.symbolic`).
+they are plain frozen dataclasses rather than sympy objects (rendering as LaTeX converts
+to sympy on demand, :mod:`springc.ir.latex`).
+
+Depth: the stages recurse over these trees, so their depth is bounded. The parser
+rejects source expressions nested deeper than :data:`MAX_DEPTH` (a sum of n terms is
+n - 1 deep), and the CLI and API run inside :func:`recursion_room`, which gives Python
+the stack that depth needs.
 """
 
 from __future__ import annotations
 
 import math
+import sys
+import threading
 from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import Any
+
+# ------------------------------------------------------------------------ depth
+
+MAX_DEPTH = 3000
+"""Deepest source expression accepted (docs/language.md, "Limits"). Measured: the
+deepest stage (lowering, index reduction and code generation for ``simulate``) takes
+about 4.5 Python calls per level, so 3,000 levels need about 13,500 of the 16,384
+calls :func:`recursion_limit` allows on an 8 MiB stack."""
+
+# Python 3.11 counts every call against one recursion limit, and calls made from C
+# (== and hash of these frozen dataclasses, generator expressions, map) take C stack
+# too: on an 8 MiB stack == of two 12,500-deep trees (37,500 calls) and a recursion
+# through map 14,000 deep (28,000 calls) overflowed it, about 300 bytes a call, and
+# compile() of generated code recurses 3 times the limit at about 145 bytes a level.
+# An overflow is a segmentation fault, so the limit leaves 512 bytes a call.
+_STACK_BYTES_PER_CALL = 512
+_DEFAULT_STACK = 8 << 20
+_RECURSION_CAP = 20_000
+
+
+def recursion_limit() -> int:
+    """The recursion limit this thread's stack can afford (at least Python's current
+    one): the stack size over 512 bytes a call, at most 20,000."""
+    size = _DEFAULT_STACK
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_STACK)[0]
+        if 0 < soft != resource.RLIM_INFINITY:
+            size = soft  # the main thread's, and the default of new threads
+    except (ImportError, OSError, ValueError):
+        pass
+    if threading.current_thread() is not threading.main_thread():
+        configured = threading.stack_size()
+        threading.stack_size(configured)  # reading it also set it (to 0): put it back
+        size = configured or size
+    return max(sys.getrecursionlimit(), min(_RECURSION_CAP, size // _STACK_BYTES_PER_CALL))
+
+
+@contextmanager
+def recursion_room() -> Iterator[None]:
+    """Run the body with :func:`recursion_limit` as Python's recursion limit, so that
+    expressions up to :data:`MAX_DEPTH` deep pass every stage; restores it after."""
+    previous = sys.getrecursionlimit()
+    sys.setrecursionlimit(recursion_limit())
+    try:
+        yield
+    finally:
+        sys.setrecursionlimit(previous)
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,7 +148,7 @@ MATH: dict[str, Callable[..., float]] = {
     "noEvent": lambda x: x, "smooth": lambda p, x: x, "homotopy": lambda a, s: a,
 }
 
-_BINARY: dict[str, Callable[[object, object], object]] = {
+_BINARY: dict[str, Callable[[Any, Any], Any]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
     "/": lambda a, b: a / b, "^": lambda a, b: a**b,
     "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
@@ -154,7 +212,7 @@ def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
     raise TypeError(f"not an expression: {e!r}")
 
 
-def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> object:
+def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> Any:
     """Numeric value of ``e``; raises ``KeyError`` for a variable missing from ``env``."""
     if isinstance(e, Const):
         return e.value

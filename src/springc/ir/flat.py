@@ -11,6 +11,7 @@ import re
 from dataclasses import dataclass, field
 
 from ..errors import Span
+from . import latex
 from .expr import Expr, format_number, to_text
 
 
@@ -117,6 +118,10 @@ class FlatModel:
                 return v
         raise KeyError(name)
 
+    def _repr_latex_(self) -> str | None:
+        """The equations as LaTeX in a notebook (:func:`springc.ir.latex.notebook`)."""
+        return latex.notebook(latex_rows(self))
+
 
 # ------------------------------------------------------------------ printing
 
@@ -198,6 +203,17 @@ def format_flat(model: FlatModel, origins: bool = False) -> str:
         lines.append(f"  annotation(experiment({args}));")
     lines.append(f"end {quote(model.name)};")
     return "\n".join(lines) + "\n"
+
+
+def latex_rows(model: FlatModel) -> list[tuple[Expr, Expr, str]]:
+    """``(lhs, rhs, note)`` of every equation, initial ones noted ``initial``."""
+    return ([(e.lhs, e.rhs, "") for e in model.equations]
+            + [(e.lhs, e.rhs, "initial") for e in model.initial_equations])
+
+
+def format_flat_latex(model: FlatModel) -> str:
+    """``springc flatten --latex``: the equations in a LaTeX ``align`` environment."""
+    return latex.align(latex_rows(model))
 
 
 # ---------------------------------------------------------------------- JSON

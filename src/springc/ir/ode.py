@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import Span
-from . import dae
-from .expr import Expr, to_text
+from . import dae, latex
+from .expr import ZERO, Expr, Var, add, mul, to_text
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,8 +86,12 @@ class ODE:
 
     def observed_names(self) -> list[str]:
         """Algebraic variables the user can ask for (derivative variables excluded)."""
-        computed = [n for n in self.step_names() if not n.startswith("der(")]
+        computed = [n for n in self.step_names() if not dae.is_derivative(n)]
         return computed + [a.name for a in self.observed]
+
+    def _repr_latex_(self) -> str | None:
+        """The evaluation order as LaTeX in a notebook (:func:`springc.ir.latex.notebook`)."""
+        return latex.notebook(latex_rows(self))
 
 
 def _step_text(step: Step) -> list[str]:
@@ -119,3 +123,28 @@ def format_ode(ode: ODE) -> str:
         lines += [f"  {a.name} = {to_text(a.expr)}" for a in ode.observed]
     lines.append(f"observed: {', '.join(observed) if observed else '(none)'}")
     return "\n".join(lines) + "\n"
+
+
+def latex_rows(ode: ODE) -> list[tuple[Expr, Expr, str]]:
+    """``(lhs, rhs, note)`` in evaluation order: assignments, each row of a linear
+    system (``A x = b``), a nonlinear system's inner assignments and residuals
+    (``0 = r``), then the aliases."""
+    rows: list[tuple[Expr, Expr, str]] = []
+    for step in ode.steps:
+        if isinstance(step, Assign):
+            rows.append((Var(step.name), step.expr, ""))
+        elif isinstance(step, LinearBlock):
+            sums: dict[int, Expr] = {}
+            for row, col, coefficient in step.matrix:
+                sums[row] = add(sums.get(row, ZERO), mul(coefficient, Var(step.names[col])))
+            rows += [(sums.get(i, ZERO), b, "linear") for i, b in enumerate(step.rhs)]
+        else:
+            rows += [(Var(a.name), a.expr, "nonlinear") for a in step.inner]
+            rows += [(ZERO, r, "nonlinear") for r in step.residuals]
+    rows += [(Var(a.name), a.expr, "alias") for a in ode.observed]
+    return rows
+
+
+def format_ode_latex(ode: ODE) -> str:
+    """``springc flatten --simplify --latex``: :func:`latex_rows` in an ``align``."""
+    return latex.align(latex_rows(ode))

@@ -9,12 +9,13 @@ over later ones, like ``MODELICAPATH``.
 
 from __future__ import annotations
 
+import difflib
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ErrorGroup, FlattenError, LoadError, Note, SpringcError
+from ..errors import ErrorGroup, FlattenError, LoadError, Note, Span, SpringcError
 from ..ir import syntax as s
 from ..resources import models_dir
 from .parser import parse_file
@@ -48,7 +49,7 @@ def _place(defn: s.ClassDef, parent: ClassEntry) -> ClassEntry:
     return entry
 
 
-_ROOT_SPAN = s.Span("<root>", 1, 1, 1, 1)
+_ROOT_SPAN = Span("<root>", 1, 1, 1, 1)
 _ROOT_DEF = s.ClassDef("", "package", False, False, "", (), (), (), (), None, None, False,
                        _ROOT_SPAN)
 
@@ -86,7 +87,7 @@ class ClassTree:
             package.classes[defn.name] = entry
         return errors
 
-    def resolve(self, path: Sequence[str], scope: ClassEntry, span: s.Span | None) -> ClassEntry:
+    def resolve(self, path: Sequence[str], scope: ClassEntry, span: Span | None) -> ClassEntry:
         """Look up a dotted class name from ``scope`` (Modelica lexical lookup)."""
         entry = lookup_class(path[0], scope)
         if entry is None:
@@ -168,8 +169,6 @@ def _imported(entry: ClassEntry, name: str) -> ClassEntry | None:
 
 
 def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
-    import difflib
-
     visible: set[str] = set()
     entry: ClassEntry | None = scope
     while entry is not None:

@@ -12,13 +12,17 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from lark import Token
+from lark.tree import Meta
 
 from ..errors import Note, ParseError, Span
 from ..ir.syntax import ElementModification, End, Expr, Modification, Ref, RefPart
 
-LATER = "springc supports a subset of Modelica; see the \"Later\" list in LANGUAGE.md"
+T = TypeVar("T")
+
+LATER = "springc supports a subset of Modelica; see \"Not supported yet\" in docs/language.md"
 
 KEYWORDS = frozenset(
     [
@@ -73,11 +77,11 @@ class Annotation:
 # ------------------------------------------------------------------- helpers
 
 
-def tokens(children: list) -> list[Token]:
+def tokens(children: list[Any]) -> list[Token]:
     return [c for c in children if isinstance(c, Token)]
 
 
-def of(children: list, kind: type):
+def of(children: list[Any], kind: type[T]) -> T | None:
     """The first child of type ``kind``, or ``None``."""
     return next((c for c in children if isinstance(c, kind)), None)
 
@@ -91,50 +95,52 @@ class RuleBase:
 
     file: str
     errors: list[ParseError]
-    _loose_ends: list[End]  # `end`s not yet known to sit in a subscript
+    loose_ends: list[End]  # `end`s not yet known to sit in a subscript
 
-    def _span(self, meta) -> Span:
+    def span_of(self, meta: Meta) -> Span:
         return Span(self.file, meta.line, meta.column, meta.end_line, meta.end_column)
 
-    def _tspan(self, tok: Token) -> Span:
-        return Span(self.file, tok.line, tok.column, tok.end_line, tok.end_column)
+    def token_span(self, tok: Token) -> Span:
+        # Tokens from the parser always carry positions (propagate_positions).
+        return Span(self.file, tok.line or 1, tok.column or 1, tok.end_line or 1,
+                    tok.end_column or 1)
 
-    def _kw(self, meta, word: str) -> Span:
+    def keyword_span(self, meta: Meta, word: str) -> Span:
         """The span of the keyword ``word`` that starts the rule at ``meta``."""
         return Span(self.file, meta.line, meta.column, meta.line, meta.column + len(word))
 
-    def _error(self, message: str, span: Span, hint: str | None = None,
+    def error(self, message: str, span: Span, hint: str | None = None,
                notes: Iterable[Note] = ()) -> None:
         self.errors.append(ParseError(message, span, notes, hint))
 
-    def _reject(self, what: str, span: Span, hint: str | None = LATER) -> Rejected:
-        self._error(f"{what} not supported yet", span, hint)
+    def reject(self, what: str, span: Span, hint: str | None = LATER) -> Rejected:
+        self.error(f"{what} not supported yet", span, hint)
         return Rejected(span)
 
-    def _ident(self, tok: Token, function: bool = False) -> str:
+    def ident(self, tok: Token, function: bool = False) -> str:
         """The name written by ``tok`` (without quotes); reserved words are errors,
         except ``der``/``initial`` as the ``function`` name of a call."""
         if tok.startswith("'"):
-            return self._unescape(tok[1:-1], tok)
+            return self.unescape(tok[1:-1], tok)
         if tok in KEYWORDS and not (function and tok in _FUNCTION_WORDS):
-            self._error(f"'{tok}' is a reserved word and cannot be used as a name",
-                        self._tspan(tok))
+            self.error(f"'{tok}' is a reserved word and cannot be used as a name",
+                        self.token_span(tok))
         return str(tok)
 
-    def _ref(self, toks: tuple[Token, ...]) -> Ref:
-        parts = tuple(RefPart(self._ident(t), (), self._tspan(t)) for t in toks)
+    def make_ref(self, toks: tuple[Token, ...]) -> Ref:
+        parts = tuple(RefPart(self.ident(t), (), self.token_span(t)) for t in toks)
         return Ref(parts, join(parts[0].span, parts[-1].span))
 
-    def _unescape(self, body: str, token: Token) -> str:
+    def unescape(self, body: str, token: Token) -> str:
         """Resolve Modelica's escapes (``\\n``, ``\\"``, ...) in a string or quoted name."""
         if "\\" not in body:
             return body
 
-        def one(m: re.Match) -> str:
+        def one(m: re.Match[str]) -> str:
             if m.group(1) in _ESCAPES:
                 return _ESCAPES[m.group(1)]
-            self._error(f"invalid escape '\\{m.group(1)}'", self._tspan(token),
+            self.error(f"invalid escape '\\{m.group(1)}'", self.token_span(token),
                         hint="Modelica knows \\' \\\" \\? \\\\ \\a \\b \\f \\n \\r \\t \\v")
-            return m.group(1)
+            return str(m.group(1))
 
         return _ESCAPE.sub(one, body)

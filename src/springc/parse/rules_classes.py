@@ -10,9 +10,12 @@ equations and algorithms here, and unsupported class kinds and sections become l
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 from lark import Token
+from lark.tree import Meta
 
 from ..errors import Note, Span
 from ..ir.syntax import ClassDef, Component, Element, Modification, ShortDef, StoredDefinition
@@ -31,7 +34,7 @@ class _Section:
     initial equation, algorithm, initial algorithm or external."""
 
     kind: str
-    items: tuple
+    items: tuple[Any, ...]
     span: Span
 
 
@@ -47,12 +50,12 @@ class _Spec:
     end_name: Token | None
 
 
-def _section_rule(kind: str):
+def _section_rule(kind: str) -> Callable[[RuleBase, Meta, list[Any]], _Section]:
     """The rule method for a section that starts with the keyword(s) ``kind``."""
 
-    def method(self: RuleBase, meta, ch) -> _Section:
+    def method(self: RuleBase, meta: Meta, ch: list[Any]) -> _Section:
         items = [i for c in ch for i in (c if isinstance(c, tuple) else (c,))]
-        return _Section(kind, tuple(items), self._kw(meta, kind.split()[0]))
+        return _Section(kind, tuple(items), self.keyword_span(meta, kind.split()[0]))
 
     return method
 
@@ -70,29 +73,29 @@ class ClassRules(RuleBase):
 
     # ----------------------------------------------------------- stored definition
 
-    def start(self, meta, ch):
+    def start(self, meta: Meta, ch: list[Any]) -> StoredDefinition:
         within = of(ch, _Within)
         classes = tuple(c for c in ch if isinstance(c, ClassDef))
         return StoredDefinition(self.file, within.path if within else None, classes)
 
-    def expression_start(self, meta, ch):
+    def expression_start(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0]
 
-    def within_clause(self, meta, ch):
-        return _Within(tuple(self._ident(t) for t in ch[0]) if ch else ())
+    def within_clause(self, meta: Meta, ch: list[Any]) -> Any:
+        return _Within(tuple(self.ident(t) for t in ch[0]) if ch else ())
 
-    def top_class(self, meta, ch):
+    def top_class(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[-1]
 
     # ----------------------------------------------------------------- classes
 
-    def class_prefixes(self, meta, ch):
+    def class_prefixes(self, meta: Meta, ch: list[Any]) -> Any:
         return [t for c in ch for t in (c if isinstance(c, list) else [c])]
 
-    def class_kind(self, meta, ch):
+    def class_kind(self, meta: Meta, ch: list[Any]) -> Any:
         return list(ch)
 
-    def class_definition(self, meta, ch):
+    def class_definition(self, meta: Meta, ch: list[Any]) -> Any:
         prefixes, spec = ch
         if isinstance(spec, Rejected):
             return spec
@@ -102,15 +105,15 @@ class ClassRules(RuleBase):
                 kind = {"operator": "`operator` classes are",
                         "expandable": "`expandable` connectors are",
                         "impure": "`impure` functions are"}[tok]
-                self._reject(kind, self._tspan(tok))
+                self.reject(kind, self.token_span(tok))
         kind = words[-1]
-        name = self._ident(spec.name)
-        span = self._span(meta)
+        name = self.ident(spec.name)
+        span = self.span_of(meta)
         if spec.end_name is not None and spec.end_name != spec.name:
             head = Span(self.file, meta.line, meta.column, spec.name.end_line,
                         spec.name.end_column)
-            self._error(f"class '{name}' ends with 'end {spec.end_name}'",
-                        self._tspan(spec.end_name),
+            self.error(f"class '{name}' ends with 'end {spec.end_name}'",
+                        self.token_span(spec.end_name),
                         hint=f"write 'end {spec.name};'",
                         notes=[Note(f"class '{name}' starts here", head)])
         body = self._body(spec.sections, kind)
@@ -124,20 +127,20 @@ class ClassRules(RuleBase):
             protected=False, span=span,
         )
 
-    def _body(self, sections: tuple[_Section, ...], kind: str) -> dict:
-        body: dict = {"elements": [], "equation": [], "initial equation": [], "algorithm": [],
-                      "annotations": []}
+    def _body(self, sections: tuple[_Section, ...], kind: str) -> dict[str, tuple[Any, ...]]:
+        body: dict[str, list[Any]] = {"elements": [], "equation": [], "initial equation": [],
+                                      "algorithm": [], "annotations": []}
         for section in sections:
             if section.kind == "algorithm" and kind != "function":
-                self._reject("`algorithm` sections outside functions are", section.span,
+                self.reject("`algorithm` sections outside functions are", section.span,
                              hint="use equations; springc accepts `algorithm` only in "
-                                  "functions (see the \"Later\" list in LANGUAGE.md)")
+                                  "functions (see \"Not supported yet\" in docs/language.md)")
             elif section.kind == "initial algorithm":
-                self._reject("`initial algorithm` sections are", section.span)
+                self.reject("`initial algorithm` sections are", section.span)
             elif section.kind == "external":
-                self._reject("`external` functions are", section.span)
+                self.reject("`external` functions are", section.span)
             elif section.kind in ("equation", "initial equation") and kind == "function":
-                self._error(f"a function cannot have an `{section.kind}` section", section.span,
+                self.error(f"a function cannot have an `{section.kind}` section", section.span,
                             hint="compute the outputs in an `algorithm` section")
             for item in section.items:
                 if isinstance(item, Annotation):
@@ -152,14 +155,14 @@ class ClassRules(RuleBase):
                     body[section.kind].append(item)
         return {k: tuple(v) for k, v in body.items()}
 
-    def long_class(self, meta, ch):
+    def long_class(self, meta: Meta, ch: list[Any]) -> Any:
         name, description, sections, end_name = ch
         return _Spec(name, description, sections, None, None, end_name)
 
-    def extends_class(self, meta, ch):
-        return self._reject("`class extends` definitions are", self._kw(meta, "extends"))
+    def extends_class(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`class extends` definitions are", self.keyword_span(meta, "extends"))
 
-    def short_class(self, meta, ch):
+    def short_class(self, meta: Meta, ch: list[Any]) -> Any:
         name, prefixes, base = ch[0], ch[1], ch[2]
         dims = of(ch, Subs)
         mod = of(ch, ClassMod)
@@ -169,30 +172,30 @@ class ClassRules(RuleBase):
             base=base, dims=dims.items if dims else (),
             modification=Modification(mod.arguments, None, mod.span) if mod else None,
             variability=variability(words), causality=causality(words),
-            flow="flow" in words, span=join(base.span, self._span(meta)),
+            flow="flow" in words, span=join(base.span, self.span_of(meta)),
         )
         return _Spec(name, comment.description, (), short, comment.annotation, None)
 
-    def enum_class(self, meta, ch):
+    def enum_class(self, meta: Meta, ch: list[Any]) -> Rejected:
         keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
-        return self._reject("`enumeration` types are", self._tspan(keyword))
+        return self.reject("`enumeration` types are", self.token_span(keyword))
 
-    def enum_body(self, meta, ch):
+    def enum_body(self, meta: Meta, ch: list[Any]) -> Any:
         return None
 
     enum_literal = enum_body
 
-    def composition(self, meta, ch):
+    def composition(self, meta: Meta, ch: list[Any]) -> Any:
         elements = [i for c in ch if not isinstance(c, _Section) for i in c]
-        first = _Section("public", tuple(elements), self._span(meta) if not meta.empty
+        first = _Section("public", tuple(elements), self.span_of(meta) if not meta.empty
                          else Span(self.file, 1, 1, 1, 1))
         return (first, *(c for c in ch if isinstance(c, _Section)))
 
-    def element_item(self, meta, ch):
+    def element_item(self, meta: Meta, ch: list[Any]) -> Any:
         item = ch[0]
         return (item,) if isinstance(item, Element | Annotation | Rejected) else tuple(item)
 
-    def equation_item(self, meta, ch):
+    def equation_item(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0]
 
     statement_item = equation_item
@@ -204,11 +207,11 @@ class ClassRules(RuleBase):
     algorithm_section = _section_rule("algorithm")
     initial_algorithm_section = _section_rule("initial algorithm")
 
-    def external_part(self, meta, ch):
-        return _Section("external", (), self._kw(meta, "external"))
+    def external_part(self, meta: Meta, ch: list[Any]) -> Any:
+        return _Section("external", (), self.keyword_span(meta, "external"))
 
-    def external_clause(self, meta, ch):
+    def external_clause(self, meta: Meta, ch: list[Any]) -> Any:
         return None
 
-    def external_call(self, meta, ch):
+    def external_call(self, meta: Meta, ch: list[Any]) -> Any:
         return None

@@ -10,8 +10,10 @@ conditional components, ``:=`` bindings) become located ``... not supported yet`
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from lark import Token
+from lark.tree import Meta
 
 from ..errors import Span
 from ..ir.syntax import (
@@ -65,16 +67,16 @@ class ElementRules(RuleBase):
 
     # ---------------------------------------------------------------- elements
 
-    def declaration_element(self, meta, ch):
+    def declaration_element(self, meta: Meta, ch: list[Any]) -> Any:
         prefixes, item = ch[0], ch[1]
         words = [str(t) for t in prefixes]
         for tok in prefixes:
             if tok in ("redeclare", "replaceable"):
-                self._reject(f"`{tok}` is", self._tspan(tok))
+                self.reject(f"`{tok}` is", self.token_span(tok))
             elif tok in ("inner", "outer"):
-                self._reject(f"`{tok}` elements are", self._tspan(tok))
+                self.reject(f"`{tok}` elements are", self.token_span(tok))
         if len(ch) > 2 and "replaceable" not in words:
-            self._reject("`constrainedby` is", ch[2])
+            self.reject("`constrainedby` is", ch[2])
         if isinstance(item, ClassDef | Rejected):
             return [item]
         words += list(item.prefixes)
@@ -88,113 +90,113 @@ class ElementRules(RuleBase):
             for d in item.declarations
         ]
 
-    def element_prefixes(self, meta, ch):
+    def element_prefixes(self, meta: Meta, ch: list[Any]) -> Any:
         return list(ch)
 
-    def type_prefix(self, meta, ch):
+    def type_prefix(self, meta: Meta, ch: list[Any]) -> Any:
         for tok in ch:
             if tok == "stream":
-                self._reject("`stream` connectors are", self._tspan(tok))
+                self.reject("`stream` connectors are", self.token_span(tok))
         return list(ch)
 
-    def constraining_clause(self, meta, ch):
-        return self._kw(meta, "constrainedby")
+    def constraining_clause(self, meta: Meta, ch: list[Any]) -> Any:
+        return self.keyword_span(meta, "constrainedby")
 
-    def import_alias(self, meta, ch):
+    def import_alias(self, meta: Meta, ch: list[Any]) -> Import:
         alias, path = ch[0], ch[1]
-        names = tuple(self._ident(t) for t in path)
-        return Import(names[:-1], names[-1:], self._ident(alias), False, self._span(meta))
+        names = tuple(self.ident(t) for t in path)
+        return Import(names[:-1], names[-1:], self.ident(alias), False, self.span_of(meta))
 
-    def import_single(self, meta, ch):
-        names = tuple(self._ident(t) for t in ch[0])
-        return Import(names[:-1], names[-1:], None, False, self._span(meta))
+    def import_single(self, meta: Meta, ch: list[Any]) -> Import:
+        names = tuple(self.ident(t) for t in ch[0])
+        return Import(names[:-1], names[-1:], None, False, self.span_of(meta))
 
-    def import_wildcard(self, meta, ch):
-        names = tuple(self._ident(t) for t in ch[0])
-        return Import(names, (), None, True, self._span(meta))
+    def import_wildcard(self, meta: Meta, ch: list[Any]) -> Import:
+        names = tuple(self.ident(t) for t in ch[0])
+        return Import(names, (), None, True, self.span_of(meta))
 
-    def import_list(self, meta, ch):
-        path = tuple(self._ident(t) for t in ch[0])
-        names = tuple(self._ident(t) for t in ch[1:] if isinstance(t, Token))
-        return Import(path, names, None, False, self._span(meta))
+    def import_list(self, meta: Meta, ch: list[Any]) -> Import:
+        path = tuple(self.ident(t) for t in ch[0])
+        names = tuple(self.ident(t) for t in ch[1:] if isinstance(t, Token))
+        return Import(path, names, None, False, self.span_of(meta))
 
-    def extends_clause(self, meta, ch):
+    def extends_clause(self, meta: Meta, ch: list[Any]) -> Extends:
         mod = of(ch, ClassMod)
         modification = Modification(mod.arguments, None, mod.span) if mod else None
-        return Extends(ch[0], modification, self._span(meta))
+        return Extends(ch[0], modification, self.span_of(meta))
 
-    def component_clause(self, meta, ch):
+    def component_clause(self, meta: Meta, ch: list[Any]) -> Any:
         prefixes, type_name = ch[0], ch[1]
         dims = of(ch, Subs)
         decls = tuple(c for c in ch if isinstance(c, _Decl))
         return _Clause(tuple(str(t) for t in prefixes), type_name,
                        dims.items if dims else (), decls)
 
-    def type_specifier(self, meta, ch):
-        return self._ref(ch[0])
+    def type_specifier(self, meta: Meta, ch: list[Any]) -> Any:
+        return self.make_ref(ch[0])
 
-    def global_type_specifier(self, meta, ch):
-        self._reject("global names (`.A.B`) are", self._kw(meta, "."))
-        return self._ref(ch[0])
+    def global_type_specifier(self, meta: Meta, ch: list[Any]) -> Any:
+        self.reject("global names (`.A.B`) are", self.keyword_span(meta, "."))
+        return self.make_ref(ch[0])
 
-    def component_declaration(self, meta, ch):
+    def component_declaration(self, meta: Meta, ch: list[Any]) -> Any:
         dims = of(ch, Subs)
         comment = ch[-1]
-        return _Decl(self._ident(ch[0]), dims.items if dims else (), of(ch, Modification),
-                     comment.description, self._span(meta))
+        return _Decl(self.ident(ch[0]), dims.items if dims else (), of(ch, Modification),
+                     comment.description, self.span_of(meta))
 
-    def condition_attribute(self, meta, ch):
-        return self._reject("conditional components (`... if condition`) are",
-                            self._kw(meta, "if"))
+    def condition_attribute(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("conditional components (`... if condition`) are",
+                            self.keyword_span(meta, "if"))
 
     # ------------------------------------------------------------ modifications
 
-    def modification(self, meta, ch):
+    def modification(self, meta: Meta, ch: list[Any]) -> Modification:
         mod = of(ch, ClassMod)
         value = ch[-1] if not isinstance(ch[-1], ClassMod) else None
-        return Modification(mod.arguments if mod else (), value, self._span(meta))
+        return Modification(mod.arguments if mod else (), value, self.span_of(meta))
 
-    def assign_modification(self, meta, ch):
-        self._reject("`:=` in a declaration is", self._kw(meta, ":="),
+    def assign_modification(self, meta: Meta, ch: list[Any]) -> Modification:
+        self.reject("`:=` in a declaration is", self.keyword_span(meta, ":="),
                      hint="use '=' for a binding")
-        return Modification((), ch[0], self._span(meta))
+        return Modification((), ch[0], self.span_of(meta))
 
-    def class_modification(self, meta, ch):
+    def class_modification(self, meta: Meta, ch: list[Any]) -> ClassMod:
         args = tuple(c for c in ch if isinstance(c, ElementModification))
-        return ClassMod(args, self._span(meta))
+        return ClassMod(args, self.span_of(meta))
 
-    def element_modification(self, meta, ch):
+    def element_modification(self, meta: Meta, ch: list[Any]) -> ElementModification:
         flags = {t.type for t in ch if isinstance(t, Token)}
         path = next(c for c in ch if isinstance(c, tuple))
         return ElementModification(
-            path=tuple(self._ident(t) for t in path), modification=of(ch, Modification),
-            each="EACH" in flags, final="FINAL" in flags, span=self._span(meta),
+            path=tuple(self.ident(t) for t in path), modification=of(ch, Modification),
+            each="EACH" in flags, final="FINAL" in flags, span=self.span_of(meta),
         )
 
-    def element_replaceable(self, meta, ch):
-        return Rejected(self._span(meta))
+    def element_replaceable(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return Rejected(self.span_of(meta))
 
-    def replaceable_body(self, meta, ch):
-        return self._reject("`replaceable` is", self._kw(meta, "replaceable"))
+    def replaceable_body(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`replaceable` is", self.keyword_span(meta, "replaceable"))
 
-    def element_redeclaration(self, meta, ch):
-        return self._reject("`redeclare` is", self._kw(meta, "redeclare"))
+    def element_redeclaration(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`redeclare` is", self.keyword_span(meta, "redeclare"))
 
-    def short_class_definition(self, meta, ch):
-        return Rejected(self._span(meta))
+    def short_class_definition(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return Rejected(self.span_of(meta))
 
-    def component_clause1(self, meta, ch):
-        return Rejected(self._span(meta))
+    def component_clause1(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return Rejected(self.span_of(meta))
 
-    def component_declaration1(self, meta, ch):
-        return Rejected(self._span(meta))
+    def component_declaration1(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return Rejected(self.span_of(meta))
 
-    def annotation_clause(self, meta, ch):
-        return Annotation(Modification(ch[0].arguments, None, self._span(meta)))
+    def annotation_clause(self, meta: Meta, ch: list[Any]) -> Annotation:
+        return Annotation(Modification(ch[0].arguments, None, self.span_of(meta)))
 
-    def comment(self, meta, ch):
+    def comment(self, meta: Meta, ch: list[Any]) -> Any:
         annotation = of(ch, Annotation)
         return _Comment(ch[0], annotation.modification if annotation else None)
 
-    def description(self, meta, ch):
-        return "".join(self._unescape(t[1:-1], t) for t in ch)
+    def description(self, meta: Meta, ch: list[Any]) -> Any:
+        return "".join(self.unescape(t[1:-1], t) for t in ch)

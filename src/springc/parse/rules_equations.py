@@ -1,12 +1,17 @@
 """Equation and statement rules -> :mod:`springc.syntax` equations and statements.
 
 :class:`EquationRules` has one method per equation or statement rule of
-``grammar/modelica.lark``; the constructs of LANGUAGE.md's "Later" list among them
+``grammar/modelica.lark``; the constructs of docs/language.md's "Not supported yet" list among them
 (``when``, ``while``, ``break``, ``return``, call statements) become located
 ``... not supported yet`` errors.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from lark.tree import Meta
 
 from ..ir.syntax import (
     Assign,
@@ -21,104 +26,104 @@ from ..ir.syntax import (
     IfStatement,
     Ref,
 )
-from .rules_base import Rejected, RuleBase, join
+from .rules_base import Rejected, RuleBase, T, join
 
 
 class EquationRules(RuleBase):
     """The equation and statement rules."""
 
-    def equation(self, meta, ch):
+    def equation(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0]
 
-    def equations(self, meta, ch):
+    def equations(self, meta: Meta, ch: list[Any]) -> Any:
         return tuple(c for c in ch if not isinstance(c, Rejected))
 
     statements = equations
 
-    def simple_equation(self, meta, ch):
-        span = self._span(meta)
+    def simple_equation(self, meta: Meta, ch: list[Any]) -> CallEquation | Equality | Rejected:
+        span = self.span_of(meta)
         if len(ch) == 2:
             return Equality(ch[0], ch[1], span)
         if isinstance(ch[0], Call):
             return CallEquation(ch[0], span)
-        self._error("this expression is not an equation", span,
+        self.error("this expression is not an equation", span,
                     hint="write 'lhs = rhs'; only a function call may stand alone")
         return Rejected(span)
 
-    def _branches(self, meta, ch, make):
+    def _branches(self, meta: Meta, ch: list[Any], make: Callable[..., T]) -> T:
         branches = [(ch[0], ch[1])]
-        otherwise: tuple = ()
+        otherwise: tuple[Any, ...] = ()
         for extra in ch[2:]:
             if extra[0] == "elseif":
                 branches.append((extra[1], extra[2]))
             else:
                 otherwise = extra[1]
-        return make(tuple(branches), otherwise, self._span(meta))
+        return make(tuple(branches), otherwise, self.span_of(meta))
 
-    def if_equation(self, meta, ch):
+    def if_equation(self, meta: Meta, ch: list[Any]) -> IfEquation:
         return self._branches(meta, ch, IfEquation)
 
-    def if_statement(self, meta, ch):
+    def if_statement(self, meta: Meta, ch: list[Any]) -> IfStatement:
         return self._branches(meta, ch, IfStatement)
 
-    def elseif_equation(self, meta, ch):
+    def elseif_equation(self, meta: Meta, ch: list[Any]) -> Any:
         return ("elseif", ch[0], ch[1])
 
     elseif_statement = elseif_equation
 
-    def else_equation(self, meta, ch):
+    def else_equation(self, meta: Meta, ch: list[Any]) -> Any:
         return ("else", ch[0])
 
     else_statement = else_equation
 
-    def for_equation(self, meta, ch):
-        return ForEquation(ch[0], ch[1], self._span(meta))
+    def for_equation(self, meta: Meta, ch: list[Any]) -> ForEquation:
+        return ForEquation(ch[0], ch[1], self.span_of(meta))
 
-    def for_statement(self, meta, ch):
-        return ForStatement(ch[0], ch[1], self._span(meta))
+    def for_statement(self, meta: Meta, ch: list[Any]) -> ForStatement:
+        return ForStatement(ch[0], ch[1], self.span_of(meta))
 
-    def connect_clause(self, meta, ch):
-        return Connect(ch[0], ch[1], self._span(meta))
+    def connect_clause(self, meta: Meta, ch: list[Any]) -> Connect:
+        return Connect(ch[0], ch[1], self.span_of(meta))
 
-    def when_equation(self, meta, ch):
-        return self._reject("`when` equations are", self._kw(meta, "when"))
+    def when_equation(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`when` equations are", self.keyword_span(meta, "when"))
 
-    def for_indices(self, meta, ch):
+    def for_indices(self, meta: Meta, ch: list[Any]) -> Any:
         return tuple(ch)
 
-    def for_index(self, meta, ch):
-        return ForIndex(self._ident(ch[0]), ch[1] if len(ch) > 1 else None, self._span(meta))
+    def for_index(self, meta: Meta, ch: list[Any]) -> ForIndex:
+        return ForIndex(self.ident(ch[0]), ch[1] if len(ch) > 1 else None, self.span_of(meta))
 
     # --------------------------------------------------------------- statements
 
-    def statement(self, meta, ch):
+    def statement(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0]
 
-    def assign_statement(self, meta, ch):
-        return Assign((ch[0],), ch[1], self._span(meta))
+    def assign_statement(self, meta: Meta, ch: list[Any]) -> Assign:
+        return Assign((ch[0],), ch[1], self.span_of(meta))
 
-    def call_statement(self, meta, ch):
-        return self._reject("call statements (`f(x);`) are", self._span(meta))
+    def call_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("call statements (`f(x);`) are", self.span_of(meta))
 
-    def multi_assign(self, meta, ch):
+    def multi_assign(self, meta: Meta, ch: list[Any]) -> Assign:
         *targets, func, args = ch
         for target in targets:
             if target is not None and not isinstance(target, Ref):
-                self._error("only a component reference can be assigned to", target.span)
-        call = Call(func, args.args, args.named, join(func.span, self._span(meta)))
-        return Assign(tuple(targets), call, self._span(meta))
+                self.error("only a component reference can be assigned to", target.span)
+        call = Call(func, args.args, args.named, join(func.span, self.span_of(meta)))
+        return Assign(tuple(targets), call, self.span_of(meta))
 
-    def output_item(self, meta, ch):
+    def output_item(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0] if ch else None
 
-    def break_statement(self, meta, ch):
-        return self._reject("`break` statements are", self._span(meta))
+    def break_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`break` statements are", self.span_of(meta))
 
-    def return_statement(self, meta, ch):
-        return self._reject("`return` statements are", self._span(meta))
+    def return_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`return` statements are", self.span_of(meta))
 
-    def while_statement(self, meta, ch):
-        return self._reject("`while` loops are", self._kw(meta, "while"))
+    def while_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`while` loops are", self.keyword_span(meta, "while"))
 
-    def when_statement(self, meta, ch):
-        return self._reject("`when` statements are", self._kw(meta, "when"))
+    def when_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
+        return self.reject("`when` statements are", self.keyword_span(meta, "when"))

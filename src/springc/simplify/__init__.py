@@ -3,7 +3,31 @@ causalization), plus the balance check, the initial problem and state choice."""
 
 from .balance import check_balance
 from .initialize import conditions, initial_state
+from .ode_eval import OdeEvaluator, describe_failure, parameter_values
 from .passes import simplify
-from .state_choice import simulate_switching
+from .state_choice import (
+    THRESHOLD,
+    StateChoice,
+    conditioning,
+    needs_switch,
+    select_states,
+    state_vector,
+    switch,
+)
 
-__all__ = ["check_balance", "conditions", "initial_state", "simplify", "simulate_switching"]
+__all__ = [
+    "THRESHOLD",
+    "OdeEvaluator",
+    "StateChoice",
+    "check_balance",
+    "conditioning",
+    "conditions",
+    "describe_failure",
+    "initial_state",
+    "needs_switch",
+    "parameter_values",
+    "select_states",
+    "simplify",
+    "state_vector",
+    "switch",
+]

@@ -2,8 +2,9 @@
 
 An equation ``a = b``, ``a = -b`` (``a + b = 0``) or ``a = p`` (a constant or parameter
 expression) removes one unknown. Chains are followed with a signed union-find; in each
-class the kept variable is the one with a fixed start value, then the strongest
-``stateSelect``, then one that appears differentiated, then the first declared.
+class the kept variable is the one that ranks highest as a state
+(:func:`~springc.simplify.index_reduction.unknown_priority`: ``stateSelect``, a fixed
+start, a start value), then one that appears differentiated, then the first declared.
 Eliminated variables become observed: ``a = ±kept`` or ``a = value``.
 """
 
@@ -14,10 +15,9 @@ from dataclasses import dataclass, replace
 from ..errors import Note
 from ..ir import dae
 from ..ir import expr as x
+from .index_reduction import unknown_priority
 from .isolate import free_variables
 from .lower import differentiate
-
-_SELECT_RANK = {"never": 0, "avoid": 1, "default": 2, "prefer": 3, "always": 4}
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,7 +47,7 @@ def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
     if isinstance(e, x.Var) and e.name in unknowns:
         out.append((sign, e.name))
         return len(out) <= 2
-    if any(n in unknowns or n.startswith("der(") for n in free_variables(e)) or any(
+    if any(n in unknowns or dae.is_derivative(n) for n in free_variables(e)) or any(
             isinstance(n, x.Time) for n in x.walk(e)):
         return False
     rest.append((sign, e))
@@ -58,7 +58,7 @@ def _classify(r: dae.Residual, unknowns: set[str]
               ) -> tuple[str, str, int, x.Expr] | None:
     """``(a, b, sign, 0)`` for ``a = sign*b``, ``(a, "", 0, value)`` for ``a = value``."""
     if sum(n in unknowns for n in r.variables) > 2 or any(
-            n.startswith("der(") for n in r.variables):
+            dae.is_derivative(n) for n in r.variables):
         return None
     terms: list[tuple[int, str]] = []
     rest: list[tuple[int, x.Expr]] = []
@@ -153,11 +153,11 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     der_map: dict[str, x.Expr] = {}
 
     def varying(name: str) -> bool:
-        return name in names or name.startswith("der(")
+        return name in names or dae.is_derivative(name)
 
     for name, value in mapping.items():
         if name in differentiated:
-            der_map[dae.der_name(name)] = differentiate(value, varying)
+            der_map[dae.derivative_name(name)] = differentiate(value, varying)
             differentiated.update(v for v in free_variables(value) if v in names)
     full = {**mapping, **der_map}
     value_vars = {name: free_variables(value) for name, value in full.items()}
@@ -180,9 +180,8 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
 
 
 def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]
-              ) -> tuple[int, int, int, int]:
-    return (int(u.fixed and u.start is not None), _SELECT_RANK[u.state_select],
-            int(u.name in differentiated), -order[u.name])
+              ) -> tuple[float, int, int]:
+    return unknown_priority(u), int(u.name in differentiated), -order[u.name]
 
 
 def _start_conflicts(members: list[tuple[str, int]], rep: str, rep_sign: int,

@@ -4,15 +4,20 @@ Counts scalar unknowns and equations and matches them (``der(x)`` counts as ``x`
 as before index reduction). When the counts differ or no complete matching exists,
 the Dulmage-Mendelsohn decomposition names exactly the variables left undetermined
 and the equations that over-determine others, each with its location and instance.
+
+``springc check`` runs it on the flat model; :func:`springc.simplify.simplify` runs it
+first too (on the incidence that lowering computed anyway, :func:`dae_incidence`), so
+that ``simulate``, ``compile`` and the Python API report the same errors.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import BalanceError, Note
+from ..ir import dae, flat
 from ..ir import expr as x
-from ..ir import flat
 from ..structure import dulmage_mendelsohn, maximum_matching
 
 MAX_NOTES = 20
@@ -44,6 +49,14 @@ def incidence(model: flat.FlatModel) -> list[list[int]]:
     return rows
 
 
+def dae_incidence(system: dae.DAE) -> list[list[int]]:
+    """:func:`incidence` from the lowered equations (the same rows: ``der(x)`` counts
+    as ``x``), which carry their variable names already."""
+    index = {u.name: i for i, u in enumerate(system.unknowns)}
+    index.update({dae.derivative_name(u.name): i for i, u in enumerate(system.unknowns)})
+    return [sorted({index[n] for n in r.variables if n in index}) for r in system.equations]
+
+
 def count_parameters(model: flat.FlatModel) -> tuple[int, int]:
     """Scalar parameters declared as scalars, and parameter arrays (counted once each)."""
     scalars, arrays = 0, set()
@@ -55,9 +68,13 @@ def count_parameters(model: flat.FlatModel) -> tuple[int, int]:
     return scalars, len(arrays)
 
 
-def check_balance(model: flat.FlatModel) -> Balance:
+def check_balance(model: flat.FlatModel, rows: Sequence[Sequence[int]] | None = None
+                  ) -> Balance:
+    """The counts of a balanced ``model``; otherwise a :class:`BalanceError` naming the
+    undetermined variables and the surplus equations. ``rows``: the model's
+    :func:`incidence`, when already known."""
     unknowns = model.unknowns
-    rows = incidence(model)
+    rows = [list(r) for r in rows] if rows is not None else incidence(model)
     matching = maximum_matching(rows, len(unknowns))
     n_eq, n_var = len(model.equations), len(unknowns)
     if n_eq == n_var and matching.is_perfect:

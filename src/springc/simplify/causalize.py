@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ..errors import Note, SimplifyError
+from ..errors import Note, SimplifyError, Span
 from ..ir import expr as x
 from ..ir import ode
-from ..structure import blt, dulmage_mendelsohn, maximum_matching, tear
+from ..structure import Matching, blt, dulmage_mendelsohn, maximum_matching, tear
 from .index_reduction import Reduced
 from .isolate import fold, free_variables, partial, solvable, solve_for
 
@@ -38,7 +38,7 @@ def causalize(reduced: Reduced) -> list[ode.Step]:
 
 
 def _solve_block(reduced: Reduced, block: list[int], names: list[str],
-                 rows: Sequence[Sequence[int]], matching: object, unknown_ids: list[int]
+                 rows: Sequence[Sequence[int]], matching: Matching, unknown_ids: list[int]
                  ) -> ode.Step:
     exprs = [reduced.equations[e] for e in block]
     spans = tuple(reduced.sources[e].span for e in block)
@@ -76,14 +76,14 @@ def _linear_system(exprs: list[x.Expr], names: list[str]
 
 
 def _torn(reduced: Reduced, block: list[int], names: list[str],
-          rows: Sequence[Sequence[int]], matching: object, unknown_ids: list[int],
-          spans: tuple) -> ode.Step:
+          rows: Sequence[Sequence[int]], matching: Matching, unknown_ids: list[int],
+          spans: tuple[Span, ...]) -> ode.Step:
     exprs = {e: reduced.equations[e] for e in block}
 
     def can_solve(eq: int, var: int) -> bool:
         return solvable(exprs[eq], reduced.names[unknown_ids[var]], knowns_only=False)
 
-    tearing = tear(block, rows, matching, can_solve)  # type: ignore[arg-type]
+    tearing = tear(block, rows, matching, can_solve)
     inner = []
     for eq, var in tearing.inner:
         name = reduced.names[unknown_ids[var]]
@@ -96,7 +96,8 @@ def _torn(reduced: Reduced, block: list[int], names: list[str],
 
 
 def _nonlinear(residuals: list[x.Expr], tearing: list[str],
-               inner: list[tuple[str, x.Expr, object]], spans: tuple) -> ode.NonlinearBlock:
+               inner: list[tuple[str, x.Expr, Span]], spans: tuple[Span, ...]
+               ) -> ode.NonlinearBlock:
     """Newton data: the Jacobian of the residuals with respect to the tearing variables,
     through the inner assignments (forward sensitivities ``d(a)/d(t)``)."""
     sensitivities: list[ode.Assign] = []
@@ -112,7 +113,7 @@ def _nonlinear(residuals: list[x.Expr], tearing: list[str],
                     total = fold(x.add(total, x.mul(partial(value, prev), sens[prev, t])))
             if total != x.ZERO:
                 sens_name = f"d({name})/d({t})"
-                sensitivities.append(ode.Assign(sens_name, total, span))  # type: ignore
+                sensitivities.append(ode.Assign(sens_name, total, span))
                 sens[name, t] = x.Var(sens_name)
     jacobian: list[tuple[int, int, x.Expr]] = []
     for i, r in enumerate(residuals):
@@ -124,7 +125,7 @@ def _nonlinear(residuals: list[x.Expr], tearing: list[str],
                     total = fold(x.add(total, x.mul(partial(r, prev), sens[prev, t])))
             if total != x.ZERO:
                 jacobian.append((i, j, total))
-    assigns = tuple(ode.Assign(n, v, s) for n, v, s in inner)  # type: ignore[arg-type]
+    assigns = tuple(ode.Assign(n, v, s) for n, v, s in inner)
     return ode.NonlinearBlock(tuple(tearing), assigns, tuple(residuals),
                               tuple(sensitivities), tuple(jacobian), spans)
 

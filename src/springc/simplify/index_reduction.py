@@ -10,7 +10,7 @@ vetted numerically at the start values. With ``at`` (values of the variables, e.
 during a simulation) every block is instead chosen numerically at those values by
 :func:`pivoted_choice`: the best-conditioned columns within each priority class, so
 that the choice stays valid for a while (dynamic state selection,
-:mod:`springc.switching`).
+:mod:`springc.simplify.state_choice`).
 """
 
 from __future__ import annotations
@@ -75,10 +75,10 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
     pending = sorted({n for r in system.equations for n in r.variables
-                      if n.startswith("der(")}, key=lambda n: (len(n), n))
+                      if dae.is_derivative(n)}, key=lambda n: (len(n), n))
     for name in pending:
-        base = name[4:-1]
-        if base not in index:
+        base = dae.derivative_base(name)
+        if base is None or base not in index:
             raise SimplifyError(f"'{base}' is differentiated but is not an unknown",
                                 system.span)
         index[name] = len(names)
@@ -98,7 +98,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
                  for r in system.equations]
 
     def varying(name: str) -> bool:
-        return name in index or name.startswith("der(")
+        return name in index or dae.is_derivative(name)
 
     def hook(eq: int, var_derivative: Sequence[int]) -> list[int]:
         # Name the derivative variables Pantelides created, then differentiate.
@@ -107,7 +107,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
             if d != -1 and d >= len(names):
                 while len(names) <= d:
                     names.append("")
-                names[d] = dae.der_name(names[v])
+                names[d] = dae.derivative_name(names[v])
                 index[names[d]] = d
         new = differentiate(exprs[eq], varying)
         exprs.append(new)
@@ -121,7 +121,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
     except StructurallySingular as err:
         raise _singular(system, err, names) from None
     unknowns = {u.name: u for u in system.unknowns}
-    priority = [_priority(unknowns[n]) if n in unknowns else state_priority() for n in names]
+    priority = [unknown_priority(unknowns[n]) if n in unknowns else state_priority() for n in names]
     try:
         if at is None:
             check = _nonsingular_at_start(system, names, exprs)
@@ -140,9 +140,12 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
                    reduction.incidence, states, blocks)
 
 
-def _priority(u: dae.Unknown) -> float:
-    """``stateSelect`` and a fixed start rank first; any start value breaks ties, so
-    that a variable the user gave a start value stays a state when possible."""
+def unknown_priority(u: dae.Unknown) -> float:
+    """How strongly ``u`` should stay a state (the one ranking of simplify, built on
+    :func:`springc.structure.state_priority`; alias elimination keeps the member of
+    an alias class that ranks highest): ``stateSelect`` and a fixed start rank first;
+    any start value breaks ties, so that a variable the user gave a start value stays
+    a state when possible."""
     bonus = START_BONUS if u.start is not None and not u.fixed else 0.0
     return state_priority(u.state_select, u.fixed and u.start is not None) + bonus
 

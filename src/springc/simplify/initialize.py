@@ -6,7 +6,7 @@ The initial problem (Modelica 8.6) is built from ``fixed = true`` start values a
 1. A state with a fixed start value takes it.
 2. The *conditions* are the initial equations and the fixed start values of
    variables that are not states (algebraic variables, dummy derivatives); each is a
-   residual evaluated by running the ODE's steps (:class:`~springc.evaluate_ode.Evaluator`).
+   residual evaluated by running the ODE's steps (:class:`~springc.evaluate_ode.OdeEvaluator`).
 3. The conditions choose which of the other states they determine: the columns of
    their Jacobian with respect to those states (at the start values) picked by
    QR with column pivoting. States not chosen keep their ``start`` (default 0), as
@@ -22,7 +22,7 @@ variables and equations with their locations.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import Note, SimulationError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import ode
-from .ode_eval import Evaluator, parameter_values, start_values
+from .ode_eval import OdeEvaluator, parameter_values, start_values
 
 
 class InitializationError(SpringcError):
@@ -81,7 +81,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     Raises :class:`InitializationError` (over-/under-determined, no convergence).
     """
     params = parameter_values(model.parameters, parameters)
-    evaluator = Evaluator(model, params)
+    evaluator = OdeEvaluator(model, params)
     starts = start_values(model.dae.unknowns, params)
     x0 = np.array([starts.get(s.name, 0.0) for s in model.states])
     fixed = [i for i, s in enumerate(model.states) if s.fixed and s.start is not None]
@@ -92,7 +92,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
         trial = x0.copy()
         trial[chosen] = z
         env = evaluator.values(t0, trial)
-        return np.array([float(x.evaluate(c.residual, env, t0)) for c in conds])  # type: ignore
+        return np.array([float(x.evaluate(c.residual, env, t0)) for c in conds])
 
     chosen: list[int] = []
     if conds:
@@ -102,7 +102,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
         chosen = _choose_states(model, conds, free, x0, lambda z, c: residuals(z, c))
         x0[chosen] = _solve(model, conds, chosen, x0, lambda z: residuals(z, chosen), tol)
     env = evaluator.values(t0, x0)
-    worst = max((abs(float(x.evaluate(c.residual, env, t0))) for c in conds),  # type: ignore
+    worst = max((abs(float(x.evaluate(c.residual, env, t0))) for c in conds),
                 default=0.0)
     names = [s.name for s in model.states]
     info = InitialInfo(env, evaluator.observed(env, t0), conds,
@@ -111,7 +111,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     return x0, info
 
 
-def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Evaluator,
+def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: OdeEvaluator,
                      x0: np.ndarray, t0: float) -> None:
     env = evaluator.values(t0, x0)
     for c in conds:
@@ -125,7 +125,8 @@ def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Ev
 
 
 def _choose_states(model: ode.ODE, conds: tuple[Condition, ...], free: list[int],
-                   x0: np.ndarray, residuals) -> list[int]:  # type: ignore[no-untyped-def]
+                   x0: np.ndarray, residuals: Callable[[np.ndarray, list[int]], np.ndarray]
+                   ) -> list[int]:
     """Step 3: the free states the conditions determine (QR with column pivoting on a
     finite-difference Jacobian at the start values)."""
     import scipy.linalg
@@ -146,13 +147,13 @@ def _choose_states(model: ode.ODE, conds: tuple[Condition, ...], free: list[int]
 
 
 def _solve(model: ode.ODE, conds: tuple[Condition, ...], chosen: list[int], x0: np.ndarray,
-           residuals, tol: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+           residuals: Callable[[np.ndarray], np.ndarray], tol: float) -> np.ndarray:
     """Step 4: Newton-type solve (MINPACK hybrid) from the start values."""
     import scipy.optimize
 
     def safe(z: np.ndarray) -> np.ndarray:
         try:
-            return residuals(z)
+            return np.asarray(residuals(z), dtype=float)
         except (SimulationError, ArithmeticError, ValueError):
             return np.full(len(conds), 1e10)
 
@@ -160,13 +161,13 @@ def _solve(model: ode.ODE, conds: tuple[Condition, ...], chosen: list[int], x0: 
     if not np.all(np.abs(safe(result.x)) <= tol * (1 + np.abs(x0[chosen]).max())):
         lsq = scipy.optimize.least_squares(safe, x0[chosen], xtol=1e-14, ftol=1e-14)
         if np.all(np.abs(safe(lsq.x)) <= tol * (1 + np.abs(lsq.x).max())):
-            return lsq.x
+            return np.asarray(lsq.x, dtype=float)
         names = ", ".join(f"'{model.states[i].name}'" for i in chosen)
         raise InitializationError(
             f"the initial equations have no solution near the start values of {names}",
             conds[0].span, [Note(f"condition: {c.text}", c.span) for c in conds[:10]],
             "check the initial equations and start values for consistency")
-    return result.x
+    return np.asarray(result.x, dtype=float)
 
 
 def _overdetermined(model: ode.ODE, conds: tuple[Condition, ...], fixed: list[int],

@@ -10,8 +10,6 @@ which the benchmark reports to show that it grows linearly with the model.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 from ..ir import expr as x
 
 _BUILD = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
@@ -77,7 +75,7 @@ def fold(e: x.Expr) -> x.Expr:
                 return neg(left)
             return build(left, right)
         if isinstance(left, x.Const) and isinstance(right, x.Const):
-            return x.Const(x.evaluate(x.BinOp(e.op, left, right), {}))  # type: ignore
+            return x.Const(x.evaluate(x.BinOp(e.op, left, right), {}))
         return x.BinOp(e.op, left, right)
     if isinstance(e, x.Neg):
         return neg(fold(e.arg))
@@ -88,7 +86,8 @@ def fold(e: x.Expr) -> x.Expr:
         args = tuple(fold(a) for a in e.args)
         if all(isinstance(a, x.Const) for a in args) and e.name in x.MATH:
             try:
-                return x.Const(x.MATH[e.name](*(a.value for a in args)))  # type: ignore
+                values = [a.value for a in args if isinstance(a, x.Const)]
+                return x.Const(x.MATH[e.name](*values))
             except (ValueError, ZeroDivisionError, OverflowError):
                 pass
         return x.Call(e.name, args)
@@ -98,10 +97,6 @@ def fold(e: x.Expr) -> x.Expr:
             return fold(e.then) if cond.value else fold(e.otherwise)
         return x.If(cond, fold(e.then), fold(e.otherwise))
     return e
-
-
-def substitute_fold(e: x.Expr, mapping: Mapping[str, x.Expr]) -> x.Expr:
-    return fold(x.substitute(e, mapping))
 
 
 _Split = tuple["x.Expr | None", x.Expr]

@@ -20,7 +20,7 @@ def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
     if isinstance(e, x.Der):
         arg = e.arg
         if isinstance(arg, x.Var):
-            return x.Var(dae.der_name(arg.name)) if varying(arg.name) else x.ZERO
+            return x.Var(dae.derivative_name(arg.name)) if varying(arg.name) else x.ZERO
         inner = lower_derivatives(arg, varying)
         return lower_derivatives(x.time_derivative(inner, varying), varying)
     if isinstance(e, (x.Const, x.Var, x.Time)):
@@ -85,12 +85,11 @@ def lower(model: flat.FlatModel) -> dae.DAE:
     names = {u.name for u in unknowns}
 
     def varying(name: str) -> bool:
-        return name in names or name.startswith("der(")
+        return name in names or dae.is_derivative(name)
 
     equations = tuple(_residual(eq, varying) for eq in model.equations)
     initial = tuple(_residual(eq, varying) for eq in model.initial_equations)
-    differentiated = frozenset(
-        n[4:-1] for r in equations + initial for n in r.variables
-        if n.startswith("der(") and n[4:-1] in names)
+    bases = (dae.derivative_base(n) for r in equations + initial for n in r.variables)
+    differentiated = frozenset(b for b in bases if b is not None and b in names)
     return dae.DAE(model.name, unknowns, parameters, equations, initial, model.experiment,
                    model.span, differentiated)

@@ -2,7 +2,7 @@
 
 A slow but simple interpreter over :func:`springc.expr.evaluate`, used by
 initialization, by state selection (numeric checks at start values) and by tests as
-an independent check of generated code. ``Evaluator.rhs(t, x)`` runs ``ode.steps`` in
+an independent check of generated code. ``OdeEvaluator.rhs(t, x)`` runs ``ode.steps`` in
 order: assignments, linear systems (dense, or sparse LU when large) and torn
 nonlinear systems (Newton on the tearing variables with the analytic Jacobian,
 starting from the previous solution, or from start values the first time).
@@ -10,7 +10,8 @@ starting from the previous solution, or from start values the first time).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import math
+from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -38,7 +39,13 @@ def parameter_values(parameters: Iterable[dae.Parameter],
             raise SimplifyError(f"the binding of parameter '{name}' depends on itself", p.span)
         active.add(name)
         e = p.binding if p.binding is not None else p.start
-        values[name] = 0.0 if e is None else evaluate_with(e, value)
+        try:
+            values[name] = 0.0 if e is None else evaluate_with(e, value)
+        except (ArithmeticError, ValueError) as err:
+            raise SimplifyError(f"the value of parameter '{name}' cannot be computed: "
+                                f"{describe_failure(err)}", p.span,
+                                hint="check the parameters its binding uses (--set)"
+                                ) from None
         active.discard(name)
         return values[name]
 
@@ -47,8 +54,8 @@ def parameter_values(parameters: Iterable[dae.Parameter],
     return values
 
 
-class _Lazy(dict):  # type: ignore[type-arg]
-    def __init__(self, lookup):  # type: ignore[no-untyped-def]
+class _Lazy(dict[str, float]):
+    def __init__(self, lookup: Callable[[str], float]) -> None:
         super().__init__()
         self.lookup = lookup
 
@@ -57,9 +64,9 @@ class _Lazy(dict):  # type: ignore[type-arg]
         return result
 
 
-def evaluate_with(e: x.Expr, lookup, time: float = 0.0) -> float:  # type: ignore[no-untyped-def]
+def evaluate_with(e: x.Expr, lookup: Callable[[str], float], time: float = 0.0) -> float:
     """Evaluate ``e``, asking ``lookup(name)`` for each variable it needs."""
-    return float(x.evaluate(e, _Lazy(lookup), time))  # type: ignore[arg-type]
+    return float(x.evaluate(e, _Lazy(lookup), time))
 
 
 def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
@@ -68,14 +75,31 @@ def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
     out = {}
     for u in unknowns:
         try:
-            out[u.name] = 0.0 if u.start is None else float(x.evaluate(u.start, params))
+            value = 0.0 if u.start is None else float(x.evaluate(u.start, params))
         except KeyError as err:
             raise SimplifyError(f"the start value of '{u.name}' must be a parameter "
                                 f"expression, but it uses {err}", u.span) from None
+        except (ArithmeticError, ValueError) as err:
+            raise SimplifyError(f"the start value of '{u.name}' cannot be computed: "
+                                f"{describe_failure(err)}", u.span,
+                                hint="check the parameters it uses (--set)") from None
+        if not math.isfinite(value):
+            raise SimplifyError(f"the start value of '{u.name}' is {value}", u.span,
+                                hint="check the parameters it uses (--set)")
+        out[u.name] = value
     return out
 
 
-class Evaluator:
+def describe_failure(err: BaseException) -> str:
+    """``division by zero``, ``overflow`` or the error's own text."""
+    if isinstance(err, ZeroDivisionError):
+        return "division by zero"
+    if isinstance(err, OverflowError):
+        return "overflow"
+    return str(err) or type(err).__name__
+
+
+class OdeEvaluator:
     """Evaluates the steps of ``model`` for given parameter values.
 
     ``guess`` (by name) overrides the start values as the first Newton guess of the
@@ -96,16 +120,27 @@ class Evaluator:
         self.max_iterations = max_iterations
 
     def values(self, t: float, states: Iterable[float]) -> dict[str, float]:
-        """All parameters, states and step variables at time ``t``."""
+        """All parameters, states and step variables at time ``t``; a step that leaves
+        the domain of an operation raises :class:`SimulationError` naming it."""
         env: dict[str, float] = dict(self.params)
         env.update(zip(self.names, (float(v) for v in states)))
         for step in self.model.steps:
-            if isinstance(step, ode.Assign):
-                env[step.name] = float(x.evaluate(step.expr, env, t))  # type: ignore
-            elif isinstance(step, ode.LinearBlock):
-                self._linear(step, env, t)
-            else:
-                self._newton(step, env, t)
+            try:
+                if isinstance(step, ode.Assign):
+                    env[step.name] = float(x.evaluate(step.expr, env, t))
+                elif isinstance(step, ode.LinearBlock):
+                    self._linear(step, env, t)
+                else:
+                    self._newton(step, env, t)
+            except (ArithmeticError, ValueError) as err:
+                names = ([step.name] if isinstance(step, ode.Assign) else
+                         list(step.names) if isinstance(step, ode.LinearBlock) else
+                         list(step.tearing))
+                span = step.span if isinstance(step, ode.Assign) else step.spans[0]
+                raise SimulationError(
+                    f"{describe_failure(err)} while computing {', '.join(names[:4])} at "
+                    f"t = {t:g}", span, hint="the model leaves the domain of an operation "
+                    "there; check the parameters (--set) and start values") from None
         return env
 
     def rhs(self, t: float, states: Iterable[float]) -> np.ndarray:
@@ -115,14 +150,14 @@ class Evaluator:
 
     def observed(self, env: Mapping[str, float], t: float = 0.0) -> dict[str, float]:
         """The eliminated aliases, from a ``values`` result."""
-        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}  # type: ignore
+        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}
 
     def _linear(self, step: ode.LinearBlock, env: dict[str, float], t: float) -> None:
         n = len(step.names)
         rows = [r for r, _, _ in step.matrix]
         cols = [c for _, c, _ in step.matrix]
-        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]  # type: ignore
-        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])  # type: ignore
+        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]
+        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])
         try:
             if n >= SPARSE_FROM:
                 from scipy.sparse import csc_matrix
@@ -147,11 +182,11 @@ class Evaluator:
         for _ in range(self.max_iterations):
             env.update(zip(step.tearing, z.tolist()))
             for a in step.inner + step.sensitivities:
-                env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
-            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])  # type: ignore
+                env[a.name] = float(x.evaluate(a.expr, env, t))
+            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])
             jac = np.zeros((n, n))
             for i, j, e in step.jacobian:
-                jac[i, j] = float(x.evaluate(e, env, t))  # type: ignore
+                jac[i, j] = float(x.evaluate(e, env, t))
             try:
                 dz = np.linalg.solve(jac, -f)
             except np.linalg.LinAlgError:
@@ -160,7 +195,7 @@ class Evaluator:
             if np.max(np.abs(dz)) <= self.newton_tol * (1 + np.max(np.abs(z))):
                 env.update(zip(step.tearing, z.tolist()))
                 for a in step.inner:
-                    env[a.name] = float(x.evaluate(a.expr, env, t))  # type: ignore
+                    env[a.name] = float(x.evaluate(a.expr, env, t))
                 self.guess.update(zip(step.tearing, z.tolist()))
                 return
         raise SimulationError(

@@ -2,10 +2,13 @@
 
 The pipeline is a short list of passes, each in its own module:
 
-1. ``lower`` (:mod:`springc.lower`): residual equations and derivative variables;
-2. ``eliminate_aliases`` (:mod:`springc.alias`): ``a = ±b`` and ``a = p`` removed;
-3. ``index_reduce`` (:mod:`springc.reduce`): Pantelides and dummy derivatives;
-4. ``causalize`` (:mod:`springc.causalize`): matching, BLT, solved blocks.
+0. ``check_balance`` (:mod:`springc.simplify.balance`): as ``springc check`` does, so
+   that a missing or surplus equation is reported with its location, before the
+   structural passes would find it less clearly;
+1. ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
+2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
+3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
+4. ``causalize`` (:mod:`springc.simplify.causalize`): matching, BLT, solved blocks.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ from dataclasses import dataclass, field
 from ..errors import Note
 from ..ir import flat, ode
 from .alias import eliminate_aliases
+from .balance import check_balance, dae_incidence
 from .causalize import causalize
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
@@ -25,7 +29,7 @@ from .lower import lower
 @dataclass(frozen=True)
 class Simplified:
     """The ODE, warnings of the passes, and the blocks of the dummy-derivative choice
-    (what :mod:`springc.switching` monitors; empty when no index reduction was done)."""
+    (what :mod:`springc.simplify.state_choice` monitors; empty when no index reduction was done)."""
 
     ode: ode.ODE
     warnings: tuple[Note, ...]
@@ -37,9 +41,9 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
     ``at``: values of variables (by name; derivatives as ``der(x)``) at which the
     states are chosen: each dummy-derivative block is then the best-conditioned
-    choice there (:func:`springc.reduce.pivoted_choice`), instead of the default
+    choice there (:func:`springc.simplify.index_reduction.pivoted_choice`), instead of the default
     priority choice checked at the start values. Used to switch states during a
-    simulation (:mod:`springc.switching`).
+    simulation (:mod:`springc.simplify.state_choice`).
 
     The cyclic garbage collector is paused meanwhile: the passes allocate millions of
     small acyclic nodes, and its full collections, each scanning the whole (large)
@@ -56,6 +60,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
     system = lower(model)
+    check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)
     reduced = index_reduce(aliased.dae, at)
     steps = causalize(reduced)

@@ -1,28 +1,68 @@
 """Simulation: ``CompiledModel`` -> ``SimulationResult`` (solvers, auto's race, output).
 
 The package is ``simulation``, not ``simulate``: ``springc.simulate`` is the API function.
+
+The solver names (:mod:`.solver_names`) load with the package; everything else loads
+on first use (PEP 562), so that the CLI can offer the solver names without importing
+numpy and scipy (a third of a second on every ``springc check``).
 """
 
-from .results import (
-    PLOT_FORMATS,
-    RESULT_FORMATS,
-    SimulationResult,
-    file_format,
-    save_outputs,
-    write_csv,
-)
-from .runner import (
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from .solver_names import (
+    ALL_SOLVERS,
+    AUTO,
     DEFAULT_SOLVER,
     FIXED_STEP,
-    LSODA_LIMIT,
+    IMPLICIT_SOLVERS,
     SOLVERS,
-    SimulationOptions,
-    initial_state,
-    output_grid,
-    resolve,
-    simulate_model,
 )
 
-__all__ = ["DEFAULT_SOLVER", "FIXED_STEP", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS",
+if TYPE_CHECKING:
+    from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
+    from .results import (
+        PLOT_FORMATS,
+        RESULT_FORMATS,
+        SimulationResult,
+        file_format,
+        save_outputs,
+        write_csv,
+    )
+    from .runner import (
+        LSODA_LIMIT,
+        SimulationOptions,
+        initial_state,
+        output_grid,
+        resolve,
+        simulate_model,
+    )
+
+__all__ = ["ALL_SOLVERS", "AUTO", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT",
+           "FIXED_STEP", "IMPLICIT_SOLVERS", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS",
            "SOLVERS", "SimulationOptions", "SimulationResult", "file_format", "initial_state",
            "output_grid", "resolve", "save_outputs", "simulate_model", "write_csv"]
+
+_LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
+_RESULTS = frozenset({"PLOT_FORMATS", "RESULT_FORMATS", "SimulationResult", "file_format",
+                      "save_outputs", "write_csv"})
+_RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "output_grid",
+                     "resolve", "simulate_model"})
+
+
+def __getattr__(name: str) -> Any:
+    # Lazy (see the docstring): numpy and scipy load with the first simulation name.
+    if name in _LIMITS:
+        from . import limits
+
+        return getattr(limits, name)
+    if name in _RESULTS:
+        from . import results
+
+        return getattr(results, name)
+    if name in _RUNNER:
+        from . import runner
+
+        return getattr(runner, name)
+    raise AttributeError(f"module 'springc.simulation' has no attribute {name!r}")

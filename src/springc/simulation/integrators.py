@@ -141,4 +141,5 @@ def _rk4(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
     k2 = f(t + h / 2, x + h / 2 * k1)
     k3 = f(t + h / 2, x + h / 2 * k2)
     k4 = f(t + h, x + h * k3)
-    return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    new: np.ndarray = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return new

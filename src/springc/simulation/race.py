@@ -3,7 +3,7 @@
 1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps. If it finishes, or its current step
    size leaves at most :data:`CHEAP_STEPS` steps to go, it finishes the run: a short
    run costs no stiffness estimate at all.
-2. Otherwise the stiffness estimate of :func:`springc.solvers.choose` (``rho * T``
+2. Otherwise the stiffness estimate of :func:`springc.simulation.solvers.choose` (``rho * T``
    from the analytic Jacobian at the current state) decides whether ``radau`` could
    be cheaper. If not, ``dop853`` goes on.
 3. If it could, the estimate alone cannot tell: a very stiff spring whose fast mode
@@ -34,7 +34,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from .solvers import EXPLICIT, IMPLICIT, RACE, AutoChoice
+from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
+from .solvers import AutoChoice
 
 EXPLICIT_PROBE = 40
 IMPLICIT_PROBE = 20
@@ -47,23 +48,33 @@ CHEAP_STEPS = 500
 
 
 class Stretch(Protocol):
-    steps: int
-    seconds: float
-    sizes: tuple[float, ...]
+    """What one stretch of steps measured (``springc.simulation.steps.Stretch``)."""
+
+    @property
+    def steps(self) -> int: ...
+
+    @property
+    def seconds(self) -> float: ...
+
+    @property
+    def sizes(self) -> tuple[float, ...]: ...
 
 
 class Run(Protocol):
-    """The simulation's step loop (``springc.simulation._Run``)."""
+    """The simulation's step loop (``springc.simulation.steps.StepLoop``)."""
 
-    failure: type[Exception]
-    done: bool
+    @property
+    def failure(self) -> type[Exception]: ...
+
+    @property
+    def done(self) -> bool: ...
 
     def start(self, solver: str, t: float, y: np.ndarray,
               first_step: float | None = None) -> Any: ...
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch: ...
 
-    def both_failed(self, first: Exception, second: Exception) -> Exception: ...
+    def both_failed(self, first: Any, second: Any) -> Exception: ...
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -76,12 +87,12 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
     try:
         probe = run.advance(explicit, EXPLICIT_PROBE)
     except run.failure as failure:
-        implicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
+        implicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
         try:
             run.advance(implicit)
         except run.failure as again:
             raise run.both_failed(failure, again) from None
-        return IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
+        return RACE_IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
     if run.done:
         return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {probe.steps} steps"
     h_explicit = _step(probe)
@@ -92,8 +103,8 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
     choice = estimate(float(explicit.t), np.array(explicit.y))
     if choice.solver == RACE:
         return _race(run, explicit, probe, h_explicit, t0, x0, stop, choice.reason)
-    if choice.solver == IMPLICIT:
-        explicit = run.start(IMPLICIT, float(explicit.t), np.array(explicit.y))
+    if choice.solver == RACE_IMPLICIT:
+        explicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
     run.advance(explicit)
     return choice.solver, choice.reason
 
@@ -101,20 +112,22 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
 def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
           x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
     explicit_cost = (stop - explicit.t) / h_explicit * probe.seconds / probe.steps
-    implicit = run.start(IMPLICIT, t0, x0)
-    steps, seconds, sizes = 0, 0.0, []
+    implicit = run.start(RACE_IMPLICIT, t0, x0)
+    steps, seconds = 0, 0.0
+    sizes: list[float] = []
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
         trial = run.advance(implicit, 1)
         steps, seconds = steps + trial.steps, seconds + trial.seconds
         sizes += trial.sizes
         if run.done:
-            return IMPLICIT, f"{stiffness}; {IMPLICIT} finished the run in its trial steps"
+            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
+                                   "trial steps")
     implicit_cost = (stop - implicit.t) / float(np.median(sizes[-5:])) * seconds / steps
-    measured = (f"measured: {IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
+    measured = (f"measured: {RACE_IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
                 f"~{explicit_cost:.2g} s")
     if implicit_cost <= explicit_cost:
         run.advance(implicit)
-        return IMPLICIT, f"{stiffness}; {measured}"
+        return RACE_IMPLICIT, f"{stiffness}; {measured}"
     run.advance(explicit)
     return EXPLICIT, (f"{stiffness}, but the fast modes must be resolved anyway; "
                       f"{measured}")

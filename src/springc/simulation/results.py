@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import OutputError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
+from ..ir import dae
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
 """Suffix -> trajectory format of ``simulate -o``."""
@@ -52,6 +53,7 @@ class SimulationStats:
     compile_time: float
     cached: bool
     reason: str = ""  # why --solver auto chose ``solver`` (empty: the user chose it)
+    note: str = ""  # what the run did differently from what was asked (e.g. the step)
 
     def summary(self, model: str) -> str:
         """One line: solver (``auto -> radau (why)``), steps, evaluations, wall time."""
@@ -59,7 +61,8 @@ class SimulationStats:
         return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s (model code {self.model_time:.3f} s; "
-                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)")
+                f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
+                + (f"; note: {self.note}" if self.note else ""))
 
 
 @dataclass
@@ -201,7 +204,9 @@ def _group(name: str, unit: str) -> tuple[str, str]:
     if unit:
         quantity = _QUANTITY.get(unit, unit)
         return quantity, f"{quantity} [{unit}]"
-    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1]).removeprefix("der(")
+    while (base := dae.derivative_base(name)) is not None:
+        name = base
+    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1])
     word = _WORDS.get(last, last)
     return word, word
 

@@ -2,17 +2,17 @@
 
 Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
 
-- **Fixed-step scene integrators** (``springc.simulation.FIXED_STEP``): ``verlet`` (velocity Verlet)
+- **Fixed-step scene integrators** (``solver_names.FIXED_STEP``): ``verlet`` (velocity Verlet)
   and ``symplectic-euler`` (semi-implicit Euler) for second-order mechanical systems,
-  and the classical ``rk4``, run by :mod:`springc.integrators` with ``--step H``.
+  and the classical ``rk4``, run by :mod:`springc.simulation.integrators` with ``--step H``.
   The position/velocity pairs they need (``der(q) = v`` with ``v`` a state) are found
   from the generated module: a state whose derivative depends structurally on one
   other state only, with slope 1 and no offset (:func:`detect_pairs`; on the ODE
   itself, :func:`pairs_from_ode` reads the ``der(q) := v`` steps directly).
-- **``auto``** (the default, run by :mod:`springc.race`): ``dop853`` unless a run
+- **``auto``** (the default, run by :mod:`springc.simulation.race`): ``dop853`` unless a run
   turns out long *and* a cheap stiffness estimate is large: the spectral radius
   ``rho`` of the analytic Jacobian times the remaining span ``T``
-  (:mod:`springc.stiffness`, :func:`choose`). Even then the estimate alone cannot
+  (:mod:`springc.simulation.stiffness`, :func:`choose`). Even then the estimate alone cannot
   tell: a stiff spring whose fast mode stays at rest costs an explicit method
   nothing, an excited one costs every method, and per-step costs differ by solver;
   so the two methods race for a few steps and the one whose projected remaining
@@ -24,42 +24,39 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import Note, SimulationError
+from ..ir import dae, ode
+from ..ir.expr import Var
 from .integrators import NonFiniteState, Pairs, integrate
+from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 
-AUTO = "auto"
-EXPLICIT, IMPLICIT = "dop853", "radau"
-RACE = "race"
-MAX_FIXED_STEPS = 20_000_000
-"""More fixed steps than this are refused up front (minutes of Python loop)."""
+T = TypeVar("T")
+
 FIXED_REMEDY = "reduce --step or use --solver radau"
 
 
 # ------------------------------------------------------------------ pairs
 
-def pairs_from_ode(system: object) -> list[tuple[str, str]]:
+def pairs_from_ode(system: ode.ODE) -> list[tuple[str, str]]:
     """``(q, v)`` for every step ``der(q) := v`` of an :class:`springc.ode.ODE` where
     ``v`` is a state too."""
-    from ..ir.expr import Var
-    from ..ir.ode import Assign
-
-    states = {s.name for s in system.states}  # type: ignore[attr-defined]
+    states = {s.name for s in system.states}
     out = []
-    for step in system.steps:  # type: ignore[attr-defined]
-        if (isinstance(step, Assign) and step.name.startswith("der(")
-                and isinstance(step.expr, Var) and step.expr.name in states):
-            q = step.name[4:-1]
+    for step in system.steps:
+        if isinstance(step, ode.Assign) and isinstance(step.expr, Var) \
+                and step.expr.name in states:
+            q = dae.derivative_base(step.name)
             if q in states:
                 out.append((q, step.expr.name))
     return _disjoint(out)
 
 
-def _disjoint(pairs: list[tuple[str, str]] | list[tuple[int, int]]) -> list:
+def _disjoint(pairs: list[tuple[T, T]]) -> list[tuple[T, T]]:
     """Drop chains (``der(a) = b``, ``der(b) = c``): a state is a position or a
     velocity, not both."""
     positions = {q for q, _ in pairs}
@@ -95,7 +92,7 @@ def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -
                 checks.append((np.asarray(module.rhs(t, x, p, z), dtype=float), x))
         except (ArithmeticError, ValueError, np.linalg.LinAlgError):
             continue
-    good = [(q, v) for q, v in candidates
+    good = [(int(q), v) for q, v in candidates
             if checks and all(d[q] == x[v] for d, x in checks)]
     return Pairs.of(_disjoint(good))
 
@@ -105,7 +102,7 @@ def detect_pairs(module: ModuleType, p: np.ndarray, x0: np.ndarray, t0: float) -
 @dataclass(frozen=True)
 class AutoChoice:
     """What ``auto`` decided at the start state and why (for the summary line):
-    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.race`)."""
+    ``dop853``, ``radau``, or :data:`RACE` (measure both, see :mod:`springc.simulation.race`)."""
 
     solver: str
     reason: str
@@ -120,7 +117,7 @@ def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
 
     if jac.shape[0] == 0 or span <= 0:
         return AutoChoice(EXPLICIT, "no dynamics to integrate", 0.0, span)
-    base = choose_solver(jac, span, EXPLICIT, IMPLICIT)
+    base = choose_solver(jac, span, EXPLICIT, RACE_IMPLICIT)
     rho = base.spectral_radius
     if base.solver == EXPLICIT or not math.isfinite(base.stiffness):
         return AutoChoice(base.solver, base.reason, rho, span)
@@ -129,9 +126,15 @@ def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
 
 # ------------------------------------------------------------------ fixed step
 
-def check_step(solver: str, step: float | None, start: float, stop: float,
-               intervals: int) -> float:
-    """The step of a fixed-step run, validated; errors name the option."""
+def check_step(solver: str, step: float | None, grid: np.ndarray, max_steps: int
+               ) -> tuple[float, str]:
+    """The step of a fixed-step run, validated (errors name the option), and a note
+    when the run cannot take it exactly.
+
+    The fixed-step solvers land on every output time, so each output interval is
+    split into whole steps: a step longer than the interval is refused, and one that
+    does not divide it is shortened to the next divisor, which the note says.
+    """
     if step is None:
         raise SimulationError(f"the fixed-step solver {solver} needs a step size",
                               hint="pass --step H (e.g. a twentieth of the fastest "
@@ -139,13 +142,30 @@ def check_step(solver: str, step: float | None, start: float, stop: float,
     if not (math.isfinite(step) and step > 0):
         raise SimulationError(f"the step must be positive and finite, not {step:g}",
                               hint="pass --step H with H > 0")
-    steps = intervals + (stop - start) / step
-    if steps > MAX_FIXED_STEPS:
-        raise SimulationError(f"--step {step:g} over {stop - start:g} s takes {steps:.3g} "
-                              f"steps, more than {MAX_FIXED_STEPS:.0e}",
+    spans = np.diff(grid)
+    interval = float(spans[0])
+    if step > float(spans.max()) * (1 + 1e-9):
+        raise SimulationError(
+            f"--step {step:g} is longer than the output interval {interval:g}: the "
+            f"fixed-step solvers step to every output time",
+            hint=f"use a step that divides the interval (--step {interval:g} or smaller), "
+                 f"or an output interval that is a multiple of the step (--interval "
+                 f"{step:g})")
+    counts = np.maximum(1, np.ceil(spans / step - 1e-9))
+    steps = float(counts.sum())
+    if steps > max_steps:
+        raise SimulationError(f"--step {step:g} over {float(grid[-1] - grid[0]):g} s takes "
+                              f"{steps:.3g} steps, more than {max_steps:.0e} (--max-steps)",
                               hint="use a larger --step, a shorter span, or an adaptive "
                               "solver (--solver auto)")
-    return float(step)
+    taken = spans / counts
+    note = ""
+    if np.any(np.abs(taken - step) > 1e-9 * step):
+        note = (f"--step {step:g} does not divide the output interval {interval:g}; "
+                f"{solver} took steps of {float(taken.min()):.6g} s"
+                + (f" to {float(taken.max()):.6g} s" if taken.max() - taken.min()
+                   > 1e-9 * step else "") + " to land on every output time")
+    return float(step), note
 
 
 def run_fixed(problem: Any, grid: np.ndarray, x0: np.ndarray, step: float

@@ -11,11 +11,14 @@ Jacobian), so the estimate costs a few dozen Jacobian-vector products.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import ArpackNoConvergence, eigs
+
+from .solver_names import EXPLICIT, RACE_IMPLICIT
 
 STIFF_THRESHOLD = 2000.0
 """``rho * T`` above which the implicit solver is chosen."""
@@ -45,7 +48,7 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
     if n == 0:
         return 0.0
     if n <= DENSE_LIMIT:
-        dense = jac.toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
+        dense = sp.csr_matrix(jac).toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
         return float(np.max(np.abs(np.linalg.eigvals(dense))))
     operator = sp.csr_matrix(jac, dtype=float)
     try:
@@ -58,8 +61,23 @@ def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
     return float(np.max(np.abs(largest)))
 
 
+def numerical_jacobian(rhs: Callable[[float, np.ndarray], np.ndarray], t: float,
+                       y: np.ndarray) -> np.ndarray:
+    """Forward differences of ``rhs`` at ``(t, y)`` (for systems without an analytic
+    Jacobian, such as the switching driver's reference evaluator; small ones)."""
+    y = np.asarray(y, dtype=float)
+    f0 = np.asarray(rhs(t, y), dtype=float)
+    jac = np.empty((len(f0), len(y)))
+    for j in range(len(y)):
+        h = 1e-7 * max(1.0, abs(y[j]))
+        shifted = y.copy()
+        shifted[j] += h
+        jac[:, j] = (np.asarray(rhs(t, shifted), dtype=float) - f0) / h
+    return jac
+
+
 def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
-                  explicit: str = "dop853", implicit: str = "radau") -> Choice:
+                  explicit: str = EXPLICIT, implicit: str = RACE_IMPLICIT) -> Choice:
     """Pick ``explicit`` or ``implicit`` from ``rho * span`` and say why.
 
     For large Jacobians the row-sum (Gershgorin) bound ``rho <= ||J||_inf`` is tried

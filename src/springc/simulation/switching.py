@@ -1,39 +1,245 @@
 """Simulate a model whose states must change during the run: CompiledModel -> result.
 
 Index reduction may leave a choice of states that becomes singular somewhere (a rod
-passing vertical, see :mod:`springc.switching`). Such models are marked
-``SWITCHABLE`` when generated; :func:`simulate_switching_model` runs them through the
-dynamic-state-selection driver of :mod:`springc.switching`, which evaluates the
-simplified system with the reference evaluator (slower than generated code, but
-these index-3 scenes are small) and reports each switch in the summary.
+passing vertical, see :mod:`springc.simplify.state_choice`). Such models are marked
+``SWITCHABLE`` when generated; :func:`simulate_switching_model` runs them through
+:func:`simulate_switching`, a reference driver on scipy's ``solve_ivp`` that
+evaluates the simplified system with the reference evaluator (slower than generated
+code, but these index-3 scenes are small) and reports each switch in the summary:
+
+- a terminal event on ``conditioning - threshold`` (:func:`conditioning_event`)
+  stops the integration before the singularity;
+- the states are reselected there (:func:`springc.simplify.switch`) and the run
+  restarts at the same time from the values there, which satisfy every constraint.
+
+The ODE's functions come from a callback (``make_functions``), by default the
+reference evaluator (:class:`EvaluatorFunctions`), so that generated code can be
+used instead.
 """
 
 from __future__ import annotations
 
+import math
 import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from functools import partial
+from typing import Protocol
 
 import numpy as np
 
+from ..errors import SimulationError
+from ..ir import flat
 from ..pipeline import CompiledModel, derive_system
-from ..simplify import simulate_switching
+from ..simplify import (
+    THRESHOLD,
+    OdeEvaluator,
+    StateChoice,
+    conditioning,
+    initial_state,
+    needs_switch,
+    parameter_values,
+    select_states,
+    state_vector,
+    switch,
+)
+from .limits import Limits, OverLimit, check_outputs, over_limit
 from .results import SimulationResult, SimulationStats
+from .solver_names import EXPLICIT, SOLVERS
+from .stiffness import numerical_jacobian
 
-EXPLICIT_DEFAULT = "dop853"
-SCIPY_NAMES = {"rk45": "RK45", "dop853": "DOP853", "radau": "Radau", "bdf": "BDF",
-               "lsoda": "LSODA"}
+MAX_SWITCHES = 10_000
+
+
+class Functions(Protocol):
+    """What the driver needs of a compiled ODE."""
+
+    def rhs(self, t: float, states: np.ndarray) -> np.ndarray:
+        """The state derivatives."""
+        ...
+
+    def values(self, t: float, states: np.ndarray) -> dict[str, float]:
+        """Every parameter, state, computed variable and alias, by name."""
+        ...
+
+
+MakeFunctions = Callable[[StateChoice, Mapping[str, float], Mapping[str, float]], Functions]
+"""``make_functions(choice, parameters, guess)``: the functions of ``choice.ode``;
+``guess`` (current values, by name) seeds the Newton iterations of torn blocks."""
+
+
+class EvaluatorFunctions:
+    """:class:`Functions` by the reference evaluator (:class:`springc.simplify.OdeEvaluator`)."""
+
+    def __init__(self, choice: StateChoice, parameters: Mapping[str, float],
+                 guess: Mapping[str, float]) -> None:
+        self.evaluator = OdeEvaluator(choice.ode, parameters, guess=guess)
+
+    def rhs(self, t: float, states: np.ndarray) -> np.ndarray:
+        return self.evaluator.rhs(t, states)
+
+    def values(self, t: float, states: np.ndarray) -> dict[str, float]:
+        env = self.evaluator.values(t, states)
+        env.update(self.evaluator.observed(env, t))
+        return env
+
+
+@dataclass(frozen=True)
+class Switch:
+    """At ``time`` the states changed from ``old_states`` to ``new_states``;
+    ``conditioning`` is that of the old choice there."""
+
+    time: float
+    old_states: tuple[str, ...]
+    new_states: tuple[str, ...]
+    conditioning: float
+
+
+@dataclass(frozen=True)
+class SwitchingResult:
+    """``values[name][k]``: every continuous variable of the flat model at ``t[k]``."""
+
+    t: np.ndarray
+    values: dict[str, np.ndarray]
+    switches: tuple[Switch, ...]
+
+
+def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
+                       t_eval: Sequence[float] | np.ndarray | None = None,
+                       rtol: float = 1e-6, atol: float = 1e-8, method: str = "DOP853",
+                       parameters: Mapping[str, float] | None = None,
+                       make_functions: MakeFunctions = EvaluatorFunctions,
+                       threshold: float = THRESHOLD, time_limit: float = math.inf
+                       ) -> SwitchingResult:
+    """Simulate ``model`` over ``t_span`` with dynamic state selection.
+
+    Starts with the default choice of states and consistent initial values
+    (:func:`springc.simplify.initial_state`; reselected at once if that choice is
+    badly conditioned there), integrates with ``solve_ivp(method=...)`` until the
+    conditioning event, switches (:func:`switch`), and restarts at the event time from
+    the values there. Output at ``t_eval`` (default: every accepted step).
+    Raises :class:`SimulationError` when the integrator fails, a switch does not
+    improve the conditioning, or the run takes over ``time_limit`` seconds (the error
+    names the time reached and the stiffness there, from a difference Jacobian).
+    """
+    from scipy.integrate import solve_ivp
+
+    deadline = time.perf_counter() + time_limit
+
+    t0, t1 = float(t_span[0]), float(t_span[1])
+    choice = select_states(model)
+    params = parameter_values(choice.ode.parameters, parameters)
+    x0, info = initial_state(choice.ode, parameters, t0)
+    values: dict[str, float] = {**info.values, **info.observed}
+    switches: list[Switch] = []
+    if needs_switch(choice, values, threshold, t0):
+        choice = _switch(model, choice, values, t0, threshold, switches)
+        x0 = state_vector(choice, values)
+    names = [v.name for v in model.variables if v.variability == "continuous"]
+    times: list[float] = []
+    rows: list[dict[str, float]] = []
+    requested = None if t_eval is None else np.asarray(t_eval, dtype=float)
+    t, state = t0, x0
+    while True:
+        functions = make_functions(choice, params, values)
+        event = conditioning_event(choice, functions, threshold)
+        segment = None
+        if requested is not None:
+            later = (requested >= t) & (requested > times[-1] if times else True)
+            segment = requested[later & (requested <= t1)]
+        rhs = _RejectingRhs(functions, deadline, time_limit, method.lower())
+        try:
+            sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
+                            rtol=rtol, atol=atol, events=event if choice.blocks else None)
+        except OverLimit as over:
+            raise over_limit(over, t0, t1, partial(numerical_jacobian, functions.rhs)
+                             ) from None
+        if sol.status == -1:
+            cause = f" (last failure: {rhs.failure})" if rhs.failure else ""
+            raise SimulationError(f"the integration failed at t = {sol.t[-1]:g}: "
+                                  f"{sol.message}{cause}")
+        # Outputs in time order from the segment's start values: each Newton guess is
+        # the previous output's solution, never one from the segment's end.
+        output = make_functions(choice, params, values)
+        skip_first = requested is None and bool(times)
+        for k, tk in enumerate(sol.t):
+            if skip_first and k == 0:
+                continue
+            times.append(float(tk))
+            rows.append(output.values(float(tk), sol.y[:, k]))
+        if sol.status == 0:
+            break
+        t = float(sol.t_events[0][0])
+        values = functions.values(t, sol.y_events[0][0])
+        if len(switches) >= MAX_SWITCHES:
+            raise SimulationError(f"more than {MAX_SWITCHES} switches of states by "
+                                  f"t = {t:g}")
+        choice = _switch(model, choice, values, t, threshold, switches)
+        state = state_vector(choice, values)
+    out = {n: np.array([r.get(n, np.nan) for r in rows]) for n in names}
+    return SwitchingResult(np.array(times), out, tuple(switches))
+
+
+class _RejectingRhs:
+    """``functions.rhs`` returning NaN where the steps fail (e.g. Newton diverges on a
+    trial stage that went past a singularity): solve_ivp's methods then reject the
+    step and retry a smaller one, so the conditioning event gets its chance."""
+
+    def __init__(self, functions: Functions, deadline: float = math.inf,
+                 time_limit: float = math.inf, solver: str = "") -> None:
+        self.functions = functions
+        self.failure: SimulationError | None = None
+        self.deadline, self.time_limit, self.solver = deadline, time_limit, solver
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        if time.perf_counter() > self.deadline:
+            raise OverLimit(f"{self.time_limit:g} s of wall clock reached the time limit "
+                            "(--time-limit)", t, np.array(y), self.solver)
+        try:
+            return self.functions.rhs(t, y)
+        except SimulationError as err:
+            self.failure = err
+            return np.full(len(y), np.nan)
+
+
+def conditioning_event(choice: StateChoice, functions: Functions,
+                       threshold: float = THRESHOLD) -> Callable[[float, np.ndarray], float]:
+    """A terminal ``solve_ivp`` event: ``conditioning - threshold`` crossing downwards."""
+
+    def event(time: float, y: np.ndarray) -> float:
+        return conditioning(choice, functions.values(time, y), time) - threshold
+
+    event.terminal = True  # type: ignore[attr-defined]
+    event.direction = -1  # type: ignore[attr-defined]
+    return event
+
+
+def _switch(model: flat.FlatModel, old: StateChoice, values: Mapping[str, float],
+            t: float, threshold: float, switches: list[Switch]) -> StateChoice:
+    """Reselect at ``values``; the new choice must be better conditioned there."""
+    before = conditioning(old, values, t)
+    new = switch(model, values)
+    if new.states == old.states or conditioning(new, values, t) < threshold:
+        raise SimulationError(
+            f"dynamic state selection found no well-conditioned choice of states at "
+            f"t = {t:g} (states {', '.join(old.states)}; conditioning {before:.3g})")
+    switches.append(Switch(t, old.states, new.states, before))
+    return new
 
 
 def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray,
-                             rtol: float, atol: float, parameters: dict[str, float]
-                             ) -> SimulationResult:
+                             rtol: float, atol: float, parameters: dict[str, float],
+                             limits: Limits | None = None) -> SimulationResult:
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
-    method = solver if solver in SCIPY_NAMES else EXPLICIT_DEFAULT
+    method = solver if solver in SOLVERS else EXPLICIT
     flat_model = derive_system(model.options).flat_model
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
-                             rtol=rtol, atol=atol, method=SCIPY_NAMES[method],
-                             parameters=parameters)
+                             rtol=rtol, atol=atol, method=SOLVERS[method],
+                             parameters=parameters,
+                             time_limit=(limits or Limits()).time_limit)
     values = np.column_stack([run.values[name] for name in model.outputs])
+    check_outputs(model.outputs, np.asarray(grid, dtype=float), values)
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))
     unit_of = dict(zip(model.states, getattr(model.module, "STATE_UNITS", ())))
     unit_of.update(zip(model.observed, units))

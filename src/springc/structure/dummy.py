@@ -50,6 +50,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from .index import NONE, IndexReduction, StructurallySingular
+from .matching import UNMATCHED, augmenting_path
 
 ALWAYS = math.inf
 PREFER = 2.0
@@ -305,33 +306,12 @@ def _greedy(
 
 
 def _assign(column: int, rows_of: dict[int, list[int]], row_mate: dict[int, int]) -> bool:
-    """Iterative augmenting-path search from ``column``; flips the path on success."""
-    visited: set[int] = set()
-    path, positions, via = [column], [0], []  # via[k]: the row leading to path[k+1]
-    while path:
-        candidates, pos = rows_of[path[-1]], positions[-1]
-        while pos < len(candidates):
-            row = candidates[pos]
-            pos += 1
-            if row in visited:
-                continue
-            visited.add(row)
-            mate = row_mate.get(row)
-            if mate is None:
-                for col, matched in zip(path, [*via, row], strict=True):
-                    row_mate[matched] = col
-                return True
-            positions[-1] = pos
-            path.append(mate)
-            positions.append(0)
-            via.append(row)
-            break
-        else:
-            path.pop()
-            positions.pop()
-            if via:
-                via.pop()
-    return False
+    """Match ``column`` by an augmenting path (:func:`augmenting_path`), if one exists."""
+    found = augmenting_path(column, rows_of.__getitem__,
+                            lambda row: row_mate.get(row, UNMATCHED))
+    for col, row in found.pairs:
+        row_mate[row] = col
+    return bool(found.pairs)
 
 
 def _search(

@@ -34,7 +34,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 
-from .matching import dulmage_mendelsohn, maximum_matching
+from .matching import augmenting_path, dulmage_mendelsohn, maximum_matching
 
 NONE = -1
 """Marks a missing derivative or an unmatched vertex."""
@@ -316,9 +316,6 @@ class _Work:
         for v, d in enumerate(self.var_derivative):
             if d != NONE:
                 self.antiderivative[d] = v
-        self.var_mark = [0] * n_var
-        self.eq_mark = [0] * len(incidence)
-        self.stamp = 0
 
     def match(self, eq: int, var: int) -> None:
         self.eq_to_var[eq] = var
@@ -331,7 +328,6 @@ class _Work:
             self.var_derivative[var] = new
             self.var_derivative.append(NONE)
             self.var_to_eq.append(NONE)
-            self.var_mark.append(0)
             self.antiderivative.append(var)
         return self.var_derivative[var]
 
@@ -352,7 +348,6 @@ class _Work:
         self.incidence.append(new_row)
         self.eq_derivative.append(NONE)
         self.eq_to_var.append(NONE)
-        self.eq_mark.append(0)
         self.eq_derivative[eq] = new
         self.differentiated.append(eq)
         return new
@@ -397,54 +392,24 @@ def _reduce(work: _Work, root: int, hook: DifferentiateEquation | None, max_step
     )
 
 
-def _augment(work: _Work, root: int) -> tuple[bool, list[int], list[int]]:
-    """Coloured augmenting-path search from the unmatched equation ``root``.
-
-    Iterative depth-first search over active equations and highest derivatives. On
-    success the path is flipped into the matching; either way the coloured
-    (visited) equations and variables are returned.
-    """
-    work.stamp += 1
-    stamp, var_mark, eq_mark = work.stamp, work.var_mark, work.eq_mark
-    var_derivative, var_to_eq, incidence = work.var_derivative, work.var_to_eq, work.incidence
-    eq_mark[root] = stamp
-    coloured_eqs, coloured_vars = [root], []
-    path, positions, via = [root], [0], []  # via[k]: the variable leading to path[k+1]
-    while path:
-        row, pos = incidence[path[-1]], positions[-1]
-        while pos < len(row):
-            var = row[pos]
-            pos += 1
-            if var_derivative[var] != NONE or var_mark[var] == stamp:
-                continue
-            var_mark[var] = stamp
-            coloured_vars.append(var)
-            owner = var_to_eq[var]
-            if owner == NONE:
-                for eq, matched in zip(path, [*via, var], strict=True):
-                    work.match(eq, matched)
-                return True, coloured_eqs, coloured_vars
-            if eq_mark[owner] != stamp:
-                eq_mark[owner] = stamp
-                coloured_eqs.append(owner)
-                positions[-1] = pos
-                path.append(owner)
-                positions.append(0)
-                via.append(var)
-                break
-        else:
-            path.pop()
-            positions.pop()
-            if via:
-                via.pop()
-    return False, coloured_eqs, coloured_vars
+def _augment(work: _Work, root: int) -> tuple[bool, tuple[int, ...], tuple[int, ...]]:
+    """Coloured augmenting-path search from the unmatched equation ``root`` over
+    active equations and highest derivatives (:func:`augmenting_path`). On success
+    the path is flipped into the matching; either way the coloured (visited)
+    equations and variables are returned."""
+    var_derivative, var_to_eq = work.var_derivative, work.var_to_eq
+    found = augmenting_path(root, work.incidence.__getitem__, var_to_eq.__getitem__,
+                            lambda var: var_derivative[var] == NONE)
+    for eq, var in found.pairs:
+        work.match(eq, var)
+    return bool(found.pairs), found.left, found.right
 
 
 def _differentiate_coloured(
     work: _Work,
     root: int,
-    eqs: list[int],
-    variables: list[int],
+    eqs: Sequence[int],
+    variables: Sequence[int],
     hook: DifferentiateEquation | None,
 ) -> int:
     """Differentiate the coloured equations, promote the coloured variables to

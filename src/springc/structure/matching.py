@@ -1,15 +1,17 @@
 """Incidence -> maximum matching and Dulmage-Mendelsohn parts.
 
 ``maximum_matching`` pairs equations with variables (Hopcroft-Karp in scipy,
-O(nnz sqrt(n))). ``dulmage_mendelsohn`` splits a system by alternating paths from the
-unmatched vertices of a maximum matching into an overdetermined part (the equations
-to blame as redundant), an underdetermined part (the variables left undetermined) and
-the well-determined rest, in O(n + nnz) using ``scipy.sparse.csgraph`` searches.
+O(nnz sqrt(n))). ``augmenting_path`` is the one incremental search (iterative
+depth-first) that Pantelides and the dummy-derivative choice grow their matchings with.
+``dulmage_mendelsohn`` splits a system by alternating paths from the unmatched vertices
+of a maximum matching into an overdetermined part (the equations to blame as
+redundant), an underdetermined part (the variables left undetermined) and the
+well-determined rest, in O(n + nnz) using ``scipy.sparse.csgraph`` searches.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -84,6 +86,65 @@ def maximum_matching(incidence: Incidence, n_var: int) -> Matching:
     matched = np.flatnonzero(eq_to_var >= 0)
     var_to_eq[eq_to_var[matched]] = matched
     return Matching(tuple(eq_to_var.tolist()), tuple(var_to_eq.tolist()))
+
+
+@dataclass(frozen=True, slots=True)
+class AugmentingPath:
+    """The result of :func:`augmenting_path`: ``pairs`` (left, right) to match, in
+    path order (empty when no path exists); ``left`` and ``right`` the vertices visited
+    (the search's *coloured* part, which Pantelides differentiates on failure)."""
+
+    pairs: tuple[tuple[int, int], ...]
+    left: tuple[int, ...]
+    right: tuple[int, ...]
+
+
+def augmenting_path(
+    root: int,
+    neighbours: Callable[[int], Sequence[int]],
+    mate: Callable[[int], int],
+    usable: Callable[[int], bool] | None = None,
+) -> AugmentingPath:
+    """Depth-first search for an augmenting path from the unmatched left vertex ``root``.
+
+    ``neighbours(left)`` lists the right vertices of a left vertex, in the order they
+    are tried; ``mate(right)`` is the left vertex matched to it, or ``UNMATCHED``;
+    ``usable(right)`` (default: all) excludes right vertices from the search. Iterative,
+    so deep paths need no recursion. On success, matching every pair of ``pairs``
+    (left to right) flips the path and grows the matching by one.
+    """
+    seen_left: set[int] = {root}
+    seen_right: set[int] = set()
+    left, right = [root], []
+    path, positions = [root], [0]
+    via: list[int] = []  # via[k]: the right vertex leading to path[k+1]
+    while path:
+        candidates, pos = neighbours(path[-1]), positions[-1]
+        while pos < len(candidates):
+            vertex = candidates[pos]
+            pos += 1
+            if vertex in seen_right or (usable is not None and not usable(vertex)):
+                continue
+            seen_right.add(vertex)
+            right.append(vertex)
+            owner = mate(vertex)
+            if owner == UNMATCHED:
+                pairs = tuple(zip(path, [*via, vertex], strict=True))
+                return AugmentingPath(pairs, tuple(left), tuple(right))
+            if owner not in seen_left:
+                seen_left.add(owner)
+                left.append(owner)
+                positions[-1] = pos
+                path.append(owner)
+                positions.append(0)
+                via.append(vertex)
+                break
+        else:
+            path.pop()
+            positions.pop()
+            if via:
+                via.pop()
+    return AugmentingPath((), tuple(left), tuple(right))
 
 
 def validate_matching(graph: csr_matrix, matching: Matching) -> None:

@@ -65,7 +65,7 @@ def _strong_components(graph: csr_matrix, var_to_eq: np.ndarray) -> np.ndarray:
         (np.ones(graph.nnz), var_to_eq[graph.indices], graph.indptr), shape=(n_eq, n_eq)
     )
     _, labels = connected_components(dependency, directed=True, connection="strong")
-    return labels.astype(np.int64)
+    return np.asarray(labels, dtype=np.int64)
 
 
 def _topological_order(

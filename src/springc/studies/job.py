@@ -21,13 +21,19 @@ import numpy as np
 
 from ..errors import SpringcError
 from ..pipeline import CompiledModel, CompileOptions, compile_files
-from ..simulation import SimulationOptions, simulate_model
+from ..simulation import (
+    DEFAULT_MAX_STEPS,
+    DEFAULT_TIME_LIMIT,
+    SimulationOptions,
+    simulate_model,
+)
 
 
 @dataclass(frozen=True)
 class RunJob:
     """What every run of a study shares: the model, the swept parameter names, the fixed
-    parameter values and the simulation settings (``None``: the model's defaults)."""
+    parameter values and the simulation settings (``None``: the model's defaults, and
+    simulate's limits of steps and seconds per run)."""
 
     compile: CompileOptions
     names: tuple[str, ...]
@@ -39,13 +45,18 @@ class RunJob:
     rtol: float | None = None
     atol: float | None = None
     step: float | None = None
+    max_steps: int | None = None
+    time_limit: float | None = None
 
     def options(self, values: Sequence[float]) -> SimulationOptions:
         """The simulation options of the run with the swept ``values``."""
         parameters = dict(self.fixed)
         parameters.update(zip(self.names, (float(v) for v in values)))
-        return SimulationOptions(self.start, self.stop, self.interval, self.solver,
-                                 self.rtol, self.atol, parameters, None, self.step)
+        return SimulationOptions(
+            self.start, self.stop, self.interval, self.solver, self.rtol, self.atol,
+            parameters, None, self.step,
+            DEFAULT_MAX_STEPS if self.max_steps is None else self.max_steps,
+            DEFAULT_TIME_LIMIT if self.time_limit is None else self.time_limit)
 
 
 @dataclass(frozen=True)

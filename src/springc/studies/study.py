@@ -69,6 +69,8 @@ class StudyOptions:
     workers: int | None = None
     scheduler: str | None = None
     energy: str | None = None
+    max_steps: int | None = None
+    time_limit: float | None = None
 
 
 @dataclass
@@ -152,7 +154,8 @@ def layout_of(model: CompiledModel, options: StudyOptions, values: np.ndarray) -
         "samples": options.samples, "seed": options.seed if options.samples else None,
         "fixed": dict(options.fixed), "start": start, "stop": stop, "interval": interval,
         "solver": options.solver, "rtol": rtol, "atol": atol, "step": options.step,
-        "energy": energy, "runs": len(values)}
+        "energy": energy, "runs": len(values), "max_steps": options.max_steps,
+        "time_limit": options.time_limit}
     return Layout(names, model.outputs, tuple(units.get(n, "") for n in model.outputs),
                   output_grid(start, stop, interval), energy, metadata)
 
@@ -165,7 +168,8 @@ def job_of(model: CompiledModel, options: StudyOptions) -> RunJob:
         libraries=tuple(os.path.abspath(f) for f in model.options.libraries))
     return RunJob(compile_options, tuple(s.name for s in options.parameters), options.fixed,
                   options.start, options.stop, options.interval, options.solver,
-                  options.rtol, options.atol, options.step)
+                  options.rtol, options.atol, options.step, options.max_steps,
+                  options.time_limit)
 
 
 Pending = Sequence[tuple[int, tuple[float, ...]]]

@@ -40,7 +40,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
-from ..simulation import FIXED_STEP, SOLVERS, SimulationOptions, simulate_model
+from ..simulation import FIXED_STEP, SOLVERS, simulate_model
 from .energy import drift, energy_series, energy_variable
 from .model import (
     DEFAULT_STEP_DIVISIONS,
@@ -65,9 +65,6 @@ from .setup import (
     warm_up,
 )
 
-ADAPTIVE = ("rk45", "dop853", "radau", "bdf", "lsoda")
-
-
 # ------------------------------------------------------------------ solvers
 
 def compare_states(model: CompiledModel) -> CompiledModel:
@@ -76,15 +73,13 @@ def compare_states(model: CompiledModel) -> CompiledModel:
 
 
 def fixed_step_solvers() -> tuple[str, ...]:
-    """The fixed-step methods the simulator offers (they need ``SimulationOptions.step``)."""
-    if "step" not in {f.name for f in dataclasses.fields(SimulationOptions)}:
-        return ()
-    offered = set(SOLVERS) | set(FIXED_STEP)
-    return tuple(s for s in FIXED_STEP if s in offered)
+    """The fixed-step methods (they need ``SimulationOptions.step``)."""
+    return FIXED_STEP
 
 
 def available_solvers() -> tuple[str, ...]:
-    return tuple(s for s in ADAPTIVE if s in SOLVERS) + fixed_step_solvers()
+    """Every solver the study can run: the adaptive ones, then the fixed-step ones."""
+    return (*SOLVERS, *FIXED_STEP)
 
 
 def check_solvers(names: Sequence[str]) -> tuple[str, ...]:

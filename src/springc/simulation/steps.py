@@ -1,0 +1,266 @@
+"""The step loop of a simulation: the generated functions wrapped for scipy
+(:class:`Problem`: counting, timing, checking, limits) and the output grid filled step
+by step by one integrator after another (:class:`StepLoop`, which ``auto``'s race of
+:mod:`springc.simulation.race` drives).
+
+The integrators are ``scipy.integrate``'s solver classes (``RK45``, ``DOP853``,
+``Radau``, ``BDF``, ``LSODA``) stepped one by one, so that springc can show progress,
+stop at the first non-finite value, and name the time and the states at fault.
+Output is interpolated with each step's dense output exactly on the grid. Implicit
+methods get the generated analytic Jacobian: dense for small systems, ``scipy.sparse``
+CSC beyond :data:`DENSE_JACOBIAN_LIMIT`.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, TextIO
+
+import numpy as np
+
+from ..errors import Note, SimulationError
+from ..ir.dae import derivative_name
+from ..pipeline import CompiledModel
+from ..simplify import describe_failure
+from .failures import Stop, code_location, format_time, remedy, state_notes
+from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
+from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
+
+DENSE_JACOBIAN_LIMIT = 64
+
+
+
+class Progress:
+    """A progress bar on ``stream``, shown once a run has taken about a second."""
+
+    def __init__(self, stream: TextIO | None, start: float, stop: float) -> None:
+        self.stream, self.start, self.stop = stream, start, stop
+        self.began = time.perf_counter()
+        self.next = self.began + 1.0 if stream is not None else math.inf
+        self.shown = False
+
+    def update(self, t: float) -> None:
+        now = time.perf_counter()
+        if self.stream is None or now < self.next:
+            return
+        self.next = now + 0.1
+        frac = min(1.0, max(0.0, (t - self.start) / (self.stop - self.start)))
+        bar = "#" * int(30 * frac)
+        self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t = {t:.4g} s  "
+                          f"{now - self.began:.1f} s ")
+        self.stream.flush()
+        self.shown = True
+
+    def close(self) -> None:
+        if self.shown and self.stream is not None:
+            self.stream.write("\r" + " " * 70 + "\r")
+            self.stream.flush()
+
+
+class Problem:
+    """The generated functions wrapped for scipy: counting, timing, checking."""
+
+    def __init__(self, model: CompiledModel, p: np.ndarray, solver: str,
+                 progress: Progress, limits: Limits | None = None) -> None:
+        mod = model.module
+        self.model, self.mod, self.p, self.solver = model, mod, p, solver
+        self.z = np.asarray(mod.guesses(p), dtype=float)
+        self.names = tuple(mod.STATES)
+        self.path = str(model.path)
+        self.nfev = self.njev = 0
+        self.model_time = 0.0
+        self.progress = progress
+        self.t = 0.0
+        self.limits = limits = limits or Limits()
+        self.deadline = time.perf_counter() + limits.time_limit
+
+    def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
+        where = code_location(err, self.path)
+        message = (f"{describe_failure(err)} while computing {where or what} at time "
+                   f"{format_time(t)}")
+        if "singular" in str(err).lower():
+            message = f"{where or 'a linear system'} is singular at time {format_time(t)}"
+        return Stop(SimulationError(
+            message, notes=state_notes(self.names, x, None),
+            hint="the model leaves the domain of an operation there; check the "
+                 "parameters (--set) and start values, or guard the expression"))
+
+    def newton_failure(self, t: float, x: np.ndarray) -> Stop:
+        step = int(self.z[-1])
+        names = self.mod.NEWTON_SYSTEMS.get(step, ("?",))
+        self.z[-1] = 0.0
+        return Stop(SimulationError(
+            f"the nonlinear system for {', '.join(names)} did not converge at time "
+            f"{format_time(t)}", notes=state_notes(self.names, x, None),
+            hint="the model may have reached a singular configuration (a rod or "
+                 "pendulum at the end of its range?); check the start values"))
+
+    def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
+        self.nfev += 1
+        began = time.perf_counter()
+        try:
+            dx = self.mod.rhs(t, x, self.p, self.z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise self.fail(err, t, x, "the derivatives") from err
+        now = time.perf_counter()
+        self.model_time += now - began
+        if now > self.deadline:
+            raise OverLimit(f"{self.limits.time_limit:g} s of wall clock reached the time "
+                            "limit (--time-limit)", t, np.array(x), self.solver)
+        if self.z[-1] != 0.0:
+            raise self.newton_failure(t, x)
+        # a sum is finite if every term is (a finite sum that overflows is checked again)
+        if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
+            bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
+            shown = ", ".join(derivative_name(n) for n in bad[:3])
+            shown += ", ..." if len(bad) > 3 else ""
+            what = "NaN" if np.isnan(dx).any() else "infinite"
+            raise Stop(SimulationError(
+                f"{shown} {'is' if len(bad) == 1 else 'are'} {what} at time {format_time(t)}",
+                notes=state_notes(self.names, x, dx), hint=remedy(self.solver)))
+        if now >= self.progress.next:
+            self.progress.update(t)
+        return np.asarray(dx)
+
+    def jacobian(self, t: float, x: np.ndarray) -> Any:
+        """The Jacobian for diagnostics: not counted, no failure checks."""
+        z = np.array(self.z)
+        return self.mod.jacobian_dense(t, x, self.p, z) if len(x) <= DENSE_JACOBIAN_LIMIT \
+            else self.mod.jacobian(t, x, self.p, z)
+
+    def jac(self, t: float, x: np.ndarray) -> Any:
+        self.njev += 1
+        began = time.perf_counter()
+        try:
+            if len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda":
+                out = self.mod.jacobian_dense(t, x, self.p, self.z)
+            else:
+                out = self.mod.jacobian(t, x, self.p, self.z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise self.fail(err, t, x, "the Jacobian") from err
+        self.model_time += time.perf_counter() - began
+        if self.z[-1] != 0.0:
+            raise self.newton_failure(t, x)
+        return out
+
+
+def integrate(problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
+               atol: float) -> tuple[np.ndarray, int]:
+    """The states on ``grid`` and the number of steps taken (solve_ivp's loop)."""
+    run = StepLoop(problem, grid, x0, rtol, atol)
+    if len(x0):
+        run.advance(run.start(problem.solver, float(grid[0]), x0))
+    return run.states, run.steps
+
+
+@dataclass(frozen=True)
+class Stretch:
+    """What :meth:`StepLoop.advance` measured: steps, wall time, last step sizes."""
+
+    steps: int
+    seconds: float
+    sizes: tuple[float, ...]
+
+
+class StepLoop:
+    """The output grid filled step by step, by one integrator after another (the
+    ``auto`` race of :mod:`springc.simulation.race` hands the state from one to the next)."""
+
+    failure = Stop
+
+    def __init__(self, problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
+                 atol: float) -> None:
+        self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
+        self.limits = problem.limits
+        self.states = np.empty((len(grid), len(x0)))
+        self.states[0] = x0
+        self.k, self.steps = 1, 0
+
+    @property
+    def done(self) -> bool:
+        return self.k >= len(self.grid)
+
+    def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
+              ) -> Any:
+        """A scipy integrator of ``solver`` from ``(t, y)`` to the end of the grid."""
+        import scipy.integrate
+
+        self.problem.solver = solver
+        kwargs: dict[str, Any] = {"jac": self.problem.jac} if solver in IMPLICIT_SOLVERS else {}
+        if first_step is not None:
+            kwargs["first_step"] = min(first_step, float(self.grid[-1]) - t)
+        cls = getattr(scipy.integrate, SOLVERS[solver])
+        return cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol, atol=self.atol,
+                   **kwargs)
+
+    @staticmethod
+    def both_failed(first: Stop, second: Stop) -> Stop:
+        """``first``'s error, with ``second`` (the implicit solver's retry) as a note."""
+        error = first.error
+        return Stop(SimulationError(
+            error.message, notes=(*error.notes, Note(f"{RACE_IMPLICIT}, tried next by auto, failed "
+                                                     f"too: {second.error.message}")),
+            hint=remedy(RACE_IMPLICIT)))
+
+    def check_limits(self, integrator: Any, steps: int, sizes: deque[float]) -> None:
+        """Stop at ``max_steps``, or at once when the current step size would need
+        :data:`~springc.simulation.limits.HOPELESS` times as many."""
+        limit, t = self.limits.max_steps, float(integrator.t)
+        stop = float(self.grid[-1])
+        if steps >= limit and t < stop:
+            raise OverLimit(f"{steps} steps of {self.problem.solver} reached the step "
+                            f"limit (--max-steps {limit})", t, np.array(integrator.y),
+                            self.problem.solver)
+        projected = projected_steps(steps, t, stop, tuple(sizes))
+        if projected > HOPELESS * limit:
+            raise OverLimit(f"at its current step size ({float(np.median(sizes)):.3g} s) "
+                            f"{self.problem.solver} needs ~{projected:.3g} steps to the "
+                            f"stop time, far over the step limit (--max-steps {limit})",
+                            t, np.array(integrator.y), self.problem.solver)
+
+    def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
+        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it."""
+        problem, grid, states = self.problem, self.grid, self.states
+        began, taken = time.perf_counter(), 0
+        sizes: deque[float] = deque(maxlen=10)
+        while not self.done and taken != max_steps:
+            before = integrator.t
+            try:
+                message = integrator.step()
+            except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
+                if "infs or NaNs" not in str(err):
+                    raise
+                raise Stop(solver_failure(problem, integrator, "the Newton matrix is "
+                                            "not finite (the Jacobian overflows)")) from None
+            taken += 1
+            if integrator.status == "failed":
+                raise Stop(solver_failure(problem, integrator, message))
+            sizes.append(integrator.t - before)
+            if taken % CHECK_EVERY == 0 or self.steps + taken >= self.limits.max_steps:
+                self.check_limits(integrator, self.steps + taken, sizes)
+            j = int(np.searchsorted(grid, integrator.t, side="right"))
+            if j > self.k:
+                dense = integrator.dense_output()
+                states[self.k:j] = dense(grid[self.k:j]).T
+                if grid[j - 1] == integrator.t:
+                    states[j - 1] = integrator.y
+                self.k = j
+            if integrator.status == "finished" and not self.done:
+                states[self.k:] = integrator.y
+                self.k = len(grid)
+        self.steps += taken
+        return Stretch(taken, time.perf_counter() - began, tuple(sizes))
+
+
+def solver_failure(problem: Problem, integrator: Any, message: str | None
+                    ) -> SimulationError:
+    t, x = float(integrator.t), np.asarray(integrator.y)
+    dx = np.asarray(problem.mod.rhs(t, x, problem.p, problem.z))
+    collapse = message is not None and "step size" in message.lower()
+    text = (f"the step size of {problem.solver} collapsed at time {format_time(t)}" if collapse
+            else f"the {problem.solver} solver failed at time {format_time(t)}: {message}")
+    notes = [Note("fastest-changing states:"), *state_notes(problem.names, x, dx)]
+    return SimulationError(text, notes=notes, hint=remedy(problem.solver))

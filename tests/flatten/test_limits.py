@@ -1,0 +1,110 @@
+"""The flat-size and loop caps (springc.flatten.limits): exact boundaries, and the two ways
+to set the cap (the ``max_size`` keyword of ``flatten``, ``$SPRINGC_MAX_SIZE``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from springc.errors import ErrorGroup, FlattenError
+from springc.flatten import flatten
+from springc.parse import load
+
+# 2 scalars in `a`, an array of 3 components, 1 scalar in each (8 elements in all), and a
+# loop of 4 iterations.
+SOURCE = """
+model Cell
+  Real y;
+equation
+  y = 1;
+end Cell;
+model M
+  Real a[2];
+  Cell c[3];
+equation
+  for i in 1:4 loop
+    a[1] = i;
+  end for;
+  a[2] = 0;
+end M;
+"""
+
+
+@pytest.fixture
+def tree(tmp_path: Path, monkeypatch: pytest.MonkeyPatch):  # type: ignore[no-untyped-def]
+    monkeypatch.delenv("SPRINGC_PATH", raising=False)
+    monkeypatch.delenv("SPRINGC_MAX_SIZE", raising=False)
+    path = tmp_path / "m.mdl"
+    path.write_text(SOURCE)
+    return load([path])
+
+
+def test_a_model_at_the_cap_flattens(tree) -> None:  # type: ignore[no-untyped-def]
+    model = flatten(tree, "M", max_size=8)
+    assert [v.name for v in model.variables] == ["a[1]", "a[2]", "c[1].y", "c[2].y",
+                                                 "c[3].y"]
+
+
+def test_one_element_past_the_cap_is_refused_at_the_declaration(tree) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "M", max_size=7)
+    assert err.value.message == ("the flat model has more than 7 scalar variables and "
+                                 "components (this declaration crosses the limit)")
+    assert err.value.span is not None and (err.value.span.line, err.value.span.column) \
+        == (9, 8)  # Cell c[3]: c[3] crosses it
+
+
+def test_the_environment_variable_sets_the_cap(tree, monkeypatch: pytest.MonkeyPatch  # type: ignore[no-untyped-def]
+                                               ) -> None:
+    monkeypatch.setenv("SPRINGC_MAX_SIZE", "3")
+    with pytest.raises(ErrorGroup) as group:
+        flatten(tree, "M")
+    assert [e.message for e in group.value.errors] == [
+        "the flat model has more than 3 scalar variables and components (this declaration "
+        "crosses the limit)", "this range has 4 elements, more than the limit of 3"]
+    monkeypatch.setenv("SPRINGC_MAX_SIZE", "8")
+    assert len(flatten(tree, "M").variables) == 5
+
+
+def test_a_bad_environment_value_is_named(tree, monkeypatch: pytest.MonkeyPatch  # type: ignore[no-untyped-def]
+                                          ) -> None:
+    monkeypatch.setenv("SPRINGC_MAX_SIZE", "lots")
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "M")
+    assert err.value.message == "SPRINGC_MAX_SIZE must be a positive integer, found 'lots'"
+
+
+def test_loop_iterations_count_against_the_cap(tmp_path: Path) -> None:
+    path = tmp_path / "loops.mdl"
+    path.write_text("model L\n  Real a;\nequation\n  for i in 1:4 loop\n    a = i;\n"
+                    "  end for;\nend L;\n")
+    tree = load([path])
+    assert len(flatten(tree, "L", max_size=4).equations) == 4
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "L", max_size=3)
+    assert err.value.message == "this range has 4 elements, more than the limit of 3"
+
+
+def test_loops_below_the_cap_one_by_one_are_counted_together(tmp_path: Path) -> None:
+    path = tmp_path / "two.mdl"
+    path.write_text("model T\n  Real a;\n  Real b;\nequation\n  for i in 1:3 loop\n    a = i;\n"
+                    "  end for;\n  for j in 1:3 loop\n    b = j;\n  end for;\nend T;\n")
+    tree = load([path])
+    assert len(flatten(tree, "T", max_size=6).equations) == 6
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "T", max_size=5)
+    assert err.value.message == ("the loops of this model run more than 5 iterations in all "
+                                 "(this loop crosses the limit)")
+    assert err.value.span is not None and err.value.span.line == 8
+
+
+def test_a_nest_is_refused_before_it_runs(tmp_path: Path) -> None:
+    path = tmp_path / "nest.mdl"
+    path.write_text("model N\n  Real a;\nequation\n  for i in 1:3 loop\n    for j in 1:2 loop\n"
+                    "      a = i + j;\n    end for;\n  end for;\nend N;\n")
+    tree = load([path])
+    with pytest.raises(FlattenError) as err:
+        flatten(tree, "N", max_size=5)
+    assert err.value.message == "this loop nest has 6 iterations, more than the limit of 5"
+    assert err.value.span is not None and err.value.span.line == 4
