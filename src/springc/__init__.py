@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["compile_model", "simulate"]
+__all__ = ["compile_model", "simulate", "sweep"]
 
 
 def __getattr__(name: str) -> Any:

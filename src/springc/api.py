@@ -13,7 +13,7 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
-from typing import TextIO
+from typing import Any, TextIO
 
 from .errors import UsageError
 from .ir.expr import recursion_room
@@ -196,3 +196,70 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
                                 DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
                                 engine)
     return simulate_model(model, options)
+
+
+def sweep(files: CompiledModel | Files, *, model: str | None = None,
+          params: Mapping[str, str | Sequence[float]], samples: int | None = None,
+          method: str = "lhs", seed: int = 0, workers: int | None = None,
+          scheduler: str | None = None, outputs: Sequence[str] | None = None,
+          parameters: Mapping[str, float] | None = None, start: float | None = None,
+          stop: float | None = None, interval: float | None = None,
+          solver: str = DEFAULT_SOLVER, rtol: float | None = None,
+          atol: float | None = None, step: float | None = None,
+          output: str | os.PathLike[str] | None = None, resume: bool = False,
+          energy: str | None = None, libraries: Sequence[str | os.PathLike[str]] = (),
+          backend: str = "python", cache: bool = True, progress: TextIO | None = None,
+          max_steps: int | None = None, time_limit: float | None = None,
+          as_: str = "dataset") -> Any:
+    """Run a parameter study and return it as an ``xarray.Dataset`` (``as_="dataset"``:
+    each output over ``run`` x ``time`` with ``units`` attributes, the swept parameters
+    as coordinates on ``run``, ``status``/``error``/solver statistics per run) or a
+    ``pandas.DataFrame`` of the study table (``as_="dataframe"``).
+
+    ``params`` maps each swept parameter to a list of values or a text as ``springc
+    sweep --param`` takes (``"1e3:1e5:log:20"``, ``"0.5,1,2"``, ``"normal(1, 0.1)"``);
+    a grid is their cartesian product, or ``samples`` draws (``method`` ``"lhs"`` or
+    ``"mc"``, from ``seed``). Runs go to ``workers`` local processes (default: one per
+    core) or to the Dask scheduler at ``scheduler``. ``parameters`` are fixed values
+    for every run. With ``output`` (``.parquet``), the study table and its summary
+    (``.summary.parquet``) are written, and ``resume`` continues an interrupted study.
+    ``max_steps`` and ``time_limit`` bound each run as in :func:`simulate`.
+    """
+    from .studies import (
+        StudyOptions,
+        check_outputs,
+        parse_values,
+        run_study,
+        summary_path,
+        to_dataset,
+    )
+
+    if as_ not in ("dataset", "dataframe"):
+        raise UsageError(f"as_ must be 'dataset' or 'dataframe', not {as_!r}", option="as_")
+    check_run_values(start, stop, interval, rtol, atol, step, parameters)
+    specs = tuple(parse_values(name, spec if isinstance(spec, str) else
+                               ",".join(repr(float(v)) for v in spec), option="params")
+                  for name, spec in params.items())
+    fixed = dict(parameters or {})
+    if isinstance(files, CompiledModel):
+        check_parameter_names(files, fixed)
+        _check_integers(files, fixed)
+        compiled = _with_structural(files, {k: v for k, v in fixed.items()
+                                            if k in files.structural})
+    else:
+        compiled = compile_model(files, model, libraries=libraries, backend=backend,
+                                 outputs=outputs, parameters=fixed, cache=cache)
+    rest = tuple((k, v) for k, v in fixed.items() if k not in compiled.structural)
+    protected = tuple(compiled.options.files)
+    target = os.fspath(output) if output is not None else None
+    if target is not None:
+        check_outputs(target, summary_path(target), protected, ("output", "output"))
+    options = StudyOptions(specs, samples, method, seed, rest, start, stop, interval,
+                           solver, rtol, atol, step, workers, scheduler, energy, max_steps,
+                           time_limit)
+    study = run_study(compiled, options, target, resume=resume, protected=protected,
+                      progress=progress)
+    if as_ == "dataframe":
+        return study.table.to_pandas()
+    return to_dataset(study)
+

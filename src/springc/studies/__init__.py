@@ -1,0 +1,31 @@
+"""Studies: CompiledModel + StudyOptions -> Study, many runs in parallel, as Parquet.
+
+Modules, each importing only those before it: ``params`` (parameter specifications,
+grids, Monte Carlo and Latin hypercube samples), ``job`` (a batch of runs in a worker),
+``engines`` (local processes or Dask), ``progress``, ``store`` (the Parquet layouts,
+shards for resuming) and ``study`` (:func:`run_study`, :func:`to_dataset`).
+
+(The package is not named ``sweep``: ``springc.sweep`` is the API function.)
+"""
+
+from .engines import default_workers
+from .job import RunJob, RunRecord, run_batch
+from .params import (
+    DISTRIBUTIONS,
+    METHODS,
+    Distribution,
+    ParameterSpec,
+    grid,
+    parse_parameter,
+    parse_values,
+    sample,
+    unit_points,
+)
+from .store import FIXED_COLUMNS, check_outputs, partial_folder, summary_path
+from .study import Study, StudyOptions, parameter_table, run_study, to_dataset
+
+__all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "ParameterSpec",
+           "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs", "default_workers",
+           "grid",
+           "parameter_table", "parse_parameter", "parse_values", "partial_folder",
+           "run_batch", "run_study", "sample", "summary_path", "to_dataset", "unit_points"]
