@@ -102,9 +102,14 @@ def _model_options(func: Callable[..., Any]) -> Callable[..., Any]:
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.option("--debug", is_flag=True, help="Show tracebacks of internal errors.")
+@click.option("--max-size", type=click.IntRange(min=1), default=None, metavar="N",
+              help="Cap on the flat model's scalars and on loop iterations while "
+                   "flattening (default 2,000,000; the same as $SPRINGC_MAX_SIZE).")
 @click.version_option(package_name="springc")
-def main(debug: bool) -> None:
+def main(debug: bool, max_size: int | None) -> None:
     """springc: compile and simulate spring-mass models written in a Modelica subset."""
+    if max_size is not None:  # read by flatten (and inherited by sweep's workers)
+        os.environ["SPRINGC_MAX_SIZE"] = str(max_size)
     try:
         if signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
             signal.signal(signal.SIGTERM, _terminate)

@@ -108,3 +108,26 @@ def test_a_nest_is_refused_before_it_runs(tmp_path: Path) -> None:
         flatten(tree, "N", max_size=5)
     assert err.value.message == "this loop nest has 6 iterations, more than the limit of 5"
     assert err.value.span is not None and err.value.span.line == 4
+
+
+def test_the_command_line_flag_sets_the_cap(tmp_path: Path,
+                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    from click.testing import CliRunner
+
+    from springc.cli import main
+
+    monkeypatch.delenv("SPRINGC_MAX_SIZE", raising=False)
+    path = tmp_path / "big.mdl"
+    path.write_text("model Big\n  Real x[10](each start = 1, each fixed = true);\n"
+                    "equation\n  der(x) = -x;\nend Big;\n")
+    runner = CliRunner()
+    refused = runner.invoke(main, ["--max-size", "9", "check", str(path)])
+    assert refused.exit_code == 1
+    assert f"{path}:2:8: error: a dimension of 'x' has 10 elements, more than the limit " \
+           "of 9" in refused.output
+    monkeypatch.delenv("SPRINGC_MAX_SIZE", raising=False)  # the flag set it for the run
+    accepted = runner.invoke(main, ["--max-size", "10", "check", str(path)])
+    assert accepted.exit_code == 0
+    assert accepted.output == "Big: 10 unknowns, 10 equations, 0 parameters: balanced\n"
+    bad = runner.invoke(main, ["--max-size", "0", "check", str(path)])
+    assert bad.exit_code == 2 and "'--max-size'" in bad.output

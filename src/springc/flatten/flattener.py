@@ -111,7 +111,7 @@ def flatten(tree: ClassTree, model: str | None = None, max_size: int | None = No
     """Flatten ``model`` (a dotted name; default: the last model of the last user file).
 
     ``max_size`` caps the scalar variables of the flat model and the iterations of its
-    loops (default: ``$SPRINGC_MAX_SIZE``, else 10 million; see :mod:`.limits`)."""
+    loops (default: ``$SPRINGC_MAX_SIZE``, else 2 million; see :mod:`.limits`)."""
     cap = max_size_setting(max_size)
     with _gc_paused():
         return _flatten(tree, model, cap)

@@ -5,8 +5,8 @@ A model of a few lines can ask for ``Real x[1000000000]`` or a loop of 10^10 ite
 without a cap springc would exhaust memory or run for hours before saying anything. The
 cap (:data:`DEFAULT_MAX_SIZE`, 2 million) bounds both the scalar variables and arrays
 that flattening creates and the iterations of ``for`` loops, ranges and array
-constructors; ``flatten(..., max_size=N)`` or the environment variable
-``SPRINGC_MAX_SIZE`` raises it.
+constructors; ``springc --max-size N``, ``flatten(..., max_size=N)`` or the environment
+variable ``SPRINGC_MAX_SIZE`` raises it.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ class Limits:
     def hint(self) -> str:
         return (f"springc caps the flat model and its loops at {self.max_size} elements; "
                 f"if this model really needs more, raise the cap with "
-                f"{ENVIRONMENT_VARIABLE}=N (or flatten(..., max_size=N))")
+                f"springc --max-size N, {ENVIRONMENT_VARIABLE}=N or flatten(..., max_size=N)")
 
     def check_size(self, count: float, what: str, span: Span | None,
                    unit: str = "elements") -> None:
