@@ -148,3 +148,11 @@ def test_equation_without_unknowns(tmp_path: Path) -> None:
                   "  x = 1;\n  p = 2;\nend M;\n")
     assert err.message == "model 'M' is over-determined: 1 unknown, 2 equations"
     assert noted(err) == {("equation `p = 2` involves no unknown", 6)}
+
+
+def test_summary_escapes_a_model_name_with_control_characters(tmp_path: Path) -> None:
+    path = tmp_path / "q.mdl"
+    path.write_text("model 'M\"\"\"\\n'\n  Real x(start = 1, fixed = true);\nequation\n"
+                    "  der(x) = -x;\nend 'M\"\"\"\\n';\n")
+    balance = check_balance(flatten_files([path]))
+    assert balance.summary() == "'M\"\"\"\\n': 1 unknown, 1 equation, 0 parameters: balanced"

@@ -34,7 +34,9 @@ class Balance:
     def summary(self) -> str:
         arrays = (f", {self.parameter_arrays} parameter array"
                   f"{'s' if self.parameter_arrays != 1 else ''}") if self.parameter_arrays else ""
-        return (f"{self.model}: {_count(self.unknowns, 'unknown')}, "
+        # a quoted name with a line break or other control character is shown escaped
+        name = self.model if self.model.isprintable() else flat.quote(self.model)
+        return (f"{name}: {_count(self.unknowns, 'unknown')}, "
                 f"{_count(self.equations, 'equation')}, "
                 f"{_count(self.parameters, 'parameter')}{arrays}: balanced")
 
