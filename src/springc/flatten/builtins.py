@@ -118,12 +118,10 @@ class Builtins:
         return self.ev.value(call.args[0], scope)
 
     def sum(self, call: s.Call, scope: Scope) -> a.Value:
-        zero: x.Expr = x.ZERO
-        return reduce(x.add, self._elements(call, scope), zero)
+        return a.fold(x.add, list(self._elements(call, scope)), x.ZERO)
 
     def product(self, call: s.Call, scope: Scope) -> a.Value:
-        one: x.Expr = x.ONE
-        return reduce(x.mul, self._elements(call, scope), one)
+        return a.fold(x.mul, list(self._elements(call, scope)), x.ONE)
 
     def min_max(self, call: s.Call, scope: Scope) -> a.Value:
         name = call.func.dotted

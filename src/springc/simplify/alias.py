@@ -38,20 +38,47 @@ class AliasResult:
 
 def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
            rest: list[tuple[int, x.Expr]]) -> bool:
-    """Split ``e`` into ±unknown terms and a remainder free of unknowns."""
-    if isinstance(e, x.BinOp) and e.op in "+-":
-        return (_terms(e.left, sign, unknowns, out, rest)
-                and _terms(e.right, sign if e.op == "+" else -sign, unknowns, out, rest))
-    if isinstance(e, x.Neg):
-        return _terms(e.arg, -sign, unknowns, out, rest)
-    if isinstance(e, x.Var) and e.name in unknowns:
-        out.append((sign, e.name))
-        return len(out) <= 2
-    if any(n in unknowns or dae.is_derivative(n) for n in free_variables(e)) or any(
-            isinstance(n, x.Time) for n in x.walk(e)):
-        return False
-    rest.append((sign, e))
+    """Split ``e`` into ±unknown terms and a remainder free of unknowns, left to right.
+
+    Iterative: a sum that flattening built from ``sum(z)`` may have tens of thousands
+    of terms."""
+    pending: list[tuple[x.Expr, int]] = [(e, sign)]
+    while pending:
+        e, sign = pending.pop()
+        if isinstance(e, x.BinOp) and e.op in "+-":
+            pending.append((e.right, sign if e.op == "+" else -sign))
+            pending.append((e.left, sign))
+        elif isinstance(e, x.Neg):
+            pending.append((e.arg, -sign))
+        elif isinstance(e, x.Var) and e.name in unknowns:
+            out.append((sign, e.name))
+            if len(out) > 2:
+                return False
+        elif any(n in unknowns or dae.is_derivative(n) for n in free_variables(e)) or any(
+                isinstance(n, x.Time) for n in x.walk(e)):
+            return False
+        else:
+            rest.append((sign, e))
     return True
+
+
+_CHUNK = 64
+
+
+def _signed_sum(terms: list[tuple[int, x.Expr]]) -> x.Expr:
+    """``t1 ± t2 ± ...``, left to right in chunks of 64 terms whose sums are combined
+    pairwise: a sum of thousands of terms stays shallow enough for the later stages,
+    which recurse over expressions (as flatten's ``sum`` does)."""
+    chunks: list[x.Expr] = []
+    for i in range(0, len(terms), _CHUNK):
+        value: x.Expr = x.ZERO
+        for sign, term in terms[i:i + _CHUNK]:
+            value = x.add(value, term) if sign == 1 else x.sub(value, term)
+        chunks.append(value)
+    while len(chunks) > 1:
+        pairs = [x.add(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
+        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
+    return chunks[0] if chunks else x.ZERO
 
 
 def _classify(r: dae.Residual, unknowns: set[str]
@@ -69,9 +96,7 @@ def _classify(r: dae.Residual, unknowns: set[str]
         return a, b, -sa * sb, x.ZERO
     if len(terms) == 1:
         (sa, a), = terms
-        value: x.Expr = x.ZERO
-        for sign, term in rest:
-            value = x.add(value, term) if sign == 1 else x.sub(value, term)
+        value = _signed_sum(rest)
         return a, "", 0, value if sa == -1 else x.neg(value)
     return None
 
