@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import re
+import shutil
 import tempfile
 import time
 from collections.abc import Mapping, Sequence
@@ -21,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen import CodegenOptions, GeneratedModule, generate
-from ..errors import SimulationError
+from ..errors import CodegenError, SimulationError
 from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
 from ..parse import ClassEntry, ClassTree, load, parse_text
@@ -203,9 +204,27 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         temporary = tempfile.TemporaryDirectory(prefix="springc-")  # private (0700)
         path = Path(temporary.name) / "model.py"
         path.write_text(generated, encoding="utf-8")
-    module = import_module(generated.encode("utf-8"), path, module_name)
+    try:
+        module = import_module(generated.encode("utf-8"), path, module_name)
+    except (SyntaxError, RecursionError, MemoryError) as err:
+        if folder is not None:  # never leave an entry that cannot be imported
+            shutil.rmtree(path.parent, ignore_errors=True)
+        raise too_deep_for_python(err) from None
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated)
+
+
+def too_deep_for_python(err: BaseException) -> BaseException:
+    """The error for a generated module that Python's compiler refuses: a located
+    :class:`CodegenError` when it nests too deeply (more than about 200 parentheses or
+    calls inside one another), else ``err`` itself (a bug in springc)."""
+    if isinstance(err, SyntaxError) and "too many nested parentheses" not in str(err):
+        return err
+    return CodegenError(
+        "an expression of this model nests deeper than Python's compiler accepts "
+        f"({err.__class__.__name__}: {err})",
+        hint="split deeply nested calls or parentheses with intermediate variables "
+             "(`Real s1 = sin(x); Real s2 = sin(s1);` ...); Python accepts about 200 levels")
 
 
 def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, ...]:
