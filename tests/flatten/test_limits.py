@@ -116,7 +116,10 @@ def test_the_command_line_flag_sets_the_cap(tmp_path: Path,
 
     from springc.cli import main
 
-    monkeypatch.delenv("SPRINGC_MAX_SIZE", raising=False)
+    # setenv first, so that teardown removes what the flag sets (delenv of an unset
+    # variable records nothing to undo, and later tests would inherit --max-size 10)
+    monkeypatch.setenv("SPRINGC_MAX_SIZE", "1")
+    monkeypatch.delenv("SPRINGC_MAX_SIZE")
     path = tmp_path / "big.mdl"
     path.write_text("model Big\n  Real x[10](each start = 1, each fixed = true);\n"
                     "equation\n  der(x) = -x;\nend Big;\n")
