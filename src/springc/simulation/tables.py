@@ -46,6 +46,7 @@ def array_variables(names: Sequence[str], units: Sequence[str]) -> list[ArrayVar
         if match is not None:
             index = tuple(int(part) for part in match["index"].split(","))
             groups.setdefault(match["base"], []).append((index, column))
+    known = set(names)
     arrays: dict[int, ArrayVariable] = {}  # first column -> array
     grouped: set[int] = set()
     for base, elements in groups.items():
@@ -53,7 +54,7 @@ def array_variables(names: Sequence[str], units: Sequence[str]) -> list[ArrayVar
         by_index = dict(elements)
         boxes = list(itertools.product(*(range(1, n + 1) for n in shape)))
         columns = [by_index.get(index) for index in boxes]
-        if (base in names or any(len(index) != len(shape) for index, _ in elements)
+        if (base in known or any(len(index) != len(shape) for index, _ in elements)
                 or len(by_index) != len(elements) or None in columns
                 or len(columns) != len(elements)
                 or len({units[c] for _, c in elements}) != 1):
