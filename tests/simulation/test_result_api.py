@@ -134,3 +134,26 @@ def test_missing_optional_dependency_names_the_extra(result: SimulationResult,
                                "springc): pip install springc[analysis]")
     with pytest.raises(ImportError, match=r"^xarray is needed .*springc\[analysis\]$"):
         result.to_xarray()
+
+
+def test_only_whole_arrays_of_one_unit_are_grouped() -> None:
+    from springc.simulation.tables import ArrayVariable, array_variables
+
+    names = ("a[1,1]", "a[1,2]", "a[2,1]", "a[2,2]", "gap[1]", "gap[3]", "u[1]", "u[2]",
+             "w", "w[1]", "der(x[1])", "c[2].f[1]", "c[2].f[2]")
+    units = ("m",) * 6 + ("m", "s", "", "", "", "N", "N")
+    assert array_variables(names, units) == [
+        ArrayVariable("a", (0, 1, 2, 3), (2, 2), "m"),
+        ArrayVariable("gap[1]", (4,), (), "m"), ArrayVariable("gap[3]", (5,), (), "m"),
+        ArrayVariable("u[1]", (6,), (), "m"), ArrayVariable("u[2]", (7,), (), "s"),
+        ArrayVariable("w", (8,), (), ""), ArrayVariable("w[1]", (9,), (), ""),
+        ArrayVariable("der(x[1])", (10,), (), ""),
+        ArrayVariable("c[2].f", (11, 12), (2,), "N")]
+    values = np.arange(26.0).reshape(2, 13)
+    result = SimulationResult("M", np.array([0.0, 1.0]), names, values, units,
+                              SimulationStats("rk4", 1, 0, 0, 0.0, 0.0, 0.0, False))
+    assert np.array_equal(result["a"], [[[0, 1], [2, 3]], [[13, 14], [15, 16]]])
+    data = result.to_xarray()
+    assert data["a"].dims == ("time", "a_index1", "a_index2")
+    assert np.array_equal(data["a"].values, result["a"])
+    assert "u[2]" in data and data["u[2]"].attrs == {"units": "s"} and data["w"].attrs == {}
