@@ -127,6 +127,42 @@ def compile_model(files: Files, model: str | None = None, *,
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
                              backend, tuple(outputs) if outputs is not None else None,
                              (), cache)
+    return _compile(options, parameters)
+
+
+STRING_FILE = "<string>"
+"""The pseudo file name of a model given as text (errors say ``<string>:3:5``)."""
+
+
+@recursion_room()
+def load_model_from_string(text: str, model: str | None = None, backend: str = "python", *,
+                           libraries: Sequence[str | os.PathLike[str]] = (),
+                           outputs: Sequence[str] | None = None,
+                           parameters: Mapping[str, float] | None = None,
+                           cache: bool = True) -> CompiledModel:
+    """Compile ``model`` of the Modelica ``text`` (a notebook cell, say) as
+    :func:`compile_model` compiles files; errors are located in ``<string>``.
+
+        >>> model = springc.load_model_from_string('''
+        ... model Fall
+        ...   Real h(start = 10, fixed = true);
+        ... equation
+        ...   der(h) = -9.81 * time;
+        ... end Fall;''')
+        >>> springc.simulate(model, stop=1.0)["h"][-1]
+    """
+    if not isinstance(text, str):
+        raise UsageError(f"the model text must be a str, not {type(text).__name__}",
+                         option="text")
+    check_run_values(parameters=parameters)
+    options = CompileOptions((), model, tuple(os.fspath(x) for x in libraries), backend,
+                             tuple(outputs) if outputs is not None else None, (), cache,
+                             ((STRING_FILE, text),))
+    return _compile(options, parameters)
+
+
+def _compile(options: CompileOptions,
+             parameters: Mapping[str, float] | None) -> CompiledModel:
     if not parameters:
         return compile_files(options)
     # Which parameters are structural is known once the unmodified model is compiled

@@ -124,8 +124,21 @@ def errors_of(exc: SpringcError | ErrorGroup) -> tuple[SpringcError, ...]:
 SourceLookup = Callable[[str], "str | None"]
 
 
+MEMORY_SOURCES: dict[str, str] = {}
+"""The text of pseudo files (``<string>``: models given as text), by name."""
+
+
+def remember_source(name: str, text: str) -> None:
+    """Show ``text`` in the excerpts of errors located in the pseudo file ``name``
+    (the latest text given under that name)."""
+    MEMORY_SOURCES[name] = text
+
+
 def read_source(path: str) -> str | None:
-    """Default source lookup: read the file from disk, ``None`` if unreadable."""
+    """Default source lookup: the remembered text of a pseudo file (``<string>``, never
+    read from disk), else the file read from disk; ``None`` if unreadable."""
+    if path.startswith("<") and path.endswith(">"):
+        return MEMORY_SOURCES.get(path)
     try:
         return Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):

@@ -15,10 +15,18 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import ErrorGroup, FlattenError, LoadError, Note, Span, SpringcError
+from ..errors import (
+    ErrorGroup,
+    FlattenError,
+    LoadError,
+    Note,
+    Span,
+    SpringcError,
+    remember_source,
+)
 from ..ir import syntax as s
 from ..resources import models_dir
-from .parser import parse_file
+from .parser import parse_file, parse_text
 
 
 @dataclass(eq=False)
@@ -194,8 +202,11 @@ def library_folders(extra: Iterable[str | Path] = ()) -> list[Path]:
     return folders
 
 
-def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = ()) -> ClassTree:
-    """Parse the user's files and every ``.mdl`` file of the library folders.
+def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
+         texts: Sequence[tuple[str, str]] = ()) -> ClassTree:
+    """Parse the user's files, the user's ``texts`` (``(pseudo file name, text)``
+    pairs, such as ``("<string>", ...)``: their excerpts are kept for error messages)
+    and every ``.mdl`` file of the library folders.
 
     All files are parsed first; classes are then placed in precedence order, files
     without ``within`` before those placed inside a package (shallow packages first).
@@ -216,6 +227,14 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = ()) -> C
         seen.add(path.resolve())
         try:
             parsed.append((_parse_cached(path), from_user))
+        except ErrorGroup as group:
+            errors += group.errors
+        except SpringcError as error:
+            errors.append(error)
+    for name, text in texts:
+        remember_source(name, text)
+        try:
+            parsed.append((parse_text(text, name), True))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:

@@ -25,6 +25,7 @@ from ..codegen import CodegenOptions, GeneratedModule, generate
 from ..errors import CodegenError, SimulationError
 from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
+from ..ir.expr import recursion_room
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
 from .cache import (
@@ -40,6 +41,7 @@ from .cache import (
     touch,
     write_entry,
 )
+from .equations import Equations
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,7 @@ class CompileOptions:
     outputs: tuple[str, ...] | None = None
     modifications: tuple[tuple[str, str], ...] = ()
     cache: bool = True
+    texts: tuple[tuple[str, str], ...] = ()  # models given as text: (pseudo file, text)
 
 
 @dataclass
@@ -73,6 +76,7 @@ class CompiledModel:
     outputs: tuple[str, ...] = field(default=())
     temporary: tempfile.TemporaryDirectory[str] | None = None
     text: str = ""  # the module's text as verified and imported (``source``)
+    derived: Derived | None = field(default=None, repr=False)  # set by ``equations``
 
     @property
     def name(self) -> str:
@@ -98,6 +102,23 @@ class CompiledModel:
     def source(self) -> str:
         """The text of the imported module (not re-read from the cache file)."""
         return self.text or self.path.read_text(encoding="utf-8")
+
+    def equations(self) -> Equations:
+        """The simplified equations in evaluation order (LaTeX in Jupyter); derived
+        again from the options (the files as they are now) on first use: a module
+        loaded from the cache keeps no equations."""
+        return Equations(self.derive().system)
+
+    def flat_equations(self) -> Equations:
+        """The flat model's equations (LaTeX in Jupyter), as ``springc flatten`` shows."""
+        return Equations(self.derive().flat_model)
+
+    @recursion_room()
+    def derive(self) -> Derived:
+        """The flat model and simplified system of this model (derived once)."""
+        if self.derived is None:
+            self.derived = derive_system(self.options)
+        return self.derived
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
         """The parameter vector with ``values`` (non-structural names) applied."""
@@ -173,7 +194,10 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             folder = private_folder(cache_dir())
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
-    settings = (options.model, options.backend, options.outputs, options.modifications)
+    settings: tuple[object, ...] = (options.model, options.backend, options.outputs,
+                                    options.modifications)
+    if options.texts:  # (the keys of file-only models are unchanged)
+        settings += (options.texts,)
     key = cache_key(settings, options.files, options.libraries)
     module_name = f"springc_model_{key}"
     if folder is not None:
@@ -249,7 +273,7 @@ WRAPPER_FILE = "<springc: structural parameters>"
 
 def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
-    tree = load(list(options.files), options.libraries)
+    tree = load(list(options.files), options.libraries, options.texts)
     model = options.model
     base = None
     if options.modifications:

@@ -19,18 +19,21 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 
 from ..errors import OutputError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
 from ..ir import dae
+from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
 """Suffix -> trajectory format of ``simulate -o``."""
 PLOT_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 """Suffix -> plot format of ``--plot``."""
+REPR_VARIABLES = 4
+"""Variables named by a result's ``repr`` before ``... N more``."""
 
 
 def file_format(path: PathLike, formats: dict[str, str], option: str) -> str:
@@ -83,10 +86,16 @@ class SimulationResult:
     parameters: dict[str, float] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
+        """The column of a flat name (``mass.pos[1]``: one value per time), or an array
+        variable (``mass.pos``: ``(times, size)``, elements in index order)."""
         try:
             return self.values[:, self.names.index(name)]
         except ValueError:
-            raise KeyError(name) from None
+            pass
+        for variable in array_variables(self.names, self.units):
+            if variable.name == name and variable.shape:
+                return array_values(self.values, variable)
+        raise KeyError(name)
 
     def __contains__(self, name: object) -> bool:
         return name in self.names
@@ -106,13 +115,44 @@ class SimulationResult:
         """Write the trajectory as CSV or MAT, by the suffix of ``path``."""
         save_outputs(self, path, None)
 
-    def plot(self, path: str | os.PathLike[str]) -> None:
-        """Plot the outputs to a PNG, SVG or PDF file, by the suffix of ``path``."""
+    def plot(self, path: str | os.PathLike[str] | None = None) -> Any:
+        """Plot the outputs: to a PNG, SVG or PDF file by the suffix of ``path``; without
+        ``path``, return the matplotlib Figure (shown inline in Jupyter), nothing written."""
+        if path is None:
+            return draw_figure(self)
         save_outputs(self, None, path)
+        return None
+
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame`` indexed by time, one column per output; units in
+        ``attrs["units"]`` (name -> unit, ``""`` if none). Needs ``springc[analysis]``."""
+        return to_pandas(self.time, self.names, self.values, self.units, self.model)
+
+    def to_xarray(self) -> Any:
+        """An ``xarray.Dataset`` over ``time``; array elements (``mass.pos[1]``,
+        ``mass.pos[2]``) form one variable (``mass.pos``) with a dimension
+        ``mass.pos_index``; units as ``units`` attributes. Needs ``springc[analysis]``."""
+        return to_xarray(self.time, self.names, self.values, self.units, self.model)
+
+    def _summary_rows(self) -> list[tuple[str, str]]:
+        stats = self.stats
+        span = (f"{len(self.time)} times from {self.time[0]:g} to {self.time[-1]:g} s"
+                if len(self.time) else "no times")
+        return [("model", self.model), ("solver", f"{stats.solver} ({stats.engine})"),
+                ("steps", str(stats.steps)), ("times", span)]
 
     def __repr__(self) -> str:
-        return (f"<SimulationResult {self.model}: {len(self.time)} times x "
-                f"{len(self.names)} variables, {self.stats.solver}>")
+        variables = array_variables(self.names, self.units)
+        shown = [v.name + (f"[{'x'.join(map(str, v.shape))}]" if v.shape else "")
+                 for v in variables[:REPR_VARIABLES]]
+        if len(variables) > REPR_VARIABLES:
+            shown.append(f"... {len(variables) - REPR_VARIABLES} more")
+        rows = dict(self._summary_rows())
+        return (f"<SimulationResult {self.model}: {rows['solver']}, {rows['steps']} steps, "
+                f"{rows['times']}, variables {', '.join(shown) or 'none'}>")
+
+    def _repr_html_(self) -> str:
+        return html_table(self._summary_rows(), array_variables(self.names, self.units))
 
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
@@ -216,13 +256,12 @@ def _group(name: str, unit: str) -> tuple[str, str]:
     return word, word
 
 
-def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
-    """Plot the outputs, one panel per quantity (positions, velocities, forces, ...), as
-    the bytes of a ``kind`` (png, svg, pdf) file. Names and units are shown literally."""
+def draw_figure(result: SimulationResult) -> Any:
+    """The plot of the outputs, one panel per quantity (positions, velocities, forces,
+    ...), as a matplotlib Figure. Names and units are shown literally."""
     # A Figure with the Agg canvas directly: no pyplot, so the user's matplotlib
     # backend (a notebook's, say) is left alone.
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from .figure import ResultFigure
 
     groups: dict[str, tuple[str, list[int]]] = {}
     for i, (name, unit) in enumerate(zip(result.names, result.units)):
@@ -230,11 +269,10 @@ def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
         groups.setdefault(title, (label, []))[1].append(i)
     panels = list(groups.items())[:MAX_PANELS]
     height = 1.2 + 2.3 * max(1, len(panels))
-    fig = Figure(figsize=(10, height))
+    fig = ResultFigure(10, height)
     # Fixed margins (in inches) instead of tight_layout, which costs a quarter second.
     fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.55 / height,
                         bottom=0.6 / height, hspace=0.35)
-    FigureCanvasAgg(fig)
     axes = fig.subplots(max(1, len(panels)), 1, sharex=True, squeeze=False)
     for ax, (title, (label, columns)) in zip(axes[:, 0], panels):
         many = len(columns) > MAX_LEGEND
@@ -253,6 +291,12 @@ def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
     note = f" ({omitted} more groups not shown)" if omitted > 0 else ""
     axes[-1, 0].set_xlabel("time [s]")
     fig.suptitle(plain_text(f"{result.model}{note}"), fontsize=11)
+    return fig
+
+
+def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
+    """The plot of :func:`draw_figure` as the bytes of a ``kind`` (png, svg, pdf) file."""
+    fig = draw_figure(result)
     buffer = io.BytesIO()
     # zlib level 1: a third of the save time of the default 6, for a slightly larger file
     if kind == "png":
