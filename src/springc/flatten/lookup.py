@@ -160,7 +160,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
         parts = model.split(".")
         entry: ClassEntry | None = tree.root
         for part in parts:
-            entry = entry.classes.get(part) if entry is not None else None
+            entry = entry.child(part) if entry is not None else None
         if entry is None:
             raise FlattenError(f"no class named '{model}' is loaded",
                                hint=_model_hint(tree, model))
@@ -171,7 +171,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
                                hint=("its models are: " + ", ".join(inner)) if inner
                                else "give the dotted name of a model")
         return entry
-    user_files = [f for f in tree.files if _from_user(tree, f)]
+    user_files = [f for f in tree.user_files if _from_user(tree, f)]
     for stored in reversed(user_files):
         for defn in reversed(stored.classes):
             if defn.kind in ("model", "block", "class"):
