@@ -1,6 +1,6 @@
 """Load time of a model that uses 5 classes of a large library (issue 12).
 
-    PYTHONPATH=src python benchmarks/bench_load.py [--repeat N]
+    PYTHONPATH=src python benchmarks/bench_load.py [--repeat N] [--quick]
 
 Generates, in a temporary folder, a library ``Big`` stored the Modelica way: 20 package
 folders (``Big/P<i>/package.mo``) of 10 files each (200 files), each file a package of 10
@@ -67,7 +67,10 @@ def measure(library: Path, user: Path, repeat: int) -> tuple[float, int]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="3 repeats")
     args = parser.parse_args()
+    if args.quick:
+        args.repeat = 3
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         make_library(root / "large", 20, 10, 10)

@@ -16,6 +16,7 @@ from springc.errors import SpringcError, render
 from springc.ir.flat import format_equation, format_flat
 from springc.parse import load
 from springc.pipeline import flatten_files
+from springc.pipeline.cache import cache_key
 
 
 @pytest.fixture(autouse=True)
@@ -135,8 +136,13 @@ def test_user_file_takes_precedence_and_named_package_is_not_the_default_model(
     assert flatten_files([package], "Mech.Oscillator").name == "Mech.Oscillator"
     with pytest.raises(SpringcError) as exc:
         flatten_files([package])
+    # package.order lists Parts before Oscillator: the first model is Parts.Mass.
     assert error_text(exc) == ("error: no model found in the given files\n"
-                               "help: name a file that defines a model, or use --model")
+                               "help: choose a model with --model, e.g. --model Mech.Parts.Mass")
+    write(lib, {"Mech/package.order": "Oscillator\nParts\n"})
+    with pytest.raises(SpringcError) as exc:
+        flatten_files([package])
+    assert error_text(exc).endswith("e.g. --model Mech.Oscillator")
 
 
 def test_within_must_match_the_folder(tmp_path: Path) -> None:
@@ -234,3 +240,37 @@ def test_quoted_names_never_name_files(tmp_path: Path) -> None:
         flatten_files([user], None, [lib])
     assert error_text(exc).splitlines()[0] == (
         f"{user}:2:3: error: class 'Pkg' has no member class '../Secret'")
+
+
+def test_cache_key_covers_every_library_file(tmp_path: Path) -> None:
+    lib = write(tmp_path / "lib", MECH)
+    user = write(tmp_path, {"m.mo": "model M\n  Mech.Oscillator osc;\nend M;\n"}) / "m.mo"
+    keys = {cache_key(("M", "python"), [str(user)], [str(lib)])}
+    for name, text in [("Mech/package.order", "Oscillator\nParts\n"),
+                       ("Mech/Parts/Spring.mo", MECH["Mech/Parts/Spring.mo"] + "\n"),
+                       ("Mech/Parts/Damper.mo", "within Mech.Parts;\nmodel Damper\nend Damper;\n")]:
+        write(lib, {name: text})
+        keys.add(cache_key(("M", "python"), [str(user)], [str(lib)]))
+    # A named package.mo covers its folder too.
+    package = lib / "Mech" / "package.mo"
+    before = cache_key(("M", "python"), [str(package)], [])
+    write(lib, {"Mech/Parts/Mass.mo": MECH["Mech/Parts/Mass.mo"] + "\n"})
+    assert len(keys) == 4 and cache_key(("M", "python"), [str(package)], []) != before
+
+
+def test_an_older_style_mdl_file_may_hold_several_classes(tmp_path: Path) -> None:
+    lib = write(tmp_path / "lib", {
+        "Parts.mdl": "package Parts\n  model A\n    Real a = 1;\n  end A;\nend Parts;\n"
+                     "model Helper\n  Real h = 2;\nend Helper;\n"})
+    user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\n  Helper h;\nend M;\n"}) / "m.mo"
+    flat = flatten_files([user], None, [lib])
+    assert [format_equation(e) for e in flat.equations] == ["'a.a' = 1;", "'h.h' = 2;"]
+
+
+def test_a_symbolic_link_back_to_a_parent_folder_is_walked_once(tmp_path: Path) -> None:
+    lib = write(tmp_path / "lib", {"sub/parts.mdl": "package Parts\n  model A\n"
+                                                    "    Real a = 1;\n  end A;\nend Parts;\n"})
+    (lib / "sub" / "loop").symlink_to(lib)
+    user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
+    assert [format_equation(e) for e in flatten_files([user], None, [lib]).equations] == [
+        "'a.a' = 1;"]

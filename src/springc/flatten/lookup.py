@@ -176,7 +176,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
         for defn in reversed(stored.classes):
             if defn.kind in ("model", "block", "class"):
                 return _entry_of(tree, stored, defn)
-    nested = [name for f in user_files for d in f.classes
+    nested = [name for f in user_files + tree.named_packages for d in f.classes
               for name in _models_below(_entry_of(tree, f, d))]
     raise FlattenError("no model found in the given files",
                        hint=f"choose a model with --model, e.g. --model {nested[0]}" if nested
@@ -186,7 +186,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
 def _models_below(entry: ClassEntry) -> list[str]:
     """Dotted names of the models nested in ``entry`` (depth first)."""
     found = []
-    for inner in entry.classes.values():
+    for inner in filter(None, map(entry.child, entry.member_names())):
         if inner.defn.kind in ("model", "block", "class"):
             found.append(inner.full_name)
         found += _models_below(inner)

@@ -95,14 +95,31 @@ def package_order(folder: Path) -> list[str]:
     return [line.strip() for line in text.splitlines() if _FILE_NAME.match(line.strip())]
 
 
+def stored_names(folder: Path) -> list[str]:
+    """The names of the classes a package folder stores in files and subfolders, sorted."""
+    try:
+        children = sorted(folder.iterdir())
+    except OSError:
+        return []
+    names = [p.stem for p in children
+             if p.suffix in SUFFIXES and not is_package_file(p) and _FILE_NAME.match(p.stem)]
+    names += [p.name for p in children
+              if p.is_dir() and _FILE_NAME.match(p.name) and package_file(p) is not None]
+    return sorted(set(names))
+
+
 def loose_files(root: Path) -> list[Path]:
     """Files of a root that are not found by class name: every ``.mo``/``.mdl`` file in
     the root and in its folders that are not packages (springc's older layout, where
     ``parts.mdl`` may hold ``package Parts``). Package folders are not entered."""
     found: list[Path] = []
     pending = [root]
+    visited: set[Path] = set()
     while pending:
         folder = pending.pop()
+        if folder.resolve() in visited:  # a symbolic link back to a parent folder
+            continue
+        visited.add(folder.resolve())
         try:
             children = sorted(folder.iterdir())
         except OSError:

@@ -24,6 +24,8 @@ from .library import (
     is_package_file,
     library_roots,
     loose_files,
+    package_order,
+    stored_names,
 )
 from .parser import parse_file
 
@@ -40,6 +42,17 @@ class ClassEntry:
     folder: Path | None = None
     #: The tree this entry belongs to (set on the root and on package folders).
     tree: ClassTree | None = None
+
+    def member_names(self) -> list[str]:
+        """The names of the classes declared in this class, loaded or not: for a package
+        folder in ``package.order`` order, then the other loaded classes, then the other
+        files and folders of the package (sorted)."""
+        names = list(self.classes)
+        if self.folder is None:
+            return names
+        stored = stored_names(self.folder)
+        ordered = [n for n in package_order(self.folder) if n in names or n in stored]
+        return list(dict.fromkeys(ordered + names + stored))
 
     def child(self, name: str) -> ClassEntry | None:
         """The class ``name`` declared in this class, loading its file if needed."""
@@ -86,6 +99,8 @@ class ClassTree:
         self.files: list[s.StoredDefinition] = []
         #: The user's own files (not ``package.mo``): where the default model comes from.
         self.user_files: list[s.StoredDefinition] = []
+        #: The ``package.mo`` files the user named.
+        self.named_packages: list[s.StoredDefinition] = []
         #: Paths (resolved) of the files parsed so far, user's and library's.
         self.parsed_paths: list[Path] = []
         self._loose_done: set[Path] = set()
@@ -170,7 +185,10 @@ class ClassTree:
                 f"'{path}' is stored in {where} but says {said}", span,
                 hint=f"start the file with `within {'.'.join(within)};` or move it to "
                 "the folder of the package it names")
-        if name is not None and [d.name for d in stored.classes] != [name]:
+        names = [d.name for d in stored.classes]
+        # An older-style .mdl file at the top of a root may hold more classes than one.
+        lenient = within == () and path.suffix == ".mdl"
+        if name is not None and (name not in names if lenient else names != [name]):
             found = ", ".join(f"'{d.name}'" for d in stored.classes) or "no class"
             raise LoadError(
                 f"'{path}' must hold exactly the class '{name}' (its file name), "
@@ -366,8 +384,7 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = ()) -> C
             errors += group.errors
         except SpringcError as error:
             errors.append(error)
-        if not package:
-            tree.user_files.append(stored)
+        (tree.named_packages if package else tree.user_files).append(stored)
     # The default model is the last of the user's files as named.
     order = {id(stored): i for i, (stored, _) in enumerate(parsed)}
     tree.user_files.sort(key=lambda f: order[id(f)])
