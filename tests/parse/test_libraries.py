@@ -274,3 +274,30 @@ def test_a_symbolic_link_back_to_a_parent_folder_is_walked_once(tmp_path: Path) 
     user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
     assert [format_equation(e) for e in flatten_files([user], None, [lib]).equations] == [
         "'a.a' = 1;"]
+
+
+def test_a_missing_member_of_a_package_folder_names_the_folder(tmp_path: Path) -> None:
+    lib = write(tmp_path / "lib", MECH)
+    user = write(tmp_path, {"m.mo": "model M\n  Mech.Parts.Damper d;\nend M;\n"}) / "m.mo"
+    with pytest.raises(SpringcError) as exc:
+        flatten_files([user], None, [lib])
+    assert error_text(exc).splitlines()[0] == (
+        f"{user}:2:3: error: class 'Mech.Parts' has no member class 'Damper'")
+    assert error_text(exc).splitlines()[-1] == (
+        f"note: searched the package folder {lib / 'Mech' / 'Parts'} for Damper.mo, "
+        "Damper.mdl and Damper/package.mo")
+
+
+def test_the_command_line_simulates_the_users_model_not_the_librarys(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from springc.cli import main
+    lib = write(tmp_path / "lib", MECH)
+    user = write(tmp_path, {"m.mo": "model M\n  Mech.Parts.Mass mass(m = 2);\n"
+                                    "equation\n  mass.f = -8 * mass.x;\nend M;\n"}) / "m.mo"
+    package = lib / "Mech" / "package.mo"
+    for files in ([str(user), str(package)], [str(package), str(user)]):
+        result = CliRunner().invoke(main, ["check", *files], prog_name="springc",
+                                    env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
+        assert (result.exit_code, result.output) == (
+            0, "M: 3 unknowns, 3 equations, 1 parameter: balanced\n")

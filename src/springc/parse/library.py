@@ -109,9 +109,10 @@ def stored_names(folder: Path) -> list[str]:
 
 
 def loose_files(root: Path) -> list[Path]:
-    """Files of a root that are not found by class name: every ``.mo``/``.mdl`` file in
-    the root and in its folders that are not packages (springc's older layout, where
-    ``parts.mdl`` may hold ``package Parts``). Package folders are not entered."""
+    """Files of a root that may not be found by class name: every ``.mdl`` file in the
+    root and in its folders that are not packages (springc's older layout, where
+    ``parts.mdl`` may hold ``package Parts``). Package folders are not entered; ``.mo``
+    files are found by their names only, as the specification says."""
     found: list[Path] = []
     pending = [root]
     visited: set[Path] = set()
@@ -128,7 +129,7 @@ def loose_files(root: Path) -> list[Path]:
             if child.is_dir():
                 if package_file(child) is None:
                     pending.append(child)
-            elif child.suffix in SUFFIXES and child.is_file():
+            elif child.suffix == ".mdl" and child.is_file():
                 found.append(child)
     return sorted(found)
 

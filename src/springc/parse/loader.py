@@ -212,9 +212,13 @@ class ClassTree:
         for part in path[1:]:
             member = member_class(entry, part)
             if member is None:
+                searched = [] if entry.folder is None else [
+                    Note(f"searched the package folder {entry.folder} for {part}.mo, "
+                         f"{part}.mdl and {part}/package.mo")]
                 raise FlattenError(
                     f"class '{entry.full_name}' has no member class '{part}'", span,
-                    [Note(f"'{entry.full_name}' is defined here", entry.defn.span)])
+                    [Note(f"'{entry.full_name}' is defined here", entry.defn.span),
+                     *searched])
             entry = member
         return entry
 
