@@ -83,7 +83,7 @@ def run_case(case: Case, workdir: Path) -> tuple[int, str]:
     os.chdir(workdir)
     try:
         result = CliRunner().invoke(main, case.command, prog_name="springc",
-                                    env={"SPRINGC_PATH": ""})
+                                    env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
     finally:
         os.chdir(old)
     output = result.stdout + result.stderr

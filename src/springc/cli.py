@@ -92,7 +92,7 @@ def _model_options(func: Callable[..., Any]) -> Callable[..., Any]:
     func = click.option("-L", "--library", "libraries", multiple=True,
                         type=click.Path(exists=True, file_okay=False),
                         help="Library folder to search for classes (repeatable); "
-                        "SPRINGC_PATH is searched too.")(func)
+                        "then SPRINGC_PATH and MODELICAPATH.")(func)
     func = click.option("--model", "model", default=None,
                         help="Dotted name of the model (default: the last model of the "
                         "last file).")(func)

@@ -16,7 +16,7 @@ SEED = str(ROOT / "models" / "SpringMass.mdl")
 
 def run(*args: str, env: dict[str, str] | None = None) -> tuple[int, str, str]:
     result = CliRunner().invoke(main, list(args), prog_name="springc",
-                                env={"SPRINGC_PATH": "", **(env or {})})
+                                env={"SPRINGC_PATH": "", "MODELICAPATH": "", **(env or {})})
     return result.exit_code, result.stdout, result.stderr
 
 

@@ -162,7 +162,8 @@ HUGE = re.compile(r"(?<![.\w])[1-9][0-9]{6,}(?![.\w])")
 def invoke(*args: str, seconds: int = SECONDS_PER_RUN) -> tuple[int, str]:
     with limits(seconds, 3 << 30):
         result = CliRunner().invoke(main, list(args), prog_name="springc",
-                                    catch_exceptions=False, env={"SPRINGC_PATH": ""})
+                                    catch_exceptions=False,
+                                    env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
     return result.exit_code, result.output
 
 

@@ -21,7 +21,7 @@ def run(tmp_path: Path, source: str, *args: str) -> tuple[int, str, str]:
     path = tmp_path / "example.mdl"
     path.write_text(source)
     result = CliRunner().invoke(main, [*args, str(path)], prog_name="springc",
-                                env={"SPRINGC_PATH": ""})
+                                env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
     return result.exit_code, result.stdout, result.stderr
 
 

@@ -67,7 +67,8 @@ def test_a_flatten_error_is_located_in_the_string() -> None:
     assert str(info.value) == ("<string>:3:3: error: unknown class 'Sprung'\n"
                                "    3 |   Sprung s;\n"
                                "      |   ^^^^^^\n"
-                               "help: did you mean 'Spring'?")
+                               "help: did you mean 'Spring'? (searched the files named, "
+                               "then the bundled models)")
 
 
 def test_the_text_must_be_a_string() -> None:

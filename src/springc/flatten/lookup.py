@@ -160,7 +160,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
         parts = model.split(".")
         entry: ClassEntry | None = tree.root
         for part in parts:
-            entry = entry.classes.get(part) if entry is not None else None
+            entry = entry.child(part) if entry is not None else None
         if entry is None:
             raise FlattenError(f"no class named '{model}' is loaded",
                                hint=_model_hint(tree, model))
@@ -171,12 +171,12 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
                                hint=("its models are: " + ", ".join(inner)) if inner
                                else "give the dotted name of a model")
         return entry
-    user_files = [f for f in tree.files if _from_user(tree, f)]
+    user_files = [f for f in tree.user_files if _from_user(tree, f)]
     for stored in reversed(user_files):
         for defn in reversed(stored.classes):
             if defn.kind in ("model", "block", "class"):
                 return _entry_of(tree, stored, defn)
-    nested = [name for f in user_files for d in f.classes
+    nested = [name for f in user_files + tree.named_packages for d in f.classes
               for name in _models_below(_entry_of(tree, f, d))]
     raise FlattenError("no model found in the given files",
                        hint=f"choose a model with --model, e.g. --model {nested[0]}" if nested
@@ -186,7 +186,7 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
 def _models_below(entry: ClassEntry) -> list[str]:
     """Dotted names of the models nested in ``entry`` (depth first)."""
     found = []
-    for inner in entry.classes.values():
+    for inner in filter(None, map(entry.child, entry.member_names())):
         if inner.defn.kind in ("model", "block", "class"):
             found.append(inner.full_name)
         found += _models_below(inner)

@@ -1,16 +1,17 @@
 """Load source files and libraries into one class tree, and look classes up in it.
 
-Input: ``.mdl`` files named by the user, library folders (``-L``, ``SPRINGC_PATH``,
-the bundled ``models/``). Output: a :class:`ClassTree` whose root holds every
-top-level class; a file's ``within`` clause places its classes inside a package.
-Files named by the user take precedence over library folders, and earlier folders
-over later ones, like ``MODELICAPATH``.
+Input: ``.mo``/``.mdl`` files named by the user and the library path (``library.py``).
+Output: a :class:`ClassTree` whose root holds the top-level classes; a file's
+``within`` clause places its classes inside a package. The user's files are parsed at
+once; a library file only when lookup first needs a class it stores (a top-level name
+-> its ``package.mo`` or ``.mo`` file; ``P.Sub.A`` -> ``P/Sub/package.mo``, then
+``P/Sub/A.mo``). Files named by the user take precedence over the library path, and
+earlier roots over later ones.
 """
 
 from __future__ import annotations
 
 import difflib
-import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +26,15 @@ from ..errors import (
     remember_source,
 )
 from ..ir import syntax as s
-from ..resources import models_dir
+from .library import (
+    LibraryRoot,
+    class_file,
+    is_package_file,
+    library_roots,
+    loose_files,
+    package_order,
+    stored_names,
+)
 from .parser import parse_file, parse_text
 
 
@@ -37,6 +46,28 @@ class ClassEntry:
     parent: ClassEntry | None
     classes: dict[str, ClassEntry] = field(default_factory=dict)
     from_user: bool = False
+    #: The folder of a package stored as ``P/package.mo``: its other classes load lazily.
+    folder: Path | None = None
+    #: The tree this entry belongs to (set on the root and on package folders).
+    tree: ClassTree | None = None
+
+    def member_names(self) -> list[str]:
+        """The names of the classes declared in this class, loaded or not: for a package
+        folder in ``package.order`` order, then the other loaded classes, then the other
+        files and folders of the package (sorted)."""
+        names = list(self.classes)
+        if self.folder is None:
+            return names
+        stored = stored_names(self.folder)
+        ordered = [n for n in package_order(self.folder) if n in names or n in stored]
+        return list(dict.fromkeys(ordered + names + stored))
+
+    def child(self, name: str) -> ClassEntry | None:
+        """The class ``name`` declared in this class, loading its file if needed."""
+        found = self.classes.get(name)
+        if found is None and self.tree is not None:
+            found = self.tree.load_member(self, name)
+        return found
 
     @property
     def name(self) -> str:
@@ -57,20 +88,36 @@ def _place(defn: s.ClassDef, parent: ClassEntry) -> ClassEntry:
     return entry
 
 
+#: Names no library may define: looking them up never reads a file.
+PREDEFINED_TYPES = frozenset({"Real", "Integer", "Boolean", "String"})
+
 _ROOT_SPAN = Span("<root>", 1, 1, 1, 1)
 _ROOT_DEF = s.ClassDef("", "package", False, False, "", (), (), (), (), None, None, False,
                        _ROOT_SPAN)
 
 
 class ClassTree:
-    """All loaded classes under one unnamed root package."""
+    """All loaded classes under one unnamed root package, and the library path that
+    supplies further top-level classes on demand."""
 
-    def __init__(self) -> None:
-        self.root = ClassEntry(_ROOT_DEF, None)
+    def __init__(self, roots: Sequence[LibraryRoot] = ()) -> None:
+        self.root = ClassEntry(_ROOT_DEF, None, tree=self)
+        self.roots = list(roots)
+        #: Every parsed file, in the order it was added.
         self.files: list[s.StoredDefinition] = []
+        #: The user's own files (not ``package.mo``): where the default model comes from.
+        self.user_files: list[s.StoredDefinition] = []
+        #: The ``package.mo`` files the user named.
+        self.named_packages: list[s.StoredDefinition] = []
+        #: Paths (resolved) of the files parsed so far, user's and library's.
+        self.parsed_paths: list[Path] = []
+        self._loose_done: set[Path] = set()
+        self._missing: set[tuple[int, str]] = set()
 
-    def add(self, stored: s.StoredDefinition, override: bool) -> list[SpringcError]:
-        """Insert a file's classes; user files (``override``) clash with each other only."""
+    def add(self, stored: s.StoredDefinition, override: bool,
+            folder: Path | None = None) -> list[SpringcError]:
+        """Insert a file's classes; user files (``override``) clash with each other only.
+        ``folder`` is the package folder of a ``package.mo`` file."""
         self.files.append(stored)
         errors: list[SpringcError] = []
         package = self.root
@@ -92,8 +139,77 @@ class ClassTree:
                 continue
             entry = _place(defn, package)
             entry.from_user = override
+            if folder is not None and defn.kind == "package":
+                entry.folder, entry.tree = folder, self
             package.classes[defn.name] = entry
         return errors
+
+    def load_member(self, package: ClassEntry, name: str) -> ClassEntry | None:
+        """Parse the file that stores class ``name`` of ``package`` (a package folder,
+        or the root: the first library root that has it); ``None`` if none does."""
+        if (id(package), name) in self._missing:
+            return None
+        found = self._find_member(package, name)
+        if found is None:
+            self._missing.add((id(package), name))
+        return found
+
+    def _find_member(self, package: ClassEntry, name: str) -> ClassEntry | None:
+        if package is self.root:
+            if name in PREDEFINED_TYPES:
+                return None
+            for root in self.roots:
+                path = class_file(root.folder, name)
+                if path is not None:
+                    self._load_library_file(path, (), name)
+                elif root.folder not in self._loose_done:
+                    self._loose_done.add(root.folder)
+                    for loose in loose_files(root.folder):
+                        self._load_library_file(loose, None, None)
+                if name in self.root.classes:
+                    return self.root.classes[name]
+            return None
+        if package.folder is None:
+            return None
+        path = class_file(package.folder, name)
+        if path is None:
+            return None
+        self._load_library_file(path, tuple(package.full_name.split(".")), name)
+        return package.classes.get(name)
+
+    def _load_library_file(self, path: Path, within: tuple[str, ...] | None,
+                           name: str | None) -> None:
+        """Parse and place a library file; ``within`` (unless ``None``) is the package
+        its place in the folders implies and ``name`` the class it must hold."""
+        if path.resolve() in self.parsed_paths:
+            return
+        self.parsed_paths.append(path.resolve())
+        stored = parse_cached(path)
+        span = stored.classes[0].span if stored.classes else Span(str(path), 1, 1, 1, 1)
+        if within is not None and (stored.within or ()) != within:
+            where = "the top level" if not within else f"package '{'.'.join(within)}'"
+            said = f"within {'.'.join(stored.within)};" if stored.within else "no `within`"
+            raise LoadError(
+                f"'{path}' is stored in {where} but says {said}", span,
+                hint=f"start the file with `within {'.'.join(within)};` or move it to "
+                "the folder of the package it names")
+        names = [d.name for d in stored.classes]
+        # An older-style .mdl file at the top of a root may hold more classes than one.
+        lenient = within == () and path.suffix == ".mdl"
+        if name is not None and (name not in names if lenient else names != [name]):
+            found = ", ".join(f"'{d.name}'" for d in stored.classes) or "no class"
+            raise LoadError(
+                f"'{path}' must hold exactly the class '{name}' (its file name), "
+                f"found {found}", span,
+                hint=f"rename the class or the file so that both are '{name}'")
+        folder = path.parent if is_package_file(path) else None
+        errors = self.add(stored, override=False, folder=folder)
+        if errors:
+            raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
+
+    def searched(self) -> str:
+        """The library path, in the words of an error message."""
+        return ", then ".join(["the files named"] + [r.describe() for r in self.roots])
 
     def resolve(self, path: Sequence[str], scope: ClassEntry, span: Span | None) -> ClassEntry:
         """Look up a dotted class name from ``scope`` (Modelica lexical lookup)."""
@@ -104,144 +220,198 @@ class ClassTree:
         for part in path[1:]:
             member = member_class(entry, part)
             if member is None:
+                searched = [] if entry.folder is None else [
+                    Note(f"searched the package folder {entry.folder} for {part}.mo, "
+                         f"{part}.mdl and {part}/package.mo")]
                 raise FlattenError(
                     f"class '{entry.full_name}' has no member class '{part}'", span,
-                    [Note(f"'{entry.full_name}' is defined here", entry.defn.span)])
+                    [Note(f"'{entry.full_name}' is defined here", entry.defn.span),
+                     *searched])
             entry = member
         return entry
 
 
-def member_class(entry: ClassEntry, name: str) -> ClassEntry | None:
-    """A class named ``name`` declared in ``entry`` or inherited by it."""
-    if name in entry.classes:
-        return entry.classes[name]
+class _LookupCycle(Exception):
+    """Looking up a member needs that same member (a package extending a class of its
+    own missing subpackage)."""
+
+
+def member_class(entry: ClassEntry, name: str,
+                 active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
+    """A class named ``name`` declared in ``entry`` or inherited by it. ``active``: the
+    (class, name) lookups in progress, to stop a lookup that would need itself."""
+    found = entry.child(name)
+    if found is not None:
+        return found
+    key = (id(entry), name)
+    if key in active:
+        raise _LookupCycle
     for element in entry.defn.elements:
         if isinstance(element, s.Extends):
             try:
-                base = _resolve_quiet(element.base, entry.parent or entry)
-            except FlattenError:
-                continue
+                base = _resolve_quiet(element.base, entry.parent or entry, active | {key})
+            except _LookupCycle:
+                dotted = ".".join(part.name for part in element.base.parts)
+                raise FlattenError(
+                    f"class '{entry.full_name}' extends '{dotted}', whose lookup "
+                    f"needs the class '{name}' of '{entry.full_name}' itself, and "
+                    f"'{entry.full_name}' has no class '{name}'", element.span,
+                    hint=f"define '{name}' in '{entry.full_name}' (in the package or, "
+                    f"for a package folder, as {name}.mo or {name}/package.mo), or "
+                    "correct the extends clause") from None
             if base is not None and base is not entry:
-                found = member_class(base, name)
+                found = member_class(base, name, active)
                 if found is not None:
                     return found
     return None
 
 
-def _resolve_quiet(ref: s.Ref, scope: ClassEntry) -> ClassEntry | None:
-    entry = lookup_class(ref.parts[0].name, scope)
+def _resolve_quiet(ref: s.Ref, scope: ClassEntry,
+                   active: frozenset[tuple[int, str]]) -> ClassEntry | None:
+    entry = lookup_class(ref.parts[0].name, scope, active)
     for part in ref.parts[1:]:
         if entry is None:
             return None
-        entry = member_class(entry, part.name)
+        entry = member_class(entry, part.name, active)
     return entry
 
 
-def lookup_class(name: str, scope: ClassEntry) -> ClassEntry | None:
+def lookup_class(name: str, scope: ClassEntry,
+                 active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
     """Find the class a simple name denotes from ``scope``: local and inherited classes,
     imports, then enclosing classes (stopping at ``encapsulated``, except for the root)."""
     entry: ClassEntry | None = scope
     while entry is not None:
-        found = member_class(entry, name) or _imported(entry, name)
+        found = member_class(entry, name, active) or _imported(entry, name, active)
         if found is not None:
             return found
         if entry.defn.encapsulated:
             root = entry
             while root.parent is not None:
                 root = root.parent
-            return root.classes.get(name)
+            return root.child(name)
         entry = entry.parent
     return None
 
 
-def _imported(entry: ClassEntry, name: str) -> ClassEntry | None:
+def _imported(entry: ClassEntry, name: str,
+              active: frozenset[tuple[int, str]]) -> ClassEntry | None:
+    """The class ``name`` imported into ``entry``. An import whose package (or, for a
+    qualified import of ``name``, whose class) is not loaded is an error at the import."""
+    root = entry
+    while root.parent is not None:
+        root = root.parent
     for element in entry.defn.elements:
         if not isinstance(element, s.Import):
             continue
-        target: tuple[str, ...] | None = None
-        if element.alias == name:
-            target = element.path + element.names
-        elif (name in element.names and element.alias is None) or element.wildcard:
-            target = (*element.path, name)
-        if target is None:
+        named = (element.alias == name) or (name in element.names and element.alias is None)
+        if not named and not element.wildcard:
             continue
-        root = entry
-        while root.parent is not None:
-            root = root.parent
-        found: ClassEntry | None = root
-        for part in target:
-            found = member_class(found, part) if found is not None else None
+        package = _import_path(root, element.path, element, active)
+        target = element.names[0] if element.alias == name else name
+        found = member_class(package, target, active)
         if found is not None:
             return found
+        if named:
+            raise FlattenError(
+                f"the imported class '{'.'.join((*element.path, target))}' is not loaded: "
+                f"'{package.full_name}' has no class '{target}'", element.span,
+                [Note(f"'{package.full_name}' is defined here", package.defn.span)],
+                hint="check the spelling of the import")
     return None
+
+
+def _import_path(root: ClassEntry, path: Sequence[str], element: s.Import,
+                 active: frozenset[tuple[int, str]]) -> ClassEntry:
+    found = root
+    for depth, part in enumerate(path):
+        member = member_class(found, part, active)
+        if member is None:
+            missing = ".".join(path[:depth + 1])
+            tree = root.tree
+            raise FlattenError(
+                f"the imported package '{'.'.join(path)}' is not loaded"
+                if depth == len(path) - 1 else
+                f"the import names '{'.'.join(path)}', but '{missing}' is not loaded",
+                element.span, hint="load the library that defines it (name its file, "
+                "or pass its folder with -L or in MODELICAPATH)"
+                + (f"; searched {tree.searched()}" if tree is not None else ""))
+        found = member
+    return found
 
 
 def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
     visible: set[str] = set()
     entry: ClassEntry | None = scope
+    root = scope
     while entry is not None:
         visible.update(entry.classes)
         for e in entry.defn.elements:
             if isinstance(e, s.Import):
                 visible.update([e.alias] if e.alias else e.names)
+        root = entry
         entry = entry.parent
+    searched = f"; searched {root.tree.searched()}" if root.tree is not None else ""
     close = difflib.get_close_matches(name, sorted(visible), 1)
     if close:
-        return f"did you mean '{close[0]}'?"
+        return f"did you mean '{close[0]}'? (searched {root.tree.searched()})" \
+            if root.tree is not None else f"did you mean '{close[0]}'?"
     return (f"no class '{name}' is visible here: check the spelling, add an `import`, "
             "or load the file that defines it (name it on the command line or pass "
-            "its folder with -L)")
-
-
-def library_folders(extra: Iterable[str | Path] = ()) -> list[Path]:
-    """Library folders in precedence order: ``-L`` folders, ``SPRINGC_PATH``, bundled."""
-    folders = [Path(p) for p in extra]
-    env = os.environ.get("SPRINGC_PATH", "")
-    folders += [Path(p) for p in env.split(os.pathsep) if p]
-    folders.append(models_dir())
-    return folders
+            f"its folder with -L){searched}")
 
 
 def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
          texts: Sequence[tuple[str, str]] = ()) -> ClassTree:
-    """Parse the user's files, the user's ``texts`` (``(pseudo file name, text)``
-    pairs, such as ``("<string>", ...)``: their excerpts are kept for error messages)
-    and every ``.mdl`` file of the library folders.
+    """Parse the user's files and the user's ``texts`` (``(pseudo file name, text)``
+    pairs, such as ``("<string>", ...)``: their excerpts are kept for error messages);
+    library classes are parsed when lookup needs them.
 
-    All files are parsed first; classes are then placed in precedence order, files
-    without ``within`` before those placed inside a package (shallow packages first).
+    Classes of the user's files are placed in precedence order: files without
+    ``within`` before those placed inside a package (shallow packages first). A
+    ``package.mo`` named by the user is loaded as a library package (its other files on
+    demand) and is not where the default model comes from.
     """
     errors: list[SpringcError] = []
-    parsed: list[tuple[s.StoredDefinition, bool]] = []
-    seen: set[Path] = set()
-    sources = [(Path(p), True) for p in files]
-    for folder in library_folders(libraries):
-        if not folder.is_dir():
-            errors.append(LoadError(f"library folder '{folder}' does not exist",
+    roots = library_roots(libraries)
+    for root in roots:
+        if not root.folder.is_dir() and root.origin != "MODELICAPATH":
+            errors.append(LoadError(f"library folder '{root.folder}' does not exist",
                                     hint="check the -L option and SPRINGC_PATH"))
+    tree = ClassTree([r for r in roots if r.folder.is_dir()])
+    parsed: list[tuple[s.StoredDefinition, Path | None]] = []
+    for name in files:
+        path = Path(name)
+        if path.resolve() in tree.parsed_paths:
             continue
-        sources += [(p, False) for p in sorted(folder.rglob("*.mdl"))]
-    for path, from_user in sources:
-        if path.resolve() in seen:
-            continue
-        seen.add(path.resolve())
+        tree.parsed_paths.append(path.resolve())
         try:
-            parsed.append((_parse_cached(path), from_user))
+            parsed.append((parse_cached(path), path))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:
             errors.append(error)
-    for name, text in texts:
-        remember_source(name, text)
+    for text_name, text in texts:
+        remember_source(text_name, text)
         try:
-            parsed.append((parse_text(text, name), True))
+            parsed.append((parse_text(text, text_name), None))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:
             errors.append(error)
-    tree = ClassTree()
-    for stored, from_user in sorted(parsed, key=lambda p: len(p[0].within or ())):
-        errors += tree.add(stored, override=from_user)
+    for stored, source in sorted(parsed, key=lambda p: len(p[0].within or ())):
+        package = source is not None and is_package_file(source)
+        try:
+            errors += tree.add(stored, override=True,
+                               folder=source.parent if source is not None and package else None)
+        except ErrorGroup as group:
+            errors += group.errors
+        except SpringcError as error:
+            errors.append(error)
+        (tree.named_packages if package else tree.user_files).append(stored)
+    # The default model is the last of the user's files as named.
+    order = {id(stored): i for i, (stored, _) in enumerate(parsed)}
+    tree.user_files.sort(key=lambda f: order[id(f)])
     if errors:
         raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
     return tree
@@ -250,7 +420,7 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
 _PARSED: dict[tuple[str, int, int], s.StoredDefinition] = {}
 
 
-def _parse_cached(path: Path) -> s.StoredDefinition:
+def parse_cached(path: Path) -> s.StoredDefinition:
     """Parse a file, reusing the syntax tree while the file is unchanged (syntax trees
     are immutable, so a process that flattens many models parses each library once)."""
     try:
@@ -262,3 +432,8 @@ def _parse_cached(path: Path) -> s.StoredDefinition:
     if stored is None:
         stored = _PARSED[key] = parse_file(path)
     return stored
+
+
+def clear_parse_cache() -> None:
+    """Forget every parsed file (benchmarks measure loading from scratch with it)."""
+    _PARSED.clear()

@@ -27,7 +27,7 @@ from types import ModuleType
 from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
-from ..parse import library_folders
+from ..parse import library_folders, source_files
 from ..resources import PACKAGE_ROOT, grammar_path
 
 CACHE_ENTRIES = 200
@@ -134,15 +134,16 @@ def springc_digest() -> bytes:
 
 def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
     """A digest of everything a generated module depends on: ``settings`` (by ``repr``:
-    model, backend, outputs, modifications), the text of ``files`` and of every ``.mdl``
-    file of the library folders, and springc's own code."""
+    model, backend, outputs, modifications), the text of ``files``, of every file loading
+    may read below the library folders and the folders of named ``package.mo`` files
+    (``.mo``, ``.mdl``, ``package.order``), and springc's own code."""
     h = hashlib.sha256()
     h.update(repr((CODEGEN_VERSION, settings)).encode())
     h.update(springc_digest())
     sources = [Path(f) for f in files]
-    for folder in library_folders(libraries):
-        if folder.is_dir():
-            sources += sorted(folder.glob("**/*.mdl"))
+    folders = [Path(f).parent for f in files if Path(f).name in ("package.mo", "package.mdl")]
+    for folder in folders + library_folders(libraries):
+        sources += source_files(folder)
     for path in sources:
         h.update(str(path.resolve()).encode() + b"\0")
         try:
