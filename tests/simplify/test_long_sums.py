@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 
 import springc
-from springc.flatten.arrays import FOLD_CHUNK, fold
+from springc.flatten.arrays import fold
 from springc.ir import expr as x
+from springc.ir.expr import FOLD_CHUNK
 
 MODEL = """
 model SumZ

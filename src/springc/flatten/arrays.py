@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from functools import reduce
 from typing import Any, TypeGuard
 
 import numpy as np
@@ -99,24 +98,11 @@ def dot(a: np.ndarray, b: np.ndarray) -> x.Expr:
     return fold(x.add, [x.mul(p, q) for p, q in zip(a, b)], x.ZERO)
 
 
-FOLD_CHUNK = 64
-"""Terms folded left to right before chunks are combined pairwise (see :func:`fold`)."""
-
-
 def fold(op: Callable[[x.Expr, x.Expr], x.Expr], items: Sequence[x.Expr],
          identity: x.Expr) -> x.Expr:
-    """``items`` combined with ``op`` (``sum``, ``product``, a scalar product).
-
-    Up to :data:`FOLD_CHUNK` items this is the left fold ``((a + b) + c) + ...`` that the
-    flat text shows; longer runs are folded in chunks of that size and the chunks combined
-    pairwise, so that the tree stays shallow (depth about 64 + log2(n/64)) and every later
-    stage, which recurses over expressions, handles a sum of thousands of terms."""
-    chunks = [reduce(op, items[i:i + FOLD_CHUNK], identity)
-              for i in range(0, len(items), FOLD_CHUNK)] or [identity]
-    while len(chunks) > 1:
-        pairs = [op(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
-        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
-    return chunks[0]
+    """``items`` combined with ``op`` (``sum``, ``product``, a scalar product), kept
+    shallow for long runs (:func:`springc.ir.expr.fold_chunked`)."""
+    return x.fold_chunked(items, op, op, identity)
 
 
 def mul(a: Value, b: Value) -> Value:

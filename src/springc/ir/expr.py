@@ -15,10 +15,10 @@ from __future__ import annotations
 import math
 import sys
 import threading
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 # ------------------------------------------------------------------------ depth
 
@@ -235,6 +235,33 @@ def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> Any:
 
 
 # ------------------------------------------------------------- construction
+
+
+FOLD_CHUNK = 64
+"""Items folded left to right before chunks are combined pairwise (see :func:`fold_chunked`)."""
+
+_Item = TypeVar("_Item")
+
+
+def fold_chunked(items: Sequence[_Item], step: Callable[[Expr, _Item], Expr],
+                 combine: Callable[[Expr, Expr], Expr], identity: Expr) -> Expr:
+    """``step`` folded over ``items`` from ``identity``, shallow for long runs.
+
+    Up to :data:`FOLD_CHUNK` items this is the left fold ``((a + b) + c) + ...`` that the
+    flat text shows; longer runs are folded in chunks of that size whose results are
+    joined pairwise with ``combine``, so the tree stays shallow (depth about
+    64 + log2(n/64)) and every later stage, which recurses over expressions, handles a
+    sum of thousands of terms."""
+    chunks: list[Expr] = []
+    for i in range(0, len(items), FOLD_CHUNK):
+        value = identity
+        for item in items[i:i + FOLD_CHUNK]:
+            value = step(value, item)
+        chunks.append(value)
+    while len(chunks) > 1:
+        pairs = [combine(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
+        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
+    return chunks[0] if chunks else identity
 
 
 def add(a: Expr, b: Expr) -> Expr:

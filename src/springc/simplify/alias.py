@@ -62,23 +62,11 @@ def _terms(e: x.Expr, sign: int, unknowns: set[str], out: list[tuple[int, str]],
     return True
 
 
-_CHUNK = 64
-
-
 def _signed_sum(terms: list[tuple[int, x.Expr]]) -> x.Expr:
-    """``t1 ± t2 ± ...``, left to right in chunks of 64 terms whose sums are combined
-    pairwise: a sum of thousands of terms stays shallow enough for the later stages,
-    which recurse over expressions (as flatten's ``sum`` does)."""
-    chunks: list[x.Expr] = []
-    for i in range(0, len(terms), _CHUNK):
-        value: x.Expr = x.ZERO
-        for sign, term in terms[i:i + _CHUNK]:
-            value = x.add(value, term) if sign == 1 else x.sub(value, term)
-        chunks.append(value)
-    while len(chunks) > 1:
-        pairs = [x.add(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
-        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
-    return chunks[0] if chunks else x.ZERO
+    """``t1 ± t2 ± ...``, kept shallow for long runs as flatten's ``sum`` is."""
+    return x.fold_chunked(
+        terms, lambda value, st: x.add(value, st[1]) if st[0] == 1 else x.sub(value, st[1]),
+        x.add, x.ZERO)
 
 
 def _classify(r: dae.Residual, unknowns: set[str]
