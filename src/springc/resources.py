@@ -30,10 +30,15 @@ def models_dir() -> Path:
     return resource_dir("models")
 
 
-def user_cache_dir() -> Path:
+def user_cache_dir() -> Path | None:
     """springc's per-user cache folder: ``$SPRINGC_CACHE_DIR``, else
-    ``$XDG_CACHE_HOME/springc``, else ``~/.cache/springc``."""
+    ``$XDG_CACHE_HOME/springc``, else ``~/.cache/springc``; None when there is no home
+    folder to put it in (no ``HOME`` and no password entry)."""
     if os.environ.get("SPRINGC_CACHE_DIR"):
         return Path(os.environ["SPRINGC_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "springc"
+    if os.environ.get("XDG_CACHE_HOME"):
+        return Path(os.environ["XDG_CACHE_HOME"]) / "springc"
+    try:
+        return Path.home() / ".cache" / "springc"
+    except RuntimeError:
+        return None

@@ -80,3 +80,14 @@ def test_a_cache_folder_that_is_not_a_folder_means_no_cache(tmp_path: Path,
     (tmp_path / "elsewhere").mkdir()
     (tmp_path / "parser").symlink_to(tmp_path / "elsewhere")
     assert parser_cache_file(grammar_path()) is None
+
+
+def test_without_a_home_folder_the_parser_is_built_without_a_cache(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_home() -> Path:
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.delenv("SPRINGC_CACHE_DIR", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    assert parser_cache_file(grammar_path()) is None

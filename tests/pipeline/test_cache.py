@@ -221,3 +221,19 @@ def test_cache_write_failure_falls_back_to_a_temporary_folder(
     assert not compiled.path.is_relative_to(folder) and compiled.path.exists()
     result = springc.simulate(compiled, stop=1.0, interval=0.5, rtol=1e-10, atol=1e-12)
     assert abs(result["x"][-1] - np.exp(-1.0)) < 1e-7
+
+
+def test_without_a_home_folder_parsing_and_compiling_still_work(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    def no_home() -> Path:
+        raise RuntimeError("Could not determine home directory.")
+
+    monkeypatch.delenv("SPRINGC_CACHE_DIR", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    path = tmp_path / "m.mdl"
+    path.write_text(MODEL.format(i=3))
+    result = springc.simulate([path], stop=1.0, interval=0.5)
+    assert "note: cannot use the cache folder: no home folder" in capsys.readouterr().err
+    assert np.allclose(result["x"], 3 * np.exp(-result.time), rtol=1e-5)

@@ -90,7 +90,10 @@ def parser_cache_file(grammar: Path) -> Path | None:
     by this user (a looser one is tightened to 0700) and the file, if present, is a
     regular file owned by this user (one that others may write is removed)."""
     try:
-        folder = user_cache_dir() / "parser"
+        home = user_cache_dir()
+        if home is None:
+            return None
+        folder = home / "parser"
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         info = os.lstat(folder)
         if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():

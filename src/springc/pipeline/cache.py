@@ -28,7 +28,7 @@ from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
 from ..parse import library_folders, source_files
-from ..resources import PACKAGE_ROOT, grammar_path
+from ..resources import PACKAGE_ROOT, grammar_path, user_cache_dir
 
 CACHE_ENTRIES = 200
 """Generated modules kept in the cache; the least recently used beyond this are removed."""
@@ -48,14 +48,10 @@ def note(text: str) -> None:
 
 def cache_dir() -> Path:
     """Where generated modules are kept (:class:`CacheUnusable` without a home)."""
-    if os.environ.get("SPRINGC_CACHE_DIR"):
-        return Path(os.environ["SPRINGC_CACHE_DIR"])
-    if os.environ.get("XDG_CACHE_HOME"):
-        return Path(os.environ["XDG_CACHE_HOME"]) / "springc"
-    try:
-        return Path.home() / ".cache" / "springc"
-    except RuntimeError as err:  # no HOME and no password entry
-        raise CacheUnusable(f"no home folder ({err})") from err
+    folder = user_cache_dir()
+    if folder is None:
+        raise CacheUnusable("no home folder")
+    return folder
 
 
 def private_folder(folder: Path) -> Path:
