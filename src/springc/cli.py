@@ -34,7 +34,7 @@ EXIT_INTERRUPTED = 128 + signal.SIGINT
 
 CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
              "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}
-"""How the checks of :func:`springc.api.check_run_values` name the options."""
+"""How the checks of :func:`springc.simulation.check_run_values` name the options."""
 
 
 def _terminate(signum: int, frame: FrameType | None) -> None:
@@ -283,8 +283,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              time_limit: float | None, output: str | None, plot: str | None,
              quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
-    from .api import check_run_values
-    from .simulation import PLOT_FORMATS, RESULT_FORMATS, choose_engine
+    from .simulation import PLOT_FORMATS, RESULT_FORMATS, check_run_values, choose_engine
 
     values = _parse_set(assignments)
     if solver.lower() in FIXED_STEP and step is None:
@@ -426,8 +425,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
     are compared; --vars selects other variables.
     """
-    from .api import check_run_values
-    from .simulation import PLOT_FORMATS
+    from .simulation import PLOT_FORMATS, check_run_values
 
     values = _parse_set(assignments)
     check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
@@ -520,7 +518,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     variable) next to it. A failing run is recorded with its error; an interrupted
     study continues with --resume.
     """
-    from .api import check_run_values
+    from .simulation import check_run_values
     from .studies import check_outputs, parse_parameter, summary_path
 
     values = _parse_set(assignments)

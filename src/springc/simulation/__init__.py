@@ -22,6 +22,7 @@ from .solver_names import (
     IMPLICIT_SOLVERS,
     SOLVERS,
 )
+from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
     from .compiled import choose_engine
@@ -43,11 +44,12 @@ if TYPE_CHECKING:
         simulate_model,
     )
 
-__all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE", "DEFAULT_MAX_STEPS",
-           "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT", "ENGINES", "FIXED_STEP", "IMPLICIT_SOLVERS",
-           "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS", "SOLVERS", "SimulationOptions",
-           "SimulationResult", "choose_engine", "file_format", "initial_state", "output_grid",
-           "resolve", "save_outputs", "simulate_model", "write_csv"]
+__all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
+           "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT", "ENGINES", "FIXED_STEP",
+           "IMPLICIT_SOLVERS", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS", "SOLVERS",
+           "SimulationOptions", "SimulationResult", "check_run_values", "choose_engine",
+           "file_format", "initial_state", "output_grid", "resolve", "save_outputs",
+           "simulate_model", "write_csv"]
 
 _LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
 _RESULTS = frozenset({"PLOT_FORMATS", "RESULT_FORMATS", "SimulationResult", "file_format",

@@ -16,6 +16,7 @@ from typing import TextIO
 import numpy as np
 
 from ..errors import SimulationError, UsageError
+from ..simulation import check_run_values
 
 DEFAULT_TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 DEFAULT_STEP_DIVISIONS = (2, 4, 8, 16, 32, 64, 128, 256)
@@ -85,18 +86,7 @@ class TradeoffOptions:
                 and not math.isnan(self.budget)):
             raise UsageError(f"budget must be a positive number of seconds, not "
                              f"{self.budget!r}", option="budget")
-        for name in ("start", "stop", "interval"):
-            value = getattr(self, name)
-            if value is not None and not (isinstance(value, (int, float))
-                                          and math.isfinite(value)):
-                raise UsageError(f"{name} must be a finite number, not {value!r}",
-                                 option=name)
-        if self.interval is not None and not self.interval > 0:
-            raise UsageError(f"interval must be a finite number > 0, not {self.interval!r}",
-                             option="interval")
-        if self.start is not None and self.stop is not None and not self.stop > self.start:
-            raise UsageError(f"stop ({self.stop:g}) must be after start ({self.start:g})",
-                             option="stop")
+        check_run_values(self.start, self.stop, self.interval)
 
 
 @dataclass(frozen=True)
