@@ -408,14 +408,15 @@ def test_unexpected_end_of_file() -> None:
     )
 
 
-def test_when_is_not_supported() -> None:
-    text = "model A\n  Real x;\nequation\n  when x > 1 then\n    reinit(x, 0);\n  end when;\nend A;"
-    assert error_text(text) == (
-        "t.mo:4:3: error: `when` equations are not supported yet\n"
-        "    4 |   when x > 1 then\n"
-        "      |   ^^^^\n"
-        'help: springc supports a subset of Modelica; see "Not supported yet" in docs/language.md'
-    )
+def test_when_equation_keeps_its_branches_in_order() -> None:
+    from springc.ir.syntax import WhenEquation
+
+    text = ("model A\n  Real x;\nequation\n  when x > 1 then\n    reinit(x, 0);\n"
+            "  elsewhen x < -1 then\n    reinit(x, 1);\n  end when;\nend A;")
+    (cls,) = parse_text(text, "t.mo").classes
+    (when,) = [e for e in cls.equations if isinstance(e, WhenEquation)]
+    assert [(c.op, len(body)) for c, body in when.branches] == [(">", 1), ("<", 1)]
+    assert (when.span.line, when.span.column) == (4, 3)
 
 
 def test_mismatched_end_name() -> None:
@@ -487,7 +488,6 @@ def test_other_lexical_and_syntax_errors() -> None:
 
 
 UNSUPPORTED = [
-    ("model A equation when c then x = 1; end when; end A;", "`when` equations are"),
     ("function f algorithm when c then x := 1; end when; end f;", "`when` statements are"),
     ("model A M m(redeclare Real x); end A;", "`redeclare` is"),
     ("model A redeclare M m; end A;", "`redeclare` is"),
@@ -527,15 +527,15 @@ def test_unsupported_constructs_are_rejected(text: str, what: str) -> None:
 
 def test_all_unsupported_constructs_are_reported_together() -> None:
     text = (
-        "model A\n  inner Real y;\nequation\n  when y > 1 then end when;\nend A;\n"
+        "model A\n  inner Real y;\nequation\n  x = 1;\nalgorithm\n  x := 1;\nend A;\n"
         "type E = enumeration(a);\n"
     )
     with pytest.raises(ErrorGroup) as info:
         parse_text(text, "t.mo")
     assert [(e.message, e.span.line, e.span.column) for e in info.value.errors] == [
         ("`inner` elements are not supported yet", 2, 3),
-        ("`when` equations are not supported yet", 4, 3),
-        ("`enumeration` types are not supported yet", 6, 10),
+        ("`algorithm` sections outside functions are not supported yet", 5, 1),
+        ("`enumeration` types are not supported yet", 8, 10),
     ]
 
 

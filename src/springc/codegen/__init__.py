@@ -2,8 +2,8 @@
 
 from .context import BACKENDS, CodegenBug, CodegenOptions, GeneratedModel
 from .generator import generate
-from .module_api import MODULE_NAMES, GeneratedModule
+from .module_api import HYBRID_NAMES, MODULE_NAMES, GeneratedModule, HybridModule
 from .module_text import CODEGEN_VERSION
 
-__all__ = ["BACKENDS", "CODEGEN_VERSION", "MODULE_NAMES", "CodegenBug", "CodegenOptions",
-           "GeneratedModel", "GeneratedModule", "generate"]
+__all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CodegenBug",
+           "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule", "generate"]

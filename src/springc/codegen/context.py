@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
+from .event_layout import EventLayout
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 
@@ -87,6 +88,13 @@ class CodegenContext:
             if isinstance(step, ode.NonlinearBlock):
                 for t in step.tearing:
                     self.guess_slots[t] = len(self.guess_slots)
+        # the event slots of z (codegen/event_layout.py), between the warm starts and
+        # the failure flag
+        self.events = EventLayout(system.events, len(self.guess_slots)) \
+            if system.events is not None else None
+        self.flag_slot = len(self.guess_slots) + (self.events.size if self.events else 0)
+        if self.events:
+            self.model_names |= set(self.events.discrete)
 
     def source_files(self) -> list[str]:
         """The model's own file, then the other files its variables come from."""
@@ -98,7 +106,7 @@ class CodegenContext:
     def loads(self) -> list[Stmt]:
         out: list[Stmt] = [Load(n, f"p[{i}]", n) for i, n in enumerate(self.params)]
         out += [Load(n, f"x[{i}]", n) for i, n in enumerate(self.states)]
-        return out
+        return out + (self.events.loads() if self.events else [])
 
     def newton_systems(self) -> dict[int, tuple[str, ...]]:
         """Failure flag value -> tearing variables of that torn system."""
@@ -176,7 +184,7 @@ class CodegenContext:
         assert done is not None
         loop.append(Let(f"_done{index}", done))
         body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))
-        body.append(Raw(f"if not _ok{index}:\n    z[{len(self.guess_slots)}] = "
+        body.append(Raw(f"if not _ok{index}:\n    z[{self.flag_slot}] = "
                         f"{float(index + 1)}"))
         body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
         names = {*block.tearing, *(a.name for a in block.inner),

@@ -26,6 +26,8 @@ from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
+from .events import FUNCTIONS as EVENT_FUNCTIONS
+from .events import held_system
 from .jacobian import jacobian_statements
 from .module_text import module_text, parameter_value, topological
 from .printer import function_lines
@@ -80,6 +82,8 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     if options.backend not in BACKENDS:
         raise CodegenError(f"unknown backend '{options.backend}'",
                            hint=f"choose one of {', '.join(BACKENDS)}")
+    if system.events is not None:  # the continuous functions read held values
+        system = held_system(system, CodegenContext(system, flat_model).events)  # type: ignore[arg-type]
     m = CodegenContext(system, flat_model)
     computed = system.step_names()
     available = [n for n in system.observed_names()]
@@ -99,7 +103,9 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     helpers: set[str] = set()
     numba = options.backend == "numba"
     vector = options.vector
-    if vector is None:
+    if m.events is not None:
+        vector = False  # the event functions are written with scalar statements
+    elif vector is None:
         vector = _vector_suits(system)
     elif vector and not _vector_suits(system, 0):
         raise CodegenError("the vector layout needs a system of explicit assignments only")
@@ -117,6 +123,10 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     else:
         bodies, pattern = _scalar_bodies(m, outputs, namer, helpers, numba)
         table = None
+    if m.events is not None:
+        prologue = [] if numba else [Raw("x = x.tolist()\np = p.tolist()")]
+        bodies += [(fn, doc, function_lines(namer, helpers, prologue + make(m, m.events)), ret)
+                   for fn, doc, make, ret in EVENT_FUNCTIONS]
     structural = structural_parameters(system, flat_model)
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
                           table)
@@ -179,6 +189,7 @@ def _scalar_bodies(m: CodegenContext, outputs: Sequence[str], namer: Namer, help
 
 def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
     known = set(m.states) | set(m.params) | set(computed) | set(m.aliases)
+    known |= set(m.events.slot) if m.events is not None else set()
     for step in m.ode.steps:
         inner = set()
         if isinstance(step, ode.NonlinearBlock):

@@ -43,6 +43,7 @@ class GeneratedModule(Protocol):
     JAC_COLS: IntArray
     JAC_INDICES: IntArray
     JAC_INDPTR: IntArray
+    EVENTS: bool  # a hybrid module: it has the names of HybridModule too
 
     def parameters(self, values: Mapping[str, float] | None = None) -> FloatArray: ...
 
@@ -72,3 +73,71 @@ MODULE_NAMES = frozenset(name for name in GeneratedModule.__annotations__) | {
     "parameters", "start", "guesses", "rhs", "jacobian_values", "jacobian",
     "jacobian_dense", "sparsity", "observed", "observed_grid"}
 """Every name a generated module defines (checked when the pipeline imports one)."""
+
+
+class HybridModule(GeneratedModule, Protocol):
+    """A generated module with events (``EVENTS`` true): Modelica 3.6, 8.5-8.6.
+
+    Where the discrete values live: in ``z``, between the Newton warm starts and the
+    failure flag (``z[-1]``), from ``Z_EVENTS`` to ``Z_SIZE - 2``: the held value of
+    every state relation (``Z_RELATIONS + k``, 1.0 true, 0.0 false, for the relation
+    ``ZERO_CROSSINGS[k]``), of every time relation and ``sample``, the discrete
+    variables (slots ``Z_DISCRETE``, names ``DISCRETE``), their ``pre`` values, the
+    when-conditions at the last event, and the flags ``Z_INITIAL``, ``Z_TERMINAL``,
+    ``Z_TERMINATE`` (0, or 1 + the index into ``TERMINATE_MESSAGES``), ``Z_CHANGED``,
+    ``Z_STATUS``. ``guesses(p)`` returns a ``z`` of ``Z_SIZE`` with the start values of
+    the discrete variables. ``rhs``, ``jacobian_values`` and ``observed`` only read
+    these slots, so between events the right-hand side is smooth; the event functions
+    write them.
+
+    How a loop drives it (``springc.simulation.events`` does exactly this):
+
+    1. at the start ``z[Z_INITIAL] = 1.0; x = event_update(t0, x, p, z)``;
+    2. integrate ``rhs`` up to ``next_time_event(t, x, p, z)`` (or the stop time);
+    3. after each accepted step compare ``zero_crossings(t, x, p, z)[k]`` (compared
+       with 0 by ``RELATION_OPS[k]``) with the held ``z[Z_RELATIONS + k]``; where one
+       differs, locate the first time it does (dense output or bisection), take the
+       states there and ``x = event_update(te, x, p, z)``; restart the integrator;
+    4. at a time event ``x = event_update(t, x, p, z)`` likewise;
+    5. after any event: ``z[Z_STATUS] != 0`` means the event iteration did not
+       settle; ``z[Z_TERMINATE] > 0`` that ``terminate()`` ended the simulation.
+    """
+
+    Z_EVENTS: int
+    Z_SIZE: int
+    Z_RELATIONS: int
+    ZERO_CROSSINGS: tuple[str, ...]
+    RELATION_OPS: tuple[str, ...]
+    TIME_EVENTS: tuple[str, ...]
+    SAMPLES: int
+    DISCRETE: tuple[str, ...]
+    Z_DISCRETE: list[int]
+    TERMINATE_MESSAGES: tuple[str, ...]
+    Z_INITIAL: int
+    Z_TERMINAL: int
+    Z_TERMINATE: int
+    Z_CHANGED: int
+    Z_STATUS: int
+    EVENT_ITERATIONS: int
+
+    def zero_crossings(self, t: float, x: FloatArray, p: FloatArray,
+                       z: FloatArray) -> FloatArray: ...
+
+    def next_time_event(self, t: float, x: FloatArray, p: FloatArray,
+                        z: FloatArray) -> float: ...
+
+    def event_update(self, t: float, x: FloatArray, p: FloatArray,
+                     z: FloatArray) -> FloatArray: ...
+
+    def event_begin(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray) -> float: ...
+
+    def event_pass(self, t: float, x: FloatArray, p: FloatArray,
+                   z: FloatArray) -> FloatArray: ...
+
+    def event_end(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray) -> float: ...
+
+
+HYBRID_NAMES = frozenset(HybridModule.__annotations__) | {
+    "zero_crossings", "next_time_event", "event_update", "event_begin", "event_pass",
+    "event_end"}
+"""The further names of a hybrid module (``EVENTS`` true)."""

@@ -16,6 +16,8 @@ from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
 from ..simplify import conditions as initial_conditions
 from .context import CodegenContext, CodegenOptions, source_comment, source_location
 from .encoding import encode_floats, encode_ints, encode_strings
+from .events import EVENT_UPDATE, NO_EVENTS
+from .events import constants as event_constants
 from .printer import HELPERS, function_lines
 from .statements import Let, Namer, Raw, Stmt, Store, escaped
 from .vector import VECTOR_THRESHOLD, VectorLayout
@@ -112,6 +114,7 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         "JAC_INDICES = JAC_ROWS",
         f"JAC_INDPTR = np.searchsorted(JAC_COLS, np.arange({n + 1}))",
     ]
+    lines += event_constants(m, m.events) if m.events is not None else NO_EVENTS
     lines += parameters_function(m, namer, helpers)
     for name in sorted(helpers):
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()
@@ -146,6 +149,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
                   '    """OBSERVED at each time ts[i] with states X[i] (a row per time)."""',
                   "    return _observed_grid(ts, X, p, z, _I)"]
     lines += ["", "", *_FOOTER.splitlines()]
+    if m.events is not None:
+        lines += ["", ""] + (["@_jit"] if numba else []) + EVENT_UPDATE.splitlines()
     return "\n".join(lines) + "\n"
 
 
@@ -243,7 +248,8 @@ def _parameters_vector(m: CodegenContext, helpers: set[str]) -> list[str]:
 
 def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> list[str]:
     """``parameters(values)``, ``start(p)`` and ``guesses(p)``: plain Python."""
-    if m.guess_slots == {} and len(m.params) + len(m.states) >= VECTOR_THRESHOLD:
+    if m.guess_slots == {} and len(m.params) + len(m.states) >= VECTOR_THRESHOLD \
+            and m.events is None:
         return _parameters_vector(m, helpers)
     index = {name: i for i, name in enumerate(m.params)}
     stmts: list[Stmt] = []
@@ -272,10 +278,14 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
               '    """Start values of the states (initialization: see springc.simulate)."""']
     lines += function_lines(namer, helpers, m.loads()[:len(m.params)] + starts)
     lines.append("    return x0")
-    guesses: list[Stmt] = [Raw(f"z = np.zeros({len(m.guess_slots) + 1})")]
+    guesses: list[Stmt] = [Raw(f"z = np.zeros({m.flag_slot + 1})")]
     for t, slot in m.guess_slots.items():
         u = m.unknowns.get(t)
         guesses.append(Store(f"z[{slot}]", _start_of(m, t, u.start if u else None), t))
+    for d in m.ode.events.discrete if m.ode.events else ():
+        assert m.events is not None
+        guesses.append(Store(f"z[{m.events.slot[d.name]}]", _start_of(m, d.name, d.start),
+                             f"{d.name} (start)"))
     lines += ["", "", "def guesses(p):",
               '    """Initial Newton guesses of the tearing variables, then the flag."""']
     lines += function_lines(namer, helpers, m.loads()[:len(m.params)] + guesses)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import FlattenError
+from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
@@ -17,6 +18,7 @@ from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
 from .loops import check_loop_nest
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .when import flatten_when, variable_if_equation
 
 
 class EquationFlattening(FlattenContext):
@@ -61,17 +63,33 @@ class EquationFlattening(FlattenContext):
             if not isinstance(where, LocalScope):  # the outermost loop of a nest
                 check_loop_nest(self.evaluator, eq, where)
             self._for(eq, eq.indices, where, owner, initial)
+        elif isinstance(eq, s.WhenEquation):
+            flatten_when(self, eq, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
+            if any(self._variable_condition(cond, where) for cond, _ in eq.branches):
+                variable_if_equation(self, eq, where, owner, initial)
+                return
             for cond, body in eq.branches:
                 if self._if_condition(cond, where):
                     self._body(body, where, owner, initial)
                     return
             self._body(eq.otherwise, where, owner, initial)
+        elif eq.call.func.dotted in ("reinit", "terminate"):
+            name = eq.call.func.dotted
+            raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
+                               hint=f"write 'when condition then {name}(...); end when;'")
         else:
             name = eq.call.func.dotted
             raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")
+
+    def _variable_condition(self, cond: s.Expr, where: Scope) -> bool:
+        """Whether an if-equation condition depends on variables (then the branches
+        switch at events: flatten/when.py)."""
+        value = self.evaluator.value(cond, where)
+        return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) \
+            and not self.is_parameter_expression(value)
 
     def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression

@@ -22,15 +22,17 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
+from .event_calls import EVENT_CALLS, event_call
+from .event_uses import EventUses
 from .functions import call_function
 from .parameters import check_powers
 from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
-    "pre", "edge", "change", "initial", "terminal", "reinit", "sample", "hold",
+    "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
     "delay", "spatialDistribution", "cardinality", "inStream", "actualStream",
-    "getInstanceName", "String", "assert", "terminate",
+    "getInstanceName", "String", "assert",
 }
 
 
@@ -46,6 +48,7 @@ class Evaluator:
         self.flattener = flattener
         self.no_event = 0  # > 0 inside noEvent(...) and smooth(...)
         self.call_depth = 0  # nesting of user-defined function calls being inlined
+        self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)
         # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
         # outlives the evaluator, so ids are not reused).
@@ -214,18 +217,8 @@ class Evaluator:
         except ValueError as err:
             raise FlattenError(str(err), e.span,
                                hint="check the sizes of both operands") from None
-        result = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
-        if op in x.RELATIONS and not isinstance(result, x.Const):
-            self._check_event(result, e.span)
-        return result
-
-    def _check_event(self, relation: x.Expr, span: Span) -> None:
-        if self.no_event or self.flattener.is_parameter_expression(relation):
-            return
-        raise FlattenError(
-            "relations on variables generate events, which are not supported yet",
-            span, hint="if the expression is continuous across the switch, wrap it in "
-            "noEvent(...)")
+        result: a.Value = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
+        return result  # a relation on variables generates events (simplify/events.py)
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
         result = self.value(e.otherwise, scope)
@@ -238,8 +231,6 @@ class Evaluator:
             then = self.value(then_expr, scope)
             if a.shape(then) != a.shape(result):
                 raise FlattenError("branches of an if-expression differ in size", e.span)
-            if not self.no_event and not self.flattener.is_parameter_expression(cond):
-                self._check_event(cond, cond_expr.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
         return result
 
@@ -356,6 +347,8 @@ class Evaluator:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")
+        if name in EVENT_CALLS:
+            return event_call(self, self.events, e, scope)
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)

@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from ..ir import expr as x
 from ..ir import flat
+from ..ir.when import When
 from ..parse import ClassTree
 from .connections import ConnectionSets
 from .equations import EquationFlattening
@@ -29,6 +30,7 @@ from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
 from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
 from .variables import attributes_of
+from .when import check_events
 
 __all__ = ["Flattener", "flatten"]
 
@@ -48,6 +50,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.connections = ConnectionSets()
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
+        self.whens: list[When] = []
         self.errors: list[SpringcError] = []
         self.mod_values = {}
         self.declared_types = {}
@@ -148,6 +151,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
             flattener.errors += binding_errors(variables, flattener.parameter_values)
+            check_events(flattener, variables)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:
@@ -156,5 +160,6 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     flattener.equations += flattener.connections.equations(scopes, top)
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
-                          experiment_of(flattener, entry, top), entry.defn.span)
+                          experiment_of(flattener, entry, top), entry.defn.span,
+                          whens=tuple(flattener.whens))
 

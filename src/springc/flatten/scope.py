@@ -24,8 +24,10 @@ from ..errors import FlattenError, FollowUpError, Note, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
+from ..ir.when import When
 from ..parse import ClassEntry
 from . import arrays as a
+from .event_uses import EventUses
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
@@ -238,6 +240,7 @@ class ExpressionEvaluator(Protocol):
     flattener: FlattenContext
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
     call_depth: int  # nesting of user-defined function calls being inlined
+    events: EventUses  # pre/edge/change uses and when-clause nesting (event_calls.py)
 
     @property
     def builtins(self) -> BuiltinFunctions: ...
@@ -272,6 +275,7 @@ class FlattenContext(Protocol):
     errors: list[SpringcError]
     equations: list[flat.Equation]
     initial_equations: list[flat.Equation]
+    whens: list[When]
     attribute_cache: AttributeCache
     reusable_views: dict[int, bool]
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from ..errors import Span
 from . import latex
 from .expr import Expr, format_number, to_text
+from .when import When, format_when
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,6 +104,7 @@ class FlatModel:
     experiment: Experiment
     span: Span
     notes: tuple[str, ...] = field(default=())
+    whens: tuple[When, ...] = field(default=())  # when-clauses (ir/when.py)
 
     @property
     def unknowns(self) -> tuple[Variable, ...]:
@@ -194,6 +196,8 @@ def format_flat(model: FlatModel, origins: bool = False) -> str:
         lines += ["  " + format_equation(e, origins) for e in model.initial_equations]
     lines.append("equation")
     lines += ["  " + format_equation(e, origins) for e in model.equations]
+    for w in model.whens:
+        lines += format_when(w, quote)
     ex = model.experiment
     pairs = [(k, v) for k, v in (("StartTime", ex.start), ("StopTime", ex.stop),
                                  ("Interval", ex.interval), ("Tolerance", ex.tolerance))
@@ -256,6 +260,7 @@ def to_json_dict(model: FlatModel) -> dict[str, object]:
             for v in model.variables],
         "equations": [_equation_dict(e) for e in model.equations],
         "initial_equations": [_equation_dict(e) for e in model.initial_equations],
+        **({"whens": [format_when(w, str, "") for w in model.whens]} if model.whens else {}),
         "experiment": {k: getattr(ex, k) for k in ("start", "stop", "interval", "tolerance")
                        if getattr(ex, k) is not None},
     }

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from . import dae, latex
 from .expr import ZERO, Expr, Var, add, mul, to_text
+from .hybrid import EventSystem
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,6 +72,7 @@ class ODE:
     observed: tuple[Assign, ...]
     parameters: tuple[dae.Parameter, ...]
     dae: dae.DAE
+    events: EventSystem | None = None  # relations, discrete variables, when-clauses
 
     def step_names(self) -> list[str]:
         """Every name computed by the steps, in order."""
@@ -87,7 +89,8 @@ class ODE:
     def observed_names(self) -> list[str]:
         """Algebraic variables the user can ask for (derivative variables excluded)."""
         computed = [n for n in self.step_names() if not dae.is_derivative(n)]
-        return computed + [a.name for a in self.observed]
+        held = [d.name for d in self.events.discrete] if self.events else []
+        return computed + [a.name for a in self.observed] + held
 
     def _repr_latex_(self) -> str | None:
         """The evaluation order as LaTeX in a notebook (:func:`springc.ir.latex.notebook`)."""

@@ -289,7 +289,16 @@ class CallEquation:
     span: Span
 
 
-Equation = Equality | Connect | ForEquation | IfEquation | CallEquation
+@dataclass(frozen=True, slots=True)
+class WhenEquation:
+    """``when c1 then ... elsewhen c2 then ... end when``: one (condition, body) per
+    branch, in order (Modelica 3.6, 8.3.5)."""
+
+    branches: tuple[tuple[Expr, tuple[Equation, ...]], ...]
+    span: Span
+
+
+Equation = Equality | Connect | ForEquation | IfEquation | CallEquation | WhenEquation
 
 # ----------------------------------------------------------------- statements
 

@@ -2,7 +2,7 @@
 
 :class:`EquationRules` has one method per equation or statement rule of
 ``grammar/modelica.lark``; the constructs of docs/language.md's "Not supported yet" list among them
-(``when``, ``while``, ``break``, ``return``, call statements) become located
+(``when`` statements, ``while``, ``break``, ``return``, call statements) become located
 ``... not supported yet`` errors.
 """
 
@@ -25,6 +25,7 @@ from ..ir.syntax import (
     IfEquation,
     IfStatement,
     Ref,
+    WhenEquation,
 )
 from .rules_base import Rejected, RuleBase, T, join
 
@@ -85,8 +86,9 @@ class EquationRules(RuleBase):
     def connect_clause(self, meta: Meta, ch: list[Any]) -> Connect:
         return Connect(ch[0], ch[1], self.span_of(meta))
 
-    def when_equation(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`when` equations are", self.keyword_span(meta, "when"))
+    def when_equation(self, meta: Meta, ch: list[Any]) -> WhenEquation:
+        branches = tuple((ch[i], ch[i + 1]) for i in range(0, len(ch), 2))
+        return WhenEquation(branches, self.span_of(meta))
 
     def for_indices(self, meta: Meta, ch: list[Any]) -> Any:
         return tuple(ch)

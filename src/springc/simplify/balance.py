@@ -19,6 +19,7 @@ from ..errors import BalanceError, Note
 from ..ir import dae, flat
 from ..ir import expr as x
 from ..structure import dulmage_mendelsohn, maximum_matching
+from .events import continuous_part
 
 MAX_NOTES = 20
 
@@ -74,7 +75,9 @@ def check_balance(model: flat.FlatModel, rows: Sequence[Sequence[int]] | None = 
                   ) -> Balance:
     """The counts of a balanced ``model``; otherwise a :class:`BalanceError` naming the
     undetermined variables and the surplus equations. ``rows``: the model's
-    :func:`incidence`, when already known."""
+    :func:`incidence`, when already known. Variables assigned in when-clauses count
+    with their when-equations, so neither is counted here."""
+    model = continuous_part(model)
     unknowns = model.unknowns
     rows = [list(r) for r in rows] if rows is not None else incidence(model)
     matching = maximum_matching(rows, len(unknowns))

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ..errors import Note, SimplifyError
 from ..ir import dae, flat
 from ..ir import expr as x
+from .events import continuous_part
 from .isolate import COUNTERS, free_variables
 
 
@@ -67,14 +67,9 @@ def _has_der(e: x.Expr) -> bool:
 
 
 def lower(model: flat.FlatModel) -> dae.DAE:
-    """Build the DAE of a flat model (continuous unknowns only, for now)."""
-    discrete = [v for v in model.unknowns if v.variability == "discrete"]
-    if discrete:
-        raise SimplifyError(
-            "discrete variables (Integer, Boolean or `discrete`) are not supported yet",
-            discrete[0].span, [Note(f"'{v.name}' is declared here", v.span)
-                               for v in discrete[1:6]],
-            "declare them as parameters if they do not change during the simulation")
+    """Build the DAE of a flat model; the variables its when-clauses assign are held
+    between events (simplify/events.py), not unknowns of the DAE."""
+    model = continuous_part(model)
     unknowns = tuple(
         dae.Unknown(v.name, v.attributes.start, bool(v.attributes.fixed),
                     v.attributes.nominal, v.attributes.state_select or "default",

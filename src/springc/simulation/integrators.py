@@ -71,8 +71,7 @@ def integrate(method: str, rhs: Rhs, times: np.ndarray, x0: np.ndarray, step: fl
         raise ValueError(f"unknown fixed-step method {method!r}; use one of {METHODS}")
     if step <= 0 or not np.isfinite(step):
         raise ValueError(f"the step must be positive, got {step!r}")
-    advance = {"euler": _euler, "symplectic-euler": _symplectic_euler,
-               "verlet": _verlet, "rk4": _rk4}[method]
+    advance = STEPPERS[method]
     if method in ("symplectic-euler", "verlet") and pairs is None:
         pairs = Pairs(np.array([], dtype=int), np.array([], dtype=int))
     f, count = _counted(rhs)
@@ -135,7 +134,7 @@ def _verlet(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
     return new
 
 
-def _rk4(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
+def _rk4_step(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
          cache: dict[str, np.ndarray]) -> np.ndarray:
     k1 = f(t, x)
     k2 = f(t + h / 2, x + h / 2 * k1)
@@ -143,3 +142,9 @@ def _rk4(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
     k4 = f(t + h, x + h * k3)
     new: np.ndarray = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     return new
+
+
+STEPPERS = {"euler": _euler, "symplectic-euler": _symplectic_euler, "verlet": _verlet,
+            "rk4": _rk4_step}
+"""One step of each method: ``(rhs, t, x, h, pairs, cache) -> x(t + h)`` (``cache``
+carries verlet's last derivative; clear it when the states jump)."""

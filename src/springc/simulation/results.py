@@ -59,6 +59,8 @@ class SimulationStats:
     note: str = ""  # what the run did differently from what was asked (e.g. the step)
     engine: str = "scipy"  # the step loop: "compiled" (springc.integrate) or "scipy"
     loop_time: float = 0.0  # seconds in the compiled loop (model code included)
+    state_events: int = 0  # events of hybrid models (simulation/events.py)
+    time_events: int = 0
 
     def summary(self, model: str) -> str:
         """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
@@ -70,6 +72,8 @@ class SimulationStats:
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s ({inside}model code {self.model_time:.3f} s; "
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
+                + (f", {self.state_events} state and {self.time_events} time events"
+                   if self.state_events or self.time_events else "")
                 + (f"; note: {self.note}" if self.note else ""))
 
 
@@ -84,6 +88,9 @@ class SimulationResult:
     units: tuple[str, ...]
     stats: SimulationStats
     parameters: dict[str, float] = field(default_factory=dict)
+    # hybrid models: the events (simulation/events.py Event) and accepted step times
+    events: tuple[Any, ...] = ()
+    step_times: tuple[float, ...] = ()
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array

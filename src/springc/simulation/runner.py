@@ -31,6 +31,7 @@ from ..simplify import describe_failure as describe_failure
 from . import solvers
 from .compiled import COMPILED, SCIPY, choose_engine, finish_dop853, run_fixed_compiled
 from .failures import Stop, code_location, state_notes
+from .hybrid_engine import events_engine
 from .limits import (
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
@@ -74,6 +75,7 @@ class SimulationOptions:
     max_steps: int = DEFAULT_MAX_STEPS
     time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
     engine: str = DEFAULT_ENGINE  # auto, compiled (springc.integrate) or scipy
+    event_rows: bool = False  # add rows with the left and right limits at each event
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -156,6 +158,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     limits = Limits(options.max_steps, options.time_limit)
     limits.validate()
     engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
+    if getattr(model.module, "EVENTS", False):
+        engine = events_engine(model.name, options.engine)
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -190,6 +194,11 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         return simulate_switching_model(model, solver, grid, rtol, atol,
                                         dict(options.parameters), limits)
     x0 = initial_state(model, p, start)
+    if getattr(model.module, "EVENTS", False):
+        from .hybrid import simulate_hybrid
+
+        return simulate_hybrid(model, options, solver, grid, x0, p, rtol, atol, limits,
+                               step if solver in FIXED_STEP else None, note, began)
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
     try:

@@ -1,0 +1,104 @@
+"""Where a hybrid model's discrete values live in the generated code: the layout of
+the event slots of ``z`` and the substitution that makes the continuous functions
+read them.
+
+``z`` = [Newton warm starts | event slots | failure flag]. The event slots, in
+order: the held value (1.0 true, 0.0 false) of every state relation (``_zr<k>``) and
+time relation (``_zt<k>``), the ``sample`` flags (``_zs<k>``, true only during the
+event at a sample time), the discrete variables (their flat names), the ``pre``
+values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), then
+``initial()`` (``_zinit``), ``terminal()`` (``_zterm``), the terminate code (0, or
+1 + the index of the ``terminate`` message), the changed flag of the last event pass
+and the event-iteration status (1.0: did not converge).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from ..ir import expr as x
+from ..ir.hybrid import EventSystem
+from .statements import Load, Stmt
+
+_QUIET = frozenset({"noEvent", "smooth"})
+FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus")
+
+
+class EventLayout:
+    """The event slots of ``z`` for ``events``, starting at ``base``."""
+
+    def __init__(self, events: EventSystem, base: int) -> None:
+        self.events = events
+        self.base = base
+        self.relations = [f"_zr{k}" for k in range(len(events.relations))]
+        self.times = [f"_zt{k}" for k in range(len(events.time_relations))]
+        self.samples = [f"_zs{k}" for k in range(len(events.samples))]
+        self.discrete = [d.name for d in events.discrete]
+        self.pre = {name: f"_zp{k}" for k, name in enumerate(events.pre)}
+        self.conditions: list[tuple[int, int, x.Expr]] = []  # (when, branch, condition)
+        for i, clause in enumerate(events.whens):
+            for j, branch in enumerate(clause.branches):
+                self.conditions += [(i, j, c) for c in branch.conditions]
+        self.condition_names = [f"_zc{k}" for k in range(len(self.conditions))]
+        names = (self.relations + self.times + self.samples + self.discrete
+                 + list(self.pre.values()) + self.condition_names + list(FLAGS))
+        self.slot = {name: base + i for i, name in enumerate(names)}
+        self.size = len(names)
+        self.held = self._held()
+        self.messages = list(dict.fromkeys(
+            t.message for clause in events.whens for b in clause.branches
+            for t in b.terminates))
+
+    def loads(self) -> list[Stmt]:
+        """Every event slot as a local of the generated functions."""
+        return [Load(name, f"z[{slot}]", name) for name, slot in self.slot.items()]
+
+    def _held(self) -> dict[x.Expr, x.Expr]:
+        mapping: dict[x.Expr, x.Expr] = {}
+        for rel, name in zip(self.events.relations, self.relations):
+            mapping[rel] = x.Var(name)
+        for tr, name in zip(self.events.time_relations, self.times):
+            mapping[tr.relation] = x.Var(name)
+        return mapping
+
+    def hold(self, e: x.Expr, held: Mapping[x.Expr, x.Expr] | None = None) -> x.Expr:
+        """``e`` as the generated code computes it: event relations read their held
+        values (``held``: another mapping, e.g. the new values during an event pass),
+        ``sample``/``initial``/``terminal`` their flags, ``pre(v)`` its slot,
+        ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``."""
+        return _replace(e, self.held if held is None else held, self, False)
+
+    def sample_name(self, call: x.Call) -> str:
+        return self.samples[self.events.samples.index((call.args[0], call.args[1]))]
+
+
+def _replace(e: x.Expr, held: Mapping[x.Expr, x.Expr], layout: EventLayout,
+             quiet: bool) -> x.Expr:
+    if isinstance(e, (x.Const, x.Var, x.Time)):
+        return e
+    if not quiet and isinstance(e, x.BinOp) and e in held:
+        return held[e]
+    if isinstance(e, x.Call):
+        if e.name == "pre":
+            return x.Var(layout.pre[e.args[0].name])  # type: ignore[union-attr]
+        if e.name == "edge":
+            return x.BinOp("and", e.args[0], x.Not(x.Var(layout.pre[e.args[0].name])))  # type: ignore[union-attr]
+        if e.name == "change":
+            return x.BinOp("<>", e.args[0], x.Var(layout.pre[e.args[0].name]))  # type: ignore[union-attr]
+        if e.name == "initial":
+            return x.Var("_zinit")
+        if e.name == "terminal":
+            return x.Var("_zterm")
+        if e.name == "sample":
+            return x.Var(layout.sample_name(e))
+        inner = quiet or e.name in _QUIET
+        return x.Call(e.name, tuple(_replace(a, held, layout, inner) for a in e.args))
+    if isinstance(e, x.BinOp):
+        return x.BinOp(e.op, _replace(e.left, held, layout, quiet),
+                       _replace(e.right, held, layout, quiet))
+    if isinstance(e, (x.Neg, x.Not, x.Der)):
+        return type(e)(_replace(e.arg, held, layout, quiet))
+    if isinstance(e, x.If):
+        return x.If(_replace(e.cond, held, layout, quiet), _replace(e.then, held, layout, quiet),
+                    _replace(e.otherwise, held, layout, quiet))
+    raise TypeError(f"not an expression: {e!r}")

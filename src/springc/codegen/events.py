@@ -1,0 +1,283 @@
+"""The event functions of a hybrid model's generated module: ode.ODE with events ->
+statement lists (printed like ``rhs``) and the module text around them.
+
+Every function has the model-function signature ``f(t, x, p, z)``:
+
+- ``zero_crossings(t, x, p, z)``: the zero-crossing function ``left - right`` of
+  each state relation (``ZERO_CROSSINGS``; the relation's held value in ``z`` is the
+  relation ``RELATION_OPS[k]`` of that value with 0 at the last event);
+- ``next_time_event(t, x, p, z)``: the first time event after ``t`` (inf if none);
+- ``event_update(t, x, p, z)``: the event at ``t``: ``event_begin`` (left limits for
+  ``pre``, sample flags), ``event_pass`` until nothing changes (at most
+  ``EVENT_ITERATIONS``; ``z[Z_STATUS]`` is 1.0 if it did not settle), ``event_end``
+  (conditions as they hold after the event); returns the states after the event.
+
+The layout of ``z`` is :mod:`.event_layout`'s.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from ..ir import expr as x
+from ..ir import ode
+from ..ir.hybrid import EventSystem
+from .context import CodegenContext
+from .encoding import encode_strings
+from .event_layout import EventLayout
+from .statements import Let, Raw, Stmt, Store
+
+EVENT_ITERATIONS = 50
+_ONE, _ZERO = x.Const(1.0), x.Const(0.0)
+
+
+def held_system(system: ode.ODE, layout: EventLayout) -> ode.ODE:
+    """``system`` whose steps and aliases read held relations and event slots."""
+    h = layout.hold
+
+    def step(s: ode.Step) -> ode.Step:
+        if isinstance(s, ode.Assign):
+            return ode.Assign(s.name, h(s.expr), s.span)
+        if isinstance(s, ode.LinearBlock):
+            return ode.LinearBlock(s.names, tuple((i, j, h(e)) for i, j, e in s.matrix),
+                                   tuple(h(e) for e in s.rhs), s.spans)
+        return ode.NonlinearBlock(
+            s.tearing, tuple(ode.Assign(a.name, h(a.expr), a.span) for a in s.inner),
+            tuple(h(e) for e in s.residuals),
+            tuple(ode.Assign(a.name, h(a.expr), a.span) for a in s.sensitivities),
+            tuple((i, j, h(e)) for i, j, e in s.jacobian), s.spans)
+
+    return dataclasses.replace(
+        system, steps=tuple(step(s) for s in system.steps),
+        observed=tuple(ode.Assign(a.name, h(a.expr), a.span) for a in system.observed))
+
+
+def _flag(cond: x.Expr) -> x.Expr:
+    return x.If(cond, _ONE, _ZERO)
+
+
+def _truth(name: str) -> x.Expr:
+    return x.BinOp("<>", x.Var(name), _ZERO)
+
+
+def _any(items: list[x.Expr]) -> x.Expr:
+    out: x.Expr = x.Const(False)
+    for item in items:
+        out = item if out == x.Const(False) else x.BinOp("or", out, item)
+    return out
+
+
+def _eps(t: x.Expr) -> x.Expr:
+    """1e-12 * max(1, |t|): times closer than this are the same event time."""
+    return x.mul(x.Const(1e-12), x.Call("max", (_ONE, x.Call("abs", (t,)))))
+
+
+def _base(m: CodegenContext) -> list[Stmt]:
+    steps, _ = m.step_stmts()
+    return m.loads() + steps + m.alias_stmts(sorted(m.aliases))
+
+
+def zero_crossings(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    out = [*_base(m), Raw(f"g = np.empty({len(layout.relations)})")]
+    for k, rel in enumerate(layout.events.relations):
+        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+        out.append(Store(f"g[{k}]", g, x.to_text(rel)))
+    return out
+
+
+def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    out: list[Stmt] = [*m.loads()[:len(m.params)], Let("_zq", x.Const(float("inf")))]
+    later = x.add(x.TIME, _eps(x.TIME))
+    for tr in layout.events.time_relations:
+        at = tr.at
+        out.append(Let("_zq", x.If(x.BinOp("and", x.BinOp(">", at, later),
+                                           x.BinOp("<", at, x.Var("_zq"))), at, x.Var("_zq"))))
+    for start, interval in layout.events.samples:
+        k = x.add(x.Call("floor", (x.div(x.sub(later, start), interval),)), _ONE)
+        nxt = x.If(x.BinOp("<", later, start), start, x.add(start, x.mul(k, interval)))
+        out.append(Let("_zq", x.Call("min", (x.Var("_zq"), nxt))))
+    return [*out, Raw("_zo = np.empty(1)"), Store("_zo[0]", x.Var("_zq"))]
+
+
+def _sample_hit(t: x.Expr, start: x.Expr, interval: x.Expr) -> x.Expr:
+    k = x.Call("floor", (x.add(x.div(x.sub(t, start), interval), x.Const(0.5)),))
+    near = x.BinOp("<=", x.Call("abs", (x.sub(x.add(start, x.mul(k, interval)), t),)),
+                   _eps(t))
+    return x.BinOp("and", x.BinOp(">=", k, _ZERO), near)
+
+
+def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    out = _base(m)
+    held = set(layout.discrete)
+    for name, slot_name in layout.pre.items():
+        if name not in held:
+            out.append(Store(f"z[{layout.slot[slot_name]}]", x.Var(name), f"pre({name})"))
+    for (start, interval), name in zip(layout.events.samples, layout.samples):
+        out.append(Store(f"z[{layout.slot[name]}]", _flag(_sample_hit(x.TIME, start, interval))))
+    out.append(Raw("_zdone = 1.0"))
+    return out
+
+
+def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    ev = layout.events
+    out = _base(m)
+    slot = layout.slot
+    changed: list[x.Expr] = []
+    # pre of the discrete variables: their values before this pass
+    for name in layout.discrete:
+        if name in layout.pre:
+            out.append(Let(layout.pre[name], x.Var(name)))
+    # the relations now
+    new: dict[x.Expr, x.Expr] = {}
+    for k, rel in enumerate(ev.relations):
+        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+        out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
+        new[rel] = _truth(f"_zn{k}")
+        changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), x.Var(layout.relations[k])))
+    for k, tr in enumerate(ev.time_relations):
+        now = x.BinOp(">=", x.TIME, x.sub(tr.at, _eps(x.TIME)))
+        out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
+        new[tr.relation] = _truth(f"_zu{k}")
+        changed.append(x.BinOp("<>", x.Var(f"_zu{k}"), x.Var(layout.times[k])))
+    # the when-conditions with the new relations; a branch fires when one of its
+    # conditions becomes true (at initialization only conditions using initial())
+    fires: dict[tuple[int, int], list[x.Expr]] = {}
+    for k, (i, j, cond) in enumerate(layout.conditions):
+        out.append(Let(f"_zd{k}", _flag(layout.hold(cond, new)), x.to_text(cond)))
+        edge = x.BinOp("and", _truth(f"_zd{k}"), x.Not(_truth(layout.condition_names[k])))
+        if not any(isinstance(n, x.Call) and n.name == "initial" for n in x.walk(cond)):
+            edge = x.BinOp("and", edge, x.Not(_truth("_zinit")))
+        fires.setdefault((i, j), []).append(edge)
+        changed.append(x.BinOp("<>", x.Var(f"_zd{k}"), x.Var(layout.condition_names[k])))
+    active: dict[tuple[int, int], x.Expr] = {}
+    for i, clause in enumerate(ev.whens):
+        earlier: list[x.Expr] = []
+        for j in range(len(clause.branches)):
+            fire = _any(fires[i, j])
+            if earlier:
+                fire = x.BinOp("and", fire, x.Not(_any(earlier)))
+            out.append(Let(f"_za{i}_{j}", _flag(fire)))
+            active[i, j] = _truth(f"_za{i}_{j}")
+            earlier.append(active[i, j])
+    # assignments, in clause order; reinits all from the values before any of them
+    reinits: dict[str, x.Expr] = {}
+    stop: x.Expr = x.Var("_zstop")
+    for i, clause in enumerate(ev.whens):
+        for j, branch in enumerate(clause.branches):
+            for a in branch.assignments:
+                value = layout.hold(a.value, new)
+                out.append(Let(a.name, x.If(active[i, j], value, x.Var(a.name)), a.name))
+            for r in branch.reinits:
+                reinits[r.name] = x.If(active[i, j], layout.hold(r.value, new),
+                                       reinits.get(r.name, x.Var(r.name)))
+            for t in branch.terminates:
+                code = x.Const(float(layout.messages.index(t.message) + 1))
+                stop = x.If(active[i, j], code, stop)
+    for n, (name, value) in enumerate(reinits.items()):
+        out.append(Let(f"_zx{n}", value, f"reinit({name})"))
+        changed.append(x.BinOp("<>", x.Var(f"_zx{n}"), x.Var(name)))
+    for name in layout.discrete:
+        if name in layout.pre:
+            changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
+        else:
+            changed.append(active_for(ev, name, active))
+    out.append(Store(f"z[{slot['_zchanged']}]", _flag(_any(changed))))
+    out.append(Store(f"z[{slot['_zstop']}]", stop))
+    for k, name in enumerate(layout.relations):
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zn{k}")))
+    for k, name in enumerate(layout.times):
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
+    for k, name in enumerate(layout.condition_names):
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zd{k}")))
+    for name in layout.discrete:
+        out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
+        if name in layout.pre:
+            out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
+    out.append(Raw(f"xn = np.empty({len(m.states)})"))
+    index = {name: n for n, name in enumerate(reinits)}
+    for k, state in enumerate(m.states):
+        value = x.Var(f"_zx{index[state]}") if state in index else x.Var(state)
+        out.append(Store(f"xn[{k}]", value, state))
+    return out
+
+
+def active_for(ev: EventSystem, name: str, active: dict[tuple[int, int], x.Expr]) -> x.Expr:
+    """Whether a branch assigning ``name`` is active (then it may have changed)."""
+    items = [active[i, j] for i, clause in enumerate(ev.whens)
+             for j, branch in enumerate(clause.branches)
+             if any(a.name == name for a in branch.assignments)]
+    return _any(items)
+
+
+def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    slot = layout.slot
+    loads = m.loads()
+    cleared: list[Stmt] = [Let(name, _ZERO) for name in layout.samples] + [Let("_zinit", _ZERO)]
+    steps, _ = m.step_stmts()
+    out = loads + cleared + steps + m.alias_stmts(sorted(m.aliases))
+    for k, (_, _, cond) in enumerate(layout.conditions):
+        out.append(Store(f"z[{slot[layout.condition_names[k]]}]", _flag(layout.hold(cond)),
+                         x.to_text(cond)))
+    for name in layout.samples:
+        out.append(Store(f"z[{slot[name]}]", _ZERO))
+    out.append(Store(f"z[{slot['_zinit']}]", _ZERO))
+    out.append(Raw("_zdone = 1.0"))
+    return out
+
+
+FUNCTIONS = (
+    ("zero_crossings", "Zero-crossing functions of the state relations (ZERO_CROSSINGS).",
+     zero_crossings, "g"),
+    ("next_time_event", "The first time event after t (inf: none).", next_time_event, "_zo[0]"),
+    ("event_begin", "Start of an event: pre() of continuous variables, sample flags.",
+     event_begin, "_zdone"),
+    ("event_pass", "One pass of the event iteration: the states after it; writes z.",
+     event_pass, "xn"),
+    ("event_end", "End of an event: conditions as they hold after it.", event_end, "_zdone"),
+)
+
+
+def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
+    """The module constants of the events (names as escaped literals)."""
+    ev = layout.events
+    s = layout.slot
+    return [
+        "# Events (see event_update): the event slots of z start at Z_EVENTS.",
+        "EVENTS = True",
+        f"Z_EVENTS = {layout.base}",
+        f"Z_SIZE = {layout.base + layout.size + 1}",
+        f"ZERO_CROSSINGS = {encode_strings([x.to_text(r) for r in ev.relations])}",
+        f"RELATION_OPS = {tuple(r.op for r in ev.relations)!r}",
+        f"Z_RELATIONS = {s[layout.relations[0]] if layout.relations else layout.base}",
+        f"TIME_EVENTS = {encode_strings([x.to_text(t.relation) for t in ev.time_relations])}",
+        f"SAMPLES = {len(ev.samples)}",
+        f"DISCRETE = {encode_strings(layout.discrete)}",
+        f"Z_DISCRETE = {[s[d] for d in layout.discrete]!r}",
+        f"TERMINATE_MESSAGES = {encode_strings(layout.messages)}",
+        f"Z_INITIAL = {s['_zinit']}",
+        f"Z_TERMINAL = {s['_zterm']}",
+        f"Z_TERMINATE = {s['_zstop']}",
+        f"Z_CHANGED = {s['_zchanged']}",
+        f"Z_STATUS = {s['_zstatus']}",
+        f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
+    ]
+
+
+EVENT_UPDATE = '''def event_update(t, x, p, z):
+    """The event at time t (Modelica 3.6, 8.6): returns the states after it and
+    leaves the discrete values in z. Set z[Z_INITIAL] = 1.0 first for the event at
+    the start; z[Z_STATUS] is 1.0 if the event iteration did not settle in
+    EVENT_ITERATIONS passes, z[Z_TERMINATE] > 0 if terminate() was called."""
+    event_begin(t, x, p, z)
+    z[Z_STATUS] = 1.0
+    for _k in range(EVENT_ITERATIONS):
+        x = event_pass(t, x, p, z)
+        if z[Z_CHANGED] == 0.0:
+            z[Z_STATUS] = 0.0
+            break
+    event_end(t, x, p, z)
+    return x'''
+
+NO_EVENTS = [
+    "EVENTS = False",
+]

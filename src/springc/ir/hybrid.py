@@ -1,0 +1,59 @@
+"""The event part of the simplified system (Modelica 3.6, 8.5 and 8.6).
+
+Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
+
+- ``discrete``: the variables assigned in when-clauses; they keep their value
+  between events (the generated code holds them in ``z``);
+- ``relations``: the relations on continuous variables outside ``noEvent``: each
+  keeps its value from the last event; its zero-crossing function is
+  ``left - right``, compared with 0 by its operator;
+- ``time_relations``: relations of ``time`` with a parameter expression
+  (``time >= t0``): time events at ``at``, hit exactly without root finding;
+- ``samples``: the ``sample(start, interval)`` calls (time events too);
+- ``pre``: the variables read by ``pre``, ``edge`` or ``change``;
+- ``whens``: the when-clauses, assignments sorted so that each reads the values
+  assigned before it at the same event.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import Span
+from .expr import BinOp, Expr
+from .when import When
+
+
+@dataclass(frozen=True, slots=True)
+class Discrete:
+    """A variable assigned in when-clauses: held between events."""
+
+    name: str
+    type: str  # Real, Integer or Boolean
+    start: Expr | None
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class TimeRelation:
+    """``relation`` compares ``time`` with the parameter expression ``at``; after
+    the event at ``at`` its value is ``after`` (true for ``time >= at``)."""
+
+    relation: BinOp
+    at: Expr
+    after: bool
+
+
+@dataclass(frozen=True)
+class EventSystem:
+    discrete: tuple[Discrete, ...]
+    relations: tuple[BinOp, ...]
+    time_relations: tuple[TimeRelation, ...]
+    samples: tuple[tuple[Expr, Expr], ...]
+    pre: tuple[str, ...]
+    whens: tuple[When, ...]
+
+    @property
+    def empty(self) -> bool:
+        return not (self.discrete or self.relations or self.time_relations
+                    or self.samples or self.whens)

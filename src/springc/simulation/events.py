@@ -1,0 +1,278 @@
+"""The event loop of a hybrid model: generated module (with ``EVENTS``) + start state
+-> states on the output grid, the discrete values there, and the events.
+
+Between events the integrator sees a smooth right-hand side: every relation keeps the
+value of the last event (held in ``z``, see codegen/event_layout.py). After each
+accepted step the zero-crossing functions are checked against the held relations; a
+relation that would now differ is a state event, located on the step's dense output
+(or, for the fixed-step integrators, by bisection of the step) to
+:data:`LOCATE_TOLERANCE` relative, taking the first time at which the relation has
+switched. Time events (``time >= t0``, ``sample``) end the integration exactly at
+their time (the solver's ``t_bound``, or a split fixed step). At every event the
+module's ``event_update`` runs the event iteration, and the integration restarts.
+
+Chattering and Zeno behaviour (a ball coming to rest, a relation that switches at
+every step) stop the run with an error: at most :data:`EVENT_BURST` events may fall
+within :data:`ZENO_FRACTION` of the simulated span.
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import Note, SimulationError
+from .failures import Stop, format_time
+from .limits import OverLimit
+from .solver_names import IMPLICIT_SOLVERS, SOLVERS
+from .steps import Problem, solver_failure
+
+LOCATE_TOLERANCE = 1e-12
+"""Event times are located to this times max(1, |t|) (a bracket that narrow)."""
+EVENT_BURST = 100
+ZENO_FRACTION = 1e-6
+"""More than EVENT_BURST events within ZENO_FRACTION x (stop - start) is chattering."""
+
+_OPS: dict[str, Callable[[float, float], bool]] = {
+    "<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
+
+
+@dataclass(frozen=True)
+class Event:
+    """An event: its time, ``state`` or ``time`` (``initial`` at the start), what
+    caused it, and the states and ``z`` just before and after it."""
+
+    time: float
+    kind: str
+    cause: str
+    x_left: np.ndarray
+    z_left: np.ndarray
+    x_right: np.ndarray
+    z_right: np.ndarray
+
+
+class EventLoop:
+    """One hybrid run over ``grid``: fills ``states`` and ``zs`` (the ``z`` vector
+    in force at each output time) and records the ``events``."""
+
+    def __init__(self, problem: Problem, grid: np.ndarray) -> None:
+        self.problem, self.grid = problem, grid
+        self.mod = problem.mod
+        self.p = problem.p
+        self.z = problem.z  # the module's rhs reads the held values from here
+        n = len(problem.names)
+        self.states = np.empty((len(grid), n))
+        self.zs = np.empty((len(grid), len(self.z)))
+        self.k = 0  # next grid row to fill
+        self.events: list[Event] = []
+        self.steps = 0
+        self.step_times: list[float] = []
+        self.recent: deque[float] = deque(maxlen=EVENT_BURST)
+        self.causes: deque[str] = deque(maxlen=EVENT_BURST)
+        self.ops = [_OPS[op] for op in self.mod.RELATION_OPS]
+        self.first = int(self.mod.Z_RELATIONS)
+        self.stopped: tuple[float, str] | None = None  # terminate(): time, message
+
+    # ---------------------------------------------------------------- checks
+
+    def switched(self, t: float, x: np.ndarray) -> list[int]:
+        """The state relations whose value at ``(t, x)`` differs from the held one."""
+        if not self.ops:
+            return []
+        g = self.mod.zero_crossings(t, x, self.p, self.z)
+        held = self.z[self.first:self.first + len(self.ops)]
+        return [k for k, op in enumerate(self.ops) if op(float(g[k]), 0.0) != (held[k] != 0.0)]
+
+    def locate(self, state: Callable[[float], np.ndarray], ta: float, tb: float,
+               k: int) -> float:
+        """The first time in ``(ta, tb]`` at which relation ``k`` has switched (to
+        :data:`LOCATE_TOLERANCE`), by regula falsi with the Illinois rule on its
+        zero-crossing function, keeping a bracket."""
+        op, held = self.ops[k], self.z[self.first + k] != 0.0
+
+        def g(t: float) -> float:
+            return float(self.mod.zero_crossings(t, state(t), self.p, self.z)[k])
+
+        ga, gb = g(ta), g(tb)
+        side = 0
+        tol = LOCATE_TOLERANCE * max(1.0, abs(tb))
+        for _ in range(200):
+            if tb - ta <= tol:
+                break
+            if math.isfinite(ga) and math.isfinite(gb) and ga != gb:
+                tm = tb - gb * (tb - ta) / (gb - ga)
+            else:
+                tm = 0.5 * (ta + tb)
+            low, high = ta + 0.01 * (tb - ta), tb - 0.01 * (tb - ta)
+            if not low <= tm <= high:
+                tm = min(max(tm, ta + tol / 2), tb - tol / 2)
+            gm = g(tm)
+            if op(gm, 0.0) != held:
+                tb, gb = tm, gm
+                if side == -1:
+                    ga *= 0.5
+                side = -1
+            else:
+                ta, ga = tm, gm
+                if side == 1:
+                    gb *= 0.5
+                side = 1
+        return tb
+
+    # ---------------------------------------------------------------- events
+
+    def event(self, t: float, x: np.ndarray, kind: str, cause: str) -> np.ndarray:
+        """Run the event iteration at ``t`` and return the states after it."""
+        x_left, z_left = np.array(x, dtype=float), self.z.copy()
+        try:
+            x_right = np.asarray(self.mod.event_update(t, x_left.copy(), self.p, self.z),
+                                 dtype=float)
+        except (ArithmeticError, ValueError) as err:
+            raise self.problem.fail(err, t, x_left, "the event update") from err
+        if self.z[-1] != 0.0:
+            raise self.problem.newton_failure(t, x_left)
+        if self.z[int(self.mod.Z_STATUS)] != 0.0:
+            raise Stop(self.unsettled(t, x_left, z_left))
+        self.events.append(Event(t, kind, cause, x_left, z_left, x_right, self.z.copy()))
+        if kind != "initial":
+            self.check_zeno(t, cause)
+        code = int(self.z[int(self.mod.Z_TERMINATE)])
+        if code > 0 and self.stopped is None:
+            self.stopped = (t, self.mod.TERMINATE_MESSAGES[code - 1])
+        return x_right
+
+    def unsettled(self, t: float, x: np.ndarray, z_left: np.ndarray) -> SimulationError:
+        """The error of an event iteration that does not settle, naming what keeps
+        changing (the discrete variables and relations that differ between passes)."""
+        z = self.z.copy()
+        y = np.array(x)
+        before = z.copy()
+        for _ in range(2):
+            y = np.asarray(self.mod.event_pass(t, y, self.p, z))
+        names = [self.mod.DISCRETE[i] for i, slot in enumerate(self.mod.Z_DISCRETE)
+                 if z[slot] != before[slot]]
+        names += [self.mod.ZERO_CROSSINGS[k] for k in range(len(self.ops))
+                  if z[self.first + k] != before[self.first + k]]
+        shown = ", ".join(names[:6]) or "the states (reinit)"
+        return SimulationError(
+            f"the event iteration at time {format_time(t)} did not settle in "
+            f"{self.mod.EVENT_ITERATIONS} passes: {shown} keep changing",
+            hint="a when-clause or relation feeds back on itself at the same instant; "
+                 "use pre(v) for the value before the event")
+
+    def check_zeno(self, t: float, cause: str) -> None:
+        self.recent.append(t)
+        self.causes.append(cause)
+        span = float(self.grid[-1] - self.grid[0])
+        if len(self.recent) == EVENT_BURST and t - self.recent[0] <= ZENO_FRACTION * span:
+            common = max(set(self.causes), key=list(self.causes).count)
+            raise Stop(SimulationError(
+                f"chattering: {EVENT_BURST} events between time {format_time(self.recent[0])}"
+                f" and {format_time(t)}, most of them of '{common}'",
+                notes=[Note(f"springc stops when more than {EVENT_BURST} events fall within "
+                            f"{ZENO_FRACTION:g} of the simulated span (Zeno behaviour)")],
+                hint="the model switches faster than it can be simulated: a ball coming to "
+                     "rest needs a minimum bounce velocity in its when-condition (when h <= "
+                     "0 and v < -v_min), a switched force hysteresis or a smooth "
+                     "transition"))
+
+    def initial(self, t: float, x: np.ndarray) -> np.ndarray:
+        """The event at the start (``initial()`` is true)."""
+        self.z[int(self.mod.Z_INITIAL)] = 1.0
+        return self.event(t, x, "initial", "initial()")
+
+    def next_time(self, t: float) -> float:
+        return float(self.mod.next_time_event(t, np.zeros(0), self.p, self.z))
+
+    # ---------------------------------------------------------------- output
+
+    def fill(self, until: float, dense: Callable[[np.ndarray], np.ndarray] | None,
+             t: float, x: np.ndarray, inclusive: bool) -> None:
+        """Grid rows up to ``until`` (included if ``inclusive``) from ``dense`` (at
+        ``t`` exactly: ``x``), with the current ``z``."""
+        grid = self.grid
+        j = int(np.searchsorted(grid, until, side="right" if inclusive else "left"))
+        if j <= self.k:
+            return
+        rows = slice(self.k, j)
+        if dense is not None:
+            self.states[rows] = np.asarray(dense(grid[rows])).T.reshape(j - self.k, -1)
+        else:
+            self.states[rows] = x
+        exact = grid[rows] == t
+        if exact.any():
+            self.states[rows][exact] = x
+        self.zs[rows] = self.z
+        self.k = j
+
+    # ---------------------------------------------------------------- adaptive
+
+    def run_adaptive(self, solver: str, x0: np.ndarray, rtol: float, atol: float,
+                     max_steps: int) -> np.ndarray:
+        """Integrate with the scipy ``solver`` from ``grid[0]``; returns the states at
+        the last time reached."""
+        import scipy.integrate
+
+        cls = getattr(scipy.integrate, SOLVERS[solver])
+        problem = self.problem
+        kwargs: dict[str, Any] = {"jac": problem.jac} if solver in IMPLICIT_SOLVERS else {}
+        t, stop = float(self.grid[0]), float(self.grid[-1])
+        x = self.initial(t, np.asarray(x0, dtype=float))
+        self.fill(t, None, t, x, True)
+        while t < stop and self.stopped is None:
+            bound = min(self.next_time(t), stop)
+            if bound <= t:
+                bound = stop
+            if not len(x):
+                self.fill(bound, None, bound, x, False)
+                t = bound
+                x = self._time_event(t, x, stop)
+                continue
+            integrator = cls(problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs)
+            while True:
+                t_old = integrator.t
+                message = integrator.step()
+                if integrator.status == "failed":
+                    raise Stop(solver_failure(problem, float(integrator.t),
+                                              np.asarray(integrator.y), message))
+                self.steps += 1
+                if self.steps >= max_steps:
+                    raise OverLimit(f"{self.steps} steps of {solver} reached the step limit "
+                                    f"(--max-steps {max_steps})", float(integrator.t),
+                                    np.array(integrator.y), solver)
+                t_new = float(integrator.t)
+                self.step_times.append(t_new)
+                dense = integrator.dense_output()
+                y = np.asarray(integrator.y, dtype=float)
+                switched = self.switched(t_new, y)
+                if switched:
+                    times = {k: self.locate(dense, t_old, t_new, k)
+                             for k in switched}
+                    k = min(times, key=times.__getitem__)
+                    te = times[k]
+                    xe = np.asarray(dense(te), dtype=float)
+                    self.fill(te, dense, t_new, y, False)
+                    t = te
+                    x = self.event(te, xe, "state", self.mod.ZERO_CROSSINGS[k])
+                    self.fill(te, None, te, x, True)
+                    break
+                if integrator.status == "finished":
+                    self.fill(t_new, dense, t_new, y, False)
+                    t, x = float(bound), y
+                    x = self._time_event(t, x, stop)
+                    break
+                self.fill(t_new, dense, t_new, y, True)
+        return x
+
+    def _time_event(self, t: float, x: np.ndarray, stop: float) -> np.ndarray:
+        """At the end of an integration: the time event there, if any; the grid row."""
+        if t < stop:
+            x = self.event(t, x, "time", f"time = {format_time(t)}")
+        self.fill(t, None, t, x, True)
+        return x

@@ -1,0 +1,130 @@
+"""Simulation of a hybrid model: CompiledModel with events -> SimulationResult.
+
+Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, the
+fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
+models), then computes the outputs row by row with the discrete values in force at
+each row. By default the result has one row per output time (the value after an
+event at that very time); ``event_rows`` adds two rows at each event, its left and
+right limits, as OpenModelica's result files do.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+
+from ..errors import SimulationError
+from ..pipeline import CompiledModel
+from .events import EventLoop
+from .failures import Stop, state_notes
+from .limits import Limits, OverLimit, check_outputs, over_limit
+from .results import SimulationResult, SimulationStats
+from .solver_names import AUTO, EXPLICIT, FIXED_STEP
+from .steps import Problem, Progress
+
+
+def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.ndarray,
+                    x0: np.ndarray, p: np.ndarray, rtol: float, atol: float,
+                    limits: Limits, step: float | None, note: str, began: float
+                    ) -> SimulationResult:
+    """Integrate the hybrid ``model`` over ``grid`` (see the module docstring)."""
+    from .events_fixed import run_fixed_events
+
+    start, stop = float(grid[0]), float(grid[-1])
+    reason = ""
+    if solver == AUTO:
+        solver, reason = EXPLICIT, "a hybrid model: dop853 with event location"
+    progress = Progress(options.progress, start, stop)
+    problem = Problem(model, p, solver, progress, limits)
+    loop = EventLoop(problem, grid)
+    try:
+        with np.errstate(all="ignore"):
+            if not np.isfinite(x0).all():
+                raise Stop(SimulationError(
+                    f"the start values are not finite at time {start}",
+                    notes=state_notes(problem.names, x0, None)))
+            if solver in FIXED_STEP:
+                assert step is not None
+                run_fixed_events(loop, solver, x0, step)
+            else:
+                loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
+            times, states, zs = rows(loop, bool(getattr(options, "event_rows", False)))
+            outputs = _outputs(model, problem, times, states, zs)
+    except Stop as stop_:
+        raise stop_.error from None
+    except OverLimit as over:
+        raise over_limit(over, start, stop, problem.jacobian) from None
+    finally:
+        progress.close()
+    if loop.stopped is not None:
+        when, message = loop.stopped
+        note = "; ".join(filter(None, (note, f"terminate() at time {when:.9g}: {message}")))
+    state_events = sum(e.kind == "state" for e in loop.events)
+    time_events = sum(e.kind == "time" for e in loop.events)
+    stats = SimulationStats(solver, loop.steps, problem.nfev, problem.njev,
+                            time.perf_counter() - began, problem.model_time,
+                            model.compile_time, model.cached, reason, note, "scipy", 0.0,
+                            state_events, time_events)
+    units = dict(zip(model.states, model.module.STATE_UNITS))
+    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    names = model.outputs
+    return SimulationResult(model.name, times, names, outputs,
+                            tuple(units.get(n, "") for n in names), stats,
+                            dict(zip(model.parameter_names, p.tolist())),
+                            tuple(loop.events), tuple(loop.step_times))
+
+
+def rows(loop: EventLoop, event_rows: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times, states and ``z`` of the result rows: the grid rows reached (a run ended
+    by terminate() stops at its time), and with ``event_rows`` the left and right
+    limits at each event after the start, before the grid row at the same time."""
+    k = loop.k
+    times, states, zs = loop.grid[:k], loop.states[:k], loop.zs[:k]
+    if loop.stopped is not None and (k == 0 or times[-1] < loop.stopped[0]):
+        last = loop.events[-1]
+        times = np.append(times, last.time)
+        states = np.vstack([states, last.x_right])
+        zs = np.vstack([zs, last.z_right])
+    if not event_rows:
+        return times, states, zs
+    extra_t, extra_x, extra_z, order = [], [], [], []
+    for e in loop.events:
+        if e.kind == "initial":
+            continue
+        extra_t += [e.time, e.time]
+        extra_x += [e.x_left, e.x_right]
+        extra_z += [e.z_left, e.z_right]
+        order += [0, 1]
+    if not extra_t:
+        return times, states, zs
+    all_t = np.concatenate([np.asarray(extra_t), times])
+    rank = np.concatenate([np.asarray(order), np.full(len(times), 2)])
+    sort = np.lexsort((rank, all_t))
+    return (all_t[sort], np.vstack([np.asarray(extra_x), states])[sort],
+            np.vstack([np.asarray(extra_z), zs])[sort])
+
+
+def _outputs(model: CompiledModel, problem: Problem, times: np.ndarray, states: np.ndarray,
+             zs: np.ndarray) -> np.ndarray:
+    """The selected outputs at every row, each with its own discrete values."""
+    names = model.outputs
+    columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
+    selected = set(names)
+    wanted = [o for o in model.observed if o in selected]
+    if wanted:
+        obs = np.empty((len(times), len(model.observed)))
+        for i in range(len(times)):
+            z = zs[i].copy()
+            try:
+                obs[i] = model.module.observed(float(times[i]), states[i], problem.p, z)
+            except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+                raise problem.fail(err, float(times[i]), states[i],
+                                   "an observed variable") from err
+        columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
+    out = np.empty((len(times), len(names)))
+    for i, name in enumerate(names):
+        out[:, i] = columns[name]
+    check_outputs(names, times, out)
+    return out
