@@ -19,7 +19,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from ..errors import OutputError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
 from ..ir import dae
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
+
+if TYPE_CHECKING:
+    from .error_estimate import ErrorEstimate
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
 """Suffix -> trajectory format of ``simulate -o``."""
@@ -59,6 +62,7 @@ class SimulationStats:
     note: str = ""  # what the run did differently from what was asked (e.g. the step)
     engine: str = "scipy"  # the step loop: "compiled" (springc.integrate) or "scipy"
     loop_time: float = 0.0  # seconds in the compiled loop (model code included)
+    error: str = ""  # the error estimate in words (empty: not estimated)
 
     def summary(self, model: str) -> str:
         """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
@@ -70,6 +74,7 @@ class SimulationStats:
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s ({inside}model code {self.model_time:.3f} s; "
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
+                + (f"; {self.error}" if self.error else "")
                 + (f"; note: {self.note}" if self.note else ""))
 
 
@@ -84,6 +89,8 @@ class SimulationResult:
     units: tuple[str, ...]
     stats: SimulationStats
     parameters: dict[str, float] = field(default_factory=dict)
+    #: the estimated global error on the grid (``--error-estimate``; None: not estimated)
+    error_estimate: ErrorEstimate | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -207,11 +214,19 @@ def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
     savemat(f, matrices, format="4")
 
 
+def error_file(output: PathLike) -> Path:
+    """The side file of a trajectory's error estimate: ``run.csv`` -> ``run.error.csv``
+    (the trajectory's own CSV keeps its plain header, so readers are unchanged)."""
+    path = Path(output)
+    return path.with_name(path.stem + ".error.csv")
+
+
 def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLike | None,
                  protected: Iterable[PathLike] = ()) -> None:
-    """Write the trajectory to ``output`` (CSV or MAT by suffix) and the plot to ``plot``
-    (PNG, SVG or PDF): both are rendered before either is put in place, and files in
-    ``protected`` (the inputs) are never replaced."""
+    """Write the trajectory to ``output`` (CSV or MAT by suffix; with an error estimate,
+    also :func:`error_file`) and the plot to ``plot`` (PNG, SVG or PDF): all are
+    rendered before any is put in place, and files in ``protected`` (the inputs) are
+    never replaced."""
     kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
     plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
     picture = render_plot(result, plot_kind) if plot_kind is not None else None
@@ -222,6 +237,9 @@ def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLi
                     write_csv(result, f)
                 else:
                     write_mat(result, f)
+            if result.error_estimate is not None:
+                with outputs.open(error_file(output), "w") as f:
+                    csv.writer(f, lineterminator="\n").writerows(result.error_estimate.rows())
         if plot is not None and picture is not None:
             with outputs.open(plot, "wb") as f:
                 f.write(picture)
