@@ -257,6 +257,13 @@ def _single_threaded_blas() -> None:
               help="compiled: numba loops (springc.integrate) for dop853, auto's dop853 "
               "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; "
               "auto: compiled for the numba backend (--backend numba), else scipy.")
+@click.option("--error-estimate", type=click.Choice(("off", "on", "auto"),
+                                                   case_sensitive=False),
+              default="auto", show_default=True,
+              help="Estimate the global error reached on the output grid (a companion "
+              "run at a 1000x tighter tolerance, or half the step for fixed-step "
+              "solvers): in the summary line and in the side file NAME.error.csv next to "
+              "-o NAME.csv; auto: where it costs at most about 30 % of the run.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
@@ -278,7 +285,8 @@ def _single_threaded_blas() -> None:
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, engine: str,
-             rtol: float | None, step: float | None, atol: float | None,
+             error_estimate: str, rtol: float | None, step: float | None,
+             atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
              quiet: bool) -> None:
@@ -302,7 +310,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                  outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
                  parameters=values, progress=progress, step=step, max_steps=max_steps,
-                 time_limit=time_limit, engine=engine.lower())
+                 time_limit=time_limit, engine=engine.lower(),
+                 error_estimate=error_estimate.lower())
     if output or plot:
         save_outputs(result, output, plot, files)
     else:

@@ -23,6 +23,13 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   the 7th-order dense output (a grid time equal to a step's end gets that step's state).
 - ``fixed_step`` runs ``euler``, ``symplectic-euler``, ``verlet`` or ``rk4`` exactly as
   ``springc.simulation``'s integrators do.
+- Events: ``crossings=Crossings(g, signs, directions)`` stops a run at the earliest
+  zero crossing of ``g(t, x, p, z) -> float64[::1]`` against the held ``signs``
+  (status STATE_EVENT; located on DOP853's dense output or on split fixed steps to about
+  1e-12 relative in time; ``run.event_time``, ``run.event_state`` (the left limit) and
+  ``run.fired`` say where and which), ``t_stop`` stops it exactly at a time (TIME_EVENT).
+  The caller updates the state and the held signs and restarts from the event;
+  :func:`run_hybrid` is that loop with a Python ``update(t, x_left, fired)``.
 - Failures never raise inside the loop: :class:`Status` says what happened
   (step too small, NaN/inf derivative or state, max steps, the model's failure flag
   ``z[-1]``) and the run carries the time and the state where it happened.
@@ -30,7 +37,9 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
 """
 
-from .engine import FIXED_STEP_METHODS, Run, dop853, fixed_step
+from .engine import FIXED_STEP_METHODS, Crossings, Run, dop853, fixed_step
+from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "Run", "Status", "dop853", "fixed_step"]
+__all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "dop853", "fixed_step",
+           "run_hybrid"]

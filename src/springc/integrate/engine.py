@@ -24,7 +24,11 @@ class Run:
 
     ``states[k]`` (and ``observed[k]``) hold the solution at ``t[k]`` for ``k < filled``;
     later rows are NaN. Unless ``status`` is SUCCESS, ``failure_time`` and
-    ``failure_state`` say where the run stopped (see :class:`Status`).
+    ``failure_state`` say where the run stopped (see :class:`Status`): for STATE_EVENT
+    and TIME_EVENT (also named ``event_time`` and ``event_state``) the event time and
+    the left-limit state there, with the grid filled up to (not including) that time.
+    ``fired[i]`` is +1 (rising), -1 (falling) or 0 for each zero-crossing indicator;
+    ``next_step`` is the step size the method would take next.
     """
 
     status: Status
@@ -37,17 +41,45 @@ class Run:
     rhs_evaluations: int
     failure_time: float
     failure_state: np.ndarray
+    fired: np.ndarray
+    next_step: float
 
     @property
     def ok(self) -> bool:
         """Whether the run reached the end of the grid."""
         return self.status == Status.SUCCESS
 
+    @property
+    def event(self) -> bool:
+        """Whether the run stopped at a state or time event (not at a failure)."""
+        return self.status in (Status.STATE_EVENT, Status.TIME_EVENT)
+
+    @property
+    def event_time(self) -> float:
+        return self.failure_time
+
+    @property
+    def event_state(self) -> np.ndarray:
+        return self.failure_state
+
+
+@dataclass(frozen=True)
+class Crossings:
+    """A model's zero crossings for a run: ``g(t, x, p, z) -> float64[::1]`` (a numba
+    function, one indicator per relation), the held sign of each indicator (+1/-1: the
+    side the model assumes now) and optional direction filters (+1 rising only, -1
+    falling only, 0 both; default both). See :mod:`springc.integrate.crossings`."""
+
+    function: ModelFunction
+    signs: Sequence[float] | np.ndarray
+    directions: Sequence[float] | np.ndarray | None = None
+
 
 def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
            atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
            max_step: float = np.inf, first_step: float | None = None,
-           max_steps: int = 0, scipy_arithmetic: bool = True) -> Run:
+           max_steps: int = 0, scipy_arithmetic: bool = True,
+           crossings: Crossings | None = None, t_stop: float = np.inf) -> Run:
     """Integrate ``x' = rhs(t, x, p, z)`` with compiled DOP853 on the output ``grid``.
 
     ``rhs`` and ``observed`` are numba-jitted functions ``f(t, x, p, z) -> array`` (the
@@ -60,6 +92,9 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     (same steps, same states; the error estimate of tiny steps is rounding noise, so any
     other summation order picks other early steps); without it, plain loops, about 1.5x
     faster on small systems, the same method within rounding.
+
+    ``crossings`` stops the run at the earliest zero crossing (status STATE_EVENT, located
+    on the dense output); a ``t_stop`` inside the grid stops it exactly there (TIME_EVENT).
     """
     from .dop853_kernel import dop853_run
 
@@ -75,19 +110,23 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     if not max_step > 0:
         raise ValueError(f"max_step must be positive, got {max_step!r}")
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
-    result = dop853_run(rhs_, observed_, n_observed, grid_, x0_, p_, z_, float(rtol), atol_,
-                        float(max_step), float(first_step or 0.0), int(max_steps),
-                        bool(scipy_arithmetic))
+    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
+    result = dop853_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
+                        float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                        int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
     return _run(grid_, result)
 
 
 def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *,
                step: float, pairs: Sequence[tuple[int, int]] = (),
-               observed: ModelFunction | None = None) -> Run:
+               observed: ModelFunction | None = None, crossings: Crossings | None = None,
+               t_stop: float = np.inf) -> Run:
     """Integrate with a fixed-step method of :data:`FIXED_STEP_METHODS`, compiled.
 
     Same methods and results as ``springc.simulation``'s fixed-step integrators:
     ``pairs`` lists (position index, velocity index) with ``der(x[q]) = x[v]``.
+    ``crossings`` and ``t_stop`` as for :func:`dop853` (a crossing is located on split
+    steps of the method; the steps after an event restart on the output interval).
     """
     from .fixed_step_kernel import METHOD_CODES, fixed_step_run
 
@@ -103,8 +142,10 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
                       and max(positions.max(), velocities.max()) < x0_.size):
         raise ValueError("a pair index is outside the state vector")
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
-    result = fixed_step_run(METHOD_CODES[method], rhs_, observed_, n_observed, grid_, x0_,
-                            p_, z_, float(step), positions, velocities)
+    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
+    result = fixed_step_run(METHOD_CODES[method], rhs_, observed_, n_observed, g, signs,
+                            directions, grid_, x0_, p_, z_, float(step), positions,
+                            velocities, _stop(t_stop, grid_))
     return _run(grid_, result)
 
 
@@ -148,9 +189,42 @@ def _functions(rhs: ModelFunction, observed: ModelFunction | None, grid: np.ndar
     return rhs, observed, n_observed
 
 
+def _crossings(crossings: Crossings | None, grid: np.ndarray, x0: np.ndarray, p: np.ndarray,
+               z: np.ndarray) -> tuple[ModelFunction, np.ndarray, np.ndarray]:
+    """The zero-crossing function, held signs and directions as the kernels take them."""
+    from numba.core.dispatcher import Dispatcher
+
+    from .models import no_observed
+
+    if crossings is None:
+        return no_observed, np.empty(0), np.empty(0)
+    if not isinstance(crossings.function, Dispatcher):
+        raise TypeError(f"the zero-crossing function must be a numba-jitted function, got "
+                        f"{type(crossings.function).__name__}")
+    signs = np.array(crossings.signs, dtype=float).ravel()
+    if not np.isin(signs, (-1.0, 1.0)).all():
+        raise ValueError("the held signs must be +1 or -1")
+    directions = np.zeros(signs.size) if crossings.directions is None \
+        else np.array(crossings.directions, dtype=float).ravel()
+    if directions.shape != signs.shape or not np.isin(directions, (-1.0, 0.0, 1.0)).all():
+        raise ValueError("the directions must be -1, 0 or +1, one per held sign")
+    size = np.asarray(crossings.function(grid[0], x0, p, z.copy())).shape
+    if size != signs.shape:
+        raise ValueError(f"the zero-crossing function returns shape {size} for "
+                         f"{signs.size} held signs")
+    return crossings.function, signs, directions
+
+
+def _stop(t_stop: float, grid: np.ndarray) -> float:
+    if not t_stop > grid[0]:
+        raise ValueError(f"t_stop must be after the start, got {t_stop!r}")
+    return float(t_stop)
+
+
 def _run(grid: np.ndarray, result: tuple[Any, ...]) -> Run:
-    status, states, observed, filled, accepted, rejected, nfev, t_fail, x_fail = result
+    (status, states, observed, filled, accepted, rejected, nfev, t_end, x_end, fired,
+     next_step) = result
     states[filled:] = np.nan
     observed[filled:] = np.nan
     return Run(Status(status), grid, states, observed, int(filled), int(accepted),
-               int(rejected), int(nfev), float(t_fail), x_fail)
+               int(rejected), int(nfev), float(t_end), x_end, fired, float(next_step))

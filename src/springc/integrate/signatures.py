@@ -14,14 +14,19 @@ from numba import types
 #: a model function as Python sees it (a numba dispatcher)
 ModelFunction = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 #: what the kernels return, as Python sees it (see RUN_RESULT)
-RunTuple = tuple[int, np.ndarray, np.ndarray, int, int, int, int, float, np.ndarray]
+RunTuple = tuple[int, np.ndarray, np.ndarray, int, int, int, int, float, np.ndarray,
+                 np.ndarray, float]
 
 VECTOR = types.float64[::1]
 MATRIX = types.float64[:, ::1]
 MODEL_FUNCTION_SIGNATURE = VECTOR(types.float64, VECTOR, VECTOR, VECTOR)
 MODEL_FUNCTION = types.FunctionType(MODEL_FUNCTION_SIGNATURE)
 
+INDICES = types.int64[::1]
+
 #: status, states (grid x n), observed (grid x m), rows filled, accepted steps,
-#: rejected steps, right-hand-side evaluations, failure time, failure state
+#: rejected steps, right-hand-side evaluations, end time, end state (where a failure or
+#: an event stopped the run), fired crossings (+1 rising, -1 falling, 0 not), next step
 RUN_RESULT = types.Tuple((types.int64, MATRIX, MATRIX, types.int64,  # type: ignore[no-untyped-call]
-                          types.int64, types.int64, types.int64, types.float64, VECTOR))
+                          types.int64, types.int64, types.int64, types.float64, VECTOR,
+                          INDICES, types.float64))

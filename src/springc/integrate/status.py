@@ -22,3 +22,10 @@ class Status(IntEnum):
     #: the model set its failure flag ``z[-1]`` (springc's generated modules do so when a
     #: Newton iteration fails): time/state = that evaluation's arguments; ``z`` keeps the flag
     MODEL_FAILED = 5
+    #: a zero-crossing function changed sign against its held sign: time = the located
+    #: crossing (the right end of a bracket narrower than about 1e-12 relative), state =
+    #: the left limit there; ``fired`` says which crossing(s), rows before it are filled
+    STATE_EVENT = 6
+    #: the run reached the requested stop time ``t_stop`` exactly (a step ends on it):
+    #: time/state = that time and the state there; rows before it are filled
+    TIME_EVENT = 7

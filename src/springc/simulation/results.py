@@ -19,7 +19,7 @@ import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from ..errors import OutputError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
 from ..ir import dae
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
+
+if TYPE_CHECKING:
+    from .error_estimate import ErrorEstimate
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
 """Suffix -> trajectory format of ``simulate -o``."""
@@ -61,6 +64,7 @@ class SimulationStats:
     loop_time: float = 0.0  # seconds in the compiled loop (model code included)
     state_events: int = 0  # events of hybrid models (simulation/events.py)
     time_events: int = 0
+    error: str = ""  # the error estimate in words (empty: not estimated)
 
     def summary(self, model: str) -> str:
         """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
@@ -74,6 +78,7 @@ class SimulationStats:
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"
                 + (f", {self.state_events} state and {self.time_events} time events"
                    if self.state_events or self.time_events else "")
+                + (f"; {self.error}" if self.error else "")
                 + (f"; note: {self.note}" if self.note else ""))
 
 
@@ -91,6 +96,8 @@ class SimulationResult:
     # hybrid models: the events (simulation/events.py Event) and accepted step times
     events: tuple[Any, ...] = ()
     step_times: tuple[float, ...] = ()
+    #: the estimated global error on the grid (``--error-estimate``; None: not estimated)
+    error_estimate: ErrorEstimate | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -214,11 +221,19 @@ def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
     savemat(f, matrices, format="4")
 
 
+def error_file(output: PathLike) -> Path:
+    """The side file of a trajectory's error estimate: ``run.csv`` -> ``run.error.csv``
+    (the trajectory's own CSV keeps its plain header, so readers are unchanged)."""
+    path = Path(output)
+    return path.with_name(path.stem + ".error.csv")
+
+
 def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLike | None,
                  protected: Iterable[PathLike] = ()) -> None:
-    """Write the trajectory to ``output`` (CSV or MAT by suffix) and the plot to ``plot``
-    (PNG, SVG or PDF): both are rendered before either is put in place, and files in
-    ``protected`` (the inputs) are never replaced."""
+    """Write the trajectory to ``output`` (CSV or MAT by suffix; with an error estimate,
+    also :func:`error_file`) and the plot to ``plot`` (PNG, SVG or PDF): all are
+    rendered before any is put in place, and files in ``protected`` (the inputs) are
+    never replaced."""
     kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
     plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
     picture = render_plot(result, plot_kind) if plot_kind is not None else None
@@ -229,6 +244,9 @@ def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLi
                     write_csv(result, f)
                 else:
                     write_mat(result, f)
+            if result.error_estimate is not None:
+                with outputs.open(error_file(output), "w") as f:
+                    csv.writer(f, lineterminator="\n").writerows(result.error_estimate.rows())
         if plot is not None and picture is not None:
             with outputs.open(plot, "wb") as f:
                 f.write(picture)

@@ -28,8 +28,16 @@ import numpy as np
 from ..errors import SimulationError
 from ..pipeline import CompiledModel, check_parameter_names
 from ..simplify import describe_failure as describe_failure
-from . import solvers
-from .compiled import COMPILED, SCIPY, choose_engine, finish_dop853, run_fixed_compiled
+from . import error_estimate, solvers
+from .compiled import (
+    COMPILED,
+    SCIPY,
+    choose_engine,
+    finish_dop853,
+    numba_available,
+    run_fixed_compiled,
+)
+from .error_estimate import DEFAULT_MODE, ErrorEstimate
 from .failures import Stop, code_location, state_notes
 from .hybrid_engine import events_engine
 from .limits import (
@@ -76,6 +84,7 @@ class SimulationOptions:
     time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
     engine: str = DEFAULT_ENGINE  # auto, compiled (springc.integrate) or scipy
     event_rows: bool = False  # add rows with the left and right limits at each event
+    error_estimate: str = DEFAULT_MODE  # off, on or auto (see .error_estimate)
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -157,6 +166,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                               hint=f"choose one of {', '.join(ALL_SOLVERS)}")
     limits = Limits(options.max_steps, options.time_limit)
     limits.validate()
+    estimate_mode = error_estimate.check_mode(options.error_estimate, "error_estimate")
     engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
     if getattr(model.module, "EVENTS", False):
         engine = events_engine(model.name, options.engine)
@@ -180,6 +190,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             f"{size / 1e9:.1f} GB", hint="select variables with --vars (outputs=[...]) or "
             "use a larger --interval")
     note = ""
+    step = 0.0  # fixed-step solvers only
     if solver in FIXED_STEP:
         step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
     p = parameter_vector(model, options.parameters)
@@ -191,8 +202,12 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                                   "only the scipy engine does",
                                   hint="use --engine scipy (or auto)")
 
-        return simulate_switching_model(model, solver, grid, rtol, atol,
-                                        dict(options.parameters), limits)
+        result = simulate_switching_model(model, solver, grid, rtol, atol,
+                                          dict(options.parameters), limits)
+        if estimate_mode != "on":  # a companion run on scipy doubles the run: not auto
+            return result
+        return _switching_estimate(model, result, solver, grid, rtol, atol,
+                                   dict(options.parameters), limits)
     x0 = initial_state(model, p, start)
     if getattr(model.module, "EVENTS", False):
         from .hybrid import simulate_hybrid
@@ -228,6 +243,9 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 run = integrate(problem, grid, x0, rtol, atol, finish)
                 states, steps, loop_time = run.states, run.steps, run.loop_time
                 compiled = compiled and len(x0) > 0
+            estimate, error_note = _estimate(estimate_mode, problem, grid, x0, states, solver,
+                                             rtol, atol, step or None, compiled, loop_time,
+                                             time.perf_counter() - began)
             outputs = _outputs(model, problem, grid, states)
     except Stop as stop_:
         raise stop_.error from None
@@ -238,13 +256,58 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
-                            COMPILED if compiled else SCIPY, loop_time)
+                            COMPILED if compiled else SCIPY, loop_time,
+                            estimate.summary() if estimate is not None else error_note)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
-                            dict(zip(model.parameter_names, p.tolist())))
+                            dict(zip(model.parameter_names, p.tolist())), estimate)
+
+
+def _estimate(mode: str, problem: Problem, grid: np.ndarray, x0: np.ndarray,
+              states: np.ndarray, solver: str, rtol: float, atol: float, step: float | None,
+              compiled: bool, loop_time: float, elapsed: float
+              ) -> tuple[ErrorEstimate | None, str]:
+    """The run's error estimate (see :mod:`.error_estimate`), or None and why not when
+    ``on`` asked for it and its companion run failed."""
+    if not len(x0) or not error_estimate.wanted(mode, solver, compiled, loop_time, elapsed):
+        return None, ""
+    fast = model_is_numba(problem) and numba_available()
+    try:
+        return error_estimate.estimate(problem, grid, x0, states, solver, rtol, atol, step,
+                                       fast), ""
+    except Stop as failed:
+        return None, f"error not estimated: its companion run failed ({failed.error.message})"
+    except OverLimit as over:
+        return None, f"error not estimated: its companion run stopped ({over})"
+
+
+def _switching_estimate(model: CompiledModel, result: SimulationResult, solver: str,
+                        grid: np.ndarray, rtol: float, atol: float,
+                        parameters: dict[str, float], limits: Limits) -> SimulationResult:
+    """``result`` of the switching driver with its error estimate (a companion run)."""
+    from dataclasses import replace
+
+    from .switching import simulate_switching_model
+
+    began = time.perf_counter()
+    tight_rtol, tight_atol = error_estimate.companion_tolerances(rtol, atol)
+    companion = simulate_switching_model(model, solver, grid, tight_rtol, tight_atol,
+                                         parameters, limits)
+    columns = [i for i, name in enumerate(result.names) if name in set(model.states)]
+    values = result.values[:, columns]
+    estimate = error_estimate.measured(
+        tuple(result.names[i] for i in columns), grid, values,
+        values - companion.values[:, columns],
+        f"companion {companion.stats.solver} run at rtol {tight_rtol:.3g}", began)
+    stats = replace(result.stats, error=estimate.summary())
+    return replace(result, stats=stats, error_estimate=estimate)
+
+
+def model_is_numba(problem: Problem) -> bool:
+    return getattr(problem.mod, "BACKEND", "") == "numba"
 
 
 def parameter_vector(model: CompiledModel, values: Mapping[str, float]) -> np.ndarray:
