@@ -184,7 +184,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
                                 step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
                                 DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
-                                engine, error_estimate)
+                                engine, error_estimate=error_estimate)
     return simulate_model(model, options)
 
 

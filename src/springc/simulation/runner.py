@@ -257,13 +257,14 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time,
-                            estimate.summary() if estimate is not None else error_note)
+                            error=estimate.summary() if estimate is not None else error_note)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
-                            dict(zip(model.parameter_names, p.tolist())), estimate)
+                            dict(zip(model.parameter_names, p.tolist())),
+                            error_estimate=estimate)
 
 
 def _estimate(mode: str, problem: Problem, grid: np.ndarray, x0: np.ndarray,
