@@ -2,7 +2,9 @@
 
 Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, the
 fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
-models), then computes the outputs row by row with the discrete values in force at
+models; on the compiled engine, chosen as for continuous models, dop853 and the
+fixed-step solvers run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
+then computes the outputs row by row with the discrete values in force at
 each row. By default the result has one row per output time (the value after an
 event at that very time); ``event_rows`` adds two rows at each event, its left and
 right limits, as OpenModelica's result files do.
@@ -17,6 +19,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
+from .compiled import COMPILED, SCIPY
 from .events import EventLoop
 from .failures import Stop, state_notes
 from .limits import Limits, OverLimit, check_outputs, over_limit
@@ -27,10 +30,12 @@ from .steps import Problem, Progress
 
 def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.ndarray,
                     x0: np.ndarray, p: np.ndarray, rtol: float, atol: float,
-                    limits: Limits, step: float | None, note: str, began: float
-                    ) -> SimulationResult:
-    """Integrate the hybrid ``model`` over ``grid`` (see the module docstring)."""
+                    limits: Limits, step: float | None, note: str, began: float,
+                    engine: str = SCIPY) -> SimulationResult:
+    """Integrate the hybrid ``model`` over ``grid`` (see the module docstring) on
+    ``engine`` (:data:`.compiled.COMPILED`: :mod:`.hybrid_compiled`)."""
     from .events_fixed import run_fixed_events
+    from .hybrid_compiled import run_compiled_events
 
     start, stop = float(grid[0]), float(grid[-1])
     reason = ""
@@ -39,13 +44,17 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
     loop = EventLoop(problem, grid)
+    compiled, loop_time = False, 0.0
     try:
         with np.errstate(all="ignore"):
             if not np.isfinite(x0).all():
                 raise Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
-            if solver in FIXED_STEP:
+            compiled = engine == COMPILED and len(x0) > 0
+            if compiled:
+                loop_time = run_compiled_events(loop, solver, x0, rtol, atol, step)
+            elif solver in FIXED_STEP:
                 assert step is not None
                 run_fixed_events(loop, solver, x0, step)
             else:
@@ -65,8 +74,9 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
     time_events = sum(e.kind == "time" for e in loop.events)
     stats = SimulationStats(solver, loop.steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
-                            model.compile_time, model.cached, reason, note, "scipy", 0.0,
-                            state_events, time_events)
+                            model.compile_time, model.cached, reason, note,
+                            COMPILED if compiled else SCIPY, loop_time, state_events,
+                            time_events)
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs

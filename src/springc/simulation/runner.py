@@ -39,7 +39,6 @@ from .compiled import (
 )
 from .error_estimate import DEFAULT_MODE, ErrorEstimate
 from .failures import Stop, code_location, state_notes
-from .hybrid_engine import events_engine
 from .limits import (
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
@@ -168,8 +167,6 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     limits.validate()
     estimate_mode = error_estimate.check_mode(options.error_estimate, "error_estimate")
     engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
-    if getattr(model.module, "EVENTS", False):
-        engine = events_engine(model.name, options.engine)
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
     check_parameter_names(model, options.parameters)
@@ -213,7 +210,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         from .hybrid import simulate_hybrid
 
         return simulate_hybrid(model, options, solver, grid, x0, p, rtol, atol, limits,
-                               step if solver in FIXED_STEP else None, note, began)
+                               step if solver in FIXED_STEP else None, note, began, engine)
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
     try:

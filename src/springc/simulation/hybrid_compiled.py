@@ -1,0 +1,131 @@
+"""The event loop of a hybrid model on the compiled engine: :class:`.events.EventLoop`
+(its grid, event iteration, Zeno and terminate checks) driven by the kernels of
+:mod:`springc.integrate` instead of scipy's step loop.
+
+Each kernel run integrates from the last event with the generated ``zero_crossings``
+as its zero-crossing function, the held relations as its signs and the next time event
+(``next_time_event``) as its ``t_stop``; it stops at the earliest state event (located
+on DOP853's dense output or on split fixed steps, to about 1e-12 relative in time, the
+left limit there), at the time event, or at the end. Python then runs the same event
+update as the scipy path (:meth:`.events.EventLoop.event`) and restarts the kernel from
+the state after the event: dop853 with a fresh initial step, as the scipy path starts
+a new integrator; the fixed-step methods on the rest of the output interval, cut into
+equal steps of at most the nominal one (the scipy path finishes the split step first).
+
+Relations and signs: the kernel holds a sign per zero-crossing function ``g`` (the side
+the model assumes); a relation ``g > 0`` or ``g >= 0`` held true is ``+1``, one held
+false ``-1``, and the other way round for ``<`` and ``<=``. The kernel fires when ``g``
+is strictly on the other side, the scipy path when the relation differs: the two differ
+only when ``g`` is exactly 0 at a step's end.
+
+A long stretch without events runs in chunks (:data:`DOP853_CHUNK` steps,
+:data:`~.compiled.FIXED_CHUNK` fixed steps) so that the step and wall-clock limits and
+the progress bar are checked between them. ``step_times`` records the steps that end a
+kernel run (time events, chunk ends, the stop time), not every step.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from .compiled import FIXED_CHUNK, failure, time_limit_reached
+from .events import EventLoop
+from .failures import format_time
+from .limits import OverLimit
+from .solver_names import EXPLICIT
+from .solvers import detect_pairs
+
+DOP853_CHUNK = 100_000
+"""Steps (accepted and rejected) of one dop853 kernel run between checks of the limits."""
+_POSITIVE = (">", ">=")
+
+
+def held_signs(loop: EventLoop) -> np.ndarray:
+    """The kernel's sign of each zero-crossing function from the held relations."""
+    mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
+    held = loop.z[loop.first:loop.first + len(loop.ops)] != 0.0
+    positive = np.array([op in _POSITIVE for op in mod.RELATION_OPS])
+    return np.where(held == positive, 1.0, -1.0)
+
+
+def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: float,
+                        atol: float, step: float | None) -> float:
+    """Fill ``loop``'s grid with ``solver`` (dop853 or a fixed-step method, of nominal
+    ``step``) in the compiled kernels; returns the seconds spent in them."""
+    from springc.integrate import Crossings, Status, dop853, fixed_step
+
+    problem, grid = loop.problem, loop.grid
+    mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
+    limit = problem.limits.max_steps
+    t, stop = float(grid[0]), float(grid[-1])
+    x = loop.initial(t, np.asarray(x0, dtype=float))
+    loop.fill(t, None, t, x, True)
+    pairs: list[tuple[int, int]] = []
+    rows_per_run = len(grid)
+    if solver != EXPLICIT:
+        assert step is not None
+        found = detect_pairs(mod, problem.p, x, t)
+        pairs = list(zip(found.positions.tolist(), found.velocities.tolist()))
+        per_interval = math.ceil(float(grid[1] - grid[0]) / step) if len(grid) > 1 else 1
+        rows_per_run = max(1, FIXED_CHUNK // max(per_interval, 1))
+    first_step: float | None = None
+    seconds = 0.0
+    while t < stop and loop.stopped is None:
+        t_event = loop.next_time(t)
+        t_stop = t_event if t < t_event < stop else math.inf
+        last = min(loop.k + rows_per_run, len(grid))
+        if last < len(grid) and grid[last - 1] == t_stop:
+            last += 1  # a time event at the chunk's end: a TIME_EVENT, not its end
+        times = np.concatenate(([t], grid[loop.k:last]))
+        crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
+        began = time.perf_counter()
+        if solver == EXPLICIT:
+            budget = min(DOP853_CHUNK, limit - loop.steps)
+            run = dop853(mod.rhs, times, x, problem.p, problem.z, rtol=rtol, atol=atol,
+                         first_step=first_step, max_steps=max(budget, 1),
+                         crossings=crossings, t_stop=t_stop)
+        else:
+            assert step is not None
+            run = fixed_step(solver, mod.rhs, times, x, problem.p, problem.z, step=step,
+                             pairs=pairs, crossings=crossings, t_stop=t_stop)
+        seconds += time.perf_counter() - began
+        problem.nfev += run.rhs_evaluations
+        loop.steps += run.accepted_steps
+        # kernel row 0 is the restart itself; its rows 1.. are the grid rows from loop.k
+        filled = max(run.filled - 1, 0)
+        loop.states[loop.k:loop.k + filled] = run.states[1:1 + filled]
+        loop.zs[loop.k:loop.k + filled] = loop.z
+        loop.k += filled
+        first_step = None
+        over = loop.steps > limit or (solver == EXPLICIT and loop.steps == limit
+                                      and run.status != Status.SUCCESS)
+        if over and (run.event or run.status in (Status.SUCCESS, Status.MAX_STEPS)):
+            raise OverLimit(f"{loop.steps} steps of {solver} reached the step limit "
+                            f"(--max-steps {limit})", run.failure_time,
+                            np.array(run.failure_state), solver)
+        if run.status == Status.STATE_EVENT:
+            t = run.event_time
+            k = int(np.flatnonzero(run.fired)[0])
+            x = loop.event(t, np.array(run.event_state), "state", mod.ZERO_CROSSINGS[k])
+            loop.fill(t, None, t, x, True)
+        elif run.status == Status.TIME_EVENT:
+            t = run.event_time
+            loop.step_times.append(t)
+            x = loop.event(t, np.array(run.event_state), "time", f"time = {format_time(t)}")
+            loop.fill(t, None, t, x, True)
+        elif run.status == Status.SUCCESS:
+            t, x = float(times[-1]), np.array(run.failure_state)
+            loop.step_times.append(t)
+        elif run.status == Status.MAX_STEPS:  # a chunk's end, within the step limit
+            t, x = run.failure_time, np.array(run.failure_state)
+            first_step = min(run.next_step, stop - t)  # the same steps go on
+        else:
+            raise failure(problem, run, solver, step=step or 0.0)
+        if t < stop and time.perf_counter() > problem.deadline:
+            raise time_limit_reached(problem, run)
+        problem.progress.update(t)
+    return seconds

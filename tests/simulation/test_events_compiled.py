@@ -1,0 +1,239 @@
+"""Hybrid models on the compiled engine (springc.integrate's kernels with the generated
+zero_crossings; simulation/hybrid_compiled.py) against exact references and against the
+scipy engine: the bouncing ball, a time event, sample clocks, a relation in an
+if-expression, terminate(), chattering, the step limit, the event rows and the engine
+choice."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import springc
+from simulation.test_events import BALL, E, G, ball_exact
+from springc.cli import main
+from springc.errors import SimulationError, UsageError
+from springc.pipeline import CompiledModel
+from springc.simulation import SimulationOptions, simulate_model
+
+SWITCH = """
+model Switch "a force switched on at t = 1.234"
+  Real x(start = 0, fixed = true);
+  Real v(start = 0, fixed = true);
+  Real f;
+equation
+  der(x) = v;
+  der(v) = f;
+  f = if time >= 1.234 then 1 else 0;
+end Switch;
+"""
+
+CLOCK = """
+model Clock "n counts the samples 0.5, 0.75, ...; x integrates n"
+  discrete Integer n(start = 0);
+  Real x(start = 0, fixed = true);
+equation
+  der(x) = n;
+  when sample(0.5, 0.25) then
+    n = pre(n) + 1;
+  end when;
+end Clock;
+"""
+
+RELAY = """
+model Relay "a unit force towards x = 0, switched by the relation x > 0"
+  Real x(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+equation
+  der(x) = v;
+  der(v) = if x > 0 then -1 else 1;
+end Relay;
+"""
+
+STOP = """
+model StopBall
+  Real h(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+equation
+  der(h) = v;
+  der(v) = -9.81;
+  when h <= 0 then
+    terminate("the ball hit the floor");
+  end when;
+end StopBall;
+"""
+
+TEXTS = {"ball": BALL, "switch": SWITCH, "clock": CLOCK, "relay": RELAY, "stop": STOP}
+FIXED = {"dop853": None, "rk4": 1e-3}  # solver -> step
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def models(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, CompiledModel]]:
+    """Every model compiled once with the numba backend (into the session's cache)."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+    try:
+        yield {name: springc.load_model_from_string(text, backend="numba")
+               for name, text in TEXTS.items()}
+    finally:
+        mp.undo()
+
+
+def both(model: CompiledModel, solver: str, **options: object
+         ) -> tuple[springc.SimulationResult, springc.SimulationResult]:
+    """The run on the scipy engine and on the compiled one."""
+    runs = tuple(springc.simulate(model, solver=solver, step=FIXED[solver], engine=engine,
+                                  **options)  # type: ignore[arg-type]
+                 for engine in ("scipy", "compiled"))
+    assert runs[1].stats.engine == "compiled" and runs[0].stats.engine == "scipy"
+    return runs[0], runs[1]
+
+
+def kinds(result: springc.SimulationResult) -> list[tuple[str, str]]:
+    return [(e.kind, e.cause) for e in result.events]
+
+
+@pytest.mark.parametrize("solver", sorted(FIXED))
+def test_bouncing_ball_matches_the_parabolas_and_the_scipy_engine(
+        models: dict[str, CompiledModel], solver: str) -> None:
+    _, _, impacts = ball_exact(np.zeros(1), 11)
+    stop = impacts[9] + 0.5 * (impacts[10] - impacts[9])
+    scipy, compiled = both(models["ball"], solver, rtol=1e-8, stop=stop, interval=1e-3)
+    h, v, _ = ball_exact(compiled.time, 11)
+    assert np.max(np.abs(compiled["h"] - h)) < 1e-6
+    assert np.max(np.abs(compiled["v"] - v)) < 1e-6
+    bounces = [e.time for e in compiled.events if e.x_right[1] != e.x_left[1]]
+    assert len(bounces) == 10
+    assert np.max(np.abs(np.array(bounces) - impacts[:10])) < 1e-9
+    assert np.max(np.abs(np.array(bounces) - [e.time for e in scipy.events
+                                              if e.x_right[1] != e.x_left[1]])) < 1e-9
+    # each bounce: h <= 0 becomes true (the reinit), then false just after
+    assert kinds(compiled) == kinds(scipy) == [("initial", "initial()")] + 20 * [
+        ("state", "h <= 0")]
+    assert (compiled.stats.state_events, compiled.stats.time_events) == (20, 0)
+    assert (scipy.stats.state_events, scipy.stats.time_events) == (20, 0)
+    assert np.max(np.abs(compiled.values - scipy.values)) < 1e-9
+
+
+@pytest.mark.parametrize("solver", sorted(FIXED))
+def test_a_time_event_is_hit_exactly(models: dict[str, CompiledModel], solver: str) -> None:
+    scipy, compiled = both(models["switch"], solver, stop=3.0, interval=0.01)
+    events = [e for e in compiled.events if e.kind == "time"]
+    assert [e.time for e in events] == [1.234]
+    assert 1.234 in compiled.step_times
+    assert events[0].z_left[events[0].z_left.size - 1] == 0.0
+    # x = (t - 1.234)^2 / 2 after the switch, 0 before: every method here is exact on it
+    exact = np.where(compiled.time >= 1.234, 0.5 * (compiled.time - 1.234) ** 2, 0.0)
+    assert np.max(np.abs(compiled["x"] - exact)) < 1e-12
+    assert kinds(compiled) == kinds(scipy)
+    assert (compiled.stats.state_events, compiled.stats.time_events) == (0, 1)
+    assert (scipy.stats.state_events, scipy.stats.time_events) == (0, 1)
+
+
+@pytest.mark.parametrize("solver", sorted(FIXED))
+def test_sample_clock_counts_the_same_events(models: dict[str, CompiledModel], solver: str
+                                             ) -> None:
+    scipy, compiled = both(models["clock"], solver, stop=4.0, interval=0.01)
+    samples = 0.5 + 0.25 * np.arange(14)  # 0.5 ... 3.75 (4.0 is the stop time)
+    assert [e.time for e in compiled.events if e.kind == "time"] == samples.tolist()
+    assert (compiled.stats.state_events, compiled.stats.time_events) == (0, 14)
+    assert kinds(compiled) == kinds(scipy)
+    np.testing.assert_array_equal(compiled["n"], scipy["n"])
+    assert compiled["n"][-1] == 14
+    # x(4) = sum over the samples of 0.25 * n = 0.25 * (1 + ... + 14)
+    assert abs(compiled["x"][-1] - 26.25) < 1e-12
+
+
+@pytest.mark.parametrize("solver", sorted(FIXED))
+def test_relation_in_an_if_expression(models: dict[str, CompiledModel], solver: str) -> None:
+    scipy, compiled = both(models["relay"], solver, rtol=1e-10, stop=4.0, interval=0.01)
+    assert kinds(compiled) == kinds(scipy) == [("initial", "initial()"), ("state", "x > 0")]
+    crossing = math.sqrt(2.0)  # x = 1 - t^2 / 2
+    assert abs(compiled.events[1].time - crossing) < 1e-9
+    s = compiled.time - crossing
+    exact = np.where(s < 0, 1 - compiled.time ** 2 / 2, -crossing * s + s ** 2 / 2)
+    assert np.max(np.abs(compiled["x"] - exact)) < 1e-9
+    assert np.max(np.abs(compiled.values - scipy.values)) < 1e-8
+
+
+def test_terminate_ends_the_run_at_its_time(models: dict[str, CompiledModel]) -> None:
+    scipy, compiled = both(models["stop"], "dop853", rtol=1e-8, stop=2.0, interval=0.01)
+    hit = math.sqrt(2 / 9.81)
+    assert abs(compiled.time[-1] - hit) < 1e-9
+    assert compiled.time[-2] == 0.45
+    assert compiled.stats.note == scipy.stats.note == (
+        "terminate() at time 0.451523641: the ball hit the floor")
+
+
+def test_chattering_stops_with_the_scipy_engine_s_message(models: dict[str, CompiledModel]
+                                                          ) -> None:
+    with pytest.raises(SimulationError) as caught:
+        springc.simulate(models["ball"], solver="dop853", engine="compiled", rtol=1e-8,
+                         stop=5.0)
+    message = str(caught.value)
+    assert message.startswith("error: chattering: 100 events between time 4.0637")
+    assert "most of them of 'h <= 0'" in message
+    assert "needs a minimum bounce velocity" in message
+
+
+def test_step_limit(models: dict[str, CompiledModel]) -> None:
+    with pytest.raises(SimulationError) as caught:
+        springc.simulate(models["ball"], solver="dop853", engine="compiled", rtol=1e-8,
+                         stop=3.0, max_steps=20)
+    assert "20 steps of dop853 reached the step limit (--max-steps 20)" in str(caught.value)
+    # the whole run to 1.76 s takes 21 steps on both engines: a limit of 22 is enough
+    scipy, compiled = both(models["ball"], "dop853", rtol=1e-8, stop=1.76, max_steps=22)
+    assert compiled.stats.steps == scipy.stats.steps == 21
+
+
+def test_event_rows_are_the_same_on_both_engines(models: dict[str, CompiledModel]) -> None:
+    runs = [simulate_model(models["ball"], SimulationOptions(
+        stop=1.5, interval=0.1, rtol=1e-8, engine=engine, event_rows=True))
+        for engine in ("scipy", "compiled")]
+    scipy, compiled = runs
+    assert compiled.stats.engine == "compiled"
+    assert len(compiled.time) == len(scipy.time) == 16 + 4 * 2  # 2 bounces, 2 rows each
+    assert np.max(np.abs(compiled.time - scipy.time)) < 1e-9
+    assert np.max(np.abs(compiled.values - scipy.values)) < 1e-8
+    first = int(np.flatnonzero(np.diff(compiled.time) == 0)[0])
+    # left limit, then right limit: v jumps from -u to e * u at the first impact
+    u = math.sqrt(2 * G)
+    assert abs(compiled["v"][first] + u) < 1e-8 and abs(compiled["v"][first + 1] - E * u) < 1e-8
+
+
+def test_auto_engine_chooses_compiled_for_numba_hybrid_models(
+        models: dict[str, CompiledModel], tmp_path: Path) -> None:
+    result = springc.simulate(models["ball"], stop=1.0)  # solver auto, engine auto
+    assert (result.stats.solver, result.stats.engine) == ("dop853", "compiled")
+    assert result.stats.reason == "a hybrid model: dop853 with event location"
+    python = springc.load_model_from_string(BALL)  # the python backend: scipy
+    assert springc.simulate(python, stop=1.0).stats.engine == "scipy"
+    with pytest.raises(UsageError, match="engine compiled: the radau solver has no "
+                                         "compiled loop"):
+        springc.simulate(models["ball"], solver="radau", engine="compiled")
+    with pytest.raises(UsageError, match="engine compiled runs the numba backend's "
+                                         "functions, not backend python"):
+        springc.simulate(python, engine="compiled")
+    path = tmp_path / "ball.mo"
+    path.write_text(BALL)
+    lines = []
+    for engine in ("scipy", "compiled"):
+        out = CliRunner().invoke(main, ["simulate", str(path), "--backend", "numba",
+                                        "--solver", "rk4", "--step", "0.001", "--stop", "1.5",
+                                        "--engine", engine])
+        assert out.exit_code == 0, out.output
+        lines.append(out.output.splitlines()[-1])
+    # the same steps (1500 and one more after each event) and events on both engines
+    assert lines[0].startswith("BouncingBall: rk4 (scipy), 1504 steps, ")
+    assert lines[1].startswith("BouncingBall: rk4 (compiled), 1504 steps, ")
+    assert all(line.endswith(", 4 state and 0 time events") for line in lines)
