@@ -11,6 +11,7 @@ are removed in every case (:mod:`springc.fileio`).
 from __future__ import annotations
 
 import functools
+import importlib.util
 import json
 import os
 import signal
@@ -453,7 +454,11 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         summary,
     )
 
-    compiled = compile_model(files, model, libraries=libraries, backend=backend or "python",
+    # numba by default: the runs of solvers with a compiled loop run there (many runs
+    # share one compilation)
+    numba = importlib.util.find_spec("numba") is not None
+    compiled = compile_model(files, model, libraries=libraries,
+                             backend=backend or ("numba" if numba else "python"),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     if not patterns:

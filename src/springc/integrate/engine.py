@@ -43,6 +43,7 @@ class Run:
     failure_state: np.ndarray
     fired: np.ndarray
     next_step: float
+    jacobian_evaluations: int = 0
 
     @property
     def ok(self) -> bool:
@@ -99,21 +100,50 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     from .dop853_kernel import dop853_run
 
     grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
-    if not rtol > 0:
-        raise ValueError(f"rtol must be positive, got {rtol!r}")
-    atol_ = np.array(np.broadcast_to(np.asarray(atol, dtype=float), x0_.shape))
-    if not (atol_ >= 0).all():
-        raise ValueError("atol must not be negative")
-    if first_step is not None and not 0 < first_step <= grid_[-1] - grid_[0]:
-        raise ValueError(f"first_step must be positive and within the interval, "
-                         f"got {first_step!r}")
-    if not max_step > 0:
-        raise ValueError(f"max_step must be positive, got {max_step!r}")
+    atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
     result = dop853_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
                         float(rtol), atol_, float(max_step), float(first_step or 0.0),
                         int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
+    return _run(grid_, result)
+
+
+def radau(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any, grid: Any,
+          x0: Any, p: Any, z: Any, *, rtol: float, atol: float | Sequence[float] | np.ndarray,
+          observed: ModelFunction | None = None, max_step: float = np.inf,
+          first_step: float | None = None, max_steps: int = 0,
+          crossings: Crossings | None = None, t_stop: float = np.inf,
+          dense_limit: int = 64) -> Run:
+    """Integrate with compiled Radau IIA (order 5), scipy's ``Radau`` method.
+
+    ``jacobian(t, x, p, z)`` returns the non-zeros of the Jacobian in the CSC order of
+    ``(indptr, indices)`` (a generated module's ``jacobian_values``, ``JAC_INDPTR``,
+    ``JAC_INDICES``). The Newton matrices are factorised dense up to ``dense_limit``
+    states, banded after a reverse Cuthill-McKee ordering above. Other arguments as
+    :func:`dop853`.
+    """
+    from .banded_lu import band_layout
+    from .radau_kernel import radau_run
+
+    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
+    atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
+    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
+    indptr_ = np.asarray(indptr, dtype=np.int64)
+    indices_ = np.asarray(indices, dtype=np.int64)
+    if indptr_.shape != (x0_.size + 1,) or indptr_[-1] != indices_.size \
+            or (indices_.size and not 0 <= indices_.min() <= indices_.max() < x0_.size):
+        raise ValueError("indptr/indices are not a CSC sparsity of the state vector")
+    values = np.asarray(jacobian(grid_[0], x0_, p_, z_.copy()))
+    if values.shape != indices_.shape:
+        raise ValueError(f"the Jacobian returns shape {values.shape} for {indices_.size} "
+                         "non-zeros")
+    order, kl, ku, positions, diagonal = band_layout(x0_.size, indptr_, indices_, dense_limit)
+    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
+    result = radau_run(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_,
+                       x0_, p_, z_, float(rtol), atol_, float(max_step),
+                       float(first_step or 0.0), int(max_steps), _stop(t_stop, grid_), order,
+                       kl, ku, positions, diagonal)
     return _run(grid_, result)
 
 
@@ -147,6 +177,22 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
                             directions, grid_, x0_, p_, z_, float(step), positions,
                             velocities, _stop(t_stop, grid_))
     return _run(grid_, result)
+
+
+def _tolerances(rtol: float, atol: Any, x0: np.ndarray, grid: np.ndarray,
+                first_step: float | None, max_step: float) -> np.ndarray:
+    """atol per state, after the checks of the adaptive methods' arguments."""
+    if not rtol > 0:
+        raise ValueError(f"rtol must be positive, got {rtol!r}")
+    atol_ = np.array(np.broadcast_to(np.asarray(atol, dtype=float), x0.shape))
+    if not (atol_ >= 0).all():
+        raise ValueError("atol must not be negative")
+    if first_step is not None and not 0 < first_step <= grid[-1] - grid[0]:
+        raise ValueError(f"first_step must be positive and within the interval, "
+                         f"got {first_step!r}")
+    if not max_step > 0:
+        raise ValueError(f"max_step must be positive, got {max_step!r}")
+    return atol_
 
 
 def _vectors(grid: Any, x0: Any, p: Any, z: Any
@@ -223,8 +269,9 @@ def _stop(t_stop: float, grid: np.ndarray) -> float:
 
 def _run(grid: np.ndarray, result: tuple[Any, ...]) -> Run:
     (status, states, observed, filled, accepted, rejected, nfev, t_end, x_end, fired,
-     next_step) = result
+     next_step) = result[:11]
     states[filled:] = np.nan
     observed[filled:] = np.nan
     return Run(Status(status), grid, states, observed, int(filled), int(accepted),
-               int(rejected), int(nfev), float(t_end), x_end, fired, float(next_step))
+               int(rejected), int(nfev), float(t_end), x_end, fired, float(next_step),
+               int(result[11]) if len(result) > 11 else 0)

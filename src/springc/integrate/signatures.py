@@ -16,6 +16,9 @@ ModelFunction = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray
 #: what the kernels return, as Python sees it (see RUN_RESULT)
 RunTuple = tuple[int, np.ndarray, np.ndarray, int, int, int, int, float, np.ndarray,
                  np.ndarray, float]
+#: the implicit kernels' result: RunTuple and the Jacobian evaluations
+ImplicitTuple = tuple[int, np.ndarray, np.ndarray, int, int, int, int, float, np.ndarray,
+                      np.ndarray, float, int]
 
 VECTOR = types.float64[::1]
 MATRIX = types.float64[:, ::1]
@@ -30,3 +33,5 @@ INDICES = types.int64[::1]
 RUN_RESULT = types.Tuple((types.int64, MATRIX, MATRIX, types.int64,  # type: ignore[no-untyped-call]
                           types.int64, types.int64, types.int64, types.float64, VECTOR,
                           INDICES, types.float64))
+#: RUN_RESULT and the Jacobian evaluations (the implicit kernels)
+IMPLICIT_RESULT = types.Tuple((*RUN_RESULT.types, types.int64))  # type: ignore[no-untyped-call]

@@ -5,7 +5,9 @@
   backend's functions; errors name the option).
 - :func:`finish_dop853`: a scipy ``DOP853`` integrator of the step loop continued to the
   end of the grid by the compiled DOP853, which takes the same steps (same state, same
-  next step size, same controller), so the run equals the scipy run bit for bit.
+  next step size, same controller), so the run equals the scipy run bit for bit; a
+  scipy ``Radau`` integrator continued by the compiled Radau IIA (the generated sparse
+  Jacobian, a banded LU).
 - :func:`run_fixed_compiled`: the fixed-step solvers, compiled.
 
 Failures come back as :class:`springc.integrate.Status` codes and become the scipy
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import importlib.util
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -25,7 +28,7 @@ import numpy as np
 from ..errors import UsageError
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
-from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP
+from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
 from .solvers import detect_pairs, non_finite_states
 from .steps import Problem, StepLoop, Stretch, solver_failure
 
@@ -89,9 +92,30 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
 
 
 def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
-    """Continue the scipy ``DOP853`` ``integrator`` of ``loop`` to the end of the grid,
-    compiled: from its state with its next step size, filling the grid from ``loop.k``."""
-    from springc.integrate import Status, dop853
+    """Continue the scipy ``DOP853`` or ``Radau`` ``integrator`` of ``loop`` to the end of
+    the grid, compiled: from its state with its next step size, filling the grid from
+    ``loop.k`` (DOP853 takes scipy's steps exactly; Radau restarts its Jacobian and
+    step-size history there)."""
+    from springc.integrate import dop853, radau
+
+    problem = loop.problem
+    mod = problem.mod
+    if type(integrator).__name__ == "Radau":
+        def run_kernel(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+            return radau(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
+                         y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
+                         first_step=first, max_steps=steps)
+        return _finish(loop, integrator, RACE_IMPLICIT, run_kernel)
+
+    def run_dop853(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        return dop853(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                      atol=loop.atol, first_step=first, max_steps=steps)
+    return _finish(loop, integrator, EXPLICIT, run_dop853)
+
+
+def _finish(loop: StepLoop, integrator: Any, solver: str,
+            run_kernel: Callable[[np.ndarray, np.ndarray, float, int], Run]) -> Stretch:
+    from springc.integrate import Status
 
     problem, grid = loop.problem, loop.grid
     t, y = float(integrator.t), np.array(integrator.y)
@@ -103,10 +127,9 @@ def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
     budget = min(FIRST_CHUNK, allowed)
     attempt = budget  # the kernel counts rejected steps too
     while True:
-        run = dop853(problem.mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                     atol=loop.atol, first_step=min(first, float(times[-1] - t)),
-                     max_steps=max(attempt, 1))
+        run = run_kernel(times, y, min(first, float(times[-1] - t)), max(attempt, 1))
         problem.nfev += run.rhs_evaluations
+        problem.njev += run.jacobian_evaluations
         if run.status != Status.MAX_STEPS:
             break
         if run.accepted_steps < budget:  # rejections used part of the attempt
@@ -119,10 +142,10 @@ def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
                                                                      1e-300)
         if projected > HOPELESS * loop.limits.max_steps:
             raise OverLimit(f"at its current step size ({(run.failure_time - t) / taken:.3g} "
-                            f"s on average) {EXPLICIT} needs ~{projected:.3g} steps to the "
+                            f"s on average) {solver} needs ~{projected:.3g} steps to the "
                             f"stop time, far over the step limit (--max-steps "
                             f"{loop.limits.max_steps})", run.failure_time,
-                            run.failure_state, EXPLICIT)
+                            run.failure_state, solver)
         if time.perf_counter() > problem.deadline:
             raise time_limit_reached(problem, run)
         budget = min(10 * budget, allowed)
@@ -131,7 +154,7 @@ def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
     loop.loop_time += seconds
     loop.compiled_steps += run.accepted_steps
     if not run.ok:
-        raise failure(problem, run, EXPLICIT, steps=loop.steps + run.accepted_steps,
+        raise failure(problem, run, solver, steps=loop.steps + run.accepted_steps,
                       limit=loop.limits.max_steps)
     if time.perf_counter() > problem.deadline:
         raise time_limit_reached(problem, run)

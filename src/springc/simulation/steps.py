@@ -267,11 +267,11 @@ class StepLoop:
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it.
 
-        A ``DOP853`` integrator run to the end on the compiled engine continues there
-        (the same steps, see :func:`springc.simulation.compiled.finish_dop853`).
+        A ``DOP853`` or ``Radau`` integrator run to the end on the compiled engine
+        continues there (see :func:`springc.simulation.compiled.finish_dop853`).
         """
         if self.finish is not None and max_steps is None and not self.done \
-                and type(integrator).__name__ == SOLVERS[EXPLICIT]:
+                and type(integrator).__name__ in (SOLVERS[EXPLICIT], SOLVERS[RACE_IMPLICIT]):
             return self.finish(self, integrator)
         problem, grid, states = self.problem, self.grid, self.states
         began, taken = time.perf_counter(), 0

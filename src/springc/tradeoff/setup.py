@@ -90,12 +90,14 @@ class StudySetup:
 
     def sim_options(self, solver: str, rtol: float | None = None, step: float | None = None,
                     progress: TextIO | Deadline | None = None) -> SimulationOptions:
-        """The simulator's options for one run (atol in the study's ratio to rtol)."""
+        """The simulator's options for one run (atol in the study's ratio to rtol; the
+        engine is the simulator's default: the compiled loop for a numba module and a
+        solver that has one; the study measures the error itself)."""
         o = self.options
         return SimulationOptions(o.start, o.stop, o.interval, solver, rtol,
                                  None if rtol is None else rtol * self.atol_ratio,
                                  dict(o.parameters), progress,  # type: ignore[arg-type]
-                                 step)
+                                 step, error_estimate="off")
 
     def log(self, text: str) -> None:
         """A line on the study's log stream, if any."""
