@@ -1,6 +1,6 @@
 """Hybrid models on the two engines: the bouncing ball (tests/simulation/test_events.py's
 model, e = 0.8, ten and a half bounces, rtol 1e-8, 1 ms output interval), warm, in
-process, with dop853 and with rk4 (step 1 ms): the scipy engine (scipy's DOP853 or the
+process, with dop853, radau and rk4 (step 1 ms): the scipy engine (scipy's solvers or the
 Python fixed-step loop, stepped from Python) against the compiled engine (the kernels of
 springc.integrate between events, simulation/hybrid_compiled.py); the ratio, the events
 and the time per event on each.
@@ -63,7 +63,7 @@ def main() -> None:
     model = springc.load_model_from_string(BALL, backend="numba")
     common = {"rtol": 1e-8, "stop": stop_time(), "interval": 1e-3}
     print(f"bouncing ball, 0..{common['stop']:.4f} s, rtol 1e-8, warm, best of {args.repeat}")
-    for solver, step in (("dop853", None), ("rk4", 1e-3)):
+    for solver, step in (("dop853", None), ("radau", None), ("rk4", 1e-3)):
         row = {}
         for engine in ("scipy", "compiled"):
             seconds, result = best(model, args.repeat, solver=solver, step=step,

@@ -1,15 +1,16 @@
 """The event loop of a hybrid model on the compiled engine: :class:`.events.EventLoop`
 (its grid, event iteration, Zeno and terminate checks) driven by the kernels of
-:mod:`springc.integrate` instead of scipy's step loop.
+:mod:`springc.integrate` (dop853, radau, the fixed-step methods) instead of scipy's
+step loop.
 
 Each kernel run integrates from the last event with the generated ``zero_crossings``
 as its zero-crossing function, the held relations as its signs and the next time event
 (``next_time_event``) as its ``t_stop``; it stops at the earliest state event (located
-on DOP853's dense output or on split fixed steps, to about 1e-12 relative in time, the
+on DOP853's dense output, Radau's collocation polynomial or split fixed steps, to about 1e-12 relative in time, the
 left limit there), at the time event, or at the end. Python then runs the same event
 update as the scipy path (:meth:`.events.EventLoop.event`) and restarts the kernel from
-the state after the event: dop853 with a fresh initial step, as the scipy path starts
-a new integrator; the fixed-step methods on the rest of the output interval, cut into
+the state after the event: dop853 and radau with a fresh initial step, as the scipy
+path starts a new integrator; the fixed-step methods on the rest of the output interval, cut into
 equal steps of at most the nominal one (the scipy path finishes the split step first).
 
 Relations and signs: the kernel holds a sign per zero-crossing function ``g`` (the side
@@ -18,7 +19,7 @@ false ``-1``, and the other way round for ``<`` and ``<=``. The kernel fires whe
 is strictly on the other side, the scipy path when the relation differs: the two differ
 only when ``g`` is exactly 0 at a step's end.
 
-A long stretch without events runs in chunks (:data:`DOP853_CHUNK` steps,
+A long stretch without events runs in chunks (:data:`ADAPTIVE_CHUNK` steps,
 :data:`~.compiled.FIXED_CHUNK` fixed steps) so that the step and wall-clock limits and
 the progress bar are checked between them. ``step_times`` records the steps that end a
 kernel run (time events, chunk ends, the stop time), not every step.
@@ -36,11 +37,12 @@ from .compiled import FIXED_CHUNK, failure, time_limit_reached
 from .events import EventLoop
 from .failures import format_time
 from .limits import OverLimit
-from .solver_names import EXPLICIT
+from .solver_names import EXPLICIT, RACE_IMPLICIT
 from .solvers import detect_pairs
 
-DOP853_CHUNK = 100_000
-"""Steps (accepted and rejected) of one dop853 kernel run between checks of the limits."""
+ADAPTIVE_CHUNK = 100_000
+"""Steps (accepted and rejected) of one dop853 or radau kernel run between checks of the
+limits."""
 _POSITIVE = (">", ">=")
 
 
@@ -54,9 +56,9 @@ def held_signs(loop: EventLoop) -> np.ndarray:
 
 def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: float,
                         atol: float, step: float | None) -> float:
-    """Fill ``loop``'s grid with ``solver`` (dop853 or a fixed-step method, of nominal
+    """Fill ``loop``'s grid with ``solver`` (dop853, radau or a fixed-step method, of nominal
     ``step``) in the compiled kernels; returns the seconds spent in them."""
-    from springc.integrate import Crossings, Status, dop853, fixed_step
+    from springc.integrate import Crossings, Status, dop853, fixed_step, radau
 
     problem, grid = loop.problem, loop.grid
     mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
@@ -66,7 +68,8 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
     loop.fill(t, None, t, x, True)
     pairs: list[tuple[int, int]] = []
     rows_per_run = len(grid)
-    if solver != EXPLICIT:
+    adaptive = solver in (EXPLICIT, RACE_IMPLICIT)
+    if not adaptive:
         assert step is not None
         found = detect_pairs(mod, problem.p, x, t)
         pairs = list(zip(found.positions.tolist(), found.velocities.tolist()))
@@ -83,17 +86,22 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         times = np.concatenate(([t], grid[loop.k:last]))
         crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
         began = time.perf_counter()
+        budget = max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1)
         if solver == EXPLICIT:
-            budget = min(DOP853_CHUNK, limit - loop.steps)
             run = dop853(mod.rhs, times, x, problem.p, problem.z, rtol=rtol, atol=atol,
-                         first_step=first_step, max_steps=max(budget, 1),
-                         crossings=crossings, t_stop=t_stop)
+                         first_step=first_step, max_steps=budget, crossings=crossings,
+                         t_stop=t_stop)
+        elif solver == RACE_IMPLICIT:
+            run = radau(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
+                        x, problem.p, problem.z, rtol=rtol, atol=atol, first_step=first_step,
+                        max_steps=budget, crossings=crossings, t_stop=t_stop)
         else:
             assert step is not None
             run = fixed_step(solver, mod.rhs, times, x, problem.p, problem.z, step=step,
                              pairs=pairs, crossings=crossings, t_stop=t_stop)
         seconds += time.perf_counter() - began
         problem.nfev += run.rhs_evaluations
+        problem.njev += run.jacobian_evaluations
         loop.steps += run.accepted_steps
         # kernel row 0 is the restart itself; its rows 1.. are the grid rows from loop.k
         filled = max(run.filled - 1, 0)
@@ -101,7 +109,7 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         loop.zs[loop.k:loop.k + filled] = loop.z
         loop.k += filled
         first_step = None
-        over = loop.steps > limit or (solver == EXPLICIT and loop.steps == limit
+        over = loop.steps > limit or (adaptive and loop.steps == limit
                                       and run.status != Status.SUCCESS)
         if over and (run.event or run.status in (Status.SUCCESS, Status.MAX_STEPS)):
             raise OverLimit(f"{loop.steps} steps of {solver} reached the step limit "
