@@ -7,11 +7,12 @@ Each kernel run integrates from the last event with the generated ``zero_crossin
 as its zero-crossing function, the held relations as its signs and the next time event
 (``next_time_event``) as its ``t_stop``; it stops at the earliest state event (located
 on DOP853's dense output, Radau's collocation polynomial or split fixed steps, to about
-1e-12 relative in time, the left limit there), at the time event, or at the end. Python then runs the same event
-update as the scipy path (:meth:`.events.EventLoop.event`) and restarts the kernel from
-the state after the event: dop853 and radau with a fresh initial step, as the scipy
-path starts a new integrator; the fixed-step methods on the rest of the output interval, cut into
-equal steps of at most the nominal one (the scipy path finishes the split step first).
+1e-12 relative in time, the left limit there), at the time event, or at the end.
+Python then runs the same event update as the scipy path
+(:meth:`.events.EventLoop.event`) and restarts the kernel from the state after the
+event: dop853 and radau with a fresh initial step, as the scipy path starts a new
+integrator; the fixed-step methods on the rest of the output interval, cut into equal
+steps of at most the nominal one (the scipy path finishes the split step first).
 
 Relations and signs: the kernel holds a sign per zero-crossing function ``g`` (the side
 the model assumes); a relation ``g > 0`` or ``g >= 0`` held true is ``+1``, one held
