@@ -237,3 +237,24 @@ def test_auto_engine_chooses_compiled_for_numba_hybrid_models(
     assert lines[0].startswith("BouncingBall: rk4 (scipy), 1504 steps, ")
     assert lines[1].startswith("BouncingBall: rk4 (compiled), 1504 steps, ")
     assert all(line.endswith(", 4 state and 0 time events") for line in lines)
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
+def test_chunked_runs_equal_a_single_run(models: dict[str, CompiledModel], solver: str,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Stretches cut into chunks (for the limits) give the same run: dop853 goes on with
+    its next step size, a fixed-step chunk ends on an output time (one ending on a time
+    event is extended, so that the event is one)."""
+    import springc.simulation.hybrid_compiled as glue
+
+    options = {"solver": solver, "step": STEP[solver], "engine": "compiled", "stop": 1.0,
+               "interval": 0.01}
+    whole = springc.simulate(models["clock"], **options)  # type: ignore[arg-type]
+    monkeypatch.setattr(glue, "ADAPTIVE_CHUNK", 3)
+    monkeypatch.setattr(glue, "FIXED_CHUNK", 20)  # two output intervals of 10 steps
+    chunked = springc.simulate(models["clock"], **options)  # type: ignore[arg-type]
+    assert kinds(chunked) == kinds(whole) == [
+        ("initial", "initial()"), ("time", "time = 0.5"), ("time", "time = 0.75")]
+    assert chunked.stats.steps == whole.stats.steps
+    np.testing.assert_array_equal(chunked.values, whole.values)
+    assert abs(chunked["x"][-1] - 0.75) < 1e-12  # 0.25 * 1 + 0.25 * 2
