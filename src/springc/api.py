@@ -143,7 +143,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
              progress: TextIO | None = None, step: float | None = None,
              max_steps: int | None = None, time_limit: float | None = None,
-             engine: str = DEFAULT_ENGINE) -> SimulationResult:
+             engine: str = DEFAULT_ENGINE, event_rows: bool = False) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -158,7 +158,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     ``"auto"``: compiled for a module generated with the numba backend (where numba is
     importable and the solver has a compiled loop), else scipy.
     ``backend`` (files only) defaults to ``"numba"`` for the compiled engine, else
-    ``"python"``.
+    ``"python"``. ``event_rows``: a model with events gets two more rows at each event,
+    its left and right limits (default: one row per output time).
     """
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
@@ -179,7 +180,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
                                 step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
                                 DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
-                                engine)
+                                engine, bool(event_rows))
     return simulate_model(model, options)
 
 
