@@ -144,7 +144,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              progress: TextIO | None = None, step: float | None = None,
              max_steps: int | None = None, time_limit: float | None = None,
              engine: str = DEFAULT_ENGINE,
-             error_estimate: str = "auto") -> SimulationResult:
+             error_estimate: str = "auto", event_rows: bool = False) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -163,7 +163,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     tolerance, or Richardson for the fixed-step solvers); ``auto`` where it costs at
     most about 30 % of the run.
     ``backend`` (files only) defaults to ``"numba"`` for the compiled engine, else
-    ``"python"``.
+    ``"python"``. ``event_rows``: a model with events gets two more rows at each event,
+    its left and right limits (default: one row per output time).
     """
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
@@ -184,7 +185,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
                                 step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
                                 DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
-                                engine, error_estimate=error_estimate)
+                                engine, event_rows=bool(event_rows),
+                                error_estimate=error_estimate)
     return simulate_model(model, options)
 
 

@@ -281,6 +281,8 @@ def _single_threaded_blas() -> None:
               "OpenModelica and Dymola); default: CSV on stdout unless --plot.")
 @click.option("--plot", type=click.Path(dir_okay=False),
               help="Write a plot: .png, .svg or .pdf.")
+@click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
+              "each event, its left and right limits (default: one row per output time).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
 @_guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -290,7 +292,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
-             quiet: bool) -> None:
+             event_rows: bool, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from .simulation import PLOT_FORMATS, RESULT_FORMATS, check_run_values, choose_engine
 
@@ -312,7 +314,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                  interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
                  parameters=values, progress=progress, step=step, max_steps=max_steps,
                  time_limit=time_limit, engine=engine.lower(),
-                 error_estimate=error_estimate.lower())
+                 error_estimate=error_estimate.lower(), event_rows=event_rows)
     if output or plot:
         save_outputs(result, output, plot, files)
     else:

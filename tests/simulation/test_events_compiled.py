@@ -1,8 +1,8 @@
 """Hybrid models on the compiled engine (springc.integrate's kernels with the generated
-zero_crossings; simulation/hybrid_compiled.py) against exact references and against the
-scipy engine: the bouncing ball, a time event, sample clocks, a relation in an
-if-expression, terminate(), chattering, the step limit, the event rows and the engine
-choice."""
+zero_crossings; simulation/hybrid_compiled.py) against exact references (the ball's of
+test_hybrid.py) and against the scipy engine: the bouncing ball, a time event, sample
+clocks, a relation in an if-expression, terminate(), chattering, the step limit, the
+event rows, chunked runs and the engine choice."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 import springc
-from simulation.test_events import BALL, E, G, ball_exact
+from simulation.test_hybrid import BALL, E, G, ball_exact
 from springc.cli import main
 from springc.errors import SimulationError, UsageError
 from springc.pipeline import CompiledModel
@@ -144,13 +144,13 @@ def test_a_time_event_is_hit_exactly(models: dict[str, CompiledModel], solver: s
 def test_sample_clock_counts_the_same_events(models: dict[str, CompiledModel], solver: str
                                              ) -> None:
     scipy, compiled = both(models["clock"], solver, stop=4.0, interval=0.01)
-    samples = 0.5 + 0.25 * np.arange(14)  # 0.5 ... 3.75 (4.0 is the stop time)
+    samples = 0.5 + 0.25 * np.arange(15)  # 0.5 ... 4.0 (one at the stop time too)
     assert [e.time for e in compiled.events if e.kind == "time"] == samples.tolist()
-    assert (compiled.stats.state_events, compiled.stats.time_events) == (0, 14)
+    assert (compiled.stats.state_events, compiled.stats.time_events) == (0, 15)
     assert kinds(compiled) == kinds(scipy)
     np.testing.assert_array_equal(compiled["n"], scipy["n"])
-    assert compiled["n"][-1] == 14
-    # x(4) = sum over the samples of 0.25 * n = 0.25 * (1 + ... + 14)
+    assert compiled["n"][-1] == 15  # the row at the stop time is after its event
+    # x(4) = sum over the intervals of 0.25 * n = 0.25 * (1 + ... + 14)
     assert abs(compiled["x"][-1] - 26.25) < 1e-12
 
 
@@ -180,10 +180,13 @@ def test_chattering_stops_with_the_scipy_engine_s_message(models: dict[str, Comp
     with pytest.raises(SimulationError) as caught:
         springc.simulate(models["ball"], solver="dop853", engine="compiled", rtol=1e-8,
                          stop=5.0)
-    message = str(caught.value)
-    assert message.startswith("error: chattering: 100 events between time 4.0637")
-    assert "most of them of 'h <= 0'" in message
-    assert "needs a minimum bounce velocity" in message
+    error = caught.value
+    assert error.message.startswith("chattering: 100 events in ")
+    assert error.message.endswith("most of them of 'h <= 0'")
+    # the bounces accumulate at t* = t1 + 2 u / g * e / (1 - e) = 4.06370...
+    last = float(error.message.split("up to time ")[1].split(",")[0])
+    assert abs(last - (1 + 2 * E / (1 - E)) * math.sqrt(2 / G)) < 1e-4
+    assert "minimum bounce velocity" in (error.hint or "")
 
 
 def test_step_limit(models: dict[str, CompiledModel]) -> None:
@@ -254,7 +257,8 @@ def test_chunked_runs_equal_a_single_run(models: dict[str, CompiledModel], solve
     monkeypatch.setattr(glue, "FIXED_CHUNK", 20)  # two output intervals of 10 steps
     chunked = springc.simulate(models["clock"], **options)  # type: ignore[arg-type]
     assert kinds(chunked) == kinds(whole) == [
-        ("initial", "initial()"), ("time", "time = 0.5"), ("time", "time = 0.75")]
+        ("initial", "initial()"), ("time", "time = 0.5"), ("time", "time = 0.75"),
+        ("time", "time = 1")]
     assert chunked.stats.steps == whole.stats.steps
     np.testing.assert_array_equal(chunked.values, whole.values)
     assert abs(chunked["x"][-1] - 0.75) < 1e-12  # 0.25 * 1 + 0.25 * 2

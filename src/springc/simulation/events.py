@@ -173,8 +173,8 @@ class EventLoop:
         if len(self.recent) == EVENT_BURST and t - self.recent[0] <= ZENO_FRACTION * span:
             common = max(set(self.causes), key=list(self.causes).count)
             raise Stop(SimulationError(
-                f"chattering: {EVENT_BURST} events between time {format_time(self.recent[0])}"
-                f" and {format_time(t)}, most of them of '{common}'",
+                f"chattering: {EVENT_BURST} events in {t - self.recent[0]:.3g} s up to time "
+                f"{format_time(t)}, most of them of '{common}'",
                 notes=[Note(f"springc stops when more than {EVENT_BURST} events fall within "
                             f"{ZENO_FRACTION:g} of the simulated span (Zeno behaviour)")],
                 hint="the model switches faster than it can be simulated: a ball coming to "
@@ -232,7 +232,7 @@ class EventLoop:
             if not len(x):
                 self.fill(bound, None, bound, x, False)
                 t = bound
-                x = self._time_event(t, x, stop)
+                x = self.time_event(t, x, stop)
                 continue
             integrator = cls(problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs)
             while True:
@@ -265,14 +265,14 @@ class EventLoop:
                 if integrator.status == "finished":
                     self.fill(t_new, dense, t_new, y, False)
                     t, x = float(bound), y
-                    x = self._time_event(t, x, stop)
+                    x = self.time_event(t, x, stop)
                     break
                 self.fill(t_new, dense, t_new, y, True)
         return x
 
-    def _time_event(self, t: float, x: np.ndarray, stop: float) -> np.ndarray:
+    def time_event(self, t: float, x: np.ndarray, stop: float) -> np.ndarray:
         """At the end of an integration: the time event there, if any; the grid row."""
-        if t < stop:
+        if t < stop or self.next_time(t - 2 * LOCATE_TOLERANCE * max(1.0, abs(t))) == t:
             x = self.event(t, x, "time", f"time = {format_time(t)}")
         self.fill(t, None, t, x, True)
         return x

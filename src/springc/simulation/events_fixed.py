@@ -23,7 +23,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
     problem = loop.problem
     advance = STEPPERS[method]
     grid = loop.grid
-    t0, stop = float(grid[0]), float(grid[-1])
+    t0 = float(grid[0])
     x = loop.initial(t0, np.asarray(x0, dtype=float))
     loop.fill(t0, None, t0, x, True)
     pairs = detect_pairs(problem.mod, problem.p, x, t0) if len(x) else Pairs.of([])
@@ -63,7 +63,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                     continue
                 t, x = target, y
                 loop.step_times.append(t)
-                if t == te and t < stop:
+                if t == te:  # a time event (one at the stop time too, as run_adaptive)
                     x = loop.event(t, x, "time", f"time = {t:.9g}")
                     cache.clear()
                 bad = ~np.isfinite(x)

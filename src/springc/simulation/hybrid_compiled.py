@@ -36,7 +36,6 @@ import numpy as np
 
 from .compiled import FIXED_CHUNK, failure, time_limit_reached
 from .events import EventLoop
-from .failures import format_time
 from .limits import OverLimit
 from .solver_names import EXPLICIT, RACE_IMPLICIT
 from .solvers import detect_pairs
@@ -124,11 +123,13 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         elif run.status == Status.TIME_EVENT:
             t = run.event_time
             loop.step_times.append(t)
-            x = loop.event(t, np.array(run.event_state), "time", f"time = {format_time(t)}")
-            loop.fill(t, None, t, x, True)
+            x = loop.time_event(t, np.array(run.event_state), stop)
         elif run.status == Status.SUCCESS:
             t, x = float(times[-1]), np.array(run.failure_state)
             loop.step_times.append(t)
+            if t == stop:  # the last row again, after a time event at the stop time
+                loop.k -= 1
+                x = loop.time_event(t, x, stop)
         elif run.status == Status.MAX_STEPS:  # a chunk's end, within the step limit
             t, x = run.failure_time, np.array(run.failure_state)
             first_step = min(run.next_step, stop - t)  # the same steps go on

@@ -191,6 +191,12 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     if solver in FIXED_STEP:
         step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
     p = parameter_vector(model, options.parameters)
+    if getattr(model.module, "EVENTS", False):  # the states chosen at compile time
+        from .hybrid import simulate_hybrid
+
+        return simulate_hybrid(model, options, solver, grid, initial_state(model, p, start),
+                               p, rtol, atol, limits, step if solver in FIXED_STEP else None,
+                               note, began, engine)
     if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
         from .switching import simulate_switching_model
 
@@ -206,11 +212,6 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         return _switching_estimate(model, result, solver, grid, rtol, atol,
                                    dict(options.parameters), limits)
     x0 = initial_state(model, p, start)
-    if getattr(model.module, "EVENTS", False):
-        from .hybrid import simulate_hybrid
-
-        return simulate_hybrid(model, options, solver, grid, x0, p, rtol, atol, limits,
-                               step if solver in FIXED_STEP else None, note, began, engine)
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
     try:

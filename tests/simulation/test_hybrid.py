@@ -1,0 +1,197 @@
+"""Hybrid models against exact or independent references: the bouncing ball's
+piecewise parabola, a time event hit exactly, the event output rows."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from hybrid_reference import wall_reference
+from springc.errors import SimulationError
+
+BALL = """
+model BouncingBall
+  parameter Real e = 0.8 "coefficient of restitution";
+  parameter Real g = 9.81;
+  Real h(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+equation
+  der(h) = v;
+  der(v) = -g;
+  when h <= 0 then
+    reinit(v, -e*pre(v));
+  end when;
+end BouncingBall;
+"""
+
+E, G = 0.8, 9.81
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def write(tmp_path: Path, text: str, name: str = "m.mo") -> str:
+    path = tmp_path / name
+    path.write_text(text)
+    return str(path)
+
+
+def ball_exact(t: np.ndarray, bounces: int) -> tuple[np.ndarray, np.ndarray, list[float]]:
+    """h, v of the ball dropped from 1 m, and its impact times."""
+    u = math.sqrt(2 * G)  # speed at the first impact
+    impacts = [u / G]
+    for k in range(1, bounces):
+        impacts.append(impacts[-1] + 2 * E**k * u / G)
+    h = 1 - G * t**2 / 2
+    v = -G * t
+    for k, tk in enumerate(impacts):
+        after = t >= tk
+        w = E ** (k + 1) * u
+        h = np.where(after, w * (t - tk) - G * (t - tk) ** 2 / 2, h)
+        v = np.where(after, w - G * (t - tk), v)
+    return h, v, impacts
+
+
+def test_bouncing_ball_matches_the_exact_parabolas(tmp_path: Path) -> None:
+    _, _, impacts = ball_exact(np.zeros(1), 11)
+    stop = impacts[9] + 0.5 * (impacts[10] - impacts[9])
+    result = springc.simulate(write(tmp_path, BALL), rtol=1e-8, stop=stop, interval=1e-3)
+    h, v, _ = ball_exact(result.time, 11)
+    assert np.max(np.abs(result["h"] - h)) < 1e-6
+    assert np.max(np.abs(result["v"] - v)) < 1e-6
+    bounces = [e.time for e in result.events if e.x_right[1] != e.x_left[1]]
+    assert len(bounces) == 10
+    assert np.max(np.abs(np.array(bounces) - impacts[:10])) < 1e-9
+    assert result.stats.state_events >= 10 and result.stats.time_events == 0
+
+
+MORE = """
+model Switched
+  parameter Real t0 = 1.234;
+  Real x(start = 0, fixed = true);
+equation
+  der(x) = if time >= t0 then 1 else 0;
+end Switched;
+
+model Counter
+  Integer n(start = 0);
+  Boolean high(start = false);
+  discrete Real last(start = -1);
+  Real y(start = 0, fixed = true);
+equation
+  der(y) = 1;
+  when sample(0, 0.25) then
+    n = pre(n) + 1;
+    last = time;
+  end when;
+  when y > 0.6 then
+    high = true;
+  end when;
+end Counter;
+
+model Wall
+  parameter Real m = 1;
+  parameter Real k = 100;
+  parameter Real kw = 1e4;
+  parameter Real dw = 10;
+  parameter Real xw = 0.05;
+  Real x(start = 0, fixed = true);
+  Real v(start = 2, fixed = true);
+  Real f;
+equation
+  der(x) = v;
+  m * der(v) = -k * x + f;
+  f = if x > xw then -kw * (x - xw) - dw * v else 0;
+end Wall;
+"""
+
+
+@pytest.fixture(scope="module")
+def more(tmp_path_factory: pytest.TempPathFactory) -> str:
+    path = tmp_path_factory.mktemp("hybrid") / "more.mo"
+    path.write_text(MORE)
+    return str(path)
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk45", "radau", "bdf", "lsoda"])
+def test_a_time_event_is_hit_exactly(more: str, solver: str) -> None:
+    result = springc.simulate(more, model_name="Switched", solver=solver, rtol=1e-8,
+                              stop=3.0, interval=0.01)
+    assert 1.234 in result.step_times
+    assert [(e.kind, e.time) for e in result.events[1:]] == [("time", 1.234)]
+    assert np.max(np.abs(result["x"] - np.maximum(0.0, result.time - 1.234))) < 1e-9
+    assert (result.stats.state_events, result.stats.time_events) == (0, 1)
+
+
+def test_discrete_integer_boolean_and_real_variables(more: str) -> None:
+    result = springc.simulate(more, model_name="Counter", stop=2.0, interval=0.125)
+    t = result.time
+    # sample(0, 0.25) ticks at 0.25, 0.5, ..., 2.0 (the tick at the start is the
+    # initialization, where when-clauses without initial() stay inactive)
+    assert np.array_equal(result["n"], np.floor(t / 0.25 + 1e-9))
+    ticks = np.floor(t / 0.25 + 1e-9)
+    assert np.array_equal(result["last"], np.where(t < 0.25, -1.0, ticks * 0.25))
+    assert np.array_equal(result["high"], (t > 0.6).astype(float))
+    crossing = [e.time for e in result.events if e.kind == "state"]
+    assert crossing == pytest.approx([0.6], abs=1e-11)
+
+
+@pytest.mark.parametrize(("solver", "step"), [
+    ("dop853", None), ("rk45", None), ("radau", None), ("bdf", None), ("lsoda", None),
+    ("auto", None), ("rk4", 2.5e-4), ("verlet", 1e-5), ("symplectic-euler", 1e-5)])
+def test_wall_contact_matches_an_independent_solve(more: str, solver: str,
+                                                   step: float | None) -> None:
+    grid, reference, crossings = wall_reference(2.0)
+    result = springc.simulate(more, model_name="Wall", solver=solver, step=step, rtol=1e-8,
+                              atol=1e-11, stop=2.0, interval=0.005)
+    assert np.array_equal(result.time, grid)
+    # verlet and symplectic Euler are first order with the velocity-dependent contact
+    # force (measured 2.2e-6 and 2.4e-6 at this step)
+    tolerance = 1e-6 if step is None or solver == "rk4" else 5e-6
+    assert np.max(np.abs(result["x"] - reference[:, 0])) < tolerance
+    assert crossings >= 8
+    assert result.stats.state_events == crossings
+
+
+ZENO = """
+model Chatter
+  Real x(start = 1, fixed = true);
+equation
+  der(x) = if x > 0 then -1 else 1;
+end Chatter;
+"""
+
+
+def test_a_ball_coming_to_rest_stops_with_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(write(tmp_path, BALL), stop=10.0)
+    error = info.value
+    # the bounces accumulate at t* = t1 + 2 u / g * e / (1 - e) = 4.06370...
+    assert error.message.startswith("chattering: 100 events in ")
+    assert error.message.endswith("most of them of 'h <= 0'")
+    last = float(error.message.split("up to time ")[1].split(",")[0])
+    assert abs(last - (1 + 2 * E / (1 - E)) * math.sqrt(2 / G)) < 1e-4
+    assert "minimum bounce velocity" in (error.hint or "")
+
+
+def test_a_relation_flipping_at_every_step_stops(tmp_path: Path) -> None:
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(write(tmp_path, ZENO), stop=3.0)
+    assert info.value.message.endswith("up to time 1, most of them of 'x > 0'")
+
+
+def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
+    plain = springc.simulate(more, model_name="Counter", stop=0.55, interval=0.275)
+    rows = springc.simulate(more, model_name="Counter", stop=0.55, interval=0.275,
+                            event_rows=True)
+    assert list(plain.time) == [0.0, 0.275, 0.55]
+    assert list(plain["n"]) == [0, 1, 2]
+    assert list(rows.time) == [0.0, 0.25, 0.25, 0.275, 0.5, 0.5, 0.55]
+    assert list(rows["n"]) == [0, 0, 1, 1, 1, 2, 2]
+    assert list(rows["last"]) == [-1, -1, 0.25, 0.25, 0.25, 0.5, 0.5]
