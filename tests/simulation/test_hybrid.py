@@ -195,3 +195,56 @@ def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
     assert list(rows.time) == [0.0, 0.25, 0.25, 0.275, 0.5, 0.5, 0.55]
     assert list(rows["n"]) == [0, 0, 1, 1, 1, 2, 2]
     assert list(rows["last"]) == [-1, -1, 0.25, 0.25, 0.25, 0.5, 0.5]
+
+
+def test_numba_backend_gives_the_python_backend_results(tmp_path: Path) -> None:
+    path = write(tmp_path, BALL)
+    python = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8)
+    numba = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="numba")
+    assert np.max(np.abs(python.values - numba.values)) < 1e-12
+    assert [e.time for e in python.events] == [e.time for e in numba.events]
+
+
+def test_the_compiled_engine_refuses_a_model_with_events(tmp_path: Path) -> None:
+    from springc.errors import UsageError
+
+    with pytest.raises(UsageError) as info:
+        springc.simulate(write(tmp_path, BALL), engine="compiled", stop=1.0)
+    assert info.value.message == ("BouncingBall has events (when-clauses, relations or "
+                                  "sample), which the compiled engine does not locate yet")
+    auto = springc.simulate(write(tmp_path, BALL), engine="auto", backend="numba", stop=1.0)
+    assert auto.stats.engine == "scipy" and auto.stats.state_events == 2
+
+
+def test_the_generated_module_runs_its_events_without_springc(tmp_path: Path) -> None:
+    """The module's own functions, driven as module_api.HybridModule says: the first
+    impact located on the zero-crossing function, then the event update."""
+    import importlib.util
+
+    import scipy.optimize
+
+    model = springc.compile_model(write(tmp_path, BALL))
+    target = tmp_path / "ball_module.py"
+    target.write_text(model.source)
+    spec = importlib.util.spec_from_file_location("ball_module", target)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    p = mod.parameters()
+    z = mod.guesses(p)
+    assert len(z) == mod.Z_SIZE
+    x = mod.start(p)
+    z[mod.Z_INITIAL] = 1.0
+    x = mod.event_update(0.0, x, p, z)
+    assert z[mod.Z_RELATIONS] == 0.0  # h <= 0 is false at h = 1
+
+    def flight(t: float) -> np.ndarray:
+        return np.array([1 - G * t**2 / 2, -G * t])
+
+    impact = scipy.optimize.brentq(
+        lambda t: mod.zero_crossings(t, flight(t), p, z)[0], 0.1, 1.0, xtol=1e-14)
+    assert abs(impact - math.sqrt(2 / G)) < 1e-12
+    after = mod.event_update(impact, flight(impact + 1e-13), p, z)
+    assert after[1] == pytest.approx(E * G * impact, rel=1e-12)
+    assert (z[mod.Z_RELATIONS], z[mod.Z_STATUS]) == (1.0, 0.0)
+    assert mod.ZERO_CROSSINGS == ("h <= 0",) and mod.RELATION_OPS == ("<=",)
