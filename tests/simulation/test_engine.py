@@ -94,6 +94,20 @@ def test_compiled_dop853_equals_scipy(name: str, rtol: float) -> None:
     assert (np.abs(default.values - python.values) <= 1e-12 * scale).all()
 
 
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_compiled_rk45_equals_scipy(name: str) -> None:
+    files, model_name = MODELS[name]
+    model = springc.compile_model(files, model_name, backend="numba")
+    compiled = springc.simulate(model, solver="rk45", engine="compiled", stop=2.0)
+    scipy_run = springc.simulate(model, solver="rk45", engine="scipy", stop=2.0)
+    assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
+    assert compiled.stats.steps == scipy_run.stats.steps
+    # scipy's sums (BLAS): the same steps; the dense output's matrix product may round
+    # differently (numba's and numpy's BLAS calls for K^T P)
+    scale = np.abs(scipy_run.values).max(axis=0)
+    assert (np.abs(compiled.values - scipy_run.values) <= 1e-13 * np.maximum(scale, 1)).all()
+
+
 @pytest.mark.parametrize("solver", ["radau", "bdf"])
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_compiled_implicit_agrees_with_scipy(name: str, solver: str) -> None:

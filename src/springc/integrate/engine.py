@@ -109,6 +109,25 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     return _run(grid_, result)
 
 
+def rk45(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
+         atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
+         max_step: float = np.inf, first_step: float | None = None, max_steps: int = 0,
+         scipy_arithmetic: bool = True, crossings: Crossings | None = None,
+         t_stop: float = np.inf) -> Run:
+    """Integrate with compiled RK45 (Dormand-Prince 5(4)), scipy's ``RK45`` method;
+    arguments as :func:`dop853`."""
+    from .rk45_kernel import rk45_run
+
+    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
+    atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
+    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
+    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
+    result = rk45_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
+                      float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                      int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
+    return _run(grid_, result)
+
+
 def radau(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any, grid: Any,
           x0: Any, p: Any, z: Any, *, rtol: float, atol: float | Sequence[float] | np.ndarray,
           **options: Any) -> Run:

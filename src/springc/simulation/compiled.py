@@ -119,11 +119,11 @@ def engine_reason(engine: str, solver: str, backend: str, compiled: bool) -> str
 
 
 def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
-    """Continue the scipy ``DOP853``, ``Radau`` or ``BDF`` ``integrator`` of ``loop`` to the
-    end of the grid, compiled: from its state with its next step size, filling the grid
-    from ``loop.k`` (DOP853 takes scipy's steps exactly; Radau and BDF restart their
-    Jacobian and step-size history there)."""
-    from springc.integrate import bdf, dop853, radau
+    """Continue the scipy ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` ``integrator`` of
+    ``loop`` to the end of the grid, compiled: from its state with its next step size,
+    filling the grid from ``loop.k`` (DOP853 and RK45 take scipy's steps exactly; Radau
+    and BDF restart their Jacobian and step-size history there)."""
+    from springc.integrate import bdf, dop853, radau, rk45
 
     problem = loop.problem
     mod = problem.mod
@@ -137,10 +137,12 @@ def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
                           first_step=first, max_steps=steps)
         return _finish(loop, integrator, name, run_kernel)
 
-    def run_dop853(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-        return dop853(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                      atol=loop.atol, first_step=first, max_steps=steps)
-    return _finish(loop, integrator, EXPLICIT, run_dop853)
+    explicit = rk45 if type(integrator).__name__ == "RK45" else dop853
+
+    def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                        atol=loop.atol, first_step=first, max_steps=steps)
+    return _finish(loop, integrator, "rk45" if explicit is rk45 else EXPLICIT, run_explicit)
 
 
 def _finish(loop: StepLoop, integrator: Any, solver: str,

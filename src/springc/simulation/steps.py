@@ -31,7 +31,7 @@ from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
 from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
-COMPILED_CLASSES = frozenset({"DOP853", "Radau", "BDF"})
+COMPILED_CLASSES = frozenset({"DOP853", "RK45", "Radau", "BDF"})
 """scipy integrators that ``StepLoop.finish`` continues in a compiled loop."""
 
 
@@ -269,8 +269,8 @@ class StepLoop:
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it.
 
-        A ``DOP853``, ``Radau`` or ``BDF`` integrator run to the end on the compiled engine
-        continues there (see :func:`springc.simulation.compiled.finish_dop853`).
+        A ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` integrator run to the end on the
+        compiled engine continues there (see :func:`springc.simulation.compiled.finish_dop853`).
         """
         if self.finish is not None and max_steps is None and not self.done \
                 and type(integrator).__name__ in COMPILED_CLASSES:
