@@ -304,7 +304,9 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                  parameters=values, progress=progress, step=step, max_steps=max_steps,
                  time_limit=time_limit, engine=engine.lower())
     if output or plot:
-        save_outputs(result, output, plot, files)
+        note = save_outputs(result, output, plot, files)
+        if note and not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
     else:
         write_csv(result, sys.stdout)
         sys.stdout.flush()
