@@ -289,20 +289,32 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
-    choose_engine(engine.lower(), solver.lower(), backend)
+    chosen = choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     _check_outputs([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
     _single_threaded_blas()
+    from .api import compile_model
     from .api import simulate as run
-    from .simulation import save_outputs, write_csv
+    from .simulation import (
+        SimulationOptions,
+        check_trajectory_size,
+        save_outputs,
+        write_csv,
+    )
 
+    compiled = compile_model(files, model, libraries=libraries, backend=backend or (
+        "numba" if chosen == "compiled" else "python"), outputs=patterns or None,
+        parameters=values, cache=not no_cache)
+    if not patterns and (output or not plot):  # the default trajectory of every output
+        check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
+                              f"-o {output}" if output else "the CSV on stdout")
     progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-    result = run(files, model_name=model, libraries=libraries, backend=backend,
-                 outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
-                 interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step, max_steps=max_steps,
-                 time_limit=time_limit, engine=engine.lower())
+    result = run(compiled, start=start, stop=stop, interval=interval,
+                 solver=solver.lower(), rtol=rtol, atol=atol,
+                 parameters={k: v for k, v in values.items() if k not in compiled.structural},
+                 progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
+                 engine=engine.lower())
     if output or plot:
         note = save_outputs(result, output, plot, files)
         if note and not quiet:
