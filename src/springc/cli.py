@@ -423,6 +423,10 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @click.option("--energy", metavar="NAME",
               help="Variable whose drift is reported per run (default: the only "
               "variable in J, if any).")
+@click.option("--workers", type=click.IntRange(min=1),
+              help="Local worker processes running the solvers (default: one per core).")
+@click.option("--scheduler", metavar="ADDRESS", help="Run the solvers on the Dask "
+              "scheduler at ADDRESS instead of local processes (as for sweep).")
 @click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
 @_guard
 def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -432,14 +436,19 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
              reference: str | None, save_reference: str | None, repeats: int,
              budget: float, output: str | None, plot: str | None, energy: str | None,
-             quiet: bool) -> None:
+             workers: int | None, scheduler: str | None, quiet: bool) -> None:
     """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
 
     The error of each run is measured on the output grid against REFERENCE, or against
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
-    are compared; --vars selects other variables.
+    are compared; --vars selects other variables. Each solver's runs are one task of
+    the studies executor (local processes, or Dask with --scheduler).
     """
     from .simulation import PLOT_FORMATS, check_run_values
+
+    if workers is not None and scheduler is not None:
+        raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
+                         "has its own workers)", option="--workers")
 
     values = _parse_set(assignments)
     check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
@@ -469,7 +478,9 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
         budget=budget, start=start, stop=stop, interval=interval, parameters=rest,
         log=None if quiet else sys.stderr, energy=energy)
-    study = run_tradeoff(compiled, options)
+    from .studies import Executor
+
+    study = run_tradeoff(compiled, options, Executor(workers, scheduler))
     click.echo(summary(study), nl=False)
     save_study(study, table=output, plot=plot, reference=save_reference, protected=inputs)
 

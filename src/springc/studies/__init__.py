@@ -8,7 +8,7 @@ shards for resuming) and ``study`` (:func:`run_study`, :func:`to_dataset`).
 (The package is not named ``sweep``: ``springc.sweep`` is the API function.)
 """
 
-from .engines import default_workers
+from .engines import Executor, default_workers
 from .job import RunJob, RunRecord, run_batch
 from .params import (
     DISTRIBUTIONS,
@@ -24,7 +24,8 @@ from .params import (
 from .store import FIXED_COLUMNS, check_outputs, partial_folder, summary_path
 from .study import Study, StudyOptions, parameter_table, run_study, to_dataset
 
-__all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "ParameterSpec",
+__all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "Executor",
+           "ParameterSpec",
            "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs", "default_workers",
            "grid",
            "parameter_table", "parse_parameter", "parse_values", "partial_folder",
