@@ -525,6 +525,11 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
               help="The summary table (.parquet), instead of NAME.summary.parquet.")
 @click.option("--resume", is_flag=True, help="Continue an interrupted study: runs "
               "already in OUTPUT.partial are kept, not run again.")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Plot one variable across "
+              "the runs (.png, .svg or .pdf): lines up to 12 runs, else a fan chart "
+              "(median, percentile bands).")
+@click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
+              "study's first variable).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress and no summary line.")
 @_guard
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -534,7 +539,8 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           workers: int | None, scheduler: str | None, solver: str, step: float | None,
           rtol: float | None, atol: float | None, max_steps: int | None,
           time_limit: float | None, energy: str | None, output: str,
-          summary_file: str | None, resume: bool, quiet: bool) -> None:
+          summary_file: str | None, resume: bool, plot: str | None,
+          plot_var: str | None, quiet: bool) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
 
     The model is compiled once; runs go to local processes (or a Dask scheduler); each
@@ -557,6 +563,10 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     specs = tuple(parse_parameter(item) for item in params)
     summary_file = summary_file or summary_path(output)
     check_outputs(output, summary_file, files)
+    from .simulation import PLOT_FORMATS
+
+    _check_outputs([("-o", output, None), ("--summary", summary_file, None),
+                    ("--plot", plot, PLOT_FORMATS)], files)
     _single_threaded_blas()
     from .api import compile_model
     from .studies import StudyOptions, parameter_table, run_study
@@ -571,6 +581,10 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
     from dataclasses import replace
 
+    from .studies import plot_variable
+
+    plotted = plot_variable(compiled.outputs, plot_var) if plot else None
+
     try:
         study = run_study(compiled, replace(options, fixed=fixed), output, summary_file,
                           resume, files, None if quiet else sys.stderr)
@@ -581,5 +595,15 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
             click.echo(f"note: finished runs are kept in {partial_folder(output)}; run "
                        "the same command with --resume to continue", err=True)
         raise
+    if plot and plotted:
+        from .fileio import atomic_write
+        from .simulation import file_format
+        from .studies import render_fan
+
+        picture, note = render_fan(study, plotted, file_format(plot, PLOT_FORMATS, "--plot"))
+        with atomic_write(plot, "wb", files) as f:
+            f.write(picture)
+        if not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
     if not quiet:
         click.echo(study.summary_line(), err=True)
