@@ -13,6 +13,7 @@ from __future__ import annotations
 import io
 import textwrap
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -64,7 +65,7 @@ def draw_layout(model: str, time: np.ndarray, values: np.ndarray,
                             width_ratios=(60, 1) if bars else None, wspace=0.02,
                             left=0.09, right=0.93 if bars else 0.98, top=1 - top / height,
                             bottom=0.6 / height, hspace=0.45 if note or bars else 0.35)
-    axes = []
+    axes: list[Any] = []
     for row, panel in enumerate(panels):
         ax = fig.add_subplot(grid[row, 0], sharex=axes[0] if axes else None)
         axes.append(ax)

@@ -11,7 +11,7 @@ shards for resuming), ``study`` (:func:`run_study`, :func:`to_dataset`) and ``fa
 
 from .engines import Executor, default_workers
 from .fan import fan_figure, plot_variable, render_fan
-from .job import RunJob, RunRecord, run_batch
+from .job import RunJob, RunRecord, StudyOptions, run_batch
 from .params import (
     DISTRIBUTIONS,
     METHODS,
@@ -24,7 +24,7 @@ from .params import (
     unit_points,
 )
 from .store import FIXED_COLUMNS, check_outputs, partial_folder, summary_path
-from .study import Study, StudyOptions, parameter_table, run_study, to_dataset
+from .study import Study, parameter_table, run_study, to_dataset
 
 __all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "Executor",
            "ParameterSpec", "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs",
