@@ -135,3 +135,11 @@ def test_cli_plot_of_a_large_scene_says_what_it_drew(tmp_path: Path) -> None:
         "(heat map); not drawn: 22 families (253 variables), select them with --vars; "
         "411 copies of another variable left out")
     assert (tmp_path / "cloth.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_a_legend_entry_names_at_most_two_copies() -> None:
+    t = np.linspace(0.0, 1.0, 3)
+    values = np.column_stack([t, t, -t, t, t * t])
+    layout = choose_layout(["a", "b", "c", "d", "e"], [""] * 5, values)
+    assert layout.panels[0].labels == ("a = b = -c (+1 more)",)
+    assert layout.copies == {1: (0, 1), 2: (0, -1), 3: (0, 1)}

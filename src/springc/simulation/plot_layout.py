@@ -40,6 +40,10 @@ LARGE_PANELS = 4
 COMPONENTS = 3
 """A last subscript of at most this many values is a vector's component (x, y, z)."""
 LINES, HEATMAP = "lines", "heatmap"
+CHUNK = 4096
+"""Candidate copies compared at a time (bounds the memory of the comparison)."""
+MAX_ALIASES = 2
+"""Copies named in a legend entry before ``(+N more)``."""
 
 _QUANTITY = {"m": "position", "m/s": "velocity", "m/s2": "acceleration", "N": "force",
              "kg": "mass", "N/m": "stiffness", "rad": "angle", "rad/s": "angular velocity",
@@ -88,26 +92,33 @@ def quantity(name: str, unit: str) -> tuple[str, str]:
 
 def copies_of(values: np.ndarray) -> dict[int, tuple[int, int]]:
     """Columns equal to an earlier column (sign 1) or to its negative (sign -1) at every
-    row: ``column -> (first such column, sign)``."""
+    row: ``column -> (first such column, sign)``. Candidates share a weighted sum with
+    the earlier column (or its negation); they are then compared exactly, many columns
+    at a time."""
     if values.ndim != 2 or values.shape[1] < 2 or values.shape[0] == 0:
         return {}
     weights = np.sqrt(np.arange(2.0, values.shape[0] + 2.0))
     with np.errstate(all="ignore"):
-        keys = weights @ values  # one weighted sum per column
+        keys = (weights @ values + 0.0).tolist()  # one weighted sum per column; -0.0 -> 0.0
     first: dict[float, int] = {}
-    out: dict[int, tuple[int, int]] = {}
-    for column, key in enumerate(keys.tolist()):
+    candidates: list[tuple[int, int, int]] = []
+    for column, key in enumerate(keys):
         if key != key:  # NaN: never a copy
             continue
-        key += 0.0  # -0.0 -> 0.0
-        for sign in (1, -1):
-            original = first.get(key * sign + 0.0)
-            if original is not None and np.array_equal(
-                    values[:, column], sign * values[:, original]):
-                out[column] = (original, sign)
-                break
-        else:
-            first.setdefault(key, column)
+        original = first.get(key)
+        if original is not None:
+            candidates.append((column, original, 1))
+            continue
+        original = first.get(-key + 0.0)
+        if original is not None:
+            candidates.append((column, original, -1))
+            continue
+        first[key] = column
+    out: dict[int, tuple[int, int]] = {}
+    for begin in range(0, len(candidates), CHUNK):
+        part = np.array(candidates[begin:begin + CHUNK], dtype=np.int64)
+        same = np.all(values[:, part[:, 0]] == values[:, part[:, 1]] * part[:, 2], axis=0)
+        out.update((int(c), (int(o), int(g))) for (c, o, g), ok in zip(part, same) if ok)
     return out
 
 
@@ -160,7 +171,7 @@ def _quantities(names: Sequence[str], groups: dict[str, tuple[str, list[int]]],
         same.setdefault(original, []).append(_copy_text(names, copy, sign))
     panels = []
     for title, (label, columns) in list(groups.items())[:MAX_PANELS]:
-        labels = tuple(" = ".join([names[c], *same.get(c, [])]) for c in columns)
+        labels = tuple(_label(names[c], same.get(c, [])) for c in columns)
         panels.append(Panel(LINES, title, label, tuple(columns), labels))
     notes = []
     if len(groups) > MAX_PANELS:
@@ -169,6 +180,14 @@ def _quantities(names: Sequence[str], groups: dict[str, tuple[str, list[int]]],
         notes.append(f"{_count(len(copies), 'copy', 'copies')} (equal to another variable "
                      "or its negative) drawn once")
     return PlotLayout(tuple(panels), copies, "; ".join(notes))
+
+
+def _label(name: str, copies: list[str]) -> str:
+    """A legend entry: the name and its copies (``x = -y``), at most
+    :data:`MAX_ALIASES` of them named."""
+    more = len(copies) - MAX_ALIASES
+    text = " = ".join([name, *copies[:MAX_ALIASES]])
+    return text + (f" (+{more} more)" if more > 0 else "")
 
 
 def _count(n: int, one: str, many: str) -> str:
