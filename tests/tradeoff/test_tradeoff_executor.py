@@ -52,3 +52,23 @@ def test_tradeoff_refuses_workers_with_a_scheduler() -> None:
     assert out.exit_code == 2
     assert out.stderr == ("error: --workers and --scheduler exclude each other (a Dask "
                           "cluster has its own workers)\n")
+
+
+def test_the_executor_on_a_dask_local_cluster_gives_the_same_table(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from distributed import LocalCluster
+
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    model = compare_states(springc.compile_model(SEED))
+    options = TradeoffOptions(solvers=("dop853", "verlet"), tolerances=(1e-4,),
+                              steps=(0.005,), stop=0.5, interval=0.01, repeats=1)
+    here = run_tradeoff(model, options)
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
+                      dashboard_address=None) as cluster:
+        executor = Executor(scheduler=cluster.scheduler_address)
+        there = run_tradeoff(model, options, executor)
+    assert executor.describe(3) == f"Dask at {cluster.scheduler_address}"
+    assert [untimed(r) for r in (*there.runs, *there.baselines)] == [
+        untimed(r) for r in (*here.runs, *here.baselines)]
+    assert [(r.solver, r.label()) for r in there.runs] == [("dop853", "rtol 1e-04"),
+                                                           ("verlet", "step 0.005")]
