@@ -23,7 +23,7 @@ from .plot_layout import HEATMAP, PlotLayout
 
 NOTE_WIDTH = 150
 """Characters per line of the note under the title."""
-NOTE_LINE = 0.16
+NOTE_LINE = 0.2
 """Inches per line of the note."""
 
 
