@@ -79,9 +79,10 @@ def scenes(quick: bool, full: bool = False) -> list[Scene]:
     return out
 
 
-def study(scene: Scene, budget: float = 20.0, log: object = sys.stderr
-          ) -> tuple[Tradeoff, float]:
-    """The tradeoff study of ``scene`` (the states compared) and its total seconds."""
+def study(scene: Scene, budget: float = 20.0, log: object = sys.stderr,
+          executor: object = None) -> tuple[Tradeoff, float]:
+    """The tradeoff study of ``scene`` (the states compared) and its total seconds; in
+    this process, or on ``executor`` (``springc.studies.Executor``)."""
     began = time.perf_counter()
     model = springc.compile_model(scene.file, scene.model, parameters=scene.parameters,
                                   backend=BACKEND)
@@ -90,8 +91,29 @@ def study(scene: Scene, budget: float = 20.0, log: object = sys.stderr
     began = time.perf_counter()
     options = TradeoffOptions(scene.solvers, scene.tolerances, targets=(TARGET,),
                               budget=scene.budget or budget, log=log)  # type: ignore[arg-type]
-    result = run_tradeoff(compare_states(model), options)
+    result = run_tradeoff(compare_states(model), options, executor)  # type: ignore[arg-type]
     return result, time.perf_counter() - began
+
+
+def compare_executor(scene: Scene, budget: float, workers: int) -> None:
+    """The study of ``scene`` in this process, then on ``workers`` local processes (the
+    default of ``springc tradeoff``): both times, and whether the tables are equal
+    except the measured times."""
+    from dataclasses import replace
+
+    from springc.studies import Executor
+
+    here, serial = study(scene, budget, None)
+    there, parallel = study(scene, budget, None, Executor(workers))
+
+    def untimed(result: Tradeoff) -> list[str]:
+        return [repr(replace(r, wall_time=0.0, repeats=0))
+                for r in (*result.runs, *result.baselines)]
+
+    print(f"{scene.key}: tradeoff in process {serial:.1f} s, on {workers} local "
+          f"processes {parallel:.1f} s ({serial / parallel:.2f}x), load average "
+          f"{os.getloadavg()[0]:.1f}; tables equal except times: "
+          f"{untimed(here) == untimed(there)}")
 
 
 @dataclass(frozen=True)
@@ -152,7 +174,13 @@ def main() -> None:
                         help="fewer tolerances")
     parser.add_argument("--full", action="store_true", help="add the 50x50 cloth")
     parser.add_argument("--budget", type=float, default=20.0, help="seconds per run")
+    parser.add_argument("--executor", type=int, metavar="WORKERS",
+                        help="only time the seed's study in process and on WORKERS local "
+                        "processes (springc tradeoff's default executor)")
     args = parser.parse_args()
+    if args.executor:
+        compare_executor(scenes(args.quick)[0], args.budget, args.executor)
+        return
     rows = []
     for scene in scenes(args.quick, args.full):
         result, seconds = study(scene, args.budget)

@@ -300,23 +300,37 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
-    choose_engine(engine.lower(), solver.lower(), backend)
+    chosen = choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     _check_outputs([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
     _single_threaded_blas()
+    from .api import compile_model
     from .api import simulate as run
-    from .simulation import save_outputs, write_csv
+    from .simulation import (
+        SimulationOptions,
+        check_trajectory_size,
+        save_outputs,
+        write_csv,
+    )
 
+    compiled = compile_model(files, model, libraries=libraries, backend=backend or (
+        "numba" if chosen == "compiled" else "python"), outputs=patterns or None,
+        parameters=values, cache=not no_cache)
+    if not patterns and (output or not plot):  # the default trajectory of every output
+        check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
+                              f"-o {output}" if output else "the CSV on stdout")
     progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-    result = run(files, model_name=model, libraries=libraries, backend=backend,
-                 outputs=patterns or None, cache=not no_cache, start=start, stop=stop,
-                 interval=interval, solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters=values, progress=progress, step=step, max_steps=max_steps,
-                 time_limit=time_limit, engine=engine.lower(),
-                 error_estimate=error_estimate.lower(), event_rows=event_rows)
+    result = run(compiled, start=start, stop=stop, interval=interval,
+                 solver=solver.lower(), rtol=rtol, atol=atol,
+                 parameters={k: v for k, v in values.items() if k not in compiled.structural},
+                 progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
+                 engine=engine.lower(), error_estimate=error_estimate.lower(),
+                 event_rows=event_rows)
     if output or plot:
-        save_outputs(result, output, plot, files)
+        note = save_outputs(result, output, plot, files)
+        if note and not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
     else:
         write_csv(result, sys.stdout)
         sys.stdout.flush()
@@ -421,6 +435,10 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @click.option("--energy", metavar="NAME",
               help="Variable whose drift is reported per run (default: the only "
               "variable in J, if any).")
+@click.option("--workers", type=click.IntRange(min=1),
+              help="Local worker processes running the solvers (default: one per core).")
+@click.option("--scheduler", metavar="ADDRESS", help="Run the solvers on the Dask "
+              "scheduler at ADDRESS instead of local processes (as for sweep).")
 @click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
 @_guard
 def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -430,14 +448,19 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
              reference: str | None, save_reference: str | None, repeats: int,
              budget: float, output: str | None, plot: str | None, energy: str | None,
-             quiet: bool) -> None:
+             workers: int | None, scheduler: str | None, quiet: bool) -> None:
     """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
 
     The error of each run is measured on the output grid against REFERENCE, or against
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
-    are compared; --vars selects other variables.
+    are compared; --vars selects other variables. Each solver's runs are one task of
+    the studies executor (local processes, or Dask with --scheduler).
     """
     from .simulation import PLOT_FORMATS, check_run_values
+
+    if workers is not None and scheduler is not None:
+        raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
+                         "has its own workers)", option="--workers")
 
     values = _parse_set(assignments)
     check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
@@ -471,7 +494,9 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
         budget=budget, start=start, stop=stop, interval=interval, parameters=rest,
         log=None if quiet else sys.stderr, energy=energy)
-    study = run_tradeoff(compiled, options)
+    from .studies import Executor
+
+    study = run_tradeoff(compiled, options, Executor(workers, scheduler))
     click.echo(summary(study), nl=False)
     save_study(study, table=output, plot=plot, reference=save_reference, protected=inputs)
 
@@ -516,6 +541,11 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
               help="The summary table (.parquet), instead of NAME.summary.parquet.")
 @click.option("--resume", is_flag=True, help="Continue an interrupted study: runs "
               "already in OUTPUT.partial are kept, not run again.")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Plot one variable across "
+              "the runs (.png, .svg or .pdf): lines up to 12 runs, else a fan chart "
+              "(median, percentile bands).")
+@click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
+              "study's first variable).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress and no summary line.")
 @_guard
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -525,7 +555,8 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           workers: int | None, scheduler: str | None, solver: str, step: float | None,
           rtol: float | None, atol: float | None, max_steps: int | None,
           time_limit: float | None, energy: str | None, output: str,
-          summary_file: str | None, resume: bool, quiet: bool) -> None:
+          summary_file: str | None, resume: bool, plot: str | None,
+          plot_var: str | None, quiet: bool) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
 
     The model is compiled once; runs go to local processes (or a Dask scheduler); each
@@ -548,6 +579,10 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     specs = tuple(parse_parameter(item) for item in params)
     summary_file = summary_file or summary_path(output)
     check_outputs(output, summary_file, files)
+    from .simulation import PLOT_FORMATS
+
+    _check_outputs([("-o", output, None), ("--summary", summary_file, None),
+                    ("--plot", plot, PLOT_FORMATS)], files)
     _single_threaded_blas()
     from .api import compile_model
     from .studies import StudyOptions, parameter_table, run_study
@@ -562,6 +597,10 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
     from dataclasses import replace
 
+    from .studies import plot_variable
+
+    plotted = plot_variable(compiled.outputs, plot_var) if plot else None
+
     try:
         study = run_study(compiled, replace(options, fixed=fixed), output, summary_file,
                           resume, files, None if quiet else sys.stderr)
@@ -572,5 +611,15 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
             click.echo(f"note: finished runs are kept in {partial_folder(output)}; run "
                        "the same command with --resume to continue", err=True)
         raise
+    if plot and plotted:
+        from .fileio import atomic_write
+        from .simulation import file_format
+        from .studies import render_fan
+
+        picture, note = render_fan(study, plotted, file_format(plot, PLOT_FORMATS, "--plot"))
+        with atomic_write(plot, "wb", files) as f:
+            f.write(picture)
+        if not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
     if not quiet:
         click.echo(study.summary_line(), err=True)

@@ -237,3 +237,60 @@ def test_without_a_home_folder_parsing_and_compiling_still_work(
     result = springc.simulate([path], stop=1.0, interval=0.5)
     assert "note: cannot use the cache folder: no home folder" in capsys.readouterr().err
     assert np.allclose(result["x"], 3 * np.exp(-result.time), rtol=1e-5)
+
+
+# ------------------------------------------------------------------ --vars
+
+
+SEED = str(Path(__file__).resolve().parents[2] / "models" / "SpringMass.mdl")
+
+
+def test_changing_vars_reuses_the_cached_module(tmp_path: Path,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    """--vars that select other states, or the same observed variables, load the module
+    already cached, without flattening; a new observed variable generates one."""
+    import springc.pipeline.compiler as compiler
+
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    first = springc.compile_model(SEED, outputs=["mass.pos[1]"])
+    assert not first.cached and first.module.OBSERVED == ()
+    derive = compiler.derive_system
+
+    def no_flattening(options: object) -> object:
+        raise AssertionError("the model was flattened again")
+
+    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    for patterns, outputs in ((["mass.v[*]"], ("mass.v[1]", "mass.v[2]")),
+                              (["mass.*"], ("mass.pos[1]", "mass.pos[2]", "mass.v[1]",
+                                            "mass.v[2]"))):
+        again = springc.compile_model(SEED, outputs=patterns)
+        assert again.cached and again.path == first.path and again.outputs == outputs
+    with pytest.raises(springc.errors.SimulationError) as info:
+        springc.compile_model(SEED, outputs=["mass.w"])
+    assert info.value.message == "--vars 'mass.w' matches no state or observed variable"
+    monkeypatch.setattr(compiler, "derive_system", derive)
+    spring = springc.compile_model(SEED, outputs=["mass.pos[1]", "spring.x"])
+    assert not spring.cached and spring.module.OBSERVED == ("spring.x",)
+    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    assert springc.compile_model(SEED, outputs=["spring.x"]).path == spring.path
+    monkeypatch.setattr(compiler, "derive_system", derive)
+    everything = springc.compile_model(SEED, outputs=["*"])  # all observed: the default
+    assert not everything.cached
+    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    assert springc.compile_model(SEED).path == everything.path
+    result = springc.simulate(SEED, outputs=["mass.v[2]"], stop=0.5)
+    assert result.names == ("mass.v[2]",) and result.stats.cached
+
+
+def test_a_damaged_names_record_is_rebuilt(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                           capsys: pytest.CaptureFixture[str]) -> None:
+    folder = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(folder))
+    springc.compile_model(SEED, outputs=["mass.pos[1]"])
+    (record,) = folder.glob("*/names.json")
+    record.write_text('{"states": ["mass.pos[1]"], "observed": ["__import__"]}')
+    again = springc.compile_model(SEED, outputs=["mass.v[1]"])
+    assert capsys.readouterr().err == (f"note: cache entry {record.parent} does not match "
+                                       "its recorded hash; regenerating it\n")
+    assert again.cached and again.outputs == ("mass.v[1]",)
+    assert '"spring.x"' in record.read_text()

@@ -17,7 +17,7 @@ import springc
 from springc.cli import main
 from springc.errors import SpringcError
 from springc.pipeline import select_names
-from springc.pipeline.compiler import wildcard_match
+from springc.pipeline.selection import wildcard_match
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "models" / "Scenes.mdl"

@@ -8,9 +8,9 @@ from .compiler import (
     derive_system,
     generate_source,
     modification_value,
-    select_names,
 )
 from .files import flatten_files
+from .selection import select_names
 
 __all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",

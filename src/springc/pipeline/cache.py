@@ -2,13 +2,17 @@
 
 Entries live in ``$SPRINGC_CACHE_DIR``, else ``$XDG_CACHE_HOME/springc``, else
 ``~/.cache/springc``: one folder per key holding ``model.py`` and ``model.sha256``, the
-SHA-256 of the module recorded when it was written. The cache folder is private (created
-0700, whatever the umask). A module is imported only from the bytes whose hash matched
-the record: an edited, planted, truncated or unreadable entry is regenerated with a
-one-line note on stderr, never executed. A cache folder that cannot be used (not a
-folder, not writable, owned by another user) gives a note, and the model is compiled
-in a private temporary folder instead. The least recently used entries beyond
-``CACHE_ENTRIES`` are removed when a new one is written.
+SHA-256 of the module recorded when it was written. A module's key is that of the
+model (:func:`cache_key`) combined with the observed variables it computes
+(:func:`selection_key`); the model's key also names an entry holding ``names.json``
+(with ``names.sha256``), its states and observed variables, so that a new ``--vars``
+is resolved to those variables without flattening the model again. The cache folder
+is private (created 0700, whatever the umask). A module is imported only from the
+bytes whose hash matched the record: an edited, planted, truncated or unreadable entry
+is regenerated with a one-line note on stderr, never executed. A cache folder that
+cannot be used (not a folder, not writable, owned by another user) gives a note, and
+the model is compiled in a private temporary folder instead. The least recently used
+entries beyond ``CACHE_ENTRIES`` are removed when a new one is written.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import json
 import os
 import shutil
 import stat
@@ -35,6 +40,8 @@ CACHE_ENTRIES = 200
 
 MODULE_FILE = "model.py"
 HASH_FILE = "model.sha256"
+NAMES_FILE = "names.json"
+"""The record of a model's output names (states, observed), in an entry of its own."""
 
 
 class CacheUnusable(Exception):
@@ -84,7 +91,7 @@ def private_folder(folder: Path) -> Path:
             note(f"the cache folder {folder} was writable by others: it is private now "
                  "and its entries were removed")
             for entry in folder.iterdir():
-                if (entry / MODULE_FILE).exists():
+                if (entry / MODULE_FILE).exists() or (entry / NAMES_FILE).exists():
                     shutil.rmtree(entry, ignore_errors=True)
     if not os.access(folder, os.W_OK | os.X_OK):
         raise CacheUnusable(f"{folder} is not writable")
@@ -98,16 +105,19 @@ def touch(path: Path) -> None:
 
 
 def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]:
-    """Remove the least recently used entries beyond ``limit`` (never ``keep``)."""
+    """Remove the least recently used entries beyond ``limit`` (never ``keep``): module
+    entries and names records are counted apart."""
     limit = CACHE_ENTRIES if limit is None else limit
-    entries = []
-    for entry in folder.iterdir() if folder.is_dir() else ():
-        try:
-            entries.append(((entry / MODULE_FILE).stat().st_mtime, entry))
-        except OSError:  # not an entry, or being written
-            continue
-    entries.sort(reverse=True)
-    removed = [e for _, e in entries[limit:] if e.name != keep]
+    removed = []
+    for name in (MODULE_FILE, NAMES_FILE):
+        entries = []
+        for entry in folder.iterdir() if folder.is_dir() else ():
+            try:
+                entries.append(((entry / name).stat().st_mtime, entry))
+            except OSError:  # not such an entry, or being written
+                continue
+        entries.sort(reverse=True)
+        removed += [e for _, e in entries[limit:] if e.name != keep]
     for entry in removed:
         shutil.rmtree(entry, ignore_errors=True)
     return removed
@@ -126,6 +136,13 @@ def springc_digest() -> bytes:
         h.update(hashlib.sha256(path.read_bytes()).digest())
     h.update(hashlib.sha256(grammar_path().read_bytes()).digest())
     return h.digest()
+
+
+def selection_key(model_key: str, observed: object) -> str:
+    """The key of the module of ``model_key`` that computes the ``observed`` variables
+    (the names, or ``"all"``): ``--vars`` that select the same observed variables,
+    whatever states they select, share one module."""
+    return hashlib.sha256(repr((model_key, observed)).encode()).hexdigest()[:24]
 
 
 def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
@@ -152,11 +169,15 @@ def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) 
 # ------------------------------------------------------------------ entries
 
 
-def read_entry(entry: Path) -> bytes | None:
-    """The module text of ``entry`` if its hash matches the record; ``None`` (with a
-    note, the entry removed) if the entry is damaged or was changed; ``None`` silently
-    if there is no entry."""
-    module, record = entry / MODULE_FILE, entry / HASH_FILE
+def _hash_file(name: str) -> str:
+    return HASH_FILE if name == MODULE_FILE else name.rsplit(".", 1)[0] + ".sha256"
+
+
+def read_entry(entry: Path, name: str = MODULE_FILE) -> bytes | None:
+    """The text of file ``name`` (the module) of ``entry`` if its hash matches the
+    record; ``None`` (with a note, the entry removed) if the entry is damaged or was
+    changed; ``None`` silently if there is no entry."""
+    module, record = entry / name, entry / _hash_file(name)
     if not module.exists() and not record.exists():
         return None
     try:
@@ -176,8 +197,9 @@ def discard(entry: Path, reason: str) -> None:
     shutil.rmtree(entry, ignore_errors=True)
 
 
-def write_entry(entry: Path, text: str) -> Path:
-    """Write ``text`` as the module of ``entry`` with its hash record; the module path.
+def write_entry(entry: Path, text: str, name: str = MODULE_FILE) -> Path:
+    """Write ``text`` as file ``name`` (the module) of ``entry`` with its hash record;
+    the file's path.
 
     Both files are written in a private temporary folder that is then renamed to
     ``entry``, so a reader sees a complete entry or none. If another process wrote the
@@ -186,15 +208,15 @@ def write_entry(entry: Path, text: str) -> Path:
     data = text.encode("utf-8")
     new = Path(tempfile.mkdtemp(dir=entry.parent, prefix=".new-"))  # created 0700
     try:
-        (new / MODULE_FILE).write_bytes(data)
-        (new / HASH_FILE).write_text(hashlib.sha256(data).hexdigest() + "\n",
-                                     encoding="ascii")
+        (new / name).write_bytes(data)
+        (new / _hash_file(name)).write_text(hashlib.sha256(data).hexdigest() + "\n",
+                                            encoding="ascii")
         os.rename(new, entry)
     except OSError:
         shutil.rmtree(new, ignore_errors=True)
         if not entry.is_dir():
             raise
-    return entry / MODULE_FILE
+    return entry / name
 
 
 def import_module(data: bytes, path: Path, name: str) -> GeneratedModule:
@@ -216,3 +238,33 @@ def import_module(data: bytes, path: Path, name: str) -> GeneratedModule:
         raise ImportError(f"{path} is not a generated module of this springc: it does "
                           f"not define {sorted(missing)[0]}")
     return cast(GeneratedModule, module)
+
+
+Names = tuple[tuple[str, ...], tuple[str, ...]]
+"""A model's states and observed variables, in model order."""
+
+
+def read_names(folder: Path | None, model_key: str) -> Names | None:
+    """The names record (states, observed) of ``model_key``; None without a cache, a
+    record or with a damaged one. The names are data: they select outputs and enter
+    keys, never code (a module is generated from the model, not from the record)."""
+    data = read_entry(folder / model_key, NAMES_FILE) if folder is not None else None
+    if data is None:
+        return None
+    try:
+        record = json.loads(data)
+        states, observed = record["states"], record["observed"]
+        if all(isinstance(n, str) for n in [*states, *observed]):
+            return tuple(states), tuple(observed)
+    except (ValueError, TypeError, KeyError):
+        pass
+    return None
+
+
+def write_names(folder: Path | None, model_key: str, names: Names) -> None:
+    """Record the names of ``model_key`` (once; a read-only cache is left alone)."""
+    if folder is None or (folder / model_key / NAMES_FILE).exists():
+        return
+    text = json.dumps({"states": list(names[0]), "observed": list(names[1])})
+    with contextlib.suppress(OSError):
+        write_entry(folder / model_key, text, NAMES_FILE)

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import difflib
-import re
 import shutil
 import tempfile
 import time
@@ -30,6 +29,7 @@ from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
 from .cache import (
     CacheUnusable,
+    Names,
     cache_dir,
     cache_key,
     discard,
@@ -38,10 +38,14 @@ from .cache import (
     private_folder,
     prune_cache,
     read_entry,
+    read_names,
+    selection_key,
     touch,
     write_entry,
+    write_names,
 )
 from .equations import Equations
+from .selection import ALL_OBSERVED, select_names, selected_observed
 
 
 @dataclass(frozen=True)
@@ -126,50 +130,6 @@ class CompiledModel:
         return self.module.parameters(dict(values or {}))
 
 
-# ------------------------------------------------------------------ selection
-
-
-def wildcard_match(pattern: str, name: str) -> bool:
-    """Whether ``name`` matches ``pattern`` (``*``: any run, ``?``: one character; no
-    other special characters, so ``x[1]`` is literal). Linear in the number of ``*``:
-    each segment between stars is found at its leftmost place, never backtracked."""
-    first, *middle = [_segment(part) for part in pattern.split("*")]
-    if not middle:
-        return first.fullmatch(name) is not None
-    last = middle.pop()
-    head = first.match(name)
-    if head is None:
-        return False
-    pos = head.end()
-    end = len(name) - (len(pattern.rsplit("*", 1)[1]))
-    if end < pos or last.fullmatch(name, end) is None:
-        return False
-    for segment in middle:
-        found = segment.search(name, pos, end)
-        if found is None:
-            return False
-        pos = found.end()
-    return True
-
-
-def _segment(text: str) -> re.Pattern[str]:
-    return re.compile("".join("." if c == "?" else re.escape(c) for c in text), re.DOTALL)
-
-
-def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> list[str]:
-    """``candidates`` matching any of ``patterns`` (all when ``None``), in model order."""
-    if patterns is None:
-        return list(candidates)
-    for text in patterns:
-        if not any(wildcard_match(text, c) for c in candidates):
-            close = difflib.get_close_matches(text, candidates, 3)
-            raise SimulationError(
-                f"--vars '{text}' matches no state or observed variable",
-                hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
-                      "use flat names such as 'mass.pos[1]', with * and ? as wildcards"))
-    return [c for c in candidates if any(wildcard_match(p, c) for p in patterns)]
-
-
 def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) -> None:
     """Reject names that are not parameters, suggesting close matches."""
     known = model.parameter_names
@@ -186,7 +146,13 @@ def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) ->
 
 
 def compile_files(options: CompileOptions) -> CompiledModel:
-    """The compiled model for ``options``: from the cache, or generated now."""
+    """The compiled model for ``options``: from the cache, or generated now.
+
+    The module computes the observed variables ``options.outputs`` selects (every one
+    without ``--vars``); its key is the model's key with that selection, so ``--vars``
+    that change only the states selected, or select the same observed variables, load
+    the same module, and the model's names record (written with the first module of a
+    model) resolves the patterns without flattening."""
     began = time.perf_counter()
     folder = None
     if options.cache:
@@ -194,11 +160,20 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             folder = private_folder(cache_dir())
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
-    settings: tuple[object, ...] = (options.model, options.backend, options.outputs,
-                                    options.modifications)
+    settings: tuple[object, ...] = (options.model, options.backend, options.modifications)
     if options.texts:  # (the keys of file-only models are unchanged)
         settings += (options.texts,)
-    key = cache_key(settings, options.files, options.libraries)
+    model_key = cache_key(settings, options.files, options.libraries)
+    derived = None
+    observed: object = ALL_OBSERVED
+    if options.outputs is not None:
+        names = read_names(folder, model_key)
+        if names is None:
+            derived = derive_system(options)
+            names = candidate_names(derived)
+            write_names(folder, model_key, names)
+        observed = selected_observed(names, options.outputs)
+    key = selection_key(model_key, observed)
     module_name = f"springc_model_{key}"
     if folder is not None:
         entry = folder / key
@@ -214,7 +189,10 @@ def compile_files(options: CompileOptions) -> CompiledModel:
                 return CompiledModel(module, options, path, True,
                                      time.perf_counter() - began, outputs_of(module, options),
                                      text=data.decode("utf-8"))
-    generated = generate_source(options)
+    if derived is None:
+        derived = derive_system(options)
+        write_names(folder, model_key, candidate_names(derived))
+    generated = generate_from(derived, options)
     temporary = None
     if folder is not None:
         try:
@@ -236,6 +214,12 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         raise too_deep_for_python(err) from None
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated)
+
+
+def candidate_names(derived: Derived) -> Names:
+    """The states and the observed variables of a derived model."""
+    system = derived.system
+    return tuple(s.name for s in system.states), tuple(system.observed_names())
 
 
 def too_deep_for_python(err: BaseException) -> BaseException:
@@ -321,7 +305,11 @@ def _add_wrapper(tree: ClassTree, entry: ClassEntry,
 
 def generate_source(options: CompileOptions) -> str:
     """Flatten, simplify and generate the module text for ``options``."""
-    derived = derive_system(options)
+    return generate_from(derive_system(options), options)
+
+
+def generate_from(derived: Derived, options: CompileOptions) -> str:
+    """The module text of a derived model with the outputs ``options`` selects."""
     system, flat_model = derived.system, derived.flat_model
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))

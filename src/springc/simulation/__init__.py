@@ -27,6 +27,7 @@ from .values import check_run_values  # light: only math and errors
 if TYPE_CHECKING:
     from .compiled import choose_engine
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
+    from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
         PLOT_FORMATS,
         RESULT_FORMATS,
@@ -46,8 +47,10 @@ if TYPE_CHECKING:
 
 __all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
            "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT", "ENGINES", "FIXED_STEP",
-           "IMPLICIT_SOLVERS", "LSODA_LIMIT", "PLOT_FORMATS", "RESULT_FORMATS", "SOLVERS",
-           "SimulationOptions", "SimulationResult", "check_run_values", "choose_engine",
+           "IMPLICIT_SOLVERS", "LARGE_TRAJECTORY", "LSODA_LIMIT", "PLOT_FORMATS",
+           "RESULT_FORMATS", "SOLVERS",
+           "SimulationOptions", "SimulationResult", "check_run_values", "check_trajectory_size",
+           "choose_engine",
            "file_format", "initial_state", "output_grid", "resolve", "save_outputs",
            "simulate_model", "write_csv"]
 
@@ -64,6 +67,10 @@ def __getattr__(name: str) -> Any:
         from . import compiled
 
         return compiled.choose_engine
+    if name in ("LARGE_TRAJECTORY", "check_trajectory_size"):
+        from . import output_size
+
+        return getattr(output_size, name)
     if name in _LIMITS:
         from . import limits
 

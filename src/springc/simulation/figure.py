@@ -1,20 +1,37 @@
-"""The figure of a result for notebooks: a matplotlib Figure that shows itself inline.
+"""The figure of a result: a PlotLayout drawn as a matplotlib Figure that shows itself
+inline in Jupyter.
 
 Imported on first plot only (matplotlib is heavy). The figure is drawn on the Agg
 canvas without pyplot, so the user's matplotlib backend is left alone; ``_repr_png_``
-lets Jupyter show it inline whatever backend is configured.
+lets Jupyter show it inline whatever backend is configured. Which panels are drawn is
+decided in :mod:`.plot_layout`; the choice is kept as ``figure.layout`` and its note
+is written under the title.
 """
 
 from __future__ import annotations
 
 import io
+import textwrap
+from collections.abc import Sequence
+from typing import Any
 
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from .plot_layout import HEATMAP, PlotLayout
+
+NOTE_WIDTH = 150
+"""Characters per line of the note under the title."""
+NOTE_LINE = 0.2
+"""Inches per line of the note."""
+
 
 class ResultFigure(Figure):
-    """A matplotlib Figure (on the Agg canvas) that Jupyter displays as a PNG."""
+    """A matplotlib Figure (on the Agg canvas) that Jupyter displays as a PNG;
+    ``layout`` is the choice of panels it shows."""
+
+    layout: PlotLayout | None = None
 
     def __init__(self, width: float, height: float) -> None:
         super().__init__(figsize=(width, height))
@@ -24,3 +41,58 @@ class ResultFigure(Figure):
         buffer = io.BytesIO()
         self.savefig(buffer, format="png", dpi=100)
         return buffer.getvalue()
+
+
+def plain_text(text: str) -> str:
+    """``text`` as matplotlib shows it literally: a ``$`` would start mathtext."""
+    return text.replace("$", r"\$")
+
+
+def draw_layout(model: str, time: np.ndarray, values: np.ndarray,
+                layout: PlotLayout, names: Sequence[str]) -> ResultFigure:
+    """``layout`` as a figure: one row per panel, a colour bar beside each heat map, the
+    note under the title. Names and units are shown literally."""
+    panels = layout.panels
+    note = textwrap.wrap(layout.note, NOTE_WIDTH)
+    top = 0.55 + NOTE_LINE * len(note)
+    height = 1.2 + 2.3 * max(1, len(panels)) + NOTE_LINE * len(note)
+    fig = ResultFigure(10, height)
+    # Fixed margins (in inches) instead of tight_layout, which costs a quarter second;
+    # with heat maps, a narrow second column holds the colour bars, so that every time
+    # axis lines up.
+    bars = any(panel.kind == HEATMAP for panel in panels)
+    grid = fig.add_gridspec(max(1, len(panels)), 2 if bars else 1,
+                            width_ratios=(60, 1) if bars else None, wspace=0.02,
+                            left=0.09, right=0.93 if bars else 0.98, top=1 - top / height,
+                            bottom=0.6 / height, hspace=0.45 if note or bars else 0.35)
+    axes: list[Any] = []
+    for row, panel in enumerate(panels):
+        ax = fig.add_subplot(grid[row, 0], sharex=axes[0] if axes else None)
+        axes.append(ax)
+        ax.set_title(plain_text(panel.title), fontsize=10, loc="left", y=1.0)  # no search
+        if panel.kind == HEATMAP:
+            rows = len(panel.columns)
+            image = ax.imshow(values[:, list(panel.columns)].T, aspect="auto",
+                              origin="lower", interpolation="nearest", cmap="viridis",
+                              extent=(float(time[0]), float(time[-1]), 0.5, rows + 0.5))
+            ax.set_ylabel("variable (model order)")
+            bar = fig.colorbar(image, cax=fig.add_subplot(grid[row, 1]))
+            bar.set_label(plain_text(panel.label), fontsize=8)
+            continue
+        for column, label in zip(panel.columns, panel.labels):
+            ax.plot(time, values[:, column], label=plain_text(label), linewidth=1.2)
+        ax.set_ylabel(plain_text(panel.label))
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right", ncol=min(3, len(panel.columns)))
+    if not axes:
+        axes.append(fig.add_subplot(grid[0, 0]))
+        axes[0].text(0.5, 0.5, "no variables selected", ha="center")
+    for ax in axes[:-1]:
+        ax.tick_params(labelbottom=False)
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle(plain_text(model), fontsize=11, y=1 - 0.12 / height, va="top")
+    if note:
+        fig.text(0.5, 1 - 0.4 / height, plain_text("\n".join(note)), ha="center",
+                 va="top", fontsize=8)
+    fig.layout = layout
+    return fig

@@ -15,7 +15,6 @@ from __future__ import annotations
 import csv
 import io
 import os
-import re
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,7 +24,7 @@ import numpy as np
 
 from ..errors import OutputError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
-from ..ir import dae
+from .plot_layout import choose_layout
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
@@ -231,14 +230,15 @@ def error_file(output: PathLike) -> Path:
 
 
 def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLike | None,
-                 protected: Iterable[PathLike] = ()) -> None:
+                 protected: Iterable[PathLike] = ()) -> str:
     """Write the trajectory to ``output`` (CSV or MAT by suffix; with an error estimate,
     also :func:`error_file`) and the plot to ``plot`` (PNG, SVG or PDF): all are
     rendered before any is put in place, and files in ``protected`` (the inputs) are
-    never replaced."""
+    never replaced. Returns the plot's note (which variables it shows, see
+    :mod:`.plot_layout`; empty: all of them)."""
     kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
     plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
-    picture = render_plot(result, plot_kind) if plot_kind is not None else None
+    picture, note = render_plot(result, plot_kind) if plot_kind is not None else (None, "")
     with OutputSet(protected) as outputs:
         if output is not None:
             with outputs.open(output, "w" if kind == "csv" else "wb") as f:
@@ -252,77 +252,25 @@ def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLi
         if plot is not None and picture is not None:
             with outputs.open(plot, "wb") as f:
                 f.write(picture)
+    return note
 
 
 # ------------------------------------------------------------------ plotting
 
-_QUANTITY = {"m": "position", "m/s": "velocity", "m/s2": "acceleration", "N": "force",
-             "kg": "mass", "N/m": "stiffness", "rad": "angle", "rad/s": "angular velocity",
-             "J": "energy", "W": "power", "N.s/m": "damping"}
-_WORDS = {"pos": "position", "s": "position", "r": "position",
-          "v": "velocity", "vel": "velocity", "w": "angular velocity", "a": "acceleration",
-          "f": "force", "len": "length", "dir": "direction", "phi": "angle"}
-MAX_PANELS = 8
-MAX_LEGEND = 12
-
-
-def plain_text(text: str) -> str:
-    """``text`` as matplotlib shows it literally: a ``$`` would start mathtext."""
-    return text.replace("$", r"\$")
-
-
-def _group(name: str, unit: str) -> tuple[str, str]:
-    """(panel title, y label) of a variable: by unit if declared, else by its last name."""
-    if unit:
-        quantity = _QUANTITY.get(unit, unit)
-        return quantity, f"{quantity} [{unit}]"
-    while (base := dae.derivative_base(name)) is not None:
-        name = base
-    last = re.sub(r"\[.*?\]", "", name.rsplit(".", 1)[-1])
-    word = _WORDS.get(last, last)
-    return word, word
-
 
 def draw_figure(result: SimulationResult) -> Any:
-    """The plot of the outputs, one panel per quantity (positions, velocities, forces,
-    ...), as a matplotlib Figure. Names and units are shown literally."""
-    # A Figure with the Agg canvas directly: no pyplot, so the user's matplotlib
-    # backend (a notebook's, say) is left alone.
-    from .figure import ResultFigure
+    """The plot of the outputs as a matplotlib Figure: the panels that
+    :func:`springc.simulation.plot_layout.choose_layout` picks (per quantity with a
+    legend; per family with heat maps for a large result), its note under the title."""
+    from .figure import draw_layout  # matplotlib loads with the first plot
 
-    groups: dict[str, tuple[str, list[int]]] = {}
-    for i, (name, unit) in enumerate(zip(result.names, result.units)):
-        title, label = _group(name, unit)
-        groups.setdefault(title, (label, []))[1].append(i)
-    panels = list(groups.items())[:MAX_PANELS]
-    height = 1.2 + 2.3 * max(1, len(panels))
-    fig = ResultFigure(10, height)
-    # Fixed margins (in inches) instead of tight_layout, which costs a quarter second.
-    fig.subplots_adjust(left=0.09, right=0.98, top=1 - 0.55 / height,
-                        bottom=0.6 / height, hspace=0.35)
-    axes = fig.subplots(max(1, len(panels)), 1, sharex=True, squeeze=False)
-    for ax, (title, (label, columns)) in zip(axes[:, 0], panels):
-        many = len(columns) > MAX_LEGEND
-        for i in columns:
-            ax.plot(result.time, result.values[:, i], label=plain_text(result.names[i]),
-                    linewidth=0.6 if many else 1.2, alpha=0.6 if many else 1.0)
-        ax.set_ylabel(plain_text(label))
-        ax.grid(True, alpha=0.3)
-        shown = f"{title}: {len(columns)} variables" if many else title
-        ax.set_title(plain_text(shown), fontsize=10, loc="left", y=1.0)  # a fixed y: no bbox search
-        if not many:
-            ax.legend(fontsize=8, loc="upper right", ncol=min(3, len(columns)))
-    if not panels:
-        axes[0, 0].text(0.5, 0.5, "no variables selected", ha="center")
-    omitted = len(groups) - len(panels)
-    note = f" ({omitted} more groups not shown)" if omitted > 0 else ""
-    axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(plain_text(f"{result.model}{note}"), fontsize=11)
-    return fig
+    layout = choose_layout(result.names, result.units, result.values)
+    return draw_layout(result.model, result.time, result.values, layout, result.names)
 
 
-def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
-    """The plot of :func:`draw_figure` as the bytes of a ``kind`` (png, svg, pdf) file."""
+def render_plot(result: SimulationResult, kind: str = "png") -> tuple[bytes, str]:
+    """The plot of :func:`draw_figure` as the bytes of a ``kind`` (png, svg, pdf) file,
+    and the note saying which variables it shows (empty: all of them)."""
     fig = draw_figure(result)
     buffer = io.BytesIO()
     # zlib level 1: a third of the save time of the default 6, for a slightly larger file
@@ -330,4 +278,4 @@ def render_plot(result: SimulationResult, kind: str = "png") -> bytes:
         fig.savefig(buffer, format=kind, dpi=100, pil_kwargs={"compress_level": 1})
     else:
         fig.savefig(buffer, format=kind, dpi=100)
-    return buffer.getvalue()
+    return buffer.getvalue(), fig.layout.note

@@ -3,13 +3,15 @@
 Modules, each importing only those before it: ``params`` (parameter specifications,
 grids, Monte Carlo and Latin hypercube samples), ``job`` (a batch of runs in a worker),
 ``engines`` (local processes or Dask), ``progress``, ``store`` (the Parquet layouts,
-shards for resuming) and ``study`` (:func:`run_study`, :func:`to_dataset`).
+shards for resuming), ``study`` (:func:`run_study`, :func:`to_dataset`) and ``fan``
+(the plot of one variable across the runs).
 
 (The package is not named ``sweep``: ``springc.sweep`` is the API function.)
 """
 
-from .engines import default_workers
-from .job import RunJob, RunRecord, run_batch
+from .engines import Executor, default_workers
+from .fan import fan_figure, plot_variable, render_fan
+from .job import RunJob, RunRecord, StudyOptions, run_batch
 from .params import (
     DISTRIBUTIONS,
     METHODS,
@@ -22,10 +24,10 @@ from .params import (
     unit_points,
 )
 from .store import FIXED_COLUMNS, check_outputs, partial_folder, summary_path
-from .study import Study, StudyOptions, parameter_table, run_study, to_dataset
+from .study import Study, parameter_table, run_study, to_dataset
 
-__all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "ParameterSpec",
-           "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs", "default_workers",
-           "grid",
-           "parameter_table", "parse_parameter", "parse_values", "partial_folder",
-           "run_batch", "run_study", "sample", "summary_path", "to_dataset", "unit_points"]
+__all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "Executor",
+           "ParameterSpec", "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs",
+           "default_workers", "fan_figure", "grid", "parameter_table", "parse_parameter",
+           "parse_values", "partial_folder", "plot_variable", "render_fan", "run_batch",
+           "run_study", "sample", "summary_path", "to_dataset", "unit_points"]

@@ -1,14 +1,16 @@
 """Where the batches run: local processes (default) or a Dask distributed scheduler.
 
-Both engines take the same function (:func:`springc.studies.job.run_batch`) and yield
-each batch's records as soon as it completes, in completion order:
+Both engines map a function over tasks (:func:`local_map`, :func:`dask_map`) and yield
+each task's result as soon as it completes, in completion order; a study's tasks are
+batches of runs (:func:`springc.studies.job.run_batch`), and :class:`Executor` offers
+the same engines to other callers (``springc tradeoff`` runs its solvers through it):
 
-- :func:`local_batches`: a ``concurrent.futures.ProcessPoolExecutor`` of the ``spawn``
+- :func:`local_map`: a ``concurrent.futures.ProcessPoolExecutor`` of the ``spawn``
   context (a fresh interpreter per worker: no state of the caller is inherited, and it
   works the same on every platform). BLAS is pinned to one thread in the workers
   (``OPENBLAS_NUM_THREADS=1`` and the like, unless the caller set them), since the
   solvers' vectors are small and the processes already use the cores.
-- :func:`dask_batches`: a ``distributed.Client`` connected to a running scheduler
+- :func:`dask_map`: a ``distributed.Client`` connected to a running scheduler
   (``dask scheduler`` + ``dask worker ADDRESS``). Dask's nanny pins BLAS to one thread
   in its workers by default. Workers need springc installed and the model files readable
   at the same absolute paths (a shared folder).
@@ -20,18 +22,21 @@ local pool waits for its running batches, which are short (see :func:`batches`).
 from __future__ import annotations
 
 import contextlib
+import functools
 import multiprocessing
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any
+from typing import Any, TypeVar
 
 from ..errors import SimulationError, UsageError
 from .job import RunJob, RunRecord, run_batch
 
 Batch = tuple[tuple[int, tuple[float, ...]], ...]
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+T = TypeVar("T")
+R = TypeVar("R")
 MAX_BATCH = 16
 """The most runs in one batch: a batch is the unit of scheduling and of resuming."""
 
@@ -64,17 +69,18 @@ def single_threaded_blas() -> Iterator[None]:
             os.environ.pop(name, None)
 
 
-def local_batches(job: RunJob, work: Sequence[Batch], workers: int
-                  ) -> Iterator[list[RunRecord]]:
-    """Run ``work`` on ``workers`` local processes; each batch's records when done."""
+def local_map(function: Callable[[T], R], items: Sequence[T], workers: int
+              ) -> Iterator[tuple[int, R]]:
+    """``function(item)`` for every item on ``workers`` local processes: (index of the
+    item, result) as each completes. ``function`` and the items must pickle."""
     context = multiprocessing.get_context("spawn")
     with single_threaded_blas():
         pool = ProcessPoolExecutor(workers, mp_context=context)
-        futures: list[Future[list[RunRecord]]] = []
+        futures: dict[Future[R], int] = {}
         try:
-            futures = [pool.submit(run_batch, job, batch) for batch in work]
+            futures = {pool.submit(function, item): i for i, item in enumerate(items)}
             for future in as_completed(futures):
-                yield future.result()
+                yield futures[future], future.result()
         except BrokenProcessPool:
             raise SimulationError(
                 "a worker process of the study ended abruptly (killed, or out of memory?)",
@@ -82,6 +88,13 @@ def local_batches(job: RunJob, work: Sequence[Batch], workers: int
                 "--workers if memory is short)") from None
         finally:
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+def local_batches(job: RunJob, work: Sequence[Batch], workers: int
+                  ) -> Iterator[list[RunRecord]]:
+    """Run ``work`` on ``workers`` local processes; each batch's records when done."""
+    for _, records in local_map(functools.partial(run_batch, job), work, workers):
+        yield records
 
 
 def connect(address: str) -> Any:
@@ -108,15 +121,56 @@ def dask_workers(client: Any) -> int:
     return max(1, sum(int(w.get("nthreads", 1)) for w in info["workers"].values()))
 
 
+def dask_map(client: Any, function: Callable[[T], R], items: Sequence[T]
+             ) -> Iterator[tuple[int, R]]:
+    """``function(item)`` for every item on the Dask cluster of ``client``: (index of the
+    item, result) as each completes."""
+    from distributed import as_completed as dask_completed
+
+    futures = [client.submit(function, item, pure=False) for item in items]
+    index = {future.key: i for i, future in enumerate(futures)}
+    try:
+        for future in dask_completed(futures, loop=client.loop):  # type: ignore[no-untyped-call]
+            yield index[future.key], future.result()
+    finally:
+        client.cancel(futures)
+
+
 def dask_batches(client: Any, job: RunJob, work: Sequence[Batch]
                  ) -> Iterator[list[RunRecord]]:
     """Run ``work`` on the Dask cluster of ``client``; each batch's records when done."""
-    from distributed import as_completed as dask_completed
+    for _, records in dask_map(client, functools.partial(run_batch, job), work):
+        yield records
 
-    futures = [client.submit(run_batch, job, batch, pure=False)
-               for batch in work]
-    try:
-        for future in dask_completed(futures, loop=client.loop):  # type: ignore[no-untyped-call]
-            yield future.result()
-    finally:
-        client.cancel(futures)
+
+class Executor:
+    """Where a study's independent tasks run: ``workers`` local processes (default: one
+    per core), or the Dask scheduler at ``scheduler``. :meth:`map` yields (index,
+    result) as tasks complete; ``tradeoff`` runs its solvers through it."""
+
+    def __init__(self, workers: int | None = None, scheduler: str | None = None) -> None:
+        if workers is not None and workers < 1:
+            raise UsageError(f"--workers must be at least 1, not {workers}",
+                             option="--workers")
+        self.workers, self.scheduler = workers, scheduler
+
+    def describe(self, tasks: int) -> str:
+        """The engine's name for ``tasks`` tasks: ``2 local processes``, ``Dask at ...``."""
+        if self.scheduler is not None:
+            return f"Dask at {self.scheduler}"
+        count = min(tasks, self.workers or default_workers())
+        return f"{count} local process{'es' if count > 1 else ''}"
+
+    def map(self, function: Callable[[T], R], items: Sequence[T]) -> Iterator[tuple[int, R]]:
+        """``function(item)`` for every item, (index, result) in completion order."""
+        if not items:
+            return
+        if self.scheduler is not None:
+            client = connect(self.scheduler)
+            try:
+                yield from dask_map(client, function, items)
+            finally:
+                client.close()
+            return
+        yield from local_map(function, items, min(len(items),
+                                                  self.workers or default_workers()))

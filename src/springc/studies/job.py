@@ -1,4 +1,5 @@
-"""One batch of runs in a worker: RunJob + (run, values) pairs -> RunRecords.
+"""One batch of runs in a worker: RunJob + (run, values) pairs -> RunRecords; the
+study's options (:class:`StudyOptions`), which the job carries to the workers.
 
 This is the code that executes in the worker processes (local or Dask). A worker gets
 the model through :func:`springc.pipeline.compile_files` with the study's
@@ -27,16 +28,21 @@ from ..simulation import (
     SimulationOptions,
     simulate_model,
 )
+from .params import ParameterSpec
 
 
 @dataclass(frozen=True)
-class RunJob:
-    """What every run of a study shares: the model, the swept parameter names, the fixed
-    parameter values and the simulation settings (``None``: the model's defaults, and
-    simulate's limits of steps and seconds per run)."""
+class StudyOptions:
+    """What to vary and how to run. ``samples`` ``None``: a grid of the parameters'
+    lists; else that many draws (``method`` ``lhs`` or ``mc``, from ``seed``). Times,
+    solver and tolerances as for ``simulate`` (``None``: the model's defaults);
+    ``fixed`` parameter values apply to every run. ``scheduler``: the address of a Dask
+    scheduler, else ``workers`` local processes (default: one per core)."""
 
-    compile: CompileOptions
-    names: tuple[str, ...]
+    parameters: tuple[ParameterSpec, ...]
+    samples: int | None = None
+    method: str = "lhs"
+    seed: int = 0
     fixed: tuple[tuple[str, float], ...] = ()
     start: float | None = None
     stop: float | None = None
@@ -45,18 +51,35 @@ class RunJob:
     rtol: float | None = None
     atol: float | None = None
     step: float | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+    energy: str | None = None
     max_steps: int | None = None
     time_limit: float | None = None
 
+
+@dataclass(frozen=True)
+class RunJob:
+    """What every run of a study shares: the model (compile options with absolute file
+    names) and the study's options (swept names, fixed values, simulation settings;
+    ``None``: the model's defaults, and simulate's limits of steps and seconds)."""
+
+    compile: CompileOptions
+    study: StudyOptions
+
+    @property
+    def solver(self) -> str:
+        return self.study.solver
+
     def options(self, values: Sequence[float]) -> SimulationOptions:
         """The simulation options of the run with the swept ``values``."""
-        parameters = dict(self.fixed)
-        parameters.update(zip(self.names, (float(v) for v in values)))
+        o = self.study
+        parameters = dict(o.fixed)
+        parameters.update(zip((s.name for s in o.parameters), (float(v) for v in values)))
         return SimulationOptions(
-            self.start, self.stop, self.interval, self.solver, self.rtol, self.atol,
-            parameters, None, self.step,
-            DEFAULT_MAX_STEPS if self.max_steps is None else self.max_steps,
-            DEFAULT_TIME_LIMIT if self.time_limit is None else self.time_limit)
+            o.start, o.stop, o.interval, o.solver, o.rtol, o.atol, parameters, None, o.step,
+            DEFAULT_MAX_STEPS if o.max_steps is None else o.max_steps,
+            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit)
 
 
 @dataclass(frozen=True)

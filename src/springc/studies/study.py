@@ -28,8 +28,8 @@ from .engines import (
     default_workers,
     local_batches,
 )
-from .job import RunJob
-from .params import ParameterSpec, grid, sample
+from .job import RunJob, StudyOptions
+from .params import grid, sample
 from .progress import StudyProgress, duration
 from .store import (
     Layout,
@@ -44,33 +44,6 @@ from .store import (
 )
 
 ENERGY_UNIT = "J"
-
-
-@dataclass(frozen=True)
-class StudyOptions:
-    """What to vary and how to run. ``samples`` ``None``: a grid of the parameters'
-    lists; else that many draws (``method`` ``lhs`` or ``mc``, from ``seed``). Times,
-    solver and tolerances as for ``simulate`` (``None``: the model's defaults);
-    ``fixed`` parameter values apply to every run. ``scheduler``: the address of a Dask
-    scheduler, else ``workers`` local processes (default: one per core)."""
-
-    parameters: tuple[ParameterSpec, ...]
-    samples: int | None = None
-    method: str = "lhs"
-    seed: int = 0
-    fixed: tuple[tuple[str, float], ...] = ()
-    start: float | None = None
-    stop: float | None = None
-    interval: float | None = None
-    solver: str = "auto"
-    rtol: float | None = None
-    atol: float | None = None
-    step: float | None = None
-    workers: int | None = None
-    scheduler: str | None = None
-    energy: str | None = None
-    max_steps: int | None = None
-    time_limit: float | None = None
 
 
 @dataclass
@@ -166,10 +139,7 @@ def job_of(model: CompiledModel, options: StudyOptions) -> RunJob:
     compile_options = replace(
         model.options, files=tuple(os.path.abspath(f) for f in model.options.files),
         libraries=tuple(os.path.abspath(f) for f in model.options.libraries))
-    return RunJob(compile_options, tuple(s.name for s in options.parameters), options.fixed,
-                  options.start, options.stop, options.interval, options.solver,
-                  options.rtol, options.atol, options.step, options.max_steps,
-                  options.time_limit)
+    return RunJob(compile_options, options)
 
 
 Pending = Sequence[tuple[int, tuple[float, ...]]]

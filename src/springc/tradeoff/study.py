@@ -30,16 +30,19 @@ time, the steps, the RHS and Jacobian evaluations, and the error on the output g
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+import os
 import statistics
 import time
-from collections.abc import Callable, Sequence
-from typing import Any
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import SimulationError
-from ..pipeline import CompiledModel
+from ..pipeline import CompiledModel, CompileOptions, compile_files
 from ..simulation import FIXED_STEP, SOLVERS, simulate_model
 from .energy import drift, energy_series, energy_variable
 from .model import (
@@ -175,8 +178,14 @@ def _with_errors(run: Run, values: np.ndarray | None, ref: Reference,
     return dataclasses.replace(run, max_error=worst, rms_error=rms)
 
 
-def run_tradeoff(model: CompiledModel, options: TradeoffOptions) -> Tradeoff:
-    """Measure every solver at every setting against the reference (see module text)."""
+def run_tradeoff(model: CompiledModel, options: TradeoffOptions,
+                 executor: Executor | None = None) -> Tradeoff:
+    """Measure every solver at every setting against the reference (see module text).
+
+    The reference is computed here; each solver's settings (and the scipy baselines)
+    are one task (:class:`Chain`), run in this process or, with ``executor`` (the
+    studies executor: local processes or Dask), in its workers; the table is the same.
+    """
     setup = study_setup(model, options)
     solvers = check_solvers(options.solvers if options.solvers is not None
                             else available_solvers())
@@ -190,42 +199,118 @@ def run_tradeoff(model: CompiledModel, options: TradeoffOptions) -> Tradeoff:
     scales = variable_scales(ref.values, setup.units)
     setup.log(f"reference: {ref.description}")
     energy = energy_variable(model, options.energy)
-    with_energy = _energy_drift(setup, energy, ref)
-    # Step 2: every solver, loosest setting first, until one is over budget.
-    runs: list[Run] = []
+    # Step 2: every solver, loosest setting first, until one is over budget; step 3:
+    # scipy's default call, then RK45 tightened until it reaches the targets.
     fixed = set(fixed_step_solvers())
     interval = float(setup.grid[1] - setup.grid[0]) if len(setup.grid) > 1 else 1.0
     steps = options.steps or tuple(interval / d for d in DEFAULT_STEP_DIVISIONS)
-    for solver in solvers:
-        settings = sorted(steps if solver in fixed else options.tolerances, reverse=True)
-        skip = False
-        for value in settings:
-            if skip:
-                runs.append(Run(solver, "step" if solver in fixed else "rtol", value,
-                                math.nan, 0, -1, -1, -1, math.nan, math.nan,
-                                "skipped (a looser setting was over budget)"))
-                continue
-            run, values = _springc_run(setup, solver, None if solver in fixed else value,
-                                       value if solver in fixed else None)
-            run = with_energy(_with_errors(run, values, ref, scales), values)
-            runs.append(run)
-            setup.log(_log_line(run))
-            skip = run.status.startswith("over budget")
-    # Step 3: scipy's default call, then RK45 tightened until it reaches the targets.
-    base, values = _scipy_run(setup, None)
-    baselines = [with_energy(_with_errors(base, values, ref, scales), values)]
-    setup.log(_log_line(baselines[0]))
-    goal = min(options.targets)
-    if not (baselines[0].ok and baselines[0].max_error <= goal):
-        for rtol in sorted((t for t in options.tolerances if t < 1e-3), reverse=True):
-            run, values = _scipy_run(setup, rtol)
-            run = with_energy(_with_errors(run, values, ref, scales), values)
-            baselines.append(run)
-            setup.log(_log_line(run))
-            if not run.ok or run.max_error <= goal:
-                break
-    return Tradeoff(model.name, len(model.states), ref, scales, tuple(runs),
-                    tuple(baselines), tuple(options.targets), energy)
+    chains = [Chain(solver, tuple(sorted(steps if solver in fixed else options.tolerances,
+                                         reverse=True))) for solver in solvers]
+    chains.append(Chain(SCIPY_DEFAULT, ()))
+    done: list[list[Run]] = [[] for _ in chains]
+    if executor is None:
+        for i, chain in enumerate(chains):
+            done[i] = chain_runs(setup, ref, scales, energy, chain, setup.log)
+    else:
+        job = ChainJob(model.options, model.outputs, dataclasses.replace(options, log=None),
+                       ref, scales, energy)
+        for i, runs in executor.map(functools.partial(run_chain, job), chains):
+            done[i] = runs
+            for run in runs:
+                setup.log(_log_line(run))
+    return Tradeoff(model.name, len(model.states), ref, scales,
+                    tuple(run for runs in done[:-1] for run in runs), tuple(done[-1]),
+                    tuple(options.targets), energy)
+
+
+class Executor(Protocol):
+    """Runs independent tasks, yielding (task index, result) as each completes
+    (:class:`springc.studies.Executor`: local processes or Dask)."""
+
+    def map(self, function: Callable[[Any], Any], items: Sequence[Any]
+            ) -> Iterable[tuple[int, Any]]: ...
+
+
+@dataclass(frozen=True)
+class Chain:
+    """One task: a solver's settings, loosest first (a run over budget skips the
+    tighter ones), or the scipy baselines (``solver`` :data:`SCIPY_DEFAULT`)."""
+
+    solver: str
+    settings: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class ChainJob:
+    """What a worker needs for any chain: the model (compile options with absolute
+    file names, and the compared outputs), the options (no log stream), the reference,
+    the scales and the energy variable."""
+
+    compile: CompileOptions
+    outputs: tuple[str, ...]
+    options: TradeoffOptions
+    reference: Reference
+    scales: np.ndarray
+    energy: str | None
+
+    def __post_init__(self) -> None:
+        absolute = dataclasses.replace(
+            self.compile, files=tuple(os.path.abspath(f) for f in self.compile.files),
+            libraries=tuple(os.path.abspath(f) for f in self.compile.libraries))
+        object.__setattr__(self, "compile", absolute)
+
+
+@functools.lru_cache(maxsize=4)
+def worker_model(options: CompileOptions) -> CompiledModel:
+    """The compiled model of ``options`` in a worker (loaded from the cache once)."""
+    return compile_files(options)
+
+
+def run_chain(job: ChainJob, chain: Chain) -> list[Run]:
+    """One chain in a worker process: the model from the cache, warmed up, then runs."""
+    model = dataclasses.replace(worker_model(job.compile), outputs=job.outputs)
+    setup = study_setup(model, job.options)
+    with np.errstate(all="ignore"):
+        warm_up(model, setup.p, setup.x0)
+    return chain_runs(setup, job.reference, job.scales, job.energy, chain)
+
+
+def chain_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: str | None,
+               chain: Chain, log: Callable[[str], None] | None = None) -> list[Run]:
+    """The runs of ``chain``, each logged with ``log`` when done."""
+    with_energy = _energy_drift(setup, energy, ref)
+    runs: list[Run] = []
+
+    def done(run: Run) -> None:
+        runs.append(run)
+        if log is not None:
+            log(_log_line(run))
+
+    if chain.solver == SCIPY_DEFAULT:
+        base, values = _scipy_run(setup, None)
+        done(with_energy(_with_errors(base, values, ref, scales), values))
+        goal = min(setup.options.targets)
+        if not (runs[0].ok and runs[0].max_error <= goal):
+            for rtol in sorted((t for t in setup.options.tolerances if t < 1e-3),
+                               reverse=True):
+                run, values = _scipy_run(setup, rtol)
+                done(with_energy(_with_errors(run, values, ref, scales), values))
+                if not runs[-1].ok or runs[-1].max_error <= goal:
+                    break
+        return runs
+    fixed = chain.solver in fixed_step_solvers()
+    skip = False
+    for value in chain.settings:
+        if skip:
+            runs.append(Run(chain.solver, "step" if fixed else "rtol", value, math.nan, 0,
+                            -1, -1, -1, math.nan, math.nan,
+                            "skipped (a looser setting was over budget)"))
+            continue
+        run, values = _springc_run(setup, chain.solver, None if fixed else value,
+                                   value if fixed else None)
+        done(with_energy(_with_errors(run, values, ref, scales), values))
+        skip = runs[-1].status.startswith("over budget")
+    return runs
 
 
 def _energy_drift(setup: StudySetup, energy: str | None, ref: Reference

@@ -1,0 +1,68 @@
+"""Which outputs ``--vars`` selects: wildcard patterns over a model's flat names.
+
+``*`` matches any run of characters and ``?`` one; nothing else is special, so
+``x[1]`` is literal. The selection decides which observed variables a generated module
+computes (:func:`selected_observed`), and thus the module's cache key.
+"""
+
+from __future__ import annotations
+
+import difflib
+import re
+from collections.abc import Sequence
+
+from ..errors import SimulationError
+
+ALL_OBSERVED = "all"
+"""The selection of a module that computes every observed variable (no ``--vars``)."""
+
+
+def wildcard_match(pattern: str, name: str) -> bool:
+    """Whether ``name`` matches ``pattern`` (``*``: any run, ``?``: one character; no
+    other special characters, so ``x[1]`` is literal). Linear in the number of ``*``:
+    each segment between stars is found at its leftmost place, never backtracked."""
+    first, *middle = [_segment(part) for part in pattern.split("*")]
+    if not middle:
+        return first.fullmatch(name) is not None
+    last = middle.pop()
+    head = first.match(name)
+    if head is None:
+        return False
+    pos = head.end()
+    end = len(name) - (len(pattern.rsplit("*", 1)[1]))
+    if end < pos or last.fullmatch(name, end) is None:
+        return False
+    for segment in middle:
+        found = segment.search(name, pos, end)
+        if found is None:
+            return False
+        pos = found.end()
+    return True
+
+
+def _segment(text: str) -> re.Pattern[str]:
+    return re.compile("".join("." if c == "?" else re.escape(c) for c in text), re.DOTALL)
+
+
+def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> list[str]:
+    """``candidates`` matching any of ``patterns`` (all when ``None``), in model order."""
+    if patterns is None:
+        return list(candidates)
+    for text in patterns:
+        if not any(wildcard_match(text, c) for c in candidates):
+            close = difflib.get_close_matches(text, candidates, 3)
+            raise SimulationError(
+                f"--vars '{text}' matches no state or observed variable",
+                hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
+                      "use flat names such as 'mass.pos[1]', with * and ? as wildcards"))
+    return [c for c in candidates if any(wildcard_match(p, c) for p in patterns)]
+
+
+def selected_observed(names: tuple[tuple[str, ...], tuple[str, ...]],
+                      patterns: Sequence[str]) -> object:
+    """The observed variables ``patterns`` select (an error names a pattern that matches
+    nothing), or :data:`ALL_OBSERVED` when they select every one."""
+    states, observed = names
+    selected = set(select_names(states + observed, patterns))
+    chosen = tuple(n for n in observed if n in selected)
+    return ALL_OBSERVED if chosen == observed else chosen

@@ -1,0 +1,145 @@
+"""Plots that scale: which panels a result gets (quantities with legends, or families
+with heat maps and colour bars), copies drawn once, the note, and the drawn figure."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import springc
+from springc.cli import main
+from springc.simulation import SimulationResult
+from springc.simulation.plot_layout import (
+    HEATMAP,
+    LINES,
+    MAX_LEGEND,
+    Panel,
+    choose_layout,
+    copies_of,
+    families,
+)
+
+SCENES = str(Path(__file__).resolve().parents[2] / "models" / "Scenes.mdl")
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def cloth(tmp_path_factory: pytest.TempPathFactory) -> SimulationResult:
+    """The 4x4 cloth: 16 masses, 728 outputs, 411 of them copies of another."""
+    import os
+
+    os.environ.setdefault("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+    return springc.simulate(SCENES, model_name="Scenes.Cloth", parameters={"N": 4, "M": 4},
+                            stop=0.1, interval=0.01)
+
+
+def test_copies_are_equal_or_negated_columns_found_exactly() -> None:
+    t = np.linspace(0.0, 1.0, 7)
+    a, b = np.sin(3 * t), np.cos(t)
+    close = a.copy()
+    close[3] += 1e-15  # one ulp-sized difference: not a copy
+    values = np.column_stack([a, b, a, -a, close, np.zeros(7), -np.zeros(7), -b])
+    assert copies_of(values) == {2: (0, 1), 3: (0, -1), 6: (5, 1), 7: (1, -1)}
+    assert copies_of(values[:, :1]) == {}
+
+
+def test_families_strip_subscripts_and_keep_vector_components_apart() -> None:
+    names = ["p[1,1].pos[1]", "p[1,1].pos[2]", "p[1,2].pos[1]", "p[1,2].pos[2]",
+             "x[1]", "x[2]", "x[3]", "x[4]", "s[1].f", "s[2].f", "mass.pos[1]",
+             "mass.pos[2]"]
+    units = ["m"] * 4 + [""] * 4 + ["N", "N", "m", "m"]
+    assert families(names, units, range(len(names))) == [
+        ("p[:].pos[1]", [0, 2]), ("p[:].pos[2]", [1, 3]), ("x[:]", [4, 5, 6, 7]),
+        ("s[:].f", [8, 9]), ("mass.pos[:]", [10, 11])]
+
+
+def test_a_small_result_gets_one_panel_per_quantity_with_copies_in_the_legend() -> None:
+    t = np.linspace(0.0, 1.0, 5)
+    x = np.column_stack([t, t * t, 2 * t, -t, t + 1, t * t])
+    names = ["m.pos[1]", "m.pos[2]", "m.v[1]", "s.a.pos", "s.len", "s.b.pos"]
+    layout = choose_layout(names, ["m", "m", "m/s", "m", "m", "m"], x)
+    assert layout.panels == (
+        Panel(LINES, "position", "position [m]", (0, 1, 4),
+              ("m.pos[1] = -s.a.pos", "m.pos[2] = s.b.pos", "s.len")),
+        Panel(LINES, "velocity", "velocity [m/s]", (2,), ("m.v[1]",)))
+    assert layout.copies == {3: (0, -1), 5: (1, 1)}
+    assert layout.note == "2 copies (equal to another variable or its negative) drawn once"
+
+
+def test_a_quantity_of_more_than_a_legend_makes_family_panels() -> None:
+    n = MAX_LEGEND + 1
+    t = np.linspace(0.0, 1.0, 4)
+    names = [f"c[{i}].s" for i in range(1, n + 1)] + ["e", "f"]
+    values = np.column_stack([t * i for i in range(1, n + 1)] + [t ** 3, t ** 4])
+    layout = choose_layout(names, ["m"] * n + ["J", "J"], values)
+    assert layout.panels == (
+        Panel(HEATMAP, f"c[:].s: {n} variables, c[1].s (bottom) to c[{n}].s (top)",
+              "position [m]", tuple(range(n))),
+        Panel(LINES, "e (energy)", "energy [J]", (n,), ("e",)),
+        Panel(LINES, "f (energy)", "energy [J]", (n + 1,), ("f",)))
+    assert layout.note == (f"{n + 2} variables in 3 families; drawn: c[:].s (heat map), "
+                           "e (lines), f (lines)")
+
+
+def test_the_cloth_gets_heat_maps_of_positions_and_velocities(cloth: SimulationResult
+                                                             ) -> None:
+    layout = choose_layout(cloth.names, cloth.units, cloth.values)
+    assert [(p.kind, p.title, p.label) for p in layout.panels] == [
+        (HEATMAP, f"p[:].{q}: 16 variables, p[1,1].{q} (bottom) to p[4,4].{q} (top)", label)
+        for q, label in (("pos[1]", "position [m]"), ("pos[2]", "position [m]"),
+                         ("v[1]", "velocity [m/s]"), ("v[2]", "velocity [m/s]"))]
+    assert [cloth.names[c] for c in layout.panels[1].columns] == [
+        f"p[{i},{j}].pos[2]" for i in range(1, 5) for j in range(1, 5)]
+    assert layout.note == (
+        "728 variables in 26 families; drawn: p[:].pos[1] (heat map), p[:].pos[2] "
+        "(heat map), p[:].v[1] (heat map), p[:].v[2] (heat map); not drawn: 22 families "
+        "(253 variables), select them with --vars; 411 copies of another variable left out")
+    for copy, (original, sign) in layout.copies.items():
+        assert np.array_equal(cloth.values[:, copy], sign * cloth.values[:, original])
+    # an alias of a mass's position: the flange of the mass is the same point
+    flange = cloth.names.index("p[2,3].flange.pos[1]")
+    assert layout.copies[flange] == (cloth.names.index("p[2,3].pos[1]"), 1)
+
+
+def test_the_cloth_figure_has_colour_bars_and_the_note(cloth: SimulationResult) -> None:
+    figure = cloth.plot()
+    maps = [ax for ax in figure.axes if ax.images]
+    assert len(maps) == 4 and len(figure.axes) == 8  # a colour bar beside each map
+    image = maps[1].images[0].get_array()
+    assert image.shape == (16, len(cloth.time))
+    assert np.array_equal(image[5], cloth["p[2,2].pos[2]"])
+    bars = [ax for ax in figure.axes if not ax.images]
+    assert [ax.get_ylabel() for ax in bars] == ["position [m]", "position [m]",
+                                                "velocity [m/s]", "velocity [m/s]"]
+    assert figure.layout.note in " ".join(t.get_text() for t in figure.texts).replace(
+        "\n", " ")
+    assert figure.get_suptitle() == "Scenes.Cloth"
+
+
+def test_cli_plot_of_a_large_scene_says_what_it_drew(tmp_path: Path) -> None:
+    out = CliRunner().invoke(main, ["simulate", SCENES, "--model", "Scenes.Cloth",
+                                    "--set", "N=4", "--set", "M=4", "--stop", "0.1",
+                                    "--interval", "0.01", "--plot",
+                                    str(tmp_path / "cloth.png")])
+    assert out.exit_code == 0, out.stderr
+    assert out.stderr.splitlines()[0] == (
+        f"note: plot {tmp_path / 'cloth.png'}: 728 variables in 26 families; drawn: "
+        "p[:].pos[1] (heat map), p[:].pos[2] (heat map), p[:].v[1] (heat map), p[:].v[2] "
+        "(heat map); not drawn: 22 families (253 variables), select them with --vars; "
+        "411 copies of another variable left out")
+    assert (tmp_path / "cloth.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+
+
+def test_a_legend_entry_names_at_most_two_copies() -> None:
+    t = np.linspace(0.0, 1.0, 3)
+    values = np.column_stack([t, t, -t, t, t * t])
+    layout = choose_layout(["a", "b", "c", "d", "e"], [""] * 5, values)
+    assert layout.panels[0].labels == ("a = b = -c (+1 more)",)
+    assert layout.copies == {1: (0, 1), 2: (0, -1), 3: (0, 1)}
