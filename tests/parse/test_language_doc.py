@@ -26,7 +26,7 @@ def run(tmp_path: Path, source: str, *args: str) -> tuple[int, str, str]:
 
 
 def test_the_document_has_its_examples() -> None:
-    assert len(EXAMPLE.findall(DOC)) == 3
+    assert len(EXAMPLE.findall(DOC)) == 4
 
 
 @pytest.mark.parametrize("options, source, flat", EXAMPLE.findall(DOC))
@@ -46,8 +46,6 @@ REJECTED = {
         "2:3: error: `replaceable` is not supported yet",
     "model B\n  Real x = 1;\nend B;\nmodel M\n  B b(redeclare Real x = 2);\nend M;\n":
         "5:7: error: `redeclare` is not supported yet",
-    "model M\n  Real x;\nalgorithm\n  x := 1;\nend M;\n":
-        "3:1: error: `algorithm` sections outside functions are not supported yet",
     "model M\n  String s = \"a\";\n  Real x = 1;\nend M;\n":
         "2:3: error: the type `String` is not supported yet",
     "model M\n  type E = enumeration(a, b);\n  Real x = 1;\nend M;\n":

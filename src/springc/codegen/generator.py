@@ -25,6 +25,7 @@ from ..errors import CodegenError, Span
 from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
+from .assertions import assertion_function
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
 from .jacobian import jacobian_statements
 from .module_text import module_text, parameter_value, topological
@@ -117,6 +118,7 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     else:
         bodies, pattern = _scalar_bodies(m, outputs, namer, helpers, numba)
         table = None
+    bodies.append(assertion_function(m, namer, helpers, numba))
     structural = structural_parameters(system, flat_model)
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
                           table)

@@ -13,6 +13,8 @@ from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
+from .algorithms import Section, algorithm_section
+from .assertions import assertion
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
 from .loops import check_loop_nest
@@ -25,6 +27,7 @@ class EquationFlattening(FlattenContext):
     connections: ConnectionSets
     # Equation templates by (id of the ClassView, initial); None: not reusable.
     templates: dict[tuple[int, bool], Template | None]
+    algorithm_sections: list[Section]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
         """The equations of one instance; from the class's template when it has one."""
@@ -67,6 +70,13 @@ class EquationFlattening(FlattenContext):
                     self._body(body, where, owner, initial)
                     return
             self._body(eq.otherwise, where, owner, initial)
+        elif isinstance(eq, s.AlgorithmSection):
+            self.algorithm_sections.append(
+                algorithm_section(self, eq, where, owner, initial))
+        elif eq.call.func.dotted == "assert":
+            kind = "initial" if initial else "equation"
+            self.assertions.append(
+                assertion(self.evaluator, eq.call, where, flat.Origin(kind, owner.prefix)))
         else:
             name = eq.call.func.dotted
             raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,

@@ -13,10 +13,12 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
+from ..errors import ErrorGroup, FlattenError, FollowUpError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..parse import ClassTree
+from .algorithms import Section, apply_starts
+from .assertions import check_conditions, unique
 from .connections import ConnectionSets
 from .equations import EquationFlattening
 from .evaluate import Evaluator
@@ -48,6 +50,8 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.connections = ConnectionSets()
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
+        self.assertions: list[tuple[flat.Assertion, Span]] = []
+        self.algorithm_sections: list[Section] = []
         self.errors: list[SpringcError] = []
         self.mod_values = {}
         self.declared_types = {}
@@ -148,6 +152,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
             flattener.errors += binding_errors(variables, flattener.parameter_values)
+            apply_starts(flattener, flattener.algorithm_sections, variables)
+            flattener.errors += check_conditions(flattener.assertions, variables)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:
@@ -156,5 +162,6 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     flattener.equations += flattener.connections.equations(scopes, top)
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
-                          experiment_of(flattener, entry, top), entry.defn.span)
+                          experiment_of(flattener, entry, top), entry.defn.span,
+                          assertions=unique(flattener.assertions))
 

@@ -15,9 +15,11 @@ import numpy as np
 
 from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
+from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .assertions import assertion
 from .loops import check_loop_nest
 from .scope import ExpressionEvaluator, FunctionScope
 
@@ -92,46 +94,64 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
         scope.names[comp.name] = None
 
 
-def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: FunctionScope) -> None:
+def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: FunctionScope,
+         guard: x.Expr | None = None) -> None:
+    """Execute ``body``; ``guard``: the condition under which it runs (inside an ``if``
+    on a value known only at run time), for the assertions in it."""
     for stmt in body:
         if isinstance(stmt, s.Assign):
             _assign(ev, stmt, scope)
         elif isinstance(stmt, s.ForStatement):
-            _for(ev, stmt, stmt.indices, scope)
+            _for(ev, stmt, stmt.indices, scope, guard)
+        elif isinstance(stmt, s.CallStatement):
+            _call(ev, stmt, scope, guard)
         else:
-            _if(ev, stmt, scope)
+            _if(ev, stmt, scope, guard)
+
+
+def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
+          guard: x.Expr | None) -> None:
+    name = stmt.call.func.dotted
+    if name != "assert":
+        raise FlattenError(f"call statements (`{name}(...);`) are not supported yet",
+                           stmt.span, hint="springc supports a subset of Modelica; see "
+                           "\"Not supported yet\" in docs/language.md")
+    origin = flat.Origin("function", "", scope.entry.full_name)
+    ev.flattener.assertions.append(assertion(ev, stmt.call, scope, origin, guard))
 
 
 def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
-         scope: FunctionScope) -> None:
+         scope: FunctionScope, guard: x.Expr | None = None) -> None:
     index, rest = indices[0], indices[1:]
     values = ev.range_values(index, scope)
     ev.flattener.limits.add_iterations(len(values), index.span)
     for value in values:
         scope.names[index.name] = value
         if rest:
-            _for(ev, stmt, rest, scope)
+            _for(ev, stmt, rest, scope, guard)
         else:
-            _run(ev, stmt.body, scope)
+            _run(ev, stmt.body, scope, guard)
     scope.names.pop(index.name, None)
 
 
-def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope) -> None:
+def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
+        guard: x.Expr | None = None) -> None:
     branches = list(stmt.branches)
     if not branches:
-        _run(ev, stmt.otherwise, scope)
+        _run(ev, stmt.otherwise, scope, guard)
         return
     cond_expr, body = branches[0]
     cond = ev.scalar(cond_expr, scope)
     rest = s.IfStatement(tuple(branches[1:]), stmt.otherwise, stmt.span)
     if isinstance(cond, x.Const):
-        _run(ev, body, scope) if cond.value else _if(ev, rest, scope)
+        _run(ev, body, scope, guard) if cond.value else _if(ev, rest, scope, guard)
         return
     before = dict(scope.names)
-    _run(ev, body, scope)
+    _run(ev, body, scope, cond if guard is None else x.BinOp("and", guard, cond))
     then_names = scope.names
     scope.names = dict(before)
-    _if(ev, rest, scope)
+    not_cond = x.Not(cond)
+    _if(ev, rest, scope, not_cond if guard is None else x.BinOp("and", guard, not_cond))
     for name, then_value in then_names.items():
         other = scope.names.get(name)
         if then_value is other or name not in before:

@@ -253,6 +253,8 @@ class ExpressionEvaluator(Protocol):
 
     def fold(self, v: a.Value) -> Any: ...
 
+    def describe(self, v: Any) -> str: ...
+
     def reference(self, e: s.Ref, scope: Scope) -> Any: ...
 
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
@@ -272,6 +274,8 @@ class FlattenContext(Protocol):
     errors: list[SpringcError]
     equations: list[flat.Equation]
     initial_equations: list[flat.Equation]
+    # assertions and the spans of their conditions (flatten/assertions.py)
+    assertions: list[tuple[flat.Assertion, Span]]
     attribute_cache: AttributeCache
     reusable_views: dict[int, bool]
 

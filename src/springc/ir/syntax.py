@@ -289,7 +289,16 @@ class CallEquation:
     span: Span
 
 
-Equation = Equality | Connect | ForEquation | IfEquation | CallEquation
+@dataclass(frozen=True, slots=True)
+class AlgorithmSection:
+    """An ``algorithm`` (or ``initial algorithm``) section of a model or block, kept
+    among the class's (initial) equations in order; section 11.1 of the specification."""
+
+    body: tuple[Statement, ...]
+    span: Span
+
+
+Equation = Equality | Connect | ForEquation | IfEquation | CallEquation | AlgorithmSection
 
 # ----------------------------------------------------------------- statements
 
@@ -317,7 +326,15 @@ class ForStatement:
     span: Span
 
 
-Statement = Assign | IfStatement | ForStatement
+@dataclass(frozen=True, slots=True)
+class CallStatement:
+    """A call standing as a statement, such as ``assert(...)``."""
+
+    call: Call
+    span: Span
+
+
+Statement = Assign | IfStatement | ForStatement | CallStatement
 
 # -------------------------------------------------------------------- classes
 

@@ -17,6 +17,7 @@ from ..ir.syntax import (
     Assign,
     Call,
     CallEquation,
+    CallStatement,
     Connect,
     Equality,
     ForEquation,
@@ -102,8 +103,10 @@ class EquationRules(RuleBase):
     def assign_statement(self, meta: Meta, ch: list[Any]) -> Assign:
         return Assign((ch[0],), ch[1], self.span_of(meta))
 
-    def call_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("call statements (`f(x);`) are", self.span_of(meta))
+    def call_statement(self, meta: Meta, ch: list[Any]) -> CallStatement:
+        func, args = ch
+        span = self.span_of(meta)
+        return CallStatement(Call(func, args.args, args.named, span), span)
 
     def multi_assign(self, meta: Meta, ch: list[Any]) -> Assign:
         *targets, func, args = ch

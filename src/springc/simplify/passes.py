@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from ..errors import Note
 from ..ir import flat, ode
 from .alias import eliminate_aliases
+from .assertions import simplified_assertions
 from .balance import check_balance, dae_incidence
 from .causalize import causalize
 from .index_reduction import DummyBlock, index_reduce
@@ -74,6 +75,7 @@ def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplifi
                                 u.nominal if u else None, u.unit if u else None,
                                 u.span if u else model.span))
     observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
+    assertions = simplified_assertions(model.assertions, system, aliased.aliases)
     result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
-                     aliased.dae.parameters, aliased.dae)
+                     aliased.dae.parameters, aliased.dae, assertions)
     return Simplified(result, aliased.warnings, reduced.blocks)

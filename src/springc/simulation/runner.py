@@ -198,6 +198,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 raise Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
+            if problem.asserts:
+                problem.asserts.start(start, x0, problem.z)
             reason = ""
             compiled = engine == COMPILED
             finish = finish_dop853 if compiled else None
@@ -219,6 +221,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 run = integrate(problem, grid, x0, rtol, atol, finish)
                 states, steps, loop_time = run.states, run.steps, run.loop_time
                 compiled = compiled and len(x0) > 0
+            if problem.asserts and (compiled or not len(x0)):
+                problem.asserts.grid(grid, states, problem.z)
             outputs = _outputs(model, problem, grid, states)
     except Stop as stop_:
         raise stop_.error from None
