@@ -80,7 +80,10 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
     if comp.causality == "input":
         raise FlattenError(f"input '{comp.name}' is missing in this call", call.span,
                            [Note("declared here", comp.span)])
-    dims = [d for d in comp.type_dims + comp.dims]
+    dims = [d for d in comp.dims + comp.type_dims]
+    if any(isinstance(d, s.Colon) for d in dims):
+        scope.names[comp.name] = None  # sized by its first assignment
+        return
     if dims:
         sizes = tuple(ev.integer(d, scope, "an array size") for d in dims)
         if any(n < 0 for n in sizes):
