@@ -506,8 +506,6 @@ UNSUPPORTED = [
     ("model A extends B; end A; model extends A end A;", "`class extends` definitions are"),
     ("operator record R end R;", "`operator` classes are"),
     ("impure function f end f;", "`impure` functions are"),
-    ("model A equation (a, b) = f(x); end A;",
-     "output lists (`(a, b)`) outside `(a, b) := f(x)` are"),
     ("model A Real x = (y)[1]; end A;", "subscripts on a parenthesized expression (`(e)[i]`) are"),
     ("model A .B b; end A;", "global names (`.A.B`) are"),
     ("model A Real x := 1; end A;", "`:=` in a declaration is"),

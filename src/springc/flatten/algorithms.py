@@ -25,7 +25,9 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion
+from .functions import multiple_outputs
 from .loops import check_loop_nest
+from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
@@ -64,11 +66,18 @@ class _Run:
                 self.call(stmt, where, guard)
 
     def assign(self, stmt: s.Assign, where: Scope) -> None:
-        if len(stmt.targets) != 1 or stmt.targets[0] is None:
-            raise FlattenError("assignments to several outputs are not supported yet in "
-                               "algorithm sections", stmt.span)
+        if len(stmt.targets) > 1:
+            values = multiple_outputs(self.ev, stmt.targets, stmt.value, where)
+            for target, value in zip(stmt.targets, values):
+                if target is not None:
+                    self.store(target, self.read(value, stmt.value.span), stmt, where)
+            return
         target = stmt.targets[0]
-        value = self.read(self.ev.value(stmt.value, where), stmt.value.span)
+        assert target is not None
+        self.store(target, self.read(self.ev.value(stmt.value, where), stmt.value.span),
+                   stmt, where)
+
+    def store(self, target: s.Ref, value: a.Value, stmt: s.Assign, where: Scope) -> None:
         names = self.ev.value(target, where)
         if a.shape(names) != a.shape(value):
             raise FlattenError(
@@ -110,7 +119,7 @@ class _Run:
 
     def for_(self, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...], where: Scope,
              guard: x.Expr | None) -> None:
-        index, rest = indices[0], indices[1:]
+        index, rest = with_range(self.ev, indices[0], stmt.body, where), indices[1:]
         values = self.ev.range_values(index, where)
         self.fl.limits.add_iterations(len(values), index.span)
         for value in values:

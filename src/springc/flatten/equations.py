@@ -17,7 +17,9 @@ from .algorithms import Section, algorithm_section
 from .assertions import assertion
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
+from .functions import multiple_outputs
 from .loops import check_loop_nest
+from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
@@ -108,7 +110,7 @@ class EquationFlattening(FlattenContext):
 
     def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Scope,
              owner: ClassScope, initial: bool) -> None:
-        index, rest = indices[0], indices[1:]
+        index, rest = with_range(self.evaluator, indices[0], eq.body, where), indices[1:]
         values = self.evaluator.range_values(index, where)
         self.limits.add_iterations(len(values), index.span)
         for value in values:
@@ -119,8 +121,18 @@ class EquationFlattening(FlattenContext):
                 self._body(eq.body, local, owner, initial)
 
     def _equality(self, eq: s.Equality, where: Scope, owner: ClassScope, initial: bool) -> None:
+        if isinstance(eq.lhs, s.Tuple):
+            outputs = multiple_outputs(self.evaluator, eq.lhs.items, eq.rhs, where)
+            for item, value in zip(eq.lhs.items, outputs):
+                if item is not None:
+                    self._sides(eq, self.evaluator.value(item, where), value, owner, initial)
+            return
         lhs = self.evaluator.value(eq.lhs, where)
         rhs = self.evaluator.value(eq.rhs, where)
+        self._sides(eq, lhs, rhs, owner, initial)
+
+    def _sides(self, eq: s.Equality, lhs: a.Value, rhs: a.Value, owner: ClassScope,
+               initial: bool) -> None:
         if a.shape(lhs) != a.shape(rhs):
             raise FlattenError(
                 f"the two sides of this equation differ in size: "

@@ -22,8 +22,9 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
-from .functions import call_function
+from .functions import call_function, function_of
 from .parameters import check_powers
+from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
@@ -162,6 +163,10 @@ class Evaluator:
 
     def _Colon(self, e: s.Colon, scope: Scope) -> a.Value:
         raise FlattenError("':' is only allowed as a subscript", e.span)
+
+    def _Tuple(self, e: s.Tuple, scope: Scope) -> a.Value:
+        raise FlattenError("an output list (`(a, b)`) is only allowed on the left of "
+                           "`(a, b) = f(x)` or `(a, b) := f(x)`", e.span)
 
     def _End(self, e: s.End, scope: Scope) -> a.Value:
         end = scope.end_value if isinstance(scope, LocalScope) else None
@@ -359,7 +364,7 @@ class Evaluator:
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
-        entry = self.flattener.resolve_function(e.func, scope)
+        entry = function_of(self, e.func, scope)
         args = [self.value(arg, scope) for arg in e.args]
         named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
         return call_function(self, entry, args, named, e)
@@ -370,6 +375,7 @@ class Evaluator:
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
                 ) -> Iterator[a.Value]:
         """Values of ``body`` for every combination of the iterators (first outermost)."""
+        indices = tuple(with_range(self, i, body, scope) for i in indices)
         ranges = [self.range_values(i, scope) for i in indices]
         self.flattener.limits.add_iterations(math.prod(len(r) for r in ranges),
                                              indices[0].span)

@@ -10,6 +10,7 @@ function calls besides the scalar built-ins.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -17,17 +18,21 @@ from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from ..parse import ClassEntry
+from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
 from .assertions import assertion
 from .loops import check_loop_nest
-from .scope import ExpressionEvaluator, FunctionScope
+from .ranges import with_range
+from .scope import ClassScope, ExpressionEvaluator, FunctionScope, Scope
 
 MAX_DEPTH = 50
 
 
 def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
-                  named: dict[str, tuple[a.Value, Span]], call: s.Call) -> a.Value:
+                  named: dict[str, tuple[a.Value, Span]], call: s.Call,
+                  count: int = 1) -> a.Value:
+    """The value of the call's first output (``count`` > 1: a list of the first
+    ``count`` outputs, for ``(a, b) := f(x)``)."""
     depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
@@ -59,13 +64,56 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
             if isinstance(stmt, s.ForStatement):
                 check_loop_nest(ev, stmt, scope)
         _run(ev, entry.defn.algorithm, scope)
-        result: a.Value | None = scope.names[outputs[0].name]
     finally:
         ev.call_depth = depth
-    if result is None:
-        raise FlattenError(f"output '{outputs[0].name}' of '{entry.full_name}' is never "
-                           "assigned", call.span, [Note("declared here", outputs[0].span)])
-    return result
+    if count > len(outputs):
+        raise FlattenError(f"'{entry.full_name}' has {len(outputs)} output(s), "
+                           f"{count} are used", call.span,
+                           [Note("function defined here", entry.defn.span)])
+    results: list[a.Value] = []
+    for output in outputs[:count]:
+        result: a.Value | None = scope.names[output.name]
+        if result is None:
+            raise FlattenError(f"output '{output.name}' of '{entry.full_name}' is never "
+                               "assigned", call.span, [Note("declared here", output.span)])
+        results.append(result)
+    if count == 1:
+        return results[0]
+    return results  # type: ignore[return-value]
+
+
+def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry:
+    """The function a call names: a class, or ``a.f`` with ``a`` a scalar component
+    whose class declares the function ``f`` (section 5.3.2)."""
+    if len(ref.parts) > 1 and lookup_class(ref.parts[0].name, scope.entry) is None:
+        owner = ev.reference(s.Ref(ref.parts[:-1], ref.span), scope)
+        if isinstance(owner, ClassScope):
+            found = member_class(owner.entry, ref.parts[-1].name)
+            if found is None or found.defn.kind != "function":
+                raise FlattenError(f"'{owner.entry.full_name}' (the class of "
+                                   f"'{owner.prefix}') has no function "
+                                   f"'{ref.parts[-1].name}'", ref.span)
+            return found
+    return ev.flattener.resolve_function(ref, scope)
+
+
+def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int
+                 ) -> list[a.Value]:
+    """The first ``count`` outputs of a call of a user-defined function."""
+    entry = function_of(ev, call.func, scope)
+    args = [ev.value(arg, scope) for arg in call.args]
+    named = {n.name: (ev.value(n.value, scope), n.span) for n in call.named}
+    values = call_function(ev, entry, args, named, call, count)
+    return values if count > 1 else [values]  # type: ignore[return-value]
+
+
+def multiple_outputs(ev: ExpressionEvaluator, targets: Sequence[object], value: s.Expr,
+                     scope: Scope) -> list[a.Value]:
+    """The outputs of ``value`` for ``(a, b) := f(x)``: ``value`` must be a call."""
+    if not isinstance(value, s.Call):
+        raise FlattenError("several outputs need a function call on the right-hand side",
+                           value.span, hint="write (a, b) := f(x)")
+    return call_outputs(ev, value, scope, len(targets))
 
 
 def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
@@ -125,7 +173,7 @@ def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
 
 def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...],
          scope: FunctionScope, guard: x.Expr | None = None) -> None:
-    index, rest = indices[0], indices[1:]
+    index, rest = with_range(ev, indices[0], stmt.body, scope), indices[1:]
     values = ev.range_values(index, scope)
     ev.flattener.limits.add_iterations(len(values), index.span)
     for value in values:
@@ -166,10 +214,19 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
 
 
 def _assign(ev: ExpressionEvaluator, stmt: s.Assign, scope: FunctionScope) -> None:
-    if len(stmt.targets) != 1 or stmt.targets[0] is None:
-        raise FlattenError("assignments to several outputs are not supported yet", stmt.span)
+    if len(stmt.targets) > 1:
+        values = multiple_outputs(ev, stmt.targets, stmt.value, scope)
+        for target, value in zip(stmt.targets, values):
+            if target is not None:
+                _store(ev, target, value, stmt, scope)
+        return
     target = stmt.targets[0]
-    value = ev.value(stmt.value, scope)
+    assert target is not None
+    _store(ev, target, ev.value(stmt.value, scope), stmt, scope)
+
+
+def _store(ev: ExpressionEvaluator, target: s.Ref, value: a.Value, stmt: s.Assign,
+           scope: FunctionScope) -> None:
     part = target.parts[0]
     if len(target.parts) > 1 or part.name not in scope.names:
         raise FlattenError(f"'{target.dotted}' is not a variable of this function",

@@ -159,9 +159,17 @@ class Range:
     span: Span
 
 
+@dataclass(frozen=True, slots=True)
+class Tuple:
+    """``(a, , c)``: the output list on the left of ``(a, b) = f(x)`` (``None``: a gap)."""
+
+    items: tuple[Expr | None, ...]
+    span: Span
+
+
 Expr = (
     Number | Bool | String | Ref | Colon | End | Unary | Binary | IfExpr | Call
-    | Comprehension | ArrayLit | MatrixLit | Range
+    | Comprehension | ArrayLit | MatrixLit | Range | Tuple
 )
 
 # -------------------------------------------------------------- modifications
