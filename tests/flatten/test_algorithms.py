@@ -129,7 +129,50 @@ algorithm
   y := 1;
   print("a");
 end M;
-""") == "5:3: call statements (`print(...);`) are not supported yet"
+""") == "5:3: `print` is not supported yet as a statement"
+
+
+def test_calls_for_effect_keep_function_assertions_under_their_branch(tmp_path: Path
+                                                                      ) -> None:
+    m = flat_of(tmp_path, """model M
+  function f
+    input Real u;
+    output Boolean b;
+  algorithm
+    assert(u < 10, "u too large");
+    b := true;
+  end f;
+  function msg
+    output String s;
+  algorithm
+    assert(false, "never: the message is evaluated only on failure");
+    s := "m";
+  end msg;
+  parameter Integer i = 4;
+  Real x;
+  Real y = time;
+equation
+  f(y);
+algorithm
+  assert(true, msg());
+  if i == 4 then
+    x := 3;
+  elseif f(2 * y) then
+    x := 4;
+  end if;
+  assert(x > 2, "x = " + String(x));
+end M;
+""")
+    # f(2 * y) is true: the elseif branch is taken where i <> 4
+    assert equations(m)[1:] == ["x = if i == 4 then 3 else 4"]
+    assert asserts(m) == [
+        ("y < 10", "u too large", "error"),
+        # msg()'s own assertion is not the model's (8.3.7)
+        ("true", "m", "error"),
+        # f(2 * y) is evaluated only where i <> 4 (11.2.6)
+        ("if not i == 4 then 2 * y < 10 else true", "u too large", "error"),
+        # String(x) reads the value assigned so far
+        ("(if i == 4 then 3 else 4) > 2", "x = 3", "error")]
 
 
 def test_asserts_as_equation_statement_and_in_functions(tmp_path: Path) -> None:

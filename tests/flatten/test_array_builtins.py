@@ -30,6 +30,17 @@ def rhs(tmp_path: Path, declaration: str) -> list[str]:
     return [x.to_text(e.rhs) for e in m.equations[3:]]
 
 
+def parameter_values(m: FlatModel) -> dict[str, object]:
+    """Every parameter's value through the bindings of the others."""
+    bindings = {v.name: v.binding for v in m.parameters if v.binding is not None}
+    values: dict[str, object] = {}
+    while len(values) < len(bindings):
+        for name, binding in bindings.items():
+            if name not in values and x.variables(binding) <= values.keys():
+                values[name] = x.evaluate(binding, values)
+    return values
+
+
 def error_of(tmp_path: Path, body: str) -> str:
     with pytest.raises((SpringcError, ErrorGroup)) as info:
         flat_of(tmp_path, body)
@@ -95,3 +106,34 @@ def test_colon_dimensions_of_parameters_and_matrices(tmp_path: Path) -> None:
 ])
 def test_misuse_is_located(tmp_path: Path, body: str, message: str) -> None:
     assert error_of(tmp_path, body) == message
+
+
+def test_symmetric_block_subscripts_and_logical_arrays(tmp_path: Path) -> None:
+    m = flat_of(tmp_path, "  parameter Integer x[3, 3] = [1, 2, 3; 4, 5, 6; 7, 8, 9];\n"
+                          "  parameter Integer y[:, :] = x[2:3, 1:2];\n"
+                          "  parameter Integer s[3, 3] = symmetric(x);\n"
+                          "  parameter Boolean b[2] = {true, false} and {true, true};\n")
+    values = parameter_values(m)
+    assert [values[f"y[{i},{j}]"] for i in (1, 2) for j in (1, 2)] == [4, 5, 7, 8]
+    assert [values[f"s[{i},{j}]"] for i in (1, 2, 3) for j in (1, 2, 3)] == \
+        [1, 2, 3, 2, 5, 6, 3, 6, 9]
+    assert [values["b[1]"], values["b[2]"]] == [True, False]
+
+
+def test_flexible_function_output_grows_by_cat(tmp_path: Path) -> None:
+    m = flat_of(tmp_path, """  function positive
+    input Integer u[:];
+    output Integer p[:];
+  algorithm
+    for i in 1:size(u, 1) loop
+      if u[i] > 0 then
+        p := cat(1, p, u[i:i]);
+      end if;
+    end for;
+  end positive;
+  parameter Integer a[:] = {-2, 1, 0, -1, 2};
+  parameter Integer q[:] = positive(a);
+""")
+    assert [v.name for v in m.parameters][-2:] == ["q[1]", "q[2]"]
+    values = parameter_values(m)
+    assert [values["q[1]"], values["q[2]"]] == [1, 2]

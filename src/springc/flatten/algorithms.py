@@ -25,7 +25,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion
-from .functions import multiple_outputs
+from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
@@ -54,16 +54,33 @@ class _Run:
         env = self.env
         return a.elementwise(lambda e: x.substitute(e, env) if env else e, value)
 
+    def guard_new(self, start: int, guard: x.Expr | None) -> None:
+        """Make the assertions of inlined functions recorded since ``start`` hold
+        where ``guard`` is false (they are evaluated only where it is true)."""
+        if guard is None:
+            return
+        for i in range(start, len(self.fl.assertions)):
+            item, span = self.fl.assertions[i]
+            if item.origin.kind == "function":
+                self.fl.assertions[i] = (
+                    _with_condition(item, x.If(guard, item.condition, x.Const(True))), span)
+
     def run(self, body: tuple[s.Statement, ...], where: Scope, guard: x.Expr | None) -> None:
         for stmt in body:
-            if isinstance(stmt, s.Assign):
-                self.assign(stmt, where)
-            elif isinstance(stmt, s.IfStatement):
-                self.if_(stmt.branches, stmt.otherwise, where, guard)
-            elif isinstance(stmt, s.ForStatement):
-                self.for_(stmt, stmt.indices, where, guard)
-            else:
-                self.call(stmt, where, guard)
+            start = len(self.fl.assertions)
+            self.statement(stmt, where, guard)
+            if not isinstance(stmt, s.IfStatement):
+                self.guard_new(start, guard)
+
+    def statement(self, stmt: s.Statement, where: Scope, guard: x.Expr | None) -> None:
+        if isinstance(stmt, s.Assign):
+            self.assign(stmt, where)
+        elif isinstance(stmt, s.IfStatement):
+            self.if_(stmt.branches, stmt.otherwise, where, guard)
+        elif isinstance(stmt, s.ForStatement):
+            self.for_(stmt, stmt.indices, where, guard)
+        else:
+            self.call(stmt, where, guard)
 
     def assign(self, stmt: s.Assign, where: Scope) -> None:
         if len(stmt.targets) > 1:
@@ -97,7 +114,9 @@ class _Run:
             self.run(otherwise, where, guard)
             return
         (cond_expr, body), rest = branches[0], branches[1:]
+        start = len(self.fl.assertions)
         cond = self.read(self.ev.scalar(cond_expr, where), cond_expr.span)
+        self.guard_new(start, guard)
         assert not isinstance(cond, (str, np.ndarray))
         if isinstance(cond, x.Const):
             if cond.value:
@@ -130,13 +149,12 @@ class _Run:
                 self.run(stmt.body, local, guard)
 
     def call(self, stmt: s.CallStatement, where: Scope, guard: x.Expr | None) -> None:
-        name = stmt.call.func.dotted
-        if name != "assert":
-            raise FlattenError(f"call statements (`{name}(...);`) are not supported yet",
-                               stmt.span, hint="springc supports a subset of Modelica; see "
-                               "\"Not supported yet\" in docs/language.md")
+        if stmt.call.func.dotted != "assert":
+            call_for_effect(self.ev, stmt.call, where, "a statement")
+            return
         origin = flat.Origin("algorithm", self.owner.prefix)
-        item, span = assertion(self.ev, stmt.call, where, origin, guard)
+        item, span = assertion(self.ev, stmt.call, where, origin, guard,
+                               lambda v: self.read(v, stmt.span))
         condition = cast(x.Expr, self.read(item.condition, span))
         self.fl.assertions.append((_with_condition(item, condition), span))
 

@@ -1,6 +1,6 @@
 """Array built-ins of chapter 10 beyond the basic ones of :mod:`.builtins`: ``cat``
-(10.4.2), ``matrix`` (10.3.1), ``outerProduct``, ``skew``, ``diagonal`` and
-``linspace`` (10.3), and the scalar ``semiLinear`` (3.7.4), vectorised.
+(10.4.2), ``matrix`` (10.3.1), ``outerProduct``, ``skew``, ``symmetric``,
+``diagonal`` and ``linspace`` (10.3), and the scalar ``semiLinear`` (3.7.4), vectorised.
 
 ``semiLinear(x, k1, k2)`` is ``smooth(0, if x >= 0 then k1*x else k2*x)``: continuous
 across ``x = 0``, so its switch generates no event (section 3.7.4.4 lets a tool skip
@@ -24,8 +24,8 @@ class ArrayBuiltins:
 
     def table(self) -> dict[str, Handler]:
         return {"cat": self.cat, "matrix": self.matrix, "outerProduct": self.outer_product,
-                "skew": self.skew, "diagonal": self.diagonal, "linspace": self.linspace,
-                "semiLinear": self.semi_linear}
+                "skew": self.skew, "diagonal": self.diagonal, "symmetric": self.symmetric,
+                "linspace": self.linspace, "semiLinear": self.semi_linear}
 
     def _args(self, call: s.Call, count: int, scope: Scope) -> list[a.Value]:
         name = call.func.dotted
@@ -97,6 +97,17 @@ class ArrayBuiltins:
         zero = x.ZERO
         return a.make_array([zero, x.neg(w[2]), w[1], w[2], zero, x.neg(w[0]),
                              x.neg(w[1]), w[0], zero], (3, 3))
+
+    def symmetric(self, call: s.Call, scope: Scope) -> a.Value:
+        """The upper triangle of a square matrix mirrored below the diagonal."""
+        (v,) = self._args(call, 1, scope)
+        m = self._array(call, v, 2, 0)
+        n = m.shape[0]
+        if m.shape != (n, n):
+            raise FlattenError(f"'symmetric' needs a square matrix, found "
+                               f"{a.describe_shape(m.shape)}", call.args[0].span)
+        return a.make_array([m[min(i, j), max(i, j)] for i in range(n) for j in range(n)],
+                            (n, n))
 
     def diagonal(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, 1, scope)

@@ -11,6 +11,7 @@ condition is Boolean is checked once the variables' types are known
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -27,12 +28,15 @@ _PARAMETERS = ("condition", "message", "level")
 
 #: An assertion and the span of its condition, for the Boolean check.
 Pending = tuple[flat.Assertion, Span]
+#: Maps an evaluated value to the one an algorithm section reads (its assignments so far).
+Read = Callable[[a.Value], a.Value]
 
 
 def assertion(ev: ExpressionEvaluator, call: s.Call, scope: Scope, origin: flat.Origin,
-              guard: x.Expr | None = None) -> Pending:
+              guard: x.Expr | None = None, read: Read | None = None) -> Pending:
     """The assertion of ``call`` evaluated in ``scope``; ``guard`` (the condition of
-    the branches it sits in, inside an inlined function) makes it ``not guard or c``."""
+    the branches it sits in, inside an inlined function) makes it ``not guard or c``;
+    ``read`` maps values to those an algorithm section has assigned so far."""
     args = _arguments(call)
     cond_expr = args.get("condition")
     message_expr = args.get("message")
@@ -52,7 +56,11 @@ def assertion(ev: ExpressionEvaluator, call: s.Call, scope: Scope, origin: flat.
     condition: x.Expr = value  # type: ignore[assignment]
     if guard is not None:
         condition = x.If(guard, condition, x.Const(True))
-    message = message_text(ev, message_expr, scope)
+    # the message is evaluated only where the condition fails (8.3.7): the
+    # assertions of functions it calls are not the model's
+    recorded = list(ev.flattener.assertions)
+    message = message_text(ev, message_expr, scope, read)
+    ev.flattener.assertions[:] = recorded
     level = _level(args.get("level"))
     return flat.Assertion(condition, message, level, call.span, origin), cond_expr.span
 
@@ -84,15 +92,16 @@ def _level(e: s.Expr | None) -> str:
     return level
 
 
-def message_text(ev: ExpressionEvaluator, e: s.Expr, scope: Scope) -> str:
+def message_text(ev: ExpressionEvaluator, e: s.Expr, scope: Scope,
+                 read: Read | None = None) -> str:
     """The text of a String expression: literals, ``+`` and ``String(e)`` of values
     known before the simulation (constants and parameters)."""
     if isinstance(e, s.String):
         return e.value
     if isinstance(e, s.Binary) and e.op == "+":
-        return message_text(ev, e.left, scope) + message_text(ev, e.right, scope)
+        return message_text(ev, e.left, scope, read) + message_text(ev, e.right, scope, read)
     if isinstance(e, s.Call) and e.func.dotted == "String":
-        return _string_of(ev, e, scope)
+        return _string_of(ev, e, scope, read)
     value = ev.value(e, scope)
     if isinstance(value, str):
         return value
@@ -101,15 +110,22 @@ def message_text(ev: ExpressionEvaluator, e: s.Expr, scope: Scope) -> str:
                        hint="write a string literal, e.g. \"x must be positive\"")
 
 
-def _string_of(ev: ExpressionEvaluator, call: s.Call, scope: Scope) -> str:
+def _string_of(ev: ExpressionEvaluator, call: s.Call, scope: Scope,
+               read: Read | None) -> str:
     """``String(e)`` (section 3.7.5) of a value known before the simulation."""
     if len(call.args) != 1:
         raise FlattenError(f"'String' takes 1 positional argument, {len(call.args)} given",
                            call.span)
     options = {n.name: ev.constant(n.value, scope, f"'{n.name}'") for n in call.named}
-    value = ev.constant(call.args[0], scope, "the argument of 'String' in a message",
-                        hint="messages that show time-varying values are not supported "
-                             "yet; show parameters and constants only")
+    arg = ev.value(call.args[0], scope)
+    try:
+        value = ev.fold(read(arg) if read is not None else arg)
+    except KeyError as missing:
+        raise FlattenError(f"the argument of 'String' in a message must be a parameter "
+                           f"expression, but it depends on {missing.args[0]}",
+                           call.args[0].span, hint="messages that show time-varying values "
+                           "are not supported yet; show parameters and constants only"
+                           ) from None
     if isinstance(value, np.ndarray):
         raise FlattenError("'String' of an array is not defined", call.args[0].span)
     if isinstance(value, str):

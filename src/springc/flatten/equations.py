@@ -17,7 +17,7 @@ from .algorithms import Section, algorithm_section
 from .assertions import assertion
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
-from .functions import multiple_outputs
+from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
@@ -80,10 +80,7 @@ class EquationFlattening(FlattenContext):
             self.assertions.append(
                 assertion(self.evaluator, eq.call, where, flat.Origin(kind, owner.prefix)))
         else:
-            name = eq.call.func.dotted
-            raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
-                               hint="springc supports a subset of Modelica; see "
-                               "\"Not supported yet\" in docs/language.md")
+            call_for_effect(self.evaluator, eq.call, where, "an equation")
 
     def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression

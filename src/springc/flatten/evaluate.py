@@ -214,6 +214,8 @@ class Evaluator:
                 return a.power(left, right)
             if op.startswith("."):
                 return a.elementwise(a.scalar_op(op[1:]), left, right)
+            if op in ("and", "or") and (a.is_array(left) or a.is_array(right)):
+                return a.elementwise(a.scalar_op(op), left, right)  # section 10.6.9
             if a.is_array(left) or a.is_array(right):
                 raise ValueError(f"'{op}' needs scalar operands")
         except ValueError as err:
@@ -310,7 +312,15 @@ class Evaluator:
                                f"{len(part.subscripts)} subscript(s) are given", part.span)
         index = tuple(self._index(sub, dims[k], scope, part)
                       for k, sub in enumerate(part.subscripts))
-        result = value[index]
+        if sum(isinstance(i, np.ndarray) for i in index) > 1:
+            # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
+            # element pairs: take them one dimension at a time
+            result = value
+            for axis in reversed(range(len(index))):
+                if not isinstance(index[axis], slice):
+                    result = np.take(result, index[axis], axis=axis)
+        else:
+            result = value[index]
         if isinstance(result, np.ndarray) and result.ndim == 0:
             return result.item()
         return result

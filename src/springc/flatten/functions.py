@@ -41,7 +41,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     comps = [c.decl for c in view.components.values()]
     inputs = [c for c in comps if c.causality == "input"]
     outputs = [c for c in comps if c.causality == "output"]
-    if not outputs:
+    if not outputs and count:
         raise FlattenError(f"function '{entry.full_name}' has no output", call.span)
     if len(args) > len(inputs):
         raise FlattenError(f"'{entry.full_name}' takes {len(inputs)} input(s), "
@@ -79,20 +79,29 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         results.append(result)
     if count == 1:
         return results[0]
-    return results  # type: ignore[return-value]
+    return results  # type: ignore[return-value]  # a list only for count != 1
 
 
 def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry:
     """The function a call names: a class, or ``a.f`` with ``a`` a scalar component
     whose class declares the function ``f`` (section 5.3.2)."""
     if len(ref.parts) > 1 and lookup_class(ref.parts[0].name, scope.entry) is None:
-        owner = ev.reference(s.Ref(ref.parts[:-1], ref.span), scope)
+        owner: object = None
+        k = len(ref.parts) - 1
+        while k > 0:  # the longest prefix that is a component: a.B.C.f
+            try:
+                owner = ev.reference(s.Ref(ref.parts[:k], ref.span), scope)
+                break
+            except FlattenError:
+                k -= 1
         if isinstance(owner, ClassScope):
-            found = member_class(owner.entry, ref.parts[-1].name)
+            found: ClassEntry | None = owner.entry
+            for part in ref.parts[k:]:
+                found = member_class(found, part.name) if found is not None else None
             if found is None or found.defn.kind != "function":
                 raise FlattenError(f"'{owner.entry.full_name}' (the class of "
                                    f"'{owner.prefix}') has no function "
-                                   f"'{ref.parts[-1].name}'", ref.span)
+                                   f"'{'.'.join(p.name for p in ref.parts[k:])}'", ref.span)
             return found
     return ev.flattener.resolve_function(ref, scope)
 
@@ -105,6 +114,21 @@ def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int
     named = {n.name: (ev.value(n.value, scope), n.span) for n in call.named}
     values = call_function(ev, entry, args, named, call, count)
     return values if count > 1 else [values]  # type: ignore[return-value]
+
+
+#: Built-in calls that may stand alone but are not supported yet (events).
+STANDALONE_BUILTINS = frozenset({"terminate", "reinit", "print"})
+
+
+def call_for_effect(ev: ExpressionEvaluator, call: s.Call, scope: Scope, what: str) -> None:
+    """A call standing as an equation or statement (``f(x);``, section 12.4.7): its
+    results are dropped, the assertions of the inlined function are kept."""
+    name = call.func.dotted
+    if ev.builtins.lookup(name, scope) is not None or name in STANDALONE_BUILTINS:
+        raise FlattenError(f"`{name}` is not supported yet as {what}",
+                           call.span, hint="springc supports a subset of Modelica; see "
+                           "\"Not supported yet\" in docs/language.md")
+    call_outputs(ev, call, scope, 0)
 
 
 def multiple_outputs(ev: ExpressionEvaluator, targets: Sequence[object], value: s.Expr,
@@ -129,6 +153,10 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
         raise FlattenError(f"input '{comp.name}' is missing in this call", call.span,
                            [Note("declared here", comp.span)])
     dims = [d for d in comp.dims + comp.type_dims]
+    if dims and all(isinstance(d, s.Colon) for d in dims):
+        # a flexible array: empty until assigned (section 12.4.5)
+        scope.names[comp.name] = np.empty((0,) * len(dims), dtype=object)
+        return
     if any(isinstance(d, s.Colon) for d in dims):
         scope.names[comp.name] = None  # sized by its first assignment
         return
@@ -162,11 +190,9 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
 
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
           guard: x.Expr | None) -> None:
-    name = stmt.call.func.dotted
-    if name != "assert":
-        raise FlattenError(f"call statements (`{name}(...);`) are not supported yet",
-                           stmt.span, hint="springc supports a subset of Modelica; see "
-                           "\"Not supported yet\" in docs/language.md")
+    if stmt.call.func.dotted != "assert":
+        call_for_effect(ev, stmt.call, scope, "a statement")
+        return
     origin = flat.Origin("function", "", scope.entry.full_name)
     ev.flattener.assertions.append(assertion(ev, stmt.call, scope, origin, guard))
 
@@ -203,6 +229,18 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
     scope.names = dict(before)
     not_cond = x.Not(cond)
     _if(ev, rest, scope, not_cond if guard is None else x.BinOp("and", guard, not_cond))
+    resized = [name for name, value in then_names.items() if name in before
+               and a.shape(value) != a.shape(scope.names.get(name))]
+    if resized and ev.flattener.is_parameter_expression(cond):
+        # sizes are fixed before the simulation: so is this branch (10.1)
+        scope.names = dict(before)
+        taken = bool(ev.fold(cond))
+        _run(ev, body, scope, guard) if taken else _if(ev, rest, scope, guard)
+        return
+    if resized:
+        raise FlattenError(f"'{resized[0]}' gets different sizes in the branches of this "
+                           "if-statement, whose condition is known only during the "
+                           "simulation", stmt.span)
     for name, then_value in then_names.items():
         other = scope.names.get(name)
         if then_value is other or name not in before:
