@@ -20,6 +20,7 @@ from .equation_templates import Template, make_template, reusable
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
+from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
@@ -118,6 +119,11 @@ class EquationFlattening(FlattenContext):
                 self._body(eq.body, local, owner, initial)
 
     def _equality(self, eq: s.Equality, where: Scope, owner: ClassScope, initial: bool) -> None:
+        fields = record_equation(self, eq, where)
+        if fields is not None:
+            for field in fields:
+                self._equality(field, where, owner, initial)
+            return
         if isinstance(eq.lhs, s.Tuple):
             outputs = multiple_outputs(self.evaluator, eq.lhs.items, eq.rhs, where)
             for item, value in zip(eq.lhs.items, outputs):

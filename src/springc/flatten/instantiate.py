@@ -22,6 +22,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
+from .records import record_mod
 from .scope import (
     ClassScope,
     ClassView,
@@ -145,10 +146,13 @@ class Instantiation(FlattenContext):
             for key, child in scope.mod.children.items():
                 if key not in view.components:
                     self._unknown_target(key, child, view, name)
+            if scope.mod.value is not None and view.entry.defn.kind == "record":
+                scope.mod = record_mod(self, scope.mod, view, name)
             if scope.mod.value is not None:
                 raise FlattenError(f"'{name}' is a component of class "
                                    f"'{view.entry.full_name}' and cannot be given a value",
                                    scope.mod.value.span)
+        scope.flow = decl.flow or parent.flow  # flow applies to the elements (4.4.2.2)
         return scope
 
     def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
@@ -208,8 +212,9 @@ class Instantiation(FlattenContext):
                 else x.Const(value)
         else:
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
+        flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+                         flow, rtype.primitive or "Real", mod, dims)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b

@@ -102,6 +102,8 @@ class ClassScope:
     failed: dict[str, SpringcError] = field(default_factory=dict)
     # The InstanceTemplate this instance was copied from, if any.
     template: object | None = None
+    # declared `flow` (or inside a flow component): its elements are flows (4.4.2.2)
+    flow: bool = False
     # Filled by connections.connector_leaves for a connector: its scalar variables, and
     # what must match for two connectors to be connected (names and flow prefixes).
     connector_leaves: list[Leaf] | None = None
