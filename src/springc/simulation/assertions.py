@@ -5,13 +5,15 @@ A failing ``AssertionLevel.error`` assertion stops the run with ``assertion fail
 t = ...: <message>`` at the ``assert``'s location; one whose condition reads only
 parameters fails before the integration starts. A failing ``AssertionLevel.warning``
 assertion is reported once on standard error and the run goes on. The scipy engine
-and the Python fixed-step integrators check after every step; the compiled engine's
-loops have no Python per step, so its runs are checked at every output time.
+and the Python fixed-step integrators check after every step (on scipy, the time of a
+failure is then located inside the step on its interpolant, by bisection); the compiled
+engine's loops have no Python per step, so its runs are checked at every output time.
 """
 
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from typing import Any, TextIO
 
 import numpy as np
@@ -51,10 +53,13 @@ class AssertionCheck:
         """Check every assertion at the start time."""
         self._check(t, x, z, first=True)
 
-    def step(self, t: float, x: np.ndarray, z: np.ndarray) -> None:
-        """Check the assertions that depend on time or the states after a step."""
+    def step(self, t: float, x: np.ndarray, z: np.ndarray, before: float | None = None,
+             dense: Callable[[], Any] | None = None) -> None:
+        """Check the assertions that depend on time or the states after a step from
+        ``before`` to ``t``; ``dense()`` (the step's interpolant) locates where in the
+        step a failing condition first fails."""
         if self.varying:
-            self._check(t, x, z, first=False)
+            self._check(t, x, z, first=False, before=before, dense=dense)
 
     def grid(self, times: np.ndarray, states: np.ndarray, z: np.ndarray) -> None:
         """Check at every output time (the compiled engine's runs)."""
@@ -62,18 +67,49 @@ class AssertionCheck:
             for t, x in zip(times, states):
                 self._check(float(t), x, z, first=False)
 
-    def _check(self, t: float, x: np.ndarray, z: np.ndarray, first: bool) -> None:
+    def _held(self, t: float, x: np.ndarray, z: np.ndarray) -> np.ndarray | None:
         assert self.function is not None
         try:
             with np.errstate(all="ignore"):
-                held = np.asarray(self.function(t, np.asarray(x, dtype=float), self.p,
+                return np.asarray(self.function(t, np.asarray(x, dtype=float), self.p,
                                                 np.array(z)))
         except (ArithmeticError, ValueError):
-            return  # the same computation fails in the step loop, which names it
+            return None  # the same computation fails in the step loop, which names it
+
+    def _first_failure(self, i: int, before: float, t: float, dense: Callable[[], Any],
+                       z: np.ndarray) -> tuple[float, np.ndarray] | None:
+        """The earliest time in ``(before, t]`` (to 1e-12 of the step) where assertion
+        ``i`` fails, by bisection on the step's interpolant, and the states there."""
+        interpolant = dense()
+        lo, hi = before, t
+        x_hi = None
+        for _ in range(60):
+            if hi - lo <= 1e-12 * max(1.0, abs(hi)):
+                break
+            mid = 0.5 * (lo + hi)
+            x_mid = np.asarray(interpolant(mid), dtype=float)
+            held = self._held(mid, x_mid, z)
+            if held is None:
+                return None
+            if held[i] == 0.0:
+                hi, x_hi = mid, x_mid
+            else:
+                lo = mid
+        return (hi, x_hi) if x_hi is not None else None
+
+    def _check(self, t: float, x: np.ndarray, z: np.ndarray, first: bool,
+               before: float | None = None, dense: Callable[[], Any] | None = None) -> None:
+        held = self._held(t, x, z)
+        if held is None:
+            return
         for i in map(int, np.flatnonzero(held == 0.0)):
             message, level, location, constant = self.table[i]
             if constant and not first:
                 continue
+            if before is not None and dense is not None and i not in self.warned:
+                found = self._first_failure(i, before, t, dense, z)
+                if found is not None:
+                    t, x = found
             when = ("before the simulation started" if constant
                     else f"at t = {format_time(t)}")
             if level == "warning":

@@ -294,7 +294,8 @@ class StepLoop:
                                           np.asarray(integrator.y), message))
             sizes.append(integrator.t - before)
             if problem.asserts:
-                problem.asserts.step(float(integrator.t), integrator.y, problem.z)
+                problem.asserts.step(float(integrator.t), integrator.y, problem.z,
+                                     float(before), integrator.dense_output)
             if taken % CHECK_EVERY == 0 or self.steps + taken >= self.limits.max_steps:
                 self.check_limits(integrator, self.steps + taken, sizes)
             j = int(np.searchsorted(grid, integrator.t, side="right"))
