@@ -226,3 +226,34 @@ equation
   {line}
 end M;
 """) == message
+
+
+def test_non_boolean_if_statement_condition_is_an_error(tmp_path: Path) -> None:
+    assert error_of(tmp_path, """model M
+  parameter Integer i = 1;
+  Real x;
+algorithm
+  if i then
+    x := 3;
+  else
+    x := 4;
+  end if;
+end M;
+""") == "5:6: the condition of an if-statement must be a Boolean expression"
+
+
+def test_an_error_assertion_that_always_fails_is_an_error(tmp_path: Path) -> None:
+    assert error_of(tmp_path, """model M
+  Real x = time;
+algorithm
+  assert(false, "always");
+end M;
+""") == "4:3: this assertion always fails: always"
+    # as a warning it is kept (and reported during the simulation)
+    m = flat_of(tmp_path, """model M
+  Real x = time;
+algorithm
+  assert(1 > 2, "always", AssertionLevel.warning);
+end M;
+""")
+    assert asserts(m) == [("false", "always", "warning")]

@@ -118,6 +118,7 @@ class _Run:
         cond = self.read(self.ev.scalar(cond_expr, where), cond_expr.span)
         self.guard_new(start, guard)
         assert not isinstance(cond, (str, np.ndarray))
+        self.fl.statement_conditions.append((cond, cond_expr.span))
         if isinstance(cond, x.Const):
             if cond.value:
                 self.run(body, where, guard)

@@ -11,7 +11,7 @@ condition is Boolean is checked once the variables' types are known
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -150,30 +150,45 @@ def _real_text(value: float, digits: int) -> str:
 
 
 def is_boolean(e: x.Expr, types: dict[str, str]) -> bool:
-    """Whether ``e`` has type Boolean (``types``: flat variable name -> type)."""
+    """Whether ``e`` may have type Boolean (``types``: flat variable name -> type);
+    false for numbers, numeric variables and numeric built-ins."""
     if isinstance(e, x.Const):
         return isinstance(e.value, (bool, np.bool_))
     if isinstance(e, x.Var):
-        return types.get(e.name) == "Boolean"
+        return types.get(e.name, "Boolean") == "Boolean"
     if isinstance(e, x.Not):
         return True
     if isinstance(e, x.BinOp):
         return e.op in x.RELATIONS or e.op in ("and", "or")
     if isinstance(e, x.If):
         return is_boolean(e.then, types) and is_boolean(e.otherwise, types)
-    if isinstance(e, x.Call) and e.name in ("noEvent", "smooth") and e.args:
-        return is_boolean(e.args[-1], types)
+    if isinstance(e, x.Call):
+        if e.name in ("noEvent", "smooth") and e.args:
+            return is_boolean(e.args[-1], types)
+        return e.name not in x.MATH  # the numeric built-ins; others (pre, edge) may be
     return False
 
 
-def check_conditions(pending: list[Pending], variables: tuple[flat.Variable, ...]
+def check_conditions(pending: list[Pending], variables: tuple[flat.Variable, ...],
+                     conditions: Sequence[tuple[x.Expr, Span]] = ()
                      ) -> list[FlattenError]:
-    """The errors of conditions that are not Boolean."""
+    """The errors of assertion and if-statement ``conditions`` that are not Boolean,
+    and of error-level assertions that fail whatever the values."""
     types = {v.name: v.type for v in variables}
-    return [FlattenError("the condition of 'assert' must be a Boolean expression",
-                         span, hint="write a comparison, e.g. assert(x > 0, "
-                         "\"x must be positive\")")
-            for item, span in pending if not is_boolean(item.condition, types)]
+    errors = [FlattenError("the condition of 'assert' must be a Boolean expression",
+                           span, hint="write a comparison, e.g. assert(x > 0, "
+                           "\"x must be positive\")")
+              for item, span in pending if not is_boolean(item.condition, types)]
+    errors += [FlattenError("the condition of an if-statement must be a Boolean "
+                            "expression", span, hint="write a comparison, e.g. if i > 0")
+               for condition, span in conditions if not is_boolean(condition, types)]
+    errors += [FlattenError(f"this assertion always fails: {item.message}", item.span,
+                            hint="its condition is false whatever the values; use "
+                            "AssertionLevel.warning to only report it")
+               for item, _span in pending
+               if item.level == "error" and isinstance(item.condition, x.Const)
+               and not item.condition.value]
+    return errors
 
 
 def unique(pending: list[Pending]) -> tuple[flat.Assertion, ...]:

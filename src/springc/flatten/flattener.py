@@ -52,6 +52,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.initial_equations: list[flat.Equation] = []
         self.assertions: list[tuple[flat.Assertion, Span]] = []
         self.algorithm_sections: list[Section] = []
+        self.statement_conditions: list[tuple[x.Expr, Span]] = []
         self.errors: list[SpringcError] = []
         self.mod_values = {}
         self.declared_types = {}
@@ -153,7 +154,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
             variables = tuple(flattener.variables(top))
             flattener.errors += binding_errors(variables, flattener.parameter_values)
             apply_starts(flattener, flattener.algorithm_sections, variables)
-            flattener.errors += check_conditions(flattener.assertions, variables)
+            flattener.errors += check_conditions(flattener.assertions, variables,
+                                                 flattener.statement_conditions)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:

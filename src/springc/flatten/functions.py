@@ -219,6 +219,7 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         return
     cond_expr, body = branches[0]
     cond = ev.scalar(cond_expr, scope)
+    ev.flattener.statement_conditions.append((cond, cond_expr.span))
     rest = s.IfStatement(tuple(branches[1:]), stmt.otherwise, stmt.span)
     if isinstance(cond, x.Const):
         _run(ev, body, scope, guard) if cond.value else _if(ev, rest, scope, guard)

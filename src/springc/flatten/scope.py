@@ -278,6 +278,8 @@ class FlattenContext(Protocol):
     initial_equations: list[flat.Equation]
     # assertions and the spans of their conditions (flatten/assertions.py)
     assertions: list[tuple[flat.Assertion, Span]]
+    # conditions of if-statements, checked to be Boolean once the types are known
+    statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
     reusable_views: dict[int, bool]
 
