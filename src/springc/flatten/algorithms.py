@@ -25,6 +25,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion
+from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
@@ -52,7 +53,7 @@ class _Run:
         if isinstance(value, str):
             raise FlattenError("strings cannot be assigned in an algorithm section", span)
         env = self.env
-        return a.elementwise(lambda e: x.substitute(e, env) if env else e, value)
+        return a.elementwise(lambda e: folded(x.substitute(e, env)) if env else e, value)
 
     def guard_new(self, start: int, guard: x.Expr | None) -> None:
         """Make the assertions of inlined functions recorded since ``start`` hold
@@ -79,6 +80,13 @@ class _Run:
             self.if_(stmt.branches, stmt.otherwise, where, guard)
         elif isinstance(stmt, s.ForStatement):
             self.for_(stmt, stmt.indices, where, guard)
+        elif isinstance(stmt, s.WhileStatement):
+            run_while(self.ev, stmt,
+                      lambda: cast(x.Expr, self.read(self.ev.scalar(stmt.condition, where),
+                                                     stmt.span)),
+                      lambda: self.run(stmt.body, where, guard))
+        elif isinstance(stmt, s.Jump):
+            raise Jumped(stmt)
         else:
             self.call(stmt, where, guard)
 
@@ -126,10 +134,11 @@ class _Run:
                 self.if_(rest, otherwise, where, guard)
             return
         before = dict(self.env)
-        self.run(body, where, _and(guard, cond))
+        span = cond_expr.span
+        branch_jumps(lambda: self.run(body, where, _and(guard, cond)), span)
         then = self.env
         self.env = dict(before)
-        self.if_(rest, otherwise, where, _and(guard, x.Not(cond)))
+        branch_jumps(lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))), span)
         for name in then.keys() | self.env.keys():
             old = before.get(name, x.Var(name))
             left, right = then.get(name, old), self.env.get(name, old)
@@ -146,8 +155,8 @@ class _Run:
             local = LocalScope({index.name: value}, where)
             if rest:
                 self.for_(stmt, rest, local, guard)
-            else:
-                self.run(stmt.body, local, guard)
+            elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
+                break
 
     def call(self, stmt: s.CallStatement, where: Scope, guard: x.Expr | None) -> None:
         if stmt.call.func.dotted != "assert":
@@ -178,7 +187,10 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
     for stmt in section.body:
         if isinstance(stmt, s.ForStatement):
             check_loop_nest(fl.evaluator, stmt, where)
-    run.run(section.body, where, None)
+    try:
+        run.run(section.body, where, None)
+    except Jumped as jumped:
+        raise stray(jumped, "an algorithm section of a model") from None
     origin = flat.Origin("algorithm", owner.prefix)
     for name, value in run.env.items():
         target.append(flat.Equation(x.Var(name), value, run.spans[name], origin))

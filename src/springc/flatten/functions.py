@@ -21,6 +21,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
 from .assertions import assertion
+from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, ExpressionEvaluator, FunctionScope, Scope
@@ -63,7 +64,11 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):
                 check_loop_nest(ev, stmt, scope)
-        _run(ev, entry.defn.algorithm, scope)
+        try:
+            _run(ev, entry.defn.algorithm, scope)
+        except Jumped as jumped:
+            if jumped.jump.kind != "return":
+                raise stray(jumped, "the algorithm of a function") from None
     finally:
         ev.call_depth = depth
     if count > len(outputs):
@@ -184,8 +189,18 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
             _for(ev, stmt, stmt.indices, scope, guard)
         elif isinstance(stmt, s.CallStatement):
             _call(ev, stmt, scope, guard)
+        elif isinstance(stmt, s.WhileStatement):
+            _while(ev, stmt, scope, guard)
+        elif isinstance(stmt, s.Jump):
+            raise Jumped(stmt)
         else:
             _if(ev, stmt, scope, guard)
+
+
+def _while(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: FunctionScope,
+           guard: x.Expr | None) -> None:
+    run_while(ev, stmt, lambda: ev.scalar(stmt.condition, scope),
+              lambda: _run(ev, stmt.body, scope, guard))
 
 
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
@@ -206,8 +221,8 @@ def _for(ev: ExpressionEvaluator, stmt: s.ForStatement, indices: tuple[s.ForInde
         scope.names[index.name] = value
         if rest:
             _for(ev, stmt, rest, scope, guard)
-        else:
-            _run(ev, stmt.body, scope, guard)
+        elif not run_loop_body(lambda: _run(ev, stmt.body, scope, guard)):
+            break
     scope.names.pop(index.name, None)
 
 
@@ -218,18 +233,20 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         _run(ev, stmt.otherwise, scope, guard)
         return
     cond_expr, body = branches[0]
-    cond = ev.scalar(cond_expr, scope)
+    cond = folded(ev.scalar(cond_expr, scope))
     ev.flattener.statement_conditions.append((cond, cond_expr.span))
     rest = s.IfStatement(tuple(branches[1:]), stmt.otherwise, stmt.span)
     if isinstance(cond, x.Const):
         _run(ev, body, scope, guard) if cond.value else _if(ev, rest, scope, guard)
         return
     before = dict(scope.names)
-    _run(ev, body, scope, cond if guard is None else x.BinOp("and", guard, cond))
+    then_guard = cond if guard is None else x.BinOp("and", guard, cond)
+    branch_jumps(lambda: _run(ev, body, scope, then_guard), stmt.span)
     then_names = scope.names
     scope.names = dict(before)
     not_cond = x.Not(cond)
-    _if(ev, rest, scope, not_cond if guard is None else x.BinOp("and", guard, not_cond))
+    else_guard = not_cond if guard is None else x.BinOp("and", guard, not_cond)
+    branch_jumps(lambda: _if(ev, rest, scope, else_guard), stmt.span)
     resized = [name for name, value in then_names.items() if name in before
                and a.shape(value) != a.shape(scope.names.get(name))]
     if resized and ev.flattener.is_parameter_expression(cond):

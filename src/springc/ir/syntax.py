@@ -342,7 +342,22 @@ class CallStatement:
     span: Span
 
 
-Statement = Assign | IfStatement | ForStatement | CallStatement
+@dataclass(frozen=True, slots=True)
+class WhileStatement:
+    condition: Expr
+    body: tuple[Statement, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Jump:
+    """``break`` or ``return`` (``kind``)."""
+
+    kind: str
+    span: Span
+
+
+Statement = Assign | IfStatement | ForStatement | CallStatement | WhileStatement | Jump
 
 # -------------------------------------------------------------------- classes
 

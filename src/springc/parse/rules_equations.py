@@ -25,7 +25,9 @@ from ..ir.syntax import (
     ForStatement,
     IfEquation,
     IfStatement,
+    Jump,
     Ref,
+    WhileStatement,
 )
 from .rules_base import Rejected, RuleBase, T, join
 
@@ -119,14 +121,14 @@ class EquationRules(RuleBase):
     def output_item(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0] if ch else None
 
-    def break_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`break` statements are", self.span_of(meta))
+    def break_statement(self, meta: Meta, ch: list[Any]) -> Jump:
+        return Jump("break", self.span_of(meta))
 
-    def return_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`return` statements are", self.span_of(meta))
+    def return_statement(self, meta: Meta, ch: list[Any]) -> Jump:
+        return Jump("return", self.span_of(meta))
 
-    def while_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`while` loops are", self.keyword_span(meta, "while"))
+    def while_statement(self, meta: Meta, ch: list[Any]) -> WhileStatement:
+        return WhileStatement(ch[0], ch[1], self.span_of(meta))
 
     def when_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
         return self.reject("`when` statements are", self.keyword_span(meta, "when"))
