@@ -129,3 +129,22 @@ algorithm
 ])
 def test_deduced_range_errors(tmp_path: Path, body: str, message: str) -> None:
     assert error_of(tmp_path, body) == message
+
+
+def test_function_defaults_from_extends_and_causality_from_types(tmp_path: Path) -> None:
+    m = flat_of(tmp_path, """  type In = input Real;
+  type Out = output Real;
+  function base
+    input Real x;
+  end base;
+  function derived
+    extends base(x = 10);
+    Out y;
+    In k = 2;
+  algorithm
+    y := k * x;
+  end derived;
+  Real a = derived();
+  Real b = derived(1, 3);
+""")
+    assert equations(m) == ["a = 20", "b = 3"]

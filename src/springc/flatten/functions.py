@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
@@ -24,7 +25,14 @@ from .assertions import assertion
 from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
 from .loops import check_loop_nest
 from .ranges import with_range
-from .scope import ClassScope, ExpressionEvaluator, FunctionScope, Scope
+from .scope import (
+    ClassScope,
+    ClassView,
+    ExpressionEvaluator,
+    FunctionScope,
+    Scope,
+    ViewComponent,
+)
 
 MAX_DEPTH = 50
 
@@ -39,7 +47,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
                            call.span, hint="recursive functions are not supported")
     view = ev.flattener.view(entry)
-    comps = [c.decl for c in view.components.values()]
+    comps = [_with_inherited(ev, c, view) for c in view.components.values()]
     inputs = [c for c in comps if c.causality == "input"]
     outputs = [c for c in comps if c.causality == "output"]
     if not outputs and count:
@@ -143,6 +151,23 @@ def multiple_outputs(ev: ExpressionEvaluator, targets: Sequence[object], value: 
         raise FlattenError("several outputs need a function call on the right-hand side",
                            value.span, hint="write (a, b) := f(x)")
     return call_outputs(ev, value, scope, len(targets))
+
+
+def _with_inherited(ev: ExpressionEvaluator, comp: ViewComponent, view: ClassView
+                    ) -> s.Component:
+    """A function's component with the causality of its type (``type In = input
+    Real``) and the default an ``extends`` modification gives it (``extends F(x = 10)``)."""
+    decl = comp.decl
+    if not decl.causality:
+        causality = ev.flattener.declared_type(comp).rtype.prefixes[1]
+        if causality:
+            decl = replace(decl, causality=causality)
+    for mod, _owner in view.extends_mods:
+        for arg in mod.arguments:
+            if arg.path == (decl.name,) and arg.modification is not None \
+                    and arg.modification.value is not None and decl.modification is None:
+                decl = replace(decl, modification=arg.modification)
+    return decl
 
 
 def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
