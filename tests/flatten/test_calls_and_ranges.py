@@ -75,6 +75,9 @@ end M;
      "are used"),
     ("  Real x, y;\nequation\n  (x, y) = 3;\n", "12:12: several outputs need a function "
      "call on the right-hand side"),
+    ("  Real x[2], y[2];\nequation\n  (x, y) = f({1, 2});\n",
+     "12:12: 'M.f' has several outputs and cannot be called element-wise: its input 'u' "
+     "is a scalar, given an array of size [2] (section 12.4.6)"),
     ("  Real x = (1, 2);\n", "10:12: an output list (`(a, b)`) is only allowed on the "
      "left of `(a, b) = f(x)` or `(a, b) := f(x)`"),
 ])

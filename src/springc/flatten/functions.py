@@ -65,6 +65,14 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         if name in given:
             raise FlattenError(f"input '{name}' is given twice", span)
         given[name] = value
+    if count > 1:
+        for comp in inputs:
+            arg = given.get(comp.name)
+            if a.is_array(arg) and not comp.dims and not comp.type_dims:
+                raise FlattenError(f"'{entry.full_name}' has several outputs and cannot be "
+                                   f"called element-wise: its input '{comp.name}' is a "
+                                   f"scalar, given {ev.describe(arg)} (section 12.4.6)",
+                                   call.span, [Note("declared here", comp.span)])
     ev.call_depth = depth + 1
     try:
         for comp in comps:
