@@ -7,18 +7,21 @@ parameters fails before the integration starts. A failing ``AssertionLevel.warni
 assertion is reported once on standard error and the run goes on. The scipy engine
 and the Python fixed-step integrators check after every step (on scipy, the time of a
 failure is then located inside the step on its interpolant, by bisection); the compiled
-engine's loops have no Python per step, so its runs are checked at every output time.
+engine's loops have no Python per step, so its runs are checked at every output time,
+as are runs that switch states (:func:`check_trajectory`, on the flat conditions).
 """
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, TextIO
 
 import numpy as np
 
 from ..errors import SimulationError, Span
+from ..ir import expr as x
+from ..ir import flat
 from .failures import format_time, state_notes
 
 
@@ -123,3 +126,35 @@ class AssertionCheck:
             raise SimulationError(f"assertion failed {when}: {message}", _span(location),
                                   notes, hint="the model left the range its author "
                                   "allowed; check the parameters (--set) and start values")
+
+
+def check_trajectory(assertions: Sequence[flat.Assertion], times: np.ndarray,
+                     values: Mapping[str, np.ndarray], parameters: Mapping[str, float],
+                     stream: TextIO | None = None) -> None:
+    """Check flat ``assertions`` at every output time of a run that has no generated
+    ``assertions`` function (a run that switches states): ``values[name][k]`` holds the
+    variables at ``times[k]``. A condition reading what the run does not record (a
+    derivative) is skipped."""
+    out = stream if stream is not None else sys.stderr
+    warned: set[int] = set()
+    for k, t in enumerate(times):
+        env: dict[str, object] = dict(parameters)
+        env.update((name, float(column[k])) for name, column in values.items())
+        for i, item in enumerate(assertions):
+            try:
+                held = x.evaluate(item.condition, env, float(t))
+            except (KeyError, ArithmeticError, ValueError):
+                continue
+            if held:
+                continue
+            location = str(item.span)
+            if item.level == "warning":
+                if i not in warned:
+                    warned.add(i)
+                    out.write(f"{location}: warning: assertion failed at t = "
+                              f"{format_time(float(t))}: {item.message}\n")
+                continue
+            raise SimulationError(f"assertion failed at t = {format_time(float(t))}: "
+                                  f"{item.message}", _span(location),
+                                  hint="the model left the range its author allowed; "
+                                  "check the parameters (--set) and start values")
