@@ -44,6 +44,9 @@ class Section:
 
 
 class _Run:
+    """One execution of a section: ``env`` holds the value each assigned variable has
+    so far (an expression of the model's variables), ``spans`` the last assignment."""
+
     def __init__(self, fl: FlattenContext, owner: ClassScope, initial: bool) -> None:
         self.fl, self.ev, self.owner, self.initial = fl, fl.evaluator, owner, initial
         self.env: dict[str, x.Expr] = {}
