@@ -257,3 +257,27 @@ algorithm
 end M;
 """)
     assert asserts(m) == [("false", "always", "warning")]
+
+
+def test_function_assertions_in_if_expressions_hold_where_the_branch_is_not_taken(
+        tmp_path: Path) -> None:
+    m = flat_of(tmp_path, """model M
+  function f
+    input Real u;
+    output Real y;
+  algorithm
+    assert(u > 0, "u must be positive");
+    y := u;
+  end f;
+  parameter Boolean b = true;
+  Real x = time;
+  Real y = if not b then f(-1) else 1;
+  Real z = noEvent(if x > 1 then f(x) elseif x > 0 then 2 else f(x + 3));
+  Real w = if true then 1 else f(-1);
+end M;
+""")
+    assert asserts(m) == [
+        ("if not b then false else true", "u must be positive", "error"),
+        ("if x > 1 then x > 0 else true", "u must be positive", "error"),
+        ("if not x > 1 and not x > 0 then x + 3 > 0 else true", "u must be positive",
+         "error")]

@@ -24,7 +24,7 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
-from .assertions import assertion
+from .assertions import assertion, guard_assertions
 from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
@@ -61,13 +61,8 @@ class _Run:
     def guard_new(self, start: int, guard: x.Expr | None) -> None:
         """Make the assertions of inlined functions recorded since ``start`` hold
         where ``guard`` is false (they are evaluated only where it is true)."""
-        if guard is None:
-            return
-        for i in range(start, len(self.fl.assertions)):
-            item, span = self.fl.assertions[i]
-            if item.origin.kind == "function":
-                self.fl.assertions[i] = (
-                    _with_condition(item, x.If(guard, item.condition, x.Const(True))), span)
+        if guard is not None:
+            guard_assertions(self.fl.assertions, start, guard)
 
     def run(self, body: tuple[s.Statement, ...], where: Scope, guard: x.Expr | None) -> None:
         for stmt in body:

@@ -92,6 +92,17 @@ def _level(e: s.Expr | None) -> str:
     return level
 
 
+def guard_assertions(assertions: list[Pending], start: int, guard: x.Expr) -> None:
+    """Make the assertions of inlined functions recorded since ``start`` hold where
+    ``guard`` is false (the function is evaluated only where it is true)."""
+    for i in range(start, len(assertions)):
+        item, span = assertions[i]
+        if item.origin.kind == "function":
+            condition = x.If(guard, item.condition, x.Const(True))
+            assertions[i] = (flat.Assertion(condition, item.message, item.level, item.span,
+                                            item.origin), span)
+
+
 def message_text(ev: ExpressionEvaluator, e: s.Expr, scope: Scope,
                  read: Read | None = None) -> str:
     """The text of a String expression: literals, ``+`` and ``String(e)`` of values

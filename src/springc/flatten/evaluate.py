@@ -21,6 +21,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .assertions import guard_assertions
 from .builtins import CONSTANTS, Builtins
 from .functions import call_function, function_of
 from .parameters import check_powers
@@ -235,20 +236,41 @@ class Evaluator:
             "noEvent(...)")
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
-        result = self.value(e.otherwise, scope)
-        for cond_expr, then_expr in reversed(e.branches):
-            cond = self.scalar(cond_expr, scope)
+        # in order: the assertions of functions a branch calls hold where it is not
+        # taken (guarded), and nothing after a constant-true condition is evaluated
+        branches: list[tuple[x.Expr, a.Value]] = []
+        guard: x.Expr | None = None  # all earlier conditions false
+        result: a.Value | None = None
+        for cond_expr, then_expr in e.branches:
+            cond = self._guarded(cond_expr, scope, guard, scalar=True)
             if isinstance(cond, x.Const):
                 if cond.value:
-                    result = self.value(then_expr, scope)
+                    result = self._guarded(then_expr, scope, guard)
+                    break
                 continue
-            then = self.value(then_expr, scope)
-            if a.shape(then) != a.shape(result):
-                raise FlattenError("branches of an if-expression differ in size", e.span)
+            then = self._guarded(then_expr, scope,
+                                 cond if guard is None else x.BinOp("and", guard, cond))
             if not self.no_event and not self.flattener.is_parameter_expression(cond):
                 self._check_event(cond, cond_expr.span)
+            branches.append((cond, then))
+            guard = x.Not(cond) if guard is None else x.BinOp("and", guard, x.Not(cond))
+        if result is None:
+            result = self._guarded(e.otherwise, scope, guard)
+        for cond, then in reversed(branches):
+            if a.shape(then) != a.shape(result):
+                raise FlattenError("branches of an if-expression differ in size", e.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
         return result
+
+    def _guarded(self, e: s.Expr, scope: Scope, guard: x.Expr | None, scalar: bool = False
+                 ) -> Any:
+        """The value of ``e``; the assertions of the functions it inlines hold where
+        ``guard`` is false."""
+        start = len(self.flattener.assertions)
+        value = self.scalar(e, scope) if scalar else self.value(e, scope)
+        if guard is not None:
+            guard_assertions(self.flattener.assertions, start, guard)
+        return value
 
     # ------------------------------------------------------------------ references
 
