@@ -25,6 +25,7 @@ from ..errors import CodegenError, Span
 from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
+from .assertions import assertion_function
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
@@ -127,6 +128,7 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
         prologue = [] if numba else [Raw("x = x.tolist()\np = p.tolist()")]
         bodies += [(fn, doc, function_lines(namer, helpers, prologue + make(m, m.events)), ret)
                    for fn, doc, make, ret in EVENT_FUNCTIONS]
+    bodies.append(assertion_function(m, namer, helpers, numba))
     structural = structural_parameters(system, flat_model)
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
                           table)

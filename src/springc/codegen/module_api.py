@@ -44,6 +44,7 @@ class GeneratedModule(Protocol):
     JAC_INDICES: IntArray
     JAC_INDPTR: IntArray
     EVENTS: bool  # a hybrid module: it has the names of HybridModule too
+    ASSERTIONS: tuple[tuple[str, str, str, bool], ...]  # message, level, location, params only
 
     def parameters(self, values: Mapping[str, float] | None = None) -> FloatArray: ...
 
@@ -68,10 +69,13 @@ class GeneratedModule(Protocol):
     def observed_grid(self, ts: FloatArray, X: FloatArray, p: FloatArray,
                       z: FloatArray) -> FloatArray: ...
 
+    def assertions(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray
+                   ) -> FloatArray: ...
+
 
 MODULE_NAMES = frozenset(name for name in GeneratedModule.__annotations__) | {
     "parameters", "start", "guesses", "rhs", "jacobian_values", "jacobian",
-    "jacobian_dense", "sparsity", "observed", "observed_grid"}
+    "jacobian_dense", "sparsity", "observed", "observed_grid", "assertions"}
 """Every name a generated module defines (checked when the pipeline imports one)."""
 
 

@@ -14,6 +14,7 @@ from ..errors import CodegenError
 from ..ir import dae
 from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
 from ..simplify import conditions as initial_conditions
+from .assertions import assertion_table
 from .context import CodegenContext, CodegenOptions, source_comment, source_location
 from .encoding import encode_floats, encode_ints, encode_strings
 from .events import EVENT_UPDATE, NO_EVENTS
@@ -106,6 +107,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         f"NEWTON_SYSTEMS = {m.newton_systems()!r}",
         f"EXPERIMENT = {experiment!r}",
         f"INITIAL_CONDITIONS = {len(initial_conditions(m.ode))}",
+        "# assert(...) of the model: (message, level, location, parameters only).",
+        f"ASSERTIONS = {assertion_table(m.ode)}",
         "# Index reduction left a choice of states that may turn singular during a run:",
         "# the simulator then switches states.",
         f"SWITCHABLE = {bool(options.switchable)}",

@@ -88,7 +88,7 @@ _RESERVED = frozenset({
     "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
     "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
     "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "JAC_ROWS",
-    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR",
+    "JAC_COLS", "JAC_INDICES", "JAC_INDPTR", "ASSERTIONS", "assertions", "ok",
 }) | frozenset(keyword.kwlist) | frozenset(dir(builtins))
 
 

@@ -130,6 +130,20 @@ def div(a: Value, b: Value) -> Value:
 
 
 def power(a: Value, b: Value) -> Value:
+    """``^``: a scalar power, or ``A^n`` of a square matrix and an Integer ``n >= 0``
+    (section 10.6.6: ``A*A*...*A``, the identity for ``n = 0``)."""
+    if isinstance(a, np.ndarray) and not is_array(b):
+        n = b.value if isinstance(b, x.Const) else None
+        if a.ndim != 2 or a.shape[0] != a.shape[1]:
+            raise ValueError(f"'^' of an array needs a square matrix, found {_fmt(a.shape)}; "
+                             "use '.^' for element-wise powers")
+        if not isinstance(n, int) or isinstance(n, bool) or n < 0:
+            raise ValueError("the exponent of a matrix power must be a constant Integer >= 0")
+        result: Value = make_array([x.Const(int(i == j)) for i in range(a.shape[0])
+                                    for j in range(a.shape[0])], a.shape)
+        for _ in range(n):
+            result = mul(result, a) if _ else a
+        return result
     if is_array(a) or is_array(b):
         raise ValueError("'^' needs scalar operands here; use '.^' for element-wise powers")
     return x.power(a, b)  # type: ignore[arg-type]

@@ -15,6 +15,7 @@ from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
+from .array_builtins import ArrayBuiltins
 from .scope import ExpressionEvaluator, Handler, Scope
 
 SCALAR_FUNCTIONS = {
@@ -47,6 +48,7 @@ class Builtins:
         }
         for name in SCALAR_FUNCTIONS:
             self.table[name] = self.math
+        self.table.update(ArrayBuiltins(evaluator).table())
 
     def lookup(self, name: str, scope: Scope) -> Handler | None:
         name = _ALIASES.get(name, name)

@@ -14,9 +14,14 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
+from .algorithms import Section, algorithm_section
+from .assertions import assertion
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
+from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
+from .ranges import with_range
+from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .when import flatten_when, variable_if_equation
 
@@ -27,6 +32,7 @@ class EquationFlattening(FlattenContext):
     connections: ConnectionSets
     # Equation templates by (id of the ClassView, initial); None: not reusable.
     templates: dict[tuple[int, bool], Template | None]
+    algorithm_sections: list[Section]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
         """The equations of one instance; from the class's template when it has one."""
@@ -78,11 +84,15 @@ class EquationFlattening(FlattenContext):
             name = eq.call.func.dotted
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")
+        elif isinstance(eq, s.AlgorithmSection):
+            self.algorithm_sections.append(
+                algorithm_section(self, eq, where, owner, initial))
+        elif eq.call.func.dotted == "assert":
+            kind = "initial" if initial else "equation"
+            self.assertions.append(
+                assertion(self.evaluator, eq.call, where, flat.Origin(kind, owner.prefix)))
         else:
-            name = eq.call.func.dotted
-            raise FlattenError(f"`{name}` is not supported yet as an equation", eq.span,
-                               hint="springc supports a subset of Modelica; see "
-                               "\"Not supported yet\" in docs/language.md")
+            call_for_effect(self.evaluator, eq.call, where, "an equation")
 
     def _variable_condition(self, cond: s.Expr, where: Scope) -> bool:
         """Whether an if-equation condition depends on variables (then the branches
@@ -116,7 +126,7 @@ class EquationFlattening(FlattenContext):
 
     def _for(self, eq: s.ForEquation, indices: tuple[s.ForIndex, ...], where: Scope,
              owner: ClassScope, initial: bool) -> None:
-        index, rest = indices[0], indices[1:]
+        index, rest = with_range(self.evaluator, indices[0], eq.body, where), indices[1:]
         values = self.evaluator.range_values(index, where)
         self.limits.add_iterations(len(values), index.span)
         for value in values:
@@ -127,8 +137,23 @@ class EquationFlattening(FlattenContext):
                 self._body(eq.body, local, owner, initial)
 
     def _equality(self, eq: s.Equality, where: Scope, owner: ClassScope, initial: bool) -> None:
+        fields = record_equation(self, eq, where)
+        if fields is not None:
+            for field in fields:
+                self._equality(field, where, owner, initial)
+            return
+        if isinstance(eq.lhs, s.Tuple):
+            outputs = multiple_outputs(self.evaluator, eq.lhs.items, eq.rhs, where)
+            for item, value in zip(eq.lhs.items, outputs):
+                if item is not None:
+                    self._sides(eq, self.evaluator.value(item, where), value, owner, initial)
+            return
         lhs = self.evaluator.value(eq.lhs, where)
         rhs = self.evaluator.value(eq.rhs, where)
+        self._sides(eq, lhs, rhs, owner, initial)
+
+    def _sides(self, eq: s.Equality, lhs: a.Value, rhs: a.Value, owner: ClassScope,
+               initial: bool) -> None:
         if a.shape(lhs) != a.shape(rhs):
             raise FlattenError(
                 f"the two sides of this equation differ in size: "

@@ -21,11 +21,13 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .assertions import guard_assertions
 from .builtins import CONSTANTS, Builtins
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
-from .functions import call_function
+from .functions import call_function, function_of
 from .parameters import check_powers
+from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
 
 UNSUPPORTED_CALLS = {
@@ -166,6 +168,10 @@ class Evaluator:
     def _Colon(self, e: s.Colon, scope: Scope) -> a.Value:
         raise FlattenError("':' is only allowed as a subscript", e.span)
 
+    def _Tuple(self, e: s.Tuple, scope: Scope) -> a.Value:
+        raise FlattenError("an output list (`(a, b)`) is only allowed on the left of "
+                           "`(a, b) = f(x)` or `(a, b) := f(x)`", e.span)
+
     def _End(self, e: s.End, scope: Scope) -> a.Value:
         end = scope.end_value if isinstance(scope, LocalScope) else None
         if end is None:
@@ -212,6 +218,8 @@ class Evaluator:
                 return a.power(left, right)
             if op.startswith("."):
                 return a.elementwise(a.scalar_op(op[1:]), left, right)
+            if op in ("and", "or") and (a.is_array(left) or a.is_array(right)):
+                return a.elementwise(a.scalar_op(op), left, right)  # section 10.6.9
             if a.is_array(left) or a.is_array(right):
                 raise ValueError(f"'{op}' needs scalar operands")
         except ValueError as err:
@@ -221,18 +229,39 @@ class Evaluator:
         return result  # a relation on variables generates events (simplify/events.py)
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
-        result = self.value(e.otherwise, scope)
-        for cond_expr, then_expr in reversed(e.branches):
-            cond = self.scalar(cond_expr, scope)
+        # in order: the assertions of functions a branch calls hold where it is not
+        # taken (guarded), and nothing after a constant-true condition is evaluated
+        branches: list[tuple[x.Expr, a.Value]] = []
+        guard: x.Expr | None = None  # all earlier conditions false
+        result: a.Value | None = None
+        for cond_expr, then_expr in e.branches:
+            cond = self._guarded(cond_expr, scope, guard, scalar=True)
             if isinstance(cond, x.Const):
                 if cond.value:
-                    result = self.value(then_expr, scope)
+                    result = self._guarded(then_expr, scope, guard)
+                    break
                 continue
-            then = self.value(then_expr, scope)
+            then = self._guarded(then_expr, scope,
+                                 cond if guard is None else x.BinOp("and", guard, cond))
+            branches.append((cond, then))
+            guard = x.Not(cond) if guard is None else x.BinOp("and", guard, x.Not(cond))
+        if result is None:
+            result = self._guarded(e.otherwise, scope, guard)
+        for cond, then in reversed(branches):
             if a.shape(then) != a.shape(result):
                 raise FlattenError("branches of an if-expression differ in size", e.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
         return result
+
+    def _guarded(self, e: s.Expr, scope: Scope, guard: x.Expr | None, scalar: bool = False
+                 ) -> Any:
+        """The value of ``e``; the assertions of the functions it inlines hold where
+        ``guard`` is false."""
+        start = len(self.flattener.assertions)
+        value = self.scalar(e, scope) if scalar else self.value(e, scope)
+        if guard is not None:
+            guard_assertions(self.flattener.assertions, start, guard)
+        return value
 
     # ------------------------------------------------------------------ references
 
@@ -296,7 +325,15 @@ class Evaluator:
                                f"{len(part.subscripts)} subscript(s) are given", part.span)
         index = tuple(self._index(sub, dims[k], scope, part)
                       for k, sub in enumerate(part.subscripts))
-        result = value[index]
+        if sum(isinstance(i, np.ndarray) for i in index) > 1:
+            # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
+            # element pairs: take them one dimension at a time
+            result = value
+            for axis in reversed(range(len(index))):
+                if not isinstance(index[axis], slice):
+                    result = np.take(result, index[axis], axis=axis)
+        else:
+            result = value[index]
         if isinstance(result, np.ndarray) and result.ndim == 0:
             return result.item()
         return result
@@ -352,7 +389,7 @@ class Evaluator:
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
-        entry = self.flattener.resolve_function(e.func, scope)
+        entry = function_of(self, e.func, scope)
         args = [self.value(arg, scope) for arg in e.args]
         named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
         return call_function(self, entry, args, named, e)
@@ -363,6 +400,7 @@ class Evaluator:
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
                 ) -> Iterator[a.Value]:
         """Values of ``body`` for every combination of the iterators (first outermost)."""
+        indices = tuple(with_range(self, i, body, scope) for i in indices)
         ranges = [self.range_values(i, scope) for i in indices]
         self.flattener.limits.add_iterations(math.prod(len(r) for r in ranges),
                                              indices[0].span)

@@ -13,11 +13,13 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
+from ..errors import ErrorGroup, FlattenError, FollowUpError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir.when import When
 from ..parse import ClassTree
+from .algorithms import Section, apply_starts
+from .assertions import check_conditions, unique
 from .connections import ConnectionSets
 from .equations import EquationFlattening
 from .evaluate import Evaluator
@@ -51,6 +53,9 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
         self.whens: list[When] = []
+        self.assertions: list[tuple[flat.Assertion, Span]] = []
+        self.algorithm_sections: list[Section] = []
+        self.statement_conditions: list[tuple[x.Expr, Span]] = []
         self.errors: list[SpringcError] = []
         self.mod_values = {}
         self.declared_types = {}
@@ -152,6 +157,9 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
             variables = tuple(flattener.variables(top))
             flattener.errors += binding_errors(variables, flattener.parameter_values)
             check_events(flattener, variables)
+            apply_starts(flattener, flattener.algorithm_sections, variables)
+            flattener.errors += check_conditions(flattener.assertions, variables,
+                                                 flattener.statement_conditions)
     except FlattenError as err:
         flattener.report(err)
     if flattener.errors:
@@ -161,5 +169,6 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
                           experiment_of(flattener, entry, top), entry.defn.span,
-                          whens=tuple(flattener.whens))
+                          whens=tuple(flattener.whens),
+                          assertions=unique(flattener.assertions))
 

@@ -22,6 +22,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
+from .records import record_mod
 from .scope import (
     ClassScope,
     ClassView,
@@ -60,7 +61,8 @@ class Instantiation(FlattenContext):
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
+        dims = declared.dims if declared.dims is not None \
+            else self._dims(decl, scope, rtype, mod, name)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
@@ -144,10 +146,13 @@ class Instantiation(FlattenContext):
             for key, child in scope.mod.children.items():
                 if key not in view.components:
                     self._unknown_target(key, child, view, name)
+            if scope.mod.value is not None and view.entry.defn.kind == "record":
+                scope.mod = record_mod(self, scope.mod, view, name)
             if scope.mod.value is not None:
                 raise FlattenError(f"'{name}' is a component of class "
                                    f"'{view.entry.full_name}' and cannot be given a value",
                                    scope.mod.value.span)
+        scope.flow = decl.flow or parent.flow  # flow applies to the elements (4.4.2.2)
         return scope
 
     def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
@@ -160,20 +165,35 @@ class Instantiation(FlattenContext):
             f"the elements of '{view.entry.full_name}' are: "
             + ", ".join(view.components))
 
-    def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType
-              ) -> tuple[int, ...]:
+    def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType,
+              mod: Mod | None = None, name: str = "") -> tuple[int, ...]:
         exprs = [(d, scope) for d in decl.dims + decl.type_dims]
         exprs += [(d, self.package_scope(e.parent or e)) for d, e in rtype.dims]
         dims = []
-        for d, where in exprs:
+        for k, (d, where) in enumerate(exprs):
             if isinstance(d, s.Colon):
-                raise FlattenError("the size of this dimension must be given ('[:]' is only "
-                                   "allowed for function inputs)", d.span)
+                dims.append(self._colon_size(k, d, mod, name or decl.name))
+                continue
             n = self.evaluator.integer(d, where, "an array size")
             if n < 0:
                 raise FlattenError(f"array size must not be negative, found {n}", d.span)
             dims.append(n)
         return tuple(dims)
+
+    def _colon_size(self, k: int, d: s.Colon, mod: Mod | None, name: str) -> int:
+        """The size of a ``[:]`` dimension: that of the binding (section 10.1)."""
+        if mod is None or mod.value is None:
+            raise FlattenError(f"the size of dimension {k + 1} of '{name}' ('[:]') is not "
+                               "given by a binding", d.span,
+                               hint="give the size ([3]) or a value that has it "
+                                    "(= {1, 2, 3})")
+        value = self.mod_value(mod.value)
+        dims = a.shape(value)
+        if k >= len(dims):
+            raise FlattenError(f"'{name}' has '[:]' as dimension {k + 1}, but its value "
+                               f"has size {a.describe_shape(dims)}", mod.value.span,
+                               [Note("the dimension is here", d.span)])
+        return dims[k]
 
     def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
                    mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
@@ -192,8 +212,9 @@ class Instantiation(FlattenContext):
                 else x.Const(value)
         else:
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
+        flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+                         flow, rtype.primitive or "Real", mod, dims)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b

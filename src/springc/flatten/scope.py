@@ -104,6 +104,8 @@ class ClassScope:
     failed: dict[str, SpringcError] = field(default_factory=dict)
     # The InstanceTemplate this instance was copied from, if any.
     template: object | None = None
+    # declared `flow` (or inside a flow component): its elements are flows (4.4.2.2)
+    flow: bool = False
     # Filled by connections.connector_leaves for a connector: its scalar variables, and
     # what must match for two connectors to be connected (names and flow prefixes).
     connector_leaves: list[Leaf] | None = None
@@ -256,6 +258,8 @@ class ExpressionEvaluator(Protocol):
 
     def fold(self, v: a.Value) -> Any: ...
 
+    def describe(self, v: Any) -> str: ...
+
     def reference(self, e: s.Ref, scope: Scope) -> Any: ...
 
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
@@ -276,6 +280,10 @@ class FlattenContext(Protocol):
     equations: list[flat.Equation]
     initial_equations: list[flat.Equation]
     whens: list[When]
+    # assertions and the spans of their conditions (flatten/assertions.py)
+    assertions: list[tuple[flat.Assertion, Span]]
+    # conditions of if-statements, checked to be Boolean once the types are known
+    statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
     reusable_views: dict[int, bool]
 

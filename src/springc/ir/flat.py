@@ -88,6 +88,18 @@ class Equation:
 
 
 @dataclass(frozen=True, slots=True)
+class Assertion:
+    """``assert(condition, message, level)`` (section 8.3.7): ``condition`` must hold
+    whenever the model is evaluated; ``level`` is ``error`` or ``warning``."""
+
+    condition: Expr
+    message: str
+    level: str
+    span: Span
+    origin: Origin
+
+
+@dataclass(frozen=True, slots=True)
 class Experiment:
     start: float | None = None
     stop: float | None = None
@@ -105,6 +117,7 @@ class FlatModel:
     span: Span
     notes: tuple[str, ...] = field(default=())
     whens: tuple[When, ...] = field(default=())  # when-clauses (ir/when.py)
+    assertions: tuple[Assertion, ...] = field(default=())
 
     @property
     def unknowns(self) -> tuple[Variable, ...]:
@@ -187,6 +200,14 @@ def format_equation(eq: Equation, origins: bool = False) -> str:
     return text
 
 
+def format_assertion(a: Assertion, origins: bool = False) -> str:
+    level = ", AssertionLevel.warning" if a.level == "warning" else ""
+    text = f"assert({_expr(a.condition)}, {_string(a.message)}{level});"
+    if origins:
+        text += f"  // {a.origin.describe()} ({a.span})"
+    return text
+
+
 def format_flat(model: FlatModel, origins: bool = False) -> str:
     """The flat model as Modelica text that springc parses back to the same model."""
     lines = [f"model {quote(model.name)}"]
@@ -198,6 +219,7 @@ def format_flat(model: FlatModel, origins: bool = False) -> str:
     lines += ["  " + format_equation(e, origins) for e in model.equations]
     for w in model.whens:
         lines += format_when(w, quote)
+    lines += ["  " + format_assertion(a, origins) for a in model.assertions]
     ex = model.experiment
     pairs = [(k, v) for k, v in (("StartTime", ex.start), ("StopTime", ex.stop),
                                  ("Interval", ex.interval), ("Tolerance", ex.tolerance))
@@ -261,6 +283,9 @@ def to_json_dict(model: FlatModel) -> dict[str, object]:
         "equations": [_equation_dict(e) for e in model.equations],
         "initial_equations": [_equation_dict(e) for e in model.initial_equations],
         **({"whens": [format_when(w, str, "") for w in model.whens]} if model.whens else {}),
+        "assertions": [{"condition": to_text(a.condition), "message": a.message,
+                        "level": a.level, "location": _span_dict(a.span)}
+                       for a in model.assertions],
         "experiment": {k: getattr(ex, k) for k in ("start", "stop", "interval", "tolerance")
                        if getattr(ex, k) is not None},
     }

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import Span
-from . import dae, latex
+from . import dae, flat, latex
 from .expr import ZERO, Expr, Var, add, mul, to_text
 from .hybrid import EventSystem
 
@@ -73,6 +73,8 @@ class ODE:
     parameters: tuple[dae.Parameter, ...]
     dae: dae.DAE
     events: EventSystem | None = None  # relations, discrete variables, when-clauses
+    # assert(...) conditions over states, step variables, parameters and time
+    assertions: tuple[flat.Assertion, ...] = ()
 
     def step_names(self) -> list[str]:
         """Every name computed by the steps, in order."""
@@ -125,6 +127,10 @@ def format_ode(ode: ODE) -> str:
         lines.append("aliases:")
         lines += [f"  {a.name} = {to_text(a.expr)}" for a in ode.observed]
     lines.append(f"observed: {', '.join(observed) if observed else '(none)'}")
+    if ode.assertions:
+        lines.append("assertions:")
+        lines += [f"  {to_text(a.condition)}  ({a.level}: {a.message!r})"
+                  for a in ode.assertions]
     return "\n".join(lines) + "\n"
 
 

@@ -159,9 +159,17 @@ class Range:
     span: Span
 
 
+@dataclass(frozen=True, slots=True)
+class Tuple:
+    """``(a, , c)``: the output list on the left of ``(a, b) = f(x)`` (``None``: a gap)."""
+
+    items: tuple[Expr | None, ...]
+    span: Span
+
+
 Expr = (
     Number | Bool | String | Ref | Colon | End | Unary | Binary | IfExpr | Call
-    | Comprehension | ArrayLit | MatrixLit | Range
+    | Comprehension | ArrayLit | MatrixLit | Range | Tuple
 )
 
 # -------------------------------------------------------------- modifications
@@ -298,7 +306,16 @@ class WhenEquation:
     span: Span
 
 
-Equation = Equality | Connect | ForEquation | IfEquation | CallEquation | WhenEquation
+class AlgorithmSection:
+    """An ``algorithm`` (or ``initial algorithm``) section of a model or block, kept
+    among the class's (initial) equations in order; section 11.1 of the specification."""
+
+    body: tuple[Statement, ...]
+    span: Span
+
+
+Equation = (Equality | Connect | ForEquation | IfEquation | CallEquation | WhenEquation
+            | AlgorithmSection)
 
 # ----------------------------------------------------------------- statements
 
@@ -326,7 +343,30 @@ class ForStatement:
     span: Span
 
 
-Statement = Assign | IfStatement | ForStatement
+@dataclass(frozen=True, slots=True)
+class CallStatement:
+    """A call standing as a statement, such as ``assert(...)``."""
+
+    call: Call
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class WhileStatement:
+    condition: Expr
+    body: tuple[Statement, ...]
+    span: Span
+
+
+@dataclass(frozen=True, slots=True)
+class Jump:
+    """``break`` or ``return`` (``kind``)."""
+
+    kind: str
+    span: Span
+
+
+Statement = Assign | IfStatement | ForStatement | CallStatement | WhileStatement | Jump
 
 # -------------------------------------------------------------------- classes
 

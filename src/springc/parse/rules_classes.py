@@ -18,7 +18,15 @@ from lark import Token
 from lark.tree import Meta
 
 from ..errors import Note, Span
-from ..ir.syntax import ClassDef, Component, Element, Modification, ShortDef, StoredDefinition
+from ..ir.syntax import (
+    AlgorithmSection,
+    ClassDef,
+    Component,
+    Element,
+    Modification,
+    ShortDef,
+    StoredDefinition,
+)
 from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
 from .rules_elements import causality, variability
 
@@ -131,10 +139,11 @@ class ClassRules(RuleBase):
         body: dict[str, list[Any]] = {"elements": [], "equation": [], "initial equation": [],
                                       "algorithm": [], "annotations": []}
         for section in sections:
-            if section.kind == "algorithm" and kind != "function":
-                self.reject("`algorithm` sections outside functions are", section.span,
-                             hint="use equations; springc accepts `algorithm` only in "
-                                  "functions (see \"Not supported yet\" in docs/language.md)")
+            if section.kind in ("algorithm", "initial algorithm") and kind != "function":
+                statements = tuple(i for i in section.items
+                                   if not isinstance(i, Annotation | Rejected))
+                target = "equation" if section.kind == "algorithm" else "initial equation"
+                body[target].append(AlgorithmSection(statements, section.span))
             elif section.kind == "initial algorithm":
                 self.reject("`initial algorithm` sections are", section.span)
             elif section.kind == "external":

@@ -17,6 +17,7 @@ from ..ir.syntax import (
     Assign,
     Call,
     CallEquation,
+    CallStatement,
     Connect,
     Equality,
     ForEquation,
@@ -24,8 +25,10 @@ from ..ir.syntax import (
     ForStatement,
     IfEquation,
     IfStatement,
+    Jump,
     Ref,
     WhenEquation,
+    WhileStatement,
 )
 from .rules_base import Rejected, RuleBase, T, join
 
@@ -104,8 +107,10 @@ class EquationRules(RuleBase):
     def assign_statement(self, meta: Meta, ch: list[Any]) -> Assign:
         return Assign((ch[0],), ch[1], self.span_of(meta))
 
-    def call_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("call statements (`f(x);`) are", self.span_of(meta))
+    def call_statement(self, meta: Meta, ch: list[Any]) -> CallStatement:
+        func, args = ch
+        span = self.span_of(meta)
+        return CallStatement(Call(func, args.args, args.named, span), span)
 
     def multi_assign(self, meta: Meta, ch: list[Any]) -> Assign:
         *targets, func, args = ch
@@ -118,14 +123,14 @@ class EquationRules(RuleBase):
     def output_item(self, meta: Meta, ch: list[Any]) -> Any:
         return ch[0] if ch else None
 
-    def break_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`break` statements are", self.span_of(meta))
+    def break_statement(self, meta: Meta, ch: list[Any]) -> Jump:
+        return Jump("break", self.span_of(meta))
 
-    def return_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`return` statements are", self.span_of(meta))
+    def return_statement(self, meta: Meta, ch: list[Any]) -> Jump:
+        return Jump("return", self.span_of(meta))
 
-    def while_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`while` loops are", self.keyword_span(meta, "while"))
+    def while_statement(self, meta: Meta, ch: list[Any]) -> WhileStatement:
+        return WhileStatement(ch[0], ch[1], self.span_of(meta))
 
     def when_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
         return self.reject("`when` statements are", self.keyword_span(meta, "when"))

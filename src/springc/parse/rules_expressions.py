@@ -31,6 +31,7 @@ from ..ir.syntax import (
     Ref,
     RefPart,
     String,
+    Tuple,
     Unary,
 )
 from .rules_base import RuleBase, Subs, join, of
@@ -98,9 +99,8 @@ class ExpressionRules(RuleBase):
                      self.span_of(meta))
         return ch[0]
 
-    def tuple(self, meta: Meta, ch: list[Any]) -> Any:
-        self.reject("output lists (`(a, b)`) outside `(a, b) := f(x)` are", self.span_of(meta))
-        return next((c for c in ch if c is not None), Bool(False, self.span_of(meta)))
+    def tuple(self, meta: Meta, ch: list[Any]) -> Tuple:
+        return Tuple(tuple(ch), self.span_of(meta))
 
     def matrix(self, meta: Meta, ch: list[Any]) -> MatrixLit:
         return MatrixLit(tuple(ch), self.span_of(meta))

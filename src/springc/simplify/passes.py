@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from ..errors import Note
 from ..ir import flat, ode
 from .alias import eliminate_aliases
+from .assertions import simplified_assertions
 from .balance import check_balance, dae_incidence
 from .causalize import causalize
 from .events import event_system
@@ -77,8 +78,9 @@ def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplifi
                                 u.nominal if u else None, u.unit if u else None,
                                 u.span if u else model.span))
     observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
+    assertions = simplified_assertions(model.assertions, system, aliased.aliases)
     result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
-                     aliased.dae.parameters, aliased.dae)
+                     aliased.dae.parameters, aliased.dae, assertions=assertions)
     events = event_system(model, result)
     if events is not None:
         check_reinits(model, result)

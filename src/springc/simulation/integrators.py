@@ -65,8 +65,11 @@ def _counted(rhs: Rhs) -> tuple[Rhs, list[int]]:
 
 
 def integrate(method: str, rhs: Rhs, times: np.ndarray, x0: np.ndarray, step: float,
-              pairs: Pairs | None = None) -> FixedStepResult:
-    """Integrate from ``times[0]`` and record the state at every output time."""
+              pairs: Pairs | None = None,
+              after_step: Callable[[float, np.ndarray], None] | None = None
+              ) -> FixedStepResult:
+    """Integrate from ``times[0]`` and record the state at every output time;
+    ``after_step(t, x)`` is called after every step (the model's assertions)."""
     if method not in METHODS:
         raise ValueError(f"unknown fixed-step method {method!r}; use one of {METHODS}")
     if step <= 0 or not np.isfinite(step):
@@ -89,6 +92,8 @@ def integrate(method: str, rhs: Rhs, times: np.ndarray, x0: np.ndarray, step: fl
             for _ in range(n):
                 x = advance(f, t, x, h, pairs, cache)
                 t += h
+                if after_step is not None:
+                    after_step(t, x)
         total_steps += n
         bad = ~np.isfinite(x)
         if bad.any():

@@ -222,6 +222,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 raise Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
+            if problem.asserts:
+                problem.asserts.start(start, x0, problem.z)
             reason = ""
             # a large model's generated functions may be plain Python: scipy's loop then
             compiled = engine == COMPILED and jitted(model.module)
@@ -247,6 +249,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             estimate, error_note = _estimate(estimate_mode, problem, grid, x0, states, solver,
                                              rtol, atol, step or None, compiled, loop_time,
                                              time.perf_counter() - began)
+            if problem.asserts and (compiled or not len(x0)):
+                problem.asserts.grid(grid, states, problem.z)
             outputs = _outputs(model, problem, grid, states)
     except Stop as stop_:
         raise stop_.error from None

@@ -180,7 +180,9 @@ def run_fixed(problem: Any, grid: np.ndarray, x0: np.ndarray, step: float
         return np.tile(x0, (len(grid), 1)), 0
     pairs = detect_pairs(problem.mod, problem.p, x0, float(grid[0]))
     try:
-        result = integrate(problem.solver, problem.rhs, grid, x0, step, pairs)
+        checks = problem.asserts
+        after = (lambda t, x: checks.step(t, x, problem.z)) if checks else None
+        result = integrate(problem.solver, problem.rhs, grid, x0, step, pairs, after)
     except NonFiniteState as err:
         raise non_finite_states(problem, err.time, err.indices, step) from None
     return result.x, result.steps

@@ -26,6 +26,7 @@ from ..errors import Note, SimulationError
 from ..ir.dae import derivative_name
 from ..pipeline import CompiledModel
 from ..simplify import describe_failure
+from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
 from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
@@ -79,6 +80,7 @@ class Problem:
         self.t = 0.0
         self.limits = limits = limits or Limits()
         self.deadline = time.perf_counter() + limits.time_limit
+        self.asserts = AssertionCheck(mod, p, self.names)
 
     def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
         where = code_location(err, self.path)
@@ -293,6 +295,9 @@ class StepLoop:
                 raise Stop(solver_failure(problem, float(integrator.t),
                                           np.asarray(integrator.y), message))
             sizes.append(integrator.t - before)
+            if problem.asserts:
+                problem.asserts.step(float(integrator.t), integrator.y, problem.z,
+                                     float(before), integrator.dense_output)
             if taken % CHECK_EVERY == 0 or self.steps + taken >= self.limits.max_steps:
                 self.check_limits(integrator, self.steps + taken, sizes)
             j = int(np.searchsorted(grid, integrator.t, side="right"))

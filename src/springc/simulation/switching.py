@@ -43,6 +43,7 @@ from ..simplify import (
     state_vector,
     switch,
 )
+from .assertions import check_trajectory
 from .limits import Limits, OverLimit, check_outputs, over_limit
 from .results import SimulationResult, SimulationStats
 from .solver_names import EXPLICIT, SOLVERS
@@ -233,11 +234,16 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
     method = solver if solver in SOLVERS else EXPLICIT
-    flat_model = derive_system(model.options).flat_model
+    derived = derive_system(model.options)
+    flat_model = derived.flat_model
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
                              rtol=rtol, atol=atol, method=SOLVERS[method],
                              parameters=parameters,
                              time_limit=(limits or Limits()).time_limit)
+    if flat_model.assertions:
+        known = parameter_values(derived.system.parameters, parameters)
+        check_trajectory(flat_model.assertions, np.asarray(grid, dtype=float), run.values,
+                         known)
     values = np.column_stack([run.values[name] for name in model.outputs])
     check_outputs(model.outputs, np.asarray(grid, dtype=float), values)
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))

@@ -1,0 +1,99 @@
+"""while, break and return (11.2.3-11.2.5) decided while flattening: exact results of
+loops on values known before the simulation, located errors otherwise."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from springc.errors import ErrorGroup, SpringcError, errors_of
+from springc.ir import expr as x
+from springc.ir.flat import FlatModel
+from springc.pipeline.files import flatten_files
+
+
+@pytest.fixture(autouse=True)
+def _no_springc_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("SPRINGC_PATH", raising=False)
+
+
+def flat_of(tmp_path: Path, text: str) -> FlatModel:
+    path = tmp_path / "m.mo"
+    path.write_text(text)
+    return flatten_files([path], None)
+
+
+def equations(m: FlatModel) -> list[str]:
+    return [f"{x.to_text(e.lhs)} = {x.to_text(e.rhs)}" for e in m.equations]
+
+
+def error_of(tmp_path: Path, text: str) -> str:
+    with pytest.raises((SpringcError, ErrorGroup)) as info:
+        flat_of(tmp_path, text)
+    (err,) = errors_of(info.value)
+    assert err.span is not None
+    return f"{err.span.line}:{err.span.column}: {err.message}"
+
+
+def test_loops_with_break_and_return(tmp_path: Path) -> None:
+    m = flat_of(tmp_path, """model M
+  function halve "halvings of u down to 1 or less (Collatz-free: a while loop)"
+    input Real u;
+    output Integer n;
+  protected
+    Real v;
+  algorithm
+    n := 0;
+    v := u;
+    while v > 1 loop
+      v := v / 2;
+      n := n + 1;
+    end while;
+  end halve;
+  function early
+    input Real u;
+    output Real r;
+  algorithm
+    r := 2 * u;
+    if r > 20 then
+      return;
+    end if;
+    r := r * u;
+  end early;
+  Real a = halve(100);
+  Real b = early(11);
+  Real c = early(5);
+  Real d;
+algorithm
+  d := 1;
+  for i in 1:10 loop
+    d := d * 2;
+    if noEvent(d > 25) then
+      break;
+    end if;
+  end for;
+end M;
+""")
+    # 100 / 2^7 = 0.78 <= 1; early(11) returns 22 at once; 2 * 5 * 5 = 50; 2^5 = 32
+    assert equations(m) == ["a = 7", "b = 22", "c = 50", "d = 32"]
+
+
+@pytest.mark.parametrize(("text", "message"), [
+    ("model M\n  Real y;\nalgorithm\n  y := time;\n  while noEvent(y > 1) loop\n"
+     "    y := y / 2;\n  end while;\nend M;\n",
+     "5:9: `while` loops whose condition is known only during the simulation are not "
+     "supported yet"),
+    ("model M\n  Real y;\nalgorithm\n  y := 0;\n  for i in 1:3 loop\n"
+     "    if noEvent(time > i) then\n      break;\n    end if;\n    y := y + 1;\n"
+     "  end for;\nend M;\n",
+     "7:7: `break` under a condition known only during the simulation is not supported "
+     "yet"),
+    ("model M\n  Real y;\nalgorithm\n  y := 1;\n  return;\nend M;\n",
+     "5:3: `return` is only allowed inside a function, not in an algorithm section of a "
+     "model"),
+    ("model M\n  Real y;\nalgorithm\n  y := 1;\n  break;\nend M;\n",
+     "5:3: `break` is only allowed inside a loop, not in an algorithm section of a model"),
+])
+def test_control_flow_errors(tmp_path: Path, text: str, message: str) -> None:
+    assert error_of(tmp_path, text) == message

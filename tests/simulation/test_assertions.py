@@ -1,0 +1,118 @@
+"""assert(...) during simulation: the step at which a decaying state crosses its bound
+(against the closed form exp(-k t)), warnings that do not stop the run, parameter-only
+assertions before the integration, the generated module's table and function."""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from springc.errors import SimulationError
+
+DECAY = """model Decay
+  parameter Real k = 2;
+  parameter Real bound = 0.5;
+  Real x(start = 1, fixed = true);
+  Real y;
+equation
+  der(x) = -k * x;
+  assert(k > 0, "k must be positive");
+algorithm
+  y := 2 * x;
+  assert(y > 2 * bound, "x fell below the bound", level = AssertionLevel.%s);
+  annotation(experiment(StopTime = 1, Interval = 0.01));
+end Decay;
+"""
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def model_file(tmp_path: Path, level: str = "error") -> str:
+    path = tmp_path / "decay.mo"
+    path.write_text(DECAY % level)
+    return str(path)
+
+
+CROSSING = math.log(2) / 2  # exp(-2 t) = 0.5
+
+
+@pytest.mark.parametrize(("solver", "step"), [("dop853", None), ("radau", None),
+                                              ("rk4", 0.001), ("verlet", 0.001)])
+def test_failing_assertion_stops_at_the_first_step_past_the_crossing(
+        tmp_path: Path, solver: str, step: float | None) -> None:
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(model_file(tmp_path), solver=solver, step=step, rtol=1e-8,
+                         engine="scipy")
+    err = info.value
+    head, _, message = err.message.partition(": ")
+    assert message == "x fell below the bound"
+    t = float(head.removeprefix("assertion failed at t = "))
+    # fixed step: the first step past the crossing; scipy's solvers: the crossing,
+    # located on the step's interpolant (rtol 1e-8; the message shows 9 digits)
+    if step is not None:
+        assert t == pytest.approx(math.ceil(CROSSING / step) * step, abs=1e-12)
+    else:
+        assert abs(t - CROSSING) < 1e-6
+    assert err.span is not None and (err.span.line, err.span.column) == (11, 3)
+
+
+def test_compiled_engine_checks_at_output_times(tmp_path: Path) -> None:
+    pytest.importorskip("numba")
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(model_file(tmp_path), solver="rk4", step=0.001,
+                         engine="compiled", backend="numba")
+    # the first output time (interval 0.01) after the crossing at 0.3466
+    assert info.value.message == "assertion failed at t = 0.35: x fell below the bound"
+
+
+def test_parameter_assertion_fails_before_the_integration(tmp_path: Path) -> None:
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(model_file(tmp_path), parameters={"k": -1.0})
+    assert info.value.message == "assertion failed before the simulation started: " \
+        "k must be positive"
+    assert info.value.span is not None and info.value.span.line == 8
+
+
+def test_warning_is_printed_once_and_the_run_goes_on(tmp_path: Path,
+                                                     capsys: pytest.CaptureFixture[str]
+                                                     ) -> None:
+    result = springc.simulate(model_file(tmp_path, "warning"), rtol=1e-8, progress=io.StringIO())
+    assert np.max(np.abs(result["x"] - np.exp(-2 * result.time))) < 1e-6
+    err = capsys.readouterr().err
+    assert err.count("warning: assertion failed") == 1
+    assert "decay.mo:11:3: warning: assertion failed at t = " in err
+    assert err.endswith(": x fell below the bound\n")
+
+
+def test_cli_exit_code_and_location(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from springc.cli import main
+
+    result = CliRunner().invoke(main, ["simulate", model_file(tmp_path), "--solver", "rk4",
+                                       "--step", "0.01", "-o", str(tmp_path / "o.csv")])
+    assert result.exit_code == 1
+    assert "decay.mo:11:3: error: assertion failed at t = 0.35: x fell below the bound" \
+        in result.stderr
+    assert not (tmp_path / "o.csv").exists()
+
+
+def test_generated_module_holds_the_messages_as_literals(tmp_path: Path) -> None:
+    path = tmp_path / "q.mo"
+    path.write_text('model Q\n  Real x = time;\nequation\n'
+                    '  assert(x < 2, "\\"\\"\\" + __import__(\'os\')");\nend Q;\n')
+    compiled = springc.compile_model(str(path))
+    module = compiled.module
+    assert (('""" + __import__(\'os\')', "error",
+                                  f"{path}:4:3", False),) == module.ASSERTIONS
+    p = module.parameters()
+    assert module.assertions(1.0, np.zeros(0), p, module.guesses(p)).tolist() == [1.0]
+    assert module.assertions(2.5, np.zeros(0), p, module.guesses(p)).tolist() == [0.0]
