@@ -43,6 +43,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.limits = Limits(max_size)
         self.views: dict[int, ClassView] = {}
         self.package_scopes: dict[int, ClassScope] = {}
+        self.rule_errors: dict[int, FlattenError] = {}
         self.parameter_values = ParameterValues()
         self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()

@@ -11,12 +11,13 @@ from __future__ import annotations
 import difflib
 from typing import Any
 
-from ..errors import FlattenError, Note, Span
+from ..errors import FlattenError, FollowUpError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
+from .rules import check_class
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -34,11 +35,19 @@ class ClassLookup(FlattenContext):
     tree: ClassTree
     views: dict[int, ClassView]
     package_scopes: dict[int, ClassScope]
+    rule_errors: dict[int, FlattenError]  # classes breaking a rule of rules.py
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
         if found is None:
             found = self.views[id(entry)] = build_view(entry, self, seen)
+            try:
+                check_class(self, found)
+            except FlattenError as err:
+                self.rule_errors[id(entry)] = err
+        broken = self.rule_errors.get(id(entry))
+        if broken is not None:
+            raise FollowUpError(broken)
         return found
 
     def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None
@@ -46,7 +55,7 @@ class ClassLookup(FlattenContext):
         for part in ref.parts:
             if part.subscripts:
                 raise FlattenError("a class name cannot have subscripts", part.span)
-        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span)
+        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span, owner)
 
     def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
         """Follow short class definitions down to a primitive type or a full class."""
