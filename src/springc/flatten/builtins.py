@@ -16,6 +16,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
 from .scope import ExpressionEvaluator, Handler, Scope
+from .type_rules import check_der_argument
 
 SCALAR_FUNCTIONS = {
     "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1,
@@ -82,6 +83,7 @@ class Builtins:
     # ---------------------------------------------------------------- handlers
 
     def der(self, call: s.Call, scope: Scope) -> a.Value:
+        check_der_argument(call, scope)
         (v,) = self._args(call, scope, 1)
         return a.elementwise(lambda e: x.ZERO if isinstance(e, x.Const) else x.Der(e), v)
 

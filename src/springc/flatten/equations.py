@@ -17,6 +17,7 @@ from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
 from .loops import check_loop_nest
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .type_rules import check_boolean_condition
 
 
 class EquationFlattening(FlattenContext):
@@ -85,6 +86,7 @@ class EquationFlattening(FlattenContext):
                 "inside noEvent(...)")
         finally:
             self.evaluator.no_event -= 1
+        check_boolean_condition(value, cond.span, "the condition of an if-equation")
         if not isinstance(value, bool | int | float | np.bool_):
             kind = "a string" if isinstance(value, str) else "an array"
             raise FlattenError(f"the condition of an if-equation must be a scalar Boolean, "

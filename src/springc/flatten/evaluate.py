@@ -21,6 +21,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .access import check_access_component
 from .builtins import CONSTANTS, Builtins
 from .functions import call_function
 from .parameters import check_powers
@@ -273,6 +274,7 @@ class Evaluator:
         if isinstance(current, ClassScope):
             if not current.has_member(part.name):
                 self._no_member(current, part)
+            check_access_component(current.view, part.name, part.span, current.prefix)
             return self._subscript(current.member(part.name, part.span), part, scope)
         if a.is_array(current) and current.size and isinstance(current.flat[0], ClassScope):
             items = [self._select(c, part, scope, ref) for c in current.flat]

@@ -15,6 +15,7 @@ from ..errors import FlattenError, FollowUpError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
+from .access import check_access_class, check_access_component
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
 from .rules import check_class
@@ -55,7 +56,9 @@ class ClassLookup(FlattenContext):
         for part in ref.parts:
             if part.subscripts:
                 raise FlattenError("a class name cannot have subscripts", part.span)
-        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span, owner)
+        found = self.tree.resolve([p.name for p in ref.parts], scope, ref.span, owner)
+        check_access_class(found, ref)
+        return found
 
     def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
         """Follow short class definitions down to a primitive type or a full class."""
@@ -122,9 +125,13 @@ class ClassLookup(FlattenContext):
         """``P.c``: a nested class or a constant of a package."""
         nested = member_class(entry, name)
         if nested is not None:
+            if nested.defn.protected:
+                check_access_class(nested, s.Ref((s.RefPart(entry.name, (), span),
+                                                  s.RefPart(name, (), span)), span))
             return nested
         package = self.package_scope(entry)
         if package.has_member(name):
+            check_access_component(package.view, name, span, entry.full_name)
             return package.member(name, span)
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
 

@@ -17,6 +17,7 @@ from ..errors import FlattenError, Note, Span
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from .scope import PRIMITIVES, ClassView, FlattenContext, ResolvedType, ViewComponent
+from .syntax_walk import mod_values, refs, statement_exprs, statements
 
 #: The kinds of base class each kind of class may extend (section 7.1.3's table).
 BASE_KINDS: dict[str, frozenset[str]] = {
@@ -69,6 +70,8 @@ def check_class(ctx: FlattenContext, view: ClassView) -> None:
         _check_block(ctx, view)
     elif defn.kind == "function":
         _check_function(view)
+    if defn.kind in ("function", "record", "connector"):
+        _check_no_time(view)
 
 
 def _check_names(defn: s.ClassDef) -> None:
@@ -266,7 +269,7 @@ def _check_function(view: ClassView) -> None:
                              "input nor output", decl.span, "the public components of a "
                              "function must be inputs or outputs; declare the others "
                              "protected", "12.2")
-    for stmt in _statements(view.entry.defn.algorithm):
+    for stmt in statements(view.entry.defn.algorithm):
         if isinstance(stmt, s.Assign):
             for target in stmt.targets:
                 if target is not None and target.parts[0].name in inputs:
@@ -275,12 +278,19 @@ def _check_function(view: ClassView) -> None:
                                      "the inputs of a function are read-only", "12.2")
 
 
-def _statements(body: tuple[s.Statement, ...]) -> Iterator[s.Statement]:
-    for stmt in body:
-        yield stmt
-        if isinstance(stmt, s.ForStatement):
-            yield from _statements(stmt.body)
-        elif isinstance(stmt, s.IfStatement):
-            for _, branch in stmt.branches:
-                yield from _statements(branch)
-            yield from _statements(stmt.otherwise)
+def _check_no_time(view: ClassView) -> None:
+    """``time`` is available in models and blocks only."""
+    kind = view.entry.defn.kind
+    local = set(view.components)
+    exprs: list[s.Expr] = []
+    for comp in view.components.values():
+        if comp.defined_in is view.entry:
+            exprs += mod_values(comp.decl.modification)
+    for stmt in statements(view.entry.defn.algorithm):
+        exprs += statement_exprs(stmt)
+    for e in exprs:
+        for ref in refs(e):
+            if ref.parts[0].name == "time" and "time" not in local:
+                raise rule_error(f"`time` cannot be used in a {kind}", ref.span,
+                                 "the built-in variable time is available only in models "
+                                 "and blocks", "3.6.7")

@@ -106,6 +106,9 @@ class ClassScope:
     # what must match for two connectors to be connected (names and flow prefixes).
     connector_leaves: list[Leaf] | None = None
     connector_signature: tuple[tuple[str, bool], ...] = ()
+    # constant/parameter/discrete on this (structured) component, which applies to its
+    # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
+    variability: str = ""
 
     @property
     def entry(self) -> ClassEntry:
