@@ -97,9 +97,8 @@ model M
   constant C c;
 end M;
 """,
-        "5:14: 'c' is declared `constant`, but its element 'x' is an input\nhelp: an input"
-        ' cannot also be a parameter or a constant (the prefix of a structured component'
-        ' applies to its elements) (Modelica 3.6, section 4.4.2.2)'),
+        "5:14: the connector 'c' cannot be declared `constant`\nhelp: a connector"
+        ' component cannot be a parameter or a constant (Modelica 3.6, section 9.3)'),
     "constant_bound_to_parameter": ("""\
 model M
   parameter Real x = 6.3;

@@ -17,6 +17,7 @@ from ..errors import ErrorGroup, FlattenError, FollowUpError, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..parse import ClassTree
+from .connect_rules import check_connector_size
 from .connections import ConnectionSets
 from .equations import EquationFlattening
 from .evaluate import Evaluator
@@ -142,6 +143,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), top]
+        for scope in scopes:
+            check_connector_size(scope)
         for scope in scopes:
             flattener.equations_of(scope)
         for scope in scopes:

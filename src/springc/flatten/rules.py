@@ -198,6 +198,10 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
                     "flow, input and output on a structured component apply to its "
                     "elements, which then may not have any of these prefixes", "4.4.2.2",
                     (Note(f"'{inner}' is declared here", inner_decl.span),))
+    if variability in ("parameter", "constant") and type_kind == "connector":
+        raise rule_error(f"the connector '{decl.name}' cannot be declared `{variability}`",
+                         decl.span, "a connector component cannot be a parameter or a "
+                         "constant", "9.3")
     if variability in ("parameter", "constant"):
         for inner, inner_decl in _elements(ctx, rtype.entry):
             if inner_decl.causality == "input":
