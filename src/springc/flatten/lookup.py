@@ -15,7 +15,7 @@ from ..errors import FlattenError, FollowUpError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
-from .access import check_access_class, check_access_component
+from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
 from .rules import check_class
@@ -56,8 +56,12 @@ class ClassLookup(FlattenContext):
         for part in ref.parts:
             if part.subscripts:
                 raise FlattenError("a class name cannot have subscripts", part.span)
-        found = self.tree.resolve([p.name for p in ref.parts], scope, ref.span, owner)
-        check_access_class(found, ref)
+        names = [p.name for p in ref.parts]
+        found = self.tree.resolve(names, scope, ref.span, owner)
+        if len(names) > 1:
+            chain = [self.tree.resolve(names[:k], scope, ref.span, owner)
+                     for k in range(1, len(names))]
+            check_access_path([*chain, found], ref)
         return found
 
     def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
@@ -123,15 +127,15 @@ class ClassLookup(FlattenContext):
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
         """``P.c``: a nested class or a constant of a package."""
+        ref = s.Ref((s.RefPart(entry.name, (), span), s.RefPart(name, (), span)), span)
         nested = member_class(entry, name)
         if nested is not None:
-            if nested.defn.protected:
-                check_access_class(nested, s.Ref((s.RefPart(entry.name, (), span),
-                                                  s.RefPart(name, (), span)), span))
+            check_access_path([entry, nested], ref)
             return nested
         package = self.package_scope(entry)
         if package.has_member(name):
             check_access_component(package.view, name, span, entry.full_name)
+            check_inside(entry, name, False, ref)
             return package.member(name, span)
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
 
@@ -149,6 +153,7 @@ class ClassLookup(FlattenContext):
         if name == "time":
             return x.TIME
         enclosing: ClassEntry | None = entry
+        encapsulated: ClassEntry | None = None
         while enclosing is not None:
             view = self.view(enclosing) if enclosing.parent is not None else None
             if view is not None and name in view.components and enclosing is not entry:
@@ -159,14 +164,35 @@ class ClassLookup(FlattenContext):
                         "only its constants are visible here", span,
                         [Note("declared here", decl.span)])
                 return self.package_scope(enclosing).member(name, span)
+            if enclosing.defn.encapsulated:  # lookup stops here (section 5.3.1)
+                encapsulated = enclosing
+                break
             enclosing = enclosing.parent
         found = lookup_class(name, entry)
         if found is not None:
             return found
         if name in CONSTANTS:
             return x.Const(CONSTANTS[name])
+        if encapsulated is not None and encapsulated.parent is not None \
+                and lookup_global_visible(self, name, encapsulated.parent):
+            raise FlattenError(
+                f"undefined name '{name}': '{encapsulated.full_name}' is encapsulated",
+                span, [Note(f"'{encapsulated.full_name}' is declared encapsulated here",
+                            encapsulated.defn.span)],
+                "name lookup stops at an encapsulated class; import what it needs "
+                "(Modelica 3.6, section 5.3.1)")
         raise FlattenError(f"undefined name '{name}'", span,
                            hint="declare it, or check the spelling")
+
+
+def lookup_global_visible(ctx: ClassLookup, name: str, entry: ClassEntry) -> bool:
+    """Whether ``name`` is a component of ``entry`` or of a class enclosing it."""
+    enclosing: ClassEntry | None = entry
+    while enclosing is not None and enclosing.parent is not None:
+        if name in ctx.view(enclosing).components:
+            return True
+        enclosing = enclosing.parent
+    return False
 
 
 def select_model(tree: ClassTree, model: str | None) -> ClassEntry:

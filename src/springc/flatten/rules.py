@@ -69,7 +69,7 @@ def check_class(ctx: FlattenContext, view: ClassView) -> None:
     if defn.kind == "block":
         _check_block(ctx, view)
     elif defn.kind == "function":
-        _check_function(view)
+        _check_function(ctx, view)
     if defn.kind in ("function", "record", "connector"):
         _check_no_time(view)
 
@@ -190,7 +190,9 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
     if causality or flow:
         prefix = causality or "flow"
         for inner, inner_decl in _elements(ctx, rtype.entry):
-            if inner_decl.causality or inner_decl.flow:
+            # flow over an input/output element is accepted (the conformance suite
+            # holds it valid: Components.Prefixes.FlowValidClassType)
+            if inner_decl.flow or (inner_decl.causality and causality):
                 inner_prefix = inner_decl.causality or "flow"
                 raise rule_error(
                     f"'{decl.name}' is declared `{prefix}`, but its element '{inner}' is "
@@ -261,14 +263,16 @@ def _is_variable(ctx: FlattenContext, decl: s.Component, entry: ClassEntry) -> b
     return rtype is not None and rtype.primitive is not None
 
 
-def _check_function(view: ClassView) -> None:
+def _check_function(ctx: FlattenContext, view: ClassView) -> None:
     """Public elements of a function are inputs or outputs; inputs are not assigned."""
     inputs = set()
     for comp in view.components.values():
         decl = comp.decl
-        if decl.causality == "input":
+        rtype = _resolved(ctx, comp)
+        causality = decl.causality or (rtype.prefixes[1] if rtype is not None else "")
+        if causality == "input":
             inputs.add(decl.name)
-        elif not decl.protected and not decl.causality:
+        elif not decl.protected and not causality:
             raise rule_error(f"'{decl.name}' is a public element of a function but neither "
                              "input nor output", decl.span, "the public components of a "
                              "function must be inputs or outputs; declare the others "

@@ -360,6 +360,13 @@ def _import_path(root: ClassEntry, path: Sequence[str], element: s.Import,
                 element.span, hint="load the library that defines it (name its file, "
                 "or pass its folder with -L or in MODELICAPATH)"
                 + (f"; searched {tree.searched()}" if tree is not None else ""))
+        if member.defn.kind != "package" and depth == len(path) - 1:
+            raise FlattenError(
+                f"'{'.'.join(path[:depth + 1])}' is a {member.defn.kind}, and an import "
+                "takes classes and constants from packages only", element.span,
+                [Note(f"'{member.full_name}' is defined here", member.defn.span)],
+                hint="import from a package, or use the class by its full name (Modelica "
+                "3.6, section 13.2.1)")
         found = member
     return found
 
