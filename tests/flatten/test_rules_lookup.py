@@ -1,5 +1,6 @@
-"""Lookup rules (Modelica 3.6 sections 4.1, 5.3.1, 5.3.2, 5.6.1, 13.2.1): for each rule a
-valid model (its balance summary) and an invalid one (the exact error, location and help)."""
+"""Lookup rules (Modelica 3.6 sections 4.1, 4.6, 5.3.1, 5.3.2, 5.3.3, 5.6.1, 13.2.1): for each
+rule a valid model (its balance summary) and an invalid one (the exact error, location and
+help)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,8 @@ from pathlib import Path
 import pytest
 
 from rule_outcome import outcome
+from springc.ir import expr as x
+from springc.pipeline.files import flatten_files
 
 CASES = {
     "extends_base_of_own_subpackage": ("""\
@@ -126,6 +129,41 @@ end M;
         ' protected element can be used only by its simple name, inside its class and the'
         ' classes extending it, not through a dot from outside (Modelica 3.6, section'
         ' 4.1)'),
+    "global_type_and_constant": ("""\
+package P
+  constant Real c = 2;
+  model B
+    Real y = 3;
+  end B;
+end P;
+model M
+  package P
+    constant Real c = 5;
+  end P;
+  .P.B b;
+  Real x = .P.c;
+end M;
+""",
+        'M: 2 unknowns, 2 equations, 0 parameters: balanced'),
+    "package_constant": ("""\
+model M
+  package P
+    constant Real p = 4.23;
+  end P;
+  Real x = P.p;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "package_parameter": ("""\
+model M
+  package P
+    parameter Real p = 4.23;
+  end P;
+  Real x = P.p;
+end M;
+""",
+        "3:20: a package cannot have a parameter: 'p'\nhelp: a package may contain only"
+        ' classes and constants (Modelica 3.6, section 4.6)'),
 }
 
 
@@ -133,3 +171,12 @@ end M;
 def test_rule(tmp_path: Path, name: str) -> None:
     text, expected = CASES[name]
     assert outcome(tmp_path, text) == expected
+
+
+def test_global_names_start_at_the_top_level(tmp_path: Path) -> None:
+    """.P.c and .P.B are the top-level package's, not the local P's."""
+    path = tmp_path / "m.mo"
+    path.write_text(CASES["global_type_and_constant"][0])
+    flat = flatten_files([path])
+    assert [f"{x.to_text(e.lhs)} = {x.to_text(e.rhs)}" for e in flat.equations] == [
+        "b.y = 3", "x = 2"]

@@ -261,8 +261,11 @@ class Evaluator:
         first = e.parts[0]
         if first.name == "Modelica" and e.dotted in CONSTANTS:
             return x.Const(CONSTANTS[e.dotted])
-        current = scope.lookup(first.name, first.span)
-        current = self._subscript(current, first, scope)
+        if e.is_global:  # .A.B: a class from the top-level package (section 5.3.3)
+            current = self.flattener.resolve_class(s.Ref((first,), first.span, True),
+                                                   scope.entry)
+        else:
+            current = self._subscript(scope.lookup(first.name, first.span), first, scope)
         for part in e.parts[1:]:
             current = self._select(current, part, scope, e)
         return current

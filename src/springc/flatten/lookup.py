@@ -57,6 +57,8 @@ class ClassLookup(FlattenContext):
             if part.subscripts:
                 raise FlattenError("a class name cannot have subscripts", part.span)
         names = [p.name for p in ref.parts]
+        if ref.is_global:  # .A.B: from the top-level package (section 5.3.3)
+            scope, owner = self.tree.root, None
         found = self.tree.resolve(names, scope, ref.span, owner)
         if len(names) > 1:
             chain = [self.tree.resolve(names[:k], scope, ref.span, owner)
@@ -114,7 +116,7 @@ class ClassLookup(FlattenContext):
         return entry if entry is not None and entry.defn.kind == "function" else None
 
     def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry:
-        if lookup_class(ref.parts[0].name, scope.entry) is None:
+        if not ref.is_global and lookup_class(ref.parts[0].name, scope.entry) is None:
             close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else

@@ -63,6 +63,8 @@ def check_class(ctx: FlattenContext, view: ClassView) -> None:
     _check_extends(ctx, entry)
     if defn.kind in ("record", "connector"):
         _check_public_only(view)
+    if defn.kind == "package":
+        _check_package(view)
     for comp in view.components.values():
         if comp.defined_in is entry:
             _check_component(ctx, entry, comp)
@@ -133,6 +135,20 @@ def _check_public_only(view: ClassView) -> None:
         if comp.decl.protected:
             raise rule_error(f"a {kind} cannot have protected elements", comp.decl.span,
                              rule, "4.6")
+
+
+def _check_package(view: ClassView) -> None:
+    """A package holds only classes and constants."""
+    for comp in view.components.values():
+        if comp.decl.variability != "constant":
+            what = f"a {comp.decl.variability}" if comp.decl.variability else "a variable"
+            raise rule_error(f"a package cannot have {what}: '{comp.decl.name}'",
+                             comp.decl.span, "a package may contain only classes and "
+                             "constants", "4.6")
+    sections = [*view.equations, *view.initial_equations]
+    if sections:
+        raise rule_error("a package cannot have equations", sections[0].equation.span,
+                         "a package may contain only classes and constants", "4.6")
 
 
 def _resolved(ctx: FlattenContext, comp: ViewComponent) -> ResolvedType | None:

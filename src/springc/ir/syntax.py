@@ -46,10 +46,12 @@ class RefPart:
 
 @dataclass(frozen=True, slots=True)
 class Ref:
-    """A component or class reference such as ``ms[i].flange.f`` or ``Modelica.Constants.pi``."""
+    """A component or class reference such as ``ms[i].flange.f`` or ``Modelica.Constants.pi``;
+    ``is_global`` for ``.A.B``, looked up from the top-level package (section 5.3.3)."""
 
     parts: tuple[RefPart, ...]
     span: Span
+    is_global: bool = False
 
     @property
     def dotted(self) -> str:
