@@ -1,4 +1,4 @@
-"""Class rules (Modelica 3.6 sections 4.2, 4.6, 4.8, 7.1.3, 12.2): for each rule a valid
+"""Class rules (Modelica 3.6 sections 4.2, 4.6, 4.8, 7.1, 7.1.3, 12.2): for each rule a valid
 model (its balance summary) and an invalid one (the exact error, location and help)."""
 
 from __future__ import annotations
@@ -252,6 +252,85 @@ end M;
 """,
         "2:8: 'x' is declared twice, as a component and as a class\nhelp: the elements of"
         ' a class must have different names (Modelica 3.6, section 4.2)'),
+    "function_two_algorithms": ("""\
+model M
+  function F
+    input Real a;
+    output Real b;
+  protected
+    Real c;
+  algorithm
+    c := a;
+  algorithm
+    b := c;
+  end F;
+  Real x = F(2);
+end M;
+""",
+        '9:3: a function can have at most one `algorithm` section\nhelp: merge the'
+        ' statements into one section (Modelica 3.6, section 12.2)'),
+    "inherited_class_differs": ("""\
+model M
+  model Base
+    model A
+      Real x = 2;
+    end A;
+  end Base;
+  model A
+    Real x = 3;
+  end A;
+  extends Base;
+  A a;
+end M;
+""",
+        "7:3: class 'A' is inherited from 'M.Base' and declared here differently\nhelp: an"
+        ' inherited element may have the name of a local one only if both are identical'
+        ' (Modelica 3.6, section 7.1)'),
+    "inherited_class_identical": ("""\
+model M
+  model Base
+    model A
+      Real x = 2;
+    end A;
+  end Base;
+  model A
+    Real x = 2;
+  end A;
+  extends Base;
+  A a;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "protected_extends": ("""\
+model M
+  model A
+    Real x = 2;
+  end A;
+  model B
+  protected
+    extends A;
+  end B;
+  B b;
+  Real y = b.x;
+end M;
+""",
+        "10:14: 'x' is protected in 'M.B' and cannot be accessed as 'b.x'\nhelp: a"
+        ' protected element can be used only by its simple name, inside its class and the'
+        ' classes extending it, not through a dot from outside (Modelica 3.6, section'
+        ' 4.1)'),
+    "public_extends": ("""\
+model M
+  model A
+    Real x = 2;
+  end A;
+  model B
+    extends A;
+  end B;
+  B b;
+  Real y = b.x;
+end M;
+""",
+        'M: 2 unknowns, 2 equations, 0 parameters: balanced'),
 }
 
 

@@ -1,4 +1,4 @@
-"""Component, expression and access rules (Modelica 3.6 sections 3.6.7, 3.7.4, 3.8.2,
+"""Component, expression and access rules (Modelica 3.6 sections 3.6.7, 3.7.1, 3.7.4, 3.8.2,
 4.1, 4.4.2.2, 4.4.4.1, 8.3.4, 10.6.5): for each rule a valid model (its balance summary)
 and an invalid one (the exact error, location and help)."""
 
@@ -307,6 +307,22 @@ model M
 end M;
 """,
         'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "abs_of_boolean": ("""\
+model M
+  Boolean b;
+equation
+  b = abs(b);
+end M;
+""",
+        "4:11: abs needs a number: 'b' is a Boolean\nhelp: the arguments of abs are"
+        ' Integer or Real (Modelica 3.6, section 3.7.1)'),
+    "abs_of_integer": ("""\
+model M
+  parameter Integer i = -2;
+  Real y = abs(i);
+end M;
+""",
+        'M: 1 unknown, 1 equation, 1 parameter: balanced'),
 }
 
 

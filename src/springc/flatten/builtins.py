@@ -16,7 +16,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
 from .scope import ExpressionEvaluator, Handler, Scope
-from .type_rules import check_der_argument
+from .type_rules import check_der_argument, check_numeric_arguments
 
 SCALAR_FUNCTIONS = {
     "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1,
@@ -89,6 +89,7 @@ class Builtins:
 
     def math(self, call: s.Call, scope: Scope) -> a.Value:
         name = _ALIASES.get(call.func.dotted, call.func.dotted)
+        check_numeric_arguments(name, call, scope)
         args = self._args(call, scope, SCALAR_FUNCTIONS[name])
         try:
             return a.elementwise(lambda *xs: _call(name, xs), *args)

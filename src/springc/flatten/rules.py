@@ -17,7 +17,7 @@ from ..errors import FlattenError, Note, Span
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from .scope import PRIMITIVES, ClassView, FlattenContext, ResolvedType, ViewComponent
-from .syntax_walk import mod_values, refs, statement_exprs, statements
+from .syntax_walk import mod_values, refs, same_text, statement_exprs, statements
 
 #: The kinds of base class each kind of class may extend (section 7.1.3's table).
 BASE_KINDS: dict[str, frozenset[str]] = {
@@ -106,6 +106,7 @@ def _check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
                 base = ctx.resolve_class(base.defn.short.base, base.parent or base)
             except FlattenError:
                 return
+        _check_inherited_classes(entry, base)
         base_kind = base.defn.kind
         if base_kind not in allowed:
             raise rule_error(
@@ -113,6 +114,19 @@ def _check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
                 f"{base_kind}", element.base.span,
                 f"{_plural(kind)} may extend only {_kinds(allowed)}", "7.1.3",
                 (Note(f"'{base.full_name}' is defined here", base.defn.span),))
+
+
+def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
+    """A class inherited under the name of a local class must be the same class."""
+    local = {e.name: e for e in entry.defn.elements if isinstance(e, s.ClassDef)}
+    for element in base.defn.elements:
+        if isinstance(element, s.ClassDef) and element.name in local and \
+                not same_text(element, local[element.name]):
+            raise rule_error(f"class '{element.name}' is inherited from '{base.full_name}' "
+                             "and declared here differently", local[element.name].span,
+                             "an inherited element may have the name of a local one only "
+                             "if both are identical", "7.1",
+                             (Note("the inherited class is defined here", element.span),))
 
 
 def _check_public_only(view: ClassView) -> None:

@@ -15,7 +15,7 @@ a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defi
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -332,6 +332,8 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
             mods.append((element.modification, entry))
         mods.extend(base_view.extends_mods)
         for name, comp in base_view.components.items():
+            if element.protected and not comp.decl.protected:  # protected extends
+                comp = ViewComponent(replace(comp.decl, protected=True), comp.defined_in)
             _add_component(components, name, comp)
         equations += base_view.equations
         initial += base_view.initial_equations

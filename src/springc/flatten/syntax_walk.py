@@ -5,6 +5,7 @@ expression. Input: ``ir.syntax`` nodes; output: iterators over nodes."""
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import fields, is_dataclass
 
 from ..ir import syntax as s
 
@@ -75,4 +76,16 @@ def refs(e: object) -> Iterator[s.Ref]:
         yield from refs(e.body)
         for index in e.indices:
             yield from refs(index.range)
+
+
+def same_text(a: object, b: object) -> bool:
+    """Whether two syntax nodes are the same text up to where they are written."""
+    if type(a) is not type(b):
+        return False
+    if is_dataclass(a):
+        return all(f.name == "span" or same_text(getattr(a, f.name), getattr(b, f.name))
+                   for f in fields(a))
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(map(same_text, a, b))
+    return a == b
 

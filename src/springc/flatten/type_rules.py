@@ -1,8 +1,8 @@
-"""Rules on the types and variabilities of expressions (Modelica 3.6, sections 3.7.4,
-3.8, 4.4.4.1, 8.3.4 and 10.6): checked where flattening meets the expression.
+"""Rules on the types and variabilities of expressions (Modelica 3.6, sections 3.7.1,
+3.7.4, 3.8, 4.4.4.1, 8.3.4 and 10.6): checked where flattening meets the expression.
 
-Input: a declaration with its binding, a ``der`` argument, a condition value. Output:
-nothing, or a :class:`FlattenError` naming the rule and its section.
+Input: a declaration with its binding, a ``der`` or numeric argument, a condition value.
+Output: nothing, or a :class:`FlattenError` naming the rule and its section.
 """
 
 from __future__ import annotations
@@ -117,3 +117,23 @@ def check_boolean_condition(value: object, span: Span, what: str) -> None:
         raise rule_error(f"{what} must be a Boolean, found {kind}", span,
                          "conditions are Boolean expressions; compare the number, "
                          "e.g. `i <> 0`", "8.3.4")
+
+
+#: Built-in functions whose arguments are numbers (Integer or Real), never Boolean.
+NUMERIC_FUNCTIONS = frozenset({
+    "abs", "sign", "sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh",
+    "cosh", "tanh", "exp", "log", "log10", "floor", "ceil", "integer", "div", "mod", "rem"})
+
+
+def check_numeric_arguments(name: str, call: s.Call, scope: Scope) -> None:
+    """``abs(b)`` with a Boolean ``b`` is a type error (3.7.1)."""
+    if name not in NUMERIC_FUNCTIONS:
+        return
+    for arg in call.args:
+        prim = declared(arg, scope) if isinstance(arg, s.Ref) else None
+        if isinstance(arg, s.Bool) or (prim is not None and prim.type == "Boolean"):
+            what = f"'{arg.dotted}' is a Boolean" if isinstance(arg, s.Ref) else \
+                "the argument is a Boolean"
+            raise rule_error(f"{name} needs a number: {what}", arg.span,
+                             f"the arguments of {name} are Integer or Real", "3.7.1")
+

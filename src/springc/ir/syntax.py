@@ -217,9 +217,13 @@ class Component:
 
 @dataclass(frozen=True, slots=True)
 class Extends:
+    """``extends Base(k = 1)``; ``protected`` when written in a protected section (the
+    inherited elements are then protected)."""
+
     base: Ref
     modification: Modification | None
     span: Span
+    protected: bool = False
 
 
 @dataclass(frozen=True, slots=True)
