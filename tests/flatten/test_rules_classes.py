@@ -331,6 +331,18 @@ model M
 end M;
 """,
         'M: 2 unknowns, 2 equations, 0 parameters: balanced'),
+    "class_extends_model": ("""\
+model M
+  model Base
+    Real x = 1;
+  end Base;
+  class C
+    extends Base;
+  end C;
+  C c;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
 }
 
 

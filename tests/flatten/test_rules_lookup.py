@@ -164,6 +164,34 @@ end M;
 """,
         "3:20: a package cannot have a parameter: 'p'\nhelp: a package may contain only"
         ' classes and constants (Modelica 3.6, section 4.6)'),
+    "inherited_binding_uses_derived_name": ("""\
+model M
+  model Base
+    Integer x = y;
+  end Base;
+  model Derived
+    Integer y = 2;
+    extends Base;
+  end Derived;
+  Derived d;
+end M;
+""",
+        "3:17: 'y' is not visible in 'M.Base', where this is written\nhelp: names in an"
+        ' inherited element are looked up from the class that declares it, not from the'
+        ' class extending it (Modelica 3.6, section 5.6.1)'),
+    "inherited_binding_uses_own_name": ("""\
+model M
+  model Base
+    parameter Integer y = 2;
+    Integer x = y;
+  end Base;
+  model Derived
+    extends Base(y = 3);
+  end Derived;
+  Derived d;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 1 parameter: balanced'),
 }
 
 

@@ -17,6 +17,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
 from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
+from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
 from .rules import check_class
 from .scope import (
@@ -44,6 +45,7 @@ class ClassLookup(FlattenContext):
             found = self.views[id(entry)] = build_view(entry, self, seen)
             try:
                 check_class(self, found)
+                check_inherited_names(self, found)
             except FlattenError as err:
                 self.rule_errors[id(entry)] = err
         broken = self.rule_errors.get(id(entry))
