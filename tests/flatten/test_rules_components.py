@@ -323,6 +323,34 @@ model M
 end M;
 """,
         'M: 1 unknown, 1 equation, 1 parameter: balanced'),
+    "if_equation_on_time": ("""\
+model M
+  Real x;
+equation
+  if time < 1.0 then
+    x = 1;
+  else
+    x = 2;
+  end if;
+end M;
+""",
+        '4:6: the condition of an if-equation must be a parameter expression, but it'
+        ' depends on time\nhelp: switching equations on a variable needs events, which are'
+        ' not supported yet; for a continuous switch write one equation with an'
+        ' if-expression inside noEvent(...)'),
+    "if_equation_on_parameter": ("""\
+model M
+  parameter Real t0 = 0.5;
+  Real x;
+equation
+  if t0 < 1.0 then
+    x = 1;
+  else
+    x = 2;
+  end if;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 1 parameter: balanced'),
 }
 
 

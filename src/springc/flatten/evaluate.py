@@ -95,6 +95,8 @@ class Evaluator:
         assert not isinstance(v, np.ndarray)
         if type(v) is x.Const:
             return v.value
+        if any(type(n) is x.Time for n in x.walk(v)):  # not a parameter (x.evaluate: 0)
+            raise KeyError("time")
         check_powers(v, self.flattener.parameter_values)
         return x.evaluate(v, self.flattener.parameter_values)
 
