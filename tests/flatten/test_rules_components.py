@@ -1,6 +1,6 @@
 """Component, expression and access rules (Modelica 3.6 sections 3.6.7, 3.7.1, 3.7.4, 3.8.2,
-4.1, 4.4.2.2, 4.4.4.1, 8.3.4, 10.6.5): for each rule a valid model (its balance summary)
-and an invalid one (the exact error, location and help)."""
+3.8.4, 4.1, 4.4.2.2, 4.4.4.1, 8.3.4, 10.6.5): for each rule a valid model (its balance
+summary) and an invalid one (the exact error, location and help)."""
 
 from __future__ import annotations
 
@@ -351,6 +351,42 @@ equation
 end M;
 """,
         'M: 1 unknown, 1 equation, 1 parameter: balanced'),
+    "integer_of_function_of_continuous": ("""\
+model M
+  function f
+    input Real x;
+    output Integer y;
+  algorithm
+    y := integer(x);
+  end f;
+  Real x = time;
+  Integer y = f(x);
+end M;
+""",
+        "9:15: 'y' is an Integer variable, but its value depends on the continuous-time"
+        " variable 'x'\nhelp: Integer, Boolean and discrete variables change only at"
+        ' events: their values are discrete-time expressions (relations, integer(),'
+        ' pre(), ... of continuous-time variables, not the variables themselves)'
+        ' (Modelica 3.6, section 3.8.4)'),
+    "integer_of_event_function": ("""\
+model M
+  Real x = 2.5;
+  Integer n = integer(x);
+  Integer s = size({x, x}, 1);
+end M;
+""",
+        'M: 3 unknowns, 3 equations, 0 parameters: balanced'),
+    "boolean_of_no_event_relation": ("""\
+model M
+  Real x = 2.5;
+  Boolean b = noEvent(x > 1);
+end M;
+""",
+        "3:15: 'b' is a Boolean variable, but its value depends on the continuous-time"
+        " variable 'x'\nhelp: Integer, Boolean and discrete variables change only at"
+        ' events: their values are discrete-time expressions (relations, integer(),'
+        ' pre(), ... of continuous-time variables, not the variables themselves)'
+        ' (Modelica 3.6, section 3.8.4)'),
 }
 
 

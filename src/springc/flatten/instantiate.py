@@ -34,7 +34,12 @@ from .scope import (
     ViewComponent,
     instance_mod,
 )
-from .type_rules import check_constant_binding, check_integer_binding, stronger
+from .type_rules import (
+    check_constant_binding,
+    check_discrete_binding,
+    check_integer_binding,
+    stronger,
+)
 from .variables import check_attribute_mods
 
 
@@ -192,6 +197,9 @@ class Instantiation(FlattenContext):
         name_list = _element_names(name, dims)
         names = a.make_array(name_list, dims) if dims else name
         binding = self.binding(mod, dims, name, decl)
+        if mod is not None and mod.value is not None:
+            check_discrete_binding(name, rtype.primitive or "Real", variability,
+                                   mod.value.expr, mod.value.scope)
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)

@@ -17,6 +17,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from .rules import rule_error
 from .scope import ClassScope, Primitive, Scope
+from .syntax_walk import refs
 
 #: Variabilities from the least to the most restrictive.
 _ORDER = ("", "continuous", "discrete", "parameter", "constant")
@@ -137,3 +138,80 @@ def check_numeric_arguments(name: str, call: s.Call, scope: Scope) -> None:
             raise rule_error(f"{name} needs a number: {what}", arg.span,
                              f"the arguments of {name} are Integer or Real", "3.7.1")
 
+
+
+#: Built-in calls whose value is discrete-time whatever their arguments (3.8.4): they
+#: generate events or give sizes.
+_DISCRETE_CALLS = frozenset({"integer", "floor", "ceil", "div", "mod", "rem", "pre", "edge",
+                             "change", "sample", "initial", "terminal", "size", "ndims",
+                             "cardinality"})
+_RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
+
+
+def continuous_part(e: s.Expr, scope: Scope) -> str | None:
+    """A continuous-time part of ``e`` (``time``, a continuous Real variable, or
+    ``noEvent`` of one), or None if ``e`` is a discrete-time expression (3.8.4);
+    references that cannot be resolved count as discrete."""
+    if isinstance(e, s.Ref):
+        if e.parts[0].name == "time" and len(e.parts) == 1:
+            prim_time = declared(e, scope)
+            return "time" if prim_time is None else None
+        prim = declared(e, scope)
+        if prim is not None and prim.type == "Real" and prim.variability == "continuous":
+            return f"the continuous-time variable '{e.dotted}'"
+        return None
+    if isinstance(e, s.Binary):
+        if e.op in _RELATIONS:
+            return None  # a relation generates events
+        return continuous_part(e.left, scope) or continuous_part(e.right, scope)
+    if isinstance(e, s.Unary):
+        return continuous_part(e.operand, scope)
+    if isinstance(e, s.IfExpr):
+        for cond, value in e.branches:
+            found = continuous_part(cond, scope) or continuous_part(value, scope)
+            if found:
+                return found
+        return continuous_part(e.otherwise, scope)
+    if isinstance(e, s.ArrayLit):
+        for item in e.items:
+            found = continuous_part(item, scope)
+            if found:
+                return found
+        return None
+    if isinstance(e, s.Call):
+        name = e.func.dotted
+        if name in _DISCRETE_CALLS:
+            return None
+        if name in ("noEvent", "smooth"):  # no events: relations inside are continuous
+            return _any_continuous_variable(e, scope)
+        for arg in (*e.args, *(n.value for n in e.named)):
+            found = continuous_part(arg, scope)
+            if found:
+                return found
+    return None
+
+
+def _any_continuous_variable(e: s.Call, scope: Scope) -> str | None:
+    for arg in e.args:
+        for ref in refs(arg):
+            found = continuous_part(ref, scope)
+            if found:
+                return found
+    return None
+
+
+def check_discrete_binding(name: str, type_name: str, variability: str,
+                           value: s.Expr | None, scope: Scope | None) -> None:
+    """An Integer, Boolean or discrete variable is bound to a discrete-time expression:
+    ``Integer y = f(x)`` with a continuous ``x`` is an error (3.8.4)."""
+    if value is None or scope is None or variability != "discrete":
+        return
+    found = continuous_part(value, scope)
+    if found is not None:
+        kind = "a discrete" if type_name == "Real" else f"an {type_name}" \
+            if type_name == "Integer" else f"a {type_name}"
+        raise rule_error(
+            f"'{name}' is {kind} variable, but its value depends on {found}", value.span,
+            "Integer, Boolean and discrete variables change only at events: their values "
+            "are discrete-time expressions (relations, integer(), pre(), ... of "
+            "continuous-time variables, not the variables themselves)", "3.8.4")
