@@ -343,6 +343,32 @@ model M
 end M;
 """,
         'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "identical_inherited_component": ("""\
+model M
+  model Base
+    Real x = 1;
+  end Base;
+  model D
+    extends Base;
+    Real x = 1;
+  end D;
+  D d;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "different_inherited_component": ("""\
+model M
+  model Base
+    Real x = 1;
+  end Base;
+  model D
+    extends Base;
+    Real x = 2;
+  end D;
+  D d;
+end M;
+""",
+        "7:10: 'x' is declared twice\nhelp: rename one of the components"),
 }
 
 

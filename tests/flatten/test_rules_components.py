@@ -387,6 +387,37 @@ end M;
         ' events: their values are discrete-time expressions (relations, integer(),'
         ' pre(), ... of continuous-time variables, not the variables themselves)'
         ' (Modelica 3.6, section 3.8.4)'),
+    "flow_record_in_connector": ("""\
+model M
+  record R
+    Real x;
+    Real y;
+  end R;
+  connector C
+    flow R r;
+    Real z = 1.0;
+    Real w = 2.0;
+  end C;
+  C c;
+end M;
+""",
+        'M: 4 unknowns, 4 equations, 0 parameters: balanced'),
+    "flow_record_over_flow_element": ("""\
+model M
+  connector C
+    Real e = 1.0;
+    flow Real f;
+  end C;
+  connector D
+    flow C c;
+    Real e;
+  end D;
+  D d;
+end M;
+""",
+        "7:12: 'c' is declared `flow`, but its element 'f' is already `flow`\nhelp: flow,"
+        ' input and output on a structured component apply to its elements, which then'
+        ' may not have any of these prefixes (Modelica 3.6, section 4.4.2.2)'),
 }
 
 

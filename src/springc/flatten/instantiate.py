@@ -146,6 +146,7 @@ class Instantiation(FlattenContext):
                      parent: ClassScope) -> ClassScope:
         scope = ClassScope(self, name, view, None, decl.span, parent)
         scope.variability = stronger(decl.variability, parent.variability)
+        scope.flow = decl.flow or parent.flow
         if mod is not None:
             check_modified(view, mod, name)
         if mod is not None or view.extends_mods:
@@ -209,7 +210,8 @@ class Instantiation(FlattenContext):
         else:
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         prim = Primitive(names, value, decl, variability, causality,
-                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+                         decl.flow or rtype.prefixes[2] or scope.flow, rtype.primitive or "Real",
+                         mod, dims)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b

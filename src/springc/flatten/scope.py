@@ -29,6 +29,7 @@ from . import arrays as a
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
+from .syntax_walk import same_text
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
 
@@ -109,6 +110,8 @@ class ClassScope:
     # constant/parameter/discrete on this (structured) component, which applies to its
     # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
     variability: str = ""
+    # flow on this structured component, which applies to its elements (4.4.2.2)
+    flow: bool = False
 
     @property
     def entry(self) -> ClassEntry:
@@ -350,7 +353,7 @@ def _add_component(components: dict[str, ViewComponent], name: str,
     existing = components.get(name)
     if existing is None:
         components[name] = comp
-    elif existing.decl != comp.decl:
+    elif not same_text(existing.decl, comp.decl):  # identical copies merge (7.1)
         raise FlattenError(f"'{name}' is declared twice", comp.decl.span,
                            [Note("first declared here", existing.decl.span)],
                            "rename one of the components")
