@@ -1,5 +1,5 @@
-"""Class rules (Modelica 3.6 sections 4.2, 4.6, 4.8, 7.1, 7.1.3, 12.2): for each rule a valid
-model (its balance summary) and an invalid one (the exact error, location and help)."""
+"""Class rules (Modelica 3.6 sections 4.2, 4.5.2, 4.6, 4.8, 7.1, 7.1.3, 12.2): for each rule a
+valid model (its balance summary) and an invalid one (the exact error, location and help)."""
 
 from __future__ import annotations
 
@@ -369,6 +369,49 @@ model M
 end M;
 """,
         "7:10: 'x' is declared twice\nhelp: rename one of the components"),
+    "extends_array_class_with_component": ("""\
+model M
+  model A
+    Real x = 1.0;
+  end A;
+  model A3 = A[3];
+  model B
+    extends A3;
+    Real y = 2.0;
+  end B;
+  B b;
+end M;
+""",
+        "7:5: 'B' extends 'A3', an array class, and cannot have other components,"
+        ' equations or base classes\nhelp: a class extending an array class, a class with'
+        ' type prefixes or a simple type holds nothing else (Modelica 3.6, section 4.5.2)'),
+    "block_extends_type": ("""\
+model M
+  type Base = Real;
+  block Derived
+    extends Base;
+  end Derived;
+  Derived d = 1.0;
+end M;
+""",
+        "4:13: a block cannot extend a type: 'Base' is a type\nhelp: blocks may extend"
+        ' only records, blocks or classes (Modelica 3.6, section 7.1.3)'),
+    "connector_extends_type": ("""\
+model M
+  type Voltage = Real(unit = "V");
+  connector Pin
+    Voltage v;
+    flow Real i;
+  end Pin;
+  connector PosPin
+    extends Pin;
+  end PosPin;
+  PosPin p;
+equation
+  p.v = 1;
+end M;
+""",
+        'M: 2 unknowns, 2 equations, 0 parameters: balanced'),
 }
 
 

@@ -19,7 +19,7 @@ from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
-from .rules import check_class
+from .rules import check_class, check_extends
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -41,7 +41,12 @@ class ClassLookup(FlattenContext):
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
-        if found is None:
+        if found is None and id(entry) not in self.rule_errors:
+            try:
+                check_extends(self, entry)
+            except FlattenError as err:
+                self.rule_errors[id(entry)] = err
+                raise
             found = self.views[id(entry)] = build_view(entry, self, seen)
             try:
                 check_class(self, found)
@@ -51,6 +56,7 @@ class ClassLookup(FlattenContext):
         broken = self.rule_errors.get(id(entry))
         if broken is not None:
             raise FollowUpError(broken)
+        assert found is not None
         return found
 
     def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None

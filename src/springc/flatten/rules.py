@@ -63,7 +63,6 @@ def check_class(ctx: FlattenContext, view: ClassView) -> None:
                          "class", defn.span, "Real, Integer, Boolean and String are "
                          "reserved names, like keywords", "4.8")
     _check_names(defn)
-    _check_extends(ctx, entry)
     if defn.kind in ("record", "connector"):
         _check_public_only(view)
     if defn.kind == "package":
@@ -95,28 +94,45 @@ def _check_names(defn: s.ClassDef) -> None:
                                        classes[element.name].span),))
 
 
-def _check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
+def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
+    """The extends clauses of ``entry``, before its inheritance is resolved: the kind of
+    each base class (7.1.3), and no other element beside a base class that is an array
+    class, has type prefixes or is a simple type (4.5.2)."""
     kind = entry.defn.kind
     allowed = BASE_KINDS.get(kind)
-    if allowed is None:
-        return
-    for element in entry.defn.elements:
-        if not isinstance(element, s.Extends):
-            continue
+    clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)]
+    for element in clauses:
         base = ctx.resolve_class(element.base, entry.parent or entry, entry)
-        while base.defn.short is not None and base.defn.short.base.dotted not in PRIMITIVES:
+        special = ""
+        while base.defn.short is not None:
+            short = base.defn.short
+            special = special or ("an array class" if short.dims else "a class with type "
+                                  "prefixes" if short.variability or short.causality or
+                                  short.flow else "")
+            if short.base.dotted in PRIMITIVES:
+                special = special or "a simple type"
+                break
             try:
-                base = ctx.resolve_class(base.defn.short.base, base.parent or base)
+                base = ctx.resolve_class(short.base, base.parent or base)
             except FlattenError:
                 return
         _check_inherited_classes(entry, base)
         base_kind = base.defn.kind
-        if base_kind not in allowed:
+        if allowed is not None and base_kind not in allowed:
             raise rule_error(
                 f"a {kind} cannot extend a {base_kind}: '{element.base.dotted}' is a "
                 f"{base_kind}", element.base.span,
                 f"{_plural(kind)} may extend only {_kinds(allowed)}", "7.1.3",
                 (Note(f"'{base.full_name}' is defined here", base.defn.span),))
+        others = [e for e in entry.defn.elements
+                  if isinstance(e, s.Component) or (isinstance(e, s.Extends) and e is not element)]
+        defn = entry.defn
+        if special and (others or defn.equations or defn.initial_equations or defn.algorithm):
+            raise rule_error(
+                f"'{entry.name}' extends '{element.base.dotted}', {special}, and cannot have "
+                "other components, equations or base classes", element.span,
+                "a class extending an array class, a class with type prefixes or a simple "
+                "type holds nothing else", "4.5.2")
 
 
 def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
