@@ -504,7 +504,6 @@ UNSUPPORTED = [
     ("operator record R end R;", "`operator` classes are"),
     ("impure function f end f;", "`impure` functions are"),
     ("model A Real x = (y)[1]; end A;", "subscripts on a parenthesized expression (`(e)[i]`) are"),
-    ("model A .B b; end A;", "global names (`.A.B`) are"),
     ("model A Real x := 1; end A;", "`:=` in a declaration is"),
     ("model A M m constrainedby N; end A;", "`constrainedby` is"),
 ]
@@ -565,3 +564,15 @@ def test_end_cannot_be_called() -> None:
         "    2 |   Real x[end(2)];\n"
         "      |          ^^^\n"
         "help: call a function by its name, e.g. size(x, 1)")
+
+
+def test_global_names_in_types_and_expressions() -> None:
+    stored = parse_text("model A\n  .P.B b;\n  Real x = .P.c + y;\nend A;\n", "g.mo")
+    b, x = stored.classes[0].elements
+    assert isinstance(b, Component) and isinstance(x, Component)
+    assert b.type_name.is_global and [p.name for p in b.type_name.parts] == ["P", "B"]
+    assert (b.type_name.span.line, b.type_name.span.column) == (2, 3)
+    value = x.modification.value if x.modification else None
+    assert isinstance(value, Binary) and isinstance(value.left, Ref)
+    assert value.left.is_global and value.left.dotted == "P.c"
+    assert isinstance(value.right, Ref) and not value.right.is_global

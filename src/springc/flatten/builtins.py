@@ -17,6 +17,7 @@ from ..ir import syntax as s
 from . import arrays as a
 from .array_builtins import ArrayBuiltins
 from .scope import ExpressionEvaluator, Handler, Scope
+from .type_rules import check_der_argument, check_numeric_arguments
 
 SCALAR_FUNCTIONS = {
     "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1,
@@ -84,11 +85,13 @@ class Builtins:
     # ---------------------------------------------------------------- handlers
 
     def der(self, call: s.Call, scope: Scope) -> a.Value:
+        check_der_argument(call, scope)
         (v,) = self._args(call, scope, 1)
         return a.elementwise(lambda e: x.ZERO if isinstance(e, x.Const) else x.Der(e), v)
 
     def math(self, call: s.Call, scope: Scope) -> a.Value:
         name = _ALIASES.get(call.func.dotted, call.func.dotted)
+        check_numeric_arguments(name, call, scope)
         args = self._args(call, scope, SCALAR_FUNCTIONS[name])
         try:
             return a.elementwise(lambda *xs: _call(name, xs), *args)

@@ -18,6 +18,7 @@ from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
+from .connect_rules import check_pair, check_sources
 from .scope import ClassScope, ExpressionEvaluator, Leaf, LocalScope, Primitive, Scope
 
 Key = tuple[str, bool]  # (flat variable name, outside)
@@ -110,6 +111,7 @@ class ConnectionSets:
         self.parent: dict[Key, Key] = {}
         self.flow: dict[Key, bool] = {}
         self.link: dict[Key, Link] = {}
+        self.causal: dict[str, str] = {}  # flat name -> input/output, for check_sources
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -173,6 +175,7 @@ class ConnectionSets:
                       cb.entry.defn.span)],
                 "connect connectors with the same variables (names, sizes and flow "
                 "prefixes)")
+        self.causal.update(check_pair(ca, cb, eq))
         link = Link(eq.span, owner.prefix, f"connect({ca.prefix}, {cb.prefix})")
         for p, q in zip(leaves_a, leaves_b):
             ka, kb = (p.name, out_a), (q.name, out_b)
@@ -193,6 +196,7 @@ class ConnectionSets:
             if self.flow[members[0]]:
                 out.append(self._flow_sum(members, first))
             else:
+                check_sources(members, self.causal, {k: self.link[k].span for k in members})
                 out += [flat.Equation(x.Var(members[0][0]), x.Var(k[0]), self.link[k].span,
                                       flat.Origin("connect", self.link[k].owner,
                                                   self.link[k].text))

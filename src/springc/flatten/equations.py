@@ -24,6 +24,7 @@ from .ranges import with_range
 from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .when import flatten_when, variable_if_equation
+from .type_rules import check_boolean_condition
 
 
 class EquationFlattening(FlattenContext):
@@ -113,6 +114,7 @@ class EquationFlattening(FlattenContext):
                 "inside noEvent(...)")
         finally:
             self.evaluator.no_event -= 1
+        check_boolean_condition(value, cond.span, "the condition of an if-equation")
         if not isinstance(value, bool | int | float | np.bool_):
             kind = "a string" if isinstance(value, str) else "an array"
             raise FlattenError(f"the condition of an if-equation must be a scalar Boolean, "

@@ -22,6 +22,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .assertions import guard_assertions
+from .access import check_access_component
 from .builtins import CONSTANTS, Builtins
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
@@ -99,6 +100,8 @@ class Evaluator:
         assert not isinstance(v, np.ndarray)
         if type(v) is x.Const:
             return v.value
+        if any(type(n) is x.Time for n in x.walk(v)):  # not a parameter (x.evaluate: 0)
+            raise KeyError("time")
         check_powers(v, self.flattener.parameter_values)
         return x.evaluate(v, self.flattener.parameter_values)
 
@@ -280,8 +283,11 @@ class Evaluator:
         first = e.parts[0]
         if first.name == "Modelica" and e.dotted in CONSTANTS:
             return x.Const(CONSTANTS[e.dotted])
-        current = scope.lookup(first.name, first.span)
-        current = self._subscript(current, first, scope)
+        if e.is_global:  # .A.B: a class from the top-level package (section 5.3.3)
+            current = self.flattener.resolve_class(s.Ref((first,), first.span, True),
+                                                   scope.entry)
+        else:
+            current = self._subscript(scope.lookup(first.name, first.span), first, scope)
         for part in e.parts[1:]:
             current = self._select(current, part, scope, e)
         return current
@@ -293,6 +299,7 @@ class Evaluator:
         if isinstance(current, ClassScope):
             if not current.has_member(part.name):
                 self._no_member(current, part)
+            check_access_component(current.view, part.name, part.span, current.prefix)
             return self._subscript(current.member(part.name, part.span), part, scope)
         if a.is_array(current) and current.size and isinstance(current.flat[0], ClassScope):
             items = [self._select(c, part, scope, ref) for c in current.flat]

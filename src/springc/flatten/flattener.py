@@ -20,6 +20,7 @@ from ..ir.when import When
 from ..parse import ClassTree
 from .algorithms import Section, apply_starts
 from .assertions import check_conditions, unique
+from .connect_rules import check_connector_size
 from .connections import ConnectionSets
 from .equations import EquationFlattening
 from .evaluate import Evaluator
@@ -47,6 +48,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.limits = Limits(max_size)
         self.views: dict[int, ClassView] = {}
         self.package_scopes: dict[int, ClassScope] = {}
+        self.rule_errors: dict[int, FlattenError] = {}
         self.parameter_values = ParameterValues()
         self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()
@@ -149,6 +151,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), top]
+        for scope in scopes:
+            check_connector_size(scope)
         for scope in scopes:
             flattener.equations_of(scope)
         for scope in scopes:

@@ -21,6 +21,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .access import check_modified
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .scope import (
@@ -33,6 +34,12 @@ from .scope import (
     ResolvedType,
     ViewComponent,
     instance_mod,
+)
+from .type_rules import (
+    check_constant_binding,
+    check_discrete_binding,
+    check_integer_binding,
+    stronger,
 )
 from .variables import check_attribute_mods
 
@@ -140,6 +147,10 @@ class Instantiation(FlattenContext):
     def _class_scope(self, name: str, view: ClassView, mod: Mod | None, decl: s.Component,
                      parent: ClassScope) -> ClassScope:
         scope = ClassScope(self, name, view, None, decl.span, parent)
+        scope.variability = stronger(decl.variability, parent.variability)
+        scope.flow = decl.flow or parent.flow
+        if mod is not None:
+            check_modified(view, mod, name)
         if mod is not None or view.extends_mods:
             scope.mod = instance_mod(mod, view, scope)
         if scope.mod is not None:
@@ -197,13 +208,19 @@ class Instantiation(FlattenContext):
 
     def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
                    mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
-        variability = decl.variability or rtype.prefixes[0] or (
-            "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous")
+        variability = stronger(decl.variability or rtype.prefixes[0] or (
+            "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous"),
+            scope.variability)
+        check_integer_binding(name, rtype.primitive or "Real",
+                              mod.value.expr if mod is not None and mod.value else None)
         causality = decl.causality or rtype.prefixes[1]
         check_attribute_mods(mod, rtype.primitive, name)
         name_list = _element_names(name, dims)
         names = a.make_array(name_list, dims) if dims else name
         binding = self.binding(mod, dims, name, decl)
+        if mod is not None and mod.value is not None:
+            check_discrete_binding(name, rtype.primitive or "Real", variability,
+                                   mod.value.expr, mod.value.scope)
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)
@@ -227,6 +244,7 @@ class Instantiation(FlattenContext):
         """The numeric value of a constant's binding (a constant expression): a number,
         or a numpy array of numbers."""
         span = mod.value.span if mod is not None and mod.value is not None else None
+        check_constant_binding(name, a.scalars(binding), self.parameter_values.bindings, span)
         try:
             value = self.evaluator.fold(binding)
         except KeyError as missing:

@@ -11,12 +11,15 @@ from __future__ import annotations
 import difflib
 from typing import Any
 
-from ..errors import FlattenError, Note, Span
+from ..errors import FlattenError, FollowUpError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, lookup_class, member_class
+from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
+from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
+from .rules import check_class, check_extends
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -34,11 +37,26 @@ class ClassLookup(FlattenContext):
     tree: ClassTree
     views: dict[int, ClassView]
     package_scopes: dict[int, ClassScope]
+    rule_errors: dict[int, FlattenError]  # classes breaking a rule of rules.py
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
-        if found is None:
+        if found is None and id(entry) not in self.rule_errors:
+            try:
+                check_extends(self, entry)
+            except FlattenError as err:
+                self.rule_errors[id(entry)] = err
+                raise
             found = self.views[id(entry)] = build_view(entry, self, seen)
+            try:
+                check_class(self, found)
+                check_inherited_names(self, found)
+            except FlattenError as err:
+                self.rule_errors[id(entry)] = err
+        broken = self.rule_errors.get(id(entry))
+        if broken is not None:
+            raise FollowUpError(broken)
+        assert found is not None
         return found
 
     def resolve_class(self, ref: s.Ref, scope: ClassEntry, owner: ClassEntry | None = None
@@ -46,7 +64,15 @@ class ClassLookup(FlattenContext):
         for part in ref.parts:
             if part.subscripts:
                 raise FlattenError("a class name cannot have subscripts", part.span)
-        return self.tree.resolve([p.name for p in ref.parts], scope, ref.span)
+        names = [p.name for p in ref.parts]
+        if ref.is_global:  # .A.B: from the top-level package (section 5.3.3)
+            scope, owner = self.tree.root, None
+        found = self.tree.resolve(names, scope, ref.span, owner)
+        if len(names) > 1:
+            chain = [self.tree.resolve(names[:k], scope, ref.span, owner)
+                     for k in range(1, len(names))]
+            check_access_path([*chain, found], ref)
+        return found
 
     def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType:
         """Follow short class definitions down to a primitive type or a full class."""
@@ -98,7 +124,7 @@ class ClassLookup(FlattenContext):
         return entry if entry is not None and entry.defn.kind == "function" else None
 
     def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry:
-        if lookup_class(ref.parts[0].name, scope.entry) is None:
+        if not ref.is_global and lookup_class(ref.parts[0].name, scope.entry) is None:
             close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else
@@ -111,11 +137,15 @@ class ClassLookup(FlattenContext):
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
         """``P.c``: a nested class or a constant of a package."""
+        ref = s.Ref((s.RefPart(entry.name, (), span), s.RefPart(name, (), span)), span)
         nested = member_class(entry, name)
         if nested is not None:
+            check_access_path([entry, nested], ref)
             return nested
         package = self.package_scope(entry)
         if package.has_member(name):
+            check_access_component(package.view, name, span, entry.full_name)
+            check_inside(entry, name, False, ref)
             return package.member(name, span)
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
 
@@ -133,6 +163,7 @@ class ClassLookup(FlattenContext):
         if name == "time":
             return x.TIME
         enclosing: ClassEntry | None = entry
+        encapsulated: ClassEntry | None = None
         while enclosing is not None:
             view = self.view(enclosing) if enclosing.parent is not None else None
             if view is not None and name in view.components and enclosing is not entry:
@@ -143,14 +174,35 @@ class ClassLookup(FlattenContext):
                         "only its constants are visible here", span,
                         [Note("declared here", decl.span)])
                 return self.package_scope(enclosing).member(name, span)
+            if enclosing.defn.encapsulated:  # lookup stops here (section 5.3.1)
+                encapsulated = enclosing
+                break
             enclosing = enclosing.parent
         found = lookup_class(name, entry)
         if found is not None:
             return found
         if name in CONSTANTS:
             return x.Const(CONSTANTS[name])
+        if encapsulated is not None and encapsulated.parent is not None \
+                and lookup_global_visible(self, name, encapsulated.parent):
+            raise FlattenError(
+                f"undefined name '{name}': '{encapsulated.full_name}' is encapsulated",
+                span, [Note(f"'{encapsulated.full_name}' is declared encapsulated here",
+                            encapsulated.defn.span)],
+                "name lookup stops at an encapsulated class; import what it needs "
+                "(Modelica 3.6, section 5.3.1)")
         raise FlattenError(f"undefined name '{name}'", span,
                            hint="declare it, or check the spelling")
+
+
+def lookup_global_visible(ctx: ClassLookup, name: str, entry: ClassEntry) -> bool:
+    """Whether ``name`` is a component of ``entry`` or of a class enclosing it."""
+    enclosing: ClassEntry | None = entry
+    while enclosing is not None and enclosing.parent is not None:
+        if name in ctx.view(enclosing).components:
+            return True
+        enclosing = enclosing.parent
+    return False
 
 
 def select_model(tree: ClassTree, model: str | None) -> ClassEntry:

@@ -15,7 +15,7 @@ a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defi
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -31,6 +31,7 @@ from .event_uses import EventUses
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
+from .syntax_walk import same_text
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
 
@@ -110,6 +111,11 @@ class ClassScope:
     # what must match for two connectors to be connected (names and flow prefixes).
     connector_leaves: list[Leaf] | None = None
     connector_signature: tuple[tuple[str, bool], ...] = ()
+    # constant/parameter/discrete on this (structured) component, which applies to its
+    # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
+    variability: str = ""
+    # flow on this structured component, which applies to its elements (4.4.2.2)
+    flow: bool = False
 
     @property
     def entry(self) -> ClassEntry:
@@ -341,6 +347,8 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
             mods.append((element.modification, entry))
         mods.extend(base_view.extends_mods)
         for name, comp in base_view.components.items():
+            if element.protected and not comp.decl.protected:  # protected extends
+                comp = ViewComponent(replace(comp.decl, protected=True), comp.defined_in)
             _add_component(components, name, comp)
         equations += base_view.equations
         initial += base_view.initial_equations
@@ -357,7 +365,7 @@ def _add_component(components: dict[str, ViewComponent], name: str,
     existing = components.get(name)
     if existing is None:
         components[name] = comp
-    elif existing.decl != comp.decl:
+    elif not same_text(existing.decl, comp.decl):  # identical copies merge (7.1)
         raise FlattenError(f"'{name}' is declared twice", comp.decl.span,
                            [Note("first declared here", existing.decl.span)],
                            "rename one of the components")

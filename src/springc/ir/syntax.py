@@ -46,10 +46,12 @@ class RefPart:
 
 @dataclass(frozen=True, slots=True)
 class Ref:
-    """A component or class reference such as ``ms[i].flange.f`` or ``Modelica.Constants.pi``."""
+    """A component or class reference such as ``ms[i].flange.f`` or ``Modelica.Constants.pi``;
+    ``is_global`` for ``.A.B``, looked up from the top-level package (section 5.3.3)."""
 
     parts: tuple[RefPart, ...]
     span: Span
+    is_global: bool = False
 
     @property
     def dotted(self) -> str:
@@ -223,9 +225,13 @@ class Component:
 
 @dataclass(frozen=True, slots=True)
 class Extends:
+    """``extends Base(k = 1)``; ``protected`` when written in a protected section (the
+    inherited elements are then protected)."""
+
     base: Ref
     modification: Modification | None
     span: Span
+    protected: bool = False
 
 
 @dataclass(frozen=True, slots=True)

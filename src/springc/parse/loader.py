@@ -211,9 +211,12 @@ class ClassTree:
         """The library path, in the words of an error message."""
         return ", then ".join(["the files named"] + [r.describe() for r in self.roots])
 
-    def resolve(self, path: Sequence[str], scope: ClassEntry, span: Span | None) -> ClassEntry:
-        """Look up a dotted class name from ``scope`` (Modelica lexical lookup)."""
-        entry = lookup_class(path[0], scope)
+    def resolve(self, path: Sequence[str], scope: ClassEntry, span: Span | None,
+                extends_in: ClassEntry | None = None) -> ClassEntry:
+        """Look up a dotted class name from ``scope`` (Modelica lexical lookup); for the
+        base class of an ``extends`` clause of ``extends_in``, see :func:`base_lookup`."""
+        entry = (lookup_class(path[0], scope) if extends_in is None
+                 else base_lookup(path[0], extends_in))
         if entry is None:
             raise FlattenError(f"unknown class '{'.'.join(path)}'", span,
                                hint=_unknown_class_hint(path[0], scope))
@@ -249,7 +252,7 @@ def member_class(entry: ClassEntry, name: str,
     for element in entry.defn.elements:
         if isinstance(element, s.Extends):
             try:
-                base = _resolve_quiet(element.base, entry.parent or entry, active | {key})
+                base = _resolve_quiet(element.base, entry, active | {key}, extends=True)
             except _LookupCycle:
                 dotted = ".".join(part.name for part in element.base.parts)
                 raise FlattenError(
@@ -266,9 +269,11 @@ def member_class(entry: ClassEntry, name: str,
     return None
 
 
-def _resolve_quiet(ref: s.Ref, scope: ClassEntry,
-                   active: frozenset[tuple[int, str]]) -> ClassEntry | None:
-    entry = lookup_class(ref.parts[0].name, scope, active)
+def _resolve_quiet(ref: s.Ref, scope: ClassEntry, active: frozenset[tuple[int, str]],
+                   extends: bool = False) -> ClassEntry | None:
+    first = ref.parts[0].name
+    entry = (base_lookup(first, scope, active) if extends
+             else lookup_class(first, scope, active))
     for part in ref.parts[1:]:
         if entry is None:
             return None
@@ -292,6 +297,25 @@ def lookup_class(name: str, scope: ClassEntry,
             return root.child(name)
         entry = entry.parent
     return None
+
+
+def base_lookup(name: str, entry: ClassEntry,
+                active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
+    """The first name of an ``extends`` clause of ``entry`` (Modelica 3.6, section
+    5.6.1): a class declared in ``entry`` itself (not inherited, so that the lookup
+    does not need the base classes it is resolving) or imported into it, else the
+    normal lookup from the enclosing class."""
+    found = entry.child(name) or _imported(entry, name, active)
+    if found is not None:
+        return found
+    if entry.parent is None:
+        return None
+    if entry.defn.encapsulated:
+        root = entry
+        while root.parent is not None:
+            root = root.parent
+        return root.child(name)
+    return lookup_class(name, entry.parent, active)
 
 
 def _imported(entry: ClassEntry, name: str,
@@ -336,6 +360,13 @@ def _import_path(root: ClassEntry, path: Sequence[str], element: s.Import,
                 element.span, hint="load the library that defines it (name its file, "
                 "or pass its folder with -L or in MODELICAPATH)"
                 + (f"; searched {tree.searched()}" if tree is not None else ""))
+        if member.defn.kind != "package" and depth == len(path) - 1:
+            raise FlattenError(
+                f"'{'.'.join(path[:depth + 1])}' is a {member.defn.kind}, and an import "
+                "takes classes and constants from packages only", element.span,
+                [Note(f"'{member.full_name}' is defined here", member.defn.span)],
+                hint="import from a package, or use the class by its full name (Modelica "
+                "3.6, section 13.2.1)")
         found = member
     return found
 

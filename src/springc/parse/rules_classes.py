@@ -23,6 +23,7 @@ from ..ir.syntax import (
     ClassDef,
     Component,
     Element,
+    Extends,
     Modification,
     ShortDef,
     StoredDefinition,
@@ -137,7 +138,8 @@ class ClassRules(RuleBase):
 
     def _body(self, sections: tuple[_Section, ...], kind: str) -> dict[str, tuple[Any, ...]]:
         body: dict[str, list[Any]] = {"elements": [], "equation": [], "initial equation": [],
-                                      "algorithm": [], "annotations": []}
+                                      "algorithm": [], "annotations": [],
+                                      "algorithm_sections": []}
         for section in sections:
             if section.kind in ("algorithm", "initial algorithm") and kind != "function":
                 statements = tuple(i for i in section.items
@@ -148,16 +150,23 @@ class ClassRules(RuleBase):
                 self.reject("`initial algorithm` sections are", section.span)
             elif section.kind == "external":
                 self.reject("`external` functions are", section.span)
+            elif section.kind == "algorithm" and body["algorithm_sections"]:
+                self.error("a function can have at most one `algorithm` section",
+                           section.span, hint="merge the statements into one section "
+                           "(Modelica 3.6, section 12.2)")
             elif section.kind in ("equation", "initial equation") and kind == "function":
                 self.error(f"a function cannot have an `{section.kind}` section", section.span,
                             hint="compute the outputs in an `algorithm` section")
+            if section.kind == "algorithm":
+                body["algorithm_sections"].append(section)
             for item in section.items:
                 if isinstance(item, Annotation):
                     body["annotations"].append(item.modification)
                 elif isinstance(item, Rejected):
                     continue
                 elif section.kind in ("public", "protected"):
-                    if section.kind == "protected" and isinstance(item, Component | ClassDef):
+                    if section.kind == "protected" and isinstance(item, Component | ClassDef
+                                                                  | Extends):
                         item = replace(item, protected=True)
                     body["elements"].append(item)
                 elif section.kind in body:

@@ -136,8 +136,8 @@ class ElementRules(RuleBase):
         return self.make_ref(ch[0])
 
     def global_type_specifier(self, meta: Meta, ch: list[Any]) -> Any:
-        self.reject("global names (`.A.B`) are", self.keyword_span(meta, "."))
-        return self.make_ref(ch[0])
+        ref = self.make_ref(ch[0])
+        return Ref(ref.parts, self.span_of(meta), is_global=True)
 
     def component_declaration(self, meta: Meta, ch: list[Any]) -> Any:
         dims = of(ch, Subs)

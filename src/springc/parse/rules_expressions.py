@@ -129,8 +129,8 @@ class ExpressionRules(RuleBase):
         return Ref(parts, self.span_of(meta))
 
     def global_reference(self, meta: Meta, ch: list[Any]) -> Any:
-        self.reject("global names (`.A.B`) are", self.keyword_span(meta, "."))
-        return self.component_reference(meta, ch)
+        ref = self.component_reference(meta, ch)
+        return Ref(ref.parts, ref.span, is_global=True)
 
     def ref_part(self, meta: Meta, ch: list[Any]) -> RefPart:
         subs = of(ch, Subs)

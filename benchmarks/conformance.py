@@ -1,0 +1,268 @@
+"""springc against the Modelica conformance suite (modelica/Modelica-Compliance).
+
+    PYTHONPATH=src python benchmarks/conformance.py [SUITE] [--jobs N] [--timeout S]
+        [--section NAME]... [--list CATEGORY] [--simulate] [--json out.json]
+
+SUITE is the folder holding ``ModelicaCompliance/`` (default /work/ref/compliance; the
+suite is never part of this repository). Every class annotated
+``__ModelicaAssociation(TestCase(shouldPass = true|false))`` is checked in process
+(load -> flatten -> balance check, as ``springc check -L SUITE --model NAME`` does), in
+at most ``--jobs`` worker processes (2 by default), each model under ``--timeout``
+seconds, and classified:
+
+- ``valid-passed``: shouldPass = true and the check passes;
+- ``valid-unsupported`` / ``valid-rejected``: a valid model rejected, every error saying
+  "not supported" / some other error;
+- ``invalid-rejected``: shouldPass = false and rejected with an error of its own;
+- ``invalid-unsupported``: an invalid model rejected only with "not supported";
+- ``invalid-accepted``: an invalid model wrongly accepted;
+- ``crash``: an internal error (what the CLI reports with exit code 3);
+- ``timeout``: the check took longer than ``--timeout``.
+
+Valid models with an error whose help cites the specification (springc's static
+rules) are listed after the table, even when another error rejects them first.
+
+The table gives the counts per section (the top-level folder: Algorithms, Arrays,
+Classes, ...). ``--list CATEGORY`` prints the models of a category with the first line
+of their error. ``--simulate`` also simulates the valid models that pass and carry an
+``experiment`` annotation (categories ``sim-ok``, ``sim-failed``, ``sim-crash``,
+``sim-timeout``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import signal
+import subprocess
+from collections import Counter, defaultdict
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from types import FrameType
+
+CHECK_CATEGORIES = ("valid-passed", "valid-unsupported", "valid-rejected",
+                    "invalid-rejected", "invalid-unsupported", "invalid-accepted",
+                    "crash", "timeout")
+SIM_CATEGORIES = ("sim-ok", "sim-failed", "sim-crash", "sim-timeout")
+SHORT = {"valid-passed": "v-ok", "valid-unsupported": "v-unsup", "valid-rejected": "v-rej",
+         "invalid-rejected": "i-rej", "invalid-unsupported": "i-unsup",
+         "invalid-accepted": "i-ACC", "crash": "crash", "timeout": "tmo",
+         "sim-ok": "sim-ok", "sim-failed": "sim-fail", "sim-crash": "sim-crash",
+         "sim-timeout": "sim-tmo"}
+
+_TEST_CASE = re.compile(r"__ModelicaAssociation\s*\(\s*TestCase\s*\(\s*shouldPass\s*=\s*"
+                        r"(true|false)")
+_WITHIN = re.compile(r"^\s*within\s+([\w.]*)\s*;", re.MULTILINE)
+_CLASS = re.compile(r"^\s*(?:encapsulated\s+|partial\s+)*(?:model|block|class|package|"
+                    r"connector|record|function)\s+(\w+)", re.MULTILINE)
+
+
+@dataclass(frozen=True)
+class TestModel:
+    name: str
+    section: str
+    should_pass: bool
+    experiment: bool
+
+
+@dataclass(frozen=True)
+class Outcome:
+    name: str
+    section: str
+    valid: bool
+    category: str
+    message: str = ""
+    sim: str = ""
+    sim_message: str = ""
+    rule: str = ""  # the first error citing the specification (a rule of springc's)
+
+
+class _Timeout(Exception):
+    pass
+
+
+def find_models(suite: Path) -> list[TestModel]:
+    """Every test model of the suite: one per file, named by ``within`` and its class."""
+    models = []
+    for path in sorted((suite / "ModelicaCompliance").rglob("*.mo")):
+        text = path.read_text(encoding="utf-8-sig", errors="replace")
+        match = _TEST_CASE.search(text)
+        if not match or (path.stem == "Template" and path.parent.name == "ModelicaCompliance"):
+            continue
+        within = _WITHIN.search(text)
+        cls = _CLASS.search(text)
+        if not within or not cls:
+            continue
+        name = f"{within.group(1)}.{cls.group(1)}"
+        section = name.split(".")[1] if name.count(".") >= 2 else "(top)"
+        models.append(TestModel(name, section, match.group(1) == "true",
+                                "experiment" in text))
+    return models
+
+
+def _alarm(signum: int, frame: FrameType | None) -> None:
+    raise _Timeout
+
+
+def _first_line(text: str) -> str:
+    return text.strip().splitlines()[0] if text.strip() else ""
+
+
+def _classify_errors(exc: BaseException) -> tuple[bool, str, str]:
+    """(every error says "not supported", first error's first line, first line of the
+    first error whose help cites the specification)."""
+    from springc.errors import errors_of, render
+
+    errors = errors_of(exc)  # type: ignore[arg-type]
+    unsupported = all("not supported" in e.message for e in errors)
+    rules = [e for e in errors if e.hint and "(Modelica 3.6, section" in e.hint]
+    return (unsupported, _first_line(render(errors[0])),
+            _first_line(render(rules[0])) if rules else "")
+
+
+def run_one(args: tuple[TestModel, str, float, bool]) -> Outcome:
+    """Check (and maybe simulate) one model in this worker process."""
+    model, suite, timeout, simulate = args
+    from springc.errors import ErrorGroup, SpringcError
+    from springc.ir.expr import recursion_room
+    from springc.pipeline import flatten_files
+    from springc.simplify import check_balance
+
+    signal.signal(signal.SIGALRM, _alarm)
+    signal.setitimer(signal.ITIMER_REAL, timeout)
+    rule = ""
+    try:
+        with recursion_room():
+            check_balance(flatten_files([], model.name, [suite]))
+        category, message = ("valid-passed" if model.should_pass else "invalid-accepted"), ""
+    except _Timeout:
+        category, message = "timeout", f"over {timeout:g} s"
+    except (SpringcError, ErrorGroup) as err:
+        unsupported, message, rule = _classify_errors(err)
+        if model.should_pass:
+            category = "valid-unsupported" if unsupported else "valid-rejected"
+        else:
+            category = "invalid-unsupported" if unsupported else "invalid-rejected"
+    except Exception as err:  # springc's own bug: exit 3 in the CLI
+        category, message = "crash", f"{type(err).__name__}: {err}"[:300]
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    if not (simulate and category == "valid-passed" and model.experiment):
+        return Outcome(model.name, model.section, model.should_pass, category,
+                       message, rule=rule)
+    sim, sim_message = _simulate(model, suite, timeout)
+    return Outcome(model.name, model.section, model.should_pass, category, message, sim,
+                   sim_message, rule)
+
+
+def _simulate(model: TestModel, suite: str, timeout: float) -> tuple[str, str]:
+    import springc
+    from springc.errors import ErrorGroup, SpringcError
+    from springc.ir.expr import recursion_room
+
+    signal.setitimer(signal.ITIMER_REAL, timeout)
+    try:
+        with recursion_room():
+            compiled = springc.compile_model([], model.name, libraries=[suite], cache=False)
+            springc.simulate(compiled)
+        return "sim-ok", ""
+    except _Timeout:
+        return "sim-timeout", f"over {timeout:g} s"
+    except (SpringcError, ErrorGroup) as err:
+        return "sim-failed", _classify_errors(err)[1]
+    except Exception as err:
+        return "sim-crash", f"{type(err).__name__}: {err}"[:300]
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+
+
+def suite_commit(suite: Path) -> str:
+    try:
+        out = subprocess.run(["git", "-C", str(suite), "rev-parse", "HEAD"],
+                             capture_output=True, text=True, check=True)
+        return out.stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown (not a git checkout)"
+
+
+def table(outcomes: list[Outcome], simulate: bool) -> str:
+    columns = CHECK_CATEGORIES + (SIM_CATEGORIES if simulate else ())
+    per: dict[str, Counter[str]] = defaultdict(Counter)
+    for o in outcomes:
+        for key in (o.section, "TOTAL"):
+            per[key][o.category] += 1
+            per[key]["n"] += 1
+            if o.sim:
+                per[key][o.sim] += 1
+    heads = ["section", "n"] + [SHORT[c] for c in columns]
+    rows = [[s, str(per[s]["n"])] + [str(per[s][c]) for c in columns]
+            for s in [*sorted(k for k in per if k != "TOTAL"), "TOTAL"]]
+    widths = [max(len(r[i]) for r in [*rows, heads]) for i in range(len(heads))]
+    lines = ["  ".join(h.ljust(w) if i == 0 else h.rjust(w)
+                       for i, (h, w) in enumerate(zip(heads, widths)))]
+    lines += ["  ".join(c.ljust(w) if i == 0 else c.rjust(w)
+                        for i, (c, w) in enumerate(zip(r, widths))) for r in rows]
+    return "\n".join(lines)
+
+
+def summary(outcomes: list[Outcome]) -> str:
+    count = Counter(o.category for o in outcomes)
+    valid = sum(1 for o in outcomes if o.valid)
+    invalid = len(outcomes) - valid
+    right = count["valid-passed"] + count["invalid-rejected"]
+    return (f"right: {right} of {len(outcomes)}; valid passed {count['valid-passed']} of "
+            f"{valid}; invalid rejected with their own error {count['invalid-rejected']} "
+            f"of {invalid} (only 'not supported': {count['invalid-unsupported']}, wrongly "
+            f"accepted: {count['invalid-accepted']}); crashes {count['crash']}, timeouts "
+            f"{count['timeout']}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("suite", nargs="?", default="/work/ref/compliance",
+                        help="folder holding ModelicaCompliance/")
+    parser.add_argument("--jobs", type=int, default=2, choices=(1, 2))
+    parser.add_argument("--timeout", type=float, default=30.0)
+    parser.add_argument("--section", action="append", default=[],
+                        help="only these top-level sections (repeatable)")
+    parser.add_argument("--list", dest="list_category", action="append", default=[],
+                        choices=CHECK_CATEGORIES + SIM_CATEGORIES,
+                        help="print the models of a category (repeatable)")
+    parser.add_argument("--simulate", action="store_true",
+                        help="also simulate valid models that pass and have an experiment")
+    parser.add_argument("--json", type=Path, help="write every outcome to this JSON file")
+    args = parser.parse_args()
+    suite = Path(args.suite)
+    if not (suite / "ModelicaCompliance" / "package.mo").is_file():
+        parser.error(f"{suite} holds no ModelicaCompliance/package.mo")
+    models = find_models(suite)
+    if args.section:
+        models = [m for m in models if m.section in args.section]
+    print(f"suite: {suite} at commit {suite_commit(suite)}; {len(models)} test models")
+    tasks = [(m, str(suite), args.timeout, args.simulate) for m in models]
+    if args.jobs == 1:
+        outcomes = [run_one(t) for t in tasks]
+    else:
+        with ProcessPoolExecutor(args.jobs) as pool:
+            outcomes = list(pool.map(run_one, tasks, chunksize=4))
+    print(table(outcomes, args.simulate))
+    print(summary(outcomes))
+    flagged = [o for o in outcomes if o.valid and o.rule]
+    if flagged:  # a static rule rejecting a valid model: a wrong reject, to fix first
+        print(f"\nvalid models with an error citing the specification ({len(flagged)}):")
+        for o in flagged:
+            print(f"  {o.name}: {o.rule}")
+    for category in args.list_category:
+        chosen = [o for o in outcomes if category in (o.category, o.sim)]
+        print(f"\n{category} ({len(chosen)}):")
+        for o in chosen:
+            text = o.sim_message if category.startswith("sim-") else o.message
+            print(f"  {o.name}: {text}" if text else f"  {o.name}")
+    if args.json:
+        args.json.write_text(json.dumps([asdict(o) for o in outcomes], indent=1))
+
+
+if __name__ == "__main__":
+    main()

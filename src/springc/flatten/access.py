@@ -1,0 +1,80 @@
+"""Access to protected elements (Modelica 3.6, section 4.1): a protected element is
+used by its simple name only, never through a dot (``a.p``, ``A.P``), and modified only
+by its own declaration or an extends clause. Input: the class view or entry reached and
+the reference; output: nothing, or a located :class:`FlattenError`."""
+
+from __future__ import annotations
+
+import itertools
+
+from ..errors import Note, Span
+from ..ir import syntax as s
+from ..parse import ClassEntry
+from .modification import Mod
+from .rules import rule_error
+from .scope import ClassView
+
+ACCESS_RULE = ("a protected element can be used only by its simple name, inside its class "
+               "and the classes extending it, not through a dot from outside")
+
+
+def check_access_component(view: ClassView, name: str, span: Span, owner: str) -> None:
+    """``a.p`` or ``P.p``: ``p`` must not be a protected component of ``view``'s class."""
+    comp = view.components.get(name)
+    if comp is not None and comp.decl.protected:
+        raise rule_error(f"'{name}' is protected in '{view.entry.full_name}' and cannot be "
+                         f"accessed as '{owner}.{name}'", span, ACCESS_RULE, "4.1",
+                         (Note("declared protected here", comp.decl.span),))
+
+
+def check_access_path(chain: list[ClassEntry], ref: s.Ref) -> None:
+    """``A.B.C`` as a class name, ``chain`` the classes its prefixes denote: neither
+    ``B`` nor ``C`` is protected (4.1), and each is found as section 5.3.2 says."""
+    for container, member in itertools.pairwise(chain):
+        if member.defn.protected:
+            raise rule_error(f"class '{member.name}' is protected in "
+                             f"'{container.full_name}' and cannot be used as '{ref.dotted}'",
+                             ref.span, ACCESS_RULE, "4.1",
+                             (Note("declared protected here", member.defn.span),))
+        check_inside(container, member.name, member.defn.encapsulated, ref)
+
+
+def package_like(entry: ClassEntry) -> bool:
+    """A package, or a class that holds only classes and constants (treated as one)."""
+    defn = entry.defn
+    if defn.kind == "package":
+        return True
+    return not (defn.equations or defn.initial_equations or defn.algorithm) and all(
+        e.variability == "constant" for e in defn.elements if isinstance(e, s.Component))
+
+
+def check_inside(container: ClassEntry, name: str, encapsulated: bool, ref: s.Ref) -> None:
+    """``A.B``: lookup inside a class finds every element of a package, only the
+    encapsulated elements of other classes; it never looks inside a partial class."""
+    if container.parent is None:
+        return
+    if container.defn.partial:
+        raise rule_error(f"'{ref.dotted}' looks inside the partial {container.defn.kind} "
+                         f"'{container.full_name}'", ref.span, "a name cannot be looked up "
+                         "inside a partial class", "5.3.2",
+                         (Note(f"'{container.full_name}' is declared partial here",
+                               container.defn.span),))
+    if not encapsulated and not package_like(container):
+        raise rule_error(f"'{name}' cannot be looked up inside the {container.defn.kind} "
+                         f"'{container.full_name}' (as '{ref.dotted}')", ref.span,
+                         "inside a class that is not a package, lookup finds only its "
+                         "encapsulated elements", "5.3.2",
+                         (Note(f"'{container.full_name}' is defined here",
+                               container.defn.span),))
+
+
+def check_modified(view: ClassView, mod: Mod, owner: str) -> None:
+    """A modification ``a(p = 1)`` of a component must not reach a protected ``p``."""
+    for name, child in mod.children.items():
+        comp = view.components.get(name)
+        if comp is not None and comp.decl.protected:
+            raise rule_error(f"'{name}' is protected in '{view.entry.full_name}' and cannot be "
+                             f"modified in '{owner}'", child.span, "a protected element "
+                             "may be modified only by its own declaration or by an extends "
+                             "clause", "4.1", (Note("declared protected here",
+                                                    comp.decl.span),))
