@@ -24,7 +24,16 @@ from . import arrays as a
 from .builtins import CONSTANTS, Builtins
 from .functions import call_function
 from .parameters import check_powers
-from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
+from .scope import (
+    BuiltinEnumeration,
+    ClassScope,
+    Disabled,
+    DisabledReference,
+    FlattenContext,
+    LocalScope,
+    Primitive,
+    Scope,
+)
 
 UNSUPPORTED_CALLS = {
     "pre", "edge", "change", "initial", "terminal", "reinit", "sample", "hold",
@@ -228,20 +237,49 @@ class Evaluator:
             "noEvent(...)")
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
-        result = self.value(e.otherwise, scope)
+        # A branch that cannot be evaluated (an index out of range, say) is an error only
+        # if it may be selected: not when its condition is a parameter expression whose
+        # value rules it out (Modelica 3.6: the branch not selected is not evaluated).
+        failure: FlattenError | None = None
+        result: a.Value = x.ZERO
+        try:
+            result = self.value(e.otherwise, scope)
+        except FlattenError as err:
+            failure = err
         for cond_expr, then_expr in reversed(e.branches):
             cond = self.scalar(cond_expr, scope)
             if isinstance(cond, x.Const):
                 if cond.value:
-                    result = self.value(then_expr, scope)
+                    result, failure = self.value(then_expr, scope), None
                 continue
-            then = self.value(then_expr, scope)
+            try:
+                then = self.value(then_expr, scope)
+            except FlattenError:
+                if self._folded(cond) is False:
+                    continue
+                raise
+            if failure is not None:
+                if self._folded(cond) is not True:
+                    raise failure
+                result, failure = then, None
+                continue
             if a.shape(then) != a.shape(result):
                 raise FlattenError("branches of an if-expression differ in size", e.span)
             if not self.no_event and not self.flattener.is_parameter_expression(cond):
                 self._check_event(cond, cond_expr.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
+        if failure is not None:
+            raise failure
         return result
+
+    def _folded(self, cond: x.Expr) -> bool | None:
+        """The value of a condition that is a parameter expression, else None."""
+        if not self.flattener.is_parameter_expression(cond):
+            return None
+        try:
+            return bool(self.fold(cond))
+        except (KeyError, ArithmeticError, ValueError, TypeError):
+            return None
 
     # ------------------------------------------------------------------ references
 
@@ -267,6 +305,12 @@ class Evaluator:
         return current
 
     def _select(self, current: Any, part: s.RefPart, scope: Scope, ref: s.Ref) -> Any:
+        if isinstance(current, BuiltinEnumeration):
+            if part.name not in current.literals:
+                raise FlattenError(f"'{part.name}' is not a literal of {current.name}",
+                                   part.span, hint="its literals are: "
+                                   + ", ".join(current.literals))
+            return x.Const(current.literals.index(part.name) + 1)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -296,6 +340,11 @@ class Evaluator:
         return member.value if isinstance(member, Primitive) else member
 
     def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
+        if isinstance(current, Disabled):
+            raise DisabledReference(
+                f"'{current.name}' is a conditional component whose condition is false",
+                part.span, [Note("declared here", current.decl.span)],
+                "a disabled conditional component may only be named in connect(...)")
         value = self.member_value(current)
         if not part.subscripts:
             return value

@@ -21,6 +21,14 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
+from .declarations import (
+    condition_holds,
+    disabled,
+    inner_member,
+    redeclared,
+    redeclared_class,
+    redeclared_class_mod,
+)
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .scope import (
     ClassScope,
@@ -47,20 +55,32 @@ class Instantiation(FlattenContext):
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
+        name = scope.flat_name(decl.name)
+        if decl.condition is not None and not condition_holds(self, scope, decl):
+            return disabled(scope, decl)
+        if decl.outer:
+            return inner_member(scope, decl)
+        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
+        if outer is not None and outer.redeclare is not None:
+            comp, outer = redeclared(comp, outer, name)
+            decl = comp.decl
         declared = self.declared_type(comp)
         rtype = declared.rtype
-        name = scope.flat_name(decl.name)
-        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
         own = from_syntax(decl.modification, scope)
-        if outer is None and own is None and len(declared.type_mods) <= 1:
-            mod = declared.type_mods[0] if declared.type_mods else None  # nothing to merge
+        type_mods = declared.type_mods
+        by_class = redeclared_class(scope, decl.type_name)
+        if by_class is not None:
+            rtype, type_mods = self._redeclared_type(by_class[0], by_class[1])
+        if outer is None and own is None and len(type_mods) <= 1:
+            mod = type_mods[0] if type_mods else None  # nothing to merge
         else:
-            mod = merge_all([outer, own, *declared.type_mods], name)
+            mod = merge_all([outer, own, *type_mods], name)
         if decl.final and outer is not None:
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = declared.dims if declared.dims is not None else self._dims(decl, scope, rtype)
+        dims = declared.dims if declared.dims is not None and by_class is None \
+            else self._dims(decl, scope, rtype)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
@@ -70,6 +90,12 @@ class Instantiation(FlattenContext):
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
                                "cannot be instantiated", decl.type_name.span)
+        if rtype.entry.defn.partial:
+            raise FlattenError(f"'{name}' is of the partial class '{rtype.entry.full_name}', "
+                               "which cannot be instantiated", decl.span,
+                               [Note(f"'{rtype.entry.full_name}' is declared partial here",
+                                     rtype.entry.defn.span)],
+                               "use a class that extends it")
         self._check_containment(scope, rtype.entry, decl, name)
         view = self.view(rtype.entry)
         if not dims:
@@ -82,6 +108,17 @@ class Instantiation(FlattenContext):
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _redeclared_type(self, defn: s.ClassDef, where: ClassScope
+                         ) -> tuple[ResolvedType, list[Mod | None]]:
+        """The type and type modifiers of a class replaced by ``redeclare model M = T(...)``."""
+        if defn.short is None:
+            raise FlattenError("a redeclaration with a long class definition is not "
+                               "supported yet", defn.span,
+                               hint="write `redeclare model M = Other(...)`")
+        rtype = self.resolve_type(defn.short.base, where.entry)
+        mods = [each(from_syntax(m, self.package_scope(e.parent or e))) for m, e in rtype.mods]
+        return rtype, [redeclared_class_mod(defn, where, None), *mods]
 
     def _check_containment(self, scope: ClassScope, entry: ClassEntry, decl: s.Component,
                            name: str) -> None:
@@ -142,7 +179,9 @@ class Instantiation(FlattenContext):
             scope.mod = instance_mod(mod, view, scope)
         if scope.mod is not None:
             for key, child in scope.mod.children.items():
-                if key not in view.components:
+                if key not in view.components and not (
+                        child.redeclare is not None
+                        and isinstance(child.redeclare.element, s.ClassDef)):
                     self._unknown_target(key, child, view, name)
             if scope.mod.value is not None:
                 raise FlattenError(f"'{name}' is a component of class "
@@ -193,7 +232,8 @@ class Instantiation(FlattenContext):
         else:
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         prim = Primitive(names, value, decl, variability, causality,
-                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims)
+                         decl.flow or rtype.prefixes[2], rtype.primitive or "Real", mod, dims,
+                         rtype.connector)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b

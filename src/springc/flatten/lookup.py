@@ -18,6 +18,7 @@ from ..parse import ClassEntry, ClassTree, lookup_class, member_class
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
 from .scope import (
+    BUILTIN_ENUMERATIONS,
     PRIMITIVES,
     ClassScope,
     ClassView,
@@ -56,12 +57,18 @@ class ClassLookup(FlattenContext):
         prefixes = ("", "", False)
         if name in PRIMITIVES and lookup_class(name, scope) is None:
             return ResolvedType(name, None, (), (), prefixes)
-        if name in ("String", "StateSelect") or name.startswith("Modelica."):
+        if name in BUILTIN_ENUMERATIONS and lookup_class(name, scope) is None:
+            return ResolvedType("Integer", None, (), (), prefixes)
+        if name == "String" and lookup_class(name, scope) is None:
             raise FlattenError(f"the type `{name}` is not supported yet", ref.span,
                                hint="use Real, Integer, Boolean or classes of your own")
         entry = self.resolve_class(ref, scope)
+        connector = False
         for _ in range(100):
             short = entry.defn.short
+            if entry.defn.enumeration is not None:
+                # Enumeration values are their ordinals (1, 2, ...): an Integer.
+                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes)
             if short is None:
                 return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
             if short.modification is not None:
@@ -69,9 +76,10 @@ class ClassLookup(FlattenContext):
             dims += [(d, entry) for d in short.dims]
             prefixes = (prefixes[0] or short.variability, prefixes[1] or short.causality,
                         prefixes[2] or short.flow)
+            connector = connector or entry.defn.kind == "connector"
             base = short.base.dotted
             if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
-                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes)
+                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes, connector)
             entry = self.resolve_class(short.base, entry.parent or entry)
         raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
 
@@ -110,7 +118,15 @@ class ClassLookup(FlattenContext):
         return entry
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
-        """``P.c``: a nested class or a constant of a package."""
+        """``P.c``: a nested class or a constant of a package, or ``E.a``: a literal of
+        an enumeration (its ordinal)."""
+        target = self.follow_short(entry)[0] if entry.defn.short is not None else entry
+        literals = target.defn.enumeration
+        if literals is not None:
+            if name not in literals:
+                raise FlattenError(f"enumeration '{entry.full_name}' has no literal '{name}'",
+                                   span, hint="its literals are: " + ", ".join(literals))
+            return x.Const(literals.index(name) + 1)
         nested = member_class(entry, name)
         if nested is not None:
             return nested
@@ -147,6 +163,8 @@ class ClassLookup(FlattenContext):
         found = lookup_class(name, entry)
         if found is not None:
             return found
+        if name in BUILTIN_ENUMERATIONS:
+            return BUILTIN_ENUMERATIONS[name]
         if name in CONSTANTS:
             return x.Const(CONSTANTS[name])
         raise FlattenError(f"undefined name '{name}'", span,

@@ -34,6 +34,20 @@ PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
 
 
 @dataclass(frozen=True)
+class BuiltinEnumeration:
+    """A predefined enumeration type (``StateSelect``); its values are the ordinals of
+    its literals, 1 for the first (Modelica 4.9.5)."""
+
+    name: str
+    literals: tuple[str, ...]
+
+
+STATE_SELECT = BuiltinEnumeration("StateSelect", ("never", "avoid", "default", "prefer",
+                                                  "always"))
+BUILTIN_ENUMERATIONS = {"StateSelect": STATE_SELECT}
+
+
+@dataclass(frozen=True)
 class ViewComponent:
     """A component declaration as seen in a class, with the class that wrote it."""
 
@@ -70,6 +84,7 @@ class ResolvedType:
     dims: tuple[tuple[s.Expr, Any], ...]
     mods: tuple[tuple[s.Modification, ClassEntry], ...]
     prefixes: tuple[str, str, bool]
+    connector: bool = False  # a primitive reached through `connector C = input Real`
 
 
 @dataclass(eq=False)
@@ -85,6 +100,20 @@ class Primitive:
     type: str
     mod: Mod | None
     dims: tuple[int, ...]
+    connector: bool = False  # declared with a short connector class (RealInput)
+
+
+@dataclass(frozen=True, eq=False)
+class Disabled:
+    """A conditional component whose condition is false: it is not part of the model,
+    and only ``connect`` statements may name it (they are dropped; Modelica 4.4.5)."""
+
+    decl: s.Component
+    name: str
+
+
+class DisabledReference(FlattenError):
+    """A reference to a disabled conditional component (see :class:`Disabled`)."""
 
 
 @dataclass(eq=False)
@@ -146,9 +175,15 @@ class ClassScope:
         self.members[name] = created
         return created
 
-    def all_members(self) -> Iterator[tuple[str, Member]]:
-        for name in self.view.components:
-            yield name, self.member(name)
+    def all_members(self) -> Iterator[tuple[str, Primitive | ClassScope | np.ndarray]]:
+        """The members this instance owns: not disabled conditional components, and not
+        ``outer`` ones (they are the ``inner`` instance's, reached from here)."""
+        for name, comp in self.view.components.items():
+            if comp.decl.outer:
+                continue
+            member = self.member(name)
+            if not isinstance(member, Disabled):
+                yield name, member
 
     def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
@@ -196,7 +231,7 @@ class FunctionScope:
 #: Where a name is looked up: an instance, loop indices over one, or a function call.
 Scope = ClassScope | LocalScope | FunctionScope
 #: A member of an instance: a primitive variable, a component, or an array of components.
-Member = Primitive | ClassScope | np.ndarray
+Member = Primitive | ClassScope | np.ndarray | Disabled
 
 
 @dataclass(frozen=True, slots=True)

@@ -185,6 +185,9 @@ class ElementModification:
     each: bool
     final: bool
     span: Span
+    # `redeclare Steel m(k = 2)` or `redeclare model M = Other` (Modelica 7.3): the new
+    # declaration of the element ``path`` names.
+    redeclare: Component | ClassDef | None = None
 
 
 # ------------------------------------------------------------------- elements
@@ -211,6 +214,15 @@ class Component:
     protected: bool
     description: str
     span: Span
+    # `Support support if useSupport`: the component exists only when this parameter
+    # expression is true (Modelica 4.4.5).
+    condition: Expr | None = None
+    inner: bool = False
+    outer: bool = False
+    replaceable: bool = False
+    # The type and modification of `constrainedby T(...)` (Modelica 7.3.2).
+    constraint: tuple[Ref, Modification | None] | None = None
+    redeclare: bool = False  # an element `redeclare T x;` replacing an inherited one
 
 
 @dataclass(frozen=True, slots=True)
@@ -341,6 +353,9 @@ class ClassDef:
     annotation: Modification | None
     protected: bool
     span: Span
+    # The literals of `type E = enumeration(a, b)`, in order (values 1, 2, ...).
+    enumeration: tuple[str, ...] | None = None
+    replaceable: bool = False
 
 
 Element = Component | Extends | Import | ClassDef
