@@ -26,7 +26,7 @@ def run(tmp_path: Path, source: str, *args: str) -> tuple[int, str, str]:
 
 
 def test_the_document_has_its_examples() -> None:
-    assert len(EXAMPLE.findall(DOC)) == 3
+    assert len(EXAMPLE.findall(DOC)) == 4
 
 
 @pytest.mark.parametrize("options, source, flat", EXAMPLE.findall(DOC))
@@ -46,6 +46,10 @@ REJECTED = {
         "3:1: error: `algorithm` sections outside functions are not supported yet",
     "model M\n  String s = \"a\";\n  Real x = 1;\nend M;\n":
         "2:3: error: the type `String` is not supported yet",
+    "model M\n  model W\n    Real g = 1;\n  end W;\n  inner outer W w;\nend M;\n":
+        "5:9: error: `inner outer` elements are not supported yet",
+    "model M\n  type E = enumeration(:);\n  Real x = 1;\nend M;\n":
+        "2:12: error: unspecified enumerations `enumeration(:)` are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n":
         "4:1: error: `external` functions are not supported yet",
     "connector C\n  Real p;\n  flow Real f;\n  stream Real h;\nend C;\n":
