@@ -151,3 +151,11 @@ def test_a_users_own_modelica_library_takes_precedence(tmp_path: Path) -> None:
     with pytest.raises(SpringcError) as info:
         flat_text(tmp_path, text)
     assert info.value.message == "'Modelica.Constants' has no element 'answer'"
+
+
+def test_an_imported_constant(tmp_path: Path) -> None:
+    text = ("model M\n  import Modelica.Constants.pi;\n  import G = Modelica.Constants.g_n;\n"
+            "  parameter Real p = 2 * pi + G;\n  Real x = p;\nend M;\n")
+    line = next(x for x in flat_text(tmp_path, text).splitlines() if "parameter" in x)
+    assert float(line.split("= ")[1].rstrip(";")) == pytest.approx(2 * math.pi + 9.80665,
+                                                                     rel=1e-15)

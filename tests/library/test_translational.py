@@ -236,3 +236,27 @@ def test_an_enabled_support_takes_the_reaction_force() -> None:
     assert np.max(np.abs(result["a.s"] - 3 * t ** 2)) < 1e-9
     assert np.max(np.abs(result["b.s"] + 1.5 * t ** 2)) < 1e-9
     assert math.isclose(float(result["force.s"][-1]), 4.5, rel_tol=1e-9)
+
+
+SENSED = f"""
+model Sensed "a constant force through power and multi sensors"
+  {T}.Sources.ConstantForce push(f_constant = 2);
+  {T}.Sensors.MultiSensor multi;
+  {T}.Sensors.PowerSensor power;
+  {T}.Components.Mass mass(m = 1, s(start = 0, fixed = true), v(start = 0, fixed = true));
+equation
+  connect(push.flange, multi.flange_a);
+  connect(multi.flange_b, power.flange_a);
+  connect(power.flange_b, mass.flange_a);
+end Sensed;
+"""
+
+
+def test_multi_and_power_sensors() -> None:
+    result = simulate(SENSED, 1.0)
+    t = result.time
+    # a = 2: v = 2 t; the force 2 N through the cuts, power 2*v.
+    assert np.max(np.abs(result["multi.f"] - 2)) < 1e-9
+    assert np.max(np.abs(result["multi.v"] - 2 * t)) < 1e-8
+    assert np.max(np.abs(result["multi.power"] - 4 * t)) < 1e-8
+    assert np.max(np.abs(result["power.power"] - 4 * t)) < 1e-8

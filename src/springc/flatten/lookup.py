@@ -14,7 +14,7 @@ from typing import Any
 from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
-from ..parse import ClassEntry, ClassTree, lookup_class, member_class
+from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
 from .builtins import CONSTANTS
 from .modification import Mod, from_syntax
 from .scope import (
@@ -163,6 +163,9 @@ class ClassLookup(FlattenContext):
         found = lookup_class(name, entry)
         if found is not None:
             return found
+        constant = imported_element(entry, name)
+        if constant is not None:
+            return self.class_member(constant[0], constant[1], span)
         if name in BUILTIN_ENUMERATIONS:
             return BUILTIN_ENUMERATIONS[name]
         if name in CONSTANTS:

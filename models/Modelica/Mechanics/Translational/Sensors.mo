@@ -48,4 +48,36 @@ package Sensors "Sensors of translational quantities"
     v_rel = der(s_rel);
     0 = flange_a.f;
   end RelSpeedSensor;
+
+  model RelAccSensor "The relative acceleration of two flanges as an output signal"
+    extends Translational.Interfaces.PartialRelativeSensor;
+    SI.Position s_rel "Distance between the flanges (= flange_b.s - flange_a.s)";
+    SI.Velocity v_rel "Relative velocity (= der(s_rel))";
+    Modelica.Blocks.Interfaces.RealOutput a_rel(unit = "m/s2") "Relative acceleration (= der(v_rel))";
+  equation
+    s_rel = flange_b.s - flange_a.s;
+    v_rel = der(s_rel);
+    a_rel = der(v_rel);
+    0 = flange_a.f;
+  end RelAccSensor;
+
+  model PowerSensor "The power flowing from flange_a to flange_b as an output signal"
+    extends Translational.Interfaces.PartialRelativeSensor;
+    Modelica.Blocks.Interfaces.RealOutput power(unit = "W") "Power flowing through the cut (= flange_a.f*der(flange_a.s))";
+  equation
+    flange_a.s = flange_b.s;
+    power = flange_a.f*der(flange_a.s);
+  end PowerSensor;
+
+  model MultiSensor "The force, velocity and power in a cut between two flanges as output signals"
+    extends Translational.Interfaces.PartialRelativeSensor;
+    Modelica.Blocks.Interfaces.RealOutput power(unit = "W") "Power flowing through the cut (= f*v)";
+    Modelica.Blocks.Interfaces.RealOutput f(unit = "N") "Force in the flange_a cut";
+    Modelica.Blocks.Interfaces.RealOutput v(unit = "m/s") "Absolute velocity of the flanges";
+  equation
+    flange_a.s = flange_b.s;
+    f = flange_a.f;
+    v = der(flange_a.s);
+    power = f*v;
+  end MultiSensor;
 end Sensors;

@@ -14,6 +14,23 @@ package Sources "Forces and prescribed motions"
     f = -f_constant;
   end ConstantForce;
 
+  model Force2 "A force given by a signal, acting between two flanges (pushing them apart for f > 0)"
+    extends Translational.Interfaces.PartialTwoFlanges;
+    Modelica.Blocks.Interfaces.RealInput f(unit = "N") "Driving force as an input signal";
+  equation
+    flange_a.f = f;
+    flange_b.f = -f;
+  end Force2;
+
+  model ConstantSpeed "A constant speed of the flange with respect to the support"
+    extends Modelica.Mechanics.Translational.Interfaces.PartialForce;
+    parameter SI.Velocity v_fixed "Fixed speed (if negative, the force acts in the opposite direction)";
+    SI.Velocity v "Speed of the flange with respect to the support (= der(s))";
+  equation
+    v = der(s);
+    v = v_fixed;
+  end ConstantSpeed;
+
   model Position "Prescribes the flange position: exactly (exact = true) or through a critically damped second-order filter"
     extends Modelica.Mechanics.Translational.Interfaces.PartialElementaryOneFlangeAndSupport2(
       s(stateSelect = if exact then StateSelect.default else StateSelect.prefer));
