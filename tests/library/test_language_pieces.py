@@ -327,3 +327,33 @@ def test_an_index_in_an_unselected_if_branch_is_not_evaluated(tmp_path: Path) ->
 def test_unused_replaceable_classes_do_not_block_the_model(tmp_path: Path) -> None:
     assert "  parameter Real 'part.k' = 1;" in flat(tmp_path, REDECLARE,
                                                   "R.Fixed").splitlines()
+
+
+UNSUPPORTED = """package L
+  model Bad
+    Real x;
+  equation
+    when time > 1 then
+      reinit(x, 0);
+    end when;
+    der(x) = 1;
+  end Bad;
+  model Good
+    Real x(start = 0, fixed = true);
+  equation
+    der(x) = 1;
+  end Good;
+  model UsesBad
+    Bad b;
+  end UsesBad;
+end L;
+"""
+
+
+def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
+        tmp_path: Path) -> None:
+    assert flat(tmp_path, UNSUPPORTED, "L.Good") == (
+        "model 'L.Good'\n  Real x(start = 0, fixed = true);\nequation\n  der(x) = 1;\n"
+        "end 'L.Good';\n")
+    assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
+        "`when` equations are not supported yet", 5, 5)

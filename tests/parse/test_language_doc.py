@@ -50,9 +50,10 @@ REJECTED = {
         "5:9: error: `inner outer` elements are not supported yet",
     "model M\n  type E = enumeration(:);\n  Real x = 1;\nend M;\n":
         "2:12: error: unspecified enumerations `enumeration(:)` are not supported yet",
-    "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n":
+    "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n"
+    "model M\n  Real x = f(1);\nend M;\n":
         "4:1: error: `external` functions are not supported yet",
-    "connector C\n  Real p;\n  flow Real f;\n  stream Real h;\nend C;\n":
+    "connector C\n  Real p;\n  flow Real f;\n  stream Real h;\nend C;\nmodel M\n  C c;\nend M;\n":
         "4:3: error: `stream` connectors are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nalgorithm\n  y := u;\n  while y > 1 loop\n"
     "    y := y / 2;\n  end while;\nend f;\nmodel M\n  Real x = f(3);\nend M;\n":
@@ -61,9 +62,9 @@ REJECTED = {
         "2:12: error: global names (`.A.B`) are not supported yet",
     "model M\n  model extends N\n  end N;\nend M;\n": (
         "2:9: error: `class extends` definitions are not supported yet"),
-    "operator record C\n  Real re;\nend C;\n":
+    "operator record C\n  Real re;\nend C;\nmodel M\n  C c;\nend M;\n":
         "1:1: error: `operator` classes are not supported yet",
-    "expandable connector C\n  Real x;\nend C;\n":
+    "expandable connector C\n  Real x;\nend C;\nmodel M\n  C c;\nend M;\n":
         "1:1: error: `expandable` connectors are not supported yet",
     "model M\n  Real x := 1;\nend M;\n": "2:10: error: `:=` in a declaration is not supported yet",
     "model M\n  Real x;\nequation\n  terminate(\"stop\");\n  x = 1;\nend M;\n":

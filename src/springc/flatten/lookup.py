@@ -11,7 +11,7 @@ from __future__ import annotations
 import difflib
 from typing import Any
 
-from ..errors import FlattenError, Note, Span
+from ..errors import ErrorGroup, FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
@@ -39,6 +39,9 @@ class ClassLookup(FlattenContext):
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
         if found is None:
+            unsupported = entry.defn.unsupported
+            if unsupported:  # a construct outside the subset, in a class the model uses
+                raise unsupported[0] if len(unsupported) == 1 else ErrorGroup(unsupported)
             found = self.views[id(entry)] = build_view(entry, self, seen)
         return found
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import Span
+from ..errors import ParseError, Span
 
 # ---------------------------------------------------------------- expressions
 
@@ -356,6 +356,9 @@ class ClassDef:
     # The literals of `type E = enumeration(a, b)`, in order (values 1, 2, ...).
     enumeration: tuple[str, ...] | None = None
     replaceable: bool = False
+    # Constructs outside springc's subset written in this class (``... not supported
+    # yet`` errors, errors.ParseError), reported when a model uses the class.
+    unsupported: tuple[ParseError, ...] = ()
 
 
 Element = Component | Extends | Import | ClassDef

@@ -424,7 +424,7 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
     for text_name, text in texts:
         remember_source(text_name, text)
         try:
-            parsed.append((parse_text(text, text_name), None))
+            parsed.append((parse_text(text, text_name, defer=True), None))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:
@@ -456,11 +456,11 @@ def parse_cached(path: Path) -> s.StoredDefinition:
     try:
         stat = path.stat()
     except OSError:
-        return parse_file(path)
+        return parse_file(path, defer=True)
     key = (str(path), stat.st_mtime_ns, stat.st_size)
     stored = _PARSED.get(key)
     if stored is None:
-        stored = _PARSED[key] = parse_file(path)
+        stored = _PARSED[key] = parse_file(path, defer=True)
     return stored
 
 

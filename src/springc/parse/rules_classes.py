@@ -131,6 +131,7 @@ class ClassRules(RuleBase):
             short=spec.short,
             annotation=_merge_annotations(spec.annotation, body["annotations"]),
             protected=False, span=span, enumeration=spec.enumeration,
+            unsupported=self.take_deferred(span) if self.defer else (),
         )
 
     def short_class_definition(self, meta: Meta, ch: list[Any]) -> Any:
