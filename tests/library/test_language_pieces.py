@@ -357,3 +357,12 @@ def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
         "end 'L.Good';\n")
     assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
         "`when` equations are not supported yet", 5, 5)
+
+
+def test_string_parameters_and_constants(tmp_path: Path) -> None:
+    text = ("model S\n  parameter String name = \"mass\";\n  constant String u = \"m\";\n"
+            "  Real x(unit = u, start = 1);\nequation\n  der(x) = -x;\nend S;\n")
+    assert flat(tmp_path, text) == (
+        "model S\n  Real x(start = 1, unit = \"m\");\nequation\n  der(x) = -x;\nend S;\n")
+    bad = text.replace("parameter String name = \"mass\";", "parameter String name = 1;")
+    assert error(tmp_path, bad) == ("'name' is a String and must be given a string", 2, 27)

@@ -45,7 +45,7 @@ REJECTED = {
     "model M\n  Real x;\nalgorithm\n  x := 1;\nend M;\n":
         "3:1: error: `algorithm` sections outside functions are not supported yet",
     "model M\n  String s = \"a\";\n  Real x = 1;\nend M;\n":
-        "2:3: error: the type `String` is not supported yet",
+        "2:10: error: `String` variables are not supported yet",
     "model M\n  model W\n    Real g = 1;\n  end W;\n  inner outer W w;\nend M;\n":
         "5:9: error: `inner outer` elements are not supported yet",
     "model M\n  type E = enumeration(:);\n  Real x = 1;\nend M;\n":

@@ -70,7 +70,8 @@ def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
         return False  # members, types or equations may differ per instance
     declared = flattener.declared_type(comp)
     rtype = declared.rtype
-    if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]):
+    if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]) \
+            or rtype.primitive == "String":
         return False
     if rtype.entry is None:
         return True

@@ -98,7 +98,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         for _name, member in scope.all_members():
             if isinstance(member, Primitive):
-                if member.variability != "constant":
+                if member.variability != "constant" and member.type != "String":
                     yield from attributes_of(self, scope, member)
             else:
                 for item in (member.flat if isinstance(member, np.ndarray) else [member]):

@@ -84,6 +84,8 @@ class Instantiation(FlattenContext):
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
+        if rtype.primitive == "String":
+            return self._string(decl, rtype, mod, dims, name)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name)
         assert rtype.entry is not None
@@ -241,6 +243,23 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
+
+    def _string(self, decl: s.Component, rtype: ResolvedType, mod: Mod | None,
+                dims: tuple[int, ...], name: str) -> Primitive:
+        """A ``String`` parameter or constant: its value, known while flattening (it is
+        not a variable of the flat model)."""
+        variability = decl.variability or rtype.prefixes[0]
+        if variability not in ("parameter", "constant"):
+            raise FlattenError("`String` variables are not supported yet", decl.span,
+                               hint="declare it a parameter or a constant")
+        if dims:
+            raise FlattenError("arrays of `String` are not supported yet", decl.span)
+        check_attribute_mods(mod, "String", name)
+        value = self.mod_value(mod.value) if mod is not None and mod.value is not None else ""
+        if not isinstance(value, str):
+            raise FlattenError(f"'{name}' is a String and must be given a string",
+                               mod.value.span if mod is not None and mod.value else decl.span)
+        return Primitive(name, value, decl, variability, "", False, "String", mod, ())
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

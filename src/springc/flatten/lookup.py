@@ -63,8 +63,7 @@ class ClassLookup(FlattenContext):
         if name in BUILTIN_ENUMERATIONS and lookup_class(name, scope) is None:
             return ResolvedType("Integer", None, (), (), prefixes)
         if name == "String" and lookup_class(name, scope) is None:
-            raise FlattenError(f"the type `{name}` is not supported yet", ref.span,
-                               hint="use Real, Integer, Boolean or classes of your own")
+            return ResolvedType("String", None, (), (), prefixes)
         entry = self.resolve_class(ref, scope)
         connector = False
         for _ in range(100):

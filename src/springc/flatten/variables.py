@@ -24,6 +24,7 @@ ATTRIBUTES = {
              "quantity"),
     "Integer": ("start", "fixed", "min", "max", "quantity"),
     "Boolean": ("start", "fixed", "quantity"),
+    "String": ("start", "fixed", "quantity"),
 }
 STATE_SELECT = ("never", "avoid", "default", "prefer", "always")
 
