@@ -357,6 +357,11 @@ def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
         "end 'L.Good';\n")
     assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
         "`when` equations are not supported yet", 5, 5)
+    with pytest.raises(SpringcError) as info:
+        flat(tmp_path, UNSUPPORTED, "L.UsesBad")
+    (note,) = info.value.notes
+    assert note.message == "'b' uses class 'L.Bad' here"
+    assert note.span is not None and (note.span.line, note.span.column) == (16, 9)
 
 
 def test_string_parameters_and_constants(tmp_path: Path) -> None:

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import ErrorGroup, FlattenError, Note, ParseError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
@@ -99,7 +99,7 @@ class Instantiation(FlattenContext):
                                      rtype.entry.defn.span)],
                                "use a class that extends it")
         self._check_containment(scope, rtype.entry, decl, name)
-        view = self.view(rtype.entry)
+        view = self._used_view(rtype.entry, decl, name)
         if not dims:
             return self._class_scope(name, view, mod, decl, scope)
         if mod is not None:
@@ -110,6 +110,19 @@ class Instantiation(FlattenContext):
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _used_view(self, entry: ClassEntry, decl: s.Component, name: str) -> ClassView:
+        """The view of a component's class; a construct outside the subset in that class
+        is reported with a note on the component that uses it."""
+        try:
+            return self.view(entry)
+        except (ParseError, ErrorGroup) as err:
+            note = Note(f"'{name}' uses class '{entry.full_name}' here", decl.span)
+            errors = err.errors if isinstance(err, ErrorGroup) else (err,)
+            if not all(isinstance(e, ParseError) for e in errors):
+                raise
+            noted = [ParseError(e.message, e.span, (*e.notes, note), e.hint) for e in errors]
+            raise (noted[0] if len(noted) == 1 else ErrorGroup(noted)) from None
 
     def _redeclared_type(self, defn: s.ClassDef, where: ClassScope
                          ) -> tuple[ResolvedType, list[Mod | None]]:
