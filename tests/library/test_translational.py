@@ -260,3 +260,28 @@ def test_multi_and_power_sensors() -> None:
     assert np.max(np.abs(result["multi.v"] - 2 * t)) < 1e-8
     assert np.max(np.abs(result["multi.power"] - 4 * t)) < 1e-8
     assert np.max(np.abs(result["power.power"] - 4 * t)) < 1e-8
+
+
+MOVED = f"""
+model Moved "a filtered position source and a Move source with constant signals"
+  {T}.Sources.Position position(f_crit = 5);
+  Modelica.Blocks.Sources.Constant s_ref(k = 0.25);
+  {T}.Components.Mass m1(m = 1);
+  {T}.Sources.Move move;
+  Modelica.Blocks.Sources.Constant u1(k = 1), u2(k = 0), u3(k = 0);
+  {T}.Components.Mass m2(m = 1);
+equation
+  connect(s_ref.y, position.s_ref);
+  connect(position.flange, m1.flange_a);
+  connect(u1.y, move.u[1]);
+  connect(u2.y, move.u[2]);
+  connect(u3.y, move.u[3]);
+  connect(move.flange, m2.flange_a);
+end Moved;
+"""
+
+
+def test_position_filter_starts_at_its_reference_and_move_follows_u() -> None:
+    result = simulate(MOVED, 1.0)
+    assert np.max(np.abs(result["m1.s"] - 0.25)) < 1e-9
+    assert np.max(np.abs(result["m2.s"] - 1)) < 1e-12
