@@ -371,3 +371,17 @@ def test_string_parameters_and_constants(tmp_path: Path) -> None:
         "model S\n  Real x(start = 1, unit = \"m\");\nequation\n  der(x) = -x;\nend S;\n")
     bad = text.replace("parameter String name = \"mass\";", "parameter String name = 1;")
     assert error(tmp_path, bad) == ("'name' is a String and must be given a string", 2, 27)
+
+
+def test_redeclare_as_an_element_replaces_the_inherited_declaration(tmp_path: Path) -> None:
+    text = ("package R\n  model Iron\n    parameter Real k = 1;\n  end Iron;\n"
+            "  model Steel\n    parameter Real k = 3;\n    parameter Real extra = 0;\n"
+            "  end Steel;\n  model Holder\n    replaceable Iron part;\n    Iron fixed;\n"
+            "  end Holder;\n  model Elem\n    extends Holder;\n"
+            "    redeclare Steel part(extra = 2);\n  end Elem;\n  model Wrong\n"
+            "    extends Holder;\n    redeclare Steel fixed;\n  end Wrong;\nend R;\n")
+    lines = flat(tmp_path, text, "R.Elem").splitlines()
+    assert "  parameter Real 'part.k' = 3;" in lines
+    assert "  parameter Real 'part.extra' = 2;" in lines
+    assert error(tmp_path, text, "R.Wrong") == (
+        "'fixed' is not replaceable and cannot be redeclared", 19, 21)

@@ -15,7 +15,7 @@ a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defi
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -368,11 +368,31 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
         equations += base_view.equations
         initial += base_view.initial_equations
     for element in entry.defn.elements:
-        if isinstance(element, s.Component):
+        if isinstance(element, s.Component) and element.redeclare:
+            _redeclare_component(components, element, entry)
+        elif isinstance(element, s.Component):
             _add_component(components, element.name, ViewComponent(element, entry))
     equations += (ViewEquation(e, entry) for e in entry.defn.equations)
     initial += (ViewEquation(e, entry) for e in entry.defn.initial_equations)
     return ClassView(entry, components, tuple(equations), tuple(initial), tuple(mods))
+
+
+def _redeclare_component(components: dict[str, ViewComponent], element: s.Component,
+                         entry: ClassEntry) -> None:
+    """``redeclare Steel part;`` as an element: it replaces the inherited declaration of
+    ``part``, which must be replaceable (Modelica 7.3)."""
+    existing = components.get(element.name)
+    if existing is None:
+        raise FlattenError(f"'{element.name}' is redeclared but no inherited element has "
+                           "that name", element.span, hint="redeclare an element of a base "
+                           "class, or drop `redeclare`")
+    if not existing.decl.replaceable:
+        raise FlattenError(f"'{element.name}' is not replaceable and cannot be redeclared",
+                           element.span, [Note("declared here", existing.decl.span)])
+    constraint = existing.decl.constraint
+    if element.modification is None and constraint is not None and constraint[1] is not None:
+        element = replace(element, modification=constraint[1])
+    components[element.name] = ViewComponent(element, entry)
 
 
 def _add_component(components: dict[str, ViewComponent], name: str,
