@@ -1,6 +1,6 @@
 """The bundled Modelica.Mechanics.Translational (event-free classes): each component
 against a closed form, and the Standard Library's own examples (Damper, SignConvention,
-Accelerate) written with ``Modelica.*`` names only,
+Accelerate, InitialConditions) written with ``Modelica.*`` names only,
 simulated with the bundled library and matched against solutions derived by hand."""
 
 from __future__ import annotations
@@ -128,6 +128,71 @@ def test_accelerate_example() -> None:
     t = result.time
     assert np.max(np.abs(result["accelerate.s"] - t ** 2 / 2)) < 1e-9
     assert np.max(np.abs(result["mass.s"] - (t ** 2 / 2 + 0.5))) < 1e-9
+
+
+INITIAL_CONDITIONS = f"""
+model InitialConditions "Modelica.Mechanics.Translational.Examples.InitialConditions"
+  extends Modelica.Icons.Example;
+  {T}.Components.Fixed fixed2(s0 = 1);
+  {T}.Components.Spring s2(s_rel0 = 2, c = 1e3);
+  {T}.Components.Mass m3(L = 3, s(start = 4.5, fixed = true), v(fixed = true), m = 1);
+  {T}.Components.SpringDamper sd2(s_rel0 = 4, c = 111, d = 1);
+  {T}.Components.Mass m4(L = 5, s(start = 12.5, fixed = true), v(fixed = true), m = 1);
+  {T}.Components.Fixed fixed1(s0 = -1);
+  {T}.Components.Spring s1(s_rel0 = 1, c = 1e3, s_rel(start = 0.5, fixed = true));
+  {T}.Components.Mass m1(L = 1, v(fixed = true), m = 1);
+  {T}.Components.SpringDamper sd1(s_rel0 = 1, c = 111, s_rel(start = 1, fixed = true),
+    v_rel(fixed = true), d = 1);
+  {T}.Components.Mass m2(L = 2, m = 1);
+equation
+  connect(s2.flange_a, fixed2.flange);
+  connect(s1.flange_a, fixed1.flange);
+  connect(m1.flange_a, s1.flange_b);
+  connect(sd1.flange_a, m1.flange_b);
+  connect(m2.flange_a, sd1.flange_b);
+  connect(m4.flange_a, sd2.flange_b);
+  connect(sd2.flange_a, m3.flange_b);
+  connect(m3.flange_a, s2.flange_b);
+end InitialConditions;
+"""
+
+
+def test_initial_conditions_example_starts_at_rest_in_equilibrium() -> None:
+    # Upper half: s2 from 1 to m3.flange_a = 3 (rest length 2), sd2 from 6 to
+    # m4.flange_a = 10 (rest length 4). Lower half, given by relative states: s1 from -1
+    # to m1.flange_a = -0.5 (rest length 1: compressed by 0.5), sd1 unstretched (1).
+    result = simulate(INITIAL_CONDITIONS, 1.0)
+    assert np.max(np.abs(result["m3.s"] - 4.5)) < 1e-12
+    assert np.max(np.abs(result["m4.s"] - 12.5)) < 1e-12
+    assert abs(float(result["m1.s"][0])) < 1e-12
+    assert abs(float(result["sd1.s_rel"][0]) - 1) < 1e-12
+    # The compressed spring pushes m1 (and m2 through sd1) along the axis: m1 starts
+    # with a = 500 m/s2 (the damper carries no force at v_rel = 0).
+    assert abs(float(result["m1.a"][0]) - 500) < 1e-6
+
+
+TWO_MASSES = f"""
+model TwoMasses "two masses coupled by a damper, a relative acceleration sensor"
+  {T}.Components.Mass m1(m = 1, s(start = 0, fixed = true), v(start = 1, fixed = true));
+  {T}.Components.Damper damper(d = 1);
+  {T}.Components.Mass m2(m = 1, L = 0.5, s(start = 1, fixed = true), v(start = 0, fixed = true));
+  {T}.Sensors.RelAccSensor relAcc;
+equation
+  connect(m1.flange_b, damper.flange_a);
+  connect(damper.flange_b, m2.flange_a);
+  connect(relAcc.flange_a, m1.flange_b);
+  connect(relAcc.flange_b, m2.flange_b);
+end TwoMasses;
+"""
+
+
+def test_two_masses_coupled_by_a_damper() -> None:
+    # Momentum is kept: v1 + v2 = 1; the relative velocity decays with rate d/m1 + d/m2.
+    result = simulate(TWO_MASSES, 1.0)
+    t = result.time
+    assert np.max(np.abs(result["m1.v"] - (0.5 + 0.5 * np.exp(-2 * t)))) < 1e-8
+    assert np.max(np.abs(result["m2.v"] - (0.5 - 0.5 * np.exp(-2 * t)))) < 1e-8
+    assert np.max(np.abs(result["relAcc.a_rel"] - 2 * np.exp(-2 * t))) < 1e-6
 
 
 OSCILLATOR = f"""
