@@ -22,10 +22,10 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .builtins import CONSTANTS, Builtins
+from .enumerations import BuiltinEnumeration
 from .functions import call_function
 from .parameters import check_powers
 from .scope import (
-    BuiltinEnumeration,
     ClassScope,
     Disabled,
     DisabledReference,

@@ -16,9 +16,9 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
 from .builtins import CONSTANTS
+from .enumerations import BUILTIN_ENUMERATIONS
 from .modification import Mod, from_syntax
 from .scope import (
-    BUILTIN_ENUMERATIONS,
     PRIMITIVES,
     ClassScope,
     ClassView,

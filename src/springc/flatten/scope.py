@@ -33,19 +33,6 @@ from .parameters import ParameterValues
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
 
 
-@dataclass(frozen=True)
-class BuiltinEnumeration:
-    """A predefined enumeration type (``StateSelect``); its values are the ordinals of
-    its literals, 1 for the first (Modelica 4.9.5)."""
-
-    name: str
-    literals: tuple[str, ...]
-
-
-STATE_SELECT = BuiltinEnumeration("StateSelect", ("never", "avoid", "default", "prefer",
-                                                  "always"))
-BUILTIN_ENUMERATIONS = {"StateSelect": STATE_SELECT}
-
 
 @dataclass(frozen=True)
 class ViewComponent:
