@@ -2,9 +2,10 @@
 ``Import``, ``Extends``) and ``Modification``s.
 
 :class:`ElementRules` has one method per rule of ``grammar/modelica.lark`` for
-declarations, imports, ``extends`` clauses, modifications and comments; unsupported
-prefixes and forms (``inner``/``outer``, ``redeclare``, ``replaceable``, ``stream``,
-conditional components, ``:=`` bindings) become located ``... not supported yet`` errors.
+declarations (with ``inner``/``outer``, ``replaceable``, ``constrainedby``, conditions),
+imports, ``extends`` clauses, modifications (with ``redeclare``) and comments; unsupported
+forms (``inner outer`` together, ``stream``, ``:=`` bindings) become located
+``... not supported yet`` errors.
 """
 
 from __future__ import annotations
