@@ -126,3 +126,41 @@ def test_ideal_gear() -> None:
     t = result.time
     assert np.max(np.abs(result["a.phi"] - t ** 2 / 2)) < 1e-9
     assert np.max(np.abs(result["b.phi"] - t ** 2 / 4)) < 1e-9
+
+
+DRIVEN = f"""
+model Driven "prescribed acceleration and angle, through power, multi and relative sensors"
+  {R}.Sources.Accelerate accelerate;
+  Modelica.Blocks.Sources.Constant a_ref(k = 2);
+  {R}.Sensors.MultiSensor multi;
+  {R}.Sensors.PowerSensor power;
+  {R}.Components.Inertia a(J = 3);
+  {R}.Sources.Position position(f_crit = 5);
+  Modelica.Blocks.Sources.Constant phi_ref(k = 0.5);
+  {R}.Components.Inertia b(J = 1);
+  {R}.Sensors.RelAccSensor relAcc;
+equation
+  connect(a_ref.y, accelerate.a_ref);
+  connect(accelerate.flange, multi.flange_a);
+  connect(multi.flange_b, power.flange_a);
+  connect(power.flange_b, a.flange_a);
+  connect(phi_ref.y, position.phi_ref);
+  connect(position.flange, b.flange_a);
+  connect(relAcc.flange_a, b.flange_b);
+  connect(relAcc.flange_b, a.flange_b);
+end Driven;
+"""
+
+
+def test_accelerate_position_and_power_sensors() -> None:
+    result = simulate(DRIVEN, 1.0)
+    t = result.time
+    # a'' = 2 from rest: phi = t^2; the torque J*a = 6 passes through both sensors.
+    assert np.max(np.abs(result["a.phi"] - t ** 2)) < 1e-9
+    assert np.max(np.abs(result["multi.tau"] - 6)) < 1e-8
+    assert np.max(np.abs(result["multi.w"] - 2 * t)) < 1e-8
+    assert np.max(np.abs(result["multi.power"] - 12 * t)) < 1e-7
+    assert np.max(np.abs(result["power.power"] - 12 * t)) < 1e-7
+    # The filter starts at its constant reference: b stays at 0.5.
+    assert np.max(np.abs(result["b.phi"] - 0.5)) < 1e-9
+    assert np.max(np.abs(result["relAcc.a_rel"] - 2)) < 1e-6
