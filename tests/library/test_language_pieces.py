@@ -385,3 +385,16 @@ def test_redeclare_as_an_element_replaces_the_inherited_declaration(tmp_path: Pa
     assert "  parameter Real 'part.extra' = 2;" in lines
     assert error(tmp_path, text, "R.Wrong") == (
         "'fixed' is not replaceable and cannot be redeclared", 19, 21)
+
+
+def test_a_for_loop_over_an_enumeration_type(tmp_path: Path) -> None:
+    text = ("model E1\n  type E = enumeration(a, b, c);\n  Real x[3];\nequation\n"
+            "  for e in E loop\n    x[Integer(e)] = Integer(e);\n  end for;\nend E1;\n")
+    assert flat(tmp_path, text).splitlines()[-4:] == [
+        "  'x[1]' = 1;", "  'x[2]' = 2;", "  'x[3]' = 3;", "end E1;"]
+
+
+def test_an_outer_element_cannot_be_modified(tmp_path: Path) -> None:
+    text = ("model E2\n  model W\n    Real g = 1;\n  end W;\n  model B\n"
+            "    outer W w(g = 2);\n  end B;\n  inner W w;\n  B b;\nend E2;\n")
+    assert error(tmp_path, text) == ("the outer element 'b.w' cannot be modified", 6, 14)

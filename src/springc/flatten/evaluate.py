@@ -430,6 +430,10 @@ class Evaluator:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
+        if isinstance(index.range, s.Ref):  # an enumeration type: its literals in order
+            target = self.reference(index.range, scope)
+            if isinstance(target, ClassEntry) and target.defn.enumeration is not None:
+                return [x.Const(i + 1) for i in range(len(target.defn.enumeration))]
         v = self.value(index.range, scope)
         if not a.is_array(v) or v.ndim != 1:
             raise FlattenError("a for-loop range must be a vector", index.range.span)

@@ -59,6 +59,12 @@ class Instantiation(FlattenContext):
         if decl.condition is not None and not condition_holds(self, scope, decl):
             return disabled(scope, decl)
         if decl.outer:
+            modified = decl.modification or (scope.mod.children.get(decl.name)
+                                             if scope.mod is not None else None)
+            if modified is not None:
+                raise FlattenError(f"the outer element '{name}' cannot be modified",
+                                   modified.span, [Note("declared here", decl.span)],
+                                   "modify the inner element instead (Modelica 5.4)")
             return inner_member(scope, decl)
         outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
         if outer is not None and outer.redeclare is not None:
