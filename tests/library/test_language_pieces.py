@@ -398,3 +398,13 @@ def test_an_outer_element_cannot_be_modified(tmp_path: Path) -> None:
     text = ("model E2\n  model W\n    Real g = 1;\n  end W;\n  model B\n"
             "    outer W w(g = 2);\n  end B;\n  inner W w;\n  B b;\nend E2;\n")
     assert error(tmp_path, text) == ("the outer element 'b.w' cannot be modified", 6, 14)
+
+
+def test_a_class_redeclared_as_an_element_of_an_extending_class(tmp_path: Path) -> None:
+    text = ("package R\n  model C\n    Real x = 1;\n  end C;\n  model D\n    Real x = 2;\n"
+            "    Real z = 3;\n  end D;\n  model B\n    replaceable model M = C;\n    M m;\n"
+            "  end B;\n  model E\n    extends B;\n    redeclare model M = D(z = 4);\n"
+            "  end E;\n  model Top\n    E e;\n  end Top;\nend R;\n")
+    assert flat(tmp_path, text, "R.Top") == (
+        "model 'R.Top'\n  Real 'e.m.x';\n  Real 'e.m.z';\nequation\n  'e.m.x' = 2;\n"
+        "  'e.m.z' = 4;\nend 'R.Top';\n")

@@ -79,13 +79,18 @@ def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent,
 
 
 def redeclared_class(scope: ClassScope, type_name: s.Ref) -> tuple[s.ClassDef, ClassScope] | None:
-    """``b(redeclare model M = Other(k = 2))``: where ``b`` declares a component of type
-    ``M``, the class definition that replaces ``M`` and the scope it is written in."""
-    if scope.mod is None or len(type_name.parts) != 1:
+    """``b(redeclare model M = Other(k = 2))``, or ``redeclare model M = Other;`` as an
+    element of ``b``'s class extending the one that declares ``M``: where ``b`` declares
+    a component of type ``M``, the class definition that replaces ``M`` and the scope it
+    is written in."""
+    if len(type_name.parts) != 1:
         return None
-    child = scope.mod.children.get(type_name.parts[0].name)
+    first = type_name.parts[0].name
+    child = scope.mod.children.get(first) if scope.mod is not None else None
     if child is None or child.redeclare is None:
-        return None
+        own = next((e for e in scope.entry.defn.elements if isinstance(e, s.ClassDef)
+                    and e.redeclare and e.name == first), None)
+        return (own, scope) if own is not None else None
     element = child.redeclare.element
     if not isinstance(element, s.ClassDef):
         raise FlattenError(f"'{type_name.dotted}' is a class and cannot be redeclared as a "

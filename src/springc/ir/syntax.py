@@ -356,6 +356,7 @@ class ClassDef:
     # The literals of `type E = enumeration(a, b)`, in order (values 1, 2, ...).
     enumeration: tuple[str, ...] | None = None
     replaceable: bool = False
+    redeclare: bool = False  # an element `redeclare model M = T;` of an extending class
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.
     unsupported: tuple[ParseError, ...] = ()

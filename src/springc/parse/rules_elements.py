@@ -94,7 +94,8 @@ class ElementRules(RuleBase):
         if isinstance(item, Rejected):
             return [item]
         if isinstance(item, ClassDef):
-            return [replace(item, replaceable="replaceable" in words)]
+            return [replace(item, replaceable="replaceable" in words,
+                            redeclare="redeclare" in words)]
         return self._components(item, words, constraint)
 
     def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
