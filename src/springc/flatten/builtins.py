@@ -46,6 +46,7 @@ class Builtins:
             "zeros": self.fill_value(0), "ones": self.fill_value(1), "fill": self.fill,
             "identity": self.identity, "cross": self.cross, "transpose": self.transpose,
             "norm": self.norm, "scalar": self.scalar, "vector": self.vector,
+            "Integer": self.enum_ordinal,
         }
         for name in SCALAR_FUNCTIONS:
             self.table[name] = self.math
@@ -217,6 +218,12 @@ class Builtins:
         if len(items) != 1:
             raise FlattenError("'scalar' needs an array with one element", call.span)
         return items[0]
+
+    def enum_ordinal(self, call: s.Call, scope: Scope) -> a.Value:
+        """``Integer(E.b)``: the ordinal of an enumeration value (enumeration values are
+        their ordinals already, Modelica 4.9.5.2)."""
+        (v,) = self._args(call, scope, 1)
+        return v
 
     def vector(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)

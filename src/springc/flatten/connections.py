@@ -19,7 +19,15 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from .connect_rules import check_pair, check_sources
-from .scope import ClassScope, ExpressionEvaluator, Leaf, LocalScope, Primitive, Scope
+from .scope import (
+    ClassScope,
+    DisabledReference,
+    ExpressionEvaluator,
+    Leaf,
+    LocalScope,
+    Primitive,
+    Scope,
+)
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -129,8 +137,12 @@ class ConnectionSets:
 
     def connect(self, ev: ExpressionEvaluator, eq: s.Connect, where: Scope,
                 owner: ClassScope) -> None:
-        """Record ``connect(a, b)``; both sides may be arrays of connectors."""
-        sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
+        """Record ``connect(a, b)``; both sides may be arrays of connectors. A connection
+        naming a disabled conditional component is dropped (Modelica 4.4.5)."""
+        try:
+            sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
+        except DisabledReference:
+            return
         (left_shape, left, left_out), (right_shape, right, right_out) = sides
         if left_shape != right_shape:
             raise FlattenError(
@@ -146,6 +158,9 @@ class ConnectionSets:
         outside connectors of ``owner``."""
         value = direct_reference(ref, where)
         if value is None:
+            signal = _signal_connector(ev, ref, where)
+            if signal is not None:
+                return signal
             value = ev.reference(ref, where)
         if isinstance(value, ClassScope):  # the common case, without numpy
             shape, items = (1,), [value]
@@ -162,8 +177,11 @@ class ConnectionSets:
             and all(c.outer is owner for c in items)
         return shape, items, outside
 
-    def _pair(self, ca: ClassScope, cb: ClassScope, out_a: bool, out_b: bool,
+    def _pair(self, ca: ClassScope | Leaf, cb: ClassScope | Leaf, out_a: bool, out_b: bool,
               eq: s.Connect, owner: ClassScope) -> None:
+        if isinstance(ca, Leaf) or isinstance(cb, Leaf):
+            self._pair_signals(ca, cb, out_a, out_b, eq, owner)
+            return
         leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
         if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
@@ -184,6 +202,23 @@ class ConnectionSets:
             ra, rb = self._find(ka), self._find(kb)
             if ra != rb:
                 self.parent[rb] = ra
+
+    def _pair_signals(self, ca: ClassScope | Leaf, cb: ClassScope | Leaf, out_a: bool,
+                      out_b: bool, eq: s.Connect, owner: ClassScope) -> None:
+        """Connect two connectors declared with a short connector class of a primitive
+        type (``connector RealInput = input Real``): one scalar variable each."""
+        if not (isinstance(ca, Leaf) and isinstance(cb, Leaf)) or ca.flow != cb.flow:
+            names = [c.name if isinstance(c, Leaf) else c.prefix for c in (ca, cb)]
+            raise FlattenError(f"connectors '{names[0]}' and '{names[1]}' do not match",
+                               eq.span, hint="connect a signal connector (such as "
+                               "RealInput) only to another signal connector")
+        link = Link(eq.span, owner.prefix, f"connect({ca.name}, {cb.name})")
+        ka, kb = (ca.name, out_a), (cb.name, out_b)
+        self._add(ka, ca.flow, link)
+        self._add(kb, cb.flow, link)
+        ra, rb = self._find(ka), self._find(kb)
+        if ra != rb:
+            self.parent[rb] = ra
 
     def equations(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
         """Equations of all sets (in order of first connection), then zero flows."""
@@ -230,6 +265,40 @@ class ConnectionSets:
                                                      if scope.outer else "",
                                                      f"{scope.prefix} is not connected")))
         return out
+
+
+def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope
+                      ) -> tuple[tuple[int, ...], list[Any], bool] | None:
+    """``connect(u, gain.u)`` where ``u`` is declared ``RealInput u``: the scalar
+    variables as leaves (shape, leaves, outside), or None for any other reference."""
+    last = ref.parts[-1]
+    owners: list[Any]
+    if len(ref.parts) == 1:
+        member = _owner_scope(where)
+        owners = [member] if member is not None and member.has_member(last.name) else []
+    else:
+        head = s.Ref(ref.parts[:-1], ref.span)
+        found = ev.reference(head, where)
+        owners = list(found.flat) if isinstance(found, np.ndarray) else [found]
+    if not owners or not all(isinstance(o, ClassScope) and o.has_member(last.name)
+                             for o in owners):
+        return None
+    members = [o.member(last.name, last.span) for o in owners]
+    if not all(isinstance(m, Primitive) and m.connector for m in members):
+        return None
+    value = ev.reference(ref, where)
+    array = np.atleast_1d(np.asarray(value, dtype=object))
+    if not all(isinstance(v, x.Var) for v in array.flat):
+        return None
+    flow = members[0].flow
+    leaves = [Leaf("", v.name, flow) for v in array.flat]
+    return array.shape, leaves, len(ref.parts) == 1
+
+
+def _owner_scope(where: Scope) -> ClassScope | None:
+    while type(where) is LocalScope:
+        where = where.parent
+    return where if isinstance(where, ClassScope) else None
 
 
 def _describe_leaves(leaves: list[Leaf]) -> str:

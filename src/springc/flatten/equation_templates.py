@@ -65,9 +65,13 @@ def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
                 class_ok: Callable[[ClassView], bool]) -> bool:
     """Literal sizes and no constants: ``comp`` has the same members in every instance
     (for a component of class type, when ``class_ok`` accepts its class)."""
+    decl = comp.decl
+    if decl.condition is not None or decl.outer or decl.inner or decl.replaceable:
+        return False  # members, types or equations may differ per instance
     declared = flattener.declared_type(comp)
     rtype = declared.rtype
-    if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]):
+    if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]) \
+            or rtype.primitive == "String":
         return False
     if rtype.entry is None:
         return True

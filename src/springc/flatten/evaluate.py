@@ -24,12 +24,21 @@ from . import arrays as a
 from .assertions import guard_assertions
 from .access import check_access_component
 from .builtins import CONSTANTS, Builtins
+from .enumerations import BuiltinEnumeration
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
 from .parameters import check_powers
 from .ranges import with_range
-from .scope import ClassScope, FlattenContext, LocalScope, Primitive, Scope
+from .scope import (
+    ClassScope,
+    Disabled,
+    DisabledReference,
+    FlattenContext,
+    LocalScope,
+    Primitive,
+    Scope,
+)
 
 UNSUPPORTED_CALLS = {
     "hold",
@@ -232,11 +241,15 @@ class Evaluator:
         return result  # a relation on variables generates events (simplify/events.py)
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
-        # in order: the assertions of functions a branch calls hold where it is not
-        # taken (guarded), and nothing after a constant-true condition is evaluated
+        # In order: the assertions of functions a branch calls hold where it is not
+        # taken (guarded), and nothing after a constant-true condition is evaluated. A
+        # branch that cannot be evaluated (an index out of range, say) is an error only
+        # if it may be selected: not when a parameter expression rules it out (Modelica
+        # 3.6: the branch not selected is not evaluated).
         branches: list[tuple[x.Expr, a.Value]] = []
         guard: x.Expr | None = None  # all earlier conditions false
         result: a.Value | None = None
+        settled = False  # an earlier condition is a parameter expression that holds
         for cond_expr, then_expr in e.branches:
             cond = self._guarded(cond_expr, scope, guard, scalar=True)
             if isinstance(cond, x.Const):
@@ -244,16 +257,29 @@ class Evaluator:
                     result = self._guarded(then_expr, scope, guard)
                     break
                 continue
-            then = self._guarded(then_expr, scope,
-                                 cond if guard is None else x.BinOp("and", guard, cond))
+            try:
+                then = self._guarded(then_expr, scope,
+                                     cond if guard is None else x.BinOp("and", guard, cond))
+            except FlattenError:
+                if settled or self._folded(cond) is False:
+                    continue
+                raise
             branches.append((cond, then))
             guard = x.Not(cond) if guard is None else x.BinOp("and", guard, x.Not(cond))
+            settled = settled or self._folded(cond) is True
         if result is None:
-            result = self._guarded(e.otherwise, scope, guard)
+            try:
+                result = self._guarded(e.otherwise, scope, guard)
+            except FlattenError:
+                if not settled:
+                    raise
+                result = branches.pop()[1]
         for cond, then in reversed(branches):
             if a.shape(then) != a.shape(result):
                 raise FlattenError("branches of an if-expression differ in size", e.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
+        if failure is not None:
+            raise failure
         return result
 
     def _guarded(self, e: s.Expr, scope: Scope, guard: x.Expr | None, scalar: bool = False
@@ -265,6 +291,15 @@ class Evaluator:
         if guard is not None:
             guard_assertions(self.flattener.assertions, start, guard)
         return value
+
+    def _folded(self, cond: x.Expr) -> bool | None:
+        """The value of a condition that is a parameter expression, else None."""
+        if not self.flattener.is_parameter_expression(cond):
+            return None
+        try:
+            return bool(self.fold(cond))
+        except (KeyError, ArithmeticError, ValueError, TypeError):
+            return None
 
     # ------------------------------------------------------------------ references
 
@@ -293,6 +328,12 @@ class Evaluator:
         return current
 
     def _select(self, current: Any, part: s.RefPart, scope: Scope, ref: s.Ref) -> Any:
+        if isinstance(current, BuiltinEnumeration):
+            if part.name not in current.literals:
+                raise FlattenError(f"'{part.name}' is not a literal of {current.name}",
+                                   part.span, hint="its literals are: "
+                                   + ", ".join(current.literals))
+            return x.Const(current.literals.index(part.name) + 1)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -323,6 +364,11 @@ class Evaluator:
         return member.value if isinstance(member, Primitive) else member
 
     def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
+        if isinstance(current, Disabled):
+            raise DisabledReference(
+                f"'{current.name}' is a conditional component whose condition is false",
+                part.span, [Note("declared here", current.decl.span)],
+                "a disabled conditional component may only be named in connect(...)")
         value = self.member_value(current)
         if not part.subscripts:
             return value
@@ -419,6 +465,10 @@ class Evaluator:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
+        if isinstance(index.range, s.Ref):  # an enumeration type: its literals in order
+            target = self.reference(index.range, scope)
+            if isinstance(target, ClassEntry) and target.defn.enumeration is not None:
+                return [x.Const(i + 1) for i in range(len(target.defn.enumeration))]
         v = self.value(index.range, scope)
         if not a.is_array(v) or v.ndim != 1:
             raise FlattenError("a for-loop range must be a vector", index.range.span)

@@ -84,12 +84,14 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def walk(self, scope: ClassScope) -> Iterator[ClassScope]:
         """Every class instance below ``scope`` (depth first, declaration order);
         a component that cannot be instantiated is reported and skipped."""
-        for name in scope.view.components:
+        for name, comp in scope.view.components.items():
             try:
                 member = scope.member(name)
             except FlattenError as err:
                 self.report(err)
                 continue
+            if comp.decl.outer:
+                continue  # the inner instance is walked where it is declared
             if isinstance(member, ClassScope):
                 yield from self._walk_one(member)
             elif isinstance(member, np.ndarray):
@@ -106,7 +108,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         for _name, member in scope.all_members():
             if isinstance(member, Primitive):
-                if member.variability != "constant":
+                if member.variability != "constant" and member.type != "String":
                     yield from attributes_of(self, scope, member)
             else:
                 for item in (member.flat if isinstance(member, np.ndarray) else [member]):
@@ -145,6 +147,9 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     entry = select_model(tree, model)
     flattener = Flattener(tree, max_size)
     base, mods = flattener.follow_short(entry)
+    if base.defn.partial:
+        raise FlattenError(f"'{entry.full_name}' is partial and cannot be simulated",
+                           entry.defn.span, hint="simulate a model that extends it")
     view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
     top.mod = instance_mod(merge_all(mods), view, top)

@@ -32,7 +32,7 @@ from ..ir import flat
 from . import arrays as a
 from .equation_templates import fixed_shape, renamer
 from .modification import Mod
-from .scope import ClassScope, ClassView, FlattenContext, Primitive, ViewComponent
+from .scope import ClassScope, ClassView, Disabled, FlattenContext, Primitive, ViewComponent
 
 Shape = tuple[Any, ...]
 
@@ -239,6 +239,8 @@ def _copy_members(source: ClassScope, target: ClassScope, rename: Callable[[x.Ex
             target.members[name] = _copy_primitive(member, rename, prefix, cut)
         elif isinstance(member, ClassScope):
             target.members[name] = _copy_scope(member, target, rename, prefix, cut)
+        elif isinstance(member, Disabled):
+            target.members[name] = member
         else:
             items = [_copy_scope(m, target, rename, prefix, cut) for m in member.flat]
             target.members[name] = a.make_array(items, member.shape)
@@ -263,7 +265,7 @@ def _copy_primitive(prim: Primitive, rename: Callable[[x.Expr], x.Expr], prefix:
         names = prefix + prim.names[cut:]
         value = rename(a.scalars(prim.value)[0])
     return Primitive(names, value, prim.decl, prim.variability, prim.causality, prim.flow,
-                     prim.type, prim.mod, prim.dims)
+                     prim.type, prim.mod, prim.dims, prim.connector)
 
 
 def _scalar_names(prim: Primitive, new: str = "", old: str = "") -> list[str]:

@@ -15,13 +15,21 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FlattenError, Note
+from ..errors import ErrorGroup, FlattenError, Note, ParseError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .access import check_modified
+from .declarations import (
+    condition_holds,
+    disabled,
+    inner_member,
+    redeclared,
+    redeclared_class,
+    redeclared_class_mod,
+)
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .scope import (
@@ -55,32 +63,57 @@ class Instantiation(FlattenContext):
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
+        name = scope.flat_name(decl.name)
+        if decl.condition is not None and not condition_holds(self, scope, decl):
+            return disabled(scope, decl)
+        if decl.outer:
+            modified = decl.modification or (scope.mod.children.get(decl.name)
+                                             if scope.mod is not None else None)
+            if modified is not None:
+                raise FlattenError(f"the outer element '{name}' cannot be modified",
+                                   modified.span, [Note("declared here", decl.span)],
+                                   "modify the inner element instead (Modelica 5.4)")
+            return inner_member(scope, decl)
+        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
+        if outer is not None and outer.redeclare is not None:
+            comp, outer = redeclared(comp, outer, name)
+            decl = comp.decl
         declared = self.declared_type(comp)
         rtype = declared.rtype
-        name = scope.flat_name(decl.name)
-        outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
         own = from_syntax(decl.modification, scope)
-        if outer is None and own is None and len(declared.type_mods) <= 1:
-            mod = declared.type_mods[0] if declared.type_mods else None  # nothing to merge
+        type_mods = declared.type_mods
+        by_class = redeclared_class(scope, decl.type_name)
+        if by_class is not None:
+            rtype, type_mods = self._redeclared_type(by_class[0], by_class[1])
+        if outer is None and own is None and len(type_mods) <= 1:
+            mod = type_mods[0] if type_mods else None  # nothing to merge
         else:
-            mod = merge_all([outer, own, *declared.type_mods], name)
+            mod = merge_all([outer, own, *type_mods], name)
         if decl.final and outer is not None:
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = declared.dims if declared.dims is not None \
+        dims = declared.dims if declared.dims is not None and by_class is None \
             else self._dims(decl, scope, rtype, mod, name)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
+        if rtype.primitive == "String":
+            return self._string(decl, rtype, mod, dims, name)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name)
         assert rtype.entry is not None
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
                                "cannot be instantiated", decl.type_name.span)
+        if rtype.entry.defn.partial:
+            raise FlattenError(f"'{name}' is of the partial class '{rtype.entry.full_name}', "
+                               "which cannot be instantiated", decl.span,
+                               [Note(f"'{rtype.entry.full_name}' is declared partial here",
+                                     rtype.entry.defn.span)],
+                               "use a class that extends it")
         self._check_containment(scope, rtype.entry, decl, name)
-        view = self.view(rtype.entry)
+        view = self._used_view(rtype.entry, decl, name)
         if not dims:
             return self._class_scope(name, view, mod, decl, scope)
         if mod is not None:
@@ -91,6 +124,30 @@ class Instantiation(FlattenContext):
             out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
                                          select(mod, sub), decl, scope)
         return out
+
+    def _used_view(self, entry: ClassEntry, decl: s.Component, name: str) -> ClassView:
+        """The view of a component's class; a construct outside the subset in that class
+        is reported with a note on the component that uses it."""
+        try:
+            return self.view(entry)
+        except (ParseError, ErrorGroup) as err:
+            note = Note(f"'{name}' uses class '{entry.full_name}' here", decl.span)
+            errors = err.errors if isinstance(err, ErrorGroup) else (err,)
+            if not all(isinstance(e, ParseError) for e in errors):
+                raise
+            noted = [ParseError(e.message, e.span, (*e.notes, note), e.hint) for e in errors]
+            raise (noted[0] if len(noted) == 1 else ErrorGroup(noted)) from None
+
+    def _redeclared_type(self, defn: s.ClassDef, where: ClassScope
+                         ) -> tuple[ResolvedType, list[Mod | None]]:
+        """The type and type modifiers of a class replaced by ``redeclare model M = T(...)``."""
+        if defn.short is None:
+            raise FlattenError("a redeclaration with a long class definition is not "
+                               "supported yet", defn.span,
+                               hint="write `redeclare model M = Other(...)`")
+        rtype = self.resolve_type(defn.short.base, where.entry)
+        mods = [each(from_syntax(m, self.package_scope(e.parent or e))) for m, e in rtype.mods]
+        return rtype, [redeclared_class_mod(defn, where, None), *mods]
 
     def _check_containment(self, scope: ClassScope, entry: ClassEntry, decl: s.Component,
                            name: str) -> None:
@@ -155,7 +212,9 @@ class Instantiation(FlattenContext):
             scope.mod = instance_mod(mod, view, scope)
         if scope.mod is not None:
             for key, child in scope.mod.children.items():
-                if key not in view.components:
+                if key not in view.components and not (
+                        child.redeclare is not None
+                        and isinstance(child.redeclare.element, s.ClassDef)):
                     self._unknown_target(key, child, view, name)
             if scope.mod.value is not None and view.entry.defn.kind == "record":
                 scope.mod = record_mod(self, scope.mod, view, name)
@@ -231,7 +290,7 @@ class Instantiation(FlattenContext):
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         flow, rtype.primitive or "Real", mod, dims)
+                         flow, rtype.primitive or "Real", mod, dims, rtype.connector)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b
@@ -239,6 +298,23 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
+
+    def _string(self, decl: s.Component, rtype: ResolvedType, mod: Mod | None,
+                dims: tuple[int, ...], name: str) -> Primitive:
+        """A ``String`` parameter or constant: its value, known while flattening (it is
+        not a variable of the flat model)."""
+        variability = decl.variability or rtype.prefixes[0]
+        if variability not in ("parameter", "constant"):
+            raise FlattenError("`String` variables are not supported yet", decl.span,
+                               hint="declare it a parameter or a constant")
+        if dims:
+            raise FlattenError("arrays of `String` are not supported yet", decl.span)
+        check_attribute_mods(mod, "String", name)
+        value = self.mod_value(mod.value) if mod is not None and mod.value is not None else ""
+        if not isinstance(value, str):
+            raise FlattenError(f"'{name}' is a String and must be given a string",
+                               mod.value.span if mod is not None and mod.value else decl.span)
+        return Primitive(name, value, decl, variability, "", False, "String", mod, ())
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

@@ -11,12 +11,13 @@ from __future__ import annotations
 import difflib
 from typing import Any
 
-from ..errors import FlattenError, FollowUpError, Note, Span
+from ..errors import ErrorGroup, FlattenError, FollowUpError, Note, Span
 from ..ir import expr as x
 from ..ir import syntax as s
-from ..parse import ClassEntry, ClassTree, lookup_class, member_class
+from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
 from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
+from .enumerations import BUILTIN_ENUMERATIONS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
 from .rules import check_class, check_extends
@@ -42,6 +43,9 @@ class ClassLookup(FlattenContext):
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
         found = self.views.get(id(entry))
         if found is None and id(entry) not in self.rule_errors:
+            unsupported = entry.defn.unsupported
+            if unsupported:  # a construct outside the subset, in a class the model uses
+                raise unsupported[0] if len(unsupported) == 1 else ErrorGroup(unsupported)
             try:
                 check_extends(self, entry)
             except FlattenError as err:
@@ -82,12 +86,17 @@ class ClassLookup(FlattenContext):
         prefixes = ("", "", False)
         if name in PRIMITIVES and lookup_class(name, scope) is None:
             return ResolvedType(name, None, (), (), prefixes)
-        if name in ("String", "StateSelect") or name.startswith("Modelica."):
-            raise FlattenError(f"the type `{name}` is not supported yet", ref.span,
-                               hint="use Real, Integer, Boolean or classes of your own")
+        if name in BUILTIN_ENUMERATIONS and lookup_class(name, scope) is None:
+            return ResolvedType("Integer", None, (), (), prefixes)
+        if name == "String" and lookup_class(name, scope) is None:
+            return ResolvedType("String", None, (), (), prefixes)
         entry = self.resolve_class(ref, scope)
+        connector = False
         for _ in range(100):
             short = entry.defn.short
+            if entry.defn.enumeration is not None:
+                # Enumeration values are their ordinals (1, 2, ...): an Integer.
+                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes)
             if short is None:
                 return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
             if short.modification is not None:
@@ -95,9 +104,10 @@ class ClassLookup(FlattenContext):
             dims += [(d, entry) for d in short.dims]
             prefixes = (prefixes[0] or short.variability, prefixes[1] or short.causality,
                         prefixes[2] or short.flow)
+            connector = connector or entry.defn.kind == "connector"
             base = short.base.dotted
             if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
-                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes)
+                return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes, connector)
             entry = self.resolve_class(short.base, entry.parent or entry)
         raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
 
@@ -136,8 +146,16 @@ class ClassLookup(FlattenContext):
         return entry
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:
-        """``P.c``: a nested class or a constant of a package."""
+        """``P.c``: a nested class or a constant of a package, or ``E.a``: a literal of
+        an enumeration (its ordinal)."""
         ref = s.Ref((s.RefPart(entry.name, (), span), s.RefPart(name, (), span)), span)
+        target = self.follow_short(entry)[0] if entry.defn.short is not None else entry
+        literals = target.defn.enumeration
+        if literals is not None:
+            if name not in literals:
+                raise FlattenError(f"enumeration '{entry.full_name}' has no literal '{name}'",
+                                   span, hint="its literals are: " + ", ".join(literals))
+            return x.Const(literals.index(name) + 1)
         nested = member_class(entry, name)
         if nested is not None:
             check_access_path([entry, nested], ref)
@@ -181,6 +199,11 @@ class ClassLookup(FlattenContext):
         found = lookup_class(name, entry)
         if found is not None:
             return found
+        constant = imported_element(entry, name)
+        if constant is not None:
+            return self.class_member(constant[0], constant[1], span)
+        if name in BUILTIN_ENUMERATIONS:
+            return BUILTIN_ENUMERATIONS[name]
         if name in CONSTANTS:
             return x.Const(CONSTANTS[name])
         if encapsulated is not None and encapsulated.parent is not None \

@@ -29,6 +29,15 @@ class ModValue:
         return self.expr.span
 
 
+@dataclass(frozen=True, slots=True)
+class Redeclaration:
+    """``redeclare T x(...)`` or ``redeclare model M = T(...)`` written in ``scope``
+    (a scope.ClassScope, where the new type name is looked up)."""
+
+    element: s.Component | s.ClassDef
+    scope: Any
+
+
 @dataclass(frozen=True)
 class Mod:
     value: ModValue | None = None
@@ -36,7 +45,7 @@ class Mod:
     each: bool = False
     final: bool = False
     span: Span | None = None
-
+    redeclare: Redeclaration | None = None
 
 
 def from_syntax(modification: s.Modification | None, scope: Any) -> Mod | None:
@@ -45,9 +54,12 @@ def from_syntax(modification: s.Modification | None, scope: Any) -> Mod | None:
         return None
     children: dict[str, Mod] = {}
     for arg in modification.arguments:
-        inner = from_syntax(arg.modification, scope)
-        sub = Mod(inner.value, inner.children, arg.each, arg.final, arg.span) \
-            if inner is not None else Mod(each=arg.each, final=arg.final, span=arg.span)
+        redeclare = Redeclaration(arg.redeclare, scope) if arg.redeclare is not None else None
+        inner = from_syntax(arg.redeclare.modification if isinstance(arg.redeclare, s.Component)
+                            else arg.modification, scope)
+        sub = Mod(inner.value, inner.children, arg.each, arg.final, arg.span, redeclare) \
+            if inner is not None else Mod(each=arg.each, final=arg.final, span=arg.span,
+                                          redeclare=redeclare)
         for name in reversed(arg.path[1:]):
             sub = Mod(children={name: sub}, span=arg.span)
         head = arg.path[0]
@@ -65,7 +77,8 @@ def _combine(a: Mod, b: Mod) -> Mod:
     children = dict(a.children)
     for name, mod in b.children.items():
         children[name] = _combine(children[name], mod) if name in children else mod
-    return Mod(a.value or b.value, children, a.each or b.each, a.final or b.final, a.span)
+    return Mod(a.value or b.value, children, a.each or b.each, a.final or b.final, a.span,
+               a.redeclare or b.redeclare)
 
 
 def merge(outer: Mod | None, inner: Mod | None, name: str = "") -> Mod | None:
@@ -86,7 +99,8 @@ def merge(outer: Mod | None, inner: Mod | None, name: str = "") -> Mod | None:
         children[key] = merged
     value = outer.value if outer.value is not None else inner.value
     each = outer.each if outer.value is not None else inner.each
-    return Mod(value, children, each, inner.final or outer.final, outer.span or inner.span)
+    return Mod(value, children, each, inner.final or outer.final, outer.span or inner.span,
+               outer.redeclare or inner.redeclare)
 
 
 def merge_all(mods: list[Mod | None], name: str = "") -> Mod | None:
@@ -109,7 +123,8 @@ def select(mod: Mod | None, index: tuple[int, ...]) -> Mod | None:
     value = ModValue(mod.value.expr, mod.value.scope, mod.value.index + index) \
         if mod.value else None
     children = {k: select(v, index) for k, v in mod.children.items()}
-    return Mod(value, children, False, mod.final, mod.span)  # type: ignore[arg-type]
+    return Mod(value, children, False, mod.final, mod.span,  # type: ignore[arg-type]
+               mod.redeclare)
 
 
 def each(mod: Mod | None) -> Mod | None:

@@ -36,6 +36,7 @@ from .syntax_walk import same_text
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
 
 
+
 @dataclass(frozen=True)
 class ViewComponent:
     """A component declaration as seen in a class, with the class that wrote it."""
@@ -73,6 +74,7 @@ class ResolvedType:
     dims: tuple[tuple[s.Expr, Any], ...]
     mods: tuple[tuple[s.Modification, ClassEntry], ...]
     prefixes: tuple[str, str, bool]
+    connector: bool = False  # a primitive reached through `connector C = input Real`
 
 
 @dataclass(eq=False)
@@ -88,6 +90,20 @@ class Primitive:
     type: str
     mod: Mod | None
     dims: tuple[int, ...]
+    connector: bool = False  # declared with a short connector class (RealInput)
+
+
+@dataclass(frozen=True, eq=False)
+class Disabled:
+    """A conditional component whose condition is false: it is not part of the model,
+    and only ``connect`` statements may name it (they are dropped; Modelica 4.4.5)."""
+
+    decl: s.Component
+    name: str
+
+
+class DisabledReference(FlattenError):
+    """A reference to a disabled conditional component (see :class:`Disabled`)."""
 
 
 @dataclass(eq=False)
@@ -156,9 +172,15 @@ class ClassScope:
         self.members[name] = created
         return created
 
-    def all_members(self) -> Iterator[tuple[str, Member]]:
-        for name in self.view.components:
-            yield name, self.member(name)
+    def all_members(self) -> Iterator[tuple[str, Primitive | ClassScope | np.ndarray]]:
+        """The members this instance owns: not disabled conditional components, and not
+        ``outer`` ones (they are the ``inner`` instance's, reached from here)."""
+        for name, comp in self.view.components.items():
+            if comp.decl.outer:
+                continue
+            member = self.member(name)
+            if not isinstance(member, Disabled):
+                yield name, member
 
     def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
@@ -206,7 +228,7 @@ class FunctionScope:
 #: Where a name is looked up: an instance, loop indices over one, or a function call.
 Scope = ClassScope | LocalScope | FunctionScope
 #: A member of an instance: a primitive variable, a component, or an array of components.
-Member = Primitive | ClassScope | np.ndarray
+Member = Primitive | ClassScope | np.ndarray | Disabled
 
 
 @dataclass(frozen=True, slots=True)
@@ -353,11 +375,31 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
         equations += base_view.equations
         initial += base_view.initial_equations
     for element in entry.defn.elements:
-        if isinstance(element, s.Component):
+        if isinstance(element, s.Component) and element.redeclare:
+            _redeclare_component(components, element, entry)
+        elif isinstance(element, s.Component):
             _add_component(components, element.name, ViewComponent(element, entry))
     equations += (ViewEquation(e, entry) for e in entry.defn.equations)
     initial += (ViewEquation(e, entry) for e in entry.defn.initial_equations)
     return ClassView(entry, components, tuple(equations), tuple(initial), tuple(mods))
+
+
+def _redeclare_component(components: dict[str, ViewComponent], element: s.Component,
+                         entry: ClassEntry) -> None:
+    """``redeclare Steel part;`` as an element: it replaces the inherited declaration of
+    ``part``, which must be replaceable (Modelica 7.3)."""
+    existing = components.get(element.name)
+    if existing is None:
+        raise FlattenError(f"'{element.name}' is redeclared but no inherited element has "
+                           "that name", element.span, hint="redeclare an element of a base "
+                           "class, or drop `redeclare`")
+    if not existing.decl.replaceable:
+        raise FlattenError(f"'{element.name}' is not replaceable and cannot be redeclared",
+                           element.span, [Note("declared here", existing.decl.span)])
+    constraint = existing.decl.constraint
+    if element.modification is None and constraint is not None and constraint[1] is not None:
+        element = replace(element, modification=constraint[1])
+    components[element.name] = ViewComponent(element, entry)
 
 
 def _add_component(components: dict[str, ViewComponent], name: str,

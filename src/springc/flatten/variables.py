@@ -14,9 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FlattenError
-from ..ir import expr as x
 from ..ir import flat
-from ..ir import syntax as s
 from . import arrays as a
 from .modification import Mod, select
 from .scope import ClassScope, FlattenContext, Primitive
@@ -26,6 +24,7 @@ ATTRIBUTES = {
              "quantity"),
     "Integer": ("start", "fixed", "min", "max", "quantity"),
     "Boolean": ("start", "fixed", "quantity"),
+    "String": ("start", "fixed", "quantity"),
 }
 STATE_SELECT = ("never", "avoid", "default", "prefer", "always")
 
@@ -85,7 +84,7 @@ def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes
         if child.value is None:
             continue
         if key == "stateSelect":
-            values["state_select"] = _state_select(child)
+            values["state_select"] = _state_select(flattener, child)
             continue
         value = flattener.mod_value(child.value)
         if a.is_array(value):
@@ -112,7 +111,7 @@ def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes
 _EMPTY = flat.Attributes()
 
 
-def _fold(flattener: FlattenContext, value: x.Expr, child: Mod, what: str) -> Any:
+def _fold(flattener: FlattenContext, value: a.Value, child: Mod, what: str) -> Any:
     try:
         return flattener.evaluator.fold(value)
     except KeyError as missing:
@@ -121,11 +120,14 @@ def _fold(flattener: FlattenContext, value: x.Expr, child: Mod, what: str) -> An
                            f"{missing.args[0]}", child.value.span) from None
 
 
-def _state_select(child: Mod) -> str:
+def _state_select(flattener: FlattenContext, child: Mod) -> str:
+    """``stateSelect = StateSelect.prefer``, or any parameter expression of that type
+    (``if exact then StateSelect.default else StateSelect.prefer``)."""
     assert child.value is not None
     e = child.value.expr
-    if isinstance(e, s.Ref) and len(e.parts) == 2 and e.parts[0].name == "StateSelect" \
-            and e.parts[1].name in STATE_SELECT:
-        return e.parts[1].name
+    value = _fold(flattener, flattener.mod_value(child.value), child, "stateSelect")
+    if isinstance(value, int | np.integer) and not isinstance(value, bool) \
+            and 1 <= value <= len(STATE_SELECT):
+        return STATE_SELECT[int(value) - 1]
     raise FlattenError("stateSelect must be one of "
                        + ", ".join(f"StateSelect.{n}" for n in STATE_SELECT), e.span)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import Span
+from ..errors import ParseError, Span
 
 # ---------------------------------------------------------------- expressions
 
@@ -195,6 +195,9 @@ class ElementModification:
     each: bool
     final: bool
     span: Span
+    # `redeclare Steel m(k = 2)` or `redeclare model M = Other` (Modelica 7.3): the new
+    # declaration of the element ``path`` names.
+    redeclare: Component | ClassDef | None = None
 
 
 # ------------------------------------------------------------------- elements
@@ -221,6 +224,15 @@ class Component:
     protected: bool
     description: str
     span: Span
+    # `Support support if useSupport`: the component exists only when this parameter
+    # expression is true (Modelica 4.4.5).
+    condition: Expr | None = None
+    inner: bool = False
+    outer: bool = False
+    replaceable: bool = False
+    # The type and modification of `constrainedby T(...)` (Modelica 7.3.2).
+    constraint: tuple[Ref, Modification | None] | None = None
+    redeclare: bool = False  # an element `redeclare T x;` replacing an inherited one
 
 
 @dataclass(frozen=True, slots=True)
@@ -396,6 +408,13 @@ class ClassDef:
     annotation: Modification | None
     protected: bool
     span: Span
+    # The literals of `type E = enumeration(a, b)`, in order (values 1, 2, ...).
+    enumeration: tuple[str, ...] | None = None
+    replaceable: bool = False
+    redeclare: bool = False  # an element `redeclare model M = T;` of an extending class
+    # Constructs outside springc's subset written in this class (``... not supported
+    # yet`` errors, errors.ParseError), reported when a model uses the class.
+    unsupported: tuple[ParseError, ...] = ()
 
 
 Element = Component | Extends | Import | ClassDef

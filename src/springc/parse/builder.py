@@ -34,11 +34,13 @@ from .rules_expressions import ExpressionRules
 __all__ = ["KEYWORDS", "LATER", "SyntaxBuilder", "build", "check_depth"]
 
 
-def build(tree: Tree[Token], file: str) -> Any:
+def build(tree: Tree[Token], file: str, defer: bool = False) -> Any:
     """The syntax node of ``tree`` (a StoredDefinition, or an Expr for an expression);
-    raises :class:`ParseError`, or :class:`ErrorGroup` if there are several errors."""
+    raises :class:`ParseError`, or :class:`ErrorGroup` if there are several errors.
+    With ``defer``, a construct outside the subset inside a class is no error here: the
+    class keeps it (``ClassDef.unsupported``) for flatten to report if a model uses it."""
     check_depth(tree, file)
-    builder = SyntaxBuilder(file)
+    builder = SyntaxBuilder(file, defer)
     result = builder.convert(tree)
     if builder.errors:
         errors = sorted(builder.errors,
@@ -55,9 +57,11 @@ class SyntaxBuilder(ClassRules, ElementRules, EquationRules, ExpressionRules):
     ``v_args(meta=True)`` costs about three times as much per node.)
     """
 
-    def __init__(self, file: str) -> None:
+    def __init__(self, file: str, defer: bool = False) -> None:
         self.file = file
         self.errors: list[ParseError] = []
+        self.defer = defer
+        self.deferred: list[ParseError] = []
         self._methods: dict[str, Callable[[Any, list[Any]], Any]] = {}
         self.loose_ends: list[End] = []  # `end`s not yet known to sit in a subscript
 

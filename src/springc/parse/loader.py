@@ -336,12 +336,42 @@ def _imported(entry: ClassEntry, name: str,
         found = member_class(package, target, active)
         if found is not None:
             return found
+        if named and _declares(package.defn, target):
+            return None  # a constant, found by imported_element
         if named:
             raise FlattenError(
                 f"the imported class '{'.'.join((*element.path, target))}' is not loaded: "
                 f"'{package.full_name}' has no class '{target}'", element.span,
                 [Note(f"'{package.full_name}' is defined here", package.defn.span)],
                 hint="check the spelling of the import")
+    return None
+
+
+def _declares(defn: s.ClassDef, name: str) -> bool:
+    return any(isinstance(e, s.Component) and e.name == name for e in defn.elements)
+
+
+def imported_element(scope: ClassEntry, name: str) -> tuple[ClassEntry, str] | None:
+    """``import Modelica.Constants.pi;`` seen from ``scope`` or an enclosing class: the
+    package and the name of the imported component (a constant), or None."""
+    entry: ClassEntry | None = scope
+    while entry is not None:
+        for element in entry.defn.elements:
+            if not isinstance(element, s.Import):
+                continue
+            named = (element.alias == name) or (name in element.names and element.alias is None)
+            if not named and not element.wildcard:
+                continue
+            root = entry
+            while root.parent is not None:
+                root = root.parent
+            package = _import_path(root, element.path, element, frozenset())
+            target = element.names[0] if element.alias == name else name
+            if _declares(package.defn, target):
+                return package, target
+        if entry.defn.encapsulated:
+            return None
+        entry = entry.parent
     return None
 
 
@@ -425,7 +455,7 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
     for text_name, text in texts:
         remember_source(text_name, text)
         try:
-            parsed.append((parse_text(text, text_name), None))
+            parsed.append((parse_text(text, text_name, defer=True), None))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:
@@ -457,11 +487,11 @@ def parse_cached(path: Path) -> s.StoredDefinition:
     try:
         stat = path.stat()
     except OSError:
-        return parse_file(path)
+        return parse_file(path, defer=True)
     key = (str(path), stat.st_mtime_ns, stat.st_size)
     stored = _PARSED.get(key)
     if stored is None:
-        stored = _PARSED[key] = parse_file(path)
+        stored = _PARSED[key] = parse_file(path, defer=True)
     return stored
 
 

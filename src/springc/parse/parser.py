@@ -117,21 +117,23 @@ def parser_cache_file(grammar: Path) -> Path | None:
 # -------------------------------------------------------------------- public API
 
 
-def parse_text(text: str, file: str) -> StoredDefinition:
-    """Parse the Modelica source ``text`` of ``file`` (used in spans only)."""
+def parse_text(text: str, file: str, defer: bool = False) -> StoredDefinition:
+    """Parse the Modelica source ``text`` of ``file`` (used in spans only). With
+    ``defer``, constructs outside the subset are kept with their classes, to be
+    reported only where a model uses them (the loader's mode)."""
     tree = _parse(text, file, "start")
-    stored = build(tree, file)
+    stored = build(tree, file, defer)
     assert isinstance(stored, StoredDefinition)
     return stored
 
 
-def parse_file(path: str | Path) -> StoredDefinition:
+def parse_file(path: str | Path, defer: bool = False) -> StoredDefinition:
     """Read and parse one ``.mo``/``.mdl`` file; :class:`LoadError` if it cannot be read."""
     try:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise LoadError(f"cannot read '{path}': {exc}") from None
-    return parse_text(text, str(path))
+    return parse_text(text, str(path), defer)
 
 
 def parse_expression(text: str, file: str = "<expr>") -> Expr:

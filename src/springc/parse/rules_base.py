@@ -86,6 +86,11 @@ def of(children: list[Any], kind: type[T]) -> T | None:
     return next((c for c in children if isinstance(c, kind)), None)
 
 
+def _within(inner: Span, outer: Span) -> bool:
+    return (outer.line, outer.column) <= (inner.line, inner.column) \
+        and (inner.end_line, inner.end_column) <= (outer.end_line, outer.end_column)
+
+
 def join(a: Span, b: Span) -> Span:
     return Span(a.file, a.line, a.column, b.end_line, b.end_column)
 
@@ -95,6 +100,8 @@ class RuleBase:
 
     file: str
     errors: list[ParseError]
+    defer: bool  # keep `not supported yet` errors with their class (see take_deferred)
+    deferred: list[ParseError]
     loose_ends: list[End]  # `end`s not yet known to sit in a subscript
 
     def span_of(self, meta: Meta) -> Span:
@@ -115,7 +122,18 @@ class RuleBase:
 
     def reject(self, what: str, span: Span, hint: str | None = LATER) -> Rejected:
         self.error(f"{what} not supported yet", span, hint)
+        if self.defer:
+            self.deferred.append(self.errors[-1])
         return Rejected(span)
+
+    def take_deferred(self, span: Span) -> tuple[ParseError, ...]:
+        """The ``not supported yet`` errors inside ``span``, moved from the file's errors
+        to the class written there (reported when a model uses that class)."""
+        inside = tuple(e for e in self.deferred if e.span is not None and _within(e.span, span))
+        if inside:
+            self.deferred = [e for e in self.deferred if e not in inside]
+            self.errors = [e for e in self.errors if e not in inside]
+        return inside
 
     def ident(self, tok: Token, function: bool = False) -> str:
         """The name written by ``tok`` (without quotes); reserved words are errors,

@@ -48,6 +48,11 @@ class _Section:
 
 
 @dataclass(frozen=True, slots=True)
+class _EnumBody:
+    literals: tuple[str, ...] | None  # None for `enumeration(:)`
+
+
+@dataclass(frozen=True, slots=True)
 class _Spec:
     """The part of a class definition after its prefixes."""
 
@@ -57,6 +62,7 @@ class _Spec:
     short: ShortDef | None
     annotation: Modification | None
     end_name: Token | None
+    enumeration: tuple[str, ...] | None = None
 
 
 def _section_rule(kind: str) -> Callable[[RuleBase, Meta, list[Any]], _Section]:
@@ -133,8 +139,13 @@ class ClassRules(RuleBase):
             initial_equations=body["initial equation"], algorithm=body["algorithm"],
             short=spec.short,
             annotation=_merge_annotations(spec.annotation, body["annotations"]),
-            protected=False, span=span,
+            protected=False, span=span, enumeration=spec.enumeration,
+            unsupported=self.take_deferred(span) if self.defer else (),
         )
+
+    def short_class_definition(self, meta: Meta, ch: list[Any]) -> Any:
+        """A class written in a modification: ``redeclare model M = Other``."""
+        return self.class_definition(meta, ch)
 
     def _body(self, sections: tuple[_Section, ...], kind: str) -> dict[str, tuple[Any, ...]]:
         body: dict[str, list[Any]] = {"elements": [], "equation": [], "initial equation": [],
@@ -194,14 +205,25 @@ class ClassRules(RuleBase):
         )
         return _Spec(name, comment.description, (), short, comment.annotation, None)
 
-    def enum_class(self, meta: Meta, ch: list[Any]) -> Rejected:
-        keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
-        return self.reject("`enumeration` types are", self.token_span(keyword))
+    def enum_class(self, meta: Meta, ch: list[Any]) -> Any:
+        name, comment = ch[0], ch[-1]
+        body = of(ch, _EnumBody)
+        if body is not None and body.literals is None:
+            keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
+            return self.reject("unspecified enumerations `enumeration(:)` are",
+                               self.token_span(keyword))
+        literals = body.literals if body is not None and body.literals is not None else ()
+        if len(set(literals)) != len(literals):
+            self.error(f"enumeration '{self.ident(name)}' has a literal twice",
+                       self.span_of(meta))
+        return _Spec(name, comment.description, (), None, comment.annotation, None, literals)
 
     def enum_body(self, meta: Meta, ch: list[Any]) -> Any:
-        return None
+        literals = [c for c in ch if isinstance(c, str)]
+        return _EnumBody(tuple(literals) if ch else None)
 
-    enum_literal = enum_body
+    def enum_literal(self, meta: Meta, ch: list[Any]) -> str:
+        return self.ident(ch[0])
 
     def composition(self, meta: Meta, ch: list[Any]) -> Any:
         elements = [i for c in ch if not isinstance(c, _Section) for i in c]

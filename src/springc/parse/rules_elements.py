@@ -2,14 +2,15 @@
 ``Import``, ``Extends``) and ``Modification``s.
 
 :class:`ElementRules` has one method per rule of ``grammar/modelica.lark`` for
-declarations, imports, ``extends`` clauses, modifications and comments; unsupported
-prefixes and forms (``inner``/``outer``, ``redeclare``, ``replaceable``, ``stream``,
-conditional components, ``:=`` bindings) become located ``... not supported yet`` errors.
+declarations (with ``inner``/``outer``, ``replaceable``, ``constrainedby``, conditions),
+imports, ``extends`` clauses, modifications (with ``redeclare``) and comments; unsupported
+forms (``inner outer`` together, ``stream``, ``:=`` bindings) become located
+``... not supported yet`` errors.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from lark import Token
@@ -42,6 +43,19 @@ class _Decl:
     modification: Modification | None
     description: str
     span: Span
+    condition: Expr | None
+
+
+@dataclass(frozen=True, slots=True)
+class _Condition:
+    expr: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class _Constraint:
+    type_name: Ref
+    modification: Modification | None
+    span: Span
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,22 +84,33 @@ class ElementRules(RuleBase):
     def declaration_element(self, meta: Meta, ch: list[Any]) -> Any:
         prefixes, item = ch[0], ch[1]
         words = [str(t) for t in prefixes]
-        for tok in prefixes:
-            if tok in ("redeclare", "replaceable"):
-                self.reject(f"`{tok}` is", self.token_span(tok))
-            elif tok in ("inner", "outer"):
-                self.reject(f"`{tok}` elements are", self.token_span(tok))
-        if len(ch) > 2 and "replaceable" not in words:
-            self.reject("`constrainedby` is", ch[2])
-        if isinstance(item, ClassDef | Rejected):
+        constraint = of(ch[2:], _Constraint)
+        if constraint is not None and "replaceable" not in words:
+            self.error("`constrainedby` needs a `replaceable` element", constraint.span,
+                       hint="write `replaceable` before the declaration")
+        if "inner" in words and "outer" in words:
+            self.reject("`inner outer` elements are",
+                        self.token_span(next(t for t in prefixes if t == "outer")))
+        if isinstance(item, Rejected):
             return [item]
-        words += list(item.prefixes)
+        if isinstance(item, ClassDef):
+            return [replace(item, replaceable="replaceable" in words,
+                            redeclare="redeclare" in words)]
+        return self._components(item, words, constraint)
+
+    def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
+                    ) -> list[Component]:
+        words = words + list(item.prefixes)
         return [
             Component(
                 name=d.name, type_name=item.type_name, type_dims=item.type_dims, dims=d.dims,
                 modification=d.modification, variability=variability(words),
                 causality=causality(words), flow="flow" in words, final="final" in words,
                 protected=False, description=d.description, span=d.span,
+                condition=d.condition, inner="inner" in words, outer="outer" in words,
+                replaceable="replaceable" in words,
+                constraint=(constraint.type_name, constraint.modification)
+                if constraint else None, redeclare="redeclare" in words,
             )
             for d in item.declarations
         ]
@@ -100,7 +125,9 @@ class ElementRules(RuleBase):
         return list(ch)
 
     def constraining_clause(self, meta: Meta, ch: list[Any]) -> Any:
-        return self.keyword_span(meta, "constrainedby")
+        mod = of(ch, ClassMod)
+        return _Constraint(ch[0], Modification(mod.arguments, None, mod.span) if mod else None,
+                           self.keyword_span(meta, "constrainedby"))
 
     def import_alias(self, meta: Meta, ch: list[Any]) -> Import:
         alias, path = ch[0], ch[1]
@@ -142,12 +169,13 @@ class ElementRules(RuleBase):
     def component_declaration(self, meta: Meta, ch: list[Any]) -> Any:
         dims = of(ch, Subs)
         comment = ch[-1]
+        condition = of(ch, _Condition)
         return _Decl(self.ident(ch[0]), dims.items if dims else (), of(ch, Modification),
-                     comment.description, self.span_of(meta))
+                     comment.description, self.span_of(meta),
+                     condition.expr if condition else None)
 
-    def condition_attribute(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("conditional components (`... if condition`) are",
-                            self.keyword_span(meta, "if"))
+    def condition_attribute(self, meta: Meta, ch: list[Any]) -> _Condition:
+        return _Condition(ch[0])
 
     # ------------------------------------------------------------ modifications
 
@@ -173,23 +201,42 @@ class ElementRules(RuleBase):
             each="EACH" in flags, final="FINAL" in flags, span=self.span_of(meta),
         )
 
-    def element_replaceable(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return Rejected(self.span_of(meta))
+    def element_replaceable(self, meta: Meta, ch: list[Any]) -> ElementModification | Rejected:
+        return self._redeclaration(meta, ch)
 
-    def replaceable_body(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`replaceable` is", self.keyword_span(meta, "replaceable"))
+    def replaceable_body(self, meta: Meta, ch: list[Any]) -> Any:
+        item = ch[0]
+        if isinstance(item, ClassDef):
+            return replace(item, replaceable=True)
+        if isinstance(item, Component):
+            constraint = of(ch[1:], _Constraint)
+            return replace(item, replaceable=True, constraint=(
+                constraint.type_name, constraint.modification) if constraint else None)
+        return item
 
-    def element_redeclaration(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`redeclare` is", self.keyword_span(meta, "redeclare"))
+    def element_redeclaration(self, meta: Meta, ch: list[Any]) -> ElementModification | Rejected:
+        return self._redeclaration(meta, ch)
 
-    def short_class_definition(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return Rejected(self.span_of(meta))
+    def _redeclaration(self, meta: Meta, ch: list[Any]) -> ElementModification | Rejected:
+        """``redeclare each final Real x = 1`` in a modification: an element modification
+        of ``x`` carrying the new declaration."""
+        flags = {t.type for t in ch if isinstance(t, Token)}
+        item = next((c for c in ch if isinstance(c, Component | ClassDef | Rejected)), None)
+        if not isinstance(item, Component | ClassDef):
+            return item if isinstance(item, Rejected) else Rejected(self.span_of(meta))
+        return ElementModification(path=(item.name,), modification=None,
+                                   each="EACH" in flags, final="FINAL" in flags,
+                                   span=self.span_of(meta), redeclare=item)
 
-    def component_clause1(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return Rejected(self.span_of(meta))
+    def component_clause1(self, meta: Meta, ch: list[Any]) -> Any:
+        clause = _Clause(tuple(str(t) for t in ch[0]), ch[1], (), (ch[2],))
+        return self._components(clause, [], None)[0]
 
-    def component_declaration1(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return Rejected(self.span_of(meta))
+    def component_declaration1(self, meta: Meta, ch: list[Any]) -> Any:
+        dims = of(ch, Subs)
+        comment = ch[-1]
+        return _Decl(self.ident(ch[0]), dims.items if dims else (), of(ch, Modification),
+                     comment.description, self.span_of(meta), None)
 
     def annotation_clause(self, meta: Meta, ch: list[Any]) -> Annotation:
         return Annotation(Modification(ch[0].arguments, None, self.span_of(meta)))

@@ -79,6 +79,7 @@ def _classify(r: dae.Residual, unknowns: set[str]
     rest: list[tuple[int, x.Expr]] = []
     if not _terms(r.expr, 1, unknowns, terms, rest):
         return None
+    rest = [(sign, e) for sign, e in rest if e != x.ZERO]  # left by a substitution
     if len(terms) == 2 and not rest and terms[0][1] != terms[1][1]:
         (sa, a), (sb, b) = terms
         return a, b, -sa * sb, x.ZERO
@@ -189,6 +190,16 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     differentiated -= set(mapping)
     reduced = replace(system, unknowns=remaining, equations=equations,
                       initial_equations=initial, differentiated=frozenset(differentiated))
+    # Step 4: a substitution may have made an alias of a kept equation (``s = f - z``
+    # with ``z = 0``): eliminate again, and express the first aliases through what is
+    # left (observed values name only unknowns).
+    left = {u.name for u in remaining}
+    if mapping and any(_classify(r, left) is not None for r in equations):
+        again = eliminate_aliases(reduced)
+        later = {a.name: a.value for a in again.aliases}
+        earlier = tuple(replace(a, value=x.substitute(a.value, later)) for a in aliases)
+        return AliasResult(again.dae, again.aliases + earlier,
+                           tuple(warnings) + again.warnings)
     return AliasResult(reduced, tuple(aliases), tuple(warnings))
 
 

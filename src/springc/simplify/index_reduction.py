@@ -102,11 +102,15 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
 
     def hook(eq: int, var_derivative: Sequence[int]) -> list[int]:
         # Name the derivative variables Pantelides created, then differentiate.
+        # Several may be new at once, in any order of their numbers: fill every gap
+        # (a new variable numbers above its base, so the base is named first).
         for v in range(len(var_derivative)):
             d = var_derivative[v]
-            if d != -1 and d >= len(names):
-                while len(names) <= d:
-                    names.append("")
+            if d == -1:
+                continue
+            while len(names) <= d:
+                names.append("")
+            if not names[d]:
                 names[d] = dae.derivative_name(names[v])
                 index[names[d]] = d
         new = differentiate(exprs[eq], varying)

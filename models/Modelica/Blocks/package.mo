@@ -1,0 +1,4 @@
+within Modelica;
+package Blocks "Input/output blocks (Modelica.Blocks)"
+  import Modelica.Units.SI;
+end Blocks;

@@ -1,0 +1,25 @@
+within Modelica;
+package Constants "Mathematical constants and constants of nature (Modelica.Constants)"
+  final constant Real pi = 2*Modelica.Math.asin(1.0) "The ratio of a circle's circumference to its diameter";
+  final constant Real e = Modelica.Math.exp(1.0) "Euler's number";
+  final constant Real D2R = pi/180 "Degree to radian";
+  final constant Real R2D = 180/pi "Radian to degree";
+  final constant Real gamma = 0.57721566490153286061 "Euler-Mascheroni constant";
+  final constant Real eps = 2.220446049250313e-16 "Smallest number such that 1.0 + eps <> 1.0 (IEEE double)";
+  final constant Real small = 1e-60 "Smallest number such that small and -small are representable";
+  final constant Real inf = 1e60 "Largest number used as infinity";
+  final constant Integer Integer_inf = 2147483647 "Largest Integer";
+  final constant Modelica.Units.SI.Velocity c = 299792458 "Speed of light in vacuum";
+  final constant Modelica.Units.SI.Acceleration g_n = 9.80665 "Standard acceleration of gravity on earth";
+  final constant Real G(final unit = "m3/(kg.s2)") = 6.67430e-11 "Newtonian constant of gravitation";
+  final constant Real q(final unit = "C") = 1.602176634e-19 "Elementary charge";
+  final constant Real h(final unit = "J.s") = 6.62607015e-34 "Planck constant";
+  final constant Real k(final unit = "J/K") = 1.380649e-23 "Boltzmann constant";
+  final constant Real N_A(final unit = "1/mol") = 6.02214076e23 "Avogadro constant";
+  final constant Real R(final unit = "J/(mol.K)") = k*N_A "Molar gas constant";
+  final constant Real F(final unit = "C/mol") = q*N_A "Faraday constant";
+  final constant Real sigma(final unit = "W/(m2.K4)") = 2*pi^5*k^4/(15*h^3*c^2) "Stefan-Boltzmann constant";
+  final constant Real mu_0(final unit = "N/A2") = 4*pi*1.00000000055e-7 "Magnetic constant";
+  final constant Real epsilon_0(final unit = "F/m") = 1/(mu_0*c*c) "Electric constant";
+  final constant Real T_zero(final unit = "degC") = -273.15 "Absolute zero temperature in degree Celsius";
+end Constants;

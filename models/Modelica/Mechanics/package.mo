@@ -1,0 +1,4 @@
+within Modelica;
+package Mechanics "Mechanical components (Modelica.Mechanics)"
+  import Modelica.Units.SI;
+end Mechanics;

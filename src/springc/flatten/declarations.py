@@ -1,0 +1,107 @@
+"""What a declaration becomes in one instance before it is instantiated: conditional
+components (Modelica 4.4.5), ``outer`` elements (5.4) and redeclarations (7.3).
+
+Input: a component declaration seen from an instance (:class:`ClassScope`) and the
+modification that reaches it. Output: :class:`Disabled` for a conditional component
+whose condition is false, the ``inner`` member an ``outer`` element stands for, or the
+declaration a ``redeclare`` puts in place of the original one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import FlattenError, Note
+from ..ir import syntax as s
+from .modification import Mod, from_syntax, merge
+from .scope import ClassScope, Disabled, FlattenContext, Member, ViewComponent
+
+
+def condition_holds(fl: FlattenContext, scope: ClassScope, decl: s.Component) -> bool:
+    """The value of ``decl``'s condition (``if useSupport``), a parameter expression."""
+    assert decl.condition is not None
+    value = fl.evaluator.constant(decl.condition, scope,
+                                  "the condition of a conditional component",
+                                  hint="use a Boolean parameter expression")
+    if not isinstance(value, bool | np.bool_):
+        raise FlattenError("the condition of a conditional component must be a Boolean, "
+                           f"found {value!r}", decl.condition.span)
+    return bool(value)
+
+
+def disabled(scope: ClassScope, decl: s.Component) -> Disabled:
+    return Disabled(decl, scope.flat_name(decl.name))
+
+
+def inner_member(scope: ClassScope, decl: s.Component) -> Member:
+    """The ``inner`` element that the ``outer`` declaration ``decl`` of ``scope`` refers
+    to: the one of the same name in the nearest enclosing instance (Modelica 5.4)."""
+    enclosing = scope.outer
+    while enclosing is not None:
+        comp = enclosing.view.components.get(decl.name)
+        if comp is not None and comp.decl.inner:
+            return enclosing.member(decl.name, decl.span)
+        enclosing = enclosing.outer
+    where = f"'{scope.prefix}'" if scope.prefix else "the model"
+    raise FlattenError(
+        f"the outer element '{scope.flat_name(decl.name)}' has no inner element "
+        f"'{decl.name}' in an enclosing instance", decl.span,
+        hint=f"declare `inner {decl.type_name.dotted} {decl.name}` in a model that "
+        f"contains {where}")
+
+
+def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent, Mod | None]:
+    """``b(redeclare Steel m(k = 2))`` on the declaration ``replaceable Iron m``: the new
+    declaration (its type looked up where the redeclaration is written) and the
+    modification that applies: the redeclaration's own, over the constraining clause's
+    (the original declaration's modifiers are replaced, Modelica 7.3.2)."""
+    assert mod.redeclare is not None
+    new = mod.redeclare.element
+    decl = comp.decl
+    if not isinstance(new, s.Component):
+        raise FlattenError(f"'{name}' is a component and cannot be redeclared as a class",
+                           new.span, [Note("declared here", decl.span)])
+    if not decl.replaceable:
+        raise FlattenError(f"'{name}' is not replaceable and cannot be redeclared",
+                           mod.span, [Note("declared here", decl.span)],
+                           f"declare it `replaceable {decl.type_name.dotted} {decl.name}`")
+    constraint = decl.constraint[1] if decl.constraint is not None else None
+    new_decl = replace(decl, type_name=new.type_name, type_dims=new.type_dims,
+                       dims=new.dims or decl.dims, modification=constraint,
+                       variability=new.variability or decl.variability,
+                       causality=new.causality or decl.causality, flow=new.flow or decl.flow,
+                       replaceable=new.replaceable, constraint=new.constraint or
+                       decl.constraint)
+    outer = replace(mod, redeclare=None)
+    return ViewComponent(new_decl, mod.redeclare.scope.entry), outer
+
+
+def redeclared_class(scope: ClassScope, type_name: s.Ref) -> tuple[s.ClassDef, ClassScope] | None:
+    """``b(redeclare model M = Other(k = 2))``, or ``redeclare model M = Other;`` as an
+    element of ``b``'s class extending the one that declares ``M``: where ``b`` declares
+    a component of type ``M``, the class definition that replaces ``M`` and the scope it
+    is written in."""
+    if len(type_name.parts) != 1:
+        return None
+    first = type_name.parts[0].name
+    child = scope.mod.children.get(first) if scope.mod is not None else None
+    if child is None or child.redeclare is None:
+        own = next((e for e in scope.entry.defn.elements if isinstance(e, s.ClassDef)
+                    and e.redeclare and e.name == first), None)
+        return (own, scope) if own is not None else None
+    element = child.redeclare.element
+    if not isinstance(element, s.ClassDef):
+        raise FlattenError(f"'{type_name.dotted}' is a class and cannot be redeclared as a "
+                           "component", element.span)
+    return element, child.redeclare.scope
+
+
+def redeclared_class_mod(defn: s.ClassDef, where: ClassScope, outer: Mod | None
+                         ) -> Mod | None:
+    """The modification a short class redeclaration adds (``= Other(k = 2)``)."""
+    short = defn.short
+    if short is None:
+        return outer
+    return merge(outer, from_syntax(short.modification, where))
