@@ -23,8 +23,8 @@ from .loops import check_loop_nest
 from .ranges import with_range
 from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
-from .when import flatten_when, variable_if_equation
 from .type_rules import check_boolean_condition
+from .when import flatten_when, variable_if_equation
 
 
 class EquationFlattening(FlattenContext):

@@ -21,8 +21,8 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
-from .assertions import guard_assertions
 from .access import check_access_component
+from .assertions import guard_assertions
 from .builtins import CONSTANTS, Builtins
 from .enumerations import BuiltinEnumeration
 from .event_calls import EVENT_CALLS, event_call
@@ -278,8 +278,6 @@ class Evaluator:
             if a.shape(then) != a.shape(result):
                 raise FlattenError("branches of an if-expression differ in size", e.span)
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
-        if failure is not None:
-            raise failure
         return result
 
     def _guarded(self, e: s.Expr, scope: Scope, guard: x.Expr | None, scalar: bool = False
