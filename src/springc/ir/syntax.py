@@ -324,6 +324,7 @@ class WhenEquation:
     span: Span
 
 
+@dataclass(frozen=True, slots=True)
 class AlgorithmSection:
     """An ``algorithm`` (or ``initial algorithm``) section of a model or block, kept
     among the class's (initial) equations in order; section 11.1 of the specification."""
