@@ -81,13 +81,13 @@ class EquationFlattening(FlattenContext):
                     self._body(body, where, owner, initial)
                     return
             self._body(eq.otherwise, where, owner, initial)
+        elif isinstance(eq, s.AlgorithmSection):
+            self.algorithm_sections.append(
+                algorithm_section(self, eq, where, owner, initial))
         elif eq.call.func.dotted in ("reinit", "terminate"):
             name = eq.call.func.dotted
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")
-        elif isinstance(eq, s.AlgorithmSection):
-            self.algorithm_sections.append(
-                algorithm_section(self, eq, where, owner, initial))
         elif eq.call.func.dotted == "assert":
             kind = "initial" if initial else "equation"
             self.assertions.append(
