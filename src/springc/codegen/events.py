@@ -212,7 +212,7 @@ def active_for(ev: EventSystem, name: str, active: dict[tuple[int, int], x.Expr]
 def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     slot = layout.slot
     loads = m.loads()
-    cleared: list[Stmt] = [Let(name, _ZERO) for name in layout.samples] + [Let("_zinit", _ZERO)]
+    cleared: list[Stmt] = [Let(name, _ZERO) for name in [*layout.samples, "_zinit"]]
     steps, _ = m.step_stmts()
     out = loads + cleared + steps + m.alias_stmts(sorted(m.aliases))
     for k, (_, _, cond) in enumerate(layout.conditions):

@@ -23,7 +23,7 @@ import operator
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -63,7 +63,7 @@ class EventLoop:
 
     def __init__(self, problem: Problem, grid: np.ndarray) -> None:
         self.problem, self.grid = problem, grid
-        self.mod = problem.mod
+        self.mod: Any = cast(Any, problem.mod)  # a hybrid module (codegen.module_api.HybridModule)
         self.p = problem.p
         self.z = problem.z  # the module's rhs reads the held values from here
         n = len(problem.names)
@@ -131,8 +131,8 @@ class EventLoop:
         """Run the event iteration at ``t`` and return the states after it."""
         x_left, z_left = np.array(x, dtype=float), self.z.copy()
         try:
-            x_right = np.asarray(self.mod.event_update(t, x_left.copy(), self.p, self.z),
-                                 dtype=float)
+            x_right = np.array(self.mod.event_update(t, x_left.copy(), self.p, self.z),
+                               dtype=float)
         except (ArithmeticError, ValueError) as err:
             raise self.problem.fail(err, t, x_left, "the event update") from err
         if self.z[-1] != 0.0:
