@@ -248,3 +248,40 @@ def test_the_generated_module_runs_its_events_without_springc(tmp_path: Path) ->
     assert after[1] == pytest.approx(E * G * impact, rel=1e-12)
     assert (z[mod.Z_RELATIONS], z[mod.Z_STATUS]) == (1.0, 0.0)
     assert mod.ZERO_CROSSINGS == ("h <= 0",) and mod.RELATION_OPS == ("<=",)
+
+
+CLAUSES = """
+model H
+  Real x(start = 1, fixed = true);
+  Boolean b(start = false);
+  Integer n(start = 0);
+  discrete Real t1(start = -1);
+equation
+  der(x) = -2 * x;
+  when {x < 0.8, sample(0, 0.5)} then
+    n = pre(n) + 1;
+  elsewhen initial() then
+    n = 0;
+  end when;
+  when change(n) then
+    t1 = time;
+  end when;
+  when x < 0.7 then
+    b = true;
+    reinit(x, 0.9);
+  end when;
+end H;
+"""
+
+
+def test_clauses_see_what_earlier_clauses_assigned_at_the_same_event(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, CLAUSES), stop=1.0, interval=0.5,
+                              rtol=1e-10, event_rows=True)
+    t, n, t1 = result.time, result["n"], result["t1"]
+    steps = [i for i in range(1, len(t)) if n[i] != n[i - 1]]
+    assert len(steps) >= 4
+    for i in steps:  # change(n) fires in the same event, after n's clause
+        assert t1[i] == t[i]
+    # x leaves 1 as exp(-2 t): the first crossing of 0.8 is at log(1.25) / 2
+    assert t[steps[0]] == pytest.approx(math.log(1.25) / 2, abs=1e-9)
+    assert set(result["b"][t > 0.3]) == {1.0}
