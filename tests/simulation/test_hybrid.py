@@ -285,3 +285,32 @@ def test_clauses_see_what_earlier_clauses_assigned_at_the_same_event(tmp_path: P
     # x leaves 1 as exp(-2 t): the first crossing of 0.8 is at log(1.25) / 2
     assert t[steps[0]] == pytest.approx(math.log(1.25) / 2, abs=1e-9)
     assert set(result["b"][t > 0.3]) == {1.0}
+
+
+ENDING = """
+model Ending
+  Real x(start = 0, fixed = true);
+  discrete Real final_x(start = -1);
+  Integer stops(start = 0);
+equation
+  der(x) = 1;
+  when terminal() then
+    final_x = x;
+  end when;
+  when x >= 0.75 then
+    stops = pre(stops) + 1;
+    terminate("x reached 0.75");
+  end when;
+end Ending;
+"""
+
+
+def test_terminate_ends_the_run_and_terminal_fires_at_the_end(tmp_path: Path) -> None:
+    path = write(tmp_path, ENDING)
+    ended = springc.simulate(path, stop=2.0, interval=0.5)
+    assert list(ended.time[:2]) == [0.0, 0.5] and len(ended.time) == 3
+    assert ended.time[2] == pytest.approx(0.75, abs=1e-9)
+    assert ended["stops"][-1] == 1
+    assert ended.stats.note == "terminate() at time 0.75: x reached 0.75"
+    full = springc.simulate(path, stop=0.6, interval=0.2)
+    assert list(full["final_x"]) == [-1, -1, -1, pytest.approx(0.6, abs=1e-12)]

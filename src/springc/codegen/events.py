@@ -264,6 +264,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         f"Z_CHANGED = {s['_zchanged']}",
         f"Z_STATUS = {s['_zstatus']}",
         f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
+        f"USES_TERMINAL = {layout.uses_terminal}",
     ]
 
 

@@ -140,7 +140,7 @@ class EventLoop:
         if self.z[int(self.mod.Z_STATUS)] != 0.0:
             raise Stop(self.unsettled(t, x_left, z_left))
         self.events.append(Event(t, kind, cause, x_left, z_left, x_right, self.z.copy()))
-        if kind != "initial":
+        if kind in ("state", "time"):
             self.check_zeno(t, cause)
         code = int(self.z[int(self.mod.Z_TERMINATE)])
         if code > 0 and self.stopped is None:
@@ -186,6 +186,16 @@ class EventLoop:
         """The event at the start (``initial()`` is true)."""
         self.z[int(self.mod.Z_INITIAL)] = 1.0
         return self.event(t, x, "initial", "initial()")
+
+    def terminal(self) -> None:
+        """The event at the end of a successful run where a when-condition uses
+        ``terminal()``: the last row gets its discrete values."""
+        if not self.mod.USES_TERMINAL or self.stopped is not None or self.k == 0:
+            return
+        row = self.k - 1
+        self.z[int(self.mod.Z_TERMINAL)] = 1.0
+        x = self.event(float(self.grid[row]), self.states[row], "terminal", "terminal()")
+        self.states[row], self.zs[row] = x, self.z
 
     def next_time(self, t: float) -> float:
         return float(self.mod.next_time_event(t, np.zeros(0), self.p, self.z))

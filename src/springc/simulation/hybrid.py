@@ -50,6 +50,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                 run_fixed_events(loop, solver, x0, step)
             else:
                 loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
+            loop.terminal()
             times, states, zs = rows(loop, bool(getattr(options, "event_rows", False)))
             outputs = _outputs(model, problem, times, states, zs)
     except Stop as stop_:
@@ -91,7 +92,7 @@ def rows(loop: EventLoop, event_rows: bool) -> tuple[np.ndarray, np.ndarray, np.
         return times, states, zs
     extra_t, extra_x, extra_z, order = [], [], [], []
     for e in loop.events:
-        if e.kind == "initial":
+        if e.kind not in ("state", "time"):
             continue
         extra_t += [e.time, e.time]
         extra_x += [e.x_left, e.x_right]
