@@ -314,3 +314,31 @@ def test_terminate_ends_the_run_and_terminal_fires_at_the_end(tmp_path: Path) ->
     assert ended.stats.note == "terminate() at time 0.75: x reached 0.75"
     full = springc.simulate(path, stop=0.6, interval=0.2)
     assert list(full["final_x"]) == [-1, -1, -1, pytest.approx(0.6, abs=1e-12)]
+
+
+INITIAL = """
+model I
+  Real x;
+  Real v;
+  Integer n(start = 2);
+initial equation
+  x = 1;
+  v = 0;
+equation
+  der(x) = v;
+  der(v) = -n * x;
+  when x < 0 then
+    n = pre(n) + 1;
+  end when;
+end I;
+"""
+
+
+def test_initial_equations_with_a_discrete_variable(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, INITIAL), stop=2.0, interval=0.01, rtol=1e-10)
+    t = result.time
+    tc = math.pi / (2 * math.sqrt(2))  # x = cos(sqrt(2) t) reaches 0
+    exact = np.where(t < tc, np.cos(math.sqrt(2) * t),
+                     -math.sqrt(2 / 3) * np.sin(math.sqrt(3) * (t - tc)))
+    assert np.max(np.abs(result["x"] - exact)) < 1e-8
+    assert np.array_equal(result["n"], np.where(t < tc, 2.0, 3.0))
