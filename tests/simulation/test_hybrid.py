@@ -342,3 +342,24 @@ def test_initial_equations_with_a_discrete_variable(tmp_path: Path) -> None:
                      -math.sqrt(2 / 3) * np.sin(math.sqrt(3) * (t - tc)))
     assert np.max(np.abs(result["x"] - exact)) < 1e-8
     assert np.array_equal(result["n"], np.where(t < tc, 2.0, 3.0))
+
+
+EDGE = """
+model E
+  Real x(start = 0, fixed = true);
+  Boolean b;
+  Integer n(start = 0);
+equation
+  der(x) = 1;
+  b = x > 0.5;
+  when edge(b) then
+    n = pre(n) + 1;
+  end when;
+end E;
+"""
+
+
+def test_edge_of_an_algebraic_boolean_fires_once(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, EDGE), stop=2.0, interval=0.25)
+    assert list(result["n"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
+    assert list(result["b"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]

@@ -225,6 +225,10 @@ def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     for name in layout.samples:
         out.append(Store(f"z[{slot[name]}]", _ZERO))
     out.append(Store(f"z[{slot['_zinit']}]", _ZERO))
+    held = set(layout.discrete)
+    for name, slot_name in layout.pre.items():  # between events pre(v) is v
+        if name not in held:
+            out.append(Store(f"z[{slot[slot_name]}]", x.Var(name), f"pre({name})"))
     out.append(Raw("_zdone = 1.0"))
     return out
 
