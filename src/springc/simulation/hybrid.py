@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
 from .events import EventLoop
+from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
 from .limits import Limits, OverLimit, check_outputs, over_limit
 from .results import SimulationResult, SimulationStats
@@ -30,8 +31,6 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                     limits: Limits, step: float | None, note: str, began: float
                     ) -> SimulationResult:
     """Integrate the hybrid ``model`` over ``grid`` (see the module docstring)."""
-    from .events_fixed import run_fixed_events
-
     start, stop = float(grid[0]), float(grid[-1])
     reason = ""
     if solver == AUTO:
