@@ -147,3 +147,106 @@ def failing() -> SimpleNamespace:
     """The model functions above that make a run fail, by name."""
     return SimpleNamespace(sqrt_of_falling=sqrt_of_falling, blow_up=blow_up,
                            flags_after_half=flags_after_half, wrong_length=wrong_length)
+
+
+# ------------------------------------------------------------------ stiff problems
+
+@njit(**JIT)
+def van_der_pol(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    d = np.empty(2)
+    d[0] = x[1]
+    d[1] = p[0] * (1 - x[0] * x[0]) * x[1] - x[0]
+    return d
+
+
+@njit(**JIT)
+def van_der_pol_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray
+                         ) -> np.ndarray:
+    """Non-zeros in CSC order: column 0 (row 1), column 1 (rows 0, 1)."""
+    v = np.empty(3)
+    v[0] = -2 * p[0] * x[0] * x[1] - 1
+    v[1] = 1.0
+    v[2] = p[0] * (1 - x[0] * x[0])
+    return v
+
+
+VDP_INDPTR, VDP_INDICES = np.array([0, 1, 3]), np.array([1, 0, 1])
+
+
+@njit(**JIT)
+def chain(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """N masses (x = s1, v1, s2, v2, ...), springs k between neighbours and to a wall at
+    the left, dampers c: p = [k, c, m]."""
+    n = x.size // 2
+    d = np.empty(x.size)
+    for i in range(n):
+        s, v = x[2 * i], x[2 * i + 1]
+        left = x[2 * i - 2] if i > 0 else 0.0
+        force = -p[0] * (s - left) - p[1] * v
+        if i + 1 < n:
+            force += p[0] * (x[2 * i + 2] - s)
+        d[2 * i] = v
+        d[2 * i + 1] = force / p[2]
+    return d
+
+
+@njit(**JIT)
+def chain_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Non-zeros in the CSC order of :func:`chain_pattern`."""
+    n = x.size // 2
+    out = np.empty(5 * n - 2)
+    k = 0
+    for i in range(n):  # column s_i: rows v_{i-1}, v_i, v_{i+1}
+        if i > 0:
+            out[k] = p[0] / p[2]
+            k += 1
+        out[k] = -(2.0 if i + 1 < n else 1.0) * p[0] / p[2]
+        k += 1
+        if i + 1 < n:
+            out[k] = p[0] / p[2]
+            k += 1
+        out[k] = 1.0  # column v_i: rows s_i, v_i
+        out[k + 1] = -p[1] / p[2]
+        k += 2
+    return out
+
+
+def chain_pattern(n: int) -> tuple[np.ndarray, np.ndarray]:
+    indices: list[int] = []
+    indptr = [0]
+    for i in range(n):
+        indices += ([2 * i - 1] if i > 0 else []) + [2 * i + 1] + \
+            ([2 * i + 3] if i + 1 < n else [])
+        indptr.append(len(indices))
+        indices += [2 * i, 2 * i + 1]
+        indptr.append(len(indices))
+    return np.array(indptr), np.array(indices)
+
+
+@njit(**JIT)
+def falling(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    d = np.empty(2)
+    d[0] = x[1]
+    d[1] = -p[0]
+    return d
+
+
+@njit(**JIT)
+def falling_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """CSC: column 0 empty, column 1 row 0 (dh'/dv = 1)."""
+    return np.ones(1)
+
+
+@njit(**JIT)
+def height(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """The zero crossing h = 0 (x[0])."""
+    return x[:1].copy()
+
+
+@pytest.fixture(scope="session")
+def stiff() -> SimpleNamespace:
+    """Stiff test problems with their Jacobians' non-zeros in CSC order (test_radau/bdf)."""
+    return SimpleNamespace(van_der_pol=van_der_pol, van_der_pol_jacobian=van_der_pol_jacobian,
+                           VDP_INDPTR=VDP_INDPTR, VDP_INDICES=VDP_INDICES, chain=chain,
+                           chain_jacobian=chain_jacobian, chain_pattern=chain_pattern,
+                           falling=falling, falling_jacobian=falling_jacobian, height=height)

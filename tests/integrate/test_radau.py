@@ -4,13 +4,13 @@ banded LU against dense solves, events on its dense output, and a sparse chain."
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import scipy.integrate
 import scipy.integrate._ivp.radau as scipy_radau
 import scipy.sparse as sp
-from numba import njit
 
 from springc.integrate import Crossings, Status, radau
 from springc.integrate import radau_tableau as tableau
@@ -18,78 +18,6 @@ from springc.integrate.banded_lu import band_factor, band_layout, band_solve
 
 JIT = {"cache": True, "error_model": "numpy"}
 NO_Z = np.zeros(0)
-
-
-@njit(**JIT)
-def van_der_pol(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-    d = np.empty(2)
-    d[0] = x[1]
-    d[1] = p[0] * (1 - x[0] * x[0]) * x[1] - x[0]
-    return d
-
-
-@njit(**JIT)
-def van_der_pol_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray
-                         ) -> np.ndarray:
-    """Non-zeros in CSC order: column 0 (row 1), column 1 (rows 0, 1)."""
-    v = np.empty(3)
-    v[0] = -2 * p[0] * x[0] * x[1] - 1
-    v[1] = 1.0
-    v[2] = p[0] * (1 - x[0] * x[0])
-    return v
-
-
-VDP_INDPTR, VDP_INDICES = np.array([0, 1, 3]), np.array([1, 0, 1])
-
-
-@njit(**JIT)
-def chain(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """N masses (x = s1, v1, s2, v2, ...), springs k between neighbours and to a wall at
-    the left, dampers c: p = [k, c, m]."""
-    n = x.size // 2
-    d = np.empty(x.size)
-    for i in range(n):
-        s, v = x[2 * i], x[2 * i + 1]
-        left = x[2 * i - 2] if i > 0 else 0.0
-        force = -p[0] * (s - left) - p[1] * v
-        if i + 1 < n:
-            force += p[0] * (x[2 * i + 2] - s)
-        d[2 * i] = v
-        d[2 * i + 1] = force / p[2]
-    return d
-
-
-@njit(**JIT)
-def chain_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """Non-zeros in the CSC order of :func:`chain_pattern`."""
-    n = x.size // 2
-    out = np.empty(5 * n - 2)
-    k = 0
-    for i in range(n):  # column s_i: rows v_{i-1}, v_i, v_{i+1}
-        if i > 0:
-            out[k] = p[0] / p[2]
-            k += 1
-        out[k] = -(2.0 if i + 1 < n else 1.0) * p[0] / p[2]
-        k += 1
-        if i + 1 < n:
-            out[k] = p[0] / p[2]
-            k += 1
-        out[k] = 1.0  # column v_i: rows s_i, v_i
-        out[k + 1] = -p[1] / p[2]
-        k += 2
-    return out
-
-
-def chain_pattern(n: int) -> tuple[np.ndarray, np.ndarray]:
-    indices: list[int] = []
-    indptr = [0]
-    for i in range(n):
-        indices += ([2 * i - 1] if i > 0 else []) + [2 * i + 1] + \
-            ([2 * i + 3] if i + 1 < n else [])
-        indptr.append(len(indices))
-        indices += [2 * i, 2 * i + 1]
-        indptr.append(len(indices))
-    return np.array(indptr), np.array(indices)
 
 
 def scipy_jacobian(values: object, indptr: np.ndarray, indices: np.ndarray, n: int) -> object:
@@ -125,27 +53,30 @@ def test_banded_lu_solves_like_a_dense_solve(n: int, dense_limit: int) -> None:
         np.testing.assert_allclose(solution, expected, rtol=1e-9, atol=1e-12)
 
 
-def test_chain_band_after_reverse_cuthill_mckee_is_narrow() -> None:
-    indptr, indices = chain_pattern(1000)
+def test_chain_band_after_reverse_cuthill_mckee_is_narrow(stiff: SimpleNamespace) -> None:
+    indptr, indices = stiff.chain_pattern(1000)
     order, kl, ku, _, _ = band_layout(2000, indptr, indices)
     assert sorted(order) == list(range(2000)) and max(kl, ku) <= 3
 
 
-def scipy_van_der_pol(rtol: float, atol: float, p: np.ndarray, stop: float) -> object:
+def scipy_van_der_pol(stiff: SimpleNamespace, rtol: float, atol: float, p: np.ndarray,
+                      stop: float) -> object:
     return scipy.integrate.solve_ivp(
-        lambda t, x: van_der_pol(t, x, p, NO_Z), (0.0, stop), [2.0, 0.0], method="Radau",
+        lambda t, x: stiff.van_der_pol(t, x, p, NO_Z), (0.0, stop), [2.0, 0.0], method="Radau",
         rtol=rtol, atol=atol, dense_output=True,
-        jac=lambda t, x: scipy_jacobian(van_der_pol_jacobian(t, x, p, NO_Z), VDP_INDPTR,
-                                        VDP_INDICES, 2).toarray())
+        jac=lambda t, x: scipy_jacobian(stiff.van_der_pol_jacobian(t, x, p, NO_Z), stiff.VDP_INDPTR,
+                                        stiff.VDP_INDICES, 2).toarray())
 
 
 @pytest.mark.parametrize("rtol", [1e-4, 1e-6, 1e-7])
-def test_same_steps_and_evaluations_as_scipy_on_stiff_van_der_pol(rtol: float) -> None:
+def test_same_steps_and_evaluations_as_scipy_on_stiff_van_der_pol(stiff: SimpleNamespace,
+                                                                 rtol: float) -> None:
     mu, stop, atol = 1000.0, 3000.0, rtol * 1e-3
     p = np.array([mu])
-    ref = scipy_van_der_pol(rtol, atol, p, stop)
+    ref = scipy_van_der_pol(stiff, rtol, atol, p, stop)
     grid = np.linspace(0.0, stop, 301)
-    run = radau(van_der_pol, van_der_pol_jacobian, VDP_INDPTR, VDP_INDICES, grid,
+    run = radau(stiff.van_der_pol, stiff.van_der_pol_jacobian, stiff.VDP_INDPTR,
+                stiff.VDP_INDICES, grid,
                 [2.0, 0.0], p, NO_Z, rtol=rtol, atol=atol)
     assert run.ok
     assert run.accepted_steps == len(ref.t) - 1
@@ -155,35 +86,36 @@ def test_same_steps_and_evaluations_as_scipy_on_stiff_van_der_pol(rtol: float) -
     assert (np.abs(run.states - ref.sol(grid).T) <= 1e-8 * scale).all()
 
 
-def test_tight_tolerance_van_der_pol_within_rounding_of_scipy() -> None:
+def test_tight_tolerance_van_der_pol_within_rounding_of_scipy(stiff: SimpleNamespace) -> None:
     # at rtol 1e-9 rounding differences grow over 7,000 steps into other step choices:
     # the step count and the solution agree to the tolerance
     mu, stop, rtol = 1000.0, 3000.0, 1e-9
     p = np.array([mu])
-    ref = scipy_van_der_pol(rtol, rtol * 1e-3, p, stop)
+    ref = scipy_van_der_pol(stiff, rtol, rtol * 1e-3, p, stop)
     grid = np.linspace(0.0, stop, 301)
-    run = radau(van_der_pol, van_der_pol_jacobian, VDP_INDPTR, VDP_INDICES, grid,
+    run = radau(stiff.van_der_pol, stiff.van_der_pol_jacobian, stiff.VDP_INDPTR,
+                stiff.VDP_INDICES, grid,
                 [2.0, 0.0], p, NO_Z, rtol=rtol, atol=rtol * 1e-3)
     assert abs(run.accepted_steps / (len(ref.t) - 1) - 1) < 0.01
     scale = np.abs(ref.y).max(axis=1)
     assert (np.abs(run.states - ref.sol(grid).T) <= 1e3 * rtol * scale).all()
 
 
-def test_sparse_chain_agrees_with_scipy_radau_at_equal_tolerance() -> None:
+def test_sparse_chain_agrees_with_scipy_radau_at_equal_tolerance(stiff: SimpleNamespace) -> None:
     masses = 100  # 200 states: above the dense limit, banded after the ordering
     p, rtol = np.array([1e4, 1.0, 1.0]), 1e-6
     x0 = np.zeros(2 * masses)
     x0[1::2] = np.linspace(1.0, 0.0, masses)  # a velocity profile
-    indptr, indices = chain_pattern(masses)
+    indptr, indices = stiff.chain_pattern(masses)
     grid = np.linspace(0.0, 2.0, 41)
-    run = radau(chain, chain_jacobian, indptr, indices, grid, x0, p, NO_Z, rtol=rtol,
+    run = radau(stiff.chain, stiff.chain_jacobian, indptr, indices, grid, x0, p, NO_Z, rtol=rtol,
                 atol=rtol * 1e-3)
     ref = scipy.integrate.solve_ivp(
-        lambda t, x: chain(t, x, p, NO_Z), (0.0, 2.0), x0, method="Radau", rtol=rtol,
+        lambda t, x: stiff.chain(t, x, p, NO_Z), (0.0, 2.0), x0, method="Radau", rtol=rtol,
         atol=rtol * 1e-3, t_eval=grid,
-        jac=lambda t, x: scipy_jacobian(chain_jacobian(t, x, p, NO_Z), indptr, indices,
+        jac=lambda t, x: scipy_jacobian(stiff.chain_jacobian(t, x, p, NO_Z), indptr, indices,
                                         2 * masses))
-    tight = radau(chain, chain_jacobian, indptr, indices, grid, x0, p, NO_Z, rtol=1e-11,
+    tight = radau(stiff.chain, stiff.chain_jacobian, indptr, indices, grid, x0, p, NO_Z, rtol=1e-11,
                   atol=1e-14)
     assert run.ok and tight.ok
     error = np.abs(run.states - tight.states).max()
@@ -192,28 +124,12 @@ def test_sparse_chain_agrees_with_scipy_radau_at_equal_tolerance() -> None:
     assert error < 1e-3 * np.abs(tight.states).max()
 
 
-def test_bouncing_ball_impact_on_the_collocation_polynomial() -> None:
-    @njit(**JIT)
-    def noop(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-        return x[:1].copy()
-
+def test_bouncing_ball_impact_on_the_collocation_polynomial(stiff: SimpleNamespace) -> None:
     # constant acceleration: the cubic collocation polynomial is exact
-    run = radau(falling, falling_jacobian, np.array([0, 1, 1]), np.array([0]),
+    run = radau(stiff.falling, stiff.falling_jacobian, np.array([0, 0, 1]), np.array([0]),
                 [0.0, 1.0], [1.0, 0.0], [9.81], NO_Z, rtol=1e-10, atol=1e-12,
-                crossings=Crossings(noop, [1.0]))
+                crossings=Crossings(stiff.height, [1.0]))
     assert run.status == Status.STATE_EVENT and list(run.fired) == [-1]
     assert run.event_time == pytest.approx(math.sqrt(2 / 9.81), abs=1e-9)
 
 
-@njit(**JIT)
-def falling(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-    d = np.empty(2)
-    d[0] = x[1]
-    d[1] = -p[0]
-    return d
-
-
-@njit(**JIT)
-def falling_jacobian(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """CSC: column 0 empty, column 1 row 0 (dh'/dv = 1)."""
-    return np.ones(1)

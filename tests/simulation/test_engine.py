@@ -95,17 +95,32 @@ def test_compiled_dop853_equals_scipy(name: str, rtol: float) -> None:
 
 
 @pytest.mark.parametrize("name", sorted(MODELS))
-def test_compiled_radau_agrees_with_scipy_radau(name: str) -> None:
-    # the compiled loop continues scipy's integrator after its first step (the same
-    # method and controller; it restarts the Jacobian and step history there), so the
-    # steps agree within 1 % and the values within the tolerance
+def test_compiled_rk45_equals_scipy(name: str) -> None:
     files, model_name = MODELS[name]
     model = springc.compile_model(files, model_name, backend="numba")
-    compiled = springc.simulate(model, solver="radau", rtol=1e-6, engine="compiled",
-                                stop=2.0)
-    scipy_run = springc.simulate(model, solver="radau", rtol=1e-6, engine="scipy", stop=2.0)
+    compiled = springc.simulate(model, solver="rk45", engine="compiled", stop=2.0)
+    scipy_run = springc.simulate(model, solver="rk45", engine="scipy", stop=2.0)
     assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
-    assert abs(compiled.stats.steps / scipy_run.stats.steps - 1) < 0.01
+    assert compiled.stats.steps == scipy_run.stats.steps
+    # scipy's sums (BLAS): the same steps; the dense output's matrix product may round
+    # differently (numba's and numpy's BLAS calls for K^T P)
+    scale = np.abs(scipy_run.values).max(axis=0)
+    assert (np.abs(compiled.values - scipy_run.values) <= 1e-13 * np.maximum(scale, 1)).all()
+
+
+@pytest.mark.parametrize("solver", ["radau", "bdf"])
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_compiled_implicit_agrees_with_scipy(name: str, solver: str) -> None:
+    # the same method and controller from scipy's initial step; the LU's rounding moves
+    # BDF's Newton decisions (scipy's own dense and sparse runs differ by 1 % in steps on
+    # the chain), so the steps agree within 5 % and the values within the tolerance
+    files, model_name = MODELS[name]
+    model = springc.compile_model(files, model_name, backend="numba")
+    compiled = springc.simulate(model, solver=solver, rtol=1e-6, engine="compiled",
+                                stop=2.0)
+    scipy_run = springc.simulate(model, solver=solver, rtol=1e-6, engine="scipy", stop=2.0)
+    assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
+    assert abs(compiled.stats.steps / scipy_run.stats.steps - 1) < 0.05
     scale = np.abs(scipy_run.values).max(axis=0)
     assert (np.abs(compiled.values - scipy_run.values) <= 1e-4 * np.maximum(scale, 1)).all()
 
@@ -171,8 +186,8 @@ def test_hopeless_step_size_stops_the_compiled_loop() -> None:
 
 
 @pytest.mark.parametrize(("arguments", "message"), [
-    (["--engine", "compiled", "--solver", "bdf"],
-     "error: --engine compiled: the bdf solver has no compiled loop\n"),
+    (["--engine", "compiled", "--solver", "lsoda"],
+     "error: --engine compiled: the lsoda solver has no compiled loop\n"),
     (["--engine", "compiled", "--backend", "python"],
      "error: --engine compiled runs the numba backend's functions, not --backend python\n"),
 ])

@@ -37,9 +37,18 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
 """
 
-from .engine import FIXED_STEP_METHODS, Crossings, Run, dop853, fixed_step, radau
+from .engine import (
+    FIXED_STEP_METHODS,
+    Crossings,
+    Run,
+    bdf,
+    dop853,
+    fixed_step,
+    radau,
+    rk45,
+)
 from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "dop853", "fixed_step",
-           "radau", "run_hybrid"]
+__all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
+           "fixed_step", "radau", "rk45", "run_hybrid"]

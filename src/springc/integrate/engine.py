@@ -109,22 +109,61 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     return _run(grid_, result)
 
 
+def rk45(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
+         atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
+         max_step: float = np.inf, first_step: float | None = None, max_steps: int = 0,
+         scipy_arithmetic: bool = True, crossings: Crossings | None = None,
+         t_stop: float = np.inf) -> Run:
+    """Integrate with compiled RK45 (Dormand-Prince 5(4)), scipy's ``RK45`` method;
+    arguments as :func:`dop853`."""
+    from .rk45_kernel import rk45_run
+
+    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
+    atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
+    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
+    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
+    result = rk45_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
+                      float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                      int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
+    return _run(grid_, result)
+
+
 def radau(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any, grid: Any,
           x0: Any, p: Any, z: Any, *, rtol: float, atol: float | Sequence[float] | np.ndarray,
-          observed: ModelFunction | None = None, max_step: float = np.inf,
-          first_step: float | None = None, max_steps: int = 0,
-          crossings: Crossings | None = None, t_stop: float = np.inf,
-          dense_limit: int = 64) -> Run:
+          **options: Any) -> Run:
     """Integrate with compiled Radau IIA (order 5), scipy's ``Radau`` method.
 
     ``jacobian(t, x, p, z)`` returns the non-zeros of the Jacobian in the CSC order of
     ``(indptr, indices)`` (a generated module's ``jacobian_values``, ``JAC_INDPTR``,
     ``JAC_INDICES``). The Newton matrices are factorised dense up to ``dense_limit``
-    states, banded after a reverse Cuthill-McKee ordering above. Other arguments as
-    :func:`dop853`.
+    (default 64) states, banded after a reverse Cuthill-McKee ordering above. Other
+    options (``observed``, ``max_step``, ``first_step``, ``max_steps``, ``crossings``,
+    ``t_stop``) as for :func:`dop853`.
     """
-    from .banded_lu import band_layout
     from .radau_kernel import radau_run
+
+    return _implicit(radau_run, rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
+                     **options)
+
+
+def bdf(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any, grid: Any,
+        x0: Any, p: Any, z: Any, *, rtol: float, atol: float | Sequence[float] | np.ndarray,
+        **options: Any) -> Run:
+    """Integrate with compiled BDF (orders 1-5), scipy's ``BDF`` method; arguments as
+    :func:`radau`."""
+    from .bdf_kernel import bdf_run
+
+    return _implicit(bdf_run, rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
+                     **options)
+
+
+def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: Any,
+              indices: Any, grid: Any, x0: Any, p: Any, z: Any, rtol: float, atol: Any, *,
+              observed: ModelFunction | None = None, max_step: float = np.inf,
+              first_step: float | None = None, max_steps: int = 0,
+              crossings: Crossings | None = None, t_stop: float = np.inf,
+              dense_limit: int = 64) -> Run:
+    from .banded_lu import band_layout
 
     grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
     atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
@@ -140,10 +179,9 @@ def radau(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any
                          "non-zeros")
     order, kl, ku, positions, diagonal = band_layout(x0_.size, indptr_, indices_, dense_limit)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
-    result = radau_run(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_,
-                       x0_, p_, z_, float(rtol), atol_, float(max_step),
-                       float(first_step or 0.0), int(max_steps), _stop(t_stop, grid_), order,
-                       kl, ku, positions, diagonal)
+    result = kernel(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_, x0_,
+                    p_, z_, float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                    int(max_steps), _stop(t_stop, grid_), order, kl, ku, positions, diagonal)
     return _run(grid_, result)
 
 

@@ -91,26 +91,58 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
     return COMPILED
 
 
+def jitted(module: Any) -> bool:
+    """Whether the generated module's functions are numba's (the compiled loops call
+    ``rhs`` and ``jacobian_values`` through function pointers)."""
+    from numba.core.dispatcher import Dispatcher
+
+    return all(isinstance(getattr(module, name, None), Dispatcher)
+               for name in ("rhs", "jacobian_values"))
+
+
+def engine_reason(engine: str, solver: str, backend: str, compiled: bool) -> str:
+    """Why a run of ``solver`` ran on the engine it did, in plain words (``engine``: the
+    ``--engine`` option, ``backend``: the generated module's)."""
+    if compiled:
+        return f"{solver} ran in the compiled loop (numba, no Python per step)"
+    if engine == SCIPY:
+        return f"{solver} ran in scipy's loop, as --engine scipy asks"
+    if solver not in COMPILED_SOLVERS:
+        return f"{solver} ran in scipy's loop: springc has no compiled loop for it"
+    if backend != "numba":
+        return (f"{solver} ran in scipy's loop: the model was generated for the python "
+                "backend (--backend numba runs it in the compiled loop)")
+    if numba_available():
+        return (f"{solver} ran in scipy's loop: the generated functions of a model this "
+                "large are plain Python, not numba's")
+    return f"{solver} ran in scipy's loop: numba is not installed"
+
+
 def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
-    """Continue the scipy ``DOP853`` or ``Radau`` ``integrator`` of ``loop`` to the end of
-    the grid, compiled: from its state with its next step size, filling the grid from
-    ``loop.k`` (DOP853 takes scipy's steps exactly; Radau restarts its Jacobian and
-    step-size history there)."""
-    from springc.integrate import dop853, radau
+    """Continue the scipy ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` ``integrator`` of
+    ``loop`` to the end of the grid, compiled: from its state with its next step size,
+    filling the grid from ``loop.k`` (DOP853 and RK45 take scipy's steps exactly; Radau
+    and BDF restart their Jacobian and step-size history there)."""
+    from springc.integrate import bdf, dop853, radau, rk45
 
     problem = loop.problem
     mod = problem.mod
-    if type(integrator).__name__ == "Radau":
-        def run_kernel(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-            return radau(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
-                         y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
-                         first_step=first, max_steps=steps)
-        return _finish(loop, integrator, RACE_IMPLICIT, run_kernel)
+    implicit = {"Radau": (radau, RACE_IMPLICIT), "BDF": (bdf, "bdf")}
+    if type(integrator).__name__ in implicit:
+        method, name = implicit[type(integrator).__name__]
 
-    def run_dop853(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-        return dop853(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                      atol=loop.atol, first_step=first, max_steps=steps)
-    return _finish(loop, integrator, EXPLICIT, run_dop853)
+        def run_kernel(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+            return method(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
+                          times, y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
+                          first_step=first, max_steps=steps)
+        return _finish(loop, integrator, name, run_kernel)
+
+    explicit = rk45 if type(integrator).__name__ == "RK45" else dop853
+
+    def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                        atol=loop.atol, first_step=first, max_steps=steps)
+    return _finish(loop, integrator, "rk45" if explicit is rk45 else EXPLICIT, run_explicit)
 
 
 def _finish(loop: StepLoop, integrator: Any, solver: str,

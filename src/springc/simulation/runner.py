@@ -33,7 +33,9 @@ from .compiled import (
     COMPILED,
     SCIPY,
     choose_engine,
+    engine_reason,
     finish_dop853,
+    jitted,
     numba_available,
     run_fixed_compiled,
 )
@@ -221,7 +223,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
             reason = ""
-            compiled = engine == COMPILED
+            # a large model's generated functions may be plain Python: scipy's loop then
+            compiled = engine == COMPILED and jitted(model.module)
             finish = finish_dop853 if compiled else None
             loop_time = 0.0
             if solver in FIXED_STEP and compiled:
@@ -255,7 +258,10 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time,
-                            error=estimate.summary() if estimate is not None else error_note)
+                            error=estimate.summary() if estimate is not None else error_note,
+                            engine_reason=engine_reason(options.engine.lower(), solver,
+                                                        model.module.BACKEND, compiled)
+                            if reason else "")
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs

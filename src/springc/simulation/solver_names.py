@@ -37,6 +37,6 @@ ENGINES = ("auto", "compiled", "scipy")
 Python per step), ``scipy`` (``scipy.integrate``'s solver classes stepped from Python),
 or ``auto``: compiled where numba is importable and the solver has a compiled loop."""
 DEFAULT_ENGINE = "auto"
-COMPILED_SOLVERS = (EXPLICIT, RACE_IMPLICIT, *FIXED_STEP)
+COMPILED_SOLVERS = ("rk45", EXPLICIT, RACE_IMPLICIT, "bdf", *FIXED_STEP)
 """Solvers with a compiled loop (``auto`` too: it finishes on :data:`EXPLICIT` or
 :data:`RACE_IMPLICIT` compiled)."""

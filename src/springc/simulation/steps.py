@@ -28,9 +28,11 @@ from ..pipeline import CompiledModel
 from ..simplify import describe_failure
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
-from .solver_names import EXPLICIT, IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
+from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
+COMPILED_CLASSES = frozenset({"DOP853", "RK45", "Radau", "BDF"})
+"""scipy integrators that ``StepLoop.finish`` continues in a compiled loop."""
 
 
 
@@ -267,11 +269,11 @@ class StepLoop:
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
         """Step ``integrator`` until the grid is full (or ``max_steps``), filling it.
 
-        A ``DOP853`` or ``Radau`` integrator run to the end on the compiled engine
-        continues there (see :func:`springc.simulation.compiled.finish_dop853`).
+        A ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` integrator run to the end on the
+        compiled engine continues there (see :func:`springc.simulation.compiled.finish_dop853`).
         """
         if self.finish is not None and max_steps is None and not self.done \
-                and type(integrator).__name__ in (SOLVERS[EXPLICIT], SOLVERS[RACE_IMPLICIT]):
+                and type(integrator).__name__ in COMPILED_CLASSES:
             return self.finish(self, integrator)
         problem, grid, states = self.problem, self.grid, self.states
         began, taken = time.perf_counter(), 0
