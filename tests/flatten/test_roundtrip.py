@@ -20,6 +20,36 @@ SCENES = {
     "Cloth3": ("model C = Scenes.Cloth(N = 3, M = 3);\n", None),
     "Pendulum": ("models/Scenes.mdl", "Scenes.Pendulum"),
     "RigidPair": ("models/Scenes.mdl", "Scenes.RigidPair"),
+    "BouncingBall": ("models/EventScenes.mdl", "EventScenes.BouncingBall"),
+    "NewtonsCradle": ("models/EventScenes.mdl", "EventScenes.NewtonsCradle"),
+    "Hybrid": ("""
+model H "when/elsewhen, vector conditions, pre/edge/change, sample, a variable if"
+  Real x(start = 1, fixed = true);
+  Real y;
+  Boolean b(start = false);
+  Integer n(start = 0);
+  discrete Real t1(start = -1);
+equation
+  if x > 0.5 then
+    y = 2 * x;
+  else
+    y = x;
+  end if;
+  der(x) = -y;
+  when {x < 0.8, sample(0, 0.5)} then
+    n = pre(n) + 1;
+  elsewhen initial() then
+    n = 0;
+  end when;
+  when edge(b) or change(n) then
+    t1 = time;
+  end when;
+  when x < 0.7 then
+    b = true;
+    reinit(x, 0.9);
+  end when;
+end H;
+""", None),
     "Attributes": ("""
 model M "attributes, initial equations, Integer and Boolean parameters, quoting"
   parameter Integer n = 2;

@@ -195,3 +195,173 @@ def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
     assert list(rows.time) == [0.0, 0.25, 0.25, 0.275, 0.5, 0.5, 0.55]
     assert list(rows["n"]) == [0, 0, 1, 1, 1, 2, 2]
     assert list(rows["last"]) == [-1, -1, 0.25, 0.25, 0.25, 0.5, 0.5]
+
+
+def test_numba_backend_gives_the_python_backend_results(tmp_path: Path) -> None:
+    path = write(tmp_path, BALL)
+    python = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8)
+    numba = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="numba",
+                             engine="scipy")  # the same loop: only the backend differs
+    assert np.max(np.abs(python.values - numba.values)) < 1e-12
+    assert [e.time for e in python.events] == [e.time for e in numba.events]
+
+
+def test_the_compiled_engine_runs_a_model_with_events(tmp_path: Path) -> None:
+    """(simulation/hybrid_compiled.py; more in test_events_compiled.py)"""
+    compiled = springc.simulate(write(tmp_path, BALL), engine="compiled", stop=1.0)
+    assert compiled.stats.engine == "compiled" and compiled.stats.state_events == 2
+    auto = springc.simulate(write(tmp_path, BALL), engine="auto", backend="numba", stop=1.0)
+    assert auto.stats.engine == "compiled" and auto.stats.state_events == 2
+    scipy = springc.simulate(write(tmp_path, BALL), engine="scipy", backend="numba", stop=1.0)
+    assert [e.cause for e in scipy.events] == [e.cause for e in auto.events]
+    assert np.max(np.abs(np.array([e.time for e in scipy.events])
+                         - [e.time for e in auto.events])) < 1e-9
+
+
+def test_the_generated_module_runs_its_events_without_springc(tmp_path: Path) -> None:
+    """The module's own functions, driven as module_api.HybridModule says: the first
+    impact located on the zero-crossing function, then the event update."""
+    import importlib.util
+
+    import scipy.optimize
+
+    model = springc.compile_model(write(tmp_path, BALL))
+    target = tmp_path / "ball_module.py"
+    target.write_text(model.source)
+    spec = importlib.util.spec_from_file_location("ball_module", target)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    p = mod.parameters()
+    z = mod.guesses(p)
+    assert len(z) == mod.Z_SIZE
+    x = mod.start(p)
+    z[mod.Z_INITIAL] = 1.0
+    x = mod.event_update(0.0, x, p, z)
+    assert z[mod.Z_RELATIONS] == 0.0  # h <= 0 is false at h = 1
+
+    def flight(t: float) -> np.ndarray:
+        return np.array([1 - G * t**2 / 2, -G * t])
+
+    impact = scipy.optimize.brentq(
+        lambda t: mod.zero_crossings(t, flight(t), p, z)[0], 0.1, 1.0, xtol=1e-14)
+    assert abs(impact - math.sqrt(2 / G)) < 1e-12
+    after = mod.event_update(impact, flight(impact + 1e-13), p, z)
+    assert after[1] == pytest.approx(E * G * impact, rel=1e-12)
+    assert (z[mod.Z_RELATIONS], z[mod.Z_STATUS]) == (1.0, 0.0)
+    assert mod.ZERO_CROSSINGS == ("h <= 0",) and mod.RELATION_OPS == ("<=",)
+
+
+CLAUSES = """
+model H
+  Real x(start = 1, fixed = true);
+  Boolean b(start = false);
+  Integer n(start = 0);
+  discrete Real t1(start = -1);
+equation
+  der(x) = -2 * x;
+  when {x < 0.8, sample(0, 0.5)} then
+    n = pre(n) + 1;
+  elsewhen initial() then
+    n = 0;
+  end when;
+  when change(n) then
+    t1 = time;
+  end when;
+  when x < 0.7 then
+    b = true;
+    reinit(x, 0.9);
+  end when;
+end H;
+"""
+
+
+def test_clauses_see_what_earlier_clauses_assigned_at_the_same_event(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, CLAUSES), stop=1.0, interval=0.5,
+                              rtol=1e-10, event_rows=True)
+    t, n, t1 = result.time, result["n"], result["t1"]
+    steps = [i for i in range(1, len(t)) if n[i] != n[i - 1]]
+    assert len(steps) >= 4
+    for i in steps:  # change(n) fires in the same event, after n's clause
+        assert t1[i] == t[i]
+    # x leaves 1 as exp(-2 t): the first crossing of 0.8 is at log(1.25) / 2
+    assert t[steps[0]] == pytest.approx(math.log(1.25) / 2, abs=1e-9)
+    assert set(result["b"][t > 0.3]) == {1.0}
+
+
+ENDING = """
+model Ending
+  Real x(start = 0, fixed = true);
+  discrete Real final_x(start = -1);
+  Integer stops(start = 0);
+equation
+  der(x) = 1;
+  when terminal() then
+    final_x = x;
+  end when;
+  when x >= 0.75 then
+    stops = pre(stops) + 1;
+    terminate("x reached 0.75");
+  end when;
+end Ending;
+"""
+
+
+def test_terminate_ends_the_run_and_terminal_fires_at_the_end(tmp_path: Path) -> None:
+    path = write(tmp_path, ENDING)
+    ended = springc.simulate(path, stop=2.0, interval=0.5)
+    assert list(ended.time[:2]) == [0.0, 0.5] and len(ended.time) == 3
+    assert ended.time[2] == pytest.approx(0.75, abs=1e-9)
+    assert ended["stops"][-1] == 1
+    assert ended.stats.note == "terminate() at time 0.75: x reached 0.75"
+    full = springc.simulate(path, stop=0.6, interval=0.2)
+    assert list(full["final_x"]) == [-1, -1, -1, pytest.approx(0.6, abs=1e-12)]
+
+
+INITIAL = """
+model I
+  Real x;
+  Real v;
+  Integer n(start = 2);
+initial equation
+  x = 1;
+  v = 0;
+equation
+  der(x) = v;
+  der(v) = -n * x;
+  when x < 0 then
+    n = pre(n) + 1;
+  end when;
+end I;
+"""
+
+
+def test_initial_equations_with_a_discrete_variable(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, INITIAL), stop=2.0, interval=0.01, rtol=1e-10)
+    t = result.time
+    tc = math.pi / (2 * math.sqrt(2))  # x = cos(sqrt(2) t) reaches 0
+    exact = np.where(t < tc, np.cos(math.sqrt(2) * t),
+                     -math.sqrt(2 / 3) * np.sin(math.sqrt(3) * (t - tc)))
+    assert np.max(np.abs(result["x"] - exact)) < 1e-8
+    assert np.array_equal(result["n"], np.where(t < tc, 2.0, 3.0))
+
+
+EDGE = """
+model E
+  Real x(start = 0, fixed = true);
+  Boolean b;
+  Integer n(start = 0);
+equation
+  der(x) = 1;
+  b = x > 0.5;
+  when edge(b) then
+    n = pre(n) + 1;
+  end when;
+end E;
+"""
+
+
+def test_edge_of_an_algebraic_boolean_fires_once(tmp_path: Path) -> None:
+    result = springc.simulate(write(tmp_path, EDGE), stop=2.0, interval=0.25)
+    assert list(result["n"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
+    assert list(result["b"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]

@@ -139,35 +139,39 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
         new[tr.relation] = _truth(f"_zu{k}")
         changed.append(x.BinOp("<>", x.Var(f"_zu{k}"), x.Var(layout.times[k])))
-    # the when-conditions with the new relations; a branch fires when one of its
-    # conditions becomes true (at initialization only conditions using initial())
-    fires: dict[tuple[int, int], list[x.Expr]] = {}
+    # clause by clause (sorted: a clause reading what another assigns comes after
+    # it): the conditions with the new relations and the values assigned so far (a
+    # branch fires when one of its conditions becomes true; at initialization only
+    # conditions using initial() fire), then the branch's assignments
+    by_clause: dict[int, list[tuple[int, int, x.Expr]]] = {}
     for k, (i, j, cond) in enumerate(layout.conditions):
-        out.append(Let(f"_zd{k}", _flag(layout.hold(cond, new)), x.to_text(cond)))
-        edge = x.BinOp("and", _truth(f"_zd{k}"), x.Not(_truth(layout.condition_names[k])))
-        if not any(isinstance(n, x.Call) and n.name == "initial" for n in x.walk(cond)):
-            edge = x.BinOp("and", edge, x.Not(_truth("_zinit")))
-        fires.setdefault((i, j), []).append(edge)
-        changed.append(x.BinOp("<>", x.Var(f"_zd{k}"), x.Var(layout.condition_names[k])))
+        by_clause.setdefault(i, []).append((k, j, cond))
     active: dict[tuple[int, int], x.Expr] = {}
+    reinits: dict[str, x.Expr] = {}
+    stop: x.Expr = x.Var("_zstop")
     for i, clause in enumerate(ev.whens):
+        fires: dict[int, list[x.Expr]] = {}
+        for k, j, cond in by_clause.get(i, []):
+            out.append(Let(f"_zd{k}", _flag(layout.hold(cond, new)), x.to_text(cond)))
+            edge = x.BinOp("and", _truth(f"_zd{k}"),
+                           x.Not(_truth(layout.condition_names[k])))
+            if not any(isinstance(n, x.Call) and n.name == "initial" for n in x.walk(cond)):
+                edge = x.BinOp("and", edge, x.Not(_truth("_zinit")))
+            fires.setdefault(j, []).append(edge)
+            changed.append(x.BinOp("<>", x.Var(f"_zd{k}"), x.Var(layout.condition_names[k])))
         earlier: list[x.Expr] = []
         for j in range(len(clause.branches)):
-            fire = _any(fires[i, j])
+            fire = _any(fires.get(j, []))
             if earlier:
                 fire = x.BinOp("and", fire, x.Not(_any(earlier)))
             out.append(Let(f"_za{i}_{j}", _flag(fire)))
             active[i, j] = _truth(f"_za{i}_{j}")
             earlier.append(active[i, j])
-    # assignments, in clause order; reinits all from the values before any of them
-    reinits: dict[str, x.Expr] = {}
-    stop: x.Expr = x.Var("_zstop")
-    for i, clause in enumerate(ev.whens):
         for j, branch in enumerate(clause.branches):
             for a in branch.assignments:
                 value = layout.hold(a.value, new)
                 out.append(Let(a.name, x.If(active[i, j], value, x.Var(a.name)), a.name))
-            for r in branch.reinits:
+            for r in branch.reinits:  # from the values before any reinit
                 reinits[r.name] = x.If(active[i, j], layout.hold(r.value, new),
                                        reinits.get(r.name, x.Var(r.name)))
             for t in branch.terminates:
@@ -212,7 +216,7 @@ def active_for(ev: EventSystem, name: str, active: dict[tuple[int, int], x.Expr]
 def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     slot = layout.slot
     loads = m.loads()
-    cleared: list[Stmt] = [Let(name, _ZERO) for name in layout.samples] + [Let("_zinit", _ZERO)]
+    cleared: list[Stmt] = [Let(name, _ZERO) for name in [*layout.samples, "_zinit"]]
     steps, _ = m.step_stmts()
     out = loads + cleared + steps + m.alias_stmts(sorted(m.aliases))
     for k, (_, _, cond) in enumerate(layout.conditions):
@@ -221,6 +225,10 @@ def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     for name in layout.samples:
         out.append(Store(f"z[{slot[name]}]", _ZERO))
     out.append(Store(f"z[{slot['_zinit']}]", _ZERO))
+    held = set(layout.discrete)
+    for name, slot_name in layout.pre.items():  # between events pre(v) is v
+        if name not in held:
+            out.append(Store(f"z[{slot[slot_name]}]", x.Var(name), f"pre({name})"))
     out.append(Raw("_zdone = 1.0"))
     return out
 
@@ -260,6 +268,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         f"Z_CHANGED = {s['_zchanged']}",
         f"Z_STATUS = {s['_zstatus']}",
         f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
+        f"USES_TERMINAL = {layout.uses_terminal}",
     ]
 
 

@@ -100,7 +100,8 @@ class HybridModule(GeneratedModule, Protocol):
        states there and ``x = event_update(te, x, p, z)``; restart the integrator;
     4. at a time event ``x = event_update(t, x, p, z)`` likewise;
     5. after any event: ``z[Z_STATUS] != 0`` means the event iteration did not
-       settle; ``z[Z_TERMINATE] > 0`` that ``terminate()`` ended the simulation.
+       settle; ``z[Z_TERMINATE] > 0`` that ``terminate()`` ended the simulation;
+    6. at the end, if ``USES_TERMINAL``: ``z[Z_TERMINAL] = 1.0`` and ``event_update``.
     """
 
     Z_EVENTS: int
@@ -119,6 +120,7 @@ class HybridModule(GeneratedModule, Protocol):
     Z_CHANGED: int
     Z_STATUS: int
     EVENT_ITERATIONS: int
+    USES_TERMINAL: bool  # a when-condition uses terminal(): run the event at the end
 
     def zero_crossings(self, t: float, x: FloatArray, p: FloatArray,
                        z: FloatArray) -> FloatArray: ...

@@ -48,7 +48,7 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
                                    "parameter expression", arg.span)
             args.append(value)
         return x.Call("sample", tuple(args))
-    value = ev.value(e.args[0], scope)
+    argument = ev.value(e.args[0], scope)
 
     def one(item: x.Expr) -> x.Expr:
         if not isinstance(item, x.Var):
@@ -59,4 +59,4 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
             uses.pre_uses.append((item.name, e.span))
         return x.Call(name, (item,))
 
-    return a.elementwise(one, value)
+    return a.elementwise(one, argument)

@@ -309,6 +309,9 @@ class FlattenContext(Protocol):
 
     def is_parameter_expression(self, e: x.Expr) -> bool: ...
 
+    def equation(self, eq: s.Equation, where: Scope, owner: ClassScope, initial: bool
+                 ) -> None: ...
+
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]: ...
 
 

@@ -20,6 +20,7 @@ from ..ir import when as w
 from . import arrays as a
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
+_EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
 _WHEN_HINT = ("a when-clause holds equations 'v = expression', reinit(x, value) and "
               "terminate(\"why\")")
 
@@ -36,17 +37,19 @@ def flatten_when(ctx: FlattenContext, eq: s.WhenEquation, where: Scope, owner: C
         branches = []
         for cond_expr, body in eq.branches:
             cond = ctx.evaluator.value(cond_expr, where)
-            conditions = tuple(a.scalars(cond)) if a.is_array(cond) else (cond,)
-            for c in conditions:
-                if isinstance(c, str) or not _boolean_shape(c):
+            items: list[object] = list(a.scalars(cond)) if a.is_array(cond) else [cond]
+            conditions: list[x.Expr] = []
+            for c in items:
+                if not isinstance(c, _EXPRS) or not _boolean_shape(c):
                     raise FlattenError("the condition of a when-clause must be a Boolean "
                                        "expression", cond_expr.span,
                                        hint="write a relation such as 'h <= 0', a Boolean "
                                        "variable, sample(start, interval) or initial()")
+                conditions.append(c)
             parts = _Body()
             for item in body:
                 _body_item(ctx, item, where, parts)
-            branches.append(w.WhenBranch(conditions, tuple(parts.assignments),
+            branches.append(w.WhenBranch(tuple(conditions), tuple(parts.assignments),
                                          tuple(parts.reinits), tuple(parts.terminates),
                                          cond_expr.span))
     finally:
@@ -191,8 +194,7 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     for _, body in [*eq.branches, (None, eq.otherwise)]:
         start = len(target)
         for item in body:
-            equation = ctx.equation  # the driver's dispatcher
-            equation(item, where, owner, initial)
+            ctx.equation(item, where, owner, initial)  # the driver's dispatcher
         lists.append(target[start:])
         del target[start:]
     sizes = {len(eqs) for eqs in lists}
@@ -253,10 +255,11 @@ def check_events(ctx: FlattenContext, variables: tuple[flat.Variable, ...]) -> N
     for clause in ctx.whens:
         for branch in clause.branches:
             for c in branch.conditions:
-                v = by_name.get(c.name) if isinstance(c, x.Var) else None
+                name = c.name if isinstance(c, x.Var) else ""
+                v = by_name.get(name)
                 if v is not None and v.type != "Boolean":
                     raise FlattenError(
-                        f"the condition of a when-clause must be Boolean, but '{c.name}' "
+                        f"the condition of a when-clause must be Boolean, but '{name}' "
                         f"is {v.type}", branch.span,
                         hint="compare it, e.g. 'when x > 0 then'")
             for r in branch.reinits:

@@ -23,7 +23,7 @@ import operator
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -63,7 +63,7 @@ class EventLoop:
 
     def __init__(self, problem: Problem, grid: np.ndarray) -> None:
         self.problem, self.grid = problem, grid
-        self.mod = problem.mod
+        self.mod: Any = cast(Any, problem.mod)  # a hybrid module (codegen.module_api.HybridModule)
         self.p = problem.p
         self.z = problem.z  # the module's rhs reads the held values from here
         n = len(problem.names)
@@ -131,8 +131,8 @@ class EventLoop:
         """Run the event iteration at ``t`` and return the states after it."""
         x_left, z_left = np.array(x, dtype=float), self.z.copy()
         try:
-            x_right = np.asarray(self.mod.event_update(t, x_left.copy(), self.p, self.z),
-                                 dtype=float)
+            x_right = np.array(self.mod.event_update(t, x_left.copy(), self.p, self.z),
+                               dtype=float)
         except (ArithmeticError, ValueError) as err:
             raise self.problem.fail(err, t, x_left, "the event update") from err
         if self.z[-1] != 0.0:
@@ -140,7 +140,7 @@ class EventLoop:
         if self.z[int(self.mod.Z_STATUS)] != 0.0:
             raise Stop(self.unsettled(t, x_left, z_left))
         self.events.append(Event(t, kind, cause, x_left, z_left, x_right, self.z.copy()))
-        if kind != "initial":
+        if kind in ("state", "time"):
             self.check_zeno(t, cause)
         code = int(self.z[int(self.mod.Z_TERMINATE)])
         if code > 0 and self.stopped is None:
@@ -186,6 +186,16 @@ class EventLoop:
         """The event at the start (``initial()`` is true)."""
         self.z[int(self.mod.Z_INITIAL)] = 1.0
         return self.event(t, x, "initial", "initial()")
+
+    def terminal(self) -> None:
+        """The event at the end of a successful run where a when-condition uses
+        ``terminal()``: the last row gets its discrete values."""
+        if not self.mod.USES_TERMINAL or self.stopped is not None or self.k == 0:
+            return
+        row = self.k - 1
+        self.z[int(self.mod.Z_TERMINAL)] = 1.0
+        x = self.event(float(self.grid[row]), self.states[row], "terminal", "terminal()")
+        self.states[row], self.zs[row] = x, self.z
 
     def next_time(self, t: float) -> float:
         return float(self.mod.next_time_event(t, np.zeros(0), self.p, self.z))

@@ -9,6 +9,8 @@ rest of the step follows from the states after the event.
 
 from __future__ import annotations
 
+from typing import Any, cast
+
 import numpy as np
 
 from .events import LOCATE_TOLERANCE, EventLoop
@@ -21,6 +23,7 @@ from .solvers import detect_pairs, non_finite_states
 def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) -> None:
     """Fill ``loop``'s grid with the fixed-step ``method`` of step about ``step``."""
     problem = loop.problem
+    mod: Any = cast(Any, problem.mod)  # a hybrid module (codegen.module_api.HybridModule)
     advance = STEPPERS[method]
     grid = loop.grid
     t0 = float(grid[0])
@@ -57,7 +60,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                     j = min(times, key=times.__getitem__)
                     t_e = times[j]
                     x = loop.event(t_e, move(t, x, t_e - t), "state",
-                                   problem.mod.ZERO_CROSSINGS[j])
+                                   mod.ZERO_CROSSINGS[j])
                     cache.clear()
                     t = t_e
                     continue
@@ -86,7 +89,7 @@ def _bisect(loop: EventLoop, move: object, t: float, x: np.ndarray, end: float, 
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)
         y = advance(t, x, mid - t)  # type: ignore[operator]
-        g = float(loop.mod.zero_crossings(mid, y, loop.p, loop.z)[k])
+        g = float(loop.mod.zero_crossings(mid, y, loop.p, loop.z)[k])  # loop.mod: Any
         if op(g, 0.0) != held:
             hi = mid
         else:

@@ -2,8 +2,8 @@
 
 Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, the
 fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
-models; on the compiled engine, chosen as for continuous models, dop853 and the
-fixed-step solvers run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
+models; on the compiled engine, chosen as for continuous models, the solvers with a
+compiled loop run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
 then computes the outputs row by row with the discrete values in force at
 each row. By default the result has one row per output time (the value after an
 event at that very time); ``event_rows`` adds two rows at each event, its left and
@@ -19,9 +19,11 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
-from .compiled import COMPILED, SCIPY
+from .compiled import COMPILED, SCIPY, engine_reason, jitted
 from .events import EventLoop
+from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
+from .hybrid_compiled import run_compiled_events
 from .limits import Limits, OverLimit, check_outputs, over_limit
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP
@@ -34,9 +36,6 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                     engine: str = SCIPY) -> SimulationResult:
     """Integrate the hybrid ``model`` over ``grid`` (see the module docstring) on
     ``engine`` (:data:`.compiled.COMPILED`: :mod:`.hybrid_compiled`)."""
-    from .events_fixed import run_fixed_events
-    from .hybrid_compiled import run_compiled_events
-
     start, stop = float(grid[0]), float(grid[-1])
     reason = ""
     if solver == AUTO:
@@ -51,7 +50,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                 raise Stop(SimulationError(
                     f"the start values are not finite at time {start}",
                     notes=state_notes(problem.names, x0, None)))
-            compiled = engine == COMPILED and len(x0) > 0
+            compiled = engine == COMPILED and len(x0) > 0 and jitted(model.module)
             if compiled:
                 loop_time = run_compiled_events(loop, solver, x0, rtol, atol, step)
             elif solver in FIXED_STEP:
@@ -59,6 +58,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                 run_fixed_events(loop, solver, x0, step)
             else:
                 loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
+            loop.terminal()
             times, states, zs = rows(loop, bool(getattr(options, "event_rows", False)))
             outputs = _outputs(model, problem, times, states, zs)
     except Stop as stop_:
@@ -76,7 +76,9 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time, state_events,
-                            time_events)
+                            time_events, engine_reason=engine_reason(
+                                options.engine.lower(), solver, model.module.BACKEND, compiled)
+                            if reason else "")
     units = dict(zip(model.states, model.module.STATE_UNITS))
     units.update(zip(model.observed, model.module.OBSERVED_UNITS))
     names = model.outputs
@@ -101,7 +103,7 @@ def rows(loop: EventLoop, event_rows: bool) -> tuple[np.ndarray, np.ndarray, np.
         return times, states, zs
     extra_t, extra_x, extra_z, order = [], [], [], []
     for e in loop.events:
-        if e.kind == "initial":
+        if e.kind not in ("state", "time"):
             continue
         extra_t += [e.time, e.time]
         extra_x += [e.x_left, e.x_right]

@@ -21,7 +21,7 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TextIO
+from typing import Any, TextIO
 
 import numpy as np
 
@@ -152,6 +152,10 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
 
     system = derive_system(model.options).system
     values = dict(zip(model.parameter_names, (float(v) for v in p)))
+    if getattr(model.module, "EVENTS", False):  # discrete variables at their start
+        mod: Any = model.module
+        z = mod.guesses(p)
+        values.update((name, float(z[slot])) for name, slot in zip(mod.DISCRETE, mod.Z_DISCRETE))
     x0, _info = solve_initial(system, values, t0)
     order = {s.name: i for i, s in enumerate(system.states)}
     return np.array([x0[order[name]] for name in model.states], dtype=float)
