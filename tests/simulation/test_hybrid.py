@@ -200,20 +200,22 @@ def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
 def test_numba_backend_gives_the_python_backend_results(tmp_path: Path) -> None:
     path = write(tmp_path, BALL)
     python = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8)
-    numba = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="numba")
+    numba = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="numba",
+                             engine="scipy")  # the same loop: only the backend differs
     assert np.max(np.abs(python.values - numba.values)) < 1e-12
     assert [e.time for e in python.events] == [e.time for e in numba.events]
 
 
-def test_the_compiled_engine_refuses_a_model_with_events(tmp_path: Path) -> None:
-    from springc.errors import UsageError
-
-    with pytest.raises(UsageError) as info:
-        springc.simulate(write(tmp_path, BALL), engine="compiled", stop=1.0)
-    assert info.value.message == ("BouncingBall has events (when-clauses, relations or "
-                                  "sample), which the compiled engine does not locate yet")
+def test_the_compiled_engine_runs_a_model_with_events(tmp_path: Path) -> None:
+    """(simulation/hybrid_compiled.py; more in test_events_compiled.py)"""
+    compiled = springc.simulate(write(tmp_path, BALL), engine="compiled", stop=1.0)
+    assert compiled.stats.engine == "compiled" and compiled.stats.state_events == 2
     auto = springc.simulate(write(tmp_path, BALL), engine="auto", backend="numba", stop=1.0)
-    assert auto.stats.engine == "scipy" and auto.stats.state_events == 2
+    assert auto.stats.engine == "compiled" and auto.stats.state_events == 2
+    scipy = springc.simulate(write(tmp_path, BALL), engine="scipy", backend="numba", stop=1.0)
+    assert [e.cause for e in scipy.events] == [e.cause for e in auto.events]
+    assert np.max(np.abs(np.array([e.time for e in scipy.events])
+                         - [e.time for e in auto.events])) < 1e-9
 
 
 def test_the_generated_module_runs_its_events_without_springc(tmp_path: Path) -> None:

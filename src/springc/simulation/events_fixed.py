@@ -46,7 +46,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                 return
             end = b if i == n - 1 else a + (i + 1) * h
             t = a + i * h
-            while t < end:
+            while t < end and loop.stopped is None:  # terminate() ends the run there
                 te = loop.next_time(t)
                 target = min(end, te)
                 y = advance(problem.rhs, t, x, target - t, pairs, cache)
@@ -72,6 +72,8 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                 bad = ~np.isfinite(x)
                 if bad.any():
                     raise Stop(non_finite_states(problem, t, np.flatnonzero(bad), step))
+        if loop.stopped is not None:
+            return
         loop.fill(b, None, b, x, True)
 
 

@@ -1,16 +1,16 @@
 """The event loop of a hybrid model on the compiled engine: :class:`.events.EventLoop`
 (its grid, event iteration, Zeno and terminate checks) driven by the kernels of
-:mod:`springc.integrate` (dop853, radau, the fixed-step methods) instead of scipy's
-step loop.
+:mod:`springc.integrate` (dop853, rk45, radau, bdf, the fixed-step methods) instead of
+scipy's step loop.
 
 Each kernel run integrates from the last event with the generated ``zero_crossings``
 as its zero-crossing function, the held relations as its signs and the next time event
 (``next_time_event``) as its ``t_stop``; it stops at the earliest state event (located
-on DOP853's dense output, Radau's collocation polynomial or split fixed steps, to about
+on the method's dense output (or interpolant) or on split fixed steps, to about
 1e-12 relative in time, the left limit there), at the time event, or at the end.
 Python then runs the same event update as the scipy path
 (:meth:`.events.EventLoop.event`) and restarts the kernel from the state after the
-event: dop853 and radau with a fresh initial step, as the scipy path starts a new
+event: the adaptive methods with a fresh initial step, as the scipy path starts a new
 integrator; the fixed-step methods on the rest of the output interval, cut into equal
 steps of at most the nominal one (the scipy path finishes the split step first).
 
@@ -30,19 +30,21 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .compiled import FIXED_CHUNK, failure, time_limit_reached
 from .events import EventLoop
 from .limits import OverLimit
-from .solver_names import EXPLICIT, RACE_IMPLICIT
+from .solver_names import EXPLICIT, FIXED_STEP, RACE_IMPLICIT
 from .solvers import detect_pairs
 
+if TYPE_CHECKING:
+    from springc.integrate import Run
+
 ADAPTIVE_CHUNK = 100_000
-"""Steps (accepted and rejected) of one dop853 or radau kernel run between checks of the
-limits."""
+"""Steps (accepted and rejected) of one adaptive kernel run between checks of the limits."""
 _POSITIVE = (">", ">=")
 
 
@@ -56,9 +58,10 @@ def held_signs(loop: EventLoop) -> np.ndarray:
 
 def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: float,
                         atol: float, step: float | None) -> float:
-    """Fill ``loop``'s grid with ``solver`` (dop853, radau or a fixed-step method, of nominal
-    ``step``) in the compiled kernels; returns the seconds spent in them."""
-    from springc.integrate import Crossings, Status, dop853, fixed_step, radau
+    """Fill ``loop``'s grid with ``solver`` (one of :data:`.solver_names.COMPILED_SOLVERS`;
+    a fixed-step method of nominal ``step``) in the compiled kernels; returns the seconds
+    spent in them."""
+    from springc.integrate import Crossings, Status, fixed_step
 
     problem, grid = loop.problem, loop.grid
     mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
@@ -68,7 +71,7 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
     loop.fill(t, None, t, x, True)
     pairs: list[tuple[int, int]] = []
     rows_per_run = len(grid)
-    adaptive = solver in (EXPLICIT, RACE_IMPLICIT)
+    adaptive = solver not in FIXED_STEP
     if not adaptive:
         assert step is not None
         found = detect_pairs(mod, problem.p, x, t)
@@ -86,15 +89,11 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         times = np.concatenate(([t], grid[loop.k:last]))
         crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
         began = time.perf_counter()
-        budget = max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1)
-        if solver == EXPLICIT:
-            run = dop853(mod.rhs, times, x, problem.p, problem.z, rtol=rtol, atol=atol,
-                         first_step=first_step, max_steps=budget, crossings=crossings,
-                         t_stop=t_stop)
-        elif solver == RACE_IMPLICIT:
-            run = radau(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
-                        x, problem.p, problem.z, rtol=rtol, atol=atol, first_step=first_step,
-                        max_steps=budget, crossings=crossings, t_stop=t_stop)
+        if adaptive:
+            run = adaptive_run(solver, mod, times, x, problem.p, problem.z, rtol=rtol,
+                               atol=atol, first_step=first_step, crossings=crossings,
+                               t_stop=t_stop,
+                               max_steps=max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1))
         else:
             assert step is not None
             run = fixed_step(solver, mod.rhs, times, x, problem.p, problem.z, step=step,
@@ -139,3 +138,17 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
             raise time_limit_reached(problem, run)
         problem.progress.update(t)
     return seconds
+
+
+def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.ndarray,
+                 z: np.ndarray, **options: Any) -> Run:
+    """One kernel run of the adaptive ``solver`` (dop853, rk45; radau and bdf with the
+    generated sparse Jacobian) on the generated module ``mod``."""
+    from springc.integrate import bdf, dop853, radau, rk45
+
+    if solver in (RACE_IMPLICIT, "bdf"):
+        implicit = radau if solver == RACE_IMPLICIT else bdf
+        return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
+                        x, p, z, **options)
+    explicit = dop853 if solver == EXPLICIT else rk45
+    return explicit(mod.rhs, times, x, p, z, **options)
