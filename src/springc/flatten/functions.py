@@ -21,7 +21,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
-from .assertions import assertion
+from .assertions import assertion, guard_assertions
 from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
 from .loops import check_loop_nest
 from .ranges import with_range
@@ -217,7 +217,10 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
     on a value known only at run time), for the assertions in it."""
     for stmt in body:
         if isinstance(stmt, s.Assign):
+            start = len(ev.flattener.assertions)
             _assign(ev, stmt, scope)
+            if guard is not None:  # the functions it calls run only where guard holds
+                guard_assertions(ev.flattener.assertions, start, guard)
         elif isinstance(stmt, s.ForStatement):
             _for(ev, stmt, stmt.indices, scope, guard)
         elif isinstance(stmt, s.CallStatement):
@@ -239,7 +242,10 @@ def _while(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: FunctionScope
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
           guard: x.Expr | None) -> None:
     if stmt.call.func.dotted != "assert":
+        start = len(ev.flattener.assertions)
         call_for_effect(ev, stmt.call, scope, "a statement")
+        if guard is not None:
+            guard_assertions(ev.flattener.assertions, start, guard)
         return
     origin = flat.Origin("function", "", scope.entry.full_name)
     ev.flattener.assertions.append(assertion(ev, stmt.call, scope, origin, guard))
