@@ -22,7 +22,15 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
 from .assertions import assertion, guard_assertions
-from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
+from .control import (
+    Jumped,
+    branch_jumps,
+    check_jumps,
+    folded,
+    run_loop_body,
+    run_while,
+    stray,
+)
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import (
@@ -77,6 +85,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):
                 check_loop_nest(ev, stmt, scope)
@@ -84,7 +93,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
             _run(ev, entry.defn.algorithm, scope)
         except Jumped as jumped:
             if jumped.jump.kind != "return":
-                raise stray(jumped, "the algorithm of a function") from None
+                raise stray(jumped) from None
     finally:
         ev.call_depth = depth
     if count > len(outputs):
