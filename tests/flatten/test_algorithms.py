@@ -281,3 +281,30 @@ end M;
         ("if x > 1 then x > 0 else true", "u must be positive", "error"),
         ("if not x > 1 and not x > 0 then x + 3 > 0 else true", "u must be positive",
          "error")]
+
+
+def test_functions_called_in_a_branch_of_a_function(tmp_path: Path) -> None:
+    m = flat_of(tmp_path, """model M
+  function f
+    input Real u;
+    output Real y;
+  algorithm
+    assert(u > 0, "u must be positive");
+    y := u;
+  end f;
+  function g
+    input Real u;
+    output Real y;
+  algorithm
+    if u > 1 then
+      y := f(u - 1);
+    else
+      y := 0;
+    end if;
+  end g;
+  Real x = time;
+  Real y = noEvent(g(x));
+end M;
+""")
+    assert asserts(m) == [("if x > 1 then x - 1 > 0 else true", "u must be positive",
+                           "error")]

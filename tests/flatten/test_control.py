@@ -90,10 +90,15 @@ end M;
      "7:7: `break` under a condition known only during the simulation is not supported "
      "yet"),
     ("model M\n  Real y;\nalgorithm\n  y := 1;\n  return;\nend M;\n",
-     "5:3: `return` is only allowed inside a function, not in an algorithm section of a "
-     "model"),
+     "5:3: `return` is only allowed in a function"),
     ("model M\n  Real y;\nalgorithm\n  y := 1;\n  break;\nend M;\n",
-     "5:3: `break` is only allowed inside a loop, not in an algorithm section of a model"),
+     "5:3: `break` is only allowed inside a loop"),
+    ("model M\n  parameter Integer i = 4;\n  Real y;\nalgorithm\n  if i == 4 then\n"
+     "    return;\n  end if;\n  y := 1;\nend M;\n",
+     "6:5: `return` is only allowed in a function"),
+    ("model M\n  parameter Integer i = 1;\n  Real y;\nalgorithm\n  y := 0;\n"
+     "  while i loop\n    y := 1;\n    break;\n  end while;\nend M;\n",
+     "6:9: the condition of a while loop must be a Boolean expression"),
 ])
 def test_control_flow_errors(tmp_path: Path, text: str, message: str) -> None:
     assert error_of(tmp_path, text) == message

@@ -25,7 +25,15 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion, guard_assertions
-from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
+from .control import (
+    Jumped,
+    branch_jumps,
+    check_jumps,
+    folded,
+    run_loop_body,
+    run_while,
+    stray,
+)
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
@@ -185,10 +193,11 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
     for stmt in section.body:
         if isinstance(stmt, s.ForStatement):
             check_loop_nest(fl.evaluator, stmt, where)
+    check_jumps(section.body, in_function=False)
     try:
         run.run(section.body, where, None)
     except Jumped as jumped:
-        raise stray(jumped, "an algorithm section of a model") from None
+        raise stray(jumped) from None
     origin = flat.Origin("algorithm", owner.prefix)
     for name, value in run.env.items():
         target.append(flat.Equation(x.Var(name), value, run.spans[name], origin))

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+import numpy as np
+
 from ..errors import FlattenError, Span
 from ..ir import expr as x
 from ..ir import syntax as s
@@ -43,6 +45,12 @@ def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
     """Run ``body`` while ``condition()`` (re-evaluated each time) is true."""
     while True:
         value = folded(condition())
+        if not isinstance(value, x.Const) and ev.flattener.is_parameter_expression(value):
+            # decided by the parameters' values, as an if-equation's condition is
+            value = x.Const(ev.fold(value))
+        if isinstance(value, x.Const) and not isinstance(value.value, (bool, np.bool_)):
+            raise FlattenError("the condition of a while loop must be a Boolean expression",
+                               stmt.condition.span)
         if not isinstance(value, x.Const):
             raise FlattenError("`while` loops whose condition is known only during the "
                                "simulation are not supported yet", stmt.condition.span,
@@ -82,8 +90,24 @@ def branch_jumps(run: Callable[[], None], span: Span) -> None:
                            "before the simulation") from None
 
 
-def stray(jumped: Jumped, where: str) -> FlattenError:
+def check_jumps(body: tuple[s.Statement, ...], in_function: bool, in_loop: bool = False
+                ) -> None:
+    """Every ``return`` inside a function and every ``break`` inside a loop, whatever
+    the conditions around them (sections 11.2.4 and 11.2.5)."""
+    for stmt in body:
+        if isinstance(stmt, s.Jump):
+            allowed = in_loop if stmt.kind == "break" else in_function
+            if not allowed:
+                raise stray(Jumped(stmt))
+        elif isinstance(stmt, (s.ForStatement, s.WhileStatement)):
+            check_jumps(stmt.body, in_function, True)
+        elif isinstance(stmt, s.IfStatement):
+            for _cond, branch in stmt.branches:
+                check_jumps(branch, in_function, in_loop)
+            check_jumps(stmt.otherwise, in_function, in_loop)
+
+
+def stray(jumped: Jumped) -> FlattenError:
     """The error of a ``break`` outside a loop or a ``return`` outside a function."""
-    what = "a loop" if jumped.jump.kind == "break" else "a function"
-    return FlattenError(f"`{jumped.jump.kind}` is only allowed inside {what}, not in "
-                        f"{where}", jumped.jump.span)
+    where = "inside a loop" if jumped.jump.kind == "break" else "in a function"
+    return FlattenError(f"`{jumped.jump.kind}` is only allowed {where}", jumped.jump.span)

@@ -21,8 +21,16 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
-from .assertions import assertion
-from .control import Jumped, branch_jumps, folded, run_loop_body, run_while, stray
+from .assertions import assertion, guard_assertions
+from .control import (
+    Jumped,
+    branch_jumps,
+    check_jumps,
+    folded,
+    run_loop_body,
+    run_while,
+    stray,
+)
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import (
@@ -77,6 +85,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):
                 check_loop_nest(ev, stmt, scope)
@@ -84,7 +93,7 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
             _run(ev, entry.defn.algorithm, scope)
         except Jumped as jumped:
             if jumped.jump.kind != "return":
-                raise stray(jumped, "the algorithm of a function") from None
+                raise stray(jumped) from None
     finally:
         ev.call_depth = depth
     if count > len(outputs):
@@ -217,7 +226,10 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
     on a value known only at run time), for the assertions in it."""
     for stmt in body:
         if isinstance(stmt, s.Assign):
+            start = len(ev.flattener.assertions)
             _assign(ev, stmt, scope)
+            if guard is not None:  # the functions it calls run only where guard holds
+                guard_assertions(ev.flattener.assertions, start, guard)
         elif isinstance(stmt, s.ForStatement):
             _for(ev, stmt, stmt.indices, scope, guard)
         elif isinstance(stmt, s.CallStatement):
@@ -239,7 +251,10 @@ def _while(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: FunctionScope
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
           guard: x.Expr | None) -> None:
     if stmt.call.func.dotted != "assert":
+        start = len(ev.flattener.assertions)
         call_for_effect(ev, stmt.call, scope, "a statement")
+        if guard is not None:
+            guard_assertions(ev.flattener.assertions, start, guard)
         return
     origin = flat.Origin("function", "", scope.entry.full_name)
     ev.flattener.assertions.append(assertion(ev, stmt.call, scope, origin, guard))
