@@ -55,8 +55,37 @@ SHORT = {"valid-passed": "v-ok", "valid-unsupported": "v-unsup", "valid-rejected
 _TEST_CASE = re.compile(r"__ModelicaAssociation\s*\(\s*TestCase\s*\(\s*shouldPass\s*=\s*"
                         r"(true|false)")
 _WITHIN = re.compile(r"^\s*within\s+([\w.]*)\s*;", re.MULTILINE)
-_CLASS = re.compile(r"^\s*(?:encapsulated\s+|partial\s+)*(?:model|block|class|package|"
-                    r"connector|record|function)\s+(\w+)", re.MULTILINE)
+_IDENT = r"('(?:[^'\\]|\\.)*'|\w+)"
+_HEADER = re.compile(r"^\s*(?:(?:encapsulated|partial|expandable|operator|impure|pure)\s+)*"
+                     r"(?:model|block|class|package|connector|record|function|type)\s+"
+                     + _IDENT + r"(\s*=)?", re.MULTILINE)
+_END = re.compile(r"\bend\s+" + _IDENT + r"\s*;")
+
+
+_ESCAPES = {"a": "\a", "b": "\b", "f": "\f", "n": "\n", "r": "\r", "t": "\t", "v": "\v"}
+
+
+def _unescape(name: str) -> str:
+    """A quoted identifier as springc stores it: without quotes, escapes resolved."""
+    if not name.startswith("'"):
+        return name
+    return re.sub(r"\\(.)", lambda m: _ESCAPES.get(m.group(1), m.group(1)), name[1:-1])
+
+
+def _class_at(text: str, pos: int) -> list[str]:
+    """The nesting of class names (as written) around position ``pos`` of ``text``."""
+    events = [(m.start(), "open", m.group(1)) for m in _HEADER.finditer(text)
+              if not m.group(2)]
+    events += [(m.start(), "close", m.group(1)) for m in _END.finditer(text)]
+    stack: list[str] = []
+    for at, kind, name in sorted(events):
+        if at > pos:
+            break
+        if kind == "open":
+            stack.append(name)
+        elif stack and stack[-1] == name:
+            stack.pop()
+    return stack
 
 
 @dataclass(frozen=True)
@@ -92,10 +121,14 @@ def find_models(suite: Path) -> list[TestModel]:
         if not match or (path.stem == "Template" and path.parent.name == "ModelicaCompliance"):
             continue
         within = _WITHIN.search(text)
-        cls = _CLASS.search(text)
-        if not within or not cls:
+        outer = _HEADER.search(text)
+        if not within or not outer:
             continue
-        name = f"{within.group(1)}.{cls.group(1)}"
+        # a test model is the file's class, or, in a package, the class holding the
+        # annotation (a quoted name that no file name could store)
+        nesting = _class_at(text, match.start()) if outer.group(0).strip().startswith(
+            "package") else [outer.group(1)]
+        name = ".".join([within.group(1), *map(_unescape, nesting)])
         section = name.split(".")[1] if name.count(".") >= 2 else "(top)"
         models.append(TestModel(name, section, match.group(1) == "true",
                                 "experiment" in text))
@@ -259,7 +292,8 @@ def main() -> None:
         print(f"\n{category} ({len(chosen)}):")
         for o in chosen:
             text = o.sim_message if category.startswith("sim-") else o.message
-            print(f"  {o.name}: {text}" if text else f"  {o.name}")
+            shown = o.name if o.name.isprintable() else repr(o.name)
+            print(f"  {shown}: {text}" if text else f"  {shown}")
     if args.json:
         args.json.write_text(json.dumps([asdict(o) for o in outcomes], indent=1))
 

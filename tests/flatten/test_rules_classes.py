@@ -412,6 +412,31 @@ equation
 end M;
 """,
         'M: 2 unknowns, 2 equations, 0 parameters: balanced'),
+    "partial_function_called": ("""\
+model M
+  partial function F
+    input Integer a;
+    output Integer b;
+  algorithm
+    b := a;
+  end F;
+  Integer x = F(2);
+end M;
+""",
+        "8:15: the partial function 'F' cannot be called\nhelp: a function called in a"
+        ' simulation model is not partial (Modelica 3.6, section 12.2)'),
+    "function_called": ("""\
+model M
+  function F
+    input Integer a;
+    output Integer b;
+  algorithm
+    b := a;
+  end F;
+  Integer x = F(2);
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
 }
 
 

@@ -192,6 +192,22 @@ model M
 end M;
 """,
         'M: 1 unknown, 1 equation, 1 parameter: balanced'),
+    "component_named_as_its_type": ("""\
+model M
+  type x = Real;
+  x x = 1.0;
+end M;
+""",
+        "3:5: the component 'x' has the name of its type 'x'\nhelp: a component hides the"
+        ' class of the same name from the lookup of its own type; rename one of them'
+        ' (Modelica 3.6, section 5.3.2)'),
+    "component_named_as_global_type": ("""\
+type x = Real;
+model M
+  .x x = 1.0;
+end M;
+""",
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
 }
 
 

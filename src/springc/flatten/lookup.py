@@ -20,7 +20,7 @@ from .builtins import CONSTANTS
 from .enumerations import BUILTIN_ENUMERATIONS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
-from .rules import check_class, check_extends
+from .rules import check_class, check_extends, rule_error
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -143,6 +143,11 @@ class ClassLookup(FlattenContext):
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])
+        if entry.defn.partial:
+            raise rule_error(f"the partial function '{ref.dotted}' cannot be called",
+                             ref.span, "a function called in a simulation model is not "
+                             "partial", "12.2", (Note("declared partial here",
+                                                      entry.defn.span),))
         return entry
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any:

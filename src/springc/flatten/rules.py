@@ -86,6 +86,12 @@ def _check_names(defn: s.ClassDef) -> None:
                 raise rule_error(f"'{element.name}' is a predefined type and cannot be the "
                                  "name of a component", element.span, "Real, Integer, "
                                  "Boolean and String are reserved names, like keywords", "4.8")
+            if element.type_name.parts[0].name == element.name and \
+                    not element.type_name.is_global:
+                raise rule_error(f"the component '{element.name}' has the name of its type "
+                                 f"'{element.type_name.dotted}'", element.span,
+                                 "a component hides the class of the same name from the "
+                                 "lookup of its own type; rename one of them", "5.3.2")
             if element.name in classes:
                 raise rule_error(f"'{element.name}' is declared twice, as a component and as "
                                  "a class", element.span,
