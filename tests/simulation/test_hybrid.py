@@ -363,3 +363,24 @@ def test_edge_of_an_algebraic_boolean_fires_once(tmp_path: Path) -> None:
     result = springc.simulate(write(tmp_path, EDGE), stop=2.0, interval=0.25)
     assert list(result["n"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
     assert list(result["b"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
+
+
+SAMPLES = """
+model S
+  Integer n(start = 0);
+equation
+  when sample(0, 0.1) then
+    n = pre(n) + 1;
+  end when;
+end S;
+"""
+
+
+@pytest.mark.parametrize(("solver", "step"), [("auto", None), ("rk4", 0.05),
+                                              ("verlet", 0.025)])
+def test_samples_without_states_tick_at_every_multiple(tmp_path: Path, solver: str,
+                                                       step: float | None) -> None:
+    result = springc.simulate(write(tmp_path, SAMPLES), solver=solver, step=step, stop=1.0,
+                              interval=0.25)
+    assert list(result["n"]) == [0, 2, 5, 7, 10]
+    assert result.stats.time_events == 10
