@@ -365,3 +365,77 @@ def test_edge_of_an_algebraic_boolean_fires_once(tmp_path: Path) -> None:
     result = springc.simulate(write(tmp_path, EDGE), stop=2.0, interval=0.25)
     assert list(result["n"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
     assert list(result["b"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
+
+
+SAMPLES = """
+model S
+  Integer n(start = 0);
+equation
+  when sample(0, 0.1) then
+    n = pre(n) + 1;
+  end when;
+end S;
+"""
+
+
+@pytest.mark.parametrize(("solver", "step"), [("auto", None), ("rk4", 0.05),
+                                              ("verlet", 0.025)])
+def test_samples_without_states_tick_at_every_multiple(tmp_path: Path, solver: str,
+                                                       step: float | None) -> None:
+    result = springc.simulate(write(tmp_path, SAMPLES), solver=solver, step=step, stop=1.0,
+                              interval=0.25)
+    assert list(result["n"]) == [0, 2, 5, 7, 10]
+    assert result.stats.time_events == 10
+
+
+HOSTILE = r"""
+model H
+  Real x(start = 0, fixed = true);
+  discrete Real 'a"b\n\')'(start = 0);
+equation
+  der(x) = 1;
+  when x > 0.5 then
+    'a"b\n\')' = time;
+    terminate("done\"\n''' import os");
+  end when;
+end H;
+"""
+
+
+def test_hostile_names_and_messages_stay_data(tmp_path: Path) -> None:
+    model = springc.compile_model(write(tmp_path, HOSTILE))
+    assert "\n''' import os" not in model.source
+    assert model.module.TERMINATE_MESSAGES == ("done\"\n''' import os",)  # type: ignore[attr-defined]
+    assert model.module.DISCRETE == ("a\"b\n')",)  # type: ignore[attr-defined]
+    result = springc.simulate(model, stop=1.0, interval=0.5)
+    assert result.stats.note == "terminate() at time 0.5: done\"\\n''' import os"
+    assert result["a\"b\n')"][-1] == pytest.approx(0.5, abs=1e-9)
+
+
+BANG = """
+model Bang
+  Real x(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+  Real speed;
+equation
+  der(x) = v;
+  der(v) = -10 * sign(x);
+  speed = abs(v);
+end Bang;
+"""
+
+
+def test_sign_and_abs_switch_at_events(tmp_path: Path) -> None:
+    """x'' = -10 sign(x): parabolas joined where x = 0 (every 2/sqrt(5) s after the
+    first quarter period 1/sqrt(5))."""
+    result = springc.simulate(write(tmp_path, BANG), stop=3.0, interval=0.01, rtol=1e-10)
+    tau, r = 1 / math.sqrt(5), math.sqrt(20)
+    u = np.mod(result.time, 4 * tau)
+    s2, s3 = u - tau, u - 3 * tau
+    exact = np.where(u < tau, 1 - 5 * u**2,
+                     np.where(u < 3 * tau, -r * s2 + 5 * s2**2, r * s3 - 5 * s3**2))
+    assert np.max(np.abs(result["x"] - exact)) < 1e-8
+    assert np.max(np.abs(result["speed"] - np.abs(result["v"]))) < 1e-12
+    crossings = [e.time for e in result.events if e.cause in ("x > 0", "x < 0")]
+    expected = [tau + 2 * tau * k for k in range(3)]
+    assert np.max(np.abs(np.array(crossings) - expected)) < 1e-9
