@@ -71,15 +71,17 @@ def test_flow_on_a_record_component_of_a_connector(tmp_path: Path) -> None:
     m = flat_of(tmp_path, """  connector C
     flow R f;
     Real e;
+    Real g;
   end C;
   C c;
 equation
   c.e = 1;
+  c.g = 2;
 """)
     assert [(v.name, v.flow) for v in m.variables] == [
-        ("c.f.x", True), ("c.f.y", True), ("c.e", False)]
+        ("c.f.x", True), ("c.f.y", True), ("c.e", False), ("c.g", False)]
     # unconnected flows are zero (9.2), so the model is balanced
-    assert equations(m) == ["c.e = 1", "c.f.x = 0", "c.f.y = 0"]
+    assert equations(m) == ["c.e = 1", "c.g = 2", "c.f.x = 0", "c.f.y = 0"]
 
 
 @pytest.mark.parametrize(("body", "message"), [

@@ -334,10 +334,7 @@ equation
   end if;
 end M;
 """,
-        '4:6: the condition of an if-equation must be a parameter expression, but it'
-        ' depends on time\nhelp: switching equations on a variable needs events, which are'
-        ' not supported yet; for a continuous switch write one equation with an'
-        ' if-expression inside noEvent(...)'),
+        'M: 1 unknown, 1 equation, 0 parameters: balanced'),  # switches at a time event
     "if_equation_on_parameter": ("""\
 model M
   parameter Real t0 = 0.5;

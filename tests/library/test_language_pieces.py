@@ -332,11 +332,11 @@ def test_unused_replaceable_classes_do_not_block_the_model(tmp_path: Path) -> No
 UNSUPPORTED = """package L
   model Bad
     Real x;
+    Real y;
+    inner outer Real z;
   equation
-    when time > 1 then
-      reinit(x, 0);
-    end when;
     der(x) = 1;
+    y = 1;
   end Bad;
   model Good
     Real x(start = 0, fixed = true);
@@ -356,7 +356,7 @@ def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
         "model 'L.Good'\n  Real x(start = 0, fixed = true);\nequation\n  der(x) = 1;\n"
         "end 'L.Good';\n")
     assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
-        "`when` equations are not supported yet", 5, 5)
+        "`inner outer` elements are not supported yet", 5, 11)
     with pytest.raises(SpringcError) as info:
         flat(tmp_path, UNSUPPORTED, "L.UsesBad")
     (note,) = info.value.notes

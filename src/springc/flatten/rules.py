@@ -142,8 +142,10 @@ def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
 
 
 def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
-    """A class inherited under the name of a local class must be the same class."""
-    local = {e.name: e for e in entry.defn.elements if isinstance(e, s.ClassDef)}
+    """A class inherited under the name of a local class must be the same class (unless
+    the local one redeclares it, section 7.3)."""
+    local = {e.name: e for e in entry.defn.elements
+             if isinstance(e, s.ClassDef) and not e.redeclare}
     for element in base.defn.elements:
         if isinstance(element, s.ClassDef) and element.name in local and \
                 not same_text(element, local[element.name]):
