@@ -130,8 +130,6 @@ class ClassScope:
     # constant/parameter/discrete on this (structured) component, which applies to its
     # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
     variability: str = ""
-    # flow on this structured component, which applies to its elements (4.4.2.2)
-    flow: bool = False
 
     @property
     def entry(self) -> ClassEntry:

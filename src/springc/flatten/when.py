@@ -123,7 +123,9 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
                            hint="combine the conditions: 'when a and b then' or use "
                            "elsewhen")
     else:
-        what = "connect" if isinstance(item, s.Connect) else f"'{item.call.func.dotted}'"
+        what = ("connect" if isinstance(item, s.Connect)
+                else "an algorithm section" if isinstance(item, s.AlgorithmSection)
+                else f"'{item.call.func.dotted}'")
         raise FlattenError(f"{what} is not allowed in a when-clause", item.span,
                            hint=_WHEN_HINT)
 
