@@ -365,3 +365,48 @@ def test_edge_of_an_algebraic_boolean_fires_once(tmp_path: Path) -> None:
     result = springc.simulate(write(tmp_path, EDGE), stop=2.0, interval=0.25)
     assert list(result["n"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
     assert list(result["b"]) == [0, 0, 0, 1, 1, 1, 1, 1, 1]
+
+
+SAMPLES = """
+model S
+  Integer n(start = 0);
+equation
+  when sample(0, 0.1) then
+    n = pre(n) + 1;
+  end when;
+end S;
+"""
+
+
+@pytest.mark.parametrize(("solver", "step"), [("auto", None), ("rk4", 0.05),
+                                              ("verlet", 0.025)])
+def test_samples_without_states_tick_at_every_multiple(tmp_path: Path, solver: str,
+                                                       step: float | None) -> None:
+    result = springc.simulate(write(tmp_path, SAMPLES), solver=solver, step=step, stop=1.0,
+                              interval=0.25)
+    assert list(result["n"]) == [0, 2, 5, 7, 10]
+    assert result.stats.time_events == 10
+
+
+HOSTILE = r"""
+model H
+  Real x(start = 0, fixed = true);
+  discrete Real 'a"b\n\')'(start = 0);
+equation
+  der(x) = 1;
+  when x > 0.5 then
+    'a"b\n\')' = time;
+    terminate("done\"\n''' import os");
+  end when;
+end H;
+"""
+
+
+def test_hostile_names_and_messages_stay_data(tmp_path: Path) -> None:
+    model = springc.compile_model(write(tmp_path, HOSTILE))
+    assert "\n''' import os" not in model.source
+    assert model.module.TERMINATE_MESSAGES == ("done\"\n''' import os",)  # type: ignore[attr-defined]
+    assert model.module.DISCRETE == ("a\"b\n')",)  # type: ignore[attr-defined]
+    result = springc.simulate(model, stop=1.0, interval=0.5)
+    assert result.stats.note == "terminate() at time 0.5: done\"\\n''' import os"
+    assert result["a\"b\n')"][-1] == pytest.approx(0.5, abs=1e-9)

@@ -48,7 +48,8 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
             t = a + i * h
             while t < end and loop.stopped is None:  # terminate() ends the run there
                 te = loop.next_time(t)
-                target = min(end, te)
+                # a time event within rounding of the step's end is the step's end
+                target = te if te <= end + LOCATE_TOLERANCE * max(1.0, abs(end)) else end
                 y = advance(problem.rhs, t, x, target - t, pairs, cache)
                 loop.steps += 1
                 if loop.steps > limit:
@@ -66,7 +67,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                     continue
                 t, x = target, y
                 loop.step_times.append(t)
-                if t == te:  # a time event (one at the stop time too, as run_adaptive)
+                if t == te:  # a time event (at the stop time too, as the adaptive loop)
                     x = loop.event(t, x, "time", f"time = {t:.9g}")
                     cache.clear()
                 bad = ~np.isfinite(x)

@@ -69,7 +69,8 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
         progress.close()
     if loop.stopped is not None:
         when, message = loop.stopped
-        note = "; ".join(filter(None, (note, f"terminate() at time {when:.9g}: {message}")))
+        shown = "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
+        note = "; ".join(filter(None, (note, f"terminate() at time {when:.9g}: {shown}")))
     state_events = sum(e.kind == "state" for e in loop.events)
     time_events = sum(e.kind == "time" for e in loop.events)
     stats = SimulationStats(solver, loop.steps, problem.nfev, problem.njev,
