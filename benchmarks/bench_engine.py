@@ -84,8 +84,9 @@ def warm(repeats: int, fused: bool) -> None:
         atol = np.full(4, ATOL)
 
         def call() -> object:
-            return fused_run(seed_rhs, observed, 0, grid, SEED_X0.copy(), SEED_P, NO_Z, RTOL,
-                             atol, np.inf, 0.0, 0, False)
+            return fused_run(seed_rhs, observed, 0, observed, np.empty(0), np.empty(0), grid,
+                             SEED_X0.copy(), SEED_P, NO_Z, RTOL, atol, np.inf, 0.0, 0, False,
+                             np.inf)  # no crossings, no time event
 
         began = time.perf_counter()
         call()
