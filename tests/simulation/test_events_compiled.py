@@ -68,7 +68,20 @@ equation
 end StopBall;
 """
 
-TEXTS = {"ball": BALL, "switch": SWITCH, "clock": CLOCK, "relay": RELAY, "stop": STOP}
+TENTHS = """
+model Tenths "n counts sample(0, 0.1): the sample times 0.1 * k are 0.30000000000000004..."
+  discrete Integer n(start = 0);
+  Real x(start = 0, fixed = true);
+equation
+  der(x) = n;
+  when sample(0, 0.1) then
+    n = pre(n) + 1;
+  end when;
+end Tenths;
+"""
+
+TEXTS = {"ball": BALL, "switch": SWITCH, "clock": CLOCK, "relay": RELAY, "stop": STOP,
+         "tenths": TENTHS}
 STEP = {"dop853": None, "rk45": None, "radau": None, "bdf": None, "rk4": 1e-3,
         "verlet": 1e-3}  # solver -> step
 
@@ -270,3 +283,17 @@ def test_chunked_runs_equal_a_single_run(models: dict[str, CompiledModel], solve
     assert chunked.stats.steps == whole.stats.steps
     np.testing.assert_array_equal(chunked.values, whole.values)
     assert abs(chunked["x"][-1] - 0.75) < 1e-12  # 0.25 * 1 + 0.25 * 2
+
+
+@pytest.mark.parametrize(("solver", "rows"), [("rk4", [0, 3, 6, 9, 10]),
+                                              ("verlet", [0, 3, 6, 9, 10]),
+                                              ("dop853", [0, 2, 5, 8, 10])])
+def test_time_events_within_rounding_of_an_output_time(models: dict[str, CompiledModel],
+                                                       solver: str, rows: list[int]) -> None:
+    """Output times 0.3, 0.6, 0.8999999999999999 lie an ulp before the samples 0.1 * k:
+    the fixed-step loops end their step at the event and show the value after it there,
+    the adaptive ones show the value before it; each engine as the other."""
+    scipy, compiled = both(models["tenths"], solver, stop=1.0, interval=0.3)
+    assert compiled["n"].tolist() == scipy["n"].tolist() == rows
+    assert compiled.stats.time_events == scipy.stats.time_events == 10
+    assert compiled.stats.steps == scipy.stats.steps

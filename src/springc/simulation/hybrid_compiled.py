@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .compiled import FIXED_CHUNK, failure, time_limit_reached
-from .events import EventLoop
+from .events import LOCATE_TOLERANCE, EventLoop
 from .limits import OverLimit
 from .solver_names import EXPLICIT, FIXED_STEP, RACE_IMPLICIT
 from .solvers import detect_pairs
@@ -86,7 +86,12 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         last = min(loop.k + rows_per_run, len(grid))
         if last < len(grid) and grid[last - 1] == t_stop:
             last += 1  # a time event at the chunk's end: a TIME_EVENT, not its end
+        snapped = not adaptive and snaps(grid, loop.k, t_event)
+        if snapped:  # the run ends at the event instead of the output time just before
+            last, t_stop = int(np.searchsorted(grid, t_event)), math.inf
         times = np.concatenate(([t], grid[loop.k:last]))
+        if snapped:
+            times[-1] = t_event
         crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
         began = time.perf_counter()
         if adaptive:
@@ -126,7 +131,7 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         elif run.status == Status.SUCCESS:
             t, x = float(times[-1]), np.array(run.failure_state)
             loop.step_times.append(t)
-            if t == stop:  # the last row again, after a time event at the stop time
+            if t >= stop or snapped:  # the last row again, after its time event
                 loop.k -= 1
                 x = loop.time_event(t, x, stop)
         elif run.status == Status.MAX_STEPS:  # a chunk's end, within the step limit
@@ -138,6 +143,15 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
             raise time_limit_reached(problem, run)
         problem.progress.update(t)
     return seconds
+
+
+def snaps(grid: np.ndarray, k: int, t_event: float) -> bool:
+    """Whether a fixed-step run ends at the time event ``t_event`` in place of the output
+    time ``grid[j] >= grid[k]`` just before it, within rounding (``0.1 * 3`` after 0.3),
+    and that row shows the values after the event, as the scipy engine's fixed-step loop
+    (:func:`.events_fixed.run_fixed_events`) does."""
+    j = int(np.searchsorted(grid, t_event)) - 1  # grid[j] < t_event
+    return j >= k and t_event <= grid[j] + LOCATE_TOLERANCE * max(1.0, abs(grid[j]))
 
 
 def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.ndarray,
