@@ -139,6 +139,11 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
         new[tr.relation] = _truth(f"_zu{k}")
         changed.append(x.BinOp("<>", x.Var(f"_zu{k}"), x.Var(layout.times[k])))
+    # the held floor values: floor of their arguments now (3.7.2)
+    for k, call in enumerate(ev.floors):
+        out.append(Let(f"_zk{k}", x.Call("floor", (layout.hold(call.args[0]),)),
+                       x.to_text(call)))
+        changed.append(x.BinOp("<>", x.Var(f"_zk{k}"), x.Var(layout.floors[k])))
     # clause by clause (sorted: a clause reading what another assigns comes after
     # it): the conditions with the new relations and the values assigned so far (a
     # branch fires when one of its conditions becomes true; at initialization only
@@ -193,6 +198,8 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
     for k, name in enumerate(layout.condition_names):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zd{k}")))
+    for k, name in enumerate(layout.floors):
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zk{k}")))
     for name in layout.discrete:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
