@@ -6,8 +6,9 @@ read them.
 order: the held value (1.0 true, 0.0 false) of every state relation (``_zr<k>``) and
 time relation (``_zt<k>``), the ``sample`` flags (``_zs<k>``, true only during the
 event at a sample time), the discrete variables (their flat names), the held value
-of every ``floor(u)`` (``_zf<k>``; its two state relations ``u < _zf<k>`` and
-``u >= _zf<k> + 1`` come last among the relations), the ``pre``
+of every ``floor(u)`` (``_zf<k>``; unless ``u`` is affine in time, its two state
+relations ``u < _zf<k>`` and ``u >= _zf<k> + 1`` come last among the relations),
+the ``pre``
 values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), then
 ``initial()`` (``_zinit``), ``terminal()`` (``_zterm``), the terminate code (0, or
 1 + the index of the ``terminate`` message), the changed flag of the last event pass
@@ -32,8 +33,11 @@ class EventLayout:
 
     def __init__(self, events: EventSystem, base: int) -> None:
         self.floors = [f"_zf{k}" for k in range(len(events.floors))]
+        self.floor_rates = list(events.floor_rates) or [None] * len(events.floors)
         bounds = []
-        for call, name in zip(events.floors, self.floors):
+        for call, name, rate in zip(events.floors, self.floors, self.floor_rates):
+            if rate is not None:  # a time event at each integer (next_time_event)
+                continue
             u, k = call.args[0], x.Var(name)
             bounds += [x.BinOp("<", u, k), x.BinOp(">=", u, x.BinOp("+", k, x.Const(1.0)))]
         events = dataclasses.replace(events, relations=events.relations + tuple(bounds))

@@ -14,7 +14,9 @@ Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
 - ``floors``: the ``floor(u)`` calls on continuous arguments outside ``noEvent``
   (``ceil``, ``integer``, ``div``, ``mod`` and ``rem`` are rewritten into them):
   each keeps its value from the last event; an event occurs when ``u`` leaves
-  ``[k, k + 1)`` (3.7.2);
+  ``[k, k + 1)`` (3.7.2); ``floor_rates``: for each, ``der(u)`` when ``u`` is
+  ``time`` times a parameter expression plus one (a time event at each integer,
+  hit exactly), else None (state events on ``u``);
 - ``whens``: the when-clauses, assignments sorted so that each reads the values
   assigned before it at the same event.
 """
@@ -57,6 +59,7 @@ class EventSystem:
     pre: tuple[str, ...]
     whens: tuple[When, ...]
     floors: tuple[Call, ...] = ()
+    floor_rates: tuple[Expr | None, ...] = ()
 
     @property
     def empty(self) -> bool:

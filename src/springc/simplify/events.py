@@ -99,7 +99,8 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     discrete = tuple(Discrete(n, by_name[n].type, by_name[n].attributes.start,
                               by_name[n].span) for n in held)
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
-                       tuple(pre), _sorted_whens(model.whens), tuple(floors))
+                       tuple(pre), _sorted_whens(model.whens), tuple(floors),
+                       tuple(_time_rate(c.args[0], params) for c in floors))
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
@@ -209,6 +210,21 @@ def _time_relation(node: x.BinOp, params: set[str]) -> TimeRelation | None:
     if isinstance(node.right, x.Time) and constant(node.left):
         return TimeRelation(node, node.left, node.op in ("<", "<="))
     return None
+
+
+def _time_rate(u: x.Expr, params: set[str]) -> x.Expr | None:
+    """``der(u)`` if ``u`` is affine in ``time`` with parameter coefficients, else None."""
+    def plain(e: x.Expr) -> bool:
+        return x.variables(e) <= params and not any(
+            isinstance(n, x.Der) or (isinstance(n, x.Call) and (
+                n.name not in x.MATH or n.name in _FLOORED)) for n in x.walk(e))
+
+    if not plain(u):
+        return None
+    rate = x.time_derivative(u, lambda _: False)
+    if not plain(rate) or any(isinstance(n, x.Time) for n in x.walk(rate)):
+        return None
+    return rate
 
 
 def _continuous(node: x.Expr, known: set[str]) -> bool:
