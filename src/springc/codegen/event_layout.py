@@ -81,7 +81,8 @@ class EventLayout:
     def hold(self, e: x.Expr, held: Mapping[x.Expr, x.Expr] | None = None) -> x.Expr:
         """``e`` as the generated code computes it: event relations read their held
         values (``held``: another mapping, e.g. the new values during an event pass),
-        ``floor`` calls their held values, ``sample``/``initial``/``terminal`` their flags, ``pre(v)`` its slot,
+        ``floor`` calls their held values, ``sample``/``initial``/``terminal`` their
+        flags, ``pre(v)`` its slot,
         ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``."""
         return _replace(e, self.held if held is None else held, self, False)
 

@@ -97,9 +97,9 @@ def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             continue
         out.append(Load(name, f"z[{layout.slot[name]}]", name))
         u0 = _at_time_zero(call.args[0])  # u = rate * time + u0
-        k = x.Var(name)
-        up = x.div(x.sub(x.add(k, _ONE), u0), rate)
-        down = x.div(x.sub(k, u0), rate)
+        held = x.Var(name)
+        up = x.div(x.sub(x.add(held, _ONE), u0), rate)
+        down = x.div(x.sub(held, u0), rate)
         at = x.If(x.BinOp(">", rate, _ZERO), up,
                   x.If(x.BinOp("<", rate, _ZERO), down, x.Const(float("inf"))))
         out.append(Let("_zq", x.If(x.BinOp("and", x.BinOp(">", at, later),

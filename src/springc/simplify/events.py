@@ -228,8 +228,8 @@ def _time_rate(u: x.Expr, params: set[str]) -> x.Expr | None:
 
 
 def _continuous(node: x.Expr, known: set[str]) -> bool:
-    """Whether a relation (or a built-in call) reads a continuous variable or ``time`` (so it can change
-    between events and needs a zero-crossing function)."""
+    """Whether a relation (or a built-in call) reads a continuous variable or ``time``
+    (so it can change between events and needs a zero-crossing function)."""
     return any(isinstance(n, (x.Time, x.Der)) or (isinstance(n, x.Var) and n.name not in known)
                for n in switching(node))
 
