@@ -193,3 +193,29 @@ def test_the_compiled_engine_switches_the_same_floors(solver: str) -> None:
     assert np.max(np.abs(np.array([e.time for e in fast.events])
                          - [e.time for e in slow.events])) < 1e-9
     assert np.max(np.abs(fast.values - slow.values)) < 1e-9
+
+
+COUNTER = """
+model Counter "a when-condition on mod(time, 0.4): n counts its rising edges"
+  discrete Integer n(start = 0);
+  discrete Real last(start = -1);
+equation
+  when mod(time, 0.4) >= 0.1 then
+    n = pre(n) + 1;
+    last = time;
+  end when;
+end Counter;
+"""
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
+def test_mod_in_a_when_condition(solver: str) -> None:
+    """No states: the relation on the held mod is watched at every output time."""
+    r = simulate(COUNTER, 2.0, solver, **({"step": 0.01} if solver == "rk4" else {}))
+    # rising edges at 0.1, 0.5, ..., 1.7 (the wrap at each 0.4 k makes it false again)
+    assert r["n"][-1] == 5
+    assert abs(r["last"][-1] - 1.7) < 1e-9
+    wraps = [e.time for e in r.events if e.kind == "time"]
+    assert np.max(np.abs(np.array(wraps) - [0.4, 0.8, 1.2, 1.6, 2.0])) < 1e-12
+    edges = [e.time for e in r.events if e.kind == "state"]
+    assert np.max(np.abs(np.array(edges) - (0.1 + 0.4 * np.arange(5)))) < 1e-9

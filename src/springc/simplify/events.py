@@ -117,10 +117,19 @@ def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
     steps = tuple(_rewrite_step(s, f) for s in system.steps)
     observed = tuple(ode.Assign(a.name, f(a.expr), a.span) for a in system.observed)
     rewritten = dataclasses.replace(system, steps=steps, observed=observed)
-    events = event_system(model, rewritten)
+    whens = tuple(_rewrite_when(c, f) for c in model.whens)
+    events = event_system(dataclasses.replace(model, whens=whens), rewritten)
     if events is None:
         return system
     return dataclasses.replace(rewritten, events=events)
+
+
+def _rewrite_when(clause: w.When, f: Callable[[x.Expr], x.Expr]) -> w.When:
+    return dataclasses.replace(clause, branches=tuple(dataclasses.replace(
+        b, conditions=tuple(f(c) for c in b.conditions),
+        assignments=tuple(dataclasses.replace(a, value=f(a.value)) for a in b.assignments),
+        reinits=tuple(dataclasses.replace(r, value=f(r.value)) for r in b.reinits))
+        for b in clause.branches))
 
 
 def _rewrite_step(s: ode.Step, f: Callable[[x.Expr], x.Expr]) -> ode.Step:
