@@ -85,13 +85,11 @@ def test_div_rem_ceil_integer_of_time() -> None:
     near = np.min(np.abs(r.time[:, None] - np.array(crossings)[None, :]), axis=1) < 1e-9
     assert np.array_equal(r["k"][~near], np.array(k, dtype=float)[~near])
     events = [e for e in r.events if e.kind != "initial"]
-    # every crossing in (0, 1] (1.0 is the stop time), one event each, hit to
-    # rounding: time events, but the event at t0 is the state event of the relation
-    # (time - t0) / T >= 0 that div's truncation switches on (located exactly too)
-    expected = sorted(crossings)
-    assert np.max(np.abs(np.array([e.time for e in events]) - expected)) < 1e-12
-    assert [e.kind for e in events] == ["state"] + ["time"] * 7
-    assert all(e.time in r.step_times for e in events[1:])
+    # every crossing in (0, 1] (1.0 is the stop time), one time event each, hit to
+    # rounding and in the step sequence
+    assert np.max(np.abs(np.array([e.time for e in events]) - sorted(crossings))) < 1e-12
+    assert [e.kind for e in events] == ["time"] * 8
+    assert all(e.time in r.step_times for e in events)
 
 
 SINE = """
@@ -116,6 +114,8 @@ def test_floor_of_a_state_switches_at_state_events() -> None:
     assert np.max(np.abs(r["y"] - integral(floor, crossings, r.time))) < 1e-8
     events = [e for e in r.events if e.kind != "initial"]
     assert [e.kind for e in events] == ["state"] * 5
+    up, down = "floor(1.5 * x) increases", "floor(1.5 * x) decreases"
+    assert [e.cause for e in events] == [up, down, down, down, up]
     assert np.max(np.abs(np.array([e.time for e in events]) - crossings)) < 1e-9
 
 

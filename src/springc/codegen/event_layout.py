@@ -35,11 +35,13 @@ class EventLayout:
         self.floors = [f"_zf{k}" for k in range(len(events.floors))]
         self.floor_rates = list(events.floor_rates) or [None] * len(events.floors)
         bounds = []
+        self.texts = [x.to_text(r) for r in events.relations]  # what each relation is
         for call, name, rate in zip(events.floors, self.floors, self.floor_rates):
             if rate is not None:  # a time event at each integer (next_time_event)
                 continue
             u, k = call.args[0], x.Var(name)
             bounds += [x.BinOp("<", u, k), x.BinOp(">=", u, x.BinOp("+", k, x.Const(1.0)))]
+            self.texts += [f"{x.to_text(call)} decreases", f"{x.to_text(call)} increases"]
         events = dataclasses.replace(events, relations=events.relations + tuple(bounds))
         self.events = events
         self.base = base

@@ -292,7 +292,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         "EVENTS = True",
         f"Z_EVENTS = {layout.base}",
         f"Z_SIZE = {layout.base + layout.size + 1}",
-        f"ZERO_CROSSINGS = {encode_strings([x.to_text(r) for r in ev.relations])}",
+        f"ZERO_CROSSINGS = {encode_strings(layout.texts)}",
         f"RELATION_OPS = {tuple(r.op for r in ev.relations)!r}",
         f"Z_RELATIONS = {s[layout.relations[0]] if layout.relations else layout.base}",
         f"TIME_EVENTS = {encode_strings([x.to_text(t.relation) for t in ev.time_relations])}",

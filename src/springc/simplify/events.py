@@ -192,7 +192,8 @@ def _floor(u: x.Expr) -> x.Expr:
 def _through_floor(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
     """The integer-valued built-in ``name(args)`` through ``floor`` (3.7.2):
     ``ceil(u) = -floor(-u)``, ``integer(u) = floor(u)``, ``div(a, b)`` the
-    truncation of ``a/b`` (``if a/b >= 0 then floor(a/b) else -floor(-a/b)``),
+    truncation of ``a/b`` (``if floor(a/b) >= 0 then floor(a/b) else -floor(-a/b)``:
+    the condition changes only where ``floor`` does, so at its events),
     ``mod(a, b) = a - floor(a/b)*b``, ``rem(a, b) = a - div(a, b)*b``."""
     if name in ("floor", "integer"):
         return _floor(args[0])
@@ -201,7 +202,7 @@ def _through_floor(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
     q = x.BinOp("/", args[0], args[1])
     if name == "mod":
         return x.BinOp("-", args[0], x.BinOp("*", _floor(q), args[1]))
-    trunc = x.If(x.BinOp(">=", q, x.ZERO), _floor(q), x.Neg(_floor(x.Neg(q))))
+    trunc = x.If(x.BinOp(">=", _floor(q), x.ZERO), _floor(q), x.Neg(_floor(x.Neg(q))))
     if name == "div":
         return trunc
     return x.BinOp("-", args[0], x.BinOp("*", trunc, args[1]))
