@@ -5,7 +5,10 @@ read them.
 ``z`` = [Newton warm starts | event slots | failure flag]. The event slots, in
 order: the held value (1.0 true, 0.0 false) of every state relation (``_zr<k>``) and
 time relation (``_zt<k>``), the ``sample`` flags (``_zs<k>``, true only during the
-event at a sample time), the discrete variables (their flat names), the ``pre``
+event at a sample time), the discrete variables (their flat names), the held value
+of every ``floor(u)`` (``_zf<k>``; unless ``u`` is affine in time, its two state
+relations ``u < _zf<k>`` and ``u >= _zf<k> + 1`` come last among the relations),
+the ``pre``
 values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), then
 ``initial()`` (``_zinit``), ``terminal()`` (``_zterm``), the terminate code (0, or
 1 + the index of the ``terminate`` message), the changed flag of the last event pass
@@ -14,6 +17,7 @@ and the event-iteration status (1.0: did not converge).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 
 from ..ir import expr as x
@@ -28,6 +32,17 @@ class EventLayout:
     """The event slots of ``z`` for ``events``, starting at ``base``."""
 
     def __init__(self, events: EventSystem, base: int) -> None:
+        self.floors = [f"_zf{k}" for k in range(len(events.floors))]
+        self.floor_rates = list(events.floor_rates) or [None] * len(events.floors)
+        bounds = []
+        self.texts = [x.to_text(r) for r in events.relations]  # what each relation is
+        for call, name, rate in zip(events.floors, self.floors, self.floor_rates):
+            if rate is not None:  # a time event at each integer (next_time_event)
+                continue
+            u, k = call.args[0], x.Var(name)
+            bounds += [x.BinOp("<", u, k), x.BinOp(">=", u, x.BinOp("+", k, x.Const(1.0)))]
+            self.texts += [f"{x.to_text(call)} decreases", f"{x.to_text(call)} increases"]
+        events = dataclasses.replace(events, relations=events.relations + tuple(bounds))
         self.events = events
         self.base = base
         self.relations = [f"_zr{k}" for k in range(len(events.relations))]
@@ -40,7 +55,7 @@ class EventLayout:
             for j, branch in enumerate(clause.branches):
                 self.conditions += [(i, j, c) for c in branch.conditions]
         self.condition_names = [f"_zc{k}" for k in range(len(self.conditions))]
-        names = (self.relations + self.times + self.samples + self.discrete
+        names = (self.relations + self.times + self.samples + self.discrete + self.floors
                  + list(self.pre.values()) + self.condition_names + list(FLAGS))
         self.slot = {name: base + i for i, name in enumerate(names)}
         self.size = len(names)
@@ -61,12 +76,15 @@ class EventLayout:
             mapping[rel] = x.Var(name)
         for tr, name in zip(self.events.time_relations, self.times):
             mapping[tr.relation] = x.Var(name)
+        for call, name in zip(self.events.floors, self.floors):
+            mapping[call] = x.Var(name)
         return mapping
 
     def hold(self, e: x.Expr, held: Mapping[x.Expr, x.Expr] | None = None) -> x.Expr:
         """``e`` as the generated code computes it: event relations read their held
         values (``held``: another mapping, e.g. the new values during an event pass),
-        ``sample``/``initial``/``terminal`` their flags, ``pre(v)`` its slot,
+        ``floor`` calls their held values, ``sample``/``initial``/``terminal`` their
+        flags, ``pre(v)`` its slot,
         ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``."""
         return _replace(e, self.held if held is None else held, self, False)
 
@@ -78,7 +96,7 @@ def _replace(e: x.Expr, held: Mapping[x.Expr, x.Expr], layout: EventLayout,
              quiet: bool) -> x.Expr:
     if isinstance(e, (x.Const, x.Var, x.Time)):
         return e
-    if not quiet and isinstance(e, x.BinOp) and e in held:
+    if not quiet and isinstance(e, (x.BinOp, x.Call)) and e in held:
         return held[e]
     if isinstance(e, x.Call):
         if e.name == "pre":

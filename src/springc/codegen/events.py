@@ -25,7 +25,7 @@ from ..ir.hybrid import EventSystem
 from .context import CodegenContext
 from .encoding import encode_strings
 from .event_layout import EventLayout
-from .statements import Let, Raw, Stmt, Store
+from .statements import Let, Load, Raw, Stmt, Store
 
 EVENT_ITERATIONS = 50
 _ONE, _ZERO = x.Const(1.0), x.Const(0.0)
@@ -92,11 +92,40 @@ def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         at = tr.at
         out.append(Let("_zq", x.If(x.BinOp("and", x.BinOp(">", at, later),
                                            x.BinOp("<", at, x.Var("_zq"))), at, x.Var("_zq"))))
+    for call, name, rate in zip(layout.events.floors, layout.floors, layout.floor_rates):
+        if rate is None:
+            continue
+        out.append(Load(name, f"z[{layout.slot[name]}]", name))
+        u0 = _at_time_zero(call.args[0])  # u = rate * time + u0
+        held = x.Var(name)
+        up = x.div(x.sub(x.add(held, _ONE), u0), rate)
+        down = x.div(x.sub(held, u0), rate)
+        at = x.If(x.BinOp(">", rate, _ZERO), up,
+                  x.If(x.BinOp("<", rate, _ZERO), down, x.Const(float("inf"))))
+        out.append(Let("_zq", x.If(x.BinOp("and", x.BinOp(">", at, later),
+                                           x.BinOp("<", at, x.Var("_zq"))), at, x.Var("_zq"))))
     for start, interval in layout.events.samples:
         k = x.add(x.Call("floor", (x.div(x.sub(later, start), interval),)), _ONE)
         nxt = x.If(x.BinOp("<", later, start), start, x.add(start, x.mul(k, interval)))
         out.append(Let("_zq", x.Call("min", (x.Var("_zq"), nxt))))
     return [*out, Raw("_zo = np.empty(1)"), Store("_zo[0]", x.Var("_zq"))]
+
+
+def _at_time_zero(e: x.Expr) -> x.Expr:
+    """``e`` with ``time`` = 0."""
+    if isinstance(e, x.Time):
+        return _ZERO
+    if isinstance(e, (x.Const, x.Var)):
+        return e
+    if isinstance(e, x.Call):
+        return x.Call(e.name, tuple(_at_time_zero(a) for a in e.args))
+    if isinstance(e, x.BinOp):
+        return x.BinOp(e.op, _at_time_zero(e.left), _at_time_zero(e.right))
+    if isinstance(e, (x.Neg, x.Not, x.Der)):
+        return type(e)(_at_time_zero(e.arg))
+    if isinstance(e, x.If):
+        return x.If(*(_at_time_zero(a) for a in (e.cond, e.then, e.otherwise)))
+    raise TypeError(f"not an expression: {e!r}")
 
 
 def _sample_hit(t: x.Expr, start: x.Expr, interval: x.Expr) -> x.Expr:
@@ -139,6 +168,13 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
         new[tr.relation] = _truth(f"_zu{k}")
         changed.append(x.BinOp("<>", x.Var(f"_zu{k}"), x.Var(layout.times[k])))
+    # the held floor values: floor of their arguments now (3.7.2)
+    for k, (call, rate) in enumerate(zip(ev.floors, layout.floor_rates)):
+        u = layout.hold(call.args[0])
+        if rate is not None:  # a time event: the value just after it
+            u = x.add(u, x.mul(rate, _eps(x.TIME)))
+        out.append(Let(f"_zk{k}", x.Call("floor", (u,)), x.to_text(call)))
+        changed.append(x.BinOp("<>", x.Var(f"_zk{k}"), x.Var(layout.floors[k])))
     # clause by clause (sorted: a clause reading what another assigns comes after
     # it): the conditions with the new relations and the values assigned so far (a
     # branch fires when one of its conditions becomes true; at initialization only
@@ -193,6 +229,8 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
     for k, name in enumerate(layout.condition_names):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zd{k}")))
+    for k, name in enumerate(layout.floors):
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zk{k}")))
     for name in layout.discrete:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
@@ -254,7 +292,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         "EVENTS = True",
         f"Z_EVENTS = {layout.base}",
         f"Z_SIZE = {layout.base + layout.size + 1}",
-        f"ZERO_CROSSINGS = {encode_strings([x.to_text(r) for r in ev.relations])}",
+        f"ZERO_CROSSINGS = {encode_strings(layout.texts)}",
         f"RELATION_OPS = {tuple(r.op for r in ev.relations)!r}",
         f"Z_RELATIONS = {s[layout.relations[0]] if layout.relations else layout.base}",
         f"TIME_EVENTS = {encode_strings([x.to_text(t.relation) for t in ev.time_relations])}",

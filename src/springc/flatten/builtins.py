@@ -242,8 +242,14 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
     return x.Call(name, args)
 
 
+_SWITCHING_CALLS = frozenset({"abs", "sign", "min", "max", "floor", "ceil", "integer", "div",
+                              "mod", "rem"})
+
+
 def _keep_no_event(e: x.Expr) -> x.Expr:
-    """``noEvent`` only matters around relations; elsewhere it is dropped."""
+    """``noEvent`` only matters around relations and the built-ins that would switch
+    at events (3.7.2); elsewhere it is dropped."""
     has_switch = any(isinstance(n, x.If) or (isinstance(n, x.BinOp) and n.op in x.RELATIONS)
+                     or (isinstance(n, x.Call) and n.name in _SWITCHING_CALLS)
                      for n in x.walk(e))
     return x.Call("noEvent", (e,)) if has_switch else e

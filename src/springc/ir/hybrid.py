@@ -11,6 +11,12 @@ Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
   (``time >= t0``): time events at ``at``, hit exactly without root finding;
 - ``samples``: the ``sample(start, interval)`` calls (time events too);
 - ``pre``: the variables read by ``pre``, ``edge`` or ``change``;
+- ``floors``: the ``floor(u)`` calls on continuous arguments outside ``noEvent``
+  (``ceil``, ``integer``, ``div``, ``mod`` and ``rem`` are rewritten into them):
+  each keeps its value from the last event; an event occurs when ``u`` leaves
+  ``[k, k + 1)`` (3.7.2); ``floor_rates``: for each, ``der(u)`` when ``u`` is
+  ``time`` times a parameter expression plus one (a time event at each integer,
+  hit exactly), else None (state events on ``u``);
 - ``whens``: the when-clauses, assignments sorted so that each reads the values
   assigned before it at the same event.
 """
@@ -20,7 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import Span
-from .expr import BinOp, Expr
+from .expr import BinOp, Call, Expr
 from .when import When
 
 
@@ -52,8 +58,10 @@ class EventSystem:
     samples: tuple[tuple[Expr, Expr], ...]
     pre: tuple[str, ...]
     whens: tuple[When, ...]
+    floors: tuple[Call, ...] = ()
+    floor_rates: tuple[Expr | None, ...] = ()
 
     @property
     def empty(self) -> bool:
         return not (self.discrete or self.relations or self.time_relations
-                    or self.samples or self.whens)
+                    or self.samples or self.whens or self.floors)

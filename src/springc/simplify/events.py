@@ -12,7 +12,7 @@ without the when-assigned variables, which the balance check and lowering see.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 
 from ..ir import expr as x
 from ..ir import flat, ode
@@ -74,6 +74,7 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     timed: dict[x.BinOp, TimeRelation] = {}
     samples: dict[tuple[x.Expr, x.Expr], None] = {}
     pre: dict[str, None] = {}
+    floors: dict[x.Call, None] = {}
     for e in exprs:
         for node in switching(e):
             if isinstance(node, x.BinOp) and node.op in STATE_RELATIONS:
@@ -84,36 +85,54 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
                     relations.setdefault(node, None)
             elif isinstance(node, x.Call) and node.name == "sample":
                 samples.setdefault((node.args[0], node.args[1]), None)
+            elif (isinstance(node, x.Call) and node.name == "floor"
+                  and _continuous(node, params | held_set)):
+                floors.setdefault(node, None)
         for node in x.walk(e):
             if isinstance(node, x.Call) and node.name in ("pre", "edge", "change"):
                 arg = node.args[0]
                 if isinstance(arg, x.Var):
                     pre.setdefault(arg.name, None)
-    if not (held or relations or timed or samples or model.whens):
+    if not (held or relations or timed or samples or model.whens or floors):
         return None
     by_name = {v.name: v for v in model.variables}
     discrete = tuple(Discrete(n, by_name[n].type, by_name[n].attributes.start,
                               by_name[n].span) for n in held)
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
-                       tuple(pre), _sorted_whens(model.whens))
+                       tuple(pre), _sorted_whens(model.whens), tuple(floors),
+                       tuple(_time_rate(c.args[0], params) for c in floors))
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
     """``system`` with its events (``ODE.events``; unchanged for a continuous model).
     ``abs``, ``sign``, ``min`` and ``max`` outside ``noEvent`` become if-expressions
-    on relations first, so that their switches are events too."""
-    steps = tuple(_rewrite_step(s) for s in system.steps)
-    observed = tuple(ode.Assign(a.name, switched_builtins(a.expr), a.span)
-                     for a in system.observed)
+    on relations first, and ``ceil``, ``integer``, ``div``, ``mod`` and ``rem`` of
+    continuous arguments expressions of ``floor`` (held between events), so that
+    their switches are events too."""
+    known = frozenset({q.name for q in system.parameters} | set(w.assigned(model.whens)))
+
+    def f(e: x.Expr) -> x.Expr:
+        return switched_builtins(e, known)
+
+    steps = tuple(_rewrite_step(s, f) for s in system.steps)
+    observed = tuple(ode.Assign(a.name, f(a.expr), a.span) for a in system.observed)
     rewritten = dataclasses.replace(system, steps=steps, observed=observed)
-    events = event_system(model, rewritten)
+    whens = tuple(_rewrite_when(c, f) for c in model.whens)
+    events = event_system(dataclasses.replace(model, whens=whens), rewritten)
     if events is None:
         return system
     return dataclasses.replace(rewritten, events=events)
 
 
-def _rewrite_step(s: ode.Step) -> ode.Step:
-    f = switched_builtins
+def _rewrite_when(clause: w.When, f: Callable[[x.Expr], x.Expr]) -> w.When:
+    return dataclasses.replace(clause, branches=tuple(dataclasses.replace(
+        b, conditions=tuple(f(c) for c in b.conditions),
+        assignments=tuple(dataclasses.replace(a, value=f(a.value)) for a in b.assignments),
+        reinits=tuple(dataclasses.replace(r, value=f(r.value)) for r in b.reinits))
+        for b in clause.branches))
+
+
+def _rewrite_step(s: ode.Step, f: Callable[[x.Expr], x.Expr]) -> ode.Step:
     if isinstance(s, ode.Assign):
         return ode.Assign(s.name, f(s.expr), s.span)
     if isinstance(s, ode.LinearBlock):
@@ -126,17 +145,19 @@ def _rewrite_step(s: ode.Step) -> ode.Step:
         tuple((i, j, f(e)) for i, j, e in s.jacobian), s.spans)
 
 
-def switched_builtins(e: x.Expr) -> x.Expr:
+def switched_builtins(e: x.Expr, known: frozenset[str] | None = None) -> x.Expr:
     """``e`` with ``abs(a)`` as ``if a >= 0 then a else -a``, ``sign(a)`` as ``if a > 0
     then 1 else if a < 0 then -1 else 0``, ``min(a, b)`` as ``if a < b then a else b``
     and ``max(a, b)`` as ``if a > b then a else b``, outside ``noEvent``/``smooth``
-    (unchanged subtrees are shared)."""
+    (unchanged subtrees are shared). With ``known`` (the parameters and discrete
+    variables), the integer-valued built-ins of arguments that read anything else
+    become expressions of ``floor`` (see :func:`_through_floor`)."""
     if isinstance(e, (x.Const, x.Var, x.Time)):
         return e
     if isinstance(e, x.Call):
         if e.name in _QUIET:
             return e
-        args = tuple(switched_builtins(a) for a in e.args)
+        args = tuple(switched_builtins(a, known) for a in e.args)
         if e.name == "abs":
             return x.If(x.BinOp(">=", args[0], x.ZERO), args[0], x.neg(args[0]))
         if e.name == "sign":
@@ -145,17 +166,46 @@ def switched_builtins(e: x.Expr) -> x.Expr:
         if e.name in ("min", "max") and len(args) == 2:
             op = "<" if e.name == "min" else ">"
             return x.If(x.BinOp(op, args[0], args[1]), args[0], args[1])
+        if (known is not None and e.name in _FLOORED
+                and any(_continuous(a, set(known)) for a in args)):
+            return _through_floor(e.name, args)
         return e if all(a is b for a, b in zip(args, e.args)) else x.Call(e.name, args)
     if isinstance(e, x.BinOp):
-        left, right = switched_builtins(e.left), switched_builtins(e.right)
+        left, right = switched_builtins(e.left, known), switched_builtins(e.right, known)
         return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
     if isinstance(e, (x.Neg, x.Not, x.Der)):
-        arg = switched_builtins(e.arg)
+        arg = switched_builtins(e.arg, known)
         return e if arg is e.arg else type(e)(arg)
     if isinstance(e, x.If):
-        c, t, o = (switched_builtins(a) for a in (e.cond, e.then, e.otherwise))
+        c, t, o = (switched_builtins(a, known) for a in (e.cond, e.then, e.otherwise))
         return e if (c is e.cond and t is e.then and o is e.otherwise) else x.If(c, t, o)
     raise TypeError(f"not an expression: {e!r}")
+
+
+_FLOORED = frozenset({"floor", "ceil", "integer", "div", "mod", "rem"})
+
+
+def _floor(u: x.Expr) -> x.Expr:
+    return x.Call("floor", (u,))
+
+
+def _through_floor(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
+    """The integer-valued built-in ``name(args)`` through ``floor`` (3.7.2):
+    ``ceil(u) = -floor(-u)``, ``integer(u) = floor(u)``, ``div(a, b)`` the
+    truncation of ``a/b`` (``if floor(a/b) >= 0 then floor(a/b) else -floor(-a/b)``:
+    the condition changes only where ``floor`` does, so at its events),
+    ``mod(a, b) = a - floor(a/b)*b``, ``rem(a, b) = a - div(a, b)*b``."""
+    if name in ("floor", "integer"):
+        return _floor(args[0])
+    if name == "ceil":
+        return x.Neg(_floor(x.Neg(args[0])))
+    q = x.BinOp("/", args[0], args[1])
+    if name == "mod":
+        return x.BinOp("-", args[0], x.BinOp("*", _floor(q), args[1]))
+    trunc = x.If(x.BinOp(">=", _floor(q), x.ZERO), _floor(q), x.Neg(_floor(x.Neg(q))))
+    if name == "div":
+        return trunc
+    return x.BinOp("-", args[0], x.BinOp("*", trunc, args[1]))
 
 
 def _time_relation(node: x.BinOp, params: set[str]) -> TimeRelation | None:
@@ -172,9 +222,24 @@ def _time_relation(node: x.BinOp, params: set[str]) -> TimeRelation | None:
     return None
 
 
-def _continuous(node: x.BinOp, known: set[str]) -> bool:
-    """Whether a relation reads a continuous variable or ``time`` (so it can change
-    between events and needs a zero-crossing function)."""
+def _time_rate(u: x.Expr, params: set[str]) -> x.Expr | None:
+    """``der(u)`` if ``u`` is affine in ``time`` with parameter coefficients, else None."""
+    def plain(e: x.Expr) -> bool:
+        return x.variables(e) <= params and not any(
+            isinstance(n, x.Der) or (isinstance(n, x.Call) and (
+                n.name not in x.MATH or n.name in _FLOORED)) for n in x.walk(e))
+
+    if not plain(u):
+        return None
+    rate = x.time_derivative(u, lambda _: False)
+    if not plain(rate) or any(isinstance(n, x.Time) for n in x.walk(rate)):
+        return None
+    return rate
+
+
+def _continuous(node: x.Expr, known: set[str]) -> bool:
+    """Whether a relation (or a built-in call) reads a continuous variable or ``time``
+    (so it can change between events and needs a zero-crossing function)."""
     return any(isinstance(n, (x.Time, x.Der)) or (isinstance(n, x.Var) and n.name not in known)
                for n in switching(node))
 

@@ -240,9 +240,7 @@ class EventLoop:
             if bound <= t:
                 bound = stop
             if not len(x):
-                self.fill(bound, None, bound, x, False)
-                t = bound
-                x = self.time_event(t, x, stop)
+                t, x = self.stateless_step(t, bound, x, stop)
                 continue
             integrator = cls(problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs)
             while True:
@@ -279,6 +277,26 @@ class EventLoop:
                     break
                 self.fill(t_new, dense, t_new, y, True)
         return x
+
+    def stateless_step(self, t: float, bound: float, x: np.ndarray, stop: float
+                       ) -> tuple[float, np.ndarray]:
+        """Without states: on to the next output time or ``bound``; a relation on
+        ``time`` that has switched there is a state event, located on it."""
+        j = int(np.searchsorted(self.grid, t, side="right"))
+        end = min(bound, float(self.grid[j])) if j < len(self.grid) else bound
+        switched = self.switched(end, x)
+        if switched:
+            times = {k: self.locate(lambda _: x, t, end, k) for k in switched}
+            k = min(times, key=times.__getitem__)
+            self.fill(times[k], None, times[k], x, False)
+            x = self.event(times[k], x, "state", self.mod.ZERO_CROSSINGS[k])
+            self.fill(times[k], None, times[k], x, True)
+            return times[k], x
+        if end < bound:
+            self.fill(end, None, end, x, True)
+            return end, x
+        self.fill(bound, None, bound, x, False)
+        return bound, self.time_event(bound, x, stop)
 
     def time_event(self, t: float, x: np.ndarray, stop: float) -> np.ndarray:
         """At the end of an integration: the time event there, if any; the grid row."""
