@@ -410,3 +410,32 @@ def test_hostile_names_and_messages_stay_data(tmp_path: Path) -> None:
     result = springc.simulate(model, stop=1.0, interval=0.5)
     assert result.stats.note == "terminate() at time 0.5: done\"\\n''' import os"
     assert result["a\"b\n')"][-1] == pytest.approx(0.5, abs=1e-9)
+
+
+BANG = """
+model Bang
+  Real x(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+  Real speed;
+equation
+  der(x) = v;
+  der(v) = -10 * sign(x);
+  speed = abs(v);
+end Bang;
+"""
+
+
+def test_sign_and_abs_switch_at_events(tmp_path: Path) -> None:
+    """x'' = -10 sign(x): parabolas joined where x = 0 (every 2/sqrt(5) s after the
+    first quarter period 1/sqrt(5))."""
+    result = springc.simulate(write(tmp_path, BANG), stop=3.0, interval=0.01, rtol=1e-10)
+    tau, r = 1 / math.sqrt(5), math.sqrt(20)
+    u = np.mod(result.time, 4 * tau)
+    s2, s3 = u - tau, u - 3 * tau
+    exact = np.where(u < tau, 1 - 5 * u**2,
+                     np.where(u < 3 * tau, -r * s2 + 5 * s2**2, r * s3 - 5 * s3**2))
+    assert np.max(np.abs(result["x"] - exact)) < 1e-8
+    assert np.max(np.abs(result["speed"] - np.abs(result["v"]))) < 1e-12
+    crossings = [e.time for e in result.events if e.cause in ("x > 0", "x < 0")]
+    expected = [tau + 2 * tau * k for k in range(3)]
+    assert np.max(np.abs(np.array(crossings) - expected)) < 1e-9

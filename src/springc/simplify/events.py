@@ -98,6 +98,66 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
                        tuple(pre), _sorted_whens(model.whens))
 
 
+def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
+    """``system`` with its events (``ODE.events``; unchanged for a continuous model).
+    ``abs``, ``sign``, ``min`` and ``max`` outside ``noEvent`` become if-expressions
+    on relations first, so that their switches are events too."""
+    steps = tuple(_rewrite_step(s) for s in system.steps)
+    observed = tuple(ode.Assign(a.name, switched_builtins(a.expr), a.span)
+                     for a in system.observed)
+    rewritten = dataclasses.replace(system, steps=steps, observed=observed)
+    events = event_system(model, rewritten)
+    if events is None:
+        return system
+    return dataclasses.replace(rewritten, events=events)
+
+
+def _rewrite_step(s: ode.Step) -> ode.Step:
+    f = switched_builtins
+    if isinstance(s, ode.Assign):
+        return ode.Assign(s.name, f(s.expr), s.span)
+    if isinstance(s, ode.LinearBlock):
+        return ode.LinearBlock(s.names, tuple((i, j, f(e)) for i, j, e in s.matrix),
+                               tuple(f(e) for e in s.rhs), s.spans)
+    return ode.NonlinearBlock(
+        s.tearing, tuple(ode.Assign(a.name, f(a.expr), a.span) for a in s.inner),
+        tuple(f(e) for e in s.residuals),
+        tuple(ode.Assign(a.name, f(a.expr), a.span) for a in s.sensitivities),
+        tuple((i, j, f(e)) for i, j, e in s.jacobian), s.spans)
+
+
+def switched_builtins(e: x.Expr) -> x.Expr:
+    """``e`` with ``abs(a)`` as ``if a >= 0 then a else -a``, ``sign(a)`` as ``if a > 0
+    then 1 else if a < 0 then -1 else 0``, ``min(a, b)`` as ``if a < b then a else b``
+    and ``max(a, b)`` as ``if a > b then a else b``, outside ``noEvent``/``smooth``
+    (unchanged subtrees are shared)."""
+    if isinstance(e, (x.Const, x.Var, x.Time)):
+        return e
+    if isinstance(e, x.Call):
+        if e.name in _QUIET:
+            return e
+        args = tuple(switched_builtins(a) for a in e.args)
+        if e.name == "abs":
+            return x.If(x.BinOp(">=", args[0], x.ZERO), args[0], x.neg(args[0]))
+        if e.name == "sign":
+            return x.If(x.BinOp(">", args[0], x.ZERO), x.ONE,
+                        x.If(x.BinOp("<", args[0], x.ZERO), x.Const(-1), x.ZERO))
+        if e.name in ("min", "max") and len(args) == 2:
+            op = "<" if e.name == "min" else ">"
+            return x.If(x.BinOp(op, args[0], args[1]), args[0], args[1])
+        return e if all(a is b for a, b in zip(args, e.args)) else x.Call(e.name, args)
+    if isinstance(e, x.BinOp):
+        left, right = switched_builtins(e.left), switched_builtins(e.right)
+        return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
+    if isinstance(e, (x.Neg, x.Not, x.Der)):
+        arg = switched_builtins(e.arg)
+        return e if arg is e.arg else type(e)(arg)
+    if isinstance(e, x.If):
+        c, t, o = (switched_builtins(a) for a in (e.cond, e.then, e.otherwise))
+        return e if (c is e.cond and t is e.then and o is e.otherwise) else x.If(c, t, o)
+    raise TypeError(f"not an expression: {e!r}")
+
+
 def _time_relation(node: x.BinOp, params: set[str]) -> TimeRelation | None:
     """``time OP t0`` or ``t0 OP time`` with ``t0`` a parameter expression."""
     def constant(e: x.Expr) -> bool:

@@ -13,7 +13,6 @@ The pipeline is a short list of passes, each in its own module:
 
 from __future__ import annotations
 
-import dataclasses
 import gc
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -23,7 +22,7 @@ from ..ir import flat, ode
 from .alias import eliminate_aliases
 from .balance import check_balance, dae_incidence
 from .causalize import causalize
-from .events import event_system
+from .events import with_events
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
@@ -79,8 +78,7 @@ def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplifi
     observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
     result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
                      aliased.dae.parameters, aliased.dae)
-    events = event_system(model, result)
-    if events is not None:
+    result = with_events(model, result)
+    if result.events is not None:
         check_reinits(model, result)
-        result = dataclasses.replace(result, events=events)
     return Simplified(result, aliased.warnings, reduced.blocks)
