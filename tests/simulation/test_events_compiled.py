@@ -80,8 +80,20 @@ equation
 end Tenths;
 """
 
+BANG = """
+model Bang "x'' = -10 sign(x): parabolas joined where x = 0"
+  Real x(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+  Real speed;
+equation
+  der(x) = v;
+  der(v) = -10 * sign(x);
+  speed = abs(v);
+end Bang;
+"""
+
 TEXTS = {"ball": BALL, "switch": SWITCH, "clock": CLOCK, "relay": RELAY, "stop": STOP,
-         "tenths": TENTHS}
+         "tenths": TENTHS, "bang": BANG}
 STEP = {"dop853": None, "rk45": None, "radau": None, "bdf": None, "rk4": 1e-3,
         "verlet": 1e-3}  # solver -> step
 
@@ -297,3 +309,21 @@ def test_time_events_within_rounding_of_an_output_time(models: dict[str, Compile
     assert compiled["n"].tolist() == scipy["n"].tolist() == rows
     assert compiled.stats.time_events == scipy.stats.time_events == 10
     assert compiled.stats.steps == scipy.stats.steps
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk4"])
+def test_sign_and_abs_switch_at_the_same_events(models: dict[str, CompiledModel], solver: str
+                                                ) -> None:
+    """sign and abs outside noEvent switch at events (their relations in zero_crossings)."""
+    scipy, compiled = both(models["bang"], solver, stop=3.0, interval=0.01, rtol=1e-10)
+    tau, r = 1 / math.sqrt(5), math.sqrt(20)  # x = 0 at tau + 2 k tau
+    u = np.mod(compiled.time, 4 * tau)
+    s2, s3 = u - tau, u - 3 * tau
+    exact = np.where(u < tau, 1 - 5 * u**2,
+                     np.where(u < 3 * tau, -r * s2 + 5 * s2**2, r * s3 - 5 * s3**2))
+    assert np.max(np.abs(compiled["x"] - exact)) < 1e-8
+    assert np.max(np.abs(compiled["speed"] - np.abs(compiled["v"]))) < 1e-12
+    crossings = [e.time for e in compiled.events if e.cause in ("x > 0", "x < 0")]
+    assert np.max(np.abs(np.array(crossings) - [tau + 2 * tau * k for k in range(3)])) < 1e-9
+    assert kinds(compiled) == kinds(scipy)
+    assert compiled.stats.state_events == scipy.stats.state_events
