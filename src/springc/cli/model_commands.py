@@ -1,0 +1,80 @@
+"""``springc check``, ``flatten`` and ``compile``: the commands that stop before a run."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from .app import guard, main
+from .options import check_output_options, compile_options, model_options
+
+
+@main.command()
+@model_options
+@click.option("--origins", is_flag=True, help="Show where each equation comes from.")
+@click.option("--json", "as_json", is_flag=True, help="Print the flat model as JSON.")
+@click.option("--simplify", "simplified", is_flag=True,
+              help="Print the simplified system: states, evaluation order, observed.")
+@click.option("--latex", "as_latex", is_flag=True,
+              help="Print the equations (with --simplify: the evaluation order) as LaTeX.")
+@guard
+def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+            origins: bool, as_json: bool, simplified: bool, as_latex: bool) -> None:
+    """Print the flat model of FILES as Modelica text (or JSON, or LaTeX)."""
+    from ..ir.flat import format_flat, format_flat_latex, to_json_dict
+    from ..pipeline import flatten_files
+
+    if as_latex and as_json:
+        raise click.UsageError("--latex and --json cannot be combined")
+    flat_model = flatten_files(files, model, libraries)
+    if simplified:
+        from ..ir.ode import format_ode, format_ode_latex
+        from ..simplify import simplify
+
+        result = simplify(flat_model)
+        click.echo((format_ode_latex if as_latex else format_ode)(result.ode), nl=False)
+        for note in result.warnings:
+            click.echo(f"{note.span}: warning: {note.message}" if note.span
+                       else f"warning: {note.message}", err=True)
+    elif as_json:
+        click.echo(json.dumps(to_json_dict(flat_model), indent=1))
+    elif as_latex:
+        click.echo(format_flat_latex(flat_model), nl=False)
+    else:
+        click.echo(format_flat(flat_model, origins), nl=False)
+
+
+@main.command()
+@model_options
+@guard
+def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...]) -> None:
+    """Check that a model flattens and is balanced; print a one-line summary."""
+    from ..pipeline import flatten_files
+    from ..simplify import check_balance
+
+    click.echo(check_balance(flatten_files(files, model, libraries)).summary())
+
+
+@main.command(name="compile")
+@model_options
+@compile_options
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the generated Python module here (default: stdout).")
+@guard
+def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool,
+             output: str | None) -> None:
+    """Generate a standalone Python module (numpy/scipy, or numba) for a model."""
+    from ..pipeline import CompileOptions, compile_files
+
+    check_output_options([("-o", output, None)], files)
+    compiled = compile_files(CompileOptions(files, model, libraries, backend or "python",
+                                            patterns or None, (), not no_cache))
+    if output:
+        from ..fileio import atomic_write
+
+        with atomic_write(output, "w", files) as f:
+            f.write(compiled.source)
+    else:
+        click.echo(compiled.source, nl=False)

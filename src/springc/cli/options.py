@@ -1,0 +1,106 @@
+"""Options and checks shared by the commands: the model's files, the compile and run
+options, ``--set`` values, output paths refused before any work."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import click
+
+from ..errors import OutputError, UsageError
+
+CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
+             "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}
+"""How the checks of :func:`springc.simulation.check_run_values` name the options."""
+
+
+def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    func = click.option("-L", "--library", "libraries", multiple=True,
+                        type=click.Path(exists=True, file_okay=False),
+                        help="Library folder to search for classes (repeatable); "
+                        "then SPRINGC_PATH and MODELICAPATH.")(func)
+    func = click.option("--model", "model", default=None,
+                        help="Dotted name of the model (default: the last model of the "
+                        "last file).")(func)
+    return click.argument("files", nargs=-1, required=True,
+                          type=click.Path(exists=True, dir_okay=False))(func)
+
+
+def parse_set(values: tuple[str, ...]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in values:
+        name, sep, text = item.partition("=")
+        if not sep or not name.strip():
+            raise click.BadParameter(f"expected NAME=VALUE, got '{item}'", param_hint="--set")
+        word = text.strip().lower()
+        if word in ("true", "false"):
+            out[name.strip()] = 1.0 if word == "true" else 0.0
+            continue
+        try:
+            out[name.strip()] = float(text)
+        except ValueError:
+            raise click.BadParameter(f"'{text}' is not a number (in '{item}')",
+                                     param_hint="--set") from None
+    return out
+
+
+def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str] | None]],
+                   protected: Sequence[str]) -> None:
+    """Refuse, before any work, outputs that cannot be written: ``(option, path,
+    formats by suffix or None)``; a UsageError names the option."""
+    from ..fileio import check_distinct, check_target
+    from ..simulation import file_format
+
+    given = [(option, path, formats) for option, path, formats in outputs if path]
+    try:
+        for option, path, formats in given:
+            if formats is not None:
+                file_format(path, formats, option)
+            try:
+                check_target(path, protected)
+            except OutputError as err:
+                raise UsageError(f"{option}: {err.message}", option=option,
+                                 hint=err.hint) from None
+        check_distinct((option, path) for option, path, _ in given)
+    except OutputError as err:
+        raise UsageError(err.message, hint=err.hint) from None
+
+
+def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """The options of a run shared by ``simulate`` and ``tradeoff``."""
+    func = click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
+                        help="Set a parameter (repeatable); array sizes re-flatten the "
+                        "model.")(func)
+    func = click.option("--interval", type=float,
+                        help="Output interval [s] (default: experiment, else "
+                        "(stop-start)/500).")(func)
+    func = click.option("--stop", type=float,
+                        help="Stop time [s] (default: experiment, else 10).")(func)
+    return click.option("--start", type=float,
+                        help="Start time [s] (default: experiment, else 0).")(func)
+
+
+def compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    func = click.option("--no-cache", is_flag=True,
+                        help="Regenerate the code instead of using the on-disk cache.")(func)
+    func = click.option("--vars", "patterns", multiple=True, metavar="PATTERN",
+                        help="Output only these variables: flat names, * and ? as "
+                        "wildcards (repeatable). Default: all states and observed.")(func)
+    return click.option("--backend", type=click.Choice(["python", "numba"]),
+                        default=None,
+                        help="Generated code: plain Python/numpy, or numba-compiled "
+                        "(default: numba for simulate's compiled engine, else "
+                        "python).")(func)
+
+
+def single_threaded_blas() -> None:
+    """Run BLAS on one thread unless the user chose otherwise: the solvers' vector
+    operations are too small to gain from threads, and on a busy machine threaded
+    OpenBLAS made a 20,000-state BDF run eight times slower."""
+    import os
+
+    if "numpy" not in sys.modules:
+        for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+            os.environ.setdefault(var, "1")

@@ -1,0 +1,113 @@
+"""``springc simulate``: one run, its trajectory (CSV or MAT) and/or a plot."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from ..simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, FIXED_STEP
+from .app import guard, main
+from .options import (
+    CLI_NAMES,
+    check_output_options,
+    compile_options,
+    model_options,
+    parse_set,
+    run_options,
+    single_threaded_blas,
+)
+
+
+@main.command()
+@model_options
+@compile_options
+@run_options
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True,
+              help="auto: dop853 or radau from a stiffness estimate at the start (the "
+              "summary says why); a scipy solve_ivp method; or a fixed-step one "
+              "(verlet, symplectic-euler, rk4) with --step.")
+@click.option("--engine", type=click.Choice(ENGINES, case_sensitive=False),
+              default=DEFAULT_ENGINE, show_default=True,
+              help="compiled: numba loops (springc.integrate) for dop853, auto's dop853 "
+              "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; "
+              "auto: compiled for the numba backend (--backend numba), else scipy.")
+@click.option("--error-estimate", type=click.Choice(("off", "on", "auto"),
+                                                   case_sensitive=False),
+              default="auto", show_default=True,
+              help="Estimate the global error reached on the output grid (a companion "
+              "run at a 1000x tighter tolerance, or half the step for fixed-step "
+              "solvers): in the summary line and in the side file NAME.error.csv next to "
+              "-o NAME.csv; auto: where it costs at most about 30 % of the run.")
+@click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
+              "(required for them).")
+@click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
+              "Tolerance, else 1e-6).")
+@click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Stop with an error after this many integrator steps (default "
+              "20,000,000).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Stop with an error after this many seconds of wall clock (default "
+              "3600).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the trajectory: .csv, or .mat (the MATLAB v4 result layout of "
+              "OpenModelica and Dymola); default: CSV on stdout unless --plot.")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write a plot: .png, .svg or .pdf.")
+@click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
+              "each event, its left and right limits (default: one row per output time).")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@guard
+def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
+             stop: float | None, interval: float | None, solver: str, engine: str,
+             error_estimate: str, rtol: float | None, step: float | None,
+             atol: float | None,
+             assignments: tuple[str, ...], max_steps: int | None,
+             time_limit: float | None, output: str | None, plot: str | None,
+             event_rows: bool, quiet: bool) -> None:
+    """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
+    from ..simulation import PLOT_FORMATS, RESULT_FORMATS, check_run_values, choose_engine
+
+    values = parse_set(assignments)
+    if solver.lower() in FIXED_STEP and step is None:
+        raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
+                               "needs --step H (e.g. --step 1e-3)")
+    chosen = choose_engine(engine.lower(), solver.lower(), backend)
+    check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
+    check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
+                   files)
+    single_threaded_blas()
+    from ..api import compile_model
+    from ..api import simulate as run
+    from ..simulation import (
+        SimulationOptions,
+        check_trajectory_size,
+        save_outputs,
+        write_csv,
+    )
+
+    compiled = compile_model(files, model, libraries=libraries, backend=backend or (
+        "numba" if chosen == "compiled" else "python"), outputs=patterns or None,
+        parameters=values, cache=not no_cache)
+    if not patterns and (output or not plot):  # the default trajectory of every output
+        check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
+                              f"-o {output}" if output else "the CSV on stdout")
+    progress = None if quiet or not sys.stderr.isatty() else sys.stderr
+    result = run(compiled, start=start, stop=stop, interval=interval,
+                 solver=solver.lower(), rtol=rtol, atol=atol,
+                 parameters={k: v for k, v in values.items() if k not in compiled.structural},
+                 progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
+                 engine=engine.lower(), error_estimate=error_estimate.lower(),
+                 event_rows=event_rows)
+    if output or plot:
+        note = save_outputs(result, output, plot, files)
+        if note and not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
+    else:
+        write_csv(result, sys.stdout)
+        sys.stdout.flush()
+    if not quiet:
+        click.echo(result.stats.summary(result.model), err=True)

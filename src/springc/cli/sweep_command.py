@@ -1,0 +1,142 @@
+"""``springc sweep``: a model over a grid or samples of parameter values, into Parquet."""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from ..errors import UsageError
+from ..simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
+from .app import guard, main
+from .options import (
+    CLI_NAMES,
+    check_output_options,
+    compile_options,
+    model_options,
+    parse_set,
+    run_options,
+    single_threaded_blas,
+)
+
+
+@main.command()
+@model_options
+@compile_options
+@run_options
+@click.option("--param", "params", multiple=True, required=True, metavar="NAME=VALUES",
+              help="A parameter to vary (repeatable): a list 0.5,1,2; a range "
+              "START:STOP[:lin|log]:COUNT; with --samples, a range START:STOP[:log] or a "
+              "distribution uniform(a,b), loguniform(a,b), normal(mean,std), "
+              "lognormal(mu,sigma), triangular(a,mode,b). Grid: every combination.")
+@click.option("--samples", type=click.IntRange(min=1), help="Draw this many runs from "
+              "the --param ranges/distributions instead of a grid.")
+@click.option("--method", type=click.Choice(["lhs", "mc"]), default="lhs",
+              show_default=True, help="With --samples: Latin hypercube or Monte Carlo.")
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
+              help="Seed of --samples (the same seed gives the same runs).")
+@click.option("--workers", type=click.IntRange(min=1),
+              help="Local worker processes (default: one per core).")
+@click.option("--scheduler", metavar="ADDRESS", help="Run on the Dask scheduler at "
+              "ADDRESS (tcp://host:8786) instead of local processes.")
+@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+              default=DEFAULT_SOLVER, show_default=True, help="As for simulate.")
+@click.option("--step", type=float, help="Step size [s] of the fixed-step solvers.")
+@click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
+              "Tolerance, else 1e-6).")
+@click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
+@click.option("--max-steps", type=click.IntRange(min=1), default=None,
+              help="Integrator steps per run before it fails (as for simulate).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+              help="Seconds of wall clock per run before it fails (as for simulate).")
+@click.option("--energy", metavar="NAME", help="Variable whose drift the summary "
+              "reports (default: the only selected variable in J, if any).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
+              help="The study table (.parquet); the summary goes to "
+              "NAME.summary.parquet.")
+@click.option("--summary", "summary_file", type=click.Path(dir_okay=False),
+              help="The summary table (.parquet), instead of NAME.summary.parquet.")
+@click.option("--resume", is_flag=True, help="Continue an interrupted study: runs "
+              "already in OUTPUT.partial are kept, not run again.")
+@click.option("--plot", type=click.Path(dir_okay=False), help="Plot one variable across "
+              "the runs (.png, .svg or .pdf): lines up to 12 runs, else a fan chart "
+              "(median, percentile bands).")
+@click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
+              "study's first variable).")
+@click.option("--quiet", "-q", is_flag=True, help="No progress and no summary line.")
+@guard
+def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+          backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
+          stop: float | None, interval: float | None, assignments: tuple[str, ...],
+          params: tuple[str, ...], samples: int | None, method: str, seed: int,
+          workers: int | None, scheduler: str | None, solver: str, step: float | None,
+          rtol: float | None, atol: float | None, max_steps: int | None,
+          time_limit: float | None, energy: str | None, output: str,
+          summary_file: str | None, resume: bool, plot: str | None,
+          plot_var: str | None, quiet: bool) -> None:
+    """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
+
+    The model is compiled once; runs go to local processes (or a Dask scheduler); each
+    run's parameters, status, solver statistics and trajectories are written to OUTPUT,
+    one row per run and output time, and a summary per run (final, min, max of each
+    variable) next to it. A failing run is recorded with its error; an interrupted
+    study continues with --resume.
+    """
+    from ..simulation import check_run_values
+    from ..studies import check_outputs, parse_parameter, summary_path
+
+    values = parse_set(assignments)
+    if solver.lower() in FIXED_STEP and step is None:
+        raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
+                               "needs --step H (e.g. --step 1e-3)")
+    if workers is not None and scheduler is not None:
+        raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
+                         "has its own workers)", option="--workers")
+    check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
+    specs = tuple(parse_parameter(item) for item in params)
+    summary_file = summary_file or summary_path(output)
+    check_outputs(output, summary_file, files)
+    from ..simulation import PLOT_FORMATS
+
+    check_output_options([("-o", output, None), ("--summary", summary_file, None),
+                    ("--plot", plot, PLOT_FORMATS)], files)
+    single_threaded_blas()
+    from ..api import compile_model
+    from ..studies import StudyOptions, parameter_table, run_study
+
+    options = StudyOptions(specs, samples, method, seed, (), start, stop, interval,
+                           solver.lower(), rtol, atol, step, workers, scheduler, energy,
+                           max_steps, time_limit)
+    parameter_table(options)  # refuse bad specifications before compiling
+    compiled = compile_model(files, model, libraries=libraries, backend=backend or "python",
+                             outputs=patterns or None, parameters=values,
+                             cache=not no_cache)
+    fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
+    from dataclasses import replace
+
+    from ..studies import plot_variable
+
+    plotted = plot_variable(compiled.outputs, plot_var) if plot else None
+
+    try:
+        study = run_study(compiled, replace(options, fixed=fixed), output, summary_file,
+                          resume, files, None if quiet else sys.stderr)
+    except (KeyboardInterrupt, SystemExit):
+        from ..studies import partial_folder
+
+        if partial_folder(output).is_dir():
+            click.echo(f"note: finished runs are kept in {partial_folder(output)}; run "
+                       "the same command with --resume to continue", err=True)
+        raise
+    if plot and plotted:
+        from ..fileio import atomic_write
+        from ..simulation import file_format
+        from ..studies import render_fan
+
+        picture, note = render_fan(study, plotted, file_format(plot, PLOT_FORMATS, "--plot"))
+        with atomic_write(plot, "wb", files) as f:
+            f.write(picture)
+        if not quiet:
+            click.echo(f"note: plot {plot}: {note}", err=True)
+    if not quiet:
+        click.echo(study.summary_line(), err=True)

@@ -1,0 +1,157 @@
+"""``springc tradeoff``: accuracy against cost of the solvers on one model."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+
+import click
+
+from ..errors import UsageError
+from .app import guard, main
+from .options import (
+    CLI_NAMES,
+    check_output_options,
+    compile_options,
+    model_options,
+    parse_set,
+    run_options,
+    single_threaded_blas,
+)
+
+
+def _split(value: str | None) -> list[str]:
+    return [] if value is None else [w for w in value.replace(",", " ").split() if w]
+
+
+def _positive_list(ctx: click.Context, param: click.Parameter, value: str | None
+                   ) -> tuple[float, ...] | None:
+    if value is None:
+        return None
+    out = []
+    for word in _split(value):
+        try:
+            number = float(word)
+        except ValueError:
+            raise click.BadParameter(f"'{word}' is not a number") from None
+        if not 0 < number < float("inf"):
+            raise click.BadParameter(f"{word} is not positive")
+        out.append(number)
+    if not out:
+        raise click.BadParameter("the list is empty")
+    return tuple(out)
+
+
+def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
+                 ) -> tuple[str, ...] | None:
+    if value is None:
+        return None
+    from ..tradeoff import available_solvers
+
+    names = tuple(w.lower() for w in _split(value))
+    known = available_solvers()
+    for name in names:
+        if name not in known:
+            raise click.BadParameter(f"unknown solver '{name}' (choose from "
+                                     f"{', '.join(known)})")
+    if not names:
+        raise click.BadParameter("the list is empty")
+    return names
+
+
+@main.command()
+@model_options
+@compile_options
+@run_options
+@click.option("--solvers", callback=_solver_list, metavar="LIST",
+              help="Solvers to compare, e.g. 'dop853,radau' (default: rk45 dop853 radau "
+              "bdf lsoda and the fixed-step ones).")
+@click.option("--tolerances", callback=_positive_list, metavar="LIST",
+              help="rtol values of the adaptive solvers (atol = rtol/1000; default "
+              "1e-3 ... 1e-10).")
+@click.option("--steps", callback=_positive_list, metavar="LIST",
+              help="Step sizes [s] of the fixed-step solvers (default: the output "
+              "interval divided by 2, 4, ..., 256).")
+@click.option("--max-error", "targets", callback=_positive_list, metavar="LIST",
+              help="Errors to recommend a setting for (default 1e-4).")
+@click.option("--reference", type=click.Path(exists=True, dir_okay=False),
+              help="Reference trajectory CSV (as written by simulate -o) instead of a "
+              "tight solve.")
+@click.option("--save-reference", type=click.Path(dir_okay=False),
+              help="Write the reference trajectory as CSV (reusable with --reference).")
+@click.option("--repeats", type=click.IntRange(min=1), default=3, show_default=True,
+              help="Timed runs per setting (median); runs over 2 s are timed once.")
+@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
+              show_default=True, help="Seconds per run: a longer run is stopped and the "
+              "solver's tighter settings are skipped.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False),
+              help="Write the table as CSV (.csv).")
+@click.option("--plot", type=click.Path(dir_okay=False),
+              help="Write the work-precision plot: .png, .svg or .pdf.")
+@click.option("--energy", metavar="NAME",
+              help="Variable whose drift is reported per run (default: the only "
+              "variable in J, if any).")
+@click.option("--workers", type=click.IntRange(min=1),
+              help="Local worker processes running the solvers (default: one per core).")
+@click.option("--scheduler", metavar="ADDRESS", help="Run the solvers on the Dask "
+              "scheduler at ADDRESS instead of local processes (as for sweep).")
+@click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
+@guard
+def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
+             stop: float | None, interval: float | None, assignments: tuple[str, ...],
+             solvers: tuple[str, ...] | None, tolerances: tuple[float, ...] | None,
+             steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
+             reference: str | None, save_reference: str | None, repeats: int,
+             budget: float, output: str | None, plot: str | None, energy: str | None,
+             workers: int | None, scheduler: str | None, quiet: bool) -> None:
+    """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
+
+    The error of each run is measured on the output grid against REFERENCE, or against
+    a tight dop853 solve checked by a second method (VODE Adams). By default the states
+    are compared; --vars selects other variables. Each solver's runs are one task of
+    the studies executor (local processes, or Dask with --scheduler).
+    """
+    from ..simulation import PLOT_FORMATS, check_run_values
+
+    if workers is not None and scheduler is not None:
+        raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
+                         "has its own workers)", option="--workers")
+
+    values = parse_set(assignments)
+    check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
+    inputs = (*files, *([reference] if reference else []))
+    check_output_options([("-o", output, {".csv": "csv"}), ("--plot", plot, PLOT_FORMATS),
+                    ("--save-reference", save_reference, {".csv": "csv"})], inputs)
+    single_threaded_blas()
+    from ..api import compile_model
+    from ..tradeoff import (
+        DEFAULT_TARGETS,
+        DEFAULT_TOLERANCES,
+        TradeoffOptions,
+        compare_states,
+        run_tradeoff,
+        save_study,
+        summary,
+    )
+
+    # numba by default: the runs of solvers with a compiled loop run there (many runs
+    # share one compilation)
+    numba = importlib.util.find_spec("numba") is not None
+    compiled = compile_model(files, model, libraries=libraries,
+                             backend=backend or ("numba" if numba else "python"),
+                             outputs=patterns or None, parameters=values,
+                             cache=not no_cache)
+    if not patterns:
+        compiled = compare_states(compiled)
+    rest = {k: v for k, v in values.items() if k not in compiled.structural}
+    options = TradeoffOptions(
+        solvers=solvers, tolerances=tolerances or DEFAULT_TOLERANCES, steps=steps,
+        targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
+        budget=budget, start=start, stop=stop, interval=interval, parameters=rest,
+        log=None if quiet else sys.stderr, energy=energy)
+    from ..studies import Executor
+
+    study = run_tradeoff(compiled, options, Executor(workers, scheduler))
+    click.echo(summary(study), nl=False)
+    save_study(study, table=output, plot=plot, reference=save_reference, protected=inputs)
