@@ -10,7 +10,7 @@ from springc.errors import ErrorGroup, FlattenError, SpringcError, errors_of
 from springc.flatten.flattener import flatten
 from springc.ir import expr as x
 from springc.ir.flat import FlatModel, Variable
-from springc.parse.loader import load
+from springc.parse import load
 from springc.pipeline.files import flatten_files
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -13,7 +13,7 @@ from springc.flatten import flattener as flattening
 from springc.flatten.instance_templates import InstanceTemplates
 from springc.ir import expr as x
 from springc.ir import flat
-from springc.parse.loader import load
+from springc.parse import load
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 

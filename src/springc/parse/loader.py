@@ -1,4 +1,4 @@
-"""Load source files and libraries into one class tree, and look classes up in it.
+"""One class tree for source files and libraries, and class lookup in it.
 
 Input: ``.mo``/``.mdl`` files named by the user and the library path (``library.py``).
 Output: a :class:`ClassTree` whose root holds the top-level classes; a file's
@@ -12,7 +12,7 @@ earlier roots over later ones.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,19 +23,17 @@ from ..errors import (
     Note,
     Span,
     SpringcError,
-    remember_source,
 )
 from ..ir import syntax as s
 from .library import (
     LibraryRoot,
     class_file,
     is_package_file,
-    library_roots,
     loose_files,
     package_order,
     stored_names,
 )
-from .parser import parse_file, parse_text
+from .parse_cache import parse_cached
 
 
 @dataclass(eq=False)
@@ -420,81 +418,3 @@ def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
     return (f"no class '{name}' is visible here: check the spelling, add an `import`, "
             "or load the file that defines it (name it on the command line or pass "
             f"its folder with -L){searched}")
-
-
-def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
-         texts: Sequence[tuple[str, str]] = ()) -> ClassTree:
-    """Parse the user's files and the user's ``texts`` (``(pseudo file name, text)``
-    pairs, such as ``("<string>", ...)``: their excerpts are kept for error messages);
-    library classes are parsed when lookup needs them.
-
-    Classes of the user's files are placed in precedence order: files without
-    ``within`` before those placed inside a package (shallow packages first). A
-    ``package.mo`` named by the user is loaded as a library package (its other files on
-    demand) and is not where the default model comes from.
-    """
-    errors: list[SpringcError] = []
-    roots = library_roots(libraries)
-    for root in roots:
-        if not root.folder.is_dir() and root.origin != "MODELICAPATH":
-            errors.append(LoadError(f"library folder '{root.folder}' does not exist",
-                                    hint="check the -L option and SPRINGC_PATH"))
-    tree = ClassTree([r for r in roots if r.folder.is_dir()])
-    parsed: list[tuple[s.StoredDefinition, Path | None]] = []
-    for name in files:
-        path = Path(name)
-        if path.resolve() in tree.parsed_paths:
-            continue
-        tree.parsed_paths.append(path.resolve())
-        try:
-            parsed.append((parse_cached(path), path))
-        except ErrorGroup as group:
-            errors += group.errors
-        except SpringcError as error:
-            errors.append(error)
-    for text_name, text in texts:
-        remember_source(text_name, text)
-        try:
-            parsed.append((parse_text(text, text_name, defer=True), None))
-        except ErrorGroup as group:
-            errors += group.errors
-        except SpringcError as error:
-            errors.append(error)
-    for stored, source in sorted(parsed, key=lambda p: len(p[0].within or ())):
-        package = source is not None and is_package_file(source)
-        try:
-            errors += tree.add(stored, override=True,
-                               folder=source.parent if source is not None and package else None)
-        except ErrorGroup as group:
-            errors += group.errors
-        except SpringcError as error:
-            errors.append(error)
-        (tree.named_packages if package else tree.user_files).append(stored)
-    # The default model is the last of the user's files as named.
-    order = {id(stored): i for i, (stored, _) in enumerate(parsed)}
-    tree.user_files.sort(key=lambda f: order[id(f)])
-    if errors:
-        raise errors[0] if len(errors) == 1 else ErrorGroup(errors)
-    return tree
-
-
-_PARSED: dict[tuple[str, int, int], s.StoredDefinition] = {}
-
-
-def parse_cached(path: Path) -> s.StoredDefinition:
-    """Parse a file, reusing the syntax tree while the file is unchanged (syntax trees
-    are immutable, so a process that flattens many models parses each library once)."""
-    try:
-        stat = path.stat()
-    except OSError:
-        return parse_file(path, defer=True)
-    key = (str(path), stat.st_mtime_ns, stat.st_size)
-    stored = _PARSED.get(key)
-    if stored is None:
-        stored = _PARSED[key] = parse_file(path, defer=True)
-    return stored
-
-
-def clear_parse_cache() -> None:
-    """Forget every parsed file (benchmarks measure loading from scratch with it)."""
-    _PARSED.clear()
