@@ -203,6 +203,12 @@ def _resolved(ctx: FlattenContext, comp: ViewComponent) -> ResolvedType | None:
 
 def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent) -> None:
     decl = comp.decl
+    if entry.defn.kind in ("record", "connector") and (decl.inner or decl.outer):
+        kind = entry.defn.kind
+        raise rule_error(f"a {kind} component cannot be declared "
+                         f"`{'inner' if decl.inner else 'outer'}`", decl.span,
+                         f"the elements of a {kind} cannot have the prefixes inner or "
+                         "outer", "4.6")
     rtype = _resolved(ctx, comp)
     if rtype is None:
         return
