@@ -16,7 +16,14 @@ import numpy as np
 from ..errors import FlattenError, Note
 from ..ir import syntax as s
 from .modification import Mod, from_syntax, merge
-from .scope import ClassScope, Disabled, FlattenContext, Member, ViewComponent
+from .scope import (
+    ClassScope,
+    Disabled,
+    FlattenContext,
+    Member,
+    ViewComponent,
+    check_redeclarable,
+)
 
 
 def condition_holds(fl: FlattenContext, scope: ClassScope, decl: s.Component) -> bool:
@@ -63,6 +70,7 @@ def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent,
     if not isinstance(new, s.Component):
         raise FlattenError(f"'{name}' is a component and cannot be redeclared as a class",
                            new.span, [Note("declared here", decl.span)])
+    check_redeclarable(decl, mod.span)
     if not decl.replaceable:
         raise FlattenError(f"'{name}' is not replaceable and cannot be redeclared",
                            mod.span, [Note("declared here", decl.span)],
