@@ -226,6 +226,12 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
                          decl.span, "an input cannot also be a parameter or a constant",
                          "4.4.2.2")
     if rtype.primitive is not None:
+        if rtype.primitive == "Real" and variability == "discrete" and kind != "function" \
+                and decl.modification is not None and decl.modification.value is not None:
+            raise rule_error(f"the discrete Real '{decl.name}' cannot have a binding "
+                             "equation", decl.modification.value.span,
+                             "a Real declared discrete is assigned only in when-clauses; "
+                             "give its initial value with `start` instead", "4.4.4")
         if flow and rtype.primitive != "Real":
             raise rule_error(f"'{decl.name}' is a flow variable of type {rtype.primitive}",
                              decl.span, "flow variables must be of type Real (or a type "
