@@ -102,6 +102,26 @@ model M
 end M;
 """,
         f"5:7: the final element 'x' cannot be redeclared\n{HELP}"),
+    "extends_plain_class": ("""\
+model M
+  model A
+    Real x = 2;
+  end A;
+  extends A;
+end M;
+""",
+        "M: 1 unknown, 1 equation, 0 parameters: balanced"),
+    "extends_replaceable_class": ("""\
+model M
+  replaceable model A
+    Real x = 2;
+  end A;
+  extends A;
+end M;
+""",
+        "5:11: 'M' extends the replaceable class 'A'\nhelp: a base class is not "
+        "replaceable (a redeclaration could change what is inherited) (Modelica 3.6, "
+        "section 7.1.4)"),
 }
 
 

@@ -109,6 +109,12 @@ def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
     clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)]
     for element in clauses:
         base = ctx.resolve_class(element.base, entry.parent or entry, entry)
+        if base.defn.replaceable:
+            raise rule_error(f"'{entry.name}' extends the replaceable class "
+                             f"'{element.base.dotted}'", element.base.span,
+                             "a base class is not replaceable (a redeclaration could "
+                             "change what is inherited)", "7.1.4",
+                             (Note("declared replaceable here", base.defn.span),))
         special = ""
         while base.defn.short is not None:
             short = base.defn.short
