@@ -361,25 +361,28 @@ def test_outside_connector_flow_sign(tmp_path: Path) -> None:
     m = flat_of(tmp_path, PINS + """
 model Wrapper
   Pin outer_p;
+  Pin outer_n;
   Two two;
 equation
   connect(outer_p, two.p);
+  connect(outer_n, two.n);
 end Wrapper;
 model M
   Wrapper w;
   Two load;
 equation
   connect(w.outer_p, load.p);
-  connect(w.two.n, load.n);
+  connect(w.outer_n, load.n);
 end M;
 """)
     text = {f"{x.to_text(e.lhs)} = {x.to_text(e.rhs)}" for e in m.equations
             if e.origin.kind == "flow"}
-    # inside the wrapper, w.outer_p is an outside connector: its flow enters with -1
+    # inside the wrapper, w.outer_p and w.outer_n are outside connectors: their flows
+    # enter with -1
     assert text == {"-w.outer_p.i + w.two.p.i = 0", "w.outer_p.i + load.p.i = 0",
-                    "w.two.n.i + load.n.i = 0"}
-    # 2 own equations, 3 potential equalities, 3 flow sums; no unconnected flows
-    assert len(m.equations) == 8
+                    "-w.outer_n.i + w.two.n.i = 0", "w.outer_n.i + load.n.i = 0"}
+    # 2 own equations, 4 potential equalities, 4 flow sums; no unconnected flows
+    assert len(m.equations) == 10
 
 
 def test_connectors_in_arrays_of_components(tmp_path: Path) -> None:

@@ -157,7 +157,7 @@ end M;
         ' of der must be of type Real (Modelica 3.6, section 3.7.4)'),
     "der_discrete_real": ("""\
 model M
-  discrete Real pa = 1;
+  discrete Real pa(start = 1, fixed = true);
   Real a = der(pa);
 end M;
 """,

@@ -201,6 +201,60 @@ end M;
         "10:5: connector 'c' (M.C) has 1 flow and 2 potential variables\nhelp: a connector"
         ' has as many flow variables as variables that are neither parameter, constant,'
         ' input, output nor flow (Modelica 3.6, section 9.3.1)'),
+    "connect_component_connectors": ("""\
+model M
+  connector C
+    Real e;
+    flow Real f;
+  end C;
+  connector Pair
+    C x;
+    C y;
+  end Pair;
+  model B
+    C c1;
+    Pair p;
+  equation
+    c1.e = 1.0;
+    p.x.e = 2.0;
+    p.y.e = 3.0;
+  end B;
+  B b;
+  C c;
+  Pair q;
+equation
+  connect(b.c1, c);
+  connect(b.p.x, q.y);
+  c.f = 0.5;
+  q.y.f = 0.5;
+  q.x.e = 4.0;
+end M;
+""",
+        "M: 12 unknowns, 12 equations, 0 parameters: balanced"),
+    "connect_too_deep": ("""\
+model M
+  connector C
+    Real e;
+    flow Real f;
+  end C;
+  model A
+    model B
+      C c1;
+      C c2;
+    end B;
+    B b;
+  end A;
+  A a;
+equation
+  connect(a.b.c1, a.b.c2);
+  a.b.c1.e = 1.0;
+  a.b.c1.f = 2.0;
+end M;
+""",
+        "15:11: 'a.b.c1' cannot be connected here: 'a.b' is a component of 'a', not a "
+        "connector\nhelp: a connect equation joins connectors of the class or of its "
+        "components (`m.c`), not connectors deeper inside components (Modelica 3.6, "
+        "section 9.1)"),
 }
 
 

@@ -208,6 +208,73 @@ model M
 end M;
 """,
         'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+    "redeclare_public_class": ("""\
+model M
+  model A
+    replaceable model B
+      Real x = 2.0;
+    end B;
+    B b;
+  end A;
+  model C
+    Real x = 3.0;
+    Real y = 4.0;
+  end C;
+  A a(redeclare model B = C);
+end M;
+""",
+        "M: 2 unknowns, 2 equations, 0 parameters: balanced"),
+    "redeclare_protected_class": ("""\
+model M
+  model A
+  protected
+    replaceable model B
+      Real x = 2.0;
+    end B;
+    B b;
+  end A;
+  model C
+    Real x = 3.0;
+  end C;
+  A a(redeclare model B = C);
+end M;
+""",
+        "12:7: class 'B' is protected in 'M.A' and cannot be redeclared in 'a'\nhelp: a "
+        "protected element may be modified only by its own declaration or by an extends "
+        "clause (Modelica 3.6, section 4.1)"),
+    "unqualified_imports_one_match": ("""\
+package P
+  constant Real x = 1.0;
+end P;
+package P2
+  constant Real y = 2.0;
+  constant Real x = 3.0;
+end P2;
+model M
+  import P.*;
+  import P2.*;
+  import P2.x;
+  Real a = x;
+  Real b = y;
+end M;
+""",
+        "M: 2 unknowns, 2 equations, 0 parameters: balanced"),
+    "unqualified_imports_conflict": ("""\
+package P
+  constant Real x = 1.0;
+end P;
+package P2
+  constant Real x = 2.0;
+end P2;
+model M
+  import P.*;
+  import P2.*;
+  Real y = x;
+end M;
+""",
+        "9:3: 'x' is found by two unqualified imports, in 'P' and 'P2'\nhelp: a name may "
+        "be found in only one unqualified import; import it by name (Modelica 3.6, "
+        "section 13.2.1.1)"),
 }
 
 

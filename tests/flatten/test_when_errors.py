@@ -89,6 +89,16 @@ CASES = {
         "simulation\n"
         "help: give every branch, including 'else', one equation for each variable the "
         "if-equation determines\n"),
+    "assert inside when": (
+        "model M\n  Real x(start = 1);\nequation\n  der(x) = -x;\n"
+        "  when x < 0.5 then\n    assert(x > 0, \"x stays positive\");\n  end when;\n"
+        "end M;\n",
+        "check",
+        "M.mo:6:5: error: `assert` inside a when-clause is not supported yet\n"
+        "    6 |     assert(x > 0, \"x stays positive\");\n"
+        "      |     ^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^\n"
+        "help: springc supports a subset of Modelica; see \"Not supported yet\" in "
+        "docs/language.md\n"),
 }
 
 

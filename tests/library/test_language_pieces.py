@@ -171,7 +171,7 @@ def test_an_enabled_component_is_connected(tmp_path: Path) -> None:
 
 def test_a_disabled_component_used_in_an_equation_is_an_error(tmp_path: Path) -> None:
     assert error(tmp_path, CONDITIONAL, "C.Bad") == (
-        "'x' is a conditional component whose condition is false", 31, 14)
+        "the conditional component 'x' is used outside a connect equation", 31, 14)
 
 
 def test_the_condition_must_be_a_parameter_expression(tmp_path: Path) -> None:

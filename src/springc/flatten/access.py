@@ -71,6 +71,15 @@ def check_inside(container: ClassEntry, name: str, encapsulated: bool, ref: s.Re
 def check_modified(view: ClassView, mod: Mod, owner: str) -> None:
     """A modification ``a(p = 1)`` of a component must not reach a protected ``p``."""
     for name, child in mod.children.items():
+        if child.redeclare is not None and isinstance(child.redeclare.element, s.ClassDef):
+            local = next((e for e in view.entry.defn.elements
+                          if isinstance(e, s.ClassDef) and e.name == name), None)
+            if local is not None and local.protected:
+                raise rule_error(f"class '{name}' is protected in '{view.entry.full_name}' "
+                                 f"and cannot be redeclared in '{owner}'", child.span,
+                                 "a protected element may be modified only by its own "
+                                 "declaration or by an extends clause", "4.1",
+                                 (Note("declared protected here", local.span),))
         comp = view.components.get(name)
         if comp is not None and comp.decl.protected:
             raise rule_error(f"'{name}' is protected in '{view.entry.full_name}' and cannot be "

@@ -126,3 +126,27 @@ def check_connector_size(scope: ClassScope) -> None:
                          "nor flow", "9.3.1",
                          (Note(f"'{scope.entry.full_name}' is defined here",
                                scope.entry.defn.span),))
+
+
+def check_reference_form(ref: s.Ref, owner: ClassScope) -> None:
+    """A connector of a connect equation is one of ``owner`` or one of a component of it
+    (``m.c``), possibly an element of such a connector (``m.c.d``): every part between
+    the first and the last names a connector (section 9.1)."""
+    if len(ref.parts) < 3 or not owner.has_member(ref.parts[0].name):
+        return
+    current: Any = owner.member(ref.parts[0].name)
+    for k, part in enumerate(ref.parts[1:-1], start=1):
+        if isinstance(current, np.ndarray):
+            current = current.flat[0] if current.size else None
+        if not isinstance(current, ClassScope) or not current.has_member(part.name):
+            return
+        current = current.member(part.name)
+        first = current.flat[0] if isinstance(current, np.ndarray) and current.size \
+            else current
+        if isinstance(first, ClassScope) and first.kind != "connector":
+            path = ".".join(p.name for p in ref.parts[:k + 1])
+            raise rule_error(
+                f"'{ref.dotted}' cannot be connected here: '{path}' is a component "
+                f"of '{ref.parts[0].name}', not a connector", ref.span,
+                "a connect equation joins connectors of the class or of its components "
+                "(`m.c`), not connectors deeper inside components", "9.1")

@@ -18,7 +18,7 @@ from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from .connect_rules import check_pair, check_sources
+from .connect_rules import check_pair, check_reference_form, check_sources
 from .scope import (
     ClassScope,
     DisabledReference,
@@ -156,6 +156,7 @@ class ConnectionSets:
         """The connectors a reference denotes: their array shape (a single connector
         counts as an array of one), the connectors in order, and whether they are
         outside connectors of ``owner``."""
+        check_reference_form(ref, owner)
         value = direct_reference(ref, where)
         if value is None:
             signal = _signal_connector(ev, ref, where)

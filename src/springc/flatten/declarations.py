@@ -16,7 +16,16 @@ import numpy as np
 from ..errors import FlattenError, Note
 from ..ir import syntax as s
 from .modification import Mod, from_syntax, merge
-from .scope import ClassScope, Disabled, FlattenContext, Member, ViewComponent
+from .rules import rule_error
+from .scope import (
+    ClassScope,
+    Declared,
+    Disabled,
+    FlattenContext,
+    Member,
+    ViewComponent,
+    check_redeclarable,
+)
 
 
 def condition_holds(fl: FlattenContext, scope: ClassScope, decl: s.Component) -> bool:
@@ -35,13 +44,15 @@ def disabled(scope: ClassScope, decl: s.Component) -> Disabled:
     return Disabled(decl, scope.flat_name(decl.name))
 
 
-def inner_member(scope: ClassScope, decl: s.Component) -> Member:
-    """The ``inner`` element that the ``outer`` declaration ``decl`` of ``scope`` refers
-    to: the one of the same name in the nearest enclosing instance (Modelica 5.4)."""
+def inner_member(fl: FlattenContext, scope: ClassScope, outer: ViewComponent) -> Member:
+    """The ``inner`` element that the ``outer`` declaration of ``scope`` refers to: the
+    one of the same name in the nearest enclosing instance (Modelica 5.4)."""
+    decl = outer.decl
     enclosing = scope.outer
     while enclosing is not None:
         comp = enclosing.view.components.get(decl.name)
         if comp is not None and comp.decl.inner:
+            _check_inner_type(fl, outer, comp)
             return enclosing.member(decl.name, decl.span)
         enclosing = enclosing.outer
     where = f"'{scope.prefix}'" if scope.prefix else "the model"
@@ -50,6 +61,39 @@ def inner_member(scope: ClassScope, decl: s.Component) -> Member:
         f"'{decl.name}' in an enclosing instance", decl.span,
         hint=f"declare `inner {decl.type_name.dotted} {decl.name}` in a model that "
         f"contains {where}")
+
+
+def _check_inner_type(fl: FlattenContext, outer: ViewComponent, inner: ViewComponent
+                      ) -> None:
+    """The inner element has the predefined type, the number of dimensions and the
+    literal sizes of the outer one (a subtype of it, section 5.4)."""
+    try:
+        types = [fl.declared_type(outer), fl.declared_type(inner)]
+    except FlattenError:
+        return  # reported where the element is instantiated
+    ndims = [len(d.comp.decl.dims) + len(d.comp.decl.type_dims) + len(d.rtype.dims)
+             for d in types]
+    prims = [d.rtype.primitive for d in types]
+    sizes = [d.dims for d in types]
+    if ndims[0] != ndims[1] or (None not in sizes and sizes[0] != sizes[1]) or (
+            None not in prims and prims[0] != prims[1]):
+        shown = [_shown(d, k) for d, k in zip(types, ndims, strict=True)]
+        name = outer.decl.name
+        raise rule_error(f"the outer element '{name}' is of type {shown[0]}, but its inner "
+                         f"element is of type {shown[1]}", outer.decl.span,
+                         "an inner element must be a subtype of its outer elements, "
+                         "with the same sizes", "5.4",
+                         (Note("the inner element is declared here", inner.decl.span),))
+
+
+def _shown(declared: Declared, ndims: int) -> str:
+    """``Real[10]``, ``Real[:]`` or ``P.Pin``: a declared type as the user writes it."""
+    rtype = declared.rtype
+    base = rtype.primitive or (rtype.entry.full_name if rtype.entry is not None else "")
+    sizes = declared.dims
+    if sizes is not None:
+        return base + (f"[{','.join(map(str, sizes))}]" if sizes else "")
+    return base + (f"[{','.join([':'] * ndims)}]" if ndims else "")
 
 
 def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent, Mod | None]:
@@ -63,6 +107,7 @@ def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent,
     if not isinstance(new, s.Component):
         raise FlattenError(f"'{name}' is a component and cannot be redeclared as a class",
                            new.span, [Note("declared here", decl.span)])
+    check_redeclarable(decl, mod.span)
     if not decl.replaceable:
         raise FlattenError(f"'{name}' is not replaceable and cannot be redeclared",
                            mod.span, [Note("declared here", decl.span)],

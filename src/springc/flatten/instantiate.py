@@ -73,7 +73,7 @@ class Instantiation(FlattenContext):
                 raise FlattenError(f"the outer element '{name}' cannot be modified",
                                    modified.span, [Note("declared here", decl.span)],
                                    "modify the inner element instead (Modelica 5.4)")
-            return inner_member(scope, decl)
+            return inner_member(self, scope, comp)
         outer = scope.mod.children.get(decl.name) if scope.mod is not None else None
         if outer is not None and outer.redeclare is not None:
             comp, outer = redeclared(comp, outer, name)

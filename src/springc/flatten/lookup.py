@@ -17,6 +17,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
 from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
+from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
@@ -55,6 +56,7 @@ class ClassLookup(FlattenContext):
             try:
                 check_class(self, found)
                 check_inherited_names(self, found)
+                check_conditional_uses(found)
             except FlattenError as err:
                 self.rule_errors[id(entry)] = err
         broken = self.rule_errors.get(id(entry))

@@ -109,6 +109,12 @@ def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
     clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)]
     for element in clauses:
         base = ctx.resolve_class(element.base, entry.parent or entry, entry)
+        if base.defn.replaceable:
+            raise rule_error(f"'{entry.name}' extends the replaceable class "
+                             f"'{element.base.dotted}'", element.base.span,
+                             "a base class is not replaceable (a redeclaration could "
+                             "change what is inherited)", "7.1.4",
+                             (Note("declared replaceable here", base.defn.span),))
         special = ""
         while base.defn.short is not None:
             short = base.defn.short
@@ -203,6 +209,12 @@ def _resolved(ctx: FlattenContext, comp: ViewComponent) -> ResolvedType | None:
 
 def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent) -> None:
     decl = comp.decl
+    if entry.defn.kind in ("record", "connector") and (decl.inner or decl.outer):
+        kind = entry.defn.kind
+        raise rule_error(f"a {kind} component cannot be declared "
+                         f"`{'inner' if decl.inner else 'outer'}`", decl.span,
+                         f"the elements of a {kind} cannot have the prefixes inner or "
+                         "outer", "4.6")
     rtype = _resolved(ctx, comp)
     if rtype is None:
         return
@@ -220,6 +232,12 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
                          decl.span, "an input cannot also be a parameter or a constant",
                          "4.4.2.2")
     if rtype.primitive is not None:
+        if rtype.primitive == "Real" and variability == "discrete" and kind != "function" \
+                and decl.modification is not None and decl.modification.value is not None:
+            raise rule_error(f"the discrete Real '{decl.name}' cannot have a binding "
+                             "equation", decl.modification.value.span,
+                             "a Real declared discrete is assigned only in when-clauses; "
+                             "give its initial value with `start` instead", "4.4.4")
         if flow and rtype.primitive != "Real":
             raise rule_error(f"'{decl.name}' is a flow variable of type {rtype.primitive}",
                              decl.span, "flow variables must be of type Real (or a type "

@@ -394,13 +394,35 @@ def _redeclare_component(components: dict[str, ViewComponent], element: s.Compon
         raise FlattenError(f"'{element.name}' is redeclared but no inherited element has "
                            "that name", element.span, hint="redeclare an element of a base "
                            "class, or drop `redeclare`")
+    check_redeclarable(existing.decl, element.span)
     if not existing.decl.replaceable:
         raise FlattenError(f"'{element.name}' is not replaceable and cannot be redeclared",
                            element.span, [Note("declared here", existing.decl.span)])
+    if element.protected != existing.decl.protected:
+        was, now = ("protected", "public") if existing.decl.protected else ("public",
+                                                                            "protected")
+        raise FlattenError(f"the {was} element '{element.name}' cannot be redeclared "
+                           f"{now}", element.span, [Note("declared here",
+                                                         existing.decl.span)],
+                           f"{REDECLARE_RULES} (Modelica 3.6, section 7.3.3)")
     constraint = existing.decl.constraint
     if element.modification is None and constraint is not None and constraint[1] is not None:
         element = replace(element, modification=constraint[1])
     components[element.name] = ViewComponent(element, entry)
+
+
+#: The restrictions on redeclarations (section 7.3.3), in a help line.
+REDECLARE_RULES = ("a constant or final element cannot be redeclared, and a redeclaration "
+                   "keeps the element public or protected")
+
+
+def check_redeclarable(decl: s.Component, span: Span | None) -> None:
+    """A ``constant`` or ``final`` component cannot be redeclared (section 7.3.3)."""
+    what = "constant" if decl.variability == "constant" else "final" if decl.final else ""
+    if what:
+        raise FlattenError(f"the {what} element '{decl.name}' cannot be redeclared", span,
+                           [Note("declared here", decl.span)],
+                           f"{REDECLARE_RULES} (Modelica 3.6, section 7.3.3)")
 
 
 def _add_component(components: dict[str, ViewComponent], name: str,

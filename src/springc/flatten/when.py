@@ -122,6 +122,11 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
         raise FlattenError("when-equations cannot be nested", item.span,
                            hint="combine the conditions: 'when a and b then' or use "
                            "elsewhen")
+    elif isinstance(item, s.CallEquation) and item.call.func.dotted == "assert":
+        # valid Modelica (section 8.3.5), not simulated by springc yet
+        raise FlattenError("`assert` inside a when-clause is not supported yet", item.span,
+                           hint="springc supports a subset of Modelica; see \"Not "
+                           "supported yet\" in docs/language.md")
     else:
         what = ("connect" if isinstance(item, s.Connect)
                 else "an algorithm section" if isinstance(item, s.AlgorithmSection)

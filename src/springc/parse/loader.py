@@ -354,6 +354,7 @@ def imported_element(scope: ClassEntry, name: str) -> tuple[ClassEntry, str] | N
     package and the name of the imported component (a constant), or None."""
     entry: ClassEntry | None = scope
     while entry is not None:
+        unqualified: list[tuple[ClassEntry, s.Import]] = []
         for element in entry.defn.elements:
             if not isinstance(element, s.Import):
                 continue
@@ -366,7 +367,19 @@ def imported_element(scope: ClassEntry, name: str) -> tuple[ClassEntry, str] | N
             package = _import_path(root, element.path, element, frozenset())
             target = element.names[0] if element.alias == name else name
             if _declares(package.defn, target):
-                return package, target
+                if named:
+                    return package, target
+                unqualified.append((package, element))
+        if len(unqualified) > 1:
+            first, second = unqualified[0][0], unqualified[1][0]
+            raise FlattenError(
+                f"'{name}' is found by two unqualified imports, in '{first.full_name}' and "
+                f"'{second.full_name}'", unqualified[1][1].span,
+                [Note(f"'{first.full_name}.*' is imported here", unqualified[0][1].span)],
+                "a name may be found in only one unqualified import; import it by name "
+                "(Modelica 3.6, section 13.2.1.1)")
+        if unqualified:
+            return unqualified[0][0], name
         if entry.defn.encapsulated:
             return None
         entry = entry.parent
