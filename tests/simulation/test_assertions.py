@@ -116,3 +116,42 @@ def test_generated_module_holds_the_messages_as_literals(tmp_path: Path) -> None
     p = module.parameters()
     assert module.assertions(1.0, np.zeros(0), p, module.guesses(p)).tolist() == [1.0]
     assert module.assertions(2.5, np.zeros(0), p, module.guesses(p)).tolist() == [0.0]
+
+
+BALL = """model Ball
+  parameter Real bound = %s;
+  Real h(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+equation
+  der(h) = v;
+  der(v) = -9.81;
+  assert(h > bound, "h fell below the bound");
+  when h <= 0 then
+    reinit(v, -0.8 * pre(v));
+  end when;
+end Ball;
+"""
+
+
+@pytest.mark.parametrize("engine", ["scipy", "compiled"])
+def test_hybrid_model_assertions_are_checked_at_output_times(tmp_path: Path,
+                                                             engine: str) -> None:
+    """h = 1 - 9.81 t^2 / 2 reaches 0.5 at t = 0.3193: on the 0.002 s grid the first
+    output time past it is 0.32 (h = 0.497728); a bound the bouncing ball never
+    crosses (-0.01) lets the run finish, one impact at sqrt(2/g) included."""
+    path = tmp_path / "ball.mo"
+    path.write_text(BALL % "0.5")
+    with pytest.raises(SimulationError) as info:
+        springc.simulate([path], stop=1, interval=0.002, rtol=1e-8, engine=engine,
+                         cache=False)
+    assert info.value.message == "assertion failed at t = 0.32: h fell below the bound"
+    assert info.value.span is not None and (info.value.span.line, info.value.span.column) \
+        == (8, 3)
+    path.write_text(BALL % "-0.01")
+    result = springc.simulate([path], stop=1, interval=0.002, rtol=1e-8, engine=engine,
+                              cache=False)
+    assert result.stats.state_events == 2  # h <= 0 becomes true, then false again
+    impact = math.sqrt(2 / 9.81)
+    up, after = 0.8 * 9.81 * impact, 1 - impact
+    assert result.time[-1] == 1.0
+    assert abs(result["h"][-1] - (up * after - 9.81 / 2 * after**2)) < 1e-6

@@ -4,10 +4,10 @@ Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, t
 fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
 models; on the compiled engine, chosen as for continuous models, the solvers with a
 compiled loop run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
-then computes the outputs row by row with the discrete values in force at
-each row. By default the result has one row per output time (the value after an
-event at that very time); ``event_rows`` adds two rows at each event, its left and
-right limits, as OpenModelica's result files do.
+then computes the outputs row by row with the discrete values in force at each row,
+and checks the model's assertions there. By default the result has one row per output
+time (the value after an event at that very time); ``event_rows`` adds two rows at each
+event, its left and right limits, as OpenModelica's result files do.
 """
 
 from __future__ import annotations
@@ -60,6 +60,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                 loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
             loop.terminal()
             times, states, zs = rows(loop, bool(getattr(options, "event_rows", False)))
+            check_assertions(problem, times, states, zs)
             outputs = _outputs(model, problem, times, states, zs)
     except Stop as stop_:
         raise stop_.error from None
@@ -117,6 +118,20 @@ def rows(loop: EventLoop, event_rows: bool) -> tuple[np.ndarray, np.ndarray, np.
     sort = np.lexsort((rank, all_t))
     return (all_t[sort], np.vstack([np.asarray(extra_x), states])[sort],
             np.vstack([np.asarray(extra_z), zs])[sort])
+
+
+def check_assertions(problem: Problem, times: np.ndarray, states: np.ndarray,
+                     zs: np.ndarray) -> None:
+    """``assert(...)`` of a hybrid model, checked at every result row with the discrete
+    values in force there (the event loop does not check after each step: a failure is
+    reported at the first output time where the condition is false)."""
+    if not problem.asserts:
+        return
+    for k, (t, x, z) in enumerate(zip(times, states, zs)):
+        if k == 0:
+            problem.asserts.start(float(t), x, z)
+        else:
+            problem.asserts.step(float(t), x, z)
 
 
 def _outputs(model: CompiledModel, problem: Problem, times: np.ndarray, states: np.ndarray,
