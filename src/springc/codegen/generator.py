@@ -43,7 +43,7 @@ def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) ->
     size arrays or pick equations) and those the flattener already evaluated away."""
     used: set[str] = set()
     for step in system.steps:
-        for e in _step_exprs(step):
+        for e in ode.step_expressions(step):
             used |= variables(e)
     for a in system.observed:
         used |= variables(a.expr)
@@ -61,15 +61,6 @@ def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) ->
     return [q.name for q in system.parameters
             if q.name not in used or types.get(q.name, "Real") != "Real"
             or q.name not in by_name]
-
-
-def _step_exprs(step: ode.Step) -> list[Expr]:
-    if isinstance(step, ode.Assign):
-        return [step.expr]
-    if isinstance(step, ode.LinearBlock):
-        return [e for _, _, e in step.matrix] + list(step.rhs)
-    return ([a.expr for a in step.inner] + list(step.residuals)
-            + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
 
 
 # ------------------------------------------------------------------ module
@@ -196,7 +187,7 @@ def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
         inner = set()
         if isinstance(step, ode.NonlinearBlock):
             inner = {*step.tearing, *(s.name for s in step.sensitivities)}
-        for e in _step_exprs(step):
+        for e in ode.step_expressions(step):
             unknown = variables(e) - known - inner
             if unknown:
                 name = sorted(unknown)[0]

@@ -53,6 +53,17 @@ class NonlinearBlock:
 Step = Assign | LinearBlock | NonlinearBlock
 
 
+def step_expressions(step: Step) -> list[Expr]:
+    """Every expression a solve step evaluates (a nonlinear block's inner assignments,
+    residuals, sensitivities and Jacobian entries included)."""
+    if isinstance(step, Assign):
+        return [step.expr]
+    if isinstance(step, LinearBlock):
+        return [e for _, _, e in step.matrix] + list(step.rhs)
+    return ([a.expr for a in step.inner] + list(step.residuals)
+            + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
+
+
 @dataclass(frozen=True, slots=True)
 class State:
     name: str

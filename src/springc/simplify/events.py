@@ -33,16 +33,6 @@ def continuous_part(model: flat.FlatModel) -> flat.FlatModel:
         v for v in model.variables if v.name not in held))
 
 
-def step_exprs(step: ode.Step) -> list[x.Expr]:
-    """Every expression a solve step evaluates."""
-    if isinstance(step, ode.Assign):
-        return [step.expr]
-    if isinstance(step, ode.LinearBlock):
-        return [e for _, _, e in step.matrix] + list(step.rhs)
-    return ([a.expr for a in step.inner] + list(step.residuals)
-            + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
-
-
 def when_exprs(whens: Iterable[w.When]) -> Iterator[x.Expr]:
     for clause in whens:
         for b in clause.branches:
@@ -67,7 +57,7 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     params = {q.name for q in system.parameters}
     held = w.assigned(model.whens)
     held_set = set(held)
-    exprs = [e for step in system.steps for e in step_exprs(step)]
+    exprs = [e for step in system.steps for e in ode.step_expressions(step)]
     exprs += [a.expr for a in system.observed]
     exprs += list(when_exprs(model.whens))
     relations: dict[x.BinOp, None] = {}
