@@ -35,20 +35,8 @@ def held_system(system: ode.ODE, layout: EventLayout) -> ode.ODE:
     """``system`` whose steps and aliases read held relations and event slots."""
     h = layout.hold
 
-    def step(s: ode.Step) -> ode.Step:
-        if isinstance(s, ode.Assign):
-            return ode.Assign(s.name, h(s.expr), s.span)
-        if isinstance(s, ode.LinearBlock):
-            return ode.LinearBlock(s.names, tuple((i, j, h(e)) for i, j, e in s.matrix),
-                                   tuple(h(e) for e in s.rhs), s.spans)
-        return ode.NonlinearBlock(
-            s.tearing, tuple(ode.Assign(a.name, h(a.expr), a.span) for a in s.inner),
-            tuple(h(e) for e in s.residuals),
-            tuple(ode.Assign(a.name, h(a.expr), a.span) for a in s.sensitivities),
-            tuple((i, j, h(e)) for i, j, e in s.jacobian), s.spans)
-
     return dataclasses.replace(
-        system, steps=tuple(step(s) for s in system.steps),
+        system, steps=tuple(ode.map_step(s, h) for s in system.steps),
         observed=tuple(ode.Assign(a.name, h(a.expr), a.span) for a in system.observed))
 
 

@@ -8,6 +8,7 @@ systems solved by Newton's method with an analytic Jacobian.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..errors import Span
@@ -62,6 +63,21 @@ def step_expressions(step: Step) -> list[Expr]:
         return [e for _, _, e in step.matrix] + list(step.rhs)
     return ([a.expr for a in step.inner] + list(step.residuals)
             + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
+
+
+def map_step(step: Step, f: Callable[[Expr], Expr]) -> Step:
+    """``step`` with ``f`` applied to every expression it evaluates (the names it
+    solves for and its structure unchanged)."""
+    if isinstance(step, Assign):
+        return Assign(step.name, f(step.expr), step.span)
+    if isinstance(step, LinearBlock):
+        return LinearBlock(step.names, tuple((i, j, f(e)) for i, j, e in step.matrix),
+                           tuple(f(e) for e in step.rhs), step.spans)
+    return NonlinearBlock(
+        step.tearing, tuple(Assign(a.name, f(a.expr), a.span) for a in step.inner),
+        tuple(f(e) for e in step.residuals),
+        tuple(Assign(a.name, f(a.expr), a.span) for a in step.sensitivities),
+        tuple((i, j, f(e)) for i, j, e in step.jacobian), step.spans)
 
 
 @dataclass(frozen=True, slots=True)

@@ -104,7 +104,7 @@ def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
     def f(e: x.Expr) -> x.Expr:
         return switched_builtins(e, known)
 
-    steps = tuple(_rewrite_step(s, f) for s in system.steps)
+    steps = tuple(ode.map_step(s, f) for s in system.steps)
     observed = tuple(ode.Assign(a.name, f(a.expr), a.span) for a in system.observed)
     rewritten = dataclasses.replace(system, steps=steps, observed=observed)
     whens = tuple(_rewrite_when(c, f) for c in model.whens)
@@ -120,19 +120,6 @@ def _rewrite_when(clause: w.When, f: Callable[[x.Expr], x.Expr]) -> w.When:
         assignments=tuple(dataclasses.replace(a, value=f(a.value)) for a in b.assignments),
         reinits=tuple(dataclasses.replace(r, value=f(r.value)) for r in b.reinits))
         for b in clause.branches))
-
-
-def _rewrite_step(s: ode.Step, f: Callable[[x.Expr], x.Expr]) -> ode.Step:
-    if isinstance(s, ode.Assign):
-        return ode.Assign(s.name, f(s.expr), s.span)
-    if isinstance(s, ode.LinearBlock):
-        return ode.LinearBlock(s.names, tuple((i, j, f(e)) for i, j, e in s.matrix),
-                               tuple(f(e) for e in s.rhs), s.spans)
-    return ode.NonlinearBlock(
-        s.tearing, tuple(ode.Assign(a.name, f(a.expr), a.span) for a in s.inner),
-        tuple(f(e) for e in s.residuals),
-        tuple(ode.Assign(a.name, f(a.expr), a.span) for a in s.sensitivities),
-        tuple((i, j, f(e)) for i, j, e in s.jacobian), s.spans)
 
 
 def switched_builtins(e: x.Expr, known: frozenset[str] | None = None) -> x.Expr:
