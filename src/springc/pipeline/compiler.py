@@ -99,6 +99,13 @@ class CompiledModel:
         return tuple(self.module.PARAMETERS)
 
     @property
+    def units(self) -> dict[str, str]:
+        """The unit of every state and observed variable, by flat name ("" for none)."""
+        units = dict(zip(self.states, self.module.STATE_UNITS))
+        units.update(zip(self.observed, self.module.OBSERVED_UNITS))
+        return units
+
+    @property
     def structural(self) -> tuple[str, ...]:
         return tuple(self.module.STRUCTURAL)
 

@@ -81,8 +81,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                             time_events, engine_reason=engine_reason(
                                 options.engine.lower(), solver, model.module.BACKEND, compiled)
                             if reason else "")
-    units = dict(zip(model.states, model.module.STATE_UNITS))
-    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    units = model.units
     names = model.outputs
     return SimulationResult(model.name, times, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,

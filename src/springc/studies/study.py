@@ -98,8 +98,7 @@ def check_names(model: CompiledModel, names: Sequence[str]) -> None:
 def energy_variable(model: CompiledModel, requested: str | None) -> str | None:
     """The output whose drift the summary reports: ``requested``, else the only output
     in J."""
-    units = dict(zip(model.states, model.module.STATE_UNITS))
-    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    units = model.units
     if requested is not None:
         if requested not in model.outputs:
             raise UsageError(f"--energy {requested}: not among the study's variables",
@@ -114,8 +113,7 @@ def layout_of(model: CompiledModel, options: StudyOptions, values: np.ndarray) -
     settings = SimulationOptions(options.start, options.stop, options.interval,
                                  options.solver, options.rtol, options.atol)
     start, stop, interval, rtol, atol = resolve(model, settings)
-    units = dict(zip(model.states, model.module.STATE_UNITS))
-    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    units = model.units
     names = tuple(s.name for s in options.parameters)
     energy = energy_variable(model, options.energy)
     metadata = {

@@ -19,8 +19,7 @@ ENERGY_UNIT = "J"
 
 def energy_variable(model: CompiledModel, requested: str | None) -> str | None:
     """The energy variable of the study, checked; ``None`` if there is none."""
-    units = dict(zip(model.states, model.module.STATE_UNITS))
-    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    units = model.units
     if requested is None:
         joules = [name for name, unit in units.items() if unit == ENERGY_UNIT]
         return joules[0] if len(joules) == 1 else None

@@ -113,8 +113,7 @@ def study_setup(model: CompiledModel, options: TradeoffOptions) -> StudySetup:
                              parameters=dict(options.parameters))
     start, stop, interval, rtol, atol = resolve(model, base)
     p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
-    units = dict(zip(model.states, model.module.STATE_UNITS))
-    units.update(zip(model.observed, model.module.OBSERVED_UNITS))
+    units = model.units
     return StudySetup(model, options, output_grid(start, stop, interval), atol / rtol, p,
                       initial_state(model, p, start),
                       tuple(units.get(n, "") for n in model.outputs))
