@@ -325,6 +325,11 @@ def test_vector_layout_matches_scalar_layout(tmp_path: Path, backend: str, scene
     vector_source = _generated(files, model, backend=backend, vector=True).source
     assert "for _q in range(" in vector_source or backend == "python"
     vector = _load(vector_source, tmp_path, f"vector_{scene}_{backend}")
+    if backend == "numba":  # jitted with the model-function signature: the compiled loops
+        from numba.core.dispatcher import Dispatcher  # call them through function pointers
+
+        assert all(isinstance(getattr(vector, fn), Dispatcher)
+                   for fn in ("rhs", "jacobian_values", "observed", "assertions"))
     assert vector.STATES == scalar.STATES and vector.OBSERVED == scalar.OBSERVED
     given = {"k": 50.0} if scene == "chain" else {"k_shear": 150.0}
     p = vector.parameters(given)
@@ -348,6 +353,6 @@ def test_vector_layout_matches_scalar_layout(tmp_path: Path, backend: str, scene
 
 def test_vector_layout_groups_a_chain_into_loops() -> None:
     source = _generated([SCENES], "Scenes.Chain", backend="numba", vector=True).source
-    rhs = source[source.index("def _rhs("):source.index("def rhs(")]
+    rhs = source[source.index("def rhs("):source.index("def jacobian_values(")]
     assert rhs.count("for _q in range(") <= 8  # a handful of loops, not 10 x 5 statements
     assert "# 9 x s[2].s_rel := m[2].s - m[1].s" in rhs

@@ -121,40 +121,32 @@ def module_text(m: CodegenContext, options: CodegenOptions,
     lines += parameters_function(m, namer, helpers)
     for name in sorted(helpers):
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()
-    kernel = table is not None and numba  # numba kernels take the index table _I
-    if table is not None:
+    if table is not None:  # numba freezes the global table as a constant of each function
         lines += ["", "# Indices of the vector layout (see springc.codegen.vector).",
                   f"_I = {encode_ints(table) if table else 'np.zeros(1, dtype=np.int64)'}"]
     for fn, doc, body, ret in bodies:
         lines += ["", ""] + (["@_jit"] if numba else [])
-        if kernel:
-            lines += [f"def _{fn}(t, x, p, z, _I):", f'    """{doc}"""', *body,
-                      f"    return {ret}", "", "",
-                      f"def {fn}(t, x, p, z):", f'    """{doc}"""',
-                      f"    return _{fn}(t, x, p, z, _I)"]
-        else:
-            lines += [f"def {fn}(t, x, p, z):", f'    """{doc}"""', *body, f"    return {ret}"]
-    grid_call = "_observed(ts[i], X[i], p, z, _I)" if kernel else "observed(ts[i], X[i], p, z)"
-    lines += ["", ""] + (["@_jit"] if numba else []) + [
-        "def _observed_grid(ts, X, p, z, _I):" if kernel else "def observed_grid(ts, X, p, z):",
-        '    """OBSERVED at each time ts[i] with states X[i] (a row per time); rows from',
-        '    a failed Newton iteration on are NaN (and z[-1] says which system)."""',
-        f"    out = np.empty((ts.shape[0], {len(outputs)}))",
-        "    for i in range(ts.shape[0]):",
-        f"        out[i] = {grid_call}",
-        "        if z[-1] != 0.0:",
-        "            out[i:] = np.nan",
-        "            break",
-        "    return out",
-    ]
-    if kernel:
-        lines += ["", "", "def observed_grid(ts, X, p, z):",
-                  '    """OBSERVED at each time ts[i] with states X[i] (a row per time)."""',
-                  "    return _observed_grid(ts, X, p, z, _I)"]
+        lines += [f"def {fn}(t, x, p, z):", f'    """{doc}"""', *body, f"    return {ret}"]
+    # Plain Python on every backend: numba would compile the loop with ``observed``
+    # inlined, seconds per model; springc runs a compiled loop of its own
+    # (springc.integrate.observed_grid, compiled once per machine).
+    lines += ["", "", *_OBSERVED_GRID.replace("N_OBSERVED", str(len(outputs))).splitlines()]
     lines += ["", "", *_FOOTER.splitlines()]
     if m.events is not None:
         lines += ["", ""] + (["@_jit"] if numba else []) + EVENT_UPDATE.splitlines()
     return "\n".join(lines) + "\n"
+
+
+_OBSERVED_GRID = '''def observed_grid(ts, X, p, z):
+    """OBSERVED at each time ts[i] with states X[i] (a row per time); rows from
+    a failed Newton iteration on are NaN (and z[-1] says which system)."""
+    out = np.empty((ts.shape[0], N_OBSERVED))
+    for i in range(ts.shape[0]):
+        out[i] = observed(ts[i], X[i], p, z)
+        if z[-1] != 0.0:
+            out[i:] = np.nan
+            break
+    return out'''
 
 
 _FOOTER = '''def jacobian(t, x, p, z):

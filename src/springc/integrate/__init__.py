@@ -30,6 +30,8 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   ``run.fired`` say where and which), ``t_stop`` stops it exactly at a time (TIME_EVENT).
   The caller updates the state and the held signs and restarts from the event;
   :func:`run_hybrid` is that loop with a Python ``update(t, x_left, fired)``.
+- ``observed_grid(observed, ts, states, p, z)``: the observed variables at states on a
+  grid (a run's states after the fact), compiled once per machine like the loops.
 - Failures never raise inside the loop: :class:`Status` says what happened
   (step too small, NaN/inf derivative or state, max steps, the model's failure flag
   ``z[-1]``) and the run carries the time and the state where it happened.
@@ -44,6 +46,7 @@ from .engine import (
     bdf,
     dop853,
     fixed_step,
+    observed_grid,
     radau,
     rk45,
 )
@@ -51,4 +54,4 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "radau", "rk45", "run_hybrid"]
+           "fixed_step", "observed_grid", "radau", "rk45", "run_hybrid"]

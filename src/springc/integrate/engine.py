@@ -217,6 +217,32 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
     return _run(grid_, result)
 
 
+def observed_grid(observed: ModelFunction, ts: Any, states: Any, p: Any, z: Any
+                  ) -> np.ndarray:
+    """``observed(ts[i], states[i], p, z)`` as row ``i`` of a (len(ts), n_observed)
+    array, compiled: a generated numba module's ``observed_grid`` without its Python
+    loop. ``z`` is updated in place; from the first row whose call sets the failure flag
+    ``z[-1]`` on, the rows are NaN (as the module's own ``observed_grid`` does)."""
+    from numba.core.dispatcher import Dispatcher
+
+    from .grid_kernel import observed_grid_run
+
+    if not isinstance(observed, Dispatcher):
+        raise TypeError(f"observed must be a numba-jitted function, got "
+                        f"{type(observed).__name__}")
+    ts_ = np.ascontiguousarray(ts, dtype=float)
+    states_ = np.ascontiguousarray(states, dtype=float)
+    if ts_.ndim != 1 or states_.ndim != 2 or states_.shape[0] != ts_.shape[0]:
+        raise ValueError(f"states must hold a row per time: shapes {ts_.shape} and "
+                         f"{states_.shape}")
+    _, _, p_, z_ = _vectors(np.zeros(1), states_[:1], p, z)
+    if ts_.size == 0:
+        return np.empty((0, np.asarray(observed(0.0, np.zeros(states_.shape[1]), p_,
+                                                z_.copy())).size))
+    n_observed = np.asarray(observed(ts_[0], states_[0], p_, z_.copy())).size
+    return observed_grid_run(observed, n_observed, ts_, states_, p_, z_)
+
+
 def _tolerances(rtol: float, atol: Any, x0: np.ndarray, grid: np.ndarray,
                 first_step: float | None, max_step: float) -> np.ndarray:
     """atol per state, after the checks of the adaptive methods' arguments."""

@@ -100,6 +100,21 @@ def jitted(module: Any) -> bool:
                for name in ("rhs", "jacobian_values"))
 
 
+def observed_on_grid(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndarray,
+                     z: np.ndarray) -> np.ndarray:
+    """The module's observed variables at ``states`` on ``ts`` (its ``observed_grid``):
+    for a numba module springc's compiled loop over its ``observed`` (compiled once per
+    machine, where the module's own loop is Python), for others the module's own."""
+    if getattr(module, "BACKEND", "") == "numba" and numba_available():
+        from numba.core.dispatcher import Dispatcher
+
+        if isinstance(module.observed, Dispatcher):
+            from springc.integrate import observed_grid
+
+            return observed_grid(module.observed, ts, states, p, z)
+    return np.asarray(module.observed_grid(ts, states, p, z))
+
+
 def engine_reason(engine: str, solver: str, backend: str, compiled: bool) -> str:
     """Why a run of ``solver`` ran on the engine it did, in plain words (``engine``: the
     ``--engine`` option, ``backend``: the generated module's)."""
