@@ -10,12 +10,14 @@ modification (``extends M(N = 100)``), in the same class tree as the user's file
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import difflib
+import gc
 import shutil
 import tempfile
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -262,6 +264,21 @@ WRAPPER_FILE = "<springc: structural parameters>"
 """The file name of the class that applies ``--set`` values of structural parameters."""
 
 
+@contextlib.contextmanager
+def fewer_collections() -> Iterator[None]:
+    """Python's cyclic garbage collector run less often, restored on exit: compiling a
+    model makes millions of objects that live to its end, which the collector walked
+    every 700 allocations (a third of compile_model's CPU time on the 1,000-mass chain:
+    1.44 s instead of 2.07 s; compiling makes few cycles)."""
+    threshold = gc.get_threshold()
+    gc.set_threshold(100_000, 50, 100)
+    try:
+        yield
+    finally:
+        gc.set_threshold(*threshold)
+
+
+@fewer_collections()
 def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
     tree = load(list(options.files), options.libraries, options.texts)
@@ -315,6 +332,7 @@ def generate_source(options: CompileOptions) -> str:
     return generate_from(derive_system(options), options)
 
 
+@fewer_collections()
 def generate_from(derived: Derived, options: CompileOptions) -> str:
     """The module text of a derived model with the outputs ``options`` selects."""
     system, flat_model = derived.system, derived.flat_model
