@@ -25,7 +25,7 @@ from .solver_names import (
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
-    from .compiled import choose_engine
+    from .compiled import choose_engine, default_backend
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -50,7 +50,7 @@ __all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
            "IMPLICIT_SOLVERS", "LARGE_TRAJECTORY", "LSODA_LIMIT", "PLOT_FORMATS",
            "RESULT_FORMATS", "SOLVERS",
            "SimulationOptions", "SimulationResult", "check_run_values", "check_trajectory_size",
-           "choose_engine",
+           "choose_engine", "default_backend",
            "file_format", "initial_state", "output_grid", "resolve", "save_outputs",
            "simulate_model", "write_csv"]
 
@@ -63,10 +63,10 @@ _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "outpu
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
-    if name == "choose_engine":
+    if name in ("choose_engine", "default_backend"):
         from . import compiled
 
-        return compiled.choose_engine
+        return getattr(compiled, name)
     if name in ("LARGE_TRAJECTORY", "check_trajectory_size"):
         from . import output_size
 
