@@ -123,12 +123,13 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
         return f"{solver} ran in scipy's loop: springc has no compiled loop for it"
     if not states:
         return "no loop ran: the model has no states to integrate"
+    if not numba_available():
+        return (f"{solver} ran in scipy's loop: numba is not installed (pip install "
+                "numba: the compiled loop runs it)")
     if getattr(module, "BACKEND", "python") != "numba":
         return (f"{solver} ran in scipy's loop: the model was generated for the python "
                 "backend (the numba backend, springc's default, runs it in the compiled "
                 "loop)")
-    if not numba_available():
-        return f"{solver} ran in scipy's loop: numba is not installed"
     return (f"{solver} ran in scipy's loop: the generated functions of a model this "
             "large are plain Python, not numba's")
 
