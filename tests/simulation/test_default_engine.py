@@ -208,3 +208,16 @@ def test_cli_defaults_to_the_compiled_engine(tmp_path: Path) -> None:
     assert "dop853 ran in scipy's loop, as --engine scipy asks" in scipy_run.output
     generated = CliRunner().invoke(main, ["compile", SEED])
     assert generated.exit_code == 0 and "\nfrom numba import njit\n" in generated.output
+
+
+def test_without_numba_the_default_is_scipy_and_says_so(monkeypatch: pytest.MonkeyPatch
+                                                        ) -> None:
+    from springc.simulation import compiled
+
+    monkeypatch.setattr(compiled, "numba_available", lambda: False)
+    result = springc.simulate(SEED, solver="dop853", stop=0.5)
+    assert result.stats.engine == "scipy"
+    assert result.stats.engine_reason == ("dop853 ran in scipy's loop: numba is not "
+                                          "installed (pip install numba: the compiled "
+                                          "loop runs it)")
+    assert springc.compile_model(SEED).module.BACKEND == "python"
