@@ -117,20 +117,21 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
     ``--engine`` option, ``module``: the generated module, ``states``: how many)."""
     if compiled:
         return f"{solver} ran in the compiled loop (numba, no Python per step)"
+    where = "springc's Python loop" if solver in FIXED_STEP else "scipy's loop"
     if engine == SCIPY:
-        return f"{solver} ran in scipy's loop, as --engine scipy asks"
+        return f"{solver} ran in {where}, as --engine scipy asks"
     if solver not in COMPILED_SOLVERS:
-        return f"{solver} ran in scipy's loop: springc has no compiled loop for it"
+        return f"{solver} ran in {where}: springc has no compiled loop for it"
     if not states:
         return "no loop ran: the model has no states to integrate"
     if not numba_available():
-        return (f"{solver} ran in scipy's loop: numba is not installed (pip install "
+        return (f"{solver} ran in {where}: numba is not installed (pip install "
                 "numba: the compiled loop runs it)")
     if getattr(module, "BACKEND", "python") != "numba":
-        return (f"{solver} ran in scipy's loop: the model was generated for the python "
+        return (f"{solver} ran in {where}: the model was generated for the python "
                 "backend (the numba backend, springc's default, runs it in the compiled "
                 "loop)")
-    return (f"{solver} ran in scipy's loop: the generated functions of a model this "
+    return (f"{solver} ran in {where}: the generated functions of a model this "
             "large are plain Python, not numba's")
 
 
