@@ -32,6 +32,7 @@ from .simulation import (
     SimulationResult,
     check_run_values,
     choose_engine,
+    default_backend,
     simulate_model,
 )
 
@@ -61,8 +62,8 @@ def _files(files: Files) -> tuple[str, ...]:
 
 @recursion_room()  # expressions up to ir.expr.MAX_DEPTH deep (docs/language.md, "Limits")
 def compile_model(files: Files, model: str | None = None, *,
-                  libraries: Sequence[str | os.PathLike[str]] = (), backend: str = "python",
-                  outputs: Sequence[str] | None = None,
+                  libraries: Sequence[str | os.PathLike[str]] = (),
+                  backend: str | None = None, outputs: Sequence[str] | None = None,
                   parameters: Mapping[str, float] | None = None,
                   cache: bool = True) -> CompiledModel:
     """Flatten, simplify and generate code for ``model`` of ``files`` (cached on disk).
@@ -70,12 +71,14 @@ def compile_model(files: Files, model: str | None = None, *,
     ``outputs`` are flat names or patterns with ``*``/``?`` (default: every state and
     observed variable); ``parameters`` may set structural parameters (array sizes),
     which re-flattens the model; other parameters are inputs of the generated code
-    and are better passed to :func:`simulate`.
+    and are better passed to :func:`simulate`. ``backend``: ``"numba"`` (the default
+    where numba is installed: :func:`simulate` runs it in the compiled loop) or
+    ``"python"`` (plain numpy, run in scipy's loop).
     """
     check_run_values(parameters=parameters)
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
-                             backend, tuple(outputs) if outputs is not None else None,
-                             (), cache)
+                             backend or default_backend(),
+                             tuple(outputs) if outputs is not None else None, (), cache)
     return _compile(options, parameters)
 
 
@@ -84,7 +87,8 @@ STRING_FILE = "<string>"
 
 
 @recursion_room()
-def load_model_from_string(text: str, model: str | None = None, backend: str = "python", *,
+def load_model_from_string(text: str, model: str | None = None,
+                           backend: str | None = None, *,
                            libraries: Sequence[str | os.PathLike[str]] = (),
                            outputs: Sequence[str] | None = None,
                            parameters: Mapping[str, float] | None = None,
@@ -104,7 +108,8 @@ def load_model_from_string(text: str, model: str | None = None, backend: str = "
         raise UsageError(f"the model text must be a str, not {type(text).__name__}",
                          option="text")
     check_run_values(parameters=parameters)
-    options = CompileOptions((), model, tuple(os.fspath(x) for x in libraries), backend,
+    options = CompileOptions((), model, tuple(os.fspath(x) for x in libraries),
+                             backend or default_backend(),
                              tuple(outputs) if outputs is not None else None, (), cache,
                              ((STRING_FILE, text),))
     return _compile(options, parameters)
@@ -154,25 +159,26 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     ``parameters`` maps flat names to values; structural ones trigger a recompilation.
     A run stops with an error after ``max_steps`` integrator steps or ``time_limit``
     seconds (``None``: 20,000,000 steps, one hour). ``engine`` runs the steps:
-    ``"compiled"`` (numba loops of :mod:`springc.integrate` for dop853, auto's dop853
-    and the fixed-step solvers), ``"scipy"`` (scipy's solvers stepped from Python), or
-    ``"auto"``: compiled for a module generated with the numba backend (where numba is
-    importable and the solver has a compiled loop), else scipy.
+    ``"compiled"`` (numba loops of :mod:`springc.integrate` for auto, dop853, rk45,
+    radau, bdf and the fixed-step solvers), ``"scipy"`` (scipy's solvers stepped from
+    Python), or ``"auto"`` (the default): compiled where numba is importable, the
+    solver has a compiled loop and the model's backend is numba, else scipy (the
+    summary, ``result.stats.engine_reason``, says why).
     ``error_estimate`` (``"off"``, ``"on"``, ``"auto"``): estimate the global error
     reached on the grid (``result.error_estimate``, a companion run at a tighter
     tolerance, or Richardson for the fixed-step solvers); ``auto`` where it costs at
     most about 30 % of the run.
-    ``backend`` (files only) defaults to ``"numba"`` for the compiled engine, else
-    ``"python"``. ``event_rows``: a model with events gets two more rows at each event,
-    its left and right limits (default: one row per output time).
+    ``backend`` (files only) defaults to ``"numba"`` where the run can take the
+    compiled loop, else ``"python"`` (``engine="scipy"``, lsoda, no numba).
+    ``event_rows``: a model with events gets two more rows at each event, its left and
+    right limits (default: one row per output time).
     """
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
     values = dict(parameters or {})
     if not isinstance(model, CompiledModel):
-        chosen = choose_engine(engine, str(solver).lower(), backend, "engine", "backend")
+        choose_engine(engine, str(solver).lower(), backend, "engine", "backend")
         model = compile_model(model, model_name, libraries=libraries,
-                              backend=backend or ("numba" if chosen == "compiled"
-                                                  else "python"),
+                              backend=backend or default_backend(engine, str(solver).lower()),
                               outputs=outputs, cache=cache, parameters=values)
         structural = {k for k, v in model.options.modifications}
     else:
@@ -200,8 +206,9 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
           atol: float | None = None, step: float | None = None,
           output: str | os.PathLike[str] | None = None, resume: bool = False,
           energy: str | None = None, libraries: Sequence[str | os.PathLike[str]] = (),
-          backend: str = "python", cache: bool = True, progress: TextIO | None = None,
-          max_steps: int | None = None, time_limit: float | None = None,
+          backend: str | None = None, cache: bool = True,
+          progress: TextIO | None = None, max_steps: int | None = None,
+          time_limit: float | None = None,
           as_: str = "dataset") -> Any:
     """Run a parameter study and return it as an ``xarray.Dataset`` (``as_="dataset"``:
     each output over ``run`` x ``time`` with ``units`` attributes, the swept parameters
@@ -215,7 +222,8 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     core) or to the Dask scheduler at ``scheduler``. ``parameters`` are fixed values
     for every run. With ``output`` (``.parquet``), the study table and its summary
     (``.summary.parquet``) are written, and ``resume`` continues an interrupted study.
-    ``max_steps`` and ``time_limit`` bound each run as in :func:`simulate`.
+    ``max_steps`` and ``time_limit`` bound each run as in :func:`simulate`;
+    ``backend`` defaults as there (numba: the runs take the compiled loop).
     """
     from .studies import (
         StudyOptions,
@@ -239,7 +247,8 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
         compiled = _with_structural(files, {k: v for k, v in fixed.items()
                                             if k in files.structural})
     else:
-        compiled = compile_model(files, model, libraries=libraries, backend=backend,
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=backend or default_backend(solver=str(solver).lower()),
                                  outputs=outputs, parameters=fixed, cache=cache)
     rest = tuple((k, v) for k, v in fixed.items() if k not in compiled.structural)
     protected = tuple(compiled.options.files)

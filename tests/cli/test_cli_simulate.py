@@ -57,7 +57,9 @@ def test_seed_csv_and_png(tmp_path: Path) -> None:
     for line in out.read_text().splitlines()[1:5]:
         assert all(repr(float(v)) == v for v in line.split(","))
     assert stdout == ""
-    assert "SpringMass: auto -> dop853 (scipy) (non-stiff: " in stderr
+    # the default engine: the numba module in the compiled loop, and why
+    assert "SpringMass: auto -> dop853 (compiled) (non-stiff: " in stderr
+    assert "; dop853 ran in the compiled loop (numba, no Python per step))" in stderr
     assert " steps, " in stderr
     assert "RHS and 1 Jacobian evaluations" in stderr  # the stiffness estimate
     import matplotlib.image
@@ -156,8 +158,11 @@ def test_each_solver_runs() -> None:
             assert code == 0, stderr
             compiled = backend == "numba" and solver in COMPILED_SOLVERS
             engine = "compiled" if compiled else "scipy"
-            shown = "auto -> dop853 (" if solver == AUTO else f"{solver} ({engine}),"
+            shown = "auto -> dop853 (" if solver == AUTO else f"{solver} ({engine})"
             assert f"SpringMass: {shown}" in stderr
+            # off the compiled loop without --engine scipy: the summary says why
+            assert (f"({solver} ran in " in stderr) == (
+                not compiled and solver != AUTO)
         if solver in ("radau", "bdf", "lsoda"):
             assert " 0 Jacobian" not in stderr
 

@@ -198,7 +198,7 @@ def test_compiled_requests_that_cannot_be_met_exit_2(arguments: list[str],
 
 
 def test_api_names_the_engine_argument() -> None:
-    model = springc.compile_model(SEED)  # python backend: no numba functions
+    model = springc.compile_model(SEED, backend="python")  # no numba functions
     with pytest.raises(UsageError, match="engine compiled runs the numba backend") as info:
         springc.simulate(model, engine="compiled")
     assert info.value.option == "engine"

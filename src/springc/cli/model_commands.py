@@ -67,9 +67,11 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              output: str | None) -> None:
     """Generate a standalone Python module (numpy/scipy, or numba) for a model."""
     from ..pipeline import CompileOptions, compile_files
+    from ..simulation import default_backend
 
     check_output_options([("-o", output, None)], files)
-    compiled = compile_files(CompileOptions(files, model, libraries, backend or "python",
+    compiled = compile_files(CompileOptions(files, model, libraries,
+                                            backend or default_backend(),
                                             patterns or None, (), not no_cache))
     if output:
         from ..fileio import atomic_write

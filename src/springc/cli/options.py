@@ -90,9 +90,10 @@ def compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
                         "wildcards (repeatable). Default: all states and observed.")(func)
     return click.option("--backend", type=click.Choice(["python", "numba"]),
                         default=None,
-                        help="Generated code: plain Python/numpy, or numba-compiled "
-                        "(default: numba for simulate's compiled engine, else "
-                        "python).")(func)
+                        help="Generated code: numba-compiled, or plain Python/numpy "
+                        "(default: numba where numba is installed, which the compiled "
+                        "engine runs; python for --engine scipy and solvers without a "
+                        "compiled loop).")(func)
 
 
 def single_threaded_blas() -> None:

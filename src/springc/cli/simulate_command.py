@@ -30,9 +30,11 @@ from .options import (
               "(verlet, symplectic-euler, rk4) with --step.")
 @click.option("--engine", type=click.Choice(ENGINES, case_sensitive=False),
               default=DEFAULT_ENGINE, show_default=True,
-              help="compiled: numba loops (springc.integrate) for dop853, auto's dop853 "
-              "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; "
-              "auto: compiled for the numba backend (--backend numba), else scipy.")
+              help="compiled: numba loops (springc.integrate) for auto, dop853, rk45, "
+              "radau, bdf and the fixed-step solvers; scipy: scipy's solvers stepped from "
+              "Python; auto: compiled where it can run (numba installed, a solver with a "
+              "compiled loop, not --backend python), else scipy, and the summary says "
+              "why.")
 @click.option("--error-estimate", type=click.Choice(("off", "on", "auto"),
                                                    case_sensitive=False),
               default="auto", show_default=True,
@@ -69,13 +71,19 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              time_limit: float | None, output: str | None, plot: str | None,
              event_rows: bool, quiet: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
-    from ..simulation import PLOT_FORMATS, RESULT_FORMATS, check_run_values, choose_engine
+    from ..simulation import (
+        PLOT_FORMATS,
+        RESULT_FORMATS,
+        check_run_values,
+        choose_engine,
+        default_backend,
+    )
 
     values = parse_set(assignments)
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
-    chosen = choose_engine(engine.lower(), solver.lower(), backend)
+    choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
@@ -89,9 +97,10 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         write_csv,
     )
 
-    compiled = compile_model(files, model, libraries=libraries, backend=backend or (
-        "numba" if chosen == "compiled" else "python"), outputs=patterns or None,
-        parameters=values, cache=not no_cache)
+    compiled = compile_model(files, model, libraries=libraries,
+                             backend=backend or default_backend(engine, solver.lower()),
+                             outputs=patterns or None, parameters=values,
+                             cache=not no_cache)
     if not patterns and (output or not plot):  # the default trajectory of every output
         check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
                               f"-o {output}" if output else "the CSV on stdout")

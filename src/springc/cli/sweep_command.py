@@ -108,7 +108,10 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
                            solver.lower(), rtol, atol, step, workers, scheduler, energy,
                            max_steps, time_limit)
     parameter_table(options)  # refuse bad specifications before compiling
-    compiled = compile_model(files, model, libraries=libraries, backend=backend or "python",
+    from ..simulation import default_backend
+
+    compiled = compile_model(files, model, libraries=libraries,
+                             backend=backend or default_backend(solver=solver.lower()),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import sys
 
 import click
@@ -125,6 +124,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                     ("--save-reference", save_reference, {".csv": "csv"})], inputs)
     single_threaded_blas()
     from ..api import compile_model
+    from ..simulation import default_backend
     from ..tradeoff import (
         DEFAULT_TARGETS,
         DEFAULT_TOLERANCES,
@@ -137,9 +137,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
 
     # numba by default: the runs of solvers with a compiled loop run there (many runs
     # share one compilation)
-    numba = importlib.util.find_spec("numba") is not None
     compiled = compile_model(files, model, libraries=libraries,
-                             backend=backend or ("numba" if numba else "python"),
+                             backend=backend or default_backend(),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     if not patterns:

@@ -25,7 +25,7 @@ from .solver_names import (
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
-    from .compiled import choose_engine, observed_on_grid
+    from .compiled import choose_engine, default_backend, observed_on_grid
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -50,7 +50,7 @@ __all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
            "IMPLICIT_SOLVERS", "LARGE_TRAJECTORY", "LSODA_LIMIT", "PLOT_FORMATS",
            "RESULT_FORMATS", "SOLVERS",
            "SimulationOptions", "SimulationResult", "check_run_values", "check_trajectory_size",
-           "choose_engine",
+           "choose_engine", "default_backend",
            "file_format", "initial_state", "observed_on_grid", "output_grid", "resolve",
            "save_outputs",
            "simulate_model", "write_csv"]
@@ -64,7 +64,7 @@ _RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "outpu
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
-    if name in ("choose_engine", "observed_on_grid"):
+    if name in ("choose_engine", "default_backend", "observed_on_grid"):
         from . import compiled
 
         return getattr(compiled, name)

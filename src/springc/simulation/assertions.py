@@ -8,7 +8,9 @@ assertion is reported once on standard error and the run goes on. The scipy engi
 and the Python fixed-step integrators check after every step (on scipy, the time of a
 failure is then located inside the step on its interpolant, by bisection); the compiled
 engine's loops have no Python per step, so its runs are checked at every output time,
-as are runs that switch states (:func:`check_trajectory`, on the flat conditions).
+and the output interval where one first fails is run again on scipy's loop, which
+locates the time as above; runs that switch states are checked at every output time
+(:func:`check_trajectory`, on the flat conditions).
 """
 
 from __future__ import annotations
@@ -64,11 +66,25 @@ class AssertionCheck:
         if self.varying:
             self._check(t, x, z, first=False, before=before, dense=dense)
 
-    def grid(self, times: np.ndarray, states: np.ndarray, z: np.ndarray) -> None:
-        """Check at every output time (the compiled engine's runs)."""
-        if self.varying:
-            for t, x in zip(times, states):
-                self._check(float(t), x, z, first=False)
+    def grid(self, times: np.ndarray, states: np.ndarray, z: np.ndarray,
+             locate: Callable[[int], None] | None = None) -> None:
+        """Check at every output time (the compiled engine's runs). Where an assertion
+        not yet reported fails at row ``k`` (held at ``k - 1``), ``locate(k)`` runs that
+        interval again step by step (scipy's loop, whose checks find the time inside a
+        step and report it); the output time is reported where it finds nothing."""
+        if not self.varying:
+            return
+        for k, (t, row) in enumerate(zip(times, states)):
+            if locate is not None and k > 0 and self._fails(float(t), row, z):
+                locate(k)
+            self._check(float(t), row, z, first=False)
+
+    def _fails(self, t: float, x: np.ndarray, z: np.ndarray) -> bool:
+        """Whether an assertion on time or the states, not yet reported, fails here."""
+        held = self._held(t, x, z)
+        return held is not None and any(
+            not self.table[i][3] and i not in self.warned
+            for i in map(int, np.flatnonzero(held == 0.0)))
 
     def _held(self, t: float, x: np.ndarray, z: np.ndarray) -> np.ndarray | None:
         assert self.function is not None

@@ -53,18 +53,28 @@ def numba_available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
+def default_backend(engine: str = AUTO, solver: str = AUTO) -> str:
+    """The generated module's backend when the user names none (``--backend`` left out):
+    ``numba`` where the run can take the compiled loop (numba importable, ``engine`` not
+    ``scipy``, ``solver`` with a compiled loop or ``auto``), else ``python``: a run on
+    scipy's loop calls the model's functions from Python, where numba's compilation of
+    a new model (seconds) costs more than it saves on most runs."""
+    name = engine.lower() if isinstance(engine, str) else engine
+    has_loop = solver == AUTO or solver in COMPILED_SOLVERS
+    return "numba" if name != SCIPY and has_loop and numba_available() else "python"
+
+
 def choose_engine(engine: str, solver: str, backend: str | None = None,
                   option: str = "--engine", backend_option: str = "--backend") -> str:
     """:data:`COMPILED` or :data:`SCIPY` for a run of ``solver``.
 
     ``backend`` is the generated module's backend if already chosen (``None``: springc
-    chooses, numba for the compiled engine). ``auto`` is compiled where the module is
-    (or is asked to be) generated with the numba backend, numba is importable and the
-    solver has a compiled loop (``auto`` counts: it finishes on dop853 compiled).
-    Otherwise it is scipy: numba's first compilation of a model costs seconds, more
-    than a short run of the seed takes on scipy, so the compiled loop is what users
-    opt into with ``--backend numba`` or ``--engine compiled``. A ``compiled`` request
-    that cannot be met is a :class:`UsageError` naming ``option``.
+    chooses, :func:`default_backend`). ``auto`` (the default) is compiled where numba
+    is importable, the solver has a compiled loop (``auto`` counts: it finishes on
+    dop853 or radau compiled) and the module is (or will be) generated with the numba
+    backend; otherwise scipy, and the run's summary says why (:func:`engine_reason`).
+    A ``compiled`` request that cannot be met is a :class:`UsageError` naming
+    ``option``.
     """
     name = engine.lower() if isinstance(engine, str) else engine
     if name not in ENGINES:
@@ -74,7 +84,8 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
     if name == SCIPY:
         return SCIPY
     if name == AUTO:
-        return COMPILED if has_loop and backend == "numba" and numba_available() else SCIPY
+        numba_module = backend in (None, "numba")
+        return COMPILED if has_loop and numba_module and numba_available() else SCIPY
     if not has_loop:
         raise UsageError(f"{option} compiled: the {solver} solver has no compiled loop",
                          option=option,
@@ -115,22 +126,35 @@ def observed_on_grid(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndar
     return np.asarray(module.observed_grid(ts, states, p, z))
 
 
-def engine_reason(engine: str, solver: str, backend: str, compiled: bool) -> str:
+def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
+                  states: int = 1) -> str:
     """Why a run of ``solver`` ran on the engine it did, in plain words (``engine``: the
-    ``--engine`` option, ``backend``: the generated module's)."""
+    ``--engine`` option, ``module``: the generated module, ``states``: how many)."""
     if compiled:
         return f"{solver} ran in the compiled loop (numba, no Python per step)"
+    where = "springc's Python loop" if solver in FIXED_STEP else "scipy's loop"
     if engine == SCIPY:
-        return f"{solver} ran in scipy's loop, as --engine scipy asks"
+        return f"{solver} ran in {where}, as --engine scipy asks"
     if solver not in COMPILED_SOLVERS:
-        return f"{solver} ran in scipy's loop: springc has no compiled loop for it"
-    if backend != "numba":
-        return (f"{solver} ran in scipy's loop: the model was generated for the python "
-                "backend (--backend numba runs it in the compiled loop)")
-    if numba_available():
-        return (f"{solver} ran in scipy's loop: the generated functions of a model this "
-                "large are plain Python, not numba's")
-    return f"{solver} ran in scipy's loop: numba is not installed"
+        return f"{solver} ran in {where}: springc has no compiled loop for it"
+    if not states:
+        return "no loop ran: the model has no states to integrate"
+    if not numba_available():
+        return (f"{solver} ran in {where}: numba is not installed (pip install "
+                "numba: the compiled loop runs it)")
+    if getattr(module, "BACKEND", "python") != "numba":
+        return (f"{solver} ran in {where}: the model was generated for the python "
+                "backend (the numba backend, springc's default, runs it in the compiled "
+                "loop)")
+    return (f"{solver} ran in {where}: the generated functions of a model this "
+            "large are plain Python, not numba's")
+
+
+def explained(engine: str, reason: str, compiled: bool) -> bool:
+    """Whether a run's summary says why it ran on its engine: ``auto``'s runs always
+    (``reason``: why auto chose its solver), others where the default engine fell back
+    to scipy's loop."""
+    return bool(reason) or (not compiled and engine.lower() == AUTO)
 
 
 def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:

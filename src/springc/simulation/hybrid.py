@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
-from .compiled import COMPILED, SCIPY, engine_reason, jitted
+from .compiled import COMPILED, SCIPY, engine_reason, explained, jitted
 from .events import EventLoop
 from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
@@ -79,8 +79,9 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time, state_events,
                             time_events, engine_reason=engine_reason(
-                                options.engine.lower(), solver, model.module.BACKEND, compiled)
-                            if reason else "")
+                                options.engine.lower(), solver, model.module, compiled,
+                                len(x0)) if explained(options.engine, reason, compiled)
+                            else "")
     units = model.units
     names = model.outputs
     return SimulationResult(model.name, times, names, outputs,

@@ -64,14 +64,17 @@ class SimulationStats:
     state_events: int = 0  # events of hybrid models (simulation/events.py)
     time_events: int = 0
     error: str = ""  # the error estimate in words (empty: not estimated)
-    engine_reason: str = ""  # why auto's run used this engine, in words
+    engine_reason: str = ""  # why auto's run (or a fallback to scipy) used this engine
 
     def summary(self, model: str) -> str:
         """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
         evaluations, wall time."""
         solver = f"{self.solver} ({self.engine})"
         why = f"{self.reason}; {self.engine_reason}" if self.engine_reason else self.reason
-        solver = f"auto -> {solver} ({why})" if self.reason else solver
+        if self.reason:
+            solver = f"auto -> {solver} ({why})"
+        elif self.engine_reason:  # the default engine fell back to scipy's loop
+            solver = f"{solver} ({self.engine_reason})"
         inside = f"compiled loop {self.loop_time:.3f} s, " if self.loop_time else ""
         return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "

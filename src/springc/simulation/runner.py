@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
 from typing import Any, TextIO
 
 import numpy as np
@@ -34,6 +34,7 @@ from .compiled import (
     SCIPY,
     choose_engine,
     engine_reason,
+    explained,
     finish_dop853,
     jitted,
     numba_available,
@@ -214,6 +215,10 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
 
         result = simulate_switching_model(model, solver, grid, rtol, atol,
                                           dict(options.parameters), limits)
+        if options.engine.lower() == AUTO:
+            result.stats = replace(result.stats, engine_reason=(
+                f"{result.stats.solver} ran in scipy's loop: the model switches its states "
+                "during the run, which only scipy's loop does"))
         if estimate_mode != "on":  # a companion run on scipy doubles the run: not auto
             return result
         return _switching_estimate(model, result, solver, grid, rtol, atol,
@@ -255,7 +260,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                                              rtol, atol, step or None, compiled, loop_time,
                                              time.perf_counter() - began)
             if problem.asserts and (compiled or not len(x0)):
-                problem.asserts.grid(grid, states, problem.z)
+                problem.asserts.grid(grid, states, problem.z, _locate(
+                    problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
             outputs = _outputs(model, problem, grid, states)
     except Stop as stop_:
         raise stop_.error from None
@@ -269,14 +275,33 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                             COMPILED if compiled else SCIPY, loop_time,
                             error=estimate.summary() if estimate is not None else error_note,
                             engine_reason=engine_reason(options.engine.lower(), solver,
-                                                        model.module.BACKEND, compiled)
-                            if reason else "")
+                                                        model.module, compiled, len(x0))
+                            if explained(options.engine, reason, compiled) else "")
     units = model.units
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
                             dict(zip(model.parameter_names, p.tolist())),
                             error_estimate=estimate)
+
+
+def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
+            rtol: float, atol: float, step: float) -> Callable[[int], None]:
+    """Run the output interval ``grid[k - 1], grid[k]`` of a compiled run again on
+    scipy's loop (or the Python fixed-step integrator, the same steps), from the state
+    at ``grid[k - 1]``: its assertion checks after every step locate a failure inside
+    the interval and raise it. A run that fails otherwise is left to the caller."""
+    def locate(k: int) -> None:
+        span = grid[k - 1:k + 1]
+        problem.solver = solver
+        try:
+            if solver in FIXED_STEP:
+                solvers.run_fixed(problem, span, states[k - 1], step)
+            else:
+                integrate(problem, span, states[k - 1], rtol, atol)
+        except (Stop, OverLimit):
+            pass
+    return locate
 
 
 def _estimate(mode: str, problem: Problem, grid: np.ndarray, x0: np.ndarray,
