@@ -5,6 +5,7 @@ in the calling process, except the measured times."""
 from __future__ import annotations
 
 import dataclasses
+import math
 from pathlib import Path
 
 import pytest
@@ -29,7 +30,7 @@ def test_the_executor_gives_the_table_of_the_calling_process(
     model = compare_states(springc.compile_model(SEED))
     options = TradeoffOptions(solvers=("dop853", "rk4", "radau"), tolerances=(1e-3, 1e-5),
                               steps=(0.01, 0.005), stop=1.0, interval=0.01, repeats=1,
-                              parameters={"spring.k": 2e3})
+                              parameters={"spring.k": 2e3}, cost_limit=math.inf)
     here = run_tradeoff(model, options)
     there = run_tradeoff(model, options, Executor(workers=2))
     assert [(r.solver, r.label()) for r in there.runs] == [
@@ -61,7 +62,8 @@ def test_the_executor_on_a_dask_local_cluster_gives_the_same_table(
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
     model = compare_states(springc.compile_model(SEED))
     options = TradeoffOptions(solvers=("dop853", "verlet"), tolerances=(1e-4,),
-                              steps=(0.005,), stop=0.5, interval=0.01, repeats=1)
+                              steps=(0.005,), stop=0.5, interval=0.01, repeats=1,
+                              cost_limit=math.inf)
     here = run_tradeoff(model, options)
     with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
                       dashboard_address=None) as cluster:
