@@ -6,8 +6,9 @@
 With ``--versus OLD/src`` (the sources of an older springc, e.g. ``git worktree add
 /tmp/tradeoff-old c2523e1``): only the whole ``springc tradeoff models/SpringMass.mdl``
 command, wall clock, with this tree, then the old one, then this tree again (same
-machine state: the ratio is the old time over the mean of the two new ones), and
-whether the recommendation lines are the same. **Target:** 10x faster, the same
+machine state: the ratio is the old time over the mean of the two new ones; each tree's
+model cache and compiled loops warmed by a short study first), and whether the
+recommendation lines are the same. **Target:** 10x faster, the same
 recommendation.
 
 For the seed (``models/SpringMass.mdl``) and the 20x20 cloth (``Scenes.Cloth``): the
@@ -184,19 +185,34 @@ VERSUS_TARGET = 10.0
 
 def command_run(src: Path) -> tuple[float, list[str], str]:
     """``springc tradeoff models/SpringMass.mdl`` with ``src`` first on the path: wall
-    seconds, the recommendation lines, and the engine column's counts."""
+    seconds, the recommendation lines, and how many rows ran on each engine (the old
+    table has no engine column: none)."""
     env = {**os.environ, "PYTHONPATH": str(src)}
     began = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "springc", "tradeoff", str(SEED), "-q"],
                           env=env, capture_output=True, text=True, check=True)
     seconds = time.perf_counter() - began
     lines = [line for line in done.stdout.splitlines() if line.startswith("for max error")]
-    counts = {e: len(re.findall(rf"\s{e}\s", done.stdout)) for e in ("compiled", "scipy")}
+    cells = [line.split() for line in done.stdout.splitlines()]
+    counts = {e: sum(len(c) > 3 and c[3] == e for c in cells) for e in ("compiled", "scipy")}
     return seconds, lines, ", ".join(f"{n} {e}" for e, n in counts.items())
 
 
+def warm(src: Path) -> None:
+    """A short study of the seed with ``src``, untimed: its model cache and compiled
+    loops are then ready (any edit of springc's code moves the model cache's key)."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    subprocess.run([sys.executable, "-m", "springc", "tradeoff", str(SEED), "-q",
+                    "--tolerances", "1e-3", "--steps", "0.01", "--stop", "0.05",
+                    "--interval", "0.01", "--repeats", "1"],
+                   env=env, capture_output=True, text=True, check=True)
+
+
 def versus(old: Path) -> None:
-    """The seed's whole command: this tree, the old one, this tree again."""
+    """The seed's whole command: this tree, the old one, this tree again (each tree
+    warmed up first)."""
+    for src in (ROOT / "src", old):
+        warm(src)
     load = os.getloadavg()[0]
     new1, lines, engines = command_run(ROOT / "src")
     print(f"new: {new1:.1f} s ({engines} rows)", file=sys.stderr, flush=True)

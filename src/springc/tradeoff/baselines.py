@@ -106,7 +106,7 @@ def baseline_runs(setup: StudySetup, ref: Reference, scales: np.ndarray,
         run = add_drift(with_errors(run, values, ref, scales), values)
         if log is not None:
             log(log_line(run))
-        return retimed(run, once, options.repeats) if rtol is None else run
+        return retimed([(run, once)], options.repeats)[0] if rtol is None else run
 
     default = measured(SCIPY_DEFAULT, None)
     goal = min(options.targets)

@@ -122,7 +122,8 @@ def solver_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: s
             stop = (f"{COST_SKIP} ({run.label()} took {run.wall_time:.3g} s > "
                     f"{options.cost_limit:g} x {ceiling / options.cost_limit:.3g} s)")
     known = [*(pilot.runs if pilot is not None else ()), *runs]
-    for i, once in onces:
-        if contender(runs[i], options.targets, known):
-            runs[i] = retimed(runs[i], once, options.repeats)
+    again = [(i, once) for i, once in onces if contender(runs[i], options.targets, known)]
+    for (i, _), run in zip(again, retimed([(runs[i], once) for i, once in again],
+                                          options.repeats)):
+        runs[i] = run
     return runs

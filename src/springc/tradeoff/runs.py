@@ -30,6 +30,12 @@ from .energy import drift, energy_series
 from .model import REPEAT_LIMIT, REPEAT_MARGIN, OverBudget, Reference, Run
 from .setup import Deadline, StudySetup, relative_errors
 
+STABLE_SECONDS = 0.15
+"""A contender is timed until its timings add up to this (at least ``repeats`` times,
+at most :data:`MAX_REPEATS`): the median of a few milliseconds' run on a loaded
+machine needs more than three."""
+MAX_REPEATS = 15
+
 Measured = tuple[float, tuple[int, int, int], np.ndarray, str]
 """What one timed run returns: seconds, (steps, RHS, Jacobian evaluations), outputs,
 engine ("compiled" or "scipy")."""
@@ -52,12 +58,26 @@ def timed_once(setup: StudySetup, solver: str, setting: str, value: float, once:
                math.nan, engine=engine), values
 
 
-def retimed(run: Run, once: Once, repeats: int) -> Run:
-    """``run`` timed ``repeats`` times in all (the median), if ok and short."""
-    if not run.ok or run.wall_time >= REPEAT_LIMIT or run.repeats >= repeats:
-        return run
-    times = [run.wall_time] + [once(math.inf)[0] for _ in range(repeats - run.repeats)]
-    return dataclasses.replace(run, wall_time=statistics.median(times), repeats=len(times))
+def retimed(runs: Sequence[tuple[Run, Once]], repeats: int) -> list[Run]:
+    """The ``runs`` (each with its ``once``) timed again in rounds, each round timing
+    every run once (a change of the machine's load falls on all of them alike): an ok
+    run under :data:`REPEAT_LIMIT` is timed ``repeats`` times in all, and a short one
+    more, up to :data:`STABLE_SECONDS` of timings or :data:`MAX_REPEATS`; the median
+    of its times is kept."""
+    def wanted(run: Run) -> int:
+        if not run.ok or run.wall_time >= REPEAT_LIMIT or repeats <= 1:
+            return 1  # the timing it has
+        short = math.ceil(STABLE_SECONDS / max(run.wall_time, 1e-9))
+        return max(repeats, min(MAX_REPEATS, short))
+
+    times = [[run.wall_time] for run, _ in runs]
+    counts = [wanted(run) for run, _ in runs]
+    for _ in range(max(counts, default=1) - 1):
+        for (_, once), timed, count in zip(runs, times, counts):
+            if len(timed) < count:
+                timed.append(once(math.inf)[0])
+    return [dataclasses.replace(run, wall_time=statistics.median(timed), repeats=len(timed))
+            if len(timed) > 1 else run for (run, _), timed in zip(runs, times)]
 
 
 def springc_once(setup: StudySetup, solver: str, rtol: float | None, step: float | None
