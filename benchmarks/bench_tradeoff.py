@@ -1,6 +1,15 @@
 """Benchmark: the setting ``springc tradeoff`` recommends vs scipy's default call.
 
     PYTHONPATH=src python benchmarks/bench_tradeoff.py [--quick]
+    PYTHONPATH=src python benchmarks/bench_tradeoff.py --versus OLD/src
+
+With ``--versus OLD/src`` (the sources of an older springc, e.g. ``git worktree add
+/tmp/tradeoff-old c2523e1``): only the whole ``springc tradeoff models/SpringMass.mdl``
+command, wall clock, with this tree, then the old one, then this tree again (same
+machine state: the ratio is the old time over the mean of the two new ones; each tree's
+model cache and compiled loops warmed by a short study first), and whether the
+recommendation lines are the same. **Target:** 10x faster, the same
+recommendation.
 
 For the seed (``models/SpringMass.mdl``) and the 20x20 cloth (``Scenes.Cloth``): the
 full tradeoff study (:mod:`springc.tradeoff.study`; ``--quick``: fewer tolerances); with
@@ -21,6 +30,8 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as `springc simulate` does
 
 import argparse
 import importlib.util
+import re
+import subprocess
 import sys
 import time
 from dataclasses import dataclass
@@ -168,6 +179,64 @@ def markdown(rows: list[tuple[str, Verdict]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+SEED = ROOT / "models" / "SpringMass.mdl"
+VERSUS_TARGET = 10.0
+
+
+def command_run(src: Path) -> tuple[float, list[str], str]:
+    """``springc tradeoff models/SpringMass.mdl`` with ``src`` first on the path: wall
+    seconds, the recommendation lines, and how many rows ran on each engine (the old
+    table has no engine column: none)."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    began = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "springc", "tradeoff", str(SEED), "-q"],
+                          env=env, capture_output=True, text=True, check=True)
+    seconds = time.perf_counter() - began
+    lines = [line for line in done.stdout.splitlines() if line.startswith("for max error")]
+    cells = [line.split() for line in done.stdout.splitlines()]
+    counts = {e: sum(len(c) > 3 and c[3] == e for c in cells) for e in ("compiled", "scipy")}
+    return seconds, lines, ", ".join(f"{n} {e}" for e, n in counts.items())
+
+
+def warm(src: Path) -> None:
+    """A short study of the seed with ``src``, untimed: its model cache and compiled
+    loops are then ready (any edit of springc's code moves the model cache's key)."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    subprocess.run([sys.executable, "-m", "springc", "tradeoff", str(SEED), "-q",
+                    "--tolerances", "1e-3", "--steps", "0.01", "--stop", "0.05",
+                    "--interval", "0.01", "--repeats", "1"],
+                   env=env, capture_output=True, text=True, check=True)
+
+
+def versus(old: Path) -> None:
+    """The seed's whole command: this tree, the old one, this tree again (each tree
+    warmed up first)."""
+    for src in (ROOT / "src", old):
+        warm(src)
+    load = os.getloadavg()[0]
+    new1, lines, engines = command_run(ROOT / "src")
+    print(f"new: {new1:.1f} s ({engines} rows)", file=sys.stderr, flush=True)
+    before, old_lines, _ = command_run(old)
+    print(f"old: {before:.1f} s", file=sys.stderr, flush=True)
+    new2, lines2, _ = command_run(ROOT / "src")
+    print(f"new again: {new2:.1f} s", file=sys.stderr, flush=True)
+    mean = (new1 + new2) / 2
+
+    def chosen(found: list[str]) -> list[str]:  # "for max error <= 1e-04 the fastest is ..."
+        return [re.sub(r" \(.*", "", line) for line in found]
+
+    same = chosen(lines) == chosen(old_lines) == chosen(lines2)
+    print(f"springc tradeoff models/SpringMass.mdl: old ({old}) {before:.1f} s, new "
+          f"{new1:.1f} s and {new2:.1f} s (mean {mean:.1f} s): {before / mean:.1f}x faster "
+          f"(target {VERSUS_TARGET:g}x); load average {load:.1f} -> "
+          f"{os.getloadavg()[0]:.1f}; same recommendation: {same}")
+    for name, found in (("old", old_lines), ("new", lines), ("new again", lines2)):
+        for line in found:
+            print(f"  {name}: {line}")
+    if not (same and before / mean >= VERSUS_TARGET):
+        sys.exit(1)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true",
@@ -177,7 +246,13 @@ def main() -> None:
     parser.add_argument("--executor", type=int, metavar="WORKERS",
                         help="only time the seed's study in process and on WORKERS local "
                         "processes (springc tradeoff's default executor)")
+    parser.add_argument("--versus", type=Path, metavar="OLD_SRC",
+                        help="only time the seed's whole command against the sources "
+                        "of an older springc (see the module text)")
     args = parser.parse_args()
+    if args.versus:
+        versus(args.versus)
+        return
     if args.executor:
         compare_executor(scenes(args.quick)[0], args.budget, args.executor)
         return

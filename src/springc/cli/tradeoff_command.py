@@ -79,7 +79,13 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @click.option("--save-reference", type=click.Path(dir_okay=False),
               help="Write the reference trajectory as CSV (reusable with --reference).")
 @click.option("--repeats", type=click.IntRange(min=1), default=3, show_default=True,
-              help="Timed runs per setting (median); runs over 2 s are timed once.")
+              help="Timed runs of a contender (median): a run meeting a --max-error "
+              "within 5x of the fastest one known, and scipy's default call; other runs, "
+              "and runs over 2 s, are timed once.")
+@click.option("--cost-limit", type=click.FloatRange(min=1), default=10.0, show_default=True,
+              metavar="FACTOR", help="Skip a solver's tighter settings once one of its runs "
+              "takes FACTOR times dop853's fastest run meeting every --max-error (the "
+              "table says which); inf runs them all.")
 @click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
               show_default=True, help="Seconds per run: a longer run is stopped and the "
               "solver's tighter settings are skipped.")
@@ -102,14 +108,16 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              solvers: tuple[str, ...] | None, tolerances: tuple[float, ...] | None,
              steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
              reference: str | None, save_reference: str | None, repeats: int,
-             budget: float, output: str | None, plot: str | None, energy: str | None,
+             cost_limit: float, budget: float, output: str | None, plot: str | None,
+             energy: str | None,
              workers: int | None, scheduler: str | None, quiet: bool) -> None:
     """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
 
     The error of each run is measured on the output grid against REFERENCE, or against
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
-    are compared; --vars selects other variables. Each solver's runs are one task of
-    the studies executor (local processes, or Dask with --scheduler).
+    are compared; --vars selects other variables. dop853 runs first, then each other
+    solver's runs are one task of the studies executor (local processes, or Dask with
+    --scheduler), its tighter settings skipped past --cost-limit.
     """
     from ..simulation import PLOT_FORMATS, check_run_values
 
@@ -128,6 +136,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     from ..tradeoff import (
         DEFAULT_TARGETS,
         DEFAULT_TOLERANCES,
+        SPREAD_ABOVE,
         TradeoffOptions,
         compare_states,
         run_tradeoff,
@@ -147,10 +156,13 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     options = TradeoffOptions(
         solvers=solvers, tolerances=tolerances or DEFAULT_TOLERANCES, steps=steps,
         targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
-        budget=budget, start=start, stop=stop, interval=interval, parameters=rest,
+        budget=budget, cost_limit=cost_limit, start=start, stop=stop, interval=interval,
+        parameters=rest,
         log=None if quiet else sys.stderr, energy=energy)
     from ..studies import Executor
 
-    study = run_tradeoff(compiled, options, Executor(workers, scheduler))
+    # a small study stays in this process unless workers or a scheduler are asked for
+    spread = 0.0 if workers is not None or scheduler is not None else SPREAD_ABOVE
+    study = run_tradeoff(compiled, options, Executor(workers, scheduler), spread)
     click.echo(summary(study), nl=False)
     save_study(study, table=output, plot=plot, reference=save_reference, protected=inputs)

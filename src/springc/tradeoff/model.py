@@ -1,9 +1,10 @@
 """The data of a tradeoff study: options in, runs and reference out, and the constants
 every other tradeoff module shares. Nothing here computes; :mod:`.study` does.
 
-The order of the package is ``model <- setup <- reference``, ``model <- report``,
-``model <- plot``, then ``{setup, reference, energy} <- study``: no module imports one
-that imports it back.
+The order of the package is ``model <- setup <- {reference, timing}``,
+``timing <- {chains, baselines}``, ``model <- report``, ``model <- plot``, then
+``{reference, energy, chains, baselines} <- study``: no module imports one that
+imports it back.
 """
 
 from __future__ import annotations
@@ -25,11 +26,24 @@ DEFAULT_TARGETS = (1e-4,)
 REFERENCE_RTOL = 1e-12
 SCALE_FLOOR = 1e-6
 REPEAT_LIMIT = 2.0
+"""Runs longer than this (seconds) are timed once, contenders or not."""
+REPEAT_MARGIN = 5.0
+"""A run is a contender, timed ``repeats`` times, when it meets a target within this
+factor of the fastest time known for it (see :mod:`.timing`)."""
+COST_LIMIT = 10.0
+"""Default factor of the cost limit: a solver's tighter settings are skipped once one
+of its runs takes this many times the pilot's fastest run meeting the targets."""
 DEFAULT_BUDGET = 30.0
 SCIPY_DEFAULT, SCIPY_RK45 = "scipy-default", "scipy-rk45"
+BUDGET_SKIP = "skipped (a looser setting was over budget)"
+COST_SKIP = "skipped: cost limit"
+"""How the status of a setting skipped by the cost limit starts (:mod:`.chains`)."""
+PROBE_SKIP = "skipped: probe"
+"""How the status of an rtol of scipy's RK45 skipped on the probe's word starts
+(:mod:`.baselines`)."""
 CSV_COLUMNS = ("solver", "setting", "value", "wall_time_s", "repeats", "steps",
                "rhs_evaluations", "jacobian_evaluations", "max_error", "rms_error",
-               "status", "energy_drift")
+               "status", "energy_drift", "engine")
 
 
 class TradeoffError(SimulationError):
@@ -73,6 +87,7 @@ class TradeoffOptions:
     parameters: Mapping[str, float] = field(default_factory=dict)
     log: TextIO | None = None
     energy: str | None = None  # None: the only variable in J, if any
+    cost_limit: float = COST_LIMIT  # math.inf: every setting of every solver is run
 
     def __post_init__(self) -> None:
         _check_positive("tolerances", self.tolerances, below_one=True)
@@ -86,6 +101,9 @@ class TradeoffOptions:
                 and not math.isnan(self.budget)):
             raise UsageError(f"budget must be a positive number of seconds, not "
                              f"{self.budget!r}", option="budget")
+        if not (isinstance(self.cost_limit, (int, float)) and self.cost_limit >= 1):
+            raise UsageError(f"cost_limit must be a factor of at least 1 (inf: no limit), "
+                             f"not {self.cost_limit!r}", option="cost_limit")
         check_run_values(self.start, self.stop, self.interval)
 
 
@@ -105,6 +123,7 @@ class Run:
     rms_error: float
     status: str = "ok"
     energy_drift: float = math.nan  # see springc.tradeoff.energy
+    engine: str = ""  # the step loop that ran it: "compiled" or "scipy" ("": not run)
 
     @property
     def ok(self) -> bool:
@@ -138,3 +157,5 @@ class Tradeoff:
     baselines: tuple[Run, ...]
     targets: tuple[float, ...]
     energy: str | None = None
+    cost_limit: str = ""  # "10x the fastest dop853 run meeting ...": what it measures
+    pilot: str = ""  # the solver run first (:mod:`.chains`)

@@ -72,7 +72,8 @@ def tight_reference(setup: StudySetup, target: float, rtol: float = REFERENCE_RT
     second = time.perf_counter() - began
     scales = variable_scales(primary.values, setup.units)
     agreement, _ = relative_errors(check, primary.values, scales)
-    description = (f"dop853 at rtol {rtol:.0e} ({first:.3g} s), verified by {checker} at "
+    description = (f"dop853 ({primary.stats.engine}) at rtol {rtol:.0e} ({first:.3g} s), "
+                   f"verified by {checker} at "
                    f"rtol {rtol:.0e} ({second:.3g} s): they agree to {agreement:.1e} "
                    "(max relative difference on the grid)")
     if not agreement <= target:

@@ -16,7 +16,16 @@ from typing import IO
 
 from ..errors import Note
 from ..fileio import atomic_write
-from .model import CSV_COLUMNS, SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff
+from .model import (
+    BUDGET_SKIP,
+    COST_SKIP,
+    CSV_COLUMNS,
+    PROBE_SKIP,
+    SCIPY_DEFAULT,
+    SCIPY_RK45,
+    Run,
+    Tradeoff,
+)
 
 
 def _times(seconds: float, other: float) -> str:
@@ -81,7 +90,7 @@ def table_rows(tradeoff: Tradeoff) -> list[tuple[str, ...]]:
                      "" if r.rhs_evaluations < 0 else str(r.rhs_evaluations),
                      "" if r.jacobian_evaluations < 0 else str(r.jacobian_evaluations),
                      num(r.max_error, ".3e"), num(r.rms_error, ".3e"), r.status,
-                     num(r.energy_drift, ".3e")))
+                     num(r.energy_drift, ".3e"), r.engine))
     return rows
 
 
@@ -100,26 +109,26 @@ def write_table_csv(tradeoff: Tradeoff, path: str | Path) -> None:
 
 def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
     """The table as aligned text (or a Markdown table)."""
-    head: tuple[str, ...] = ("solver", "setting", "time s", "steps", "RHS", "Jacobians",
-                             "max error", "RMS error", "status")
+    head: tuple[str, ...] = ("solver", "setting", "engine", "time s", "steps", "RHS",
+                             "Jacobians", "max error", "RMS error", "status")
     energy = tradeoff.energy is not None
     if energy:
         head = (*head[:-1], f"{tradeoff.energy} drift", head[-1])
     body = []
     for r in (*tradeoff.runs, *tradeoff.baselines):
         ok = r.ok
-        body.append((r.solver, r.label(), f"{r.wall_time:.3g}" if ok else "",
+        body.append((r.solver, r.label(), r.engine, f"{r.wall_time:.3g}" if ok else "",
                      str(r.steps) if ok and r.steps >= 0 else "",
                      str(r.rhs_evaluations) if ok else "",
                      str(r.jacobian_evaluations) if ok else "",
                      f"{r.max_error:.1e}" if ok else "", f"{r.rms_error:.1e}" if ok else "",
                      *([f"{r.energy_drift:.1e}" if ok else ""] if energy else []), r.status))
     if markdown:
-        right = "| --- | --- |" + " ---: |" * (len(head) - 3) + " --- |"
+        right = "| --- | --- | --- |" + " ---: |" * (len(head) - 4) + " --- |"
         return "\n".join(["| " + " | ".join(head) + " |", right,
                           *("| " + " | ".join(row) + " |" for row in body)]) + "\n"
     widths = [max(len(row[i]) for row in (head, *body)) for i in range(len(head))]
-    left = (0, 1, len(head) - 1)
+    left = (0, 1, 2, len(head) - 1)
     lines = ["  ".join(c.ljust(w) if i in left else c.rjust(w)
                        for i, (c, w) in enumerate(zip(row, widths))).rstrip()
              for row in (head, *body)]
@@ -132,9 +141,9 @@ def summary(tradeoff: Tradeoff) -> str:
     lines = [f"{tradeoff.model}: {tradeoff.states} states, {len(ref.time)} output times, "
              f"{len(ref.names)} variables compared",
              f"reference: {ref.description}", "", format_table(tradeoff).rstrip(), ""]
-    note = unresolved_note(tradeoff)
-    if note is not None:
-        lines += [f"note: {note.message}", ""]
+    for note in (*skipped_notes(tradeoff), unresolved_note(tradeoff)):
+        if note is not None:
+            lines += [f"note: {note.message}", ""]
     return "\n".join(lines + recommendations(tradeoff)) + "\n"
 
 
@@ -148,3 +157,31 @@ def unresolved_note(tradeoff: Tradeoff) -> Note | None:
         return None
     return Note(f"{len(low)} runs have max errors below 10x the reference agreement "
                 f"({10 * agreement:.0e}); those errors are not resolved")
+
+
+def skipped_notes(tradeoff: Tradeoff) -> list[Note]:
+    """Notes naming the settings not run (the table has a row for each), by reason."""
+    kinds = ((COST_SKIP, f"a looser setting of the same solver took over "
+              f"{tradeoff.cost_limit}, and tighter settings cost more (--cost-limit)"),
+             (PROBE_SKIP, "springc's compiled rk45, the same method taking the same steps, "
+              "does not reach the target there (its error is in the table)"),
+             (BUDGET_SKIP, "a looser setting of the same solver was over the budget "
+              "(--budget)"))
+    notes = []
+    for start, reason in kinds:
+        per: dict[str, list[Run]] = {}
+        for r in (*tradeoff.runs, *tradeoff.baselines):
+            if r.status.startswith(start):
+                per.setdefault(r.solver, []).append(r)
+        if per:
+            count = sum(len(v) for v in per.values())
+            named = ", ".join(f"{solver} {run_label(runs)}" for solver, runs in per.items())
+            notes.append(Note(f"{count} setting{'s were' if count > 1 else ' was'} not run "
+                              f"({named}): {reason}"))
+    return notes
+
+
+def run_label(runs: Sequence[Run]) -> str:
+    """``rtol 1e-04 to 1e-10`` or ``rtol 1e-04``: the settings of ``runs``."""
+    first, last = runs[0].label(), runs[-1].label()
+    return first if len(runs) == 1 else f"{first} to {last.split(' ', 1)[1]}"

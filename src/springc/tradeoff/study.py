@@ -17,40 +17,39 @@ time, the steps, the RHS and Jacobian evaluations, and the error on the output g
   no Jacobian, so it suits any size) at the same tolerance. Their difference, in the
   error measure above, is reported; if it exceeds the smallest target error the
   reference is refused.
-- **Time.** Wall time of ``simulate_model`` (integration and outputs, not compilation),
-  the median of ``repeats`` runs; runs longer than :data:`REPEAT_LIMIT` are timed once.
-  A run longer than ``budget`` seconds is stopped, and the solver's tighter settings
-  are skipped.
+- **Time.** Wall time of ``simulate_model`` (integration and outputs, not compilation:
+  each solver's loop is warmed up untimed), timed once; the contenders for a
+  recommendation are timed ``repeats`` times (the median), see :mod:`.runs`. A run
+  longer than ``budget`` seconds is stopped, and the solver's tighter settings are
+  skipped.
+- **Order and cost limit.** The pilot solver (``dop853``) runs first, in this process,
+  right after the reference; the other solvers' tighter settings are skipped once a run
+  costs ``cost_limit`` times the pilot's fastest run meeting the targets
+  (:mod:`.chains`); skipped rows say why.
 - **Baselines.** scipy's default call ``solve_ivp(rhs, span, x0, t_eval=grid)`` (RK45,
-  rtol 1e-3, atol 1e-6) on the same generated right-hand side, timed the same way
-  (observed outputs included), and ``solve_ivp`` RK45 at the requested tolerances
-  (atol = rtol/1000), loosest first, until it reaches the smallest target.
+  rtol 1e-3, atol 1e-6) on the same generated right-hand side, and ``solve_ivp`` RK45
+  tightened until it reaches the smallest target (:mod:`.baselines`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 import os
-import statistics
-import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import SimulationError
 from ..pipeline import CompiledModel, CompileOptions, compile_files
-from ..simulation import FIXED_STEP, SOLVERS, simulate_model
-from .energy import drift, energy_series, energy_variable
+from ..simulation import FIXED_STEP, SOLVERS
+from .baselines import baseline_runs
+from .chains import Chain, Pilot, cost_ceiling, pilot_solver, solver_runs
+from .energy import energy_variable
 from .model import (
     DEFAULT_STEP_DIVISIONS,
-    REPEAT_LIMIT,
     SCIPY_DEFAULT,
-    SCIPY_RK45,
-    OverBudget,
     Reference,
     Run,
     Tradeoff,
@@ -58,15 +57,8 @@ from .model import (
     TradeoffOptions,
 )
 from .reference import read_reference, tight_reference
-from .setup import (
-    Deadline,
-    StudySetup,
-    relative_errors,
-    scipy_outputs,
-    study_setup,
-    variable_scales,
-    warm_up,
-)
+from .runs import log_line
+from .setup import StudySetup, study_setup, variable_scales, warm_up
 
 # ------------------------------------------------------------------ solvers
 
@@ -94,97 +86,22 @@ def check_solvers(names: Sequence[str]) -> tuple[str, ...]:
     return tuple(names)
 
 
-Measured = tuple[float, tuple[int, int, int], np.ndarray]
-"""What one timed run returns: seconds, (steps, RHS, Jacobian evaluations), outputs."""
-
-
-def _timed(setup: StudySetup, solver: str, setting: str, value: float,
-           once: Callable[[float], Measured]) -> tuple[Run, np.ndarray | None]:
-    """Run ``once(budget)`` (it returns (seconds, stats, values)), repeat if short."""
-    try:
-        seconds, (steps, rhs, jacobians), values = once(setup.options.budget)
-    except OverBudget:
-        return Run(solver, setting, value, math.nan, 1, -1, -1, -1, math.nan, math.nan,
-                   f"over budget (> {setup.options.budget:g} s)"), None
-    except SimulationError as err:
-        return Run(solver, setting, value, math.nan, 1, -1, -1, -1, math.nan, math.nan,
-                   f"failed: {err.message}"), None
-    times = [seconds]
-    while seconds < REPEAT_LIMIT and len(times) < setup.options.repeats:
-        times.append(once(math.inf)[0])
-    return Run(solver, setting, value, statistics.median(times), len(times), steps, rhs,
-               jacobians, math.nan, math.nan), values
-
-
-def _springc_run(setup: StudySetup, solver: str, rtol: float | None,
-                 step: float | None) -> tuple[Run, np.ndarray | None]:
-    def once(budget: float) -> Measured:
-        deadline = Deadline(budget) if math.isfinite(budget) else None
-        result = simulate_model(setup.model, setup.sim_options(solver, rtol, step, deadline))
-        s = result.stats
-        return s.wall_time, (s.steps, s.rhs_evaluations, s.jacobian_evaluations), result.values
-
-    if step is not None:
-        return _timed(setup, solver, "step", step, once)
-    assert rtol is not None, "an adaptive run needs rtol"
-    return _timed(setup, solver, "rtol", rtol, once)
-
-
-def _counting_rhs(setup: StudySetup, budget: float) -> tuple[Callable[..., Any], list[int]]:
-    mod, p = setup.model.module, setup.p
-    z = np.asarray(mod.guesses(p), dtype=float)
-    deadline = Deadline(budget)
-    count = [0]
-
-    def rhs(t: float, x: np.ndarray) -> np.ndarray:
-        count[0] += 1
-        if count[0] % 64 == 0:
-            deadline.check()
-        dx: np.ndarray = mod.rhs(t, x, p, z)
-        return dx
-
-    return rhs, count
-
-
-def _scipy_run(setup: StudySetup, rtol: float | None) -> tuple[Run, np.ndarray | None]:
-    """``solve_ivp`` RK45 with the generated RHS: scipy's defaults when ``rtol`` is None."""
-    from scipy.integrate import solve_ivp
-
-    grid = setup.grid
-
-    def once(budget: float) -> Measured:
-        rhs, count = _counting_rhs(setup, budget)
-        kwargs = {} if rtol is None else {"rtol": rtol, "atol": rtol * setup.atol_ratio}
-        began = time.perf_counter()
-        with np.errstate(all="ignore"):
-            sol = solve_ivp(rhs, (grid[0], grid[-1]), setup.x0, t_eval=grid, **kwargs)
-            if not sol.success or sol.y.shape[1] != len(grid):
-                raise SimulationError(f"solve_ivp: {sol.message}")
-            values = scipy_outputs(setup.model, setup.p, grid, sol.y.T)
-        return time.perf_counter() - began, (-1, count[0], 0), values
-
-    if rtol is None:
-        return _timed(setup, SCIPY_DEFAULT, "rtol", 1e-3, once)
-    return _timed(setup, SCIPY_RK45, "rtol", rtol, once)
-
-
-def _with_errors(run: Run, values: np.ndarray | None, ref: Reference,
-                 scales: np.ndarray) -> Run:
-    if values is None:
-        return run
-    worst, rms = relative_errors(values, ref.values, scales)
-    if not math.isfinite(worst):
-        return dataclasses.replace(run, status="failed: non-finite outputs")
-    return dataclasses.replace(run, max_error=worst, rms_error=rms)
+SPREAD_ABOVE = 2.0
+"""Seconds of the pilot's runs below which ``springc tradeoff`` keeps the other solvers
+in its own process unless told otherwise: starting a worker process (a fresh
+interpreter importing springc, numba and scipy, then loading the model and the
+compiled loops) costs seconds, more than such a study's remaining runs."""
 
 
 def run_tradeoff(model: CompiledModel, options: TradeoffOptions,
-                 executor: Executor | None = None) -> Tradeoff:
+                 executor: Executor | None = None, spread_above: float = 0.0) -> Tradeoff:
     """Measure every solver at every setting against the reference (see module text).
 
-    The reference is computed here; each solver's settings (and the scipy baselines)
-    are one task (:class:`Chain`), run in this process or, with ``executor`` (the
-    studies executor: local processes or Dask), in its workers; the table is the same.
+    The reference and the pilot solver's runs are computed here; each other solver's
+    settings (and the scipy baselines) are one task (:class:`Chain`), run in this
+    process or, with ``executor`` (the studies executor: local processes or Dask), in
+    its workers, when the pilot's runs took ``spread_above`` seconds or more in all;
+    the table is the same.
     """
     setup = study_setup(model, options)
     solvers = check_solvers(options.solvers if options.solvers is not None
@@ -199,28 +116,38 @@ def run_tradeoff(model: CompiledModel, options: TradeoffOptions,
     scales = variable_scales(ref.values, setup.units)
     setup.log(f"reference: {ref.description}")
     energy = energy_variable(model, options.energy)
-    # Step 2: every solver, loosest setting first, until one is over budget; step 3:
-    # scipy's default call, then RK45 tightened until it reaches the targets.
-    fixed = set(fixed_step_solvers())
+    # Step 2: the pilot, then every other solver, loosest setting first, until one is
+    # over budget or over the cost limit; step 3: the scipy baselines.
     interval = float(setup.grid[1] - setup.grid[0]) if len(setup.grid) > 1 else 1.0
     steps = options.steps or tuple(interval / d for d in DEFAULT_STEP_DIVISIONS)
-    chains = [Chain(solver, tuple(sorted(steps if solver in fixed else options.tolerances,
+    chains = [Chain(solver, tuple(sorted(steps if solver in FIXED_STEP else options.tolerances,
                                          reverse=True))) for solver in solvers]
     chains.append(Chain(SCIPY_DEFAULT, ()))
+    first = solvers.index(pilot_solver(solvers))
     done: list[list[Run]] = [[] for _ in chains]
+    done[first] = solver_runs(setup, ref, scales, energy, chains[first], None, setup.log)
+    pilot = Pilot(chains[first].solver, tuple(done[first]))
+    rest = [i for i in range(len(chains)) if i != first]
+    pilot_seconds = sum(r.wall_time for r in pilot.runs if r.ok)
+    if executor is not None and pilot_seconds < spread_above:
+        setup.log(f"the other solvers run in this process: {pilot.solver}'s runs took "
+                  f"{pilot_seconds:.2g} s, less than starting worker processes costs")
+        executor = None
     if executor is None:
-        for i, chain in enumerate(chains):
-            done[i] = chain_runs(setup, ref, scales, energy, chain, setup.log)
+        for i in rest:
+            done[i] = chain_runs(setup, ref, scales, energy, chains[i], pilot, setup.log)
     else:
         job = ChainJob(model.options, model.outputs, dataclasses.replace(options, log=None),
-                       ref, scales, energy)
-        for i, runs in executor.map(functools.partial(run_chain, job), chains):
-            done[i] = runs
+                       ref, scales, energy, pilot)
+        for k, runs in executor.map(functools.partial(run_chain, job),
+                                    [chains[i] for i in rest]):
+            done[rest[k]] = runs
             for run in runs:
-                setup.log(_log_line(run))
+                setup.log(log_line(run))
     return Tradeoff(model.name, len(model.states), ref, scales,
                     tuple(run for runs in done[:-1] for run in runs), tuple(done[-1]),
-                    tuple(options.targets), energy)
+                    tuple(options.targets), energy,
+                    cost_ceiling(pilot, options.targets, options.cost_limit)[1], pilot.solver)
 
 
 class Executor(Protocol):
@@ -232,19 +159,10 @@ class Executor(Protocol):
 
 
 @dataclass(frozen=True)
-class Chain:
-    """One task: a solver's settings, loosest first (a run over budget skips the
-    tighter ones), or the scipy baselines (``solver`` :data:`SCIPY_DEFAULT`)."""
-
-    solver: str
-    settings: tuple[float, ...]
-
-
-@dataclass(frozen=True)
 class ChainJob:
     """What a worker needs for any chain: the model (compile options with absolute
     file names, and the compared outputs), the options (no log stream), the reference,
-    the scales and the energy variable."""
+    the scales, the energy variable and the pilot's runs."""
 
     compile: CompileOptions
     outputs: tuple[str, ...]
@@ -252,6 +170,7 @@ class ChainJob:
     reference: Reference
     scales: np.ndarray
     energy: str | None
+    pilot: Pilot | None = None
 
     def __post_init__(self) -> None:
         absolute = dataclasses.replace(
@@ -272,66 +191,14 @@ def run_chain(job: ChainJob, chain: Chain) -> list[Run]:
     setup = study_setup(model, job.options)
     with np.errstate(all="ignore"):
         warm_up(model, setup.p, setup.x0)
-    return chain_runs(setup, job.reference, job.scales, job.energy, chain)
+    return chain_runs(setup, job.reference, job.scales, job.energy, chain, job.pilot)
 
 
 def chain_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: str | None,
-               chain: Chain, log: Callable[[str], None] | None = None) -> list[Run]:
-    """The runs of ``chain``, each logged with ``log`` when done."""
-    with_energy = _energy_drift(setup, energy, ref)
-    runs: list[Run] = []
-
-    def done(run: Run) -> None:
-        runs.append(run)
-        if log is not None:
-            log(_log_line(run))
-
+               chain: Chain, pilot: Pilot | None = None,
+               log: Callable[[str], None] | None = None) -> list[Run]:
+    """The runs of ``chain``: a solver's (:func:`.chains.solver_runs`) or the scipy
+    baselines (:func:`.baselines.baseline_runs`), each logged with ``log`` when done."""
     if chain.solver == SCIPY_DEFAULT:
-        base, values = _scipy_run(setup, None)
-        done(with_energy(_with_errors(base, values, ref, scales), values))
-        goal = min(setup.options.targets)
-        if not (runs[0].ok and runs[0].max_error <= goal):
-            for rtol in sorted((t for t in setup.options.tolerances if t < 1e-3),
-                               reverse=True):
-                run, values = _scipy_run(setup, rtol)
-                done(with_energy(_with_errors(run, values, ref, scales), values))
-                if not runs[-1].ok or runs[-1].max_error <= goal:
-                    break
-        return runs
-    fixed = chain.solver in fixed_step_solvers()
-    skip = False
-    for value in chain.settings:
-        if skip:
-            runs.append(Run(chain.solver, "step" if fixed else "rtol", value, math.nan, 0,
-                            -1, -1, -1, math.nan, math.nan,
-                            "skipped (a looser setting was over budget)"))
-            continue
-        run, values = _springc_run(setup, chain.solver, None if fixed else value,
-                                   value if fixed else None)
-        done(with_energy(_with_errors(run, values, ref, scales), values))
-        skip = runs[-1].status.startswith("over budget")
-    return runs
-
-
-def _energy_drift(setup: StudySetup, energy: str | None, ref: Reference
-                  ) -> Callable[[Run, np.ndarray | None], Run]:
-    """A function adding the energy drift to a run (the identity without energy)."""
-    if energy is None:
-        return lambda run, values: run
-    model, p, grid = setup.model, setup.p, setup.grid
-    scale = float(np.max(np.abs(energy_series(model, p, grid, ref.values, energy))))
-
-    def add(run: Run, values: np.ndarray | None) -> Run:
-        if values is None or not run.ok:
-            return run
-        series = energy_series(model, p, grid, values, energy)
-        return dataclasses.replace(run, energy_drift=drift(series, scale))
-
-    return add
-
-
-def _log_line(run: Run) -> str:
-    if not run.ok:
-        return f"{run.solver} {run.label()}: {run.status}"
-    return (f"{run.solver} {run.label()}: {run.wall_time:.3g} s, max error "
-            f"{run.max_error:.1e}")
+        return baseline_runs(setup, ref, scales, energy, log)
+    return solver_runs(setup, ref, scales, energy, chain, pilot, log)
