@@ -22,6 +22,8 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .assertions import guard_assertions
 from .builtins import Builtins
+from .cardinality import NAME as CARDINALITY
+from .cardinality import cardinality_call
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
@@ -38,7 +40,7 @@ from .scope import (
 UNSUPPORTED_CALLS = {
     "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
-    "delay", "spatialDistribution", "cardinality", "inStream", "actualStream",
+    "delay", "spatialDistribution", "inStream", "actualStream",
     "getInstanceName", "String", "assert",
 }
 
@@ -60,6 +62,7 @@ class Evaluator(ReferenceResolver):
         # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
         # outlives the evaluator, so ids are not reused).
         self.uses_end: dict[int, bool] = {}
+        self.cardinality_used = False  # placeholders to replace (flatten/cardinality.py)
 
     # ------------------------------------------------------------ entry points
 
@@ -304,6 +307,9 @@ class Evaluator(ReferenceResolver):
                                "\"Not supported yet\" in docs/language.md")
         if name in EVENT_CALLS:
             return event_call(self, self.events, e, scope)
+        if name == CARDINALITY:
+            self.cardinality_used = True
+            return cardinality_call(self, e, scope)
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
