@@ -24,7 +24,7 @@ from .assertions import guard_assertions
 from .builtins import Builtins
 from .cardinality import NAME as CARDINALITY
 from .cardinality import cardinality_call
-from .event_calls import EVENT_CALLS, event_call
+from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
 from .parameters import check_powers
@@ -209,6 +209,8 @@ class Evaluator(ReferenceResolver):
         left = self.value(e.left, scope)
         right = self.value(e.right, scope)
         scalar = _ARITHMETIC.get(e.op)
+        if scalar is not None and (type(left) is x.Call or type(right) is x.Call):
+            check_arithmetic_operands(e.op, (left, right), e)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check
             return scalar(cast(x.Expr, left), cast(x.Expr, right))

@@ -21,6 +21,7 @@ from ..ir.hybrid import Discrete, EventSystem, TimeRelation
 
 STATE_RELATIONS = frozenset({"<", "<=", ">", ">="})
 _QUIET = frozenset({"noEvent", "smooth"})
+_PHASES = frozenset({"initial", "terminal"})
 
 
 def continuous_part(model: flat.FlatModel) -> flat.FlatModel:
@@ -83,14 +84,17 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
                 arg = node.args[0]
                 if isinstance(arg, x.Var):
                     pre.setdefault(arg.name, None)
-    if not (held or relations or timed or samples or model.whens or floors):
+    phases = {n.name for e in [*exprs, *(a.condition for a in model.assertions)]
+              for n in x.walk(e) if isinstance(n, x.Call) and n.name in _PHASES}
+    if not (held or relations or timed or samples or model.whens or floors or phases):
         return None
     by_name = {v.name: v for v in model.variables}
     discrete = tuple(Discrete(n, by_name[n].type, by_name[n].attributes.start,
                               by_name[n].span) for n in held)
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
                        tuple(pre), _sorted_whens(model.whens), tuple(floors),
-                       tuple(_time_rate(c.args[0], params) for c in floors))
+                       tuple(_time_rate(c.args[0], params) for c in floors),
+                       "initial" in phases, "terminal" in phases)
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
