@@ -24,6 +24,8 @@ from .assertions import guard_assertions
 from .builtins import Builtins
 from .cardinality import NAME as CARDINALITY
 from .cardinality import cardinality_call
+from .delay import NAME as DELAY
+from .delay import delay_call
 from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
@@ -40,7 +42,7 @@ from .scope import (
 UNSUPPORTED_CALLS = {
     "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
-    "delay", "spatialDistribution", "inStream", "actualStream",
+    "spatialDistribution", "inStream", "actualStream",
     "getInstanceName", "String", "assert",
 }
 
@@ -312,6 +314,8 @@ class Evaluator(ReferenceResolver):
         if name == CARDINALITY:
             self.cardinality_used = True
             return cardinality_call(self, e, scope)
+        if name == DELAY:
+            return delay_call(self, e, scope)
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
