@@ -488,7 +488,6 @@ def test_other_lexical_and_syntax_errors() -> None:
 
 
 UNSUPPORTED = [
-    ("function f algorithm when c then x := 1; end when; end f;", "`when` statements are"),
     ("function f initial algorithm end f;", "`initial algorithm` sections are"),
     ('function f external "C"; end f;', "`external` functions are"),
     ("connector C stream Real h; end C;", "`stream` connectors are"),

@@ -42,8 +42,9 @@ def assertion_function(m: CodegenContext, namer: Namer, helpers: set[str], numba
         read = sorted({n for item in items for n in variables(item.condition)})
         stmts = m.loads() + steps + m.alias_stmts(read)
     stmts.append(Raw(f"ok = np.empty({len(items)})"))
-    stmts += [Store(f"ok[{i}]", item.condition, f"assertion {i}")
-              for i, item in enumerate(items)]
+    layout = m.events  # initial() and terminal() read their event slots
+    stmts += [Store(f"ok[{i}]", layout.hold(item.condition) if layout else item.condition,
+                    f"assertion {i}") for i, item in enumerate(items)]
     prologue: list[Stmt] = [] if numba or not items else [
         Raw("x = x.tolist()\np = p.tolist()")]
     doc = "1.0 for each ASSERTIONS condition that holds at time t, 0.0 where it fails."

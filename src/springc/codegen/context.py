@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
+from .delays import DelayLayout
 from .event_layout import EventLayout
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
@@ -70,6 +71,8 @@ class CodegenContext:
     and the module text (the parts of codegen below the generator take it)."""
 
     def __init__(self, system: ode.ODE, flat_model: flat.FlatModel | None) -> None:
+        self.delays = DelayLayout(system)  # delay(...) calls read z slots (delays.py)
+        system = self.delays.system
         self.ode = system
         self.states = [s.name for s in system.states]
         self.derivatives = [s.derivative for s in system.states]
@@ -93,6 +96,8 @@ class CodegenContext:
         self.events = EventLayout(system.events, len(self.guess_slots)) \
             if system.events is not None else None
         self.flag_slot = len(self.guess_slots) + (self.events.size if self.events else 0)
+        self.delays.base = self.flag_slot
+        self.flag_slot += len(self.delays)
         if self.events:
             self.model_names |= set(self.events.discrete)
 
@@ -106,7 +111,7 @@ class CodegenContext:
     def loads(self) -> list[Stmt]:
         out: list[Stmt] = [Load(n, f"p[{i}]", n) for i, n in enumerate(self.params)]
         out += [Load(n, f"x[{i}]", n) for i, n in enumerate(self.states)]
-        return out + (self.events.loads() if self.events else [])
+        return out + (self.events.loads() if self.events else []) + self.delays.loads()
 
     def newton_systems(self) -> dict[int, tuple[str, ...]]:
         """Failure flag value -> tearing variables of that torn system."""

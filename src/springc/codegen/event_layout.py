@@ -60,8 +60,9 @@ class EventLayout:
         self.slot = {name: base + i for i, name in enumerate(names)}
         self.size = len(names)
         self.held = self._held()
-        self.uses_terminal = any(isinstance(n, x.Call) and n.name == "terminal"
-                                 for _, _, c in self.conditions for n in x.walk(c))
+        self.uses_terminal = events.reads_terminal or any(
+            isinstance(n, x.Call) and n.name == "terminal"
+            for _, _, c in self.conditions for n in x.walk(c))
         self.messages = list(dict.fromkeys(
             t.message for clause in events.whens for b in clause.branches
             for t in b.terminates))

@@ -244,9 +244,13 @@ def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     loads = m.loads()
     cleared: list[Stmt] = [Let(name, _ZERO) for name in [*layout.samples, "_zinit"]]
     steps, _ = m.step_stmts()
-    out = loads + cleared + steps + m.alias_stmts(sorted(m.aliases))
+    out = [*loads, Let("_zinit_was", x.Var("_zinit")), *cleared, *steps,
+           *m.alias_stmts(sorted(m.aliases))]
     for k, (_, _, cond) in enumerate(layout.conditions):
-        out.append(Store(f"z[{slot[layout.condition_names[k]]}]", _flag(layout.hold(cond)),
+        # a condition on initial() keeps its value at the event: 'not initial()'
+        # becomes true at the event right after the initialization (after_initial)
+        now = x.substitute(layout.hold(cond), {"_zinit": x.Var("_zinit_was")})
+        out.append(Store(f"z[{slot[layout.condition_names[k]]}]", _flag(now),
                          x.to_text(cond)))
     for name in layout.samples:
         out.append(Store(f"z[{slot[name]}]", _ZERO))
@@ -295,7 +299,17 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         f"Z_STATUS = {s['_zstatus']}",
         f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
         f"USES_TERMINAL = {layout.uses_terminal}",
+        f"AFTER_INITIAL = {after_initial(layout)}",
     ]
+
+
+def after_initial(layout: EventLayout) -> bool:
+    """Whether a when-condition reads ``initial()`` other than as the whole condition
+    (``not initial()``): then an event follows the initialization at the start time,
+    where such a condition may become true."""
+    return any(cond != x.Call("initial", ()) and any(
+        isinstance(n, x.Call) and n.name == "initial" for n in x.walk(cond))
+        for _, _, cond in layout.conditions)
 
 
 EVENT_UPDATE = '''def event_update(t, x, p, z):

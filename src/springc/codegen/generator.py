@@ -27,6 +27,7 @@ from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
 from .assertions import assertion_function
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
+from .delays import used_names
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
 from .jacobian import jacobian_statements
@@ -95,7 +96,7 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     helpers: set[str] = set()
     numba = options.backend == "numba"
     vector = options.vector
-    if m.events is not None:
+    if m.events is not None or len(m.delays):
         vector = False  # the event functions are written with scalar statements
     elif vector is None:
         vector = _vector_suits(system)
@@ -120,6 +121,13 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
         bodies += [(fn, doc, function_lines(namer, helpers, prologue + make(m, m.events)), ret)
                    for fn, doc, make, ret in EVENT_FUNCTIONS]
     bodies.append(assertion_function(m, namer, helpers, numba))
+    if len(m.delays):
+        prologue = [] if numba else [Raw("x = x.tolist()\np = p.tolist()")]
+        steps, _ = m.step_stmts()
+        base = m.loads() + steps + m.alias_stmts(sorted(used_names(m.delays)))
+        bodies.append(("delay_inputs", "The delayed expressions, then the delay times.",
+                       function_lines(namer, helpers, prologue + m.delays.inputs_body(base)),
+                       "di"))
     structural = structural_parameters(system, flat_model)
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
                           table)
@@ -183,6 +191,7 @@ def _scalar_bodies(m: CodegenContext, outputs: Sequence[str], namer: Namer, help
 def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
     known = set(m.states) | set(m.params) | set(computed) | set(m.aliases)
     known |= set(m.events.slot) if m.events is not None else set()
+    known |= set(m.delays.names)
     for step in m.ode.steps:
         inner = set()
         if isinstance(step, ode.NonlinearBlock):

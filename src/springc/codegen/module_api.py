@@ -96,7 +96,9 @@ class HybridModule(GeneratedModule, Protocol):
 
     How a loop drives it (``springc.simulation.events`` does exactly this):
 
-    1. at the start ``z[Z_INITIAL] = 1.0; x = event_update(t0, x, p, z)``;
+    1. at the start ``z[Z_INITIAL] = 1.0; x = event_update(t0, x, p, z)``, and if
+       ``AFTER_INITIAL`` (a when-condition such as ``not initial()``) once more at
+       ``t0`` with ``z[Z_INITIAL]`` cleared;
     2. integrate ``rhs`` up to ``next_time_event(t, x, p, z)`` (or the stop time);
     3. after each accepted step compare ``zero_crossings(t, x, p, z)[k]`` (compared
        with 0 by ``RELATION_OPS[k]``) with the held ``z[Z_RELATIONS + k]``; where one
@@ -125,6 +127,7 @@ class HybridModule(GeneratedModule, Protocol):
     Z_STATUS: int
     EVENT_ITERATIONS: int
     USES_TERMINAL: bool  # a when-condition uses terminal(): run the event at the end
+    AFTER_INITIAL: bool  # a when-condition such as 'not initial()': an event after init
 
     def zero_crossings(self, t: float, x: FloatArray, p: FloatArray,
                        z: FloatArray) -> FloatArray: ...

@@ -118,6 +118,7 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         f"JAC_INDPTR = np.searchsorted(JAC_COLS, np.arange({n + 1}))",
     ]
     lines += event_constants(m, m.events) if m.events is not None else NO_EVENTS
+    lines += m.delays.constants()
     lines += parameters_function(m, namer, helpers)
     for name in sorted(helpers):
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()

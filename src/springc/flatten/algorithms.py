@@ -38,6 +38,13 @@ from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .when_statements import (
+    WhenParts,
+    check_nesting,
+    check_place,
+    terminate_of,
+    when_statement,
+)
 
 
 @dataclass(frozen=True)
@@ -59,6 +66,9 @@ class _Run:
         self.fl, self.ev, self.owner, self.initial = fl, fl.evaluator, owner, initial
         self.env: dict[str, x.Expr] = {}
         self.spans: dict[str, Span] = {}
+        self.context: list[str] = []  # the loops, variable ifs and whens around
+        self.held: set[str] = set()  # assigned in when statements (discrete)
+        self.parts: list[WhenParts] = []  # of the when statements around
 
     def read(self, value: a.Value, span: Span) -> a.Value:
         if isinstance(value, str):
@@ -87,10 +97,16 @@ class _Run:
         elif isinstance(stmt, s.ForStatement):
             self.for_(stmt, stmt.indices, where, guard)
         elif isinstance(stmt, s.WhileStatement):
-            run_while(self.ev, stmt,
-                      lambda: cast(x.Expr, self.read(self.ev.scalar(stmt.condition, where),
-                                                     stmt.span)),
-                      lambda: self.run(stmt.body, where, guard))
+            self.context.append("while")
+            try:
+                run_while(self.ev, stmt,
+                          lambda: cast(x.Expr, self.read(
+                              self.ev.scalar(stmt.condition, where), stmt.span)),
+                          lambda: self.run(stmt.body, where, guard))
+            finally:
+                self.context.pop()
+        elif isinstance(stmt, s.WhenStatement):
+            self.when(stmt, where, guard)
         elif isinstance(stmt, s.Jump):
             raise Jumped(stmt)
         else:
@@ -119,6 +135,11 @@ class _Run:
                 raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
                                    "parameter or constant", target.span,
                                    hint="an algorithm section assigns variables only")
+            if name.name in self.held and not self.parts:
+                raise FlattenError(f"'{name.name}' is assigned both in a when statement "
+                                   "and outside of it in this algorithm section", stmt.span,
+                                   hint="a variable a when statement assigns is discrete: "
+                                   "assign it only in when statements")
             self.env[name.name] = item
             self.spans[name.name] = stmt.span
 
@@ -141,10 +162,15 @@ class _Run:
             return
         before = dict(self.env)
         span = cond_expr.span
-        branch_jumps(lambda: self.run(body, where, _and(guard, cond)), span)
-        then = self.env
-        self.env = dict(before)
-        branch_jumps(lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))), span)
+        self.context.append("if")
+        try:
+            branch_jumps(lambda: self.run(body, where, _and(guard, cond)), span)
+            then = self.env
+            self.env = dict(before)
+            branch_jumps(lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))),
+                         span)
+        finally:
+            self.context.pop()
         for name in then.keys() | self.env.keys():
             old = before.get(name, x.Var(name))
             left, right = then.get(name, old), self.env.get(name, old)
@@ -157,6 +183,15 @@ class _Run:
         index, rest = with_range(self.ev, indices[0], stmt.body, where), indices[1:]
         values = self.ev.range_values(index, where)
         self.fl.limits.add_iterations(len(values), index.span)
+        self.context.append("for")
+        try:
+            self._iterations(stmt, values, index, rest, where, guard)
+        finally:
+            self.context.pop()
+
+    def _iterations(self, stmt: s.ForStatement, values: list[x.Expr], index: s.ForIndex,
+                    rest: tuple[s.ForIndex, ...], where: Scope, guard: x.Expr | None
+                    ) -> None:
         for value in values:
             local = LocalScope({index.name: value}, where)
             if rest:
@@ -164,10 +199,43 @@ class _Run:
             elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
                 break
 
+    def when(self, stmt: s.WhenStatement, where: Scope, guard: x.Expr | None) -> None:
+        check_place(stmt, self.context, self.initial)
+
+        def branch(body: tuple[s.Statement, ...], parts: WhenParts
+                   ) -> dict[str, tuple[x.Expr, Span]]:
+            before, spans = self.env, dict(self.spans)
+            self.env = dict(before)
+            self.context.append("when")
+            self.parts.append(parts)
+            try:
+                self.run(body, where, guard)
+                return {n: (v, self.spans[n]) for n, v in self.env.items()
+                        if before.get(n) is not v}
+            finally:
+                self.context.pop()
+                self.parts.pop()
+                self.env, self.spans = before, spans
+
+        self.fl.whens.append(when_statement(
+            self.ev, stmt, where, self.env, self.held,
+            lambda v, span: self.read(cast(a.Value, v), span), branch, self.owner.prefix))
+
     def call(self, stmt: s.CallStatement, where: Scope, guard: x.Expr | None) -> None:
-        if stmt.call.func.dotted != "assert":
+        name = stmt.call.func.dotted
+        if name == "terminate" and self.parts:
+            self.parts[-1].terminates.append(terminate_of(self.ev, stmt, where))
+            return
+        if name != "assert":
             call_for_effect(self.ev, stmt.call, where, "a statement")
             return
+        if self.parts:
+            guard = self.parts[-1].guard
+            if guard is None:
+                raise FlattenError("`assert` inside a when statement is not supported "
+                                   "yet, unless the condition is initial() or terminal()",
+                                   stmt.span, hint="springc supports a subset of Modelica; "
+                                   "see \"Not supported yet\" in docs/language.md")
         origin = flat.Origin("algorithm", self.owner.prefix)
         item, span = assertion(self.ev, stmt.call, where, origin, guard,
                                lambda v: self.read(v, stmt.span))
@@ -194,6 +262,7 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
         if isinstance(stmt, s.ForStatement):
             check_loop_nest(fl.evaluator, stmt, where)
     check_jumps(section.body, in_function=False)
+    check_nesting(section.body, initial)
     try:
         run.run(section.body, where, None)
     except Jumped as jumped:

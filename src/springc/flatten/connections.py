@@ -9,6 +9,7 @@ connectors that are connected nowhere are set to zero.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from typing import Any
 
@@ -120,6 +121,7 @@ class ConnectionSets:
         self.flow: dict[Key, bool] = {}
         self.link: dict[Key, Link] = {}
         self.causal: dict[str, str] = {}  # flat name -> input/output, for check_sources
+        self.counts: Counter[str] = Counter()  # connect equations per connector (cardinality)
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -150,6 +152,8 @@ class ConnectionSets:
                 eq.span, hint="connect arrays of connectors of the same size")
         for ca, cb in zip(left, right):
             self._pair(ca, cb, left_out, right_out, eq, owner)
+            for c in (ca, cb):
+                self.counts[c.name if isinstance(c, Leaf) else c.prefix] += 1
 
     def _connectors(self, ev: ExpressionEvaluator, ref: s.Ref, where: Scope, owner: ClassScope
                     ) -> tuple[tuple[int, ...], list[Any], bool]:

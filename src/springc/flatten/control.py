@@ -105,6 +105,9 @@ def check_jumps(body: tuple[s.Statement, ...], in_function: bool, in_loop: bool 
             for _cond, branch in stmt.branches:
                 check_jumps(branch, in_function, in_loop)
             check_jumps(stmt.otherwise, in_function, in_loop)
+        elif isinstance(stmt, s.WhenStatement):
+            for _cond, branch in stmt.branches:
+                check_jumps(branch, in_function, in_loop)
 
 
 def stray(jumped: Jumped) -> FlattenError:

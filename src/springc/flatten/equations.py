@@ -18,6 +18,7 @@ from .algorithms import Section, algorithm_section
 from .assertions import assertion
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
+from .event_calls import event_dependent
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
@@ -73,10 +74,10 @@ class EquationFlattening(FlattenContext):
         elif isinstance(eq, s.WhenEquation):
             flatten_when(self, eq, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
-            if any(self._variable_condition(cond, where) for cond, _ in eq.branches):
-                variable_if_equation(self, eq, where, owner, initial)
-                return
-            for cond, body in eq.branches:
+            for cond, body in eq.branches:  # in order, up to the first true (8.3.4)
+                if self._variable_condition(cond, where):
+                    variable_if_equation(self, eq, where, owner, initial)
+                    return
                 if self._if_condition(cond, where):
                     self._body(body, where, owner, initial)
                     return
@@ -99,8 +100,8 @@ class EquationFlattening(FlattenContext):
         """Whether an if-equation condition depends on variables (then the branches
         switch at events: flatten/when.py)."""
         value = self.evaluator.value(cond, where)
-        return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) \
-            and not self.is_parameter_expression(value)
+        return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) and (
+            not self.is_parameter_expression(value) or event_dependent(value))
 
     def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression

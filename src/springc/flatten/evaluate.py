@@ -22,7 +22,11 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .assertions import guard_assertions
 from .builtins import Builtins
-from .event_calls import EVENT_CALLS, event_call
+from .cardinality import NAME as CARDINALITY
+from .cardinality import cardinality_call
+from .delay import NAME as DELAY
+from .delay import delay_call
+from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
 from .parameters import check_powers
@@ -38,7 +42,7 @@ from .scope import (
 UNSUPPORTED_CALLS = {
     "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
-    "delay", "spatialDistribution", "cardinality", "inStream", "actualStream",
+    "spatialDistribution", "inStream", "actualStream",
     "getInstanceName", "String", "assert",
 }
 
@@ -60,6 +64,7 @@ class Evaluator(ReferenceResolver):
         # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
         # outlives the evaluator, so ids are not reused).
         self.uses_end: dict[int, bool] = {}
+        self.cardinality_used = False  # placeholders to replace (flatten/cardinality.py)
 
     # ------------------------------------------------------------ entry points
 
@@ -206,6 +211,8 @@ class Evaluator(ReferenceResolver):
         left = self.value(e.left, scope)
         right = self.value(e.right, scope)
         scalar = _ARITHMETIC.get(e.op)
+        if scalar is not None and (type(left) is x.Call or type(right) is x.Call):
+            check_arithmetic_operands(e.op, (left, right), e)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check
             return scalar(cast(x.Expr, left), cast(x.Expr, right))
@@ -304,6 +311,11 @@ class Evaluator(ReferenceResolver):
                                "\"Not supported yet\" in docs/language.md")
         if name in EVENT_CALLS:
             return event_call(self, self.events, e, scope)
+        if name == CARDINALITY:
+            self.cardinality_used = True
+            return cardinality_call(self, e, scope)
+        if name == DELAY:
+            return delay_call(self, e, scope)
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)

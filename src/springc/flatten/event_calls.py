@@ -60,3 +60,25 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
         return x.Call(name, (item,))
 
     return a.elementwise(one, argument)
+
+
+#: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.
+BOOLEAN_CALLS = frozenset({"edge", "change", "initial", "terminal", "sample"})
+
+
+def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary) -> None:
+    """``2.0*terminal()`` is a type error: the Boolean event built-ins are no numbers."""
+    for value, side in zip(operands, (e.left, e.right)):
+        if type(value) is x.Call and value.name in BOOLEAN_CALLS:
+            raise FlattenError(
+                f"'{x.to_text(value)}' is a Boolean and cannot be an operand of '{op}'",
+                side.span, hint=f"{value.name} returns a Boolean, and arithmetic needs "
+                "Integer or Real operands; choose a number with an if-expression "
+                f"('if {x.to_text(value)} then 1.0 else 0.0') (Modelica 3.6, section "
+                "3.7.5)")
+
+
+def event_dependent(e: x.Expr) -> bool:
+    """Whether ``e`` calls an event built-in (``initial()``, ``terminal()``, ``pre``,
+    ...): its value changes during the simulation even without variables."""
+    return any(type(n) is x.Call and n.name in EVENT_CALLS for n in x.walk(e))

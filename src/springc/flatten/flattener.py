@@ -10,6 +10,7 @@ from __future__ import annotations
 import gc
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import cast
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from ..ir.when import When
 from ..parse import ClassTree
 from .algorithms import Section, apply_starts
 from .assertions import check_conditions, unique
+from .cardinality import apply_cardinalities
 from .connect_rules import check_connector_size
 from .connections import ConnectionSets
 from .equations import EquationFlattening
@@ -162,6 +164,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
             flattener.equations_of(scope)
         for scope in scopes:
             flattener.equations_of(scope, initial=True)
+        if cast(Evaluator, flattener.evaluator).cardinality_used:
+            apply_cardinalities(flattener, flattener.connections.counts)
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
             flattener.errors += binding_errors(variables, flattener.parameter_values)

@@ -238,6 +238,11 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
             _while(ev, stmt, scope, guard)
         elif isinstance(stmt, s.Jump):
             raise Jumped(stmt)
+        elif isinstance(stmt, s.WhenStatement):
+            raise FlattenError("a when statement is not allowed in a function",
+                               stmt.span, hint="functions have no events: move the when "
+                               "statement to an algorithm section of a model (Modelica "
+                               "3.6, section 12.2)")
         else:
             _if(ev, stmt, scope, guard)
 

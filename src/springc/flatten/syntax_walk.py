@@ -19,6 +19,10 @@ def statements(body: tuple[s.Statement, ...]) -> Iterator[s.Statement]:
             for _, branch in stmt.branches:
                 yield from statements(branch)
             yield from statements(stmt.otherwise)
+        elif isinstance(stmt, (s.WhileStatement, s.WhenStatement)):
+            for branch in ([stmt.body] if isinstance(stmt, s.WhileStatement)
+                           else [b for _, b in stmt.branches]):
+                yield from statements(branch)
 
 
 def mod_values(mod: s.Modification | None) -> list[s.Expr]:
@@ -33,7 +37,7 @@ def mod_values(mod: s.Modification | None) -> list[s.Expr]:
 def statement_exprs(stmt: s.Statement) -> list[s.Expr]:
     if isinstance(stmt, s.Assign):
         return [stmt.value]
-    if isinstance(stmt, s.IfStatement):
+    if isinstance(stmt, (s.IfStatement, s.WhenStatement)):
         return [c for c, _ in stmt.branches]
     if isinstance(stmt, s.ForStatement):
         return [i.range for i in stmt.indices if i.range is not None]

@@ -10,14 +10,16 @@ when-conditions, reinit of a variable that is not Real).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 
-from ..errors import FlattenError, Note
+from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from ..ir import when as w
 from . import arrays as a
+from .assertions import assertion
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 _EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
@@ -35,18 +37,11 @@ def flatten_when(ctx: FlattenContext, eq: s.WhenEquation, where: Scope, owner: C
     uses.in_when += 1
     try:
         branches = []
+        earlier: list[x.Expr] = []  # the conditions of the branches before
         for cond_expr, body in eq.branches:
-            cond = ctx.evaluator.value(cond_expr, where)
-            items: list[object] = list(a.scalars(cond)) if a.is_array(cond) else [cond]
-            conditions: list[x.Expr] = []
-            for c in items:
-                if not isinstance(c, _EXPRS) or not _boolean_shape(c):
-                    raise FlattenError("the condition of a when-clause must be a Boolean "
-                                       "expression", cond_expr.span,
-                                       hint="write a relation such as 'h <= 0', a Boolean "
-                                       "variable, sample(start, interval) or initial()")
-                conditions.append(c)
-            parts = _Body()
+            conditions = when_conditions(ctx.evaluator.value(cond_expr, where), cond_expr)
+            parts = _Body(phase_guard(conditions, earlier), owner)
+            earlier += conditions
             for item in body:
                 _body_item(ctx, item, where, parts)
             branches.append(w.WhenBranch(tuple(conditions), tuple(parts.assignments),
@@ -57,11 +52,45 @@ def flatten_when(ctx: FlattenContext, eq: s.WhenEquation, where: Scope, owner: C
     ctx.whens.append(w.When(tuple(branches), eq.span, owner.prefix))
 
 
+def when_conditions(cond: a.Value, cond_expr: s.Expr) -> list[x.Expr]:
+    """The scalar conditions of a when-clause's condition value (a vector fires when
+    any element becomes true)."""
+    items: list[object] = list(a.scalars(cond)) if a.is_array(cond) else [cond]
+    conditions: list[x.Expr] = []
+    for c in items:
+        if not isinstance(c, _EXPRS) or not _boolean_shape(c):
+            raise FlattenError("the condition of a when-clause must be a Boolean "
+                               "expression", cond_expr.span,
+                               hint="write a relation such as 'h <= 0', a Boolean "
+                               "variable, sample(start, interval) or initial()")
+        conditions.append(c)
+    return conditions
+
+
 class _Body:
-    def __init__(self) -> None:
+    def __init__(self, guard: x.Expr | None = None, owner: ClassScope | None = None
+                 ) -> None:
         self.assignments: list[w.Assignment] = []
         self.reinits: list[w.Reinit] = []
         self.terminates: list[w.Terminate] = []
+        self.guard, self.owner = guard, owner  # for assert (see phase_guard)
+
+
+_PHASES = (x.Call("initial", ()), x.Call("terminal", ()))
+
+
+def phase_guard(conditions: list[x.Expr], earlier: list[x.Expr]) -> x.Expr | None:
+    """When a branch whose conditions are ``initial()`` or ``terminal()`` is active (the
+    result rows where it holds are exactly its events), else None: an ``assert`` in
+    the branch is checked where this guard holds."""
+    if not all(c in _PHASES for c in [*conditions, *earlier]):
+        return None
+    guard: x.Expr = conditions[0]
+    for c in conditions[1:]:
+        guard = x.BinOp("or", guard, c)
+    for c in earlier:
+        guard = x.BinOp("and", guard, x.Not(c))
+    return guard
 
 
 def _boolean_shape(e: x.Expr) -> bool:
@@ -123,10 +152,14 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
                            hint="combine the conditions: 'when a and b then' or use "
                            "elsewhen")
     elif isinstance(item, s.CallEquation) and item.call.func.dotted == "assert":
-        # valid Modelica (section 8.3.5), not simulated by springc yet
-        raise FlattenError("`assert` inside a when-clause is not supported yet", item.span,
-                           hint="springc supports a subset of Modelica; see \"Not "
-                           "supported yet\" in docs/language.md")
+        if parts.guard is None or parts.owner is None:
+            # valid Modelica (section 8.3.5), not simulated by springc yet
+            raise FlattenError("`assert` inside a when-clause is not supported yet, "
+                               "unless the condition is initial() or terminal()",
+                               item.span, hint="springc supports a subset of Modelica; "
+                               "see \"Not supported yet\" in docs/language.md")
+        ctx.assertions.append(assertion(ev, item.call, where, flat.Origin(
+            "equation", parts.owner.prefix), parts.guard))
     else:
         what = ("connect" if isinstance(item, s.Connect)
                 else "an algorithm section" if isinstance(item, s.AlgorithmSection)
@@ -198,12 +231,19 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     target = ctx.initial_equations if initial else ctx.equations
     conds = [ctx.evaluator.scalar(c, where) for c, _ in eq.branches]
     lists: list[list[flat.Equation]] = []
-    for _, body in [*eq.branches, (None, eq.otherwise)]:
-        start = len(target)
+    earlier: x.Expr | None = None  # some earlier branch is taken
+    for k, (_, body) in enumerate([*eq.branches, (None, eq.otherwise)]):
+        start, asserts = len(target), len(ctx.assertions)
         for item in body:
             ctx.equation(item, where, owner, initial)  # the driver's dispatcher
         lists.append(target[start:])
         del target[start:]
+        taken = conds[k] if k < len(conds) else None
+        guard = _branch_guard(taken, earlier)
+        if guard is not None:
+            _guard_all(ctx.assertions, asserts, guard)
+        if taken is not None:
+            earlier = taken if earlier is None else x.BinOp("or", earlier, taken)
     sizes = {len(eqs) for eqs in lists}
     if len(sizes) > 1:
         counts = ", ".join(str(len(eqs)) for eqs in lists)
@@ -225,6 +265,25 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
             for cond, r in reversed(list(zip(conds, rows[:-1]))):
                 value = x.If(cond, x.sub(r.lhs, r.rhs), value)
             target.append(flat.Equation(x.ZERO, value, first.span, first.origin))
+
+
+def _branch_guard(cond: x.Expr | None, earlier: x.Expr | None) -> x.Expr | None:
+    """When a branch of an if-equation is taken: its condition and no earlier one."""
+    if earlier is None:
+        return cond
+    if cond is None:
+        return x.Not(earlier)
+    return x.BinOp("and", x.Not(earlier), cond)
+
+
+def _guard_all(assertions: list[tuple[flat.Assertion, Span]], start: int, guard: x.Expr
+               ) -> None:
+    """The assertions recorded since ``start`` are checked only where ``guard`` holds
+    (they sit in a branch of an if-equation with a variable condition)."""
+    for i in range(start, len(assertions)):
+        item, span = assertions[i]
+        condition = x.If(guard, item.condition, x.Const(True))
+        assertions[i] = (dataclasses.replace(item, condition=condition), span)
 
 
 def _find_when(body: tuple[s.Equation, ...]) -> s.WhenEquation | None:

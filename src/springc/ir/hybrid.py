@@ -18,7 +18,10 @@ Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
   ``time`` times a parameter expression plus one (a time event at each integer,
   hit exactly), else None (state events on ``u``);
 - ``whens``: the when-clauses, assignments sorted so that each reads the values
-  assigned before it at the same event.
+  assigned before it at the same event;
+- ``reads_initial``, ``reads_terminal``: whether equations or assertions read
+  ``initial()`` or ``terminal()`` (an if-equation on them): true during the
+  initialization and at the event at the end of the run.
 """
 
 from __future__ import annotations
@@ -60,8 +63,12 @@ class EventSystem:
     whens: tuple[When, ...]
     floors: tuple[Call, ...] = ()
     floor_rates: tuple[Expr | None, ...] = ()
+    # initial() / terminal() read by equations or assertions (an if-equation on them)
+    reads_initial: bool = False
+    reads_terminal: bool = False
 
     @property
     def empty(self) -> bool:
         return not (self.discrete or self.relations or self.time_relations
-                    or self.samples or self.whens or self.floors)
+                    or self.samples or self.whens or self.floors or self.reads_initial
+                    or self.reads_terminal)

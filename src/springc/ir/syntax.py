@@ -385,7 +385,16 @@ class Jump:
     span: Span
 
 
-Statement = Assign | IfStatement | ForStatement | CallStatement | WhileStatement | Jump
+@dataclass(frozen=True, slots=True)
+class WhenStatement:
+    """``when c then ... elsewhen d then ... end when;`` in an algorithm (11.2.7)."""
+
+    branches: tuple[tuple[Expr, tuple[Statement, ...]], ...]
+    span: Span
+
+
+Statement = (Assign | IfStatement | ForStatement | CallStatement | WhileStatement | Jump
+             | WhenStatement)
 
 # -------------------------------------------------------------------- classes
 

@@ -28,6 +28,7 @@ from ..ir.syntax import (
     Jump,
     Ref,
     WhenEquation,
+    WhenStatement,
     WhileStatement,
 )
 from .rules_base import Rejected, RuleBase, T, join
@@ -132,5 +133,6 @@ class EquationRules(RuleBase):
     def while_statement(self, meta: Meta, ch: list[Any]) -> WhileStatement:
         return WhileStatement(ch[0], ch[1], self.span_of(meta))
 
-    def when_statement(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`when` statements are", self.keyword_span(meta, "when"))
+    def when_statement(self, meta: Meta, ch: list[Any]) -> WhenStatement:
+        branches = tuple((ch[i], ch[i + 1]) for i in range(0, len(ch), 2))
+        return WhenStatement(branches, self.span_of(meta))

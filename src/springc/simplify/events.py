@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
 
 from ..ir import expr as x
 from ..ir import flat, ode
@@ -21,16 +22,51 @@ from ..ir.hybrid import Discrete, EventSystem, TimeRelation
 
 STATE_RELATIONS = frozenset({"<", "<=", ">", ">="})
 _QUIET = frozenset({"noEvent", "smooth"})
+_PHASES = frozenset({"initial", "terminal"})
 
 
 def continuous_part(model: flat.FlatModel) -> flat.FlatModel:
     """``model`` without the variables its when-clauses assign (they are discrete:
-    the when-equations determine them, at events)."""
+    the when-equations determine them, at events), nor the initial equations that
+    give them their start values (:func:`discrete_starts`)."""
     if not model.whens:
         return model
     held = set(w.assigned(model.whens))
-    return dataclasses.replace(model, variables=tuple(
-        v for v in model.variables if v.name not in held))
+    starts = discrete_starts(model)
+    return dataclasses.replace(
+        model, variables=tuple(v for v in model.variables if v.name not in held),
+        initial_equations=tuple(eq for eq in model.initial_equations
+                                if id(eq) not in starts.equations))
+
+
+@dataclass(frozen=True)
+class DiscreteStarts:
+    """Start values of when-assigned variables from initial equations ``v = e`` (or
+    ``pre(v) = e``) with ``e`` an expression of parameters: by name, and the ids of
+    those equations (taken out of the initial problem of the continuous part)."""
+
+    values: dict[str, x.Expr]
+    equations: frozenset[int]
+
+
+def discrete_starts(model: flat.FlatModel) -> DiscreteStarts:
+    held = set(w.assigned(model.whens))
+    # parameters with known values (fixed = false ones are what initial equations find)
+    params = {v.name for v in model.parameters if v.attributes.fixed is not False}
+    values: dict[str, x.Expr] = {}
+    used: set[int] = set()
+    for eq in model.initial_equations:
+        for side, value in ((eq.lhs, eq.rhs), (eq.rhs, eq.lhs)):
+            if isinstance(side, x.Call) and side.name == "pre" and side.args:
+                side = side.args[0]
+            if (isinstance(side, x.Var) and side.name in held and side.name not in values
+                    and x.variables(value) <= params
+                    and not any(isinstance(n, (x.Time, x.Der, x.Call)) and not (
+                        isinstance(n, x.Call) and n.name in x.MATH) for n in x.walk(value))):
+                values[side.name] = value
+                used.add(id(eq))
+                break
+    return DiscreteStarts(values, frozenset(used))
 
 
 def when_exprs(whens: Iterable[w.When]) -> Iterator[x.Expr]:
@@ -83,14 +119,19 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
                 arg = node.args[0]
                 if isinstance(arg, x.Var):
                     pre.setdefault(arg.name, None)
-    if not (held or relations or timed or samples or model.whens or floors):
+    phases = {n.name for e in [*exprs, *(a.condition for a in model.assertions)]
+              for n in x.walk(e) if isinstance(n, x.Call) and n.name in _PHASES}
+    if not (held or relations or timed or samples or model.whens or floors or phases):
         return None
     by_name = {v.name: v for v in model.variables}
-    discrete = tuple(Discrete(n, by_name[n].type, by_name[n].attributes.start,
-                              by_name[n].span) for n in held)
+    starts = discrete_starts(model).values  # initial equations v = e come first
+    discrete = tuple(Discrete(n, by_name[n].type,
+                              starts.get(n, by_name[n].attributes.start), by_name[n].span)
+                     for n in held)
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
                        tuple(pre), _sorted_whens(model.whens), tuple(floors),
-                       tuple(_time_rate(c.args[0], params) for c in floors))
+                       tuple(_time_rate(c.args[0], params) for c in floors),
+                       "initial" in phases, "terminal" in phases)
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:

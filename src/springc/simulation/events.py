@@ -185,7 +185,10 @@ class EventLoop:
     def initial(self, t: float, x: np.ndarray) -> np.ndarray:
         """The event at the start (``initial()`` is true)."""
         self.z[int(self.mod.Z_INITIAL)] = 1.0
-        return self.event(t, x, "initial", "initial()")
+        x = self.event(t, x, "initial", "initial()")
+        if getattr(self.mod, "AFTER_INITIAL", False):  # when not initial() fires now
+            x = self.event(t, x, "initial", "not initial()")
+        return x
 
     def terminal(self) -> None:
         """The event at the end of a successful run where a when-condition uses

@@ -13,7 +13,7 @@ event, its left and right limits, as OpenModelica's result files do.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -128,7 +128,9 @@ def check_assertions(problem: Problem, times: np.ndarray, states: np.ndarray,
     if not problem.asserts:
         return
     for k, (t, x, z) in enumerate(zip(times, states, zs)):
-        if k == 0:
+        if k == 0:  # the first row is the initialization: initial() holds there
+            z = np.array(z)
+            z[int(cast(Any, problem.mod).Z_INITIAL)] = 1.0  # a HybridModule
             problem.asserts.start(float(t), x, z)
         else:
             problem.asserts.step(float(t), x, z)

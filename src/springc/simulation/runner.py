@@ -199,6 +199,11 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     if solver in FIXED_STEP:
         step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
     p = parameter_vector(model, options.parameters)
+    if getattr(model.module, "DELAYS", 0):  # the history of delay(...) (delays.py)
+        from .delays import simulate_delayed
+
+        return simulate_delayed(model, options, solver, grid, initial_state(model, p, start),
+                                p, rtol, atol, limits, began)
     if getattr(model.module, "EVENTS", False):  # the states chosen at compile time
         from .hybrid import simulate_hybrid
 
