@@ -16,6 +16,7 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
 from .array_builtins import ArrayBuiltins
+from .enumerations import EnumLiteral
 from .scope import ExpressionEvaluator, Handler, Scope
 from .type_rules import check_der_argument, check_numeric_arguments
 
@@ -223,7 +224,8 @@ class Builtins:
         """``Integer(E.b)``: the ordinal of an enumeration value (enumeration values are
         their ordinals already, Modelica 4.9.5.2)."""
         (v,) = self._args(call, scope, 1)
-        return v
+        return a.elementwise(lambda e: x.Const(int(e.value)) if isinstance(e, x.Const)
+                             and isinstance(e.value, EnumLiteral) else e, v)
 
     def vector(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)

@@ -22,11 +22,12 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .assertions import guard_assertions
 from .builtins import Builtins
+from .enum_rules import check_enum_relation
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
 from .parameters import check_powers
-from .ranges import with_range
+from .ranges import type_range, typed_range, typed_range_bounds, with_range
 from .references import ReferenceResolver
 from .scope import (
     ClassScope,
@@ -159,6 +160,8 @@ class Evaluator(ReferenceResolver):
         start = self.constant(e.start, scope, "a range bound")
         stop = self.constant(e.stop, scope, "a range bound")
         step = self.constant(e.step, scope, "a range step") if e.step else 1
+        if typed_range_bounds(start, stop, e):  # false:true, E.a:E.c (section 10.4.3)
+            return a.make_array(typed_range(start, stop))
         for bound in (start, stop, step):
             if isinstance(bound, (np.ndarray, str)) or not math.isfinite(bound):
                 raise FlattenError(f"the bounds and step of a range must be finite numbers, "
@@ -232,6 +235,7 @@ class Evaluator(ReferenceResolver):
         except ValueError as err:
             raise FlattenError(str(err), e.span,
                                hint="check the sizes of both operands") from None
+        check_enum_relation(e, left, right, scope, self)
         result: a.Value = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
         return result  # a relation on variables generates events (simplify/events.py)
 
@@ -330,10 +334,10 @@ class Evaluator(ReferenceResolver):
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
-        if isinstance(index.range, s.Ref):  # an enumeration type: its literals in order
-            target = self.reference(index.range, scope)
-            if isinstance(target, ClassEntry) and target.defn.enumeration is not None:
-                return [x.Const(i + 1) for i in range(len(target.defn.enumeration))]
+        if isinstance(index.range, s.Ref):  # Boolean or an enumeration type (11.2.2.2)
+            typed = type_range(self.flattener, index.range, scope)
+            if typed is not None:
+                return typed
         v = self.value(index.range, scope)
         if not a.is_array(v) or v.ndim != 1:
             raise FlattenError("a for-loop range must be a vector", index.range.span)

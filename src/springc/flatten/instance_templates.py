@@ -20,7 +20,7 @@ given from outside are evaluated anew per instance; they may only set whole para
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from itertools import islice
 from typing import Any
 
@@ -264,8 +264,7 @@ def _copy_primitive(prim: Primitive, rename: Callable[[x.Expr], x.Expr], prefix:
     else:
         names = prefix + prim.names[cut:]
         value = rename(a.scalars(prim.value)[0])
-    return Primitive(names, value, prim.decl, prim.variability, prim.causality, prim.flow,
-                     prim.type, prim.mod, prim.dims, prim.connector)
+    return replace(prim, names=names, value=value)
 
 
 def _scalar_names(prim: Primitive, new: str = "", old: str = "") -> list[str]:

@@ -30,6 +30,9 @@ from .declarations import (
     redeclared_class,
     redeclared_class_mod,
 )
+from .dimensions import typed_dimension
+from .enum_rules import check_enum_binding
+from .enumerations import DimensionKind
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .scope import (
@@ -93,7 +96,7 @@ class Instantiation(FlattenContext):
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = declared.dims if declared.dims is not None and by_class is None \
+        dims, kinds = (declared.dims, ()) if declared.dims is not None and by_class is None \
             else self._dims(decl, scope, rtype, mod, name)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
@@ -101,7 +104,7 @@ class Instantiation(FlattenContext):
         if rtype.primitive == "String":
             return self._string(decl, rtype, mod, dims, name)
         if rtype.primitive is not None:
-            return self._primitive(scope, decl, rtype, mod, dims, name)
+            return self._primitive(scope, decl, rtype, mod, dims, name, kinds)
         assert rtype.entry is not None
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
@@ -236,19 +239,29 @@ class Instantiation(FlattenContext):
             + ", ".join(view.components))
 
     def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType,
-              mod: Mod | None = None, name: str = "") -> tuple[int, ...]:
+              mod: Mod | None = None, name: str = ""
+              ) -> tuple[tuple[int, ...], tuple[DimensionKind, ...]]:
+        """The sizes of a declaration's dimensions, and their kinds (() if every
+        dimension is an Integer size)."""
         exprs = [(d, scope) for d in decl.dims + decl.type_dims]
         exprs += [(d, self.package_scope(e.parent or e)) for d, e in rtype.dims]
         dims = []
+        kinds: list[DimensionKind] = []
         for k, (d, where) in enumerate(exprs):
+            kinds.append(None)
             if isinstance(d, s.Colon):
                 dims.append(self._colon_size(k, d, mod, name or decl.name))
+                continue
+            typed = typed_dimension(self, d, where)
+            if typed is not None:  # [Boolean], [E] (section 10.1)
+                dims.append(typed[0])
+                kinds[-1] = typed[1]
                 continue
             n = self.evaluator.integer(d, where, "an array size")
             if n < 0:
                 raise FlattenError(f"array size must not be negative, found {n}", d.span)
             dims.append(n)
-        return tuple(dims)
+        return tuple(dims), tuple(kinds) if any(k is not None for k in kinds) else ()
 
     def _colon_size(self, k: int, d: s.Colon, mod: Mod | None, name: str) -> int:
         """The size of a ``[:]`` dimension: that of the binding (section 10.1)."""
@@ -266,12 +279,16 @@ class Instantiation(FlattenContext):
         return dims[k]
 
     def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
-                   mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
+                   mod: Mod | None, dims: tuple[int, ...], name: str,
+                   kinds: tuple[DimensionKind, ...] = ()) -> Primitive:
         variability = stronger(decl.variability or rtype.prefixes[0] or (
             "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous"),
             scope.variability)
         check_integer_binding(name, rtype.primitive or "Real",
                               mod.value.expr if mod is not None and mod.value else None)
+        if mod is not None and mod.value is not None:
+            check_enum_binding(name, rtype.primitive or "Real", rtype.enumeration,
+                               mod.value.expr, mod.value.scope, self.evaluator)
         causality = decl.causality or rtype.prefixes[1]
         check_attribute_mods(mod, rtype.primitive, name)
         name_list = _element_names(name, dims)
@@ -290,7 +307,8 @@ class Instantiation(FlattenContext):
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         flow, rtype.primitive or "Real", mod, dims, rtype.connector)
+                         flow, rtype.primitive or "Real", mod, dims, rtype.connector,
+                         rtype.enumeration, kinds)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b

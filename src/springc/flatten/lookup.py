@@ -18,7 +18,7 @@ from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, membe
 from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
 from .conditional_rules import check_conditional_uses
-from .enumerations import BUILTIN_ENUMERATIONS
+from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
 from .rules import check_class, check_extends, rule_error
@@ -89,7 +89,8 @@ class ClassLookup(FlattenContext):
         if name in PRIMITIVES and lookup_class(name, scope) is None:
             return ResolvedType(name, None, (), (), prefixes)
         if name in BUILTIN_ENUMERATIONS and lookup_class(name, scope) is None:
-            return ResolvedType("Integer", None, (), (), prefixes)
+            return ResolvedType("Integer", None, (), (), prefixes,
+                                enumeration=BUILTIN_ENUMERATIONS[name])
         if name == "String" and lookup_class(name, scope) is None:
             return ResolvedType("String", None, (), (), prefixes)
         entry = self.resolve_class(ref, scope)
@@ -98,7 +99,8 @@ class ClassLookup(FlattenContext):
             short = entry.defn.short
             if entry.defn.enumeration is not None:
                 # Enumeration values are their ordinals (1, 2, ...): an Integer.
-                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes)
+                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes,
+                                    enumeration=enumeration_of(entry))
             if short is None:
                 return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
             if short.modification is not None:
@@ -162,7 +164,7 @@ class ClassLookup(FlattenContext):
             if name not in literals:
                 raise FlattenError(f"enumeration '{entry.full_name}' has no literal '{name}'",
                                    span, hint="its literals are: " + ", ".join(literals))
-            return x.Const(literals.index(name) + 1)
+            return literal_value(enumeration_of(target), literals.index(name) + 1)
         nested = member_class(entry, name)
         if nested is not None:
             check_access_path([entry, nested], ref)

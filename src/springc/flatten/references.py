@@ -18,7 +18,8 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .access import check_access_component
 from .builtins import CONSTANTS
-from .enumerations import BuiltinEnumeration
+from .dimensions import typed_index
+from .enumerations import BuiltinEnumeration, DimensionKind, literal_value, value_kind
 from .scope import (
     ClassScope,
     Disabled,
@@ -71,7 +72,7 @@ class ReferenceResolver:
                 raise FlattenError(f"'{part.name}' is not a literal of {current.name}",
                                    part.span, hint="its literals are: "
                                    + ", ".join(current.literals))
-            return x.Const(current.literals.index(part.name) + 1)
+            return literal_value(current, current.literals.index(part.name) + 1)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -114,7 +115,8 @@ class ReferenceResolver:
         if len(part.subscripts) > len(dims):
             raise FlattenError(f"'{part.name}' has {len(dims)} dimension(s) but "
                                f"{len(part.subscripts)} subscript(s) are given", part.span)
-        index = tuple(self._index(sub, dims[k], scope, part)
+        kinds = current.kinds if isinstance(current, Primitive) else ()
+        index = tuple(self._index(sub, dims[k], scope, part, kinds[k] if kinds else None)
                       for k, sub in enumerate(part.subscripts))
         if sum(isinstance(i, np.ndarray) for i in index) > 1:
             # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
@@ -129,7 +131,8 @@ class ReferenceResolver:
             return result.item()
         return result
 
-    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart) -> Any:
+    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart,
+               kind: DimensionKind = None) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
         uses_end = self.uses_end.get(id(sub))
@@ -141,6 +144,9 @@ class ReferenceResolver:
         if v is None:
             v = self.constant(sub, scope, "a subscript")
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
+        if kind is not None or any(value_kind(i) is not None for i in values):
+            values = [typed_index(i, kind, sub.span, part.name) for i in values]
+            v = np.array(values, dtype=object) if isinstance(v, np.ndarray) else values[0]
         for i in values:
             if isinstance(i, bool | str) or not math.isfinite(i) or i != int(i):
                 raise FlattenError(f"a subscript must be an integer, found {i!r}", sub.span)

@@ -27,6 +27,7 @@ from ..ir import syntax as s
 from ..ir.when import When
 from ..parse import ClassEntry
 from . import arrays as a
+from .enumerations import DimensionKind, Enumeration
 from .event_uses import EventUses
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
@@ -75,6 +76,7 @@ class ResolvedType:
     mods: tuple[tuple[s.Modification, ClassEntry], ...]
     prefixes: tuple[str, str, bool]
     connector: bool = False  # a primitive reached through `connector C = input Real`
+    enumeration: Enumeration | None = None  # the type of an enumeration ("Integer")
 
 
 @dataclass(eq=False)
@@ -91,6 +93,8 @@ class Primitive:
     mod: Mod | None
     dims: tuple[int, ...]
     connector: bool = False  # declared with a short connector class (RealInput)
+    enumeration: Enumeration | None = None  # its type, if an enumeration ("Integer")
+    kinds: tuple[DimensionKind, ...] = ()  # of its dimensions; () if all are Integer
 
 
 @dataclass(frozen=True, eq=False)
