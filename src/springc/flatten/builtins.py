@@ -18,6 +18,7 @@ from . import arrays as a
 from .array_builtins import ArrayBuiltins
 from .enumerations import EnumLiteral
 from .scope import ExpressionEvaluator, Handler, Scope
+from .strings import string_call
 from .type_rules import check_der_argument, check_numeric_arguments
 
 SCALAR_FUNCTIONS = {
@@ -48,6 +49,7 @@ class Builtins:
             "identity": self.identity, "cross": self.cross, "transpose": self.transpose,
             "norm": self.norm, "scalar": self.scalar, "vector": self.vector,
             "Integer": self.enum_ordinal,
+            "String": lambda call, scope: string_call(self.ev, call, scope),
         }
         for name in SCALAR_FUNCTIONS:
             self.table[name] = self.math

@@ -23,6 +23,7 @@ from .loops import check_loop_nest
 from .ranges import with_range
 from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .strings import string_equation
 from .type_rules import check_boolean_condition
 from .when import flatten_when, variable_if_equation
 
@@ -161,6 +162,8 @@ class EquationFlattening(FlattenContext):
                 f"the two sides of this equation differ in size: "
                 f"{a.describe_shape(a.shape(lhs))} and {a.describe_shape(a.shape(rhs))}",
                 eq.span, hint="both sides of an equation must have the same size")
+        if string_equation(lhs, rhs, eq.span):
+            return  # known while flattening (flatten/strings.py)
         for side, e in ((lhs, eq.lhs), (rhs, eq.rhs)):
             if isinstance(side, str):
                 raise FlattenError("strings cannot appear in equations", e.span)

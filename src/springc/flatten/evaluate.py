@@ -35,12 +35,13 @@ from .scope import (
     LocalScope,
     Scope,
 )
+from .strings import string_binary
 
 UNSUPPORTED_CALLS = {
     "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
     "delay", "spatialDistribution", "cardinality", "inStream", "actualStream",
-    "getInstanceName", "String", "assert",
+    "getInstanceName", "assert",
 }
 
 
@@ -212,6 +213,9 @@ class Evaluator(ReferenceResolver):
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check
             return scalar(cast(x.Expr, left), cast(x.Expr, right))
+        text = string_binary(e.op, left, right, e.span)
+        if text is not None:
+            return text
         self._numeric(left, e.left.span)
         self._numeric(right, e.right.span)
         op = e.op
@@ -341,7 +345,9 @@ class Evaluator(ReferenceResolver):
         v = self.value(index.range, scope)
         if not a.is_array(v) or v.ndim != 1:
             raise FlattenError("a for-loop range must be a vector", index.range.span)
-        return [x.Const(self._plain(self.fold_at(item, index.range))) for item in v]
+        values = [self.fold_at(item, index.range) for item in v]
+        return [item if isinstance(item, str) else x.Const(self._plain(item))
+                for item in values]  # a String range: the strings themselves
 
     def fold_at(self, v: a.Value, e: s.Expr) -> Any:
         try:

@@ -32,6 +32,7 @@ from .lookup import ClassLookup, select_model
 from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
 from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
+from .strings import undefined_strings
 from .variables import attributes_of
 from .when import check_events
 
@@ -108,7 +109,9 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         for _name, member in scope.all_members():
             if isinstance(member, Primitive):
-                if member.variability != "constant" and member.type != "String":
+                if member.type == "String":
+                    self.errors += undefined_strings(member.value)
+                elif member.variability != "constant":
                     yield from attributes_of(self, scope, member)
             else:
                 for item in (member.flat if isinstance(member, np.ndarray) else [member]):

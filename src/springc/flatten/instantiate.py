@@ -46,6 +46,7 @@ from .scope import (
     ViewComponent,
     instance_mod,
 )
+from .strings import check_known, is_string, string_variables
 from .type_rules import (
     check_constant_binding,
     check_discrete_binding,
@@ -319,20 +320,26 @@ class Instantiation(FlattenContext):
 
     def _string(self, decl: s.Component, rtype: ResolvedType, mod: Mod | None,
                 dims: tuple[int, ...], name: str) -> Primitive:
-        """A ``String`` parameter or constant: its value, known while flattening (it is
-        not a variable of the flat model)."""
+        """A ``String`` component: its value, known while flattening (flatten/strings.py;
+        it is not a variable of the flat model)."""
         variability = decl.variability or rtype.prefixes[0]
-        if variability not in ("parameter", "constant"):
-            raise FlattenError("`String` variables are not supported yet", decl.span,
-                               hint="declare it a parameter or a constant")
-        if dims:
-            raise FlattenError("arrays of `String` are not supported yet", decl.span)
         check_attribute_mods(mod, "String", name)
-        value = self.mod_value(mod.value) if mod is not None and mod.value is not None else ""
-        if not isinstance(value, str):
-            raise FlattenError(f"'{name}' is a String and must be given a string",
-                               mod.value.span if mod is not None and mod.value else decl.span)
-        return Primitive(name, value, decl, variability, "", False, "String", mod, ())
+        names = _element_names(name, dims)
+        if mod is not None and mod.value is not None:
+            value = self.mod_value(mod.value)
+            if not is_string(value) or a.shape(value) != dims:
+                raise FlattenError(
+                    f"'{name}' is a String array of size {a.describe_shape(dims)} and must "
+                    "be given Strings of that size" if dims else
+                    f"'{name}' is a String and must be given a string", mod.value.span)
+            check_known(value, mod.value.span)
+        elif variability in ("parameter", "constant"):
+            value = a.make_array([""] * len(names), dims) if dims else ""
+        else:  # given by an equation
+            value = string_variables(names, dims, decl.span)
+        return Primitive(a.make_array(names, dims) if dims else name, value, decl,
+                         variability or "discrete", decl.causality, False, "String", mod,
+                         dims)
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

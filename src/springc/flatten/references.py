@@ -29,6 +29,7 @@ from .scope import (
     Primitive,
     Scope,
 )
+from .strings import read as read_string
 
 
 class ReferenceResolver:
@@ -100,7 +101,9 @@ class ReferenceResolver:
             hint)
 
     def member_value(self, member: Any) -> Any:
-        return member.value if isinstance(member, Primitive) else member
+        if not isinstance(member, Primitive):
+            return member
+        return read_string(member.value) if member.type == "String" else member.value
 
     def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
         if isinstance(current, Disabled):
