@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, cast
 
 import numpy as np
@@ -334,7 +334,7 @@ class Evaluator(ReferenceResolver):
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
 
-    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
+    def range_values(self, index: s.ForIndex, scope: Scope) -> Sequence[x.Expr | str]:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)

@@ -14,7 +14,7 @@ a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defi
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
@@ -295,7 +295,7 @@ class ExpressionEvaluator(Protocol):
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
                 ) -> Iterator[a.Value]: ...
 
-    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]: ...
+    def range_values(self, index: s.ForIndex, scope: Scope) -> Sequence[x.Expr | str]: ...
 
 
 class FlattenContext(Protocol):
