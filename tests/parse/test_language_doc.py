@@ -57,8 +57,6 @@ REJECTED = {
     "  Real x = f(time);\nend M;\n":
         "6:9: error: `while` loops whose condition is known only during the simulation are "
         "not supported yet",
-    "model M\n  model extends N\n  end N;\nend M;\n": (
-        "2:9: error: `class extends` definitions are not supported yet"),
     "operator record C\n  Real re;\nend C;\nmodel M\n  C c;\nend M;\n":
         "1:1: error: `operator` classes are not supported yet",
     "expandable connector C\n  Real x;\nend C;\nmodel M\n  C c;\nend M;\n":

@@ -493,7 +493,6 @@ UNSUPPORTED = [
     ('function f external "C"; end f;', "`external` functions are"),
     ("connector C stream Real h; end C;", "`stream` connectors are"),
     ("expandable connector C end C;", "`expandable` connectors are"),
-    ("model A extends B; end A; model extends A end A;", "`class extends` definitions are"),
     ("operator record R end R;", "`operator` classes are"),
     ("impure function f end f;", "`impure` functions are"),
     ("model A Real x = (y)[1]; end A;", "subscripts on a parenthesized expression (`(e)[i]`) are"),

@@ -44,7 +44,7 @@ class EquationFlattening(FlattenContext):
             return
         target = self.initial_equations if initial else self.equations
         key = (id(view), initial)
-        template = self.templates.get(key)
+        template = self.templates.get(key) if scope.package is None else None
         if template is not None:
             target += template.instantiate(scope.prefix)
             return
@@ -54,7 +54,8 @@ class EquationFlattening(FlattenContext):
                 self.equation(item.equation, scope, scope, initial)
             except FlattenError as err:
                 self.report(err)
-        if key not in self.templates and scope.prefix and len(self.errors) == errors:
+        if key not in self.templates and scope.prefix and len(self.errors) == errors \
+                and scope.package is None:
             independent = self.parameter_values.reads == reads and reusable(self, view)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None

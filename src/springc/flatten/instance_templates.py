@@ -74,7 +74,7 @@ class InstanceTemplates:
         recording if it is the second instance of its kind (the first one has warmed
         the caches of values given from outside, which are then not read again)."""
         if scope.members or scope.failed or scope.variability or scope.flow or \
-                not self._class_reusable(scope.view):
+                scope.package is not None or not self._class_reusable(scope.view):
             return None
         mod_shape = shape(scope.mod, scope, 0)
         if mod_shape is None:

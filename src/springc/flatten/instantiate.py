@@ -33,6 +33,7 @@ from .declarations import (
 from .dimensions import typed_dimension
 from .enum_rules import check_enum_binding
 from .enumerations import DimensionKind
+from .instance_classes import named_through, type_name_package
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .scope import (
@@ -46,7 +47,7 @@ from .scope import (
     ViewComponent,
     instance_mod,
 )
-from .strings import check_known, is_string, string_variables
+from .strings import string_component
 from .type_rules import (
     check_constant_binding,
     check_discrete_binding,
@@ -89,6 +90,13 @@ class Instantiation(FlattenContext):
         by_class = redeclared_class(scope, decl.type_name)
         if by_class is not None:
             rtype, type_mods = self._redeclared_type(by_class[0], by_class[1])
+        package = None if by_class is not None else type_name_package(self, scope, decl)
+        retyped = by_class is not None or package is not None
+        if package is not None:  # Medium.BaseProperties, with Medium redeclared
+            rest = decl.type_name.parts[1:]
+            rtype = self.resolve_type(s.Ref(rest, decl.type_name.span), package)
+            type_mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
+                         for m, e in rtype.mods]
         if outer is None and own is None and len(type_mods) <= 1:
             mod = type_mods[0] if type_mods else None  # nothing to merge
         else:
@@ -97,13 +105,13 @@ class Instantiation(FlattenContext):
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims, kinds = (declared.dims, ()) if declared.dims is not None and by_class is None \
+        dims, kinds = (declared.dims, ()) if declared.dims is not None and not retyped \
             else self._dims(decl, scope, rtype, mod, name)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
         if rtype.primitive == "String":
-            return self._string(decl, rtype, mod, dims, name)
+            return string_component(self, decl, rtype, mod, dims, name)
         if rtype.primitive is not None:
             return self._primitive(scope, decl, rtype, mod, dims, name, kinds)
         assert rtype.entry is not None
@@ -118,15 +126,20 @@ class Instantiation(FlattenContext):
                                "use a class that extends it")
         self._check_containment(scope, rtype.entry, decl, name)
         view = self._used_view(rtype.entry, decl, name)
+        through = named_through(self, scope, comp.decl, package, rtype.entry)
         if not dims:
-            return self._class_scope(name, view, mod, decl, scope)
+            made = self._class_scope(name, view, mod, decl, scope)
+            made.package = through
+            return made
         if mod is not None:
             self._check_array_mod(mod, dims, name, "")
         out = np.empty(dims, dtype=object)
         for idx in np.ndindex(dims):
             sub = tuple(i + 1 for i in idx)
-            out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
-                                         select(mod, sub), decl, scope)
+            item = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
+                                     select(mod, sub), decl, scope)
+            item.package = through
+            out[idx] = item
         return out
 
     def _used_view(self, entry: ClassEntry, decl: s.Component, name: str) -> ClassView:
@@ -145,10 +158,9 @@ class Instantiation(FlattenContext):
     def _redeclared_type(self, defn: s.ClassDef, where: ClassScope
                          ) -> tuple[ResolvedType, list[Mod | None]]:
         """The type and type modifiers of a class replaced by ``redeclare model M = T(...)``."""
-        if defn.short is None:
-            raise FlattenError("a redeclaration with a long class definition is not "
-                               "supported yet", defn.span,
-                               hint="write `redeclare model M = Other(...)`")
+        if defn.short is None:  # `redeclare model M ... end M;`: that class itself
+            return self.resolve_type(s.Ref((s.RefPart(defn.name, (), defn.span),),
+                                           defn.span), where.entry), []
         rtype = self.resolve_type(defn.short.base, where.entry)
         mods = [each(from_syntax(m, self.package_scope(e.parent or e))) for m, e in rtype.mods]
         return rtype, [redeclared_class_mod(defn, where, None), *mods]
@@ -317,29 +329,6 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
-
-    def _string(self, decl: s.Component, rtype: ResolvedType, mod: Mod | None,
-                dims: tuple[int, ...], name: str) -> Primitive:
-        """A ``String`` component: its value, known while flattening (flatten/strings.py;
-        it is not a variable of the flat model)."""
-        variability = decl.variability or rtype.prefixes[0]
-        check_attribute_mods(mod, "String", name)
-        names = _element_names(name, dims)
-        if mod is not None and mod.value is not None:
-            value = self.mod_value(mod.value)
-            if not is_string(value) or a.shape(value) != dims:
-                raise FlattenError(
-                    f"'{name}' is a String array of size {a.describe_shape(dims)} and must "
-                    "be given Strings of that size" if dims else
-                    f"'{name}' is a String and must be given a string", mod.value.span)
-            check_known(value, mod.value.span)
-        elif variability in ("parameter", "constant"):
-            value = a.make_array([""] * len(names), dims) if dims else ""
-        else:  # given by an equation
-            value = string_variables(names, dims, decl.span)
-        return Primitive(a.make_array(names, dims) if dims else name, value, decl,
-                         variability or "discrete", decl.causality, False, "String", mod,
-                         dims)
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

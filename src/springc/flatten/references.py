@@ -20,6 +20,7 @@ from .access import check_access_component
 from .builtins import CONSTANTS
 from .dimensions import typed_index
 from .enumerations import BuiltinEnumeration, DimensionKind, literal_value, value_kind
+from .instance_classes import instance_scope, redeclared_package
 from .scope import (
     ClassScope,
     Disabled,
@@ -62,7 +63,11 @@ class ReferenceResolver:
             current = self.flattener.resolve_class(s.Ref((first,), first.span, True),
                                                    scope.entry)
         else:
-            current = self._subscript(scope.lookup(first.name, first.span), first, scope)
+            instance = instance_scope(scope)
+            package = None if instance is None or len(e.parts) == 1 else \
+                redeclared_package(self.flattener, instance, first.name)
+            current = package if package is not None else \
+                self._subscript(scope.lookup(first.name, first.span), first, scope)
         for part in e.parts[1:]:
             current = self._select(current, part, scope, e)
         return current

@@ -27,6 +27,7 @@ from ..ir import syntax as s
 from ..ir.when import When
 from ..parse import ClassEntry
 from . import arrays as a
+from .class_extends import inherited_class
 from .enumerations import DimensionKind, Enumeration
 from .event_uses import EventUses
 from .limits import Limits
@@ -134,6 +135,10 @@ class ClassScope:
     # constant/parameter/discrete on this (structured) component, which applies to its
     # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
     variability: str = ""
+    # The package its class was named through (`Medium.Props p` with Medium a package
+    # extending the one that declares Props): its constants are those the class sees
+    # (the package is the class's enclosing class there, section 5.3).
+    package: ClassScope | None = None
 
     @property
     def entry(self) -> ClassEntry:
@@ -187,6 +192,8 @@ class ClassScope:
     def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
             return self.member(name, span)
+        if self.package is not None and self.package.has_member(name):
+            return self.package.member(name, span)
         return self.flattener.lookup_global(name, self.entry, span)
 
 
@@ -365,7 +372,10 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
     for element in entry.defn.elements:
         if not isinstance(element, s.Extends):
             continue
-        base = flattener.resolve_class(element.base, entry.parent or entry, entry)
+        if entry.defn.class_extends and element is entry.defn.elements[0]:
+            base = inherited_class(flattener.resolve_class, entry, element.span)
+        else:
+            base = flattener.resolve_class(element.base, entry.parent or entry, entry)
         if base.defn.short is not None:
             raise FlattenError("extending a short class definition is not supported yet",
                                element.span)

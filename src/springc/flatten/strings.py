@@ -15,6 +15,7 @@ Output: the variables' values (:class:`StringVariable`), strings, Boolean consta
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass
@@ -27,7 +28,9 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
 from .enumerations import EnumLiteral
-from .scope import ExpressionEvaluator, Scope
+from .modification import Mod
+from .scope import ExpressionEvaluator, FlattenContext, Primitive, ResolvedType, Scope
+from .variables import check_attribute_mods
 
 _HINT = "springc supports a subset of Modelica; see \"Not supported yet\" in docs/language.md"
 
@@ -222,3 +225,28 @@ def undefined_strings(value: Any) -> list[FlattenError]:
                          "an equation s = \"...\"")
             for item in _items(value)
             if isinstance(item, StringVariable) and item.value is None and not item.at_events]
+
+
+def string_component(ctx: FlattenContext, decl: s.Component, rtype: ResolvedType,
+                     mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
+    """A ``String`` component: its value or its :class:`StringVariable`s (it is not a
+    variable of the flat model)."""
+    variability = decl.variability or rtype.prefixes[0]
+    check_attribute_mods(mod, "String", name)
+    names = [name] if not dims else [
+        f"{name}[{','.join(map(str, idx))}]"
+        for idx in itertools.product(*(range(1, n + 1) for n in dims))]
+    if mod is not None and mod.value is not None:
+        value = ctx.mod_value(mod.value)
+        if not is_string(value) or a.shape(value) != dims:
+            raise FlattenError(
+                f"'{name}' is a String array of size {a.describe_shape(dims)} and must "
+                "be given Strings of that size" if dims else
+                f"'{name}' is a String and must be given a string", mod.value.span)
+        check_known(value, mod.value.span)
+    elif variability in ("parameter", "constant"):
+        value = a.make_array([""] * len(names), dims) if dims else ""
+    else:  # given by an equation
+        value = string_variables(names, dims, decl.span)
+    return Primitive(a.make_array(names, dims) if dims else name, value, decl,
+                     variability or "discrete", decl.causality, False, "String", mod, dims)
