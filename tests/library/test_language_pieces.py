@@ -333,7 +333,7 @@ UNSUPPORTED = """package L
   model Bad
     Real x;
     Real y;
-    inner outer Real z;
+    Real z := 1;
   equation
     der(x) = 1;
     y = 1;
@@ -356,7 +356,7 @@ def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
         "model 'L.Good'\n  Real x(start = 0, fixed = true);\nequation\n  der(x) = 1;\n"
         "end 'L.Good';\n")
     assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
-        "`inner outer` elements are not supported yet", 5, 11)
+        "`:=` in a declaration is not supported yet", 5, 12)
     with pytest.raises(SpringcError) as info:
         flat(tmp_path, UNSUPPORTED, "L.UsesBad")
     (note,) = info.value.notes

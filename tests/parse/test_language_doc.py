@@ -43,8 +43,6 @@ REJECTED = {
     "model M\n  String s;\nequation\n  s = String(time);\nend M;\n":
         "4:14: error: 'String' of a value that changes during the simulation is not "
         "supported yet: it depends on time",
-    "model M\n  model W\n    Real g = 1;\n  end W;\n  inner outer W w;\nend M;\n":
-        "5:9: error: `inner outer` elements are not supported yet",
     "model M\n  type E = enumeration(:);\n  Real x = 1;\nend M;\n":
         "2:12: error: unspecified enumerations `enumeration(:)` are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n"

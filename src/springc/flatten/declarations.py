@@ -53,6 +53,8 @@ def inner_member(fl: FlattenContext, scope: ClassScope, outer: ViewComponent) ->
         comp = enclosing.view.components.get(decl.name)
         if comp is not None and comp.decl.inner:
             _check_inner_type(fl, outer, comp)
+            if comp.decl.outer:  # `inner outer`: its inner part
+                return enclosing.inner_part(decl.name)
             return enclosing.member(decl.name, decl.span)
         enclosing = enclosing.outer
     where = f"'{scope.prefix}'" if scope.prefix else "the model"

@@ -88,10 +88,12 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         for name, comp in scope.view.components.items():
             try:
                 member = scope.member(name)
+                if comp.decl.outer and comp.decl.inner:
+                    member = scope.inner_part(name)  # the outer part is walked elsewhere
             except FlattenError as err:
                 self.report(err)
                 continue
-            if comp.decl.outer:
+            if comp.decl.outer and not comp.decl.inner:
                 continue  # the inner instance is walked where it is declared
             if isinstance(member, ClassScope):
                 yield from self._walk_one(member)

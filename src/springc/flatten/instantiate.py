@@ -71,10 +71,10 @@ class Instantiation(FlattenContext):
         name = scope.flat_name(decl.name)
         if decl.condition is not None and not condition_holds(self, scope, decl):
             return disabled(scope, decl)
-        if decl.outer:
+        if decl.outer:  # (of an `inner outer` element: its outer part, section 5.4)
             modified = decl.modification or (scope.mod.children.get(decl.name)
                                              if scope.mod is not None else None)
-            if modified is not None:
+            if modified is not None and not decl.inner:
                 raise FlattenError(f"the outer element '{name}' cannot be modified",
                                    modified.span, [Note("declared here", decl.span)],
                                    "modify the inner element instead (Modelica 5.4)")

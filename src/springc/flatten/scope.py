@@ -139,6 +139,9 @@ class ClassScope:
     # extending the one that declares Props): its constants are those the class sees
     # (the package is the class's enclosing class there, section 5.3).
     package: ClassScope | None = None
+    # The inner parts of its `inner outer` elements (section 5.4): local references
+    # name the outer part (the member), the outer elements below the inner part.
+    inner_parts: dict[str, Member] = field(default_factory=dict)
 
     @property
     def entry(self) -> ClassEntry:
@@ -179,13 +182,24 @@ class ClassScope:
         self.members[name] = created
         return created
 
+    def inner_part(self, name: str) -> Member:
+        """The inner part of the ``inner outer`` element ``name``, instantiated on first
+        use: the element as if declared ``inner`` only."""
+        found = self.inner_parts.get(name)
+        if found is None:
+            comp = self.view.components[name]
+            inner = ViewComponent(replace(comp.decl, outer=False), comp.defined_in)
+            found = self.inner_parts[name] = self.flattener.instantiate(self, inner)
+        return found
+
     def all_members(self) -> Iterator[tuple[str, Primitive | ClassScope | np.ndarray]]:
         """The members this instance owns: not disabled conditional components, and not
-        ``outer`` ones (they are the ``inner`` instance's, reached from here)."""
+        ``outer`` ones (they are the ``inner`` instance's, reached from here), but the
+        inner parts of ``inner outer`` ones."""
         for name, comp in self.view.components.items():
-            if comp.decl.outer:
+            if comp.decl.outer and not comp.decl.inner:
                 continue
-            member = self.member(name)
+            member = self.inner_part(name) if comp.decl.outer else self.member(name)
             if not isinstance(member, Disabled):
                 yield name, member
 
@@ -227,7 +241,10 @@ class FunctionScope:
 
     def lookup(self, name: str, span: Span) -> Any:
         if name not in self.names:
-            return self.parent.lookup(name, span)
+            if self.parent.has_member(name):
+                return self.parent.lookup(name, span)
+            # from the function itself: its imports, then its enclosing classes
+            return self.parent.flattener.lookup_global(name, self.entry, span)
         value = self.names[name]
         if value is None:
             raise FlattenError(f"'{name}' is used before it is assigned", span)
