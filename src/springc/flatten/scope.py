@@ -142,6 +142,9 @@ class ClassScope:
     # The inner parts of its `inner outer` elements (section 5.4): local references
     # name the outer part (the member), the outer elements below the inner part.
     inner_parts: dict[str, Member] = field(default_factory=dict)
+    # Of the model: the inner elements added for outer ones that have none (5.4), with
+    # the outer declaration that caused each.
+    added_inners: dict[str, tuple[Member, ViewComponent]] = field(default_factory=dict)
 
     @property
     def entry(self) -> ClassEntry:
@@ -202,6 +205,8 @@ class ClassScope:
             member = self.inner_part(name) if comp.decl.outer else self.member(name)
             if not isinstance(member, Disabled):
                 yield name, member
+        for name, (added, _) in self.added_inners.items():
+            yield name, added  # type: ignore[misc]
 
     def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
