@@ -103,10 +103,24 @@ def test_outer_elements_at_several_depths_refer_to_the_inner_one(tmp_path: Path)
     assert "group.b.world" not in text
 
 
-def test_an_outer_element_without_inner_is_an_error(tmp_path: Path) -> None:
+def test_an_outer_element_without_inner_gets_one_at_the_top(tmp_path: Path) -> None:
+    """Section 5.4: an inner element of the outer element's class is added, with a
+    diagnostic; the ball then falls with the World's default g."""
+    path = tmp_path / "M.mo"
+    path.write_text(WORLD)
+    model = flatten_files([path], "W.Lonely")
+    assert "  parameter Real 'world.g' = 9.81;" in format_flat(model).splitlines()
+    assert model.notes == (
+        f"{path}:6:17: warning: the outer element 'world' has no inner element: `inner "
+        "World world` is added at the top of the model (Modelica 3.6, section 5.4)",)
+
+
+def test_an_outer_element_of_a_partial_class_without_inner_is_an_error(
+        tmp_path: Path) -> None:
     message = "the outer element 'ball.world' has no inner element 'world' in an " \
               "enclosing instance"
-    assert error(tmp_path, WORLD, "W.Lonely") == (message, 6, 17)
+    text = WORLD.replace("  model World", "  partial model World")
+    assert error(tmp_path, text, "W.Lonely") == (message, 6, 17)
 
 
 def test_outer_gravity_simulates() -> None:
@@ -333,7 +347,7 @@ UNSUPPORTED = """package L
   model Bad
     Real x;
     Real y;
-    inner outer Real z;
+    Real z := 1;
   equation
     der(x) = 1;
     y = 1;
@@ -356,7 +370,7 @@ def test_a_construct_outside_the_subset_blocks_only_the_models_that_use_it(
         "model 'L.Good'\n  Real x(start = 0, fixed = true);\nequation\n  der(x) = 1;\n"
         "end 'L.Good';\n")
     assert error(tmp_path, UNSUPPORTED, "L.UsesBad") == (
-        "`inner outer` elements are not supported yet", 5, 11)
+        "`:=` in a declaration is not supported yet", 5, 12)
     with pytest.raises(SpringcError) as info:
         flat(tmp_path, UNSUPPORTED, "L.UsesBad")
     (note,) = info.value.notes

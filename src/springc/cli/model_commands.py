@@ -53,7 +53,10 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...])
     from ..pipeline import flatten_files
     from ..simplify import check_balance
 
-    click.echo(check_balance(flatten_files(files, model, libraries)).summary())
+    flat = flatten_files(files, model, libraries)
+    for note in flat.notes:  # diagnostics that are not errors
+        click.echo(note, err=True)
+    click.echo(check_balance(flat).summary())
 
 
 @main.command(name="compile")

@@ -38,6 +38,7 @@ from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .strings import is_string, string_equation
 from .when_statements import (
     WhenParts,
     check_nesting,
@@ -71,8 +72,8 @@ class _Run:
         self.parts: list[WhenParts] = []  # of the when statements around
 
     def read(self, value: a.Value, span: Span) -> a.Value:
-        if isinstance(value, str):
-            raise FlattenError("strings cannot be assigned in an algorithm section", span)
+        if is_string(value):
+            return value  # known while flattening (flatten/strings.py)
         env = self.env
         return a.elementwise(lambda e: folded(x.substitute(e, env)) if env else e, value)
 
@@ -126,7 +127,8 @@ class _Run:
 
     def store(self, target: s.Ref, value: a.Value, stmt: s.Assign, where: Scope) -> None:
         names = self.ev.value(target, where)
-        if a.shape(names) != a.shape(value):
+        if string_equation(names, value, stmt.span):
+            return
             raise FlattenError(
                 f"cannot assign a value of size {a.describe_shape(a.shape(value))} to "
                 f"'{target.dotted}' of size {a.describe_shape(a.shape(names))}", stmt.span)

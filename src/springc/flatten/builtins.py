@@ -16,7 +16,9 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from . import arrays as a
 from .array_builtins import ArrayBuiltins
+from .enumerations import EnumLiteral
 from .scope import ExpressionEvaluator, Handler, Scope
+from .strings import string_call
 from .type_rules import check_der_argument, check_numeric_arguments
 
 SCALAR_FUNCTIONS = {
@@ -47,6 +49,7 @@ class Builtins:
             "identity": self.identity, "cross": self.cross, "transpose": self.transpose,
             "norm": self.norm, "scalar": self.scalar, "vector": self.vector,
             "Integer": self.enum_ordinal,
+            "String": lambda call, scope: string_call(self.ev, call, scope),
         }
         for name in SCALAR_FUNCTIONS:
             self.table[name] = self.math
@@ -223,7 +226,8 @@ class Builtins:
         """``Integer(E.b)``: the ordinal of an enumeration value (enumeration values are
         their ordinals already, Modelica 4.9.5.2)."""
         (v,) = self._args(call, scope, 1)
-        return v
+        return a.elementwise(lambda e: x.Const(int(e.value)) if isinstance(e, x.Const)
+                             and isinstance(e.value, EnumLiteral) else e, v)
 
     def vector(self, call: s.Call, scope: Scope) -> a.Value:
         (v,) = self._args(call, scope, 1)

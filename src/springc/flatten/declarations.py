@@ -53,14 +53,52 @@ def inner_member(fl: FlattenContext, scope: ClassScope, outer: ViewComponent) ->
         comp = enclosing.view.components.get(decl.name)
         if comp is not None and comp.decl.inner:
             _check_inner_type(fl, outer, comp)
+            if comp.decl.outer:  # `inner outer`: its inner part
+                return enclosing.inner_part(decl.name)
             return enclosing.member(decl.name, decl.span)
         enclosing = enclosing.outer
+    added = added_inner(fl, scope, outer)
+    if added is not None:
+        return added
     where = f"'{scope.prefix}'" if scope.prefix else "the model"
     raise FlattenError(
         f"the outer element '{scope.flat_name(decl.name)}' has no inner element "
         f"'{decl.name}' in an enclosing instance", decl.span,
         hint=f"declare `inner {decl.type_name.dotted} {decl.name}` in a model that "
         f"contains {where}")
+
+
+def added_inner(fl: FlattenContext, scope: ClassScope, outer: ViewComponent
+                ) -> Member | None:
+    """The inner element added at the top of the model for an outer one that has none
+    (section 5.4): of the outer element's class, if that is not partial; one for all
+    the outer elements of that name, which must all be of one class."""
+    root = scope
+    while root.outer is not None:
+        root = root.outer
+    decl = outer.decl
+    try:
+        rtype = fl.declared_type(outer).rtype
+    except FlattenError:
+        return None  # reported where the element is instantiated
+    if rtype.entry is not None and rtype.entry.defn.partial:
+        return None
+    found = root.added_inners.get(decl.name)
+    if found is not None:
+        first = fl.declared_type(found[1]).rtype
+        if (first.entry, first.primitive) != (rtype.entry, rtype.primitive):
+            raise rule_error(f"the outer elements '{decl.name}' have no inner element and "
+                             "are of different classes", decl.span,
+                             "an inner element is added at the top of the model only "
+                             "for outer elements of one class", "5.4",
+                             (Note("another outer element of that name", found[1].decl.span),))
+        return found[0]
+    if decl.name in root.view.components:
+        return None
+    inner = ViewComponent(replace(decl, outer=False, inner=True), outer.defined_in)
+    member = fl.instantiate(root, inner)
+    root.added_inners[decl.name] = (member, outer)
+    return member
 
 
 def _check_inner_type(fl: FlattenContext, outer: ViewComponent, inner: ViewComponent

@@ -24,6 +24,7 @@ from .loops import check_loop_nest
 from .ranges import with_range
 from .records import record_equation
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .strings import string_equation
 from .type_rules import check_boolean_condition
 from .when import flatten_when, variable_if_equation
 
@@ -44,7 +45,7 @@ class EquationFlattening(FlattenContext):
             return
         target = self.initial_equations if initial else self.equations
         key = (id(view), initial)
-        template = self.templates.get(key)
+        template = self.templates.get(key) if scope.package is None else None
         if template is not None:
             target += template.instantiate(scope.prefix)
             return
@@ -54,7 +55,8 @@ class EquationFlattening(FlattenContext):
                 self.equation(item.equation, scope, scope, initial)
             except FlattenError as err:
                 self.report(err)
-        if key not in self.templates and scope.prefix and len(self.errors) == errors:
+        if key not in self.templates and scope.prefix and len(self.errors) == errors \
+                and scope.package is None:
             independent = self.parameter_values.reads == reads and reusable(self, view)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
@@ -162,6 +164,8 @@ class EquationFlattening(FlattenContext):
                 f"the two sides of this equation differ in size: "
                 f"{a.describe_shape(a.shape(lhs))} and {a.describe_shape(a.shape(rhs))}",
                 eq.span, hint="both sides of an equation must have the same size")
+        if string_equation(lhs, rhs, eq.span):
+            return  # known while flattening (flatten/strings.py)
         for side, e in ((lhs, eq.lhs), (rhs, eq.rhs)):
             if isinstance(side, str):
                 raise FlattenError("strings cannot appear in equations", e.span)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, cast
 
 import numpy as np
@@ -26,11 +26,12 @@ from .cardinality import NAME as CARDINALITY
 from .cardinality import cardinality_call
 from .delay import NAME as DELAY
 from .delay import delay_call
+from .enum_rules import check_enum_relation
 from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call
 from .event_uses import EventUses
 from .functions import call_function, function_of
 from .parameters import check_powers
-from .ranges import with_range
+from .ranges import type_range, typed_range, typed_range_bounds, with_range
 from .references import ReferenceResolver
 from .scope import (
     ClassScope,
@@ -38,12 +39,12 @@ from .scope import (
     LocalScope,
     Scope,
 )
+from .strings import string_binary
 
 UNSUPPORTED_CALLS = {
     "hold",
     "Clock", "previous", "subSample", "superSample", "shiftSample", "backSample",
-    "spatialDistribution", "inStream", "actualStream",
-    "getInstanceName", "String", "assert",
+    "spatialDistribution", "inStream", "actualStream", "getInstanceName", "assert",
 }
 
 
@@ -164,6 +165,8 @@ class Evaluator(ReferenceResolver):
         start = self.constant(e.start, scope, "a range bound")
         stop = self.constant(e.stop, scope, "a range bound")
         step = self.constant(e.step, scope, "a range step") if e.step else 1
+        if typed_range_bounds(start, stop, e):  # false:true, E.a:E.c (section 10.4.3)
+            return a.make_array(typed_range(start, stop))
         for bound in (start, stop, step):
             if isinstance(bound, (np.ndarray, str)) or not math.isfinite(bound):
                 raise FlattenError(f"the bounds and step of a range must be finite numbers, "
@@ -216,6 +219,9 @@ class Evaluator(ReferenceResolver):
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check
             return scalar(cast(x.Expr, left), cast(x.Expr, right))
+        text = string_binary(e.op, left, right, e.span)
+        if text is not None:
+            return text
         self._numeric(left, e.left.span)
         self._numeric(right, e.right.span)
         op = e.op
@@ -239,6 +245,7 @@ class Evaluator(ReferenceResolver):
         except ValueError as err:
             raise FlattenError(str(err), e.span,
                                hint="check the sizes of both operands") from None
+        check_enum_relation(e, left, right, scope, self)
         result: a.Value = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
         return result  # a relation on variables generates events (simplify/events.py)
 
@@ -338,18 +345,20 @@ class Evaluator(ReferenceResolver):
             local = LocalScope({i.name: v for i, v in zip(indices, combo)}, scope)
             yield self.value(body, local)
 
-    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]:
+    def range_values(self, index: s.ForIndex, scope: Scope) -> Sequence[x.Expr | str]:
         if index.range is None:
             raise FlattenError(f"the range of '{index.name}' must be given "
                                f"('for {index.name} in 1:N')", index.span)
-        if isinstance(index.range, s.Ref):  # an enumeration type: its literals in order
-            target = self.reference(index.range, scope)
-            if isinstance(target, ClassEntry) and target.defn.enumeration is not None:
-                return [x.Const(i + 1) for i in range(len(target.defn.enumeration))]
+        if isinstance(index.range, s.Ref):  # Boolean or an enumeration type (11.2.2.2)
+            typed = type_range(self.flattener, index.range, scope)
+            if typed is not None:
+                return typed
         v = self.value(index.range, scope)
         if not a.is_array(v) or v.ndim != 1:
             raise FlattenError("a for-loop range must be a vector", index.range.span)
-        return [x.Const(self._plain(self.fold_at(item, index.range))) for item in v]
+        values = [self.fold_at(item, index.range) for item in v]
+        return [item if isinstance(item, str) else x.Const(self._plain(item))
+                for item in values]  # a String range: the strings themselves
 
     def fold_at(self, v: a.Value, e: s.Expr) -> Any:
         try:

@@ -34,6 +34,7 @@ from .lookup import ClassLookup, select_model
 from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
 from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
+from .strings import undefined_strings
 from .variables import attributes_of
 from .when import check_events
 
@@ -89,10 +90,12 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         for name, comp in scope.view.components.items():
             try:
                 member = scope.member(name)
+                if comp.decl.outer and comp.decl.inner:
+                    member = scope.inner_part(name)  # the outer part is walked elsewhere
             except FlattenError as err:
                 self.report(err)
                 continue
-            if comp.decl.outer:
+            if comp.decl.outer and not comp.decl.inner:
                 continue  # the inner instance is walked where it is declared
             if isinstance(member, ClassScope):
                 yield from self._walk_one(member)
@@ -107,10 +110,23 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
             self.instance_templates.finish(recording)
         yield scope
 
+    def walk_added(self, top: ClassScope) -> Iterator[ClassScope]:
+        """The instances below the inner elements added for outer ones without
+        (``ClassScope.added_inners``), and those they add in turn."""
+        done = 0
+        while done < len(top.added_inners):
+            added = list(top.added_inners.values())[done][0]
+            done += 1
+            for item in (added.flat if isinstance(added, np.ndarray) else [added]):
+                if isinstance(item, ClassScope):
+                    yield from self._walk_one(item)
+
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]:
         for _name, member in scope.all_members():
             if isinstance(member, Primitive):
-                if member.variability != "constant" and member.type != "String":
+                if member.type == "String":
+                    self.errors += undefined_strings(member.value)
+                elif member.variability != "constant":
                     yield from attributes_of(self, scope, member)
             else:
                 for item in (member.flat if isinstance(member, np.ndarray) else [member]):
@@ -157,7 +173,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     top.mod = instance_mod(merge_all(mods), view, top)
     scopes = [top]
     try:
-        scopes = [*flattener.walk(top), top]
+        scopes = [*flattener.walk(top), *flattener.walk_added(top), top]
         for scope in scopes:
             check_connector_size(scope)
         for scope in scopes:
@@ -182,6 +198,16 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
                           experiment_of(flattener, entry, top), entry.defn.span,
+                          notes=tuple(added_inner_notes(top)),
                           whens=tuple(flattener.whens),
                           assertions=unique(flattener.assertions))
+
+
+def added_inner_notes(top: ClassScope) -> Iterator[str]:
+    """The diagnostics of the inner elements added for outer ones (section 5.4)."""
+    for name, (_, outer) in top.added_inners.items():
+        where = f"{outer.decl.span}: " if outer.decl.span is not None else ""
+        yield (f"{where}warning: the outer element '{name}' has no inner element: "
+               f"`inner {outer.decl.type_name.dotted} {name}` is added at the top of the "
+               "model (Modelica 3.6, section 5.4)")
 

@@ -20,7 +20,7 @@ given from outside are evaluated anew per instance; they may only set whole para
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from itertools import islice
 from typing import Any
 
@@ -74,7 +74,7 @@ class InstanceTemplates:
         recording if it is the second instance of its kind (the first one has warmed
         the caches of values given from outside, which are then not read again)."""
         if scope.members or scope.failed or scope.variability or scope.flow or \
-                not self._class_reusable(scope.view):
+                scope.package is not None or not self._class_reusable(scope.view):
             return None
         mod_shape = shape(scope.mod, scope, 0)
         if mod_shape is None:
@@ -264,8 +264,7 @@ def _copy_primitive(prim: Primitive, rename: Callable[[x.Expr], x.Expr], prefix:
     else:
         names = prefix + prim.names[cut:]
         value = rename(a.scalars(prim.value)[0])
-    return Primitive(names, value, prim.decl, prim.variability, prim.causality, prim.flow,
-                     prim.type, prim.mod, prim.dims, prim.connector)
+    return replace(prim, names=names, value=value)
 
 
 def _scalar_names(prim: Primitive, new: str = "", old: str = "") -> list[str]:

@@ -30,6 +30,10 @@ from .declarations import (
     redeclared_class,
     redeclared_class_mod,
 )
+from .dimensions import typed_dimension
+from .enum_rules import check_enum_binding
+from .enumerations import DimensionKind
+from .instance_classes import named_through, type_name_package
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .scope import (
@@ -43,6 +47,7 @@ from .scope import (
     ViewComponent,
     instance_mod,
 )
+from .strings import string_component
 from .type_rules import (
     check_constant_binding,
     check_discrete_binding,
@@ -66,10 +71,10 @@ class Instantiation(FlattenContext):
         name = scope.flat_name(decl.name)
         if decl.condition is not None and not condition_holds(self, scope, decl):
             return disabled(scope, decl)
-        if decl.outer:
+        if decl.outer:  # (of an `inner outer` element: its outer part, section 5.4)
             modified = decl.modification or (scope.mod.children.get(decl.name)
                                              if scope.mod is not None else None)
-            if modified is not None:
+            if modified is not None and not decl.inner:
                 raise FlattenError(f"the outer element '{name}' cannot be modified",
                                    modified.span, [Note("declared here", decl.span)],
                                    "modify the inner element instead (Modelica 5.4)")
@@ -85,6 +90,13 @@ class Instantiation(FlattenContext):
         by_class = redeclared_class(scope, decl.type_name)
         if by_class is not None:
             rtype, type_mods = self._redeclared_type(by_class[0], by_class[1])
+        package = None if by_class is not None else type_name_package(self, scope, decl)
+        retyped = by_class is not None or package is not None
+        if package is not None:  # Medium.BaseProperties, with Medium redeclared
+            rest = decl.type_name.parts[1:]
+            rtype = self.resolve_type(s.Ref(rest, decl.type_name.span), package)
+            type_mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
+                         for m, e in rtype.mods]
         if outer is None and own is None and len(type_mods) <= 1:
             mod = type_mods[0] if type_mods else None  # nothing to merge
         else:
@@ -93,15 +105,15 @@ class Instantiation(FlattenContext):
             raise FlattenError(f"'{name}' is final and cannot be "
                                "modified", outer.span, [Note("declared final here",
                                                               decl.span)])
-        dims = declared.dims if declared.dims is not None and by_class is None \
+        dims, kinds = (declared.dims, ()) if declared.dims is not None and not retyped \
             else self._dims(decl, scope, rtype, mod, name)
         for n in dims:
             self.limits.check_size(n, f"a dimension of '{name}'", decl.span)
         self.limits.add_scalars(math.prod(dims), name, decl.span)
         if rtype.primitive == "String":
-            return self._string(decl, rtype, mod, dims, name)
+            return string_component(self, decl, rtype, mod, dims, name)
         if rtype.primitive is not None:
-            return self._primitive(scope, decl, rtype, mod, dims, name)
+            return self._primitive(scope, decl, rtype, mod, dims, name, kinds)
         assert rtype.entry is not None
         if rtype.entry.defn.kind in ("function", "package"):
             raise FlattenError(f"'{rtype.entry.full_name}' is a {rtype.entry.defn.kind} and "
@@ -114,15 +126,20 @@ class Instantiation(FlattenContext):
                                "use a class that extends it")
         self._check_containment(scope, rtype.entry, decl, name)
         view = self._used_view(rtype.entry, decl, name)
+        through = named_through(self, scope, comp.decl, package, rtype.entry)
         if not dims:
-            return self._class_scope(name, view, mod, decl, scope)
+            made = self._class_scope(name, view, mod, decl, scope)
+            made.package = through
+            return made
         if mod is not None:
             self._check_array_mod(mod, dims, name, "")
         out = np.empty(dims, dtype=object)
         for idx in np.ndindex(dims):
             sub = tuple(i + 1 for i in idx)
-            out[idx] = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
-                                         select(mod, sub), decl, scope)
+            item = self._class_scope(f"{name}[{','.join(map(str, sub))}]", view,
+                                     select(mod, sub), decl, scope)
+            item.package = through
+            out[idx] = item
         return out
 
     def _used_view(self, entry: ClassEntry, decl: s.Component, name: str) -> ClassView:
@@ -141,10 +158,9 @@ class Instantiation(FlattenContext):
     def _redeclared_type(self, defn: s.ClassDef, where: ClassScope
                          ) -> tuple[ResolvedType, list[Mod | None]]:
         """The type and type modifiers of a class replaced by ``redeclare model M = T(...)``."""
-        if defn.short is None:
-            raise FlattenError("a redeclaration with a long class definition is not "
-                               "supported yet", defn.span,
-                               hint="write `redeclare model M = Other(...)`")
+        if defn.short is None:  # `redeclare model M ... end M;`: that class itself
+            return self.resolve_type(s.Ref((s.RefPart(defn.name, (), defn.span),),
+                                           defn.span), where.entry), []
         rtype = self.resolve_type(defn.short.base, where.entry)
         mods = [each(from_syntax(m, self.package_scope(e.parent or e))) for m, e in rtype.mods]
         return rtype, [redeclared_class_mod(defn, where, None), *mods]
@@ -236,19 +252,29 @@ class Instantiation(FlattenContext):
             + ", ".join(view.components))
 
     def _dims(self, decl: s.Component, scope: ClassScope, rtype: ResolvedType,
-              mod: Mod | None = None, name: str = "") -> tuple[int, ...]:
+              mod: Mod | None = None, name: str = ""
+              ) -> tuple[tuple[int, ...], tuple[DimensionKind, ...]]:
+        """The sizes of a declaration's dimensions, and their kinds (() if every
+        dimension is an Integer size)."""
         exprs = [(d, scope) for d in decl.dims + decl.type_dims]
         exprs += [(d, self.package_scope(e.parent or e)) for d, e in rtype.dims]
         dims = []
+        kinds: list[DimensionKind] = []
         for k, (d, where) in enumerate(exprs):
+            kinds.append(None)
             if isinstance(d, s.Colon):
                 dims.append(self._colon_size(k, d, mod, name or decl.name))
+                continue
+            typed = typed_dimension(self, d, where)
+            if typed is not None:  # [Boolean], [E] (section 10.1)
+                dims.append(typed[0])
+                kinds[-1] = typed[1]
                 continue
             n = self.evaluator.integer(d, where, "an array size")
             if n < 0:
                 raise FlattenError(f"array size must not be negative, found {n}", d.span)
             dims.append(n)
-        return tuple(dims)
+        return tuple(dims), tuple(kinds) if any(k is not None for k in kinds) else ()
 
     def _colon_size(self, k: int, d: s.Colon, mod: Mod | None, name: str) -> int:
         """The size of a ``[:]`` dimension: that of the binding (section 10.1)."""
@@ -266,12 +292,16 @@ class Instantiation(FlattenContext):
         return dims[k]
 
     def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
-                   mod: Mod | None, dims: tuple[int, ...], name: str) -> Primitive:
+                   mod: Mod | None, dims: tuple[int, ...], name: str,
+                   kinds: tuple[DimensionKind, ...] = ()) -> Primitive:
         variability = stronger(decl.variability or rtype.prefixes[0] or (
             "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous"),
             scope.variability)
         check_integer_binding(name, rtype.primitive or "Real",
                               mod.value.expr if mod is not None and mod.value else None)
+        if mod is not None and mod.value is not None:
+            check_enum_binding(name, rtype.primitive or "Real", rtype.enumeration,
+                               mod.value.expr, mod.value.scope, self.evaluator)
         causality = decl.causality or rtype.prefixes[1]
         check_attribute_mods(mod, rtype.primitive, name)
         name_list = _element_names(name, dims)
@@ -290,7 +320,8 @@ class Instantiation(FlattenContext):
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         flow, rtype.primitive or "Real", mod, dims, rtype.connector)
+                         flow, rtype.primitive or "Real", mod, dims, rtype.connector,
+                         rtype.enumeration, kinds)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):
                 self.parameter_values.bindings[n] = b
@@ -298,23 +329,6 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
-
-    def _string(self, decl: s.Component, rtype: ResolvedType, mod: Mod | None,
-                dims: tuple[int, ...], name: str) -> Primitive:
-        """A ``String`` parameter or constant: its value, known while flattening (it is
-        not a variable of the flat model)."""
-        variability = decl.variability or rtype.prefixes[0]
-        if variability not in ("parameter", "constant"):
-            raise FlattenError("`String` variables are not supported yet", decl.span,
-                               hint="declare it a parameter or a constant")
-        if dims:
-            raise FlattenError("arrays of `String` are not supported yet", decl.span)
-        check_attribute_mods(mod, "String", name)
-        value = self.mod_value(mod.value) if mod is not None and mod.value is not None else ""
-        if not isinstance(value, str):
-            raise FlattenError(f"'{name}' is a String and must be given a string",
-                               mod.value.span if mod is not None and mod.value else decl.span)
-        return Primitive(name, value, decl, variability, "", False, "String", mod, ())
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

@@ -17,10 +17,11 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
 from .access import check_access_component, check_access_path, check_inside
 from .builtins import CONSTANTS
+from .class_extends import check_class_redeclarations
 from .conditional_rules import check_conditional_uses
-from .enumerations import BUILTIN_ENUMERATIONS
+from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
-from .modification import Mod, from_syntax
+from .modification import Mod, from_syntax, merge_all
 from .rules import check_class, check_extends, rule_error
 from .scope import (
     PRIMITIVES,
@@ -30,6 +31,7 @@ from .scope import (
     ResolvedType,
     Scope,
     build_view,
+    instance_mod,
 )
 
 
@@ -55,6 +57,7 @@ class ClassLookup(FlattenContext):
             found = self.views[id(entry)] = build_view(entry, self, seen)
             try:
                 check_class(self, found)
+                check_class_redeclarations(self.resolve_class, entry)
                 check_inherited_names(self, found)
                 check_conditional_uses(found)
             except FlattenError as err:
@@ -89,7 +92,8 @@ class ClassLookup(FlattenContext):
         if name in PRIMITIVES and lookup_class(name, scope) is None:
             return ResolvedType(name, None, (), (), prefixes)
         if name in BUILTIN_ENUMERATIONS and lookup_class(name, scope) is None:
-            return ResolvedType("Integer", None, (), (), prefixes)
+            return ResolvedType("Integer", None, (), (), prefixes,
+                                enumeration=BUILTIN_ENUMERATIONS[name])
         if name == "String" and lookup_class(name, scope) is None:
             return ResolvedType("String", None, (), (), prefixes)
         entry = self.resolve_class(ref, scope)
@@ -98,7 +102,8 @@ class ClassLookup(FlattenContext):
             short = entry.defn.short
             if entry.defn.enumeration is not None:
                 # Enumeration values are their ordinals (1, 2, ...): an Integer.
-                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes)
+                return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes,
+                                    enumeration=enumeration_of(entry))
             if short is None:
                 return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
             if short.modification is not None:
@@ -162,7 +167,7 @@ class ClassLookup(FlattenContext):
             if name not in literals:
                 raise FlattenError(f"enumeration '{entry.full_name}' has no literal '{name}'",
                                    span, hint="its literals are: " + ", ".join(literals))
-            return x.Const(literals.index(name) + 1)
+            return literal_value(enumeration_of(target), literals.index(name) + 1)
         nested = member_class(entry, name)
         if nested is not None:
             check_access_path([entry, nested], ref)
@@ -175,12 +180,27 @@ class ClassLookup(FlattenContext):
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
 
     def package_scope(self, entry: ClassEntry) -> ClassScope:
+        """The instance of a package whose constants are read: ``package M2 = M1(y =
+        2)`` is ``M1`` with that modification, and a package extending another with a
+        modification (``extends Base(n = 3)``) has it."""
         scope = self.package_scopes.get(id(entry))
         if scope is None:
-            view = self.view(entry)
+            target, mods = self._short_package(entry)
+            view = self.view(target)
             scope = ClassScope(self, entry.full_name, view, None, entry.defn.span)
+            if view.extends_mods or any(m is not None for m in mods):
+                scope.mod = instance_mod(merge_all(mods), view, scope)
             self.package_scopes[id(entry)] = scope
         return scope
+
+    def _short_package(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:
+        short = entry.defn.short
+        if short is None or short.dims or short.base.dotted in PRIMITIVES:
+            return entry, []
+        try:
+            return self.follow_short(entry)
+        except FlattenError:  # reported where the class is used
+            return entry, []
 
     def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any:
         """A name not declared in the instance: time, a constant of an enclosing class,

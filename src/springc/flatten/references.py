@@ -18,7 +18,9 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .access import check_access_component
 from .builtins import CONSTANTS
-from .enumerations import BuiltinEnumeration
+from .dimensions import typed_index
+from .enumerations import BuiltinEnumeration, DimensionKind, literal_value, value_kind
+from .instance_classes import instance_scope, redeclared_package
 from .scope import (
     ClassScope,
     Disabled,
@@ -28,6 +30,7 @@ from .scope import (
     Primitive,
     Scope,
 )
+from .strings import read as read_string
 
 
 class ReferenceResolver:
@@ -60,7 +63,11 @@ class ReferenceResolver:
             current = self.flattener.resolve_class(s.Ref((first,), first.span, True),
                                                    scope.entry)
         else:
-            current = self._subscript(scope.lookup(first.name, first.span), first, scope)
+            instance = instance_scope(scope)
+            package = None if instance is None or len(e.parts) == 1 else \
+                redeclared_package(self.flattener, instance, first.name)
+            current = package if package is not None else \
+                self._subscript(scope.lookup(first.name, first.span), first, scope)
         for part in e.parts[1:]:
             current = self._select(current, part, scope, e)
         return current
@@ -71,7 +78,7 @@ class ReferenceResolver:
                 raise FlattenError(f"'{part.name}' is not a literal of {current.name}",
                                    part.span, hint="its literals are: "
                                    + ", ".join(current.literals))
-            return x.Const(current.literals.index(part.name) + 1)
+            return literal_value(current, current.literals.index(part.name) + 1)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)
@@ -99,7 +106,9 @@ class ReferenceResolver:
             hint)
 
     def member_value(self, member: Any) -> Any:
-        return member.value if isinstance(member, Primitive) else member
+        if not isinstance(member, Primitive):
+            return member
+        return read_string(member.value) if member.type == "String" else member.value
 
     def _subscript(self, current: Any, part: s.RefPart, scope: Scope) -> Any:
         if isinstance(current, Disabled):
@@ -114,7 +123,8 @@ class ReferenceResolver:
         if len(part.subscripts) > len(dims):
             raise FlattenError(f"'{part.name}' has {len(dims)} dimension(s) but "
                                f"{len(part.subscripts)} subscript(s) are given", part.span)
-        index = tuple(self._index(sub, dims[k], scope, part)
+        kinds = current.kinds if isinstance(current, Primitive) else ()
+        index = tuple(self._index(sub, dims[k], scope, part, kinds[k] if kinds else None)
                       for k, sub in enumerate(part.subscripts))
         if sum(isinstance(i, np.ndarray) for i in index) > 1:
             # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
@@ -129,7 +139,8 @@ class ReferenceResolver:
             return result.item()
         return result
 
-    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart) -> Any:
+    def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart,
+               kind: DimensionKind = None) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
         uses_end = self.uses_end.get(id(sub))
@@ -141,6 +152,9 @@ class ReferenceResolver:
         if v is None:
             v = self.constant(sub, scope, "a subscript")
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
+        if kind is not None or any(value_kind(i) is not None for i in values):
+            values = [typed_index(i, kind, sub.span, part.name) for i in values]
+            v = np.array(values, dtype=object) if isinstance(v, np.ndarray) else values[0]
         for i in values:
             if isinstance(i, bool | str) or not math.isfinite(i) or i != int(i):
                 raise FlattenError(f"a subscript must be an integer, found {i!r}", sub.span)

@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from ..errors import FlattenError, Note, Span
 from ..ir import syntax as s
 from ..parse import ClassEntry
+from .class_extends import inherited_class
 from .scope import PRIMITIVES, ClassView, FlattenContext, ResolvedType, ViewComponent
 from .syntax_walk import mod_values, refs, same_text, statement_exprs, statements
 
@@ -108,8 +109,10 @@ def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
     allowed = BASE_KINDS.get(kind)
     clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)]
     for element in clauses:
-        base = ctx.resolve_class(element.base, entry.parent or entry, entry)
-        if base.defn.replaceable:
+        inherited = entry.defn.class_extends and element is entry.defn.elements[0]
+        base = inherited_class(ctx.resolve_class, entry, element.span) if inherited \
+            else ctx.resolve_class(element.base, entry.parent or entry, entry)
+        if base.defn.replaceable and not inherited:
             raise rule_error(f"'{entry.name}' extends the replaceable class "
                              f"'{element.base.dotted}'", element.base.span,
                              "a base class is not replaceable (a redeclaration could "
@@ -151,7 +154,7 @@ def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
     """A class inherited under the name of a local class must be the same class (unless
     the local one redeclares it, section 7.3)."""
     local = {e.name: e for e in entry.defn.elements
-             if isinstance(e, s.ClassDef) and not e.redeclare}
+             if isinstance(e, s.ClassDef) and not e.redeclare and not e.class_extends}
     for element in base.defn.elements:
         if isinstance(element, s.ClassDef) and element.name in local and \
                 not same_text(element, local[element.name]):

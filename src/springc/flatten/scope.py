@@ -14,7 +14,7 @@ a :class:`FlattenContext` or an :class:`ExpressionEvaluator`, the Protocols defi
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
@@ -27,6 +27,8 @@ from ..ir import syntax as s
 from ..ir.when import When
 from ..parse import ClassEntry
 from . import arrays as a
+from .class_extends import inherited_class
+from .enumerations import DimensionKind, Enumeration
 from .event_uses import EventUses
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
@@ -75,6 +77,7 @@ class ResolvedType:
     mods: tuple[tuple[s.Modification, ClassEntry], ...]
     prefixes: tuple[str, str, bool]
     connector: bool = False  # a primitive reached through `connector C = input Real`
+    enumeration: Enumeration | None = None  # the type of an enumeration ("Integer")
 
 
 @dataclass(eq=False)
@@ -91,6 +94,8 @@ class Primitive:
     mod: Mod | None
     dims: tuple[int, ...]
     connector: bool = False  # declared with a short connector class (RealInput)
+    enumeration: Enumeration | None = None  # its type, if an enumeration ("Integer")
+    kinds: tuple[DimensionKind, ...] = ()  # of its dimensions; () if all are Integer
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,6 +135,16 @@ class ClassScope:
     # constant/parameter/discrete on this (structured) component, which applies to its
     # elements of a less restrictive variability (Modelica 3.6, section 4.4.4.1)
     variability: str = ""
+    # The package its class was named through (`Medium.Props p` with Medium a package
+    # extending the one that declares Props): its constants are those the class sees
+    # (the package is the class's enclosing class there, section 5.3).
+    package: ClassScope | None = None
+    # The inner parts of its `inner outer` elements (section 5.4): local references
+    # name the outer part (the member), the outer elements below the inner part.
+    inner_parts: dict[str, Member] = field(default_factory=dict)
+    # Of the model: the inner elements added for outer ones that have none (5.4), with
+    # the outer declaration that caused each.
+    added_inners: dict[str, tuple[Member, ViewComponent]] = field(default_factory=dict)
 
     @property
     def entry(self) -> ClassEntry:
@@ -170,19 +185,34 @@ class ClassScope:
         self.members[name] = created
         return created
 
+    def inner_part(self, name: str) -> Member:
+        """The inner part of the ``inner outer`` element ``name``, instantiated on first
+        use: the element as if declared ``inner`` only."""
+        found = self.inner_parts.get(name)
+        if found is None:
+            comp = self.view.components[name]
+            inner = ViewComponent(replace(comp.decl, outer=False), comp.defined_in)
+            found = self.inner_parts[name] = self.flattener.instantiate(self, inner)
+        return found
+
     def all_members(self) -> Iterator[tuple[str, Primitive | ClassScope | np.ndarray]]:
         """The members this instance owns: not disabled conditional components, and not
-        ``outer`` ones (they are the ``inner`` instance's, reached from here)."""
+        ``outer`` ones (they are the ``inner`` instance's, reached from here), but the
+        inner parts of ``inner outer`` ones."""
         for name, comp in self.view.components.items():
-            if comp.decl.outer:
+            if comp.decl.outer and not comp.decl.inner:
                 continue
-            member = self.member(name)
+            member = self.inner_part(name) if comp.decl.outer else self.member(name)
             if not isinstance(member, Disabled):
                 yield name, member
+        for name, (added, _) in self.added_inners.items():
+            yield name, added  # type: ignore[misc]
 
     def lookup(self, name: str, span: Span) -> Any:
         if name in self.view.components:
             return self.member(name, span)
+        if self.package is not None and self.package.has_member(name):
+            return self.package.member(name, span)
         return self.flattener.lookup_global(name, self.entry, span)
 
 
@@ -216,7 +246,10 @@ class FunctionScope:
 
     def lookup(self, name: str, span: Span) -> Any:
         if name not in self.names:
-            return self.parent.lookup(name, span)
+            if self.parent.has_member(name):
+                return self.parent.lookup(name, span)
+            # from the function itself: its imports, then its enclosing classes
+            return self.parent.flattener.lookup_global(name, self.entry, span)
         value = self.names[name]
         if value is None:
             raise FlattenError(f"'{name}' is used before it is assigned", span)
@@ -291,7 +324,7 @@ class ExpressionEvaluator(Protocol):
     def iterate(self, body: s.Expr, indices: tuple[s.ForIndex, ...], scope: Scope
                 ) -> Iterator[a.Value]: ...
 
-    def range_values(self, index: s.ForIndex, scope: Scope) -> list[x.Expr]: ...
+    def range_values(self, index: s.ForIndex, scope: Scope) -> Sequence[x.Expr | str]: ...
 
 
 class FlattenContext(Protocol):
@@ -361,7 +394,10 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
     for element in entry.defn.elements:
         if not isinstance(element, s.Extends):
             continue
-        base = flattener.resolve_class(element.base, entry.parent or entry, entry)
+        if entry.defn.class_extends and element is entry.defn.elements[0]:
+            base = inherited_class(flattener.resolve_class, entry, element.span)
+        else:
+            base = flattener.resolve_class(element.base, entry.parent or entry, entry)
         if base.defn.short is not None:
             raise FlattenError("extending a short class definition is not supported yet",
                                element.span)

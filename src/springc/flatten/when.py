@@ -21,6 +21,7 @@ from ..ir import when as w
 from . import arrays as a
 from .assertions import assertion
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .strings import string_equation
 
 _EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
 _WHEN_HINT = ("a when-clause holds equations 'v = expression', reinit(x, value) and "
@@ -114,6 +115,8 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
         rhs = ev.value(item.rhs, where)
         if a.shape(lhs) != a.shape(rhs):
             raise FlattenError("the two sides of this equation differ in size", item.span)
+        if string_equation(lhs, rhs, item.span, at_events=True):
+            return  # a discrete String: not simulated (flatten/strings.py)
         for left, right in zip(_scalars(lhs), _scalars(rhs)):
             if not isinstance(left, x.Var):
                 raise FlattenError("the left-hand side of an equation in a when-clause must "

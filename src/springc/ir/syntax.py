@@ -422,6 +422,10 @@ class ClassDef:
     enumeration: tuple[str, ...] | None = None
     replaceable: bool = False
     redeclare: bool = False  # an element `redeclare model M = T;` of an extending class
+    # `model extends M ... end M;` (section 7.3.1): its first element `extends M(...)`
+    # names the class M that the enclosing class inherits.
+    class_extends: bool = False
+    final: bool = False  # declared `final model M ...`: it cannot be redeclared
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.
     unsupported: tuple[ParseError, ...] = ()

@@ -247,6 +247,22 @@ def member_class(entry: ClassEntry, name: str,
     key = (id(entry), name)
     if key in active:
         raise _LookupCycle
+    short = entry.defn.short
+    if short is not None and not short.dims and entry.parent is not None:
+        # `package Medium = Base`: the classes of Base, and those its modification
+        # redeclares: `package P2 = P(redeclare model A = B)` (section 7.3). Not when
+        # it modifies constants (`= Base(n = 3)`): its classes would see them.
+        for arg in short.modification.arguments if short.modification else ():
+            new = arg.redeclare
+            if not isinstance(new, s.ClassDef):
+                return None
+            if isinstance(new, s.ClassDef) and new.name == name and new.short is not None:
+                if new.short.modification is not None:
+                    return None  # with a modification of its own: not a plain class
+                return _resolve_quiet(new.short.base, entry.parent, active | {key})
+        target = _resolve_quiet(short.base, entry.parent, active | {key})
+        return member_class(target, name, active | {key}) \
+            if target is not None and target is not entry else None
     for element in entry.defn.elements:
         if isinstance(element, s.Extends):
             try:

@@ -63,6 +63,7 @@ class _Spec:
     annotation: Modification | None
     end_name: Token | None
     enumeration: tuple[str, ...] | None = None
+    class_extends: bool = False
 
 
 def _section_rule(kind: str) -> Callable[[RuleBase, Meta, list[Any]], _Section]:
@@ -140,6 +141,7 @@ class ClassRules(RuleBase):
             short=spec.short,
             annotation=_merge_annotations(spec.annotation, body["annotations"]),
             protected=False, span=span, enumeration=spec.enumeration,
+            class_extends=spec.class_extends,
             unsupported=self.take_deferred(span) if self.defer else (),
         )
 
@@ -188,8 +190,17 @@ class ClassRules(RuleBase):
         name, description, sections, end_name = ch
         return _Spec(name, description, sections, None, None, end_name)
 
-    def extends_class(self, meta: Meta, ch: list[Any]) -> Rejected:
-        return self.reject("`class extends` definitions are", self.keyword_span(meta, "extends"))
+    def extends_class(self, meta: Meta, ch: list[Any]) -> Any:
+        """``model extends M(k = 1) ... end M;``: a long class whose first element extends
+        the class M inherited by the enclosing class (section 7.3.1)."""
+        name, (description, sections, end_name) = ch[0], ch[-3:]
+        mod = of(ch, ClassMod)
+        base = Extends(self.make_ref((name,)),
+                       Modification(mod.arguments, None, mod.span) if mod else None,
+                       self.keyword_span(meta, "extends"))
+        first = replace(sections[0], items=(base, *sections[0].items))
+        return _Spec(name, description, (first, *sections[1:]), None, None, end_name,
+                     class_extends=True)
 
     def short_class(self, meta: Meta, ch: list[Any]) -> Any:
         name, prefixes, base = ch[0], ch[1], ch[2]

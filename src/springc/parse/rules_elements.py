@@ -4,7 +4,7 @@
 :class:`ElementRules` has one method per rule of ``grammar/modelica.lark`` for
 declarations (with ``inner``/``outer``, ``replaceable``, ``constrainedby``, conditions),
 imports, ``extends`` clauses, modifications (with ``redeclare``) and comments; unsupported
-forms (``inner outer`` together, ``stream``, ``:=`` bindings) become located
+forms (``stream``, ``:=`` bindings) become located
 ``... not supported yet`` errors.
 """
 
@@ -88,14 +88,11 @@ class ElementRules(RuleBase):
         if constraint is not None and "replaceable" not in words:
             self.error("`constrainedby` needs a `replaceable` element", constraint.span,
                        hint="write `replaceable` before the declaration")
-        if "inner" in words and "outer" in words:
-            self.reject("`inner outer` elements are",
-                        self.token_span(next(t for t in prefixes if t == "outer")))
         if isinstance(item, Rejected):
             return [item]
         if isinstance(item, ClassDef):
             return [replace(item, replaceable="replaceable" in words,
-                            redeclare="redeclare" in words)]
+                            redeclare="redeclare" in words, final="final" in words)]
         return self._components(item, words, constraint)
 
     def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
