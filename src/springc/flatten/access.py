@@ -9,7 +9,7 @@ import itertools
 
 from ..errors import Note, Span
 from ..ir import syntax as s
-from ..parse import ClassEntry
+from ..parse import ClassEntry, member_class
 from .modification import Mod
 from .rules import rule_error
 from .scope import ClassView
@@ -74,6 +74,9 @@ def check_modified(view: ClassView, mod: Mod, owner: str) -> None:
         if child.redeclare is not None and isinstance(child.redeclare.element, s.ClassDef):
             local = next((e for e in view.entry.defn.elements
                           if isinstance(e, s.ClassDef) and e.name == name), None)
+            if local is None:  # an inherited class keeps its protection (7.3)
+                found = member_class(view.entry, name)
+                local = found.defn if found is not None else None
             if local is not None and local.protected:
                 raise rule_error(f"class '{name}' is protected in '{view.entry.full_name}' "
                                  f"and cannot be redeclared in '{owner}'", child.span,

@@ -31,6 +31,7 @@ from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .lookup import ClassLookup, select_model
 from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
+from .redeclare_rules import check_redeclarations
 from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
 from .variables import attributes_of
 from .when import check_events
@@ -153,6 +154,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
     top.mod = instance_mod(merge_all(mods), view, top)
+    check_redeclarations(flattener, view, top.mod)
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), top]

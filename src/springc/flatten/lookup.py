@@ -21,6 +21,7 @@ from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
+from .redeclare_rules import check_replaceables
 from .rules import check_class, check_extends, rule_error
 from .scope import (
     PRIMITIVES,
@@ -56,6 +57,7 @@ class ClassLookup(FlattenContext):
             try:
                 check_class(self, found)
                 check_inherited_names(self, found)
+                check_replaceables(self, found)
                 check_conditional_uses(found)
             except FlattenError as err:
                 self.rule_errors[id(entry)] = err

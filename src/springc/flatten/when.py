@@ -19,6 +19,7 @@ from ..ir import syntax as s
 from ..ir import when as w
 from . import arrays as a
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .when_rules import check_when_target
 
 _EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
 _WHEN_HINT = ("a when-clause holds equations 'v = expression', reinit(x, value) and "
@@ -81,6 +82,7 @@ def _boolean_shape(e: x.Expr) -> bool:
 def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body) -> None:
     ev = ctx.evaluator
     if isinstance(item, s.Equality):
+        check_when_target(ctx, item.lhs, where.entry)
         lhs = ev.value(item.lhs, where)
         rhs = ev.value(item.rhs, where)
         if a.shape(lhs) != a.shape(rhs):

@@ -413,6 +413,9 @@ class ClassDef:
     enumeration: tuple[str, ...] | None = None
     replaceable: bool = False
     redeclare: bool = False  # an element `redeclare model M = T;` of an extending class
+    # `constrainedby T(...)` of a replaceable class (Modelica 7.3.2), and `final`
+    constraint: tuple[Ref, Modification | None] | None = None
+    final: bool = False
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.
     unsupported: tuple[ParseError, ...] = ()
