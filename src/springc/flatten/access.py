@@ -31,12 +31,18 @@ def check_access_path(chain: list[ClassEntry], ref: s.Ref) -> None:
     """``A.B.C`` as a class name, ``chain`` the classes its prefixes denote: neither
     ``B`` nor ``C`` is protected (4.1), and each is found as section 5.3.2 says."""
     for container, member in itertools.pairwise(chain):
-        if member.defn.protected:
-            raise rule_error(f"class '{member.name}' is protected in "
-                             f"'{container.full_name}' and cannot be used as '{ref.dotted}'",
-                             ref.span, ACCESS_RULE, "4.1",
-                             (Note("declared protected here", member.defn.span),))
+        check_access_class(container, member, ref)
         check_inside(container, member.name, member.defn.encapsulated, ref)
+
+
+def check_access_class(container: ClassEntry, member: ClassEntry, ref: s.Ref) -> None:
+    """``A.f`` or ``a.f``: the class ``f`` of ``A`` (or of ``a``'s class) is not
+    protected (4.1)."""
+    if member.defn.protected:
+        raise rule_error(f"class '{member.name}' is protected in "
+                         f"'{container.full_name}' and cannot be used as '{ref.dotted}'",
+                         ref.span, ACCESS_RULE, "4.1",
+                         (Note("declared protected here", member.defn.span),))
 
 
 def package_like(entry: ClassEntry) -> bool:

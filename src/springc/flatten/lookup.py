@@ -21,6 +21,7 @@ from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax
+from .outer_rules import check_outer_uses
 from .redeclare_rules import check_replaceables
 from .rules import check_class, check_extends, rule_error
 from .scope import (
@@ -58,6 +59,7 @@ class ClassLookup(FlattenContext):
                 check_class(self, found)
                 check_inherited_names(self, found)
                 check_replaceables(self, found)
+                check_outer_uses(self, found)
                 check_conditional_uses(found)
             except FlattenError as err:
                 self.rule_errors[id(entry)] = err

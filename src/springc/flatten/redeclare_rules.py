@@ -98,9 +98,10 @@ def component_bound(ctx: FlattenContext, comp: ViewComponent) -> Bound:
     current = interface(ctx, decl.type_name, comp.defined_in, len(decl.type_dims))
     bound = (_constraint(ctx, decl.constraint[0], comp.defined_in)
              if decl.constraint is not None else current)
-    # a final or constant component: scope.check_redeclarable reports it where the
-    # redeclaration is applied, with its own message
-    return Bound(bound, current, decl.replaceable or decl.final, False, decl.span)
+    # a final, constant or non-replaceable declaration: declarations.redeclared and
+    # scope.check_redeclarable report it where the redeclaration is applied; the chain
+    # checks the redeclarations that follow
+    return Bound(bound, current, True, False, decl.span)
 
 
 def class_bound(ctx: FlattenContext, entry: ClassEntry) -> Bound:

@@ -18,6 +18,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..ir import when as w
 from . import arrays as a
+from .connect_rules import check_no_connect
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .when_rules import check_when_target
 
@@ -190,6 +191,7 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     same number of scalar equations; the i-th equations of the branches become one
     equation with if-expressions (``lhs = if c then r1 else r2`` when the branches
     share the left-hand side, ``0 = if c then l1 - r1 else l2 - r2`` otherwise)."""
+    check_no_connect(eq)
     for _, body in [*eq.branches, (None, eq.otherwise)]:
         nested = _find_when(body)
         if nested is not None:

@@ -160,7 +160,10 @@ class ClassRules(RuleBase):
                 target = "equation" if section.kind == "algorithm" else "initial equation"
                 body[target].append(AlgorithmSection(statements, section.span))
             elif section.kind == "initial algorithm":
-                self.reject("`initial algorithm` sections are", section.span)
+                self.error("a function cannot have an `initial algorithm` section",
+                           section.span, hint="a function computes its outputs in one "
+                           "`algorithm` section, and has no equations and no initial "
+                           "algorithms (Modelica 3.6, section 12.2)")
             elif section.kind == "external":
                 self.reject("`external` functions are", section.span)
             elif section.kind == "algorithm" and body["algorithm_sections"]:
