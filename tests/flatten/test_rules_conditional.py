@@ -28,13 +28,12 @@ model M
   end Load;
   parameter Boolean use = true;
   Load load(R = 2) if use;
-  P q;
+  Load other;
 equation
-  connect(load.p, q);
-  q.v = 3;
+  connect(load.p, other.p);
 end M;
 """,
-        "M: 4 unknowns, 4 equations, 2 parameters: balanced"),
+        "M: 4 unknowns, 4 equations, 3 parameters: balanced"),
     "in_equation": ("""\
 model M
   Real x if true;

@@ -20,11 +20,14 @@ model M
     Integer v;
     flow Real i;
   end IntPin;
-  Pin a, b;
+  model Part
+    Pin p;
+  equation
+    p.v = p.i;
+  end Part;
+  Part a, b;
 equation
-  connect(a, b);
-  a.v = 1;
-  a.i = 2;
+  connect(a.p, b.p);
 end M;
 """,
         'M: 4 unknowns, 4 equations, 0 parameters: balanced'),
@@ -225,8 +228,6 @@ model M
 equation
   connect(b.c1, c);
   connect(b.p.x, q.y);
-  c.f = 0.5;
-  q.y.f = 0.5;
   q.x.e = 4.0;
 end M;
 """,

@@ -240,7 +240,8 @@ end R;
 
 def test_a_replaceable_component_keeps_its_type_until_redeclared(tmp_path: Path) -> None:
     text = flat(tmp_path, REDECLARE, "R.Plain")
-    assert "  parameter Real 'h.part.k' = 1;" in text.splitlines()
+    # the constraining clause's modifier (k = 5) applies to the declaration too (7.3.2)
+    assert "  parameter Real 'h.part.k' = 5;" in text.splitlines()
     assert "  parameter Real 'h.other.k' = 1;" in text.splitlines()
 
 

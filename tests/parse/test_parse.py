@@ -483,12 +483,13 @@ def test_other_lexical_and_syntax_errors() -> None:
         "t.mo:1:19: error: `end` may only be used inside array subscripts such as x[end]")
     assert error_text("function f equation x = 1; end f;").startswith(
         "t.mo:1:12: error: a function cannot have an `equation` section")
+    assert error_text("function f initial algorithm end f;").startswith(
+        "t.mo:1:12: error: a function cannot have an `initial algorithm` section")
     with pytest.raises(ParseError, match="unexpected end of file"):
         parse_expression("1 +")
 
 
 UNSUPPORTED = [
-    ("function f initial algorithm end f;", "`initial algorithm` sections are"),
     ('function f external "C"; end f;', "`external` functions are"),
     ("connector C stream Real h; end C;", "`stream` connectors are"),
     ("expandable connector C end C;", "`expandable` connectors are"),

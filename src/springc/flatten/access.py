@@ -9,7 +9,7 @@ import itertools
 
 from ..errors import Note, Span
 from ..ir import syntax as s
-from ..parse import ClassEntry
+from ..parse import ClassEntry, member_class
 from .modification import Mod
 from .rules import rule_error
 from .scope import ClassView
@@ -31,12 +31,18 @@ def check_access_path(chain: list[ClassEntry], ref: s.Ref) -> None:
     """``A.B.C`` as a class name, ``chain`` the classes its prefixes denote: neither
     ``B`` nor ``C`` is protected (4.1), and each is found as section 5.3.2 says."""
     for container, member in itertools.pairwise(chain):
-        if member.defn.protected:
-            raise rule_error(f"class '{member.name}' is protected in "
-                             f"'{container.full_name}' and cannot be used as '{ref.dotted}'",
-                             ref.span, ACCESS_RULE, "4.1",
-                             (Note("declared protected here", member.defn.span),))
+        check_access_class(container, member, ref)
         check_inside(container, member.name, member.defn.encapsulated, ref)
+
+
+def check_access_class(container: ClassEntry, member: ClassEntry, ref: s.Ref) -> None:
+    """``A.f`` or ``a.f``: the class ``f`` of ``A`` (or of ``a``'s class) is not
+    protected (4.1)."""
+    if member.defn.protected:
+        raise rule_error(f"class '{member.name}' is protected in "
+                         f"'{container.full_name}' and cannot be used as '{ref.dotted}'",
+                         ref.span, ACCESS_RULE, "4.1",
+                         (Note("declared protected here", member.defn.span),))
 
 
 def package_like(entry: ClassEntry) -> bool:
@@ -74,6 +80,9 @@ def check_modified(view: ClassView, mod: Mod, owner: str) -> None:
         if child.redeclare is not None and isinstance(child.redeclare.element, s.ClassDef):
             local = next((e for e in view.entry.defn.elements
                           if isinstance(e, s.ClassDef) and e.name == name), None)
+            if local is None:  # an inherited class keeps its protection (7.3)
+                found = member_class(view.entry, name)
+                local = found.defn if found is not None else None
             if local is not None and local.protected:
                 raise rule_error(f"class '{name}' is protected in '{view.entry.full_name}' "
                                  f"and cannot be redeclared in '{owner}'", child.span,

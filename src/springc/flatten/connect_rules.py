@@ -150,3 +150,33 @@ def check_reference_form(ref: s.Ref, owner: ClassScope) -> None:
                 f"of '{ref.parts[0].name}', not a connector", ref.span,
                 "a connect equation joins connectors of the class or of its components "
                 "(`m.c`), not connectors deeper inside components", "9.1")
+
+
+def check_no_connect(eq: s.IfEquation) -> None:
+    """An if-equation whose condition is not a parameter expression holds no ``connect``
+    (section 8.3.3): the connection structure is fixed at translation time."""
+    for _, body in [*eq.branches, (None, eq.otherwise)]:
+        found = _connect_in(body)
+        if found is not None:
+            raise rule_error("connect inside an if-equation whose condition is not a "
+                             "parameter expression", found.span, "connect-equations may "
+                             "be inside if-equations only when the conditions are parameter "
+                             "expressions", "8.3.3",
+                             (Note("the condition of this if-equation varies during the "
+                                   "simulation", eq.branches[0][0].span),))
+
+
+def _connect_in(body: tuple[s.Equation, ...]) -> s.Connect | None:
+    for item in body:
+        if isinstance(item, s.Connect):
+            return item
+        inner: list[tuple[s.Equation, ...]] = []
+        if isinstance(item, s.ForEquation):
+            inner = [item.body]
+        elif isinstance(item, s.IfEquation):
+            inner = [b for _, b in item.branches] + [item.otherwise]
+        for nested in inner:
+            found = _connect_in(nested)
+            if found is not None:
+                return found
+    return None

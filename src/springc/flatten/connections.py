@@ -163,7 +163,7 @@ class ConnectionSets:
         check_reference_form(ref, owner)
         value = direct_reference(ref, where)
         if value is None:
-            signal = _signal_connector(ev, ref, where)
+            signal = _signal_connector(ev, ref, where, self.causal)
             if signal is not None:
                 return signal
             value = ev.reference(ref, where)
@@ -176,10 +176,14 @@ class ConnectionSets:
                                 for c in items):
             raise FlattenError(f"'{ref.dotted}' is not a connector", ref.span,
                                hint="connect(...) joins connectors, such as flanges")
+        # outside: a connector of the class itself, or an element of one (`q.y` with
+        # `q` a connector of the class); inside: one of a component (section 9.1.2)
         head = ref.parts[0].name
-        outside = owner.has_member(head) and isinstance(owner.member(head), (ClassScope,
-                                                                            np.ndarray)) \
-            and all(c.outer is owner for c in items)
+        first = owner.member(head) if owner.has_member(head) else None
+        if isinstance(first, np.ndarray):
+            first = first.flat[0] if first.size else None
+        outside = isinstance(first, ClassScope) and first.kind == "connector" \
+            and first.outer is owner
         return shape, items, outside
 
     def _pair(self, ca: ClassScope | Leaf, cb: ClassScope | Leaf, out_a: bool, out_b: bool,
@@ -258,12 +262,12 @@ class ConnectionSets:
             if scope.kind != "connector" or (scope.outer is not None
                                              and scope.outer.kind == "connector"):
                 continue
-            at_top = scope.outer is top
+            # every flow variable is also an inside element of its own set (9.2): one
+            # never connected as inside, as those of the model's own connectors, is zero
             for leaf in connector_leaves(scope):
                 if not leaf.flow:
                     continue
-                if (leaf.name, False) in self.parent or (at_top and (leaf.name, True)
-                                                         in self.parent):
+                if (leaf.name, False) in self.parent:
                     continue
                 out.append(flat.Equation(x.Var(leaf.name), x.ZERO, scope.span,
                                          flat.Origin("unconnected", scope.outer.prefix
@@ -272,10 +276,11 @@ class ConnectionSets:
         return out
 
 
-def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope
-                      ) -> tuple[tuple[int, ...], list[Any], bool] | None:
+def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
+                      causal: dict[str, str]) -> tuple[tuple[int, ...], list[Any], bool] | None:
     """``connect(u, gain.u)`` where ``u`` is declared ``RealInput u``: the scalar
-    variables as leaves (shape, leaves, outside), or None for any other reference."""
+    variables as leaves (shape, leaves, outside), or None for any other reference.
+    Their causality goes to ``causal``, for the one-source rule (9.3)."""
     last = ref.parts[-1]
     owners: list[Any]
     if len(ref.parts) == 1:
@@ -296,6 +301,8 @@ def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope
     if not all(isinstance(v, x.Var) for v in array.flat):
         return None
     flow = members[0].flow
+    if members[0].causality:
+        causal.update((v.name, members[0].causality) for v in array.flat)
     leaves = [Leaf("", v.name, flow) for v in array.flat]
     return array.shape, leaves, len(ref.parts) == 1
 

@@ -146,17 +146,30 @@ def redeclared(comp: ViewComponent, mod: Mod, name: str) -> tuple[ViewComponent,
         raise FlattenError(f"'{name}' is a component and cannot be redeclared as a class",
                            new.span, [Note("declared here", decl.span)])
     check_redeclarable(decl, mod.span)
-    if not decl.replaceable:
+    # a non-replaceable element keeps its type (redeclare_rules checks it resolves to
+    # the same class) and may change its array sizes or variability (section 7.3.3)
+    if not decl.replaceable and new.type_name.dotted != decl.type_name.dotted:
         raise FlattenError(f"'{name}' is not replaceable and cannot be redeclared",
                            mod.span, [Note("declared here", decl.span)],
                            f"declare it `replaceable {decl.type_name.dotted} {decl.name}`")
-    constraint = decl.constraint[1] if decl.constraint is not None else None
+    # the constraining clause in force: the declaration's, or that of a redeclaration
+    # this one overrides (`extends D(replaceable C b constrainedby C(x = 2))`)
+    effective = decl.constraint
+    link = mod.redeclare.replaced
+    while link is not None:
+        if isinstance(link.element, s.Component) and link.element.constraint is not None:
+            effective = link.element.constraint
+            break
+        link = link.replaced
+    # without a constraining clause, the declaration's own modifiers are those of its
+    # (implicit) constraining type, and apply to the redeclaration (section 7.3.2)
+    constraint = effective[1] if effective is not None else decl.modification
     new_decl = replace(decl, type_name=new.type_name, type_dims=new.type_dims,
                        dims=new.dims or decl.dims, modification=constraint,
                        variability=new.variability or decl.variability,
                        causality=new.causality or decl.causality, flow=new.flow or decl.flow,
                        replaceable=new.replaceable, constraint=new.constraint or
-                       decl.constraint)
+                       effective)
     outer = replace(mod, redeclare=None)
     return ViewComponent(new_decl, mod.redeclare.scope.entry), outer
 

@@ -33,6 +33,7 @@ from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .lookup import ClassLookup, select_model
 from .modification import merge_all
 from .parameters import ParameterValues, binding_errors
+from .redeclare_rules import check_redeclarations
 from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
 from .strings import undefined_strings
 from .variables import attributes_of
@@ -171,6 +172,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     view = flattener.view(base)
     top = ClassScope(flattener, "", view, None, entry.defn.span)
     top.mod = instance_mod(merge_all(mods), view, top)
+    check_redeclarations(flattener, view, top.mod)
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), *flattener.walk_added(top), top]

@@ -21,6 +21,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class, member_class
 from . import arrays as a
+from .access import check_access_class
 from .assertions import assertion, guard_assertions
 from .control import (
     Jumped,
@@ -127,7 +128,10 @@ def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry
         if isinstance(owner, ClassScope):
             found: ClassEntry | None = owner.entry
             for part in ref.parts[k:]:
+                container = found
                 found = member_class(found, part.name) if found is not None else None
+                if container is not None and found is not None:
+                    check_access_class(container, found, ref)
             if found is None or found.defn.kind != "function":
                 raise FlattenError(f"'{owner.entry.full_name}' (the class of "
                                    f"'{owner.prefix}') has no function "

@@ -36,6 +36,7 @@ from .enumerations import DimensionKind
 from .instance_classes import named_through, type_name_package
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
+from .redeclare_rules import check_redeclarations
 from .scope import (
     ClassScope,
     ClassView,
@@ -86,6 +87,10 @@ class Instantiation(FlattenContext):
         declared = self.declared_type(comp)
         rtype = declared.rtype
         own = from_syntax(decl.modification, scope)
+        if decl.constraint is not None and decl.constraint[1] is not None:
+            # `constrainedby A(x = 2)` modifies the declaration too, under its own
+            # modifiers (section 7.3.2)
+            own = merge_all([own, from_syntax(decl.constraint[1], scope)], name)
         type_mods = declared.type_mods
         by_class = redeclared_class(scope, decl.type_name)
         if by_class is not None:
@@ -226,6 +231,7 @@ class Instantiation(FlattenContext):
             check_modified(view, mod, name)
         if mod is not None or view.extends_mods:
             scope.mod = instance_mod(mod, view, scope)
+            check_redeclarations(self, view, scope.mod)
         if scope.mod is not None:
             for key, child in scope.mod.children.items():
                 if key not in view.components and not (

@@ -22,6 +22,8 @@ from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
 from .modification import Mod, from_syntax, merge_all
+from .outer_rules import check_outer_uses
+from .redeclare_rules import check_replaceables
 from .rules import check_class, check_extends, rule_error
 from .scope import (
     PRIMITIVES,
@@ -59,6 +61,8 @@ class ClassLookup(FlattenContext):
                 check_class(self, found)
                 check_class_redeclarations(self.resolve_class, entry)
                 check_inherited_names(self, found)
+                check_replaceables(self, found)
+                check_outer_uses(self, found)
                 check_conditional_uses(found)
             except FlattenError as err:
                 self.rule_errors[id(entry)] = err

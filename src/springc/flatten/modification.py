@@ -36,6 +36,21 @@ class Redeclaration:
 
     element: s.Component | s.ClassDef
     scope: Any
+    # the redeclaration this one overrides (of an inner modification, as an extends
+    # clause's), checked against it by redeclare_rules
+    replaced: Redeclaration | None = None
+
+
+def _chain(outer: Redeclaration | None, inner: Redeclaration | None) -> Redeclaration | None:
+    """``outer`` overriding ``inner``: the chain of redeclarations, outermost first."""
+    if outer is None or inner is None:
+        return outer or inner
+    link: Redeclaration | None = outer
+    while link is not None:
+        if link is inner:  # the same modification met twice
+            return outer
+        link = link.replaced
+    return replace(outer, replaced=_chain(outer.replaced, inner))
 
 
 @dataclass(frozen=True)
@@ -100,7 +115,7 @@ def merge(outer: Mod | None, inner: Mod | None, name: str = "") -> Mod | None:
     value = outer.value if outer.value is not None else inner.value
     each = outer.each if outer.value is not None else inner.each
     return Mod(value, children, each, inner.final or outer.final, outer.span or inner.span,
-               outer.redeclare or inner.redeclare)
+               _chain(outer.redeclare, inner.redeclare))
 
 
 def merge_all(mods: list[Mod | None], name: str = "") -> Mod | None:

@@ -20,8 +20,10 @@ from ..ir import syntax as s
 from ..ir import when as w
 from . import arrays as a
 from .assertions import assertion
+from .connect_rules import check_no_connect
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .strings import string_equation
+from .when_rules import check_when_target
 
 _EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
 _WHEN_HINT = ("a when-clause holds equations 'v = expression', reinit(x, value) and "
@@ -111,6 +113,7 @@ def _boolean_shape(e: x.Expr) -> bool:
 def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body) -> None:
     ev = ctx.evaluator
     if isinstance(item, s.Equality):
+        check_when_target(ctx, item.lhs, where.entry)
         lhs = ev.value(item.lhs, where)
         rhs = ev.value(item.rhs, where)
         if a.shape(lhs) != a.shape(rhs):
@@ -224,6 +227,7 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     same number of scalar equations; the i-th equations of the branches become one
     equation with if-expressions (``lhs = if c then r1 else r2`` when the branches
     share the left-hand side, ``0 = if c then l1 - r1 else l2 - r2`` otherwise)."""
+    check_no_connect(eq)
     for _, body in [*eq.branches, (None, eq.otherwise)]:
         nested = _find_when(body)
         if nested is not None:

@@ -425,6 +425,8 @@ class ClassDef:
     # `model extends M ... end M;` (section 7.3.1): its first element `extends M(...)`
     # names the class M that the enclosing class inherits.
     class_extends: bool = False
+    # `constrainedby T(...)` of a replaceable class (Modelica 7.3.2)
+    constraint: tuple[Ref, Modification | None] | None = None
     final: bool = False  # declared `final model M ...`: it cannot be redeclared
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.

@@ -31,6 +31,8 @@ from ..ir.syntax import (
 from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
 from .rules_elements import causality, variability
 
+#: The attributes of enumeration types, which no literal may be named (section 4.8.5.1).
+ENUMERATION_ATTRIBUTES = frozenset({"quantity", "min", "max", "start", "fixed"})
 
 @dataclass(frozen=True, slots=True)
 class _Within:
@@ -160,7 +162,10 @@ class ClassRules(RuleBase):
                 target = "equation" if section.kind == "algorithm" else "initial equation"
                 body[target].append(AlgorithmSection(statements, section.span))
             elif section.kind == "initial algorithm":
-                self.reject("`initial algorithm` sections are", section.span)
+                self.error("a function cannot have an `initial algorithm` section",
+                           section.span, hint="a function computes its outputs in one "
+                           "`algorithm` section, and has no equations and no initial "
+                           "algorithms (Modelica 3.6, section 12.2)")
             elif section.kind == "external":
                 self.reject("`external` functions are", section.span)
             elif section.kind == "algorithm" and body["algorithm_sections"]:
@@ -227,6 +232,14 @@ class ClassRules(RuleBase):
         if len(set(literals)) != len(literals):
             self.error(f"enumeration '{self.ident(name)}' has a literal twice",
                        self.span_of(meta))
+        attributes = [lit for lit in literals if lit in ENUMERATION_ATTRIBUTES]
+        if attributes:
+            self.error(f"enumeration '{self.ident(name)}' has a literal named "
+                       f"'{attributes[0]}', like an attribute of enumeration types",
+                       self.span_of(meta), "the literals and the attributes of an "
+                       "enumeration type share one scope, so quantity, min, max, start and "
+                       "fixed cannot be literals; rename the literal (Modelica 3.6, "
+                       "section 4.8.5.1)")
         return _Spec(name, comment.description, (), None, comment.annotation, None, literals)
 
     def enum_body(self, meta: Meta, ch: list[Any]) -> Any:

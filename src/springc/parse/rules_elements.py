@@ -92,7 +92,9 @@ class ElementRules(RuleBase):
             return [item]
         if isinstance(item, ClassDef):
             return [replace(item, replaceable="replaceable" in words,
-                            redeclare="redeclare" in words, final="final" in words)]
+                            redeclare="redeclare" in words, final="final" in words,
+                            constraint=(constraint.type_name, constraint.modification)
+                            if constraint else None)]
         return self._components(item, words, constraint)
 
     def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
@@ -203,10 +205,11 @@ class ElementRules(RuleBase):
 
     def replaceable_body(self, meta: Meta, ch: list[Any]) -> Any:
         item = ch[0]
+        constraint = of(ch[1:], _Constraint)
         if isinstance(item, ClassDef):
-            return replace(item, replaceable=True)
+            return replace(item, replaceable=True, constraint=(
+                constraint.type_name, constraint.modification) if constraint else None)
         if isinstance(item, Component):
-            constraint = of(ch[1:], _Constraint)
             return replace(item, replaceable=True, constraint=(
                 constraint.type_name, constraint.modification) if constraint else None)
         return item

@@ -27,6 +27,7 @@ from .events import with_events
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
+from .state_select import check_state_select
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,7 @@ def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplifi
     reduced = index_reduce(aliased.dae, at)
     steps = causalize(reduced)
     unknowns = {u.name: u for u in aliased.dae.unknowns}
+    check_state_select(unknowns.values(), {reduced.names[s] for s, _ in reduced.states})
     states = []
     for state, derivative in reduced.states:
         name = reduced.names[state]
