@@ -14,6 +14,7 @@ reads are replaced at the end of flattening (:func:`apply_starts`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -191,7 +192,7 @@ class _Run:
         finally:
             self.context.pop()
 
-    def _iterations(self, stmt: s.ForStatement, values: list[x.Expr], index: s.ForIndex,
+    def _iterations(self, stmt: s.ForStatement, values: Sequence[x.Expr | str], index: s.ForIndex,
                     rest: tuple[s.ForIndex, ...], where: Scope, guard: x.Expr | None
                     ) -> None:
         for value in values:
