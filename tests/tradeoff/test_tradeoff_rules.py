@@ -21,7 +21,7 @@ from springc.errors import UsageError
 from springc.pipeline import CompiledModel
 from springc.simulation import COMPILED_SOLVERS
 from springc.tradeoff import baselines
-from springc.tradeoff.baselines import baseline_runs
+from springc.tradeoff.baselines import baseline_runs, probe_errors
 from springc.tradeoff.chains import Chain, Pilot, cost_ceiling, solver_runs
 from springc.tradeoff.model import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff, TradeoffOptions
 from springc.tradeoff.reference import read_reference
@@ -214,6 +214,19 @@ def test_the_rk45_probe_starts_scipys_sweep_where_it_needs_to(
     assert [(r.label(), r.status) for r in rows[1:]] == [
         (f"rtol {r:.0e}", "ok") for r in (1e-4, 1e-5, 1e-6, 1e-7)]
     assert [r.max_error for r in rows[1:]] == pytest.approx(full[:4], rel=1e-9)
+
+
+def test_without_a_compiled_rk45_every_rtol_of_scipys_rk45_is_run(tmp_path: Path,
+                                                                   exact_csv: str) -> None:
+    model = oscillator(tmp_path, "python")  # the python backend: rk45 in scipy's loop
+    tolerances = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+    setup, ref, scales = study_parts(model, exact_csv, repeats=1, targets=(1e-7,),
+                                     tolerances=tolerances)
+    assert probe_errors(setup, ref, scales, list(tolerances[1:]), 1e-7) is None
+    rows = baseline_runs(setup, ref, scales, None)
+    assert [(r.label(), r.status, r.engine) for r in rows[1:]] == [
+        (f"rtol {r:.0e}", "ok", "scipy") for r in (1e-4, 1e-5, 1e-6, 1e-7)]
+    assert rows[-2].max_error > 1e-7 >= rows[-1].max_error
 
 
 # ------------------------------------------------------------------ engines

@@ -94,10 +94,10 @@ def springc_once(setup: StudySetup, solver: str, rtol: float | None, step: float
 
 
 def warm_up_solver(setup: StudySetup, solver: str, rtol: float | None,
-                   step: float | None) -> float:
+                   step: float | None) -> tuple[float, str]:
     """Run ``solver`` untimed over the first output interval, so that loading (or
-    compiling) its compiled loop is not timed; its seconds. A failure is left to the
-    timed runs to report."""
+    compiling) its compiled loop is not timed: its seconds and engine ("" if it
+    failed: a failure is left to the timed runs to report)."""
     grid = setup.grid
     options = dataclasses.replace(setup.sim_options(solver, rtol, step),
                                   start=float(grid[0]), stop=float(grid[1]),
@@ -105,10 +105,10 @@ def warm_up_solver(setup: StudySetup, solver: str, rtol: float | None,
     began = time.perf_counter()
     try:
         with np.errstate(all="ignore"):
-            simulate_model(setup.model, options)
+            engine = simulate_model(setup.model, options).stats.engine
     except SimulationError:
-        pass
-    return time.perf_counter() - began
+        engine = ""
+    return time.perf_counter() - began, engine
 
 
 # ------------------------------------------------------------------ measures
