@@ -69,7 +69,7 @@ its output with a reference on the output grid:
 - **Time**: wall time of one simulation (integration and outputs, not compilation:
   each solver's compiled loop is loaded by an untimed run first), timed once; the
   contenders (runs meeting the target within 5x of the fastest known, under
-  {repeat:g} s) are timed 3 times, the median kept. A run over the budget
+  {repeat:g} s) are timed 3 times or more, the fastest kept. A run over the budget
   ({budget:g} s) is stopped and the solver's tighter settings are skipped.
   Adaptive solvers use atol = rtol/1000, the ratio of scipy's defaults.
 - **Cost limit**: dop853 runs first; a solver's tighter settings are skipped once

@@ -21,7 +21,7 @@ from springc.errors import UsageError
 from springc.pipeline import CompiledModel
 from springc.simulation import COMPILED_SOLVERS
 from springc.tradeoff import baselines
-from springc.tradeoff.baselines import baseline_runs
+from springc.tradeoff.baselines import baseline_runs, probe_errors
 from springc.tradeoff.chains import Chain, Pilot, cost_ceiling, solver_runs
 from springc.tradeoff.model import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff, TradeoffOptions
 from springc.tradeoff.reference import read_reference
@@ -147,7 +147,7 @@ def test_contenders_are_timed_in_rounds_short_ones_more() -> None:
     def timed_once(seconds: float) -> Run:
         return dataclasses.replace(pilot_run(seconds, 1e-5), repeats=1)
 
-    short = timed_once(0.04)  # 0.15 s of timings: 4 in all
+    short = timed_once(0.05)  # 0.2 s of timings: 4 in all
     medium = timed_once(0.5)  # the 3 of --repeats
     long = timed_once(3.0)  # over 2 s: timed once
     failed = dataclasses.replace(short, status="failed: x", wall_time=math.nan)
@@ -156,7 +156,7 @@ def test_contenders_are_timed_in_rounds_short_ones_more() -> None:
                     (failed, once("failed", []))], repeats=3)
     assert calls == ["short", "medium", "short", "medium", "short"]
     assert [(r.wall_time, r.repeats) for r in done[:3]] == [
-        (pytest.approx(0.035), 4), (0.7, 3), (3.0, 1)]
+        (0.01, 4), (0.5, 3), (3.0, 1)]
     assert done[3] is failed
     assert retimed([(short, once("short", []))], repeats=1) == [short]
 
@@ -214,6 +214,19 @@ def test_the_rk45_probe_starts_scipys_sweep_where_it_needs_to(
     assert [(r.label(), r.status) for r in rows[1:]] == [
         (f"rtol {r:.0e}", "ok") for r in (1e-4, 1e-5, 1e-6, 1e-7)]
     assert [r.max_error for r in rows[1:]] == pytest.approx(full[:4], rel=1e-9)
+
+
+def test_without_a_compiled_rk45_every_rtol_of_scipys_rk45_is_run(tmp_path: Path,
+                                                                   exact_csv: str) -> None:
+    model = oscillator(tmp_path, "python")  # the python backend: rk45 in scipy's loop
+    tolerances = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
+    setup, ref, scales = study_parts(model, exact_csv, repeats=1, targets=(1e-7,),
+                                     tolerances=tolerances)
+    assert probe_errors(setup, ref, scales, list(tolerances[1:]), 1e-7) is None
+    rows = baseline_runs(setup, ref, scales, None)
+    assert [(r.label(), r.status, r.engine) for r in rows[1:]] == [
+        (f"rtol {r:.0e}", "ok", "scipy") for r in (1e-4, 1e-5, 1e-6, 1e-7)]
+    assert rows[-2].max_error > 1e-7 >= rows[-1].max_error
 
 
 # ------------------------------------------------------------------ engines

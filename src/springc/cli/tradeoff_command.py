@@ -79,9 +79,10 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @click.option("--save-reference", type=click.Path(dir_okay=False),
               help="Write the reference trajectory as CSV (reusable with --reference).")
 @click.option("--repeats", type=click.IntRange(min=1), default=3, show_default=True,
-              help="Timed runs of a contender (median): a run meeting a --max-error "
-              "within 5x of the fastest one known, and scipy's default call; other runs, "
-              "and runs over 2 s, are timed once.")
+              help="Timed runs of a contender, at least (the fastest kept; a short one "
+              "until 0.2 s of timings): a run meeting a --max-error within 5x of the fastest "
+              "one known, and scipy's default call; other runs, and runs over 2 s, are "
+              "timed once.")
 @click.option("--cost-limit", type=click.FloatRange(min=1), default=10.0, show_default=True,
               metavar="FACTOR", help="Skip a solver's tighter settings once one of its runs "
               "takes FACTOR times dop853's fastest run meeting every --max-error (the "

@@ -25,7 +25,16 @@ import numpy as np
 
 from ..errors import SimulationError
 from .model import PROBE_SKIP, SCIPY_DEFAULT, SCIPY_RK45, Reference, Run
-from .runs import Measured, energy_drift, log_line, retimed, springc_once, timed_once, with_errors
+from .runs import (
+    Measured,
+    energy_drift,
+    log_line,
+    retimed,
+    springc_once,
+    timed_once,
+    warm_up_solver,
+    with_errors,
+)
 from .setup import Deadline, StudySetup, relative_errors, scipy_outputs
 
 PROBE = "rk45"
@@ -74,7 +83,10 @@ def scipy_once(setup: StudySetup, rtol: float | None) -> Callable[[float], Measu
 def probe_errors(setup: StudySetup, ref: Reference, scales: np.ndarray,
                  rtols: list[float], goal: float) -> list[float] | None:
     """The max errors of springc's compiled :data:`PROBE` at ``rtols`` (loosest first),
-    up to the first that meets ``goal``; None if it does not run compiled or fails."""
+    up to the first that meets ``goal``; None if it does not run compiled (as a short
+    run over the first output interval says first) or fails."""
+    if warm_up_solver(setup, PROBE, rtols[0], None)[1] != "compiled":
+        return None
     errors: list[float] = []
     for rtol in rtols:
         try:

@@ -98,7 +98,7 @@ def solver_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: s
         return (None, value) if fixed else (value, None)
 
     if chain.settings:
-        seconds = warm_up_solver(setup, chain.solver, *arguments(chain.settings[0]))
+        seconds, _ = warm_up_solver(setup, chain.solver, *arguments(chain.settings[0]))
         if log is not None and seconds > 1.0:
             log(f"{chain.solver}: its loop loaded or compiled in {seconds:.1f} s (not timed)")
     runs: list[Run] = []

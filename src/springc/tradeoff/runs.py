@@ -9,16 +9,16 @@ its errors and energy drift, and whether it is timed again.
 - **Contenders are timed again.** A run that meets a target within
   :data:`~.model.REPEAT_MARGIN` times the fastest time known to meet it (the pilot's
   runs and the solver's own) is a contender for the recommendation: it is timed
-  ``repeats`` times and its median kept, unless it took over
-  :data:`~.model.REPEAT_LIMIT`. Other runs cannot be recommended, so a second timing
-  would change no conclusion of the study.
+  ``repeats`` times, short ones more (:func:`retimed`), and the fastest of its
+  timings kept (a run computes the same thing each time: the load of a shared machine
+  only adds time to it), unless it took over :data:`~.model.REPEAT_LIMIT`. Other runs
+  cannot be recommended, so a second timing would change no conclusion of the study.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-import statistics
 import time
 from collections.abc import Callable, Iterable, Sequence
 
@@ -30,10 +30,10 @@ from .energy import drift, energy_series
 from .model import REPEAT_LIMIT, REPEAT_MARGIN, OverBudget, Reference, Run
 from .setup import Deadline, StudySetup, relative_errors
 
-STABLE_SECONDS = 0.15
+STABLE_SECONDS = 0.2
 """A contender is timed until its timings add up to this (at least ``repeats`` times,
-at most :data:`MAX_REPEATS`): the median of a few milliseconds' run on a loaded
-machine needs more than three."""
+at most :data:`MAX_REPEATS`): a run of a few milliseconds on a loaded machine needs
+more than three timings for its fastest to be its cost."""
 MAX_REPEATS = 15
 
 Measured = tuple[float, tuple[int, int, int], np.ndarray, str]
@@ -62,7 +62,7 @@ def retimed(runs: Sequence[tuple[Run, Once]], repeats: int) -> list[Run]:
     """The ``runs`` (each with its ``once``) timed again in rounds, each round timing
     every run once (a change of the machine's load falls on all of them alike): an ok
     run under :data:`REPEAT_LIMIT` is timed ``repeats`` times in all, and a short one
-    more, up to :data:`STABLE_SECONDS` of timings or :data:`MAX_REPEATS`; the median
+    more, up to :data:`STABLE_SECONDS` of timings or :data:`MAX_REPEATS`; the fastest
     of its times is kept."""
     def wanted(run: Run) -> int:
         if not run.ok or run.wall_time >= REPEAT_LIMIT or repeats <= 1:
@@ -76,7 +76,7 @@ def retimed(runs: Sequence[tuple[Run, Once]], repeats: int) -> list[Run]:
         for (_, once), timed, count in zip(runs, times, counts):
             if len(timed) < count:
                 timed.append(once(math.inf)[0])
-    return [dataclasses.replace(run, wall_time=statistics.median(timed), repeats=len(timed))
+    return [dataclasses.replace(run, wall_time=min(timed), repeats=len(timed))
             if len(timed) > 1 else run for (run, _), timed in zip(runs, times)]
 
 
@@ -94,10 +94,10 @@ def springc_once(setup: StudySetup, solver: str, rtol: float | None, step: float
 
 
 def warm_up_solver(setup: StudySetup, solver: str, rtol: float | None,
-                   step: float | None) -> float:
+                   step: float | None) -> tuple[float, str]:
     """Run ``solver`` untimed over the first output interval, so that loading (or
-    compiling) its compiled loop is not timed; its seconds. A failure is left to the
-    timed runs to report."""
+    compiling) its compiled loop is not timed: its seconds and engine ("" if it
+    failed: a failure is left to the timed runs to report)."""
     grid = setup.grid
     options = dataclasses.replace(setup.sim_options(solver, rtol, step),
                                   start=float(grid[0]), stop=float(grid[1]),
@@ -105,10 +105,10 @@ def warm_up_solver(setup: StudySetup, solver: str, rtol: float | None,
     began = time.perf_counter()
     try:
         with np.errstate(all="ignore"):
-            simulate_model(setup.model, options)
+            engine = simulate_model(setup.model, options).stats.engine
     except SimulationError:
-        pass
-    return time.perf_counter() - began
+        engine = ""
+    return time.perf_counter() - began, engine
 
 
 # ------------------------------------------------------------------ measures

@@ -19,7 +19,7 @@ time, the steps, the RHS and Jacobian evaluations, and the error on the output g
   reference is refused.
 - **Time.** Wall time of ``simulate_model`` (integration and outputs, not compilation:
   each solver's loop is warmed up untimed), timed once; the contenders for a
-  recommendation are timed ``repeats`` times (the median), see :mod:`.runs`. A run
+  recommendation are timed ``repeats`` times (the fastest), see :mod:`.runs`. A run
   longer than ``budget`` seconds is stopped, and the solver's tighter settings are
   skipped.
 - **Order and cost limit.** The pilot solver (``dop853``) runs first, in this process,
