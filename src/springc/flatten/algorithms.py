@@ -14,6 +14,7 @@ reads are replaced at the end of flattening (:func:`apply_starts`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
@@ -35,6 +36,14 @@ from .control import (
     stray,
 )
 from .functions import call_for_effect, multiple_outputs
+from .loop_break import (
+    BROKEN_TERMS,
+    FALSE,
+    TRUE,
+    choose,
+    kept,
+    too_large,
+)
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
@@ -69,6 +78,9 @@ class _Run:
         self.context: list[str] = []  # the loops, variable ifs and whens around
         self.held: set[str] = set()  # assigned in when statements (discrete)
         self.parts: list[WhenParts] = []  # of the when statements around
+        # where a break under a condition known only during the simulation has left
+        # the innermost for loop: the statements after it hold their values there
+        self.broken: x.Expr = FALSE
 
     def read(self, value: a.Value, span: Span) -> a.Value:
         if isinstance(value, str):
@@ -85,9 +97,24 @@ class _Run:
     def run(self, body: tuple[s.Statement, ...], where: Scope, guard: x.Expr | None) -> None:
         for stmt in body:
             start = len(self.fl.assertions)
-            self.statement(stmt, where, guard)
+            broken = self.broken
+            if broken == FALSE:
+                self.statement(stmt, where, guard)
+            else:  # runs only where the loop was not left
+                before, self.broken = dict(self.env), FALSE
+                try:
+                    self.statement(stmt, where, _and(guard, x.Not(broken)))
+                finally:
+                    for name, value in self.env.items():
+                        old = before.get(name, x.Var(name))
+                        if value is not old:
+                            self.env[name] = kept(broken, old, value)
+                    inner = self.broken
+                    self.broken = broken if inner == FALSE else TRUE if inner == TRUE \
+                        else x.BinOp("or", broken, inner)
             if not isinstance(stmt, s.IfStatement):
-                self.guard_new(start, guard)
+                self.guard_new(start, guard if broken == FALSE
+                               else _and(guard, x.Not(broken)))
 
     def statement(self, stmt: s.Statement, where: Scope, guard: x.Expr | None) -> None:
         if isinstance(stmt, s.Assign):
@@ -160,23 +187,40 @@ class _Run:
             else:
                 self.if_(rest, otherwise, where, guard)
             return
-        before = dict(self.env)
+        before, broken = dict(self.env), self.broken
         span = cond_expr.span
         self.context.append("if")
         try:
-            branch_jumps(lambda: self.run(body, where, _and(guard, cond)), span)
+            broken_then = self.branch(lambda: self.run(body, where, _and(guard, cond)), span)
             then = self.env
-            self.env = dict(before)
-            branch_jumps(lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))),
-                         span)
+            self.env, self.broken = dict(before), broken
+            broken_else = self.branch(
+                lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))), span)
         finally:
             self.context.pop()
+        self.broken = choose(cond, broken_then, broken_else)
         for name in then.keys() | self.env.keys():
             old = before.get(name, x.Var(name))
             left, right = then.get(name, old), self.env.get(name, old)
             if left is not right:
                 self.env[name] = x.If(cond, left, right)
                 self.spans.setdefault(name, cond_expr.span)
+
+    def branch(self, run: Callable[[], None], span: Span) -> x.Expr:
+        """Run a branch of an if on a run-time condition: where the loop is left after
+        it (true if it ends with a ``break`` of the innermost loop, a for loop; a
+        ``break`` of a while loop there is not supported)."""
+        loops = [k for k in self.context if k in ("for", "while")]
+        if not loops or loops[-1] != "for":
+            branch_jumps(run, span)
+            return self.broken
+        try:
+            run()
+        except Jumped as jumped:
+            if jumped.jump.kind != "break":
+                raise
+            return TRUE
+        return self.broken
 
     def for_(self, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...], where: Scope,
              guard: x.Expr | None) -> None:
@@ -192,12 +236,25 @@ class _Run:
     def _iterations(self, stmt: s.ForStatement, values: list[x.Expr], index: s.ForIndex,
                     rest: tuple[s.ForIndex, ...], where: Scope, guard: x.Expr | None
                     ) -> None:
-        for value in values:
-            local = LocalScope({index.name: value}, where)
-            if rest:
-                self.for_(stmt, rest, local, guard)
-            elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
-                break
+        outer, self.broken = self.broken, FALSE
+        try:
+            for value in values:
+                if self.broken != FALSE and too_large(self.env.values()):
+                    raise FlattenError(
+                        "the values of a for loop left by a break under a condition known "
+                        f"only during the simulation grow beyond {BROKEN_TERMS} terms",
+                        index.span, hint="springc unrolls such a loop into if-expressions, "
+                        "each iteration after the break nesting them deeper; shorten the "
+                        "loop's range or compute the value with equations")
+                local = LocalScope({index.name: value}, where)
+                if rest:
+                    self.for_(stmt, rest, local, guard)
+                elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
+                    break
+                if self.broken == TRUE:
+                    break
+        finally:
+            self.broken = outer
 
     def when(self, stmt: s.WhenStatement, where: Scope, guard: x.Expr | None) -> None:
         check_place(stmt, self.context, self.initial)
