@@ -118,3 +118,11 @@ def test_break_under_a_run_time_condition_leaves_a_for_loop(tmp_path: Path) -> N
         "y = (if noEvent(time > 1) then 0 else 1) + (if noEvent(time > 1) or "
         "noEvent(time > 2) then 0 else 1) + (if noEvent(time > 1) or noEvent(time > 2) or "
         "noEvent(time > 3) then 0 else 1)"]
+
+
+def test_a_while_loop_on_start_values_is_decided_while_flattening(tmp_path: Path) -> None:
+    # n is read before the section assigns it: its start value 3 (11.1.2)
+    m = flat_of(tmp_path, "model M\n  Integer n(start = 3);\n  Real s;\nalgorithm\n"
+                "  s := 0;\n  while n < 6 loop\n    n := n + 1;\n    s := s + n;\n"
+                "  end while;\nend M;\n")
+    assert sorted(equations(m)) == ["n = 6", "s = 15"]

@@ -47,6 +47,7 @@ from .loop_break import (
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .section_starts import known_starts
 from .when_statements import (
     WhenParts,
     check_nesting,
@@ -81,6 +82,8 @@ class _Run:
         # where a break under a condition known only during the simulation has left
         # the innermost for loop: the statements after it hold their values there
         self.broken: x.Expr = FALSE
+        self.body: tuple[s.Statement, ...] = ()  # the section's statements
+        self.starts: dict[str, x.Const] | None = None  # see while_condition
 
     def read(self, value: a.Value, span: Span) -> a.Value:
         if isinstance(value, str):
@@ -126,9 +129,7 @@ class _Run:
         elif isinstance(stmt, s.WhileStatement):
             self.context.append("while")
             try:
-                run_while(self.ev, stmt,
-                          lambda: cast(x.Expr, self.read(
-                              self.ev.scalar(stmt.condition, where), stmt.span)),
+                run_while(self.ev, stmt, lambda: self.while_condition(stmt, where),
                           lambda: self.run(stmt.body, where, guard))
             finally:
                 self.context.pop()
@@ -138,6 +139,29 @@ class _Run:
             raise Jumped(stmt)
         else:
             self.call(stmt, where, guard)
+
+    def while_condition(self, stmt: s.WhileStatement, where: Scope) -> x.Expr:
+        """The condition of ``stmt`` now; where it reads variables the section assigns
+        but has not assigned yet, their start values (11.1.2, as :func:`apply_starts`
+        gives them at the end) are taken at once, so that the loop may be decided
+        while flattening."""
+        def value() -> x.Expr:
+            return folded(cast(x.Expr, self.read(self.ev.scalar(stmt.condition, where),
+                                                 stmt.span)))
+
+        cond = value()
+        if isinstance(cond, x.Const):
+            return cond
+        if self.starts is None:
+            self.starts = known_starts(self.fl, self.body, where, self.owner)
+        seeded = False
+        for name in x.variables(cond) - self.env.keys():
+            start = self.starts.get(name)
+            if start is not None:
+                self.env[name] = start
+                self.spans.setdefault(name, stmt.span)
+                seeded = True
+        return value() if seeded else cond
 
     def assign(self, stmt: s.Assign, where: Scope) -> None:
         if len(stmt.targets) > 1:
@@ -320,6 +344,7 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
             check_loop_nest(fl.evaluator, stmt, where)
     check_jumps(section.body, in_function=False)
     check_nesting(section.body, initial)
+    run.body = section.body
     try:
         run.run(section.body, where, None)
     except Jumped as jumped:
