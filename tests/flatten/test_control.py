@@ -84,11 +84,16 @@ end M;
      "    y := y / 2;\n  end while;\nend M;\n",
      "5:9: `while` loops whose condition is known only during the simulation are not "
      "supported yet"),
-    ("model M\n  Real y;\nalgorithm\n  y := 0;\n  for i in 1:3 loop\n"
-     "    if noEvent(time > i) then\n      break;\n    end if;\n    y := y + 1;\n"
-     "  end for;\nend M;\n",
+    ("model M\n  Real y;\nalgorithm\n  y := 0;\n  while true loop\n"
+     "    if noEvent(time > 1) then\n      break;\n    end if;\n    y := y + 1;\n"
+     "  end while;\nend M;\n",
      "7:7: `break` under a condition known only during the simulation is not supported "
      "yet"),
+    ("model M\n  Real y;\nalgorithm\n  y := 0;\n  for i in 1:40 loop\n"
+     "    if noEvent(time > i) then\n      break;\n    end if;\n    y := y * y + 1;\n"
+     "  end for;\nend M;\n",
+     "5:7: the values of a for loop left by a break under a condition known only during "
+     "the simulation grow beyond 20000 terms"),
     ("model M\n  Real y;\nalgorithm\n  y := 1;\n  return;\nend M;\n",
      "5:3: `return` is only allowed in a function"),
     ("model M\n  Real y;\nalgorithm\n  y := 1;\n  break;\nend M;\n",
@@ -102,3 +107,22 @@ end M;
 ])
 def test_control_flow_errors(tmp_path: Path, text: str, message: str) -> None:
     assert error_of(tmp_path, text) == message
+
+
+def test_break_under_a_run_time_condition_leaves_a_for_loop(tmp_path: Path) -> None:
+    # after the break at i the statements and iterations that follow keep the values
+    m = flat_of(tmp_path, "model M\n  Real y;\nalgorithm\n  y := 0;\n  for i in 1:3 loop\n"
+                "    if noEvent(time > i) then\n      break;\n    end if;\n"
+                "    y := y + 1;\n  end for;\nend M;\n")
+    assert equations(m) == [
+        "y = (if noEvent(time > 1) then 0 else 1) + (if noEvent(time > 1) or "
+        "noEvent(time > 2) then 0 else 1) + (if noEvent(time > 1) or noEvent(time > 2) or "
+        "noEvent(time > 3) then 0 else 1)"]
+
+
+def test_a_while_loop_on_start_values_is_decided_while_flattening(tmp_path: Path) -> None:
+    # n is read before the section assigns it: its start value 3 (11.1.2)
+    m = flat_of(tmp_path, "model M\n  Integer n(start = 3);\n  Real s;\nalgorithm\n"
+                "  s := 0;\n  while n < 6 loop\n    n := n + 1;\n    s := s + n;\n"
+                "  end while;\nend M;\n")
+    assert sorted(equations(m)) == ["n = 6", "s = 15"]

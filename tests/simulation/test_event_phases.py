@@ -26,6 +26,17 @@ equation
 end Decay;
 """
 
+TERMINAL_WHEN = """model Ending
+  Real x(start = 1, fixed = true);
+equation
+  der(x) = -x;
+  when terminal() then
+    assert(x < LIMIT, "ends low");
+  end when;
+  annotation(experiment(StopTime = 1, Interval = 0.1));
+end Ending;
+"""
+
 PRIORITY = """model Priority
   Boolean close(fixed = true);
   Real x(start = 3, fixed = true);
@@ -69,3 +80,16 @@ def test_when_not_initial_fires_at_the_start(tmp_path: Path, engine: str) -> Non
     # x = 6 right after the initialization, so 'x >= 5' (the first branch) sets close
     assert result["x"].tolist() == [6.0, 6.0, 6.0]
     assert result["close"].tolist() == [1.0, 1.0, 1.0]
+
+
+@pytest.mark.parametrize("engine", ["scipy", "compiled"])
+def test_assert_in_a_when_clause_on_terminal_checks_the_end(tmp_path: Path, engine: str
+                                                           ) -> None:
+    # x(1) = exp(-1) = 0.3679: below 0.37, above 0.36
+    path = tmp_path / "Ending.mo"
+    path.write_text(TERMINAL_WHEN.replace("LIMIT", "0.37"))
+    springc.simulate(str(path), rtol=1e-8, engine=engine)
+    path.write_text(TERMINAL_WHEN.replace("LIMIT", "0.36"))
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(str(path), rtol=1e-8, engine=engine)
+    assert info.value.message == "assertion failed at t = 1: ends low"

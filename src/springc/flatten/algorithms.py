@@ -14,7 +14,7 @@ reads are replaced at the end of flattening (:func:`apply_starts`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -36,9 +36,18 @@ from .control import (
     stray,
 )
 from .functions import call_for_effect, multiple_outputs
+from .loop_break import (
+    BROKEN_TERMS,
+    FALSE,
+    TRUE,
+    choose,
+    kept,
+    too_large,
+)
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
+from .section_starts import known_starts
 from .strings import is_string, string_equation
 from .when_statements import (
     WhenParts,
@@ -71,6 +80,11 @@ class _Run:
         self.context: list[str] = []  # the loops, variable ifs and whens around
         self.held: set[str] = set()  # assigned in when statements (discrete)
         self.parts: list[WhenParts] = []  # of the when statements around
+        # where a break under a condition known only during the simulation has left
+        # the innermost for loop: the statements after it hold their values there
+        self.broken: x.Expr = FALSE
+        self.body: tuple[s.Statement, ...] = ()  # the section's statements
+        self.starts: dict[str, x.Const] | None = None  # see while_condition
 
     def read(self, value: a.Value, span: Span) -> a.Value:
         if is_string(value):
@@ -87,9 +101,24 @@ class _Run:
     def run(self, body: tuple[s.Statement, ...], where: Scope, guard: x.Expr | None) -> None:
         for stmt in body:
             start = len(self.fl.assertions)
-            self.statement(stmt, where, guard)
+            broken = self.broken
+            if broken == FALSE:
+                self.statement(stmt, where, guard)
+            else:  # runs only where the loop was not left
+                before, self.broken = dict(self.env), FALSE
+                try:
+                    self.statement(stmt, where, _and(guard, x.Not(broken)))
+                finally:
+                    for name, value in self.env.items():
+                        old = before.get(name, x.Var(name))
+                        if value is not old:
+                            self.env[name] = kept(broken, old, value)
+                    inner = self.broken
+                    self.broken = broken if inner == FALSE else TRUE if inner == TRUE \
+                        else x.BinOp("or", broken, inner)
             if not isinstance(stmt, s.IfStatement):
-                self.guard_new(start, guard)
+                self.guard_new(start, guard if broken == FALSE
+                               else _and(guard, x.Not(broken)))
 
     def statement(self, stmt: s.Statement, where: Scope, guard: x.Expr | None) -> None:
         if isinstance(stmt, s.Assign):
@@ -101,9 +130,7 @@ class _Run:
         elif isinstance(stmt, s.WhileStatement):
             self.context.append("while")
             try:
-                run_while(self.ev, stmt,
-                          lambda: cast(x.Expr, self.read(
-                              self.ev.scalar(stmt.condition, where), stmt.span)),
+                run_while(self.ev, stmt, lambda: self.while_condition(stmt, where),
                           lambda: self.run(stmt.body, where, guard))
             finally:
                 self.context.pop()
@@ -113,6 +140,29 @@ class _Run:
             raise Jumped(stmt)
         else:
             self.call(stmt, where, guard)
+
+    def while_condition(self, stmt: s.WhileStatement, where: Scope) -> x.Expr:
+        """The condition of ``stmt`` now; where it reads variables the section assigns
+        but has not assigned yet, their start values (11.1.2, as :func:`apply_starts`
+        gives them at the end) are taken at once, so that the loop may be decided
+        while flattening."""
+        def value() -> x.Expr:
+            return folded(cast(x.Expr, self.read(self.ev.scalar(stmt.condition, where),
+                                                 stmt.span)))
+
+        cond = value()
+        if isinstance(cond, x.Const):
+            return cond
+        if self.starts is None:
+            self.starts = known_starts(self.fl, self.body, where, self.owner)
+        seeded = False
+        for name in x.variables(cond) - self.env.keys():
+            start = self.starts.get(name)
+            if start is not None:
+                self.env[name] = start
+                self.spans.setdefault(name, stmt.span)
+                seeded = True
+        return value() if seeded else cond
 
     def assign(self, stmt: s.Assign, where: Scope) -> None:
         if len(stmt.targets) > 1:
@@ -163,23 +213,40 @@ class _Run:
             else:
                 self.if_(rest, otherwise, where, guard)
             return
-        before = dict(self.env)
+        before, broken = dict(self.env), self.broken
         span = cond_expr.span
         self.context.append("if")
         try:
-            branch_jumps(lambda: self.run(body, where, _and(guard, cond)), span)
+            broken_then = self.branch(lambda: self.run(body, where, _and(guard, cond)), span)
             then = self.env
-            self.env = dict(before)
-            branch_jumps(lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))),
-                         span)
+            self.env, self.broken = dict(before), broken
+            broken_else = self.branch(
+                lambda: self.if_(rest, otherwise, where, _and(guard, x.Not(cond))), span)
         finally:
             self.context.pop()
+        self.broken = choose(cond, broken_then, broken_else)
         for name in then.keys() | self.env.keys():
             old = before.get(name, x.Var(name))
             left, right = then.get(name, old), self.env.get(name, old)
             if left is not right:
                 self.env[name] = x.If(cond, left, right)
                 self.spans.setdefault(name, cond_expr.span)
+
+    def branch(self, run: Callable[[], None], span: Span) -> x.Expr:
+        """Run a branch of an if on a run-time condition: where the loop is left after
+        it (true if it ends with a ``break`` of the innermost loop, a for loop; a
+        ``break`` of a while loop there is not supported)."""
+        loops = [k for k in self.context if k in ("for", "while")]
+        if not loops or loops[-1] != "for":
+            branch_jumps(run, span)
+            return self.broken
+        try:
+            run()
+        except Jumped as jumped:
+            if jumped.jump.kind != "break":
+                raise
+            return TRUE
+        return self.broken
 
     def for_(self, stmt: s.ForStatement, indices: tuple[s.ForIndex, ...], where: Scope,
              guard: x.Expr | None) -> None:
@@ -192,15 +259,29 @@ class _Run:
         finally:
             self.context.pop()
 
-    def _iterations(self, stmt: s.ForStatement, values: Sequence[x.Expr | str], index: s.ForIndex,
+    def _iterations(self, stmt: s.ForStatement, values: Sequence[x.Expr | str],
+                    index: s.ForIndex,
                     rest: tuple[s.ForIndex, ...], where: Scope, guard: x.Expr | None
                     ) -> None:
-        for value in values:
-            local = LocalScope({index.name: value}, where)
-            if rest:
-                self.for_(stmt, rest, local, guard)
-            elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
-                break
+        outer, self.broken = self.broken, FALSE
+        try:
+            for value in values:
+                if self.broken != FALSE and too_large(self.env.values()):
+                    raise FlattenError(
+                        "the values of a for loop left by a break under a condition known "
+                        f"only during the simulation grow beyond {BROKEN_TERMS} terms",
+                        index.span, hint="springc unrolls such a loop into if-expressions, "
+                        "each iteration after the break nesting them deeper; shorten the "
+                        "loop's range or compute the value with equations")
+                local = LocalScope({index.name: value}, where)
+                if rest:
+                    self.for_(stmt, rest, local, guard)
+                elif not run_loop_body(lambda: self.run(stmt.body, local, guard)):  # noqa: B023
+                    break
+                if self.broken == TRUE:
+                    break
+        finally:
+            self.broken = outer
 
     def when(self, stmt: s.WhenStatement, where: Scope, guard: x.Expr | None) -> None:
         check_place(stmt, self.context, self.initial)
@@ -266,6 +347,7 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
             check_loop_nest(fl.evaluator, stmt, where)
     check_jumps(section.body, in_function=False)
     check_nesting(section.body, initial)
+    run.body = section.body
     try:
         run.run(section.body, where, None)
     except Jumped as jumped:
