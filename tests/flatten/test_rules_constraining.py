@@ -200,6 +200,36 @@ model M
   H h(redeclare model D = Big);
 end M;
 """, f"13:17: the final element 'D' cannot be redeclared\n{REPLACEABLE}"),
+    # a redeclared class keeps its protection
+    "redeclare_class_same_protection": (f"""\
+model M
+{CLASSES}  model H
+  protected
+    replaceable model D = Small;
+  end H;
+  model K
+    extends H;
+  protected
+    redeclare model D = Big;
+  end K;
+  K k;
+end M;
+""", "M: 0 unknowns, 0 equations, 0 parameters: balanced"),
+    "redeclare_protected_class_public": (f"""\
+model M
+{CLASSES}  model H
+  protected
+    replaceable model D = Small;
+  end H;
+  model K
+    extends H;
+    redeclare model D = Big;
+  end K;
+  K k;
+end M;
+""", "15:15: the protected class 'D' cannot be redeclared public\nhelp: a constant or final "
+         "element cannot be redeclared, and a redeclaration keeps the element public or "
+         "protected (Modelica 3.6, section 7.3.3)"),
     # an inherited protected class stays protected
     "redeclare_inherited_protected_class": ("""\
 model M
