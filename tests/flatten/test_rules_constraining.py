@@ -10,6 +10,7 @@ import pytest
 
 from rule_outcome import outcome
 from springc.ir.expr import Const
+from springc.ir.flat import format_equation
 from springc.pipeline.files import flatten_files
 
 SUBTYPE = ("help: the type of a replaceable or redeclared element must be a subtype of "
@@ -200,6 +201,36 @@ model M
   H h(redeclare model D = Big);
 end M;
 """, f"13:17: the final element 'D' cannot be redeclared\n{REPLACEABLE}"),
+    # a redeclared class keeps its protection
+    "redeclare_class_same_protection": (f"""\
+model M
+{CLASSES}  model H
+  protected
+    replaceable model D = Small;
+  end H;
+  model K
+    extends H;
+  protected
+    redeclare model D = Big;
+  end K;
+  K k;
+end M;
+""", "M: 0 unknowns, 0 equations, 0 parameters: balanced"),
+    "redeclare_protected_class_public": (f"""\
+model M
+{CLASSES}  model H
+  protected
+    replaceable model D = Small;
+  end H;
+  model K
+    extends H;
+    redeclare model D = Big;
+  end K;
+  K k;
+end M;
+""", "15:15: the protected class 'D' cannot be redeclared public\nhelp: a constant or final "
+         "element cannot be redeclared, and a redeclaration keeps the element public or "
+         "protected (Modelica 3.6, section 7.3.3)"),
     # an inherited protected class stays protected
     "redeclare_inherited_protected_class": ("""\
 model M
@@ -262,3 +293,34 @@ end M;
     assert _bindings(tmp_path, text) == {
         "h1.b.x": 4.0, "h1.b.y": 5.0, "h1.s.x": 6.0,
         "h2.b.x": 4.0, "h2.b.y": 3.0, "h2.s.x": 6.0, "h2.s.y": 3.0}
+
+
+def test_redeclared_function_called_through_a_component(tmp_path: Path) -> None:
+    """`b.f(3)` where `b`'s class redeclares `f` in its extends clause calls the new
+    function (section 7.3; the suite's Redeclare.Flattening.InheritancePublicClass)."""
+    path = tmp_path / "m.mo"
+    path.write_text("""\
+model M
+  model A
+    replaceable function f
+      input Real u;
+      output Real y;
+    algorithm
+      y := u;
+    end f;
+  end A;
+  model B
+    extends A(redeclare function f = g);
+  protected
+    function g
+      input Real u;
+      output Real y;
+    algorithm
+      y := 2 * u;
+    end g;
+  end B;
+  B b;
+  Real x = b.f(3);
+end M;
+""")
+    assert [format_equation(eq) for eq in flatten_files([path]).equations] == ["x = 6;"]

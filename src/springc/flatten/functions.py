@@ -32,6 +32,7 @@ from .control import (
     run_while,
     stray,
 )
+from .declarations import redeclared_class
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import (
@@ -126,6 +127,9 @@ def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry
             except FlattenError:
                 k -= 1
         if isinstance(owner, ClassScope):
+            replaced = _redeclared_function(ev, owner, ref.parts[k:])
+            if replaced is not None:
+                return replaced
             found: ClassEntry | None = owner.entry
             for part in ref.parts[k:]:
                 container = found
@@ -138,6 +142,21 @@ def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry
                                    f"'{'.'.join(p.name for p in ref.parts[k:])}'", ref.span)
             return found
     return ev.flattener.resolve_function(ref, scope)
+
+
+def _redeclared_function(ev: ExpressionEvaluator, owner: ClassScope,
+                         parts: tuple[s.RefPart, ...]) -> ClassEntry | None:
+    """``b.f()`` where ``b``'s class was given ``redeclare function f = g`` (in an
+    extends clause or a modification): the function ``g``, looked up where the
+    redeclaration is written (section 7.3)."""
+    if len(parts) != 1:
+        return None
+    found = redeclared_class(owner, s.Ref(parts, parts[0].span))
+    short = found[0].short if found is not None else None
+    if found is None or short is None:
+        return None
+    entry = ev.flattener.resolve_class(short.base, found[1].entry)
+    return entry if entry.defn.kind == "function" else None
 
 
 def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int

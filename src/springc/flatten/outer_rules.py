@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from ..errors import FlattenError, Note
+from ..errors import ErrorGroup, Note, SpringcError
 from ..ir import syntax as s
 from ..parse import member_class
 from .rules import rule_error
@@ -69,7 +69,7 @@ def _check(ctx: FlattenContext, comp: ViewComponent, ref: s.Ref) -> None:
         if rtype.entry is None:
             return
         declared = ctx.view(rtype.entry)
-    except FlattenError:
+    except (SpringcError, ErrorGroup):
         return  # reported where the component is instantiated
     name = ref.parts[1].name
     if name in declared.components or member_class(rtype.entry, name) is not None:

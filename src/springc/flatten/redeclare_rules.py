@@ -20,7 +20,7 @@ from ..ir import syntax as s
 from ..parse import ClassEntry, member_class
 from .modification import Mod, Redeclaration
 from .rules import rule_error
-from .scope import ClassView, FlattenContext, ViewComponent
+from .scope import REDECLARE_RULES, ClassView, FlattenContext, ViewComponent
 from .subtyping import Interface, incompatibility, interface
 
 _SUBTYPE = ("the type of a replaceable or redeclared element must be a subtype of its "
@@ -52,6 +52,12 @@ def check_replaceables(ctx: FlattenContext, view: ClassView) -> None:
                              [(element, entry)])
         elif isinstance(element, s.ClassDef) and element.redeclare:
             original = _inherited_class(ctx, entry, element.name)
+            if original is not None and original.defn.protected != element.protected:
+                was, now = (("protected", "public") if original.defn.protected
+                            else ("public", "protected"))
+                raise rule_error(f"the {was} class '{element.name}' cannot be redeclared "
+                                 f"{now}", element.span, REDECLARE_RULES, "7.3.3",
+                                 (Note("declared here", original.defn.span),))
             if original is not None:
                 _check_chain(ctx, element.name, class_bound(ctx, original),
                              [(element, entry)])

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..errors import FlattenError, SpringcError
+from ..errors import ErrorGroup, SpringcError
 from ..ir import syntax as s
 from ..parse import ClassEntry, lookup_class
 from .enumerations import BUILTIN_ENUMERATIONS
@@ -48,7 +48,7 @@ def interface(ctx: FlattenContext, ref: s.Ref, scope: ClassEntry,
     try:
         rtype = ctx.resolve_type(ref, scope)
         literals = _enumeration(ctx, ref, scope)
-    except (FlattenError, SpringcError):
+    except (SpringcError, ErrorGroup):
         return None
     primitive = None if literals is not None else rtype.primitive
     return Interface(ref.dotted, primitive, rtype.entry, literals,
@@ -107,7 +107,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
         return f"'{a.name}' is a {ka} and '{b.name}' a {kb}, which are not compatible"
     try:
         va, vb = ctx.view(a.entry), ctx.view(b.entry)
-    except SpringcError:
+    except (SpringcError, ErrorGroup):
         return None  # reported where the class is used
     inner_seen = seen | {(id(a.entry), id(b.entry))}
     for name, cb in vb.components.items():

@@ -9,7 +9,7 @@ it is written in. Output: nothing, or a :class:`FlattenError` at the reference.
 
 from __future__ import annotations
 
-from ..errors import FlattenError, Note
+from ..errors import ErrorGroup, Note, SpringcError
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from .rules import rule_error
@@ -22,13 +22,13 @@ def check_when_target(ctx: FlattenContext, lhs: s.Expr, where: ClassEntry) -> No
         return
     entry = where
     for depth, part in enumerate(lhs.parts[:-1]):
-        comp = ctx.view(entry).components.get(part.name)
-        if comp is None:
-            return  # a name outside the instance: reported where it is evaluated
         try:
+            comp = ctx.view(entry).components.get(part.name)
+            if comp is None:
+                return  # a name outside the instance: reported where it is evaluated
             rtype = ctx.resolve_type(comp.decl.type_name, comp.defined_in)
-        except FlattenError:
-            return
+        except (SpringcError, ErrorGroup):
+            return  # reported where the component is instantiated
         if rtype.entry is None:
             return
         kind = rtype.entry.defn.kind
