@@ -108,6 +108,29 @@ def test_compiled_rk45_equals_scipy(name: str) -> None:
     assert (np.abs(compiled.values - scipy_run.values) <= 1e-13 * np.maximum(scale, 1)).all()
 
 
+@pytest.mark.parametrize("solver", ["dop853", "rk45"])
+def test_long_runs_go_on_where_a_stretch_stopped(monkeypatch: pytest.MonkeyPatch,
+                                                  solver: str) -> None:
+    # stretches of 50 steps (then 500, 5000): each goes on from the time, state and next
+    # step size where the one before stopped, so the run takes scipy's steps and values
+    # exactly, with one more RHS evaluation per stretch (its start), not the whole run
+    # again per stretch
+    import springc.simulation.compiled as compiled_engine
+
+    monkeypatch.setattr(compiled_engine, "FIRST_CHUNK", 50)
+    model = springc.compile_model(SEED, backend="numba")
+    compiled = springc.simulate(model, solver=solver, rtol=1e-8, engine="compiled")
+    scipy_run = springc.simulate(model, solver=solver, rtol=1e-8, engine="scipy")
+    assert compiled.stats.engine == "compiled"
+    assert compiled.stats.steps == scipy_run.stats.steps > 550
+    # stretches of 50, 500, 5,000 and 50,000 steps (rejected ones included): 3 to 5
+    extra = compiled.stats.rhs_evaluations - scipy_run.stats.rhs_evaluations
+    assert 2 <= extra <= 4, extra
+    scale = np.abs(scipy_run.values).max(axis=0)
+    bound = 0.0 if solver == "dop853" else 1e-13  # rk45: see test_compiled_rk45_equals_scipy
+    assert (np.abs(compiled.values - scipy_run.values) <= bound * np.maximum(scale, 1)).all()
+
+
 @pytest.mark.parametrize("solver", ["radau", "bdf"])
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_compiled_implicit_agrees_with_scipy(name: str, solver: str) -> None:

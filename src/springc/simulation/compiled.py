@@ -37,11 +37,11 @@ if TYPE_CHECKING:
 
 COMPILED, SCIPY = "compiled", "scipy"
 FIRST_CHUNK = 10_000
-"""Accepted steps of the first compiled attempt: a longer run is retried from the same
-start with ten times the budget (at most 11 % repeated work), so that a run whose step
-size is hopeless stops early and the wall-clock limit is checked between attempts.
-(The kernel counts rejected steps too; its budget is raised by them, so that the step
-limit counts accepted steps, as scipy's loop does.)"""
+"""Steps (accepted and rejected) of the first compiled stretch: a longer run goes on
+from where the stretch stopped (its time, state and next step size: the explicit
+methods take the same steps as one uninterrupted run) in stretches ten times longer,
+so that a run whose step size is hopeless stops early and the wall-clock limit is
+checked between stretches. The step limit counts accepted steps, as scipy's loop does."""
 FIXED_CHUNK = 200_000
 """Steps of a fixed-step stretch between two checks of the wall clock."""
 SCIPY_COLLAPSE = "Required step size is less than spacing between numbers."
@@ -192,49 +192,44 @@ def _finish(loop: StepLoop, integrator: Any, solver: str,
     t, y = float(integrator.t), np.array(integrator.y)
     rest = grid[loop.k:]
     times = np.concatenate(([t], rest[rest > t]))
-    first = float(integrator.h_abs)
+    started, first = t, float(integrator.h_abs)
     began = time.perf_counter()
     allowed = loop.limits.max_steps - loop.steps  # accepted steps, as scipy's loop counts
-    budget = min(FIRST_CHUNK, allowed)
-    attempt = budget  # the kernel counts rejected steps too
+    chunk, accepted = FIRST_CHUNK, 0
     while True:
-        run = run_kernel(times, y, min(first, float(times[-1] - t)), max(attempt, 1))
+        attempt = max(min(chunk, allowed - accepted), 1)
+        run = run_kernel(times, y, min(first, float(times[-1] - t)), attempt)
         problem.nfev += run.rhs_evaluations
         problem.njev += run.jacobian_evaluations
-        if run.status != Status.MAX_STEPS:
+        accepted += run.accepted_steps
+        rows = run.filled - 1  # row 0 is the stretch's start
+        loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
+        loop.k += rows
+        if run.status != Status.MAX_STEPS or accepted >= allowed:
             break
-        if run.accepted_steps < budget:  # rejections used part of the attempt
-            attempt += budget - run.accepted_steps
-            continue
-        if budget >= allowed:
-            break
-        taken = run.accepted_steps
-        projected = loop.steps + taken * (float(grid[-1]) - t) / max(run.failure_time - t,
-                                                                     1e-300)
+        t, y, first = run.failure_time, np.array(run.failure_state), run.next_step
+        times = np.concatenate(([t], times[run.filled:]))
+        projected = loop.steps + accepted * (float(grid[-1]) - started) / max(t - started,
+                                                                               1e-300)
         if projected > HOPELESS * loop.limits.max_steps:
-            raise OverLimit(f"at its current step size ({(run.failure_time - t) / taken:.3g} "
-                            f"s on average) {solver} needs ~{projected:.3g} steps to the "
+            raise OverLimit(f"at its current step size ({(t - started) / accepted:.3g} s "
+                            f"on average) {solver} needs ~{projected:.3g} steps to the "
                             f"stop time, far over the step limit (--max-steps "
-                            f"{loop.limits.max_steps})", run.failure_time,
-                            run.failure_state, solver)
+                            f"{loop.limits.max_steps})", t, run.failure_state, solver)
         if time.perf_counter() > problem.deadline:
             raise time_limit_reached(problem, run)
-        budget = min(10 * budget, allowed)
-        attempt = budget + run.rejected_steps
+        chunk *= 10
     seconds = time.perf_counter() - began
     loop.loop_time += seconds
-    loop.compiled_steps += run.accepted_steps
+    loop.compiled_steps += accepted
     if not run.ok:
-        raise failure(problem, run, solver, steps=loop.steps + run.accepted_steps,
+        raise failure(problem, run, solver, steps=loop.steps + accepted,
                       limit=loop.limits.max_steps)
     if time.perf_counter() > problem.deadline:
         raise time_limit_reached(problem, run)
-    filled = times[1:]
-    k = loop.k
-    loop.states[k:k + len(filled)] = run.states[1:]
     loop.k = len(grid)
-    loop.steps += run.accepted_steps
-    return Stretch(run.accepted_steps, seconds, ())
+    loop.steps += accepted
+    return Stretch(accepted, seconds, ())
 
 
 def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step: float
