@@ -121,9 +121,9 @@ class VectorLayout:
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
             comment = f"{name} := {to_text(e)}  {span.file}:{span.line}"
-            group = groups.setdefault((level, shape, kinds), len(groups))
-            self.assignments[name] = _Assignment(name, shape, slots, kinds, level, comment,
-                                                 group, _order(name))
+            self.assignments[name] = _Assignment(
+                name, shape, slots, kinds, level, comment,
+                groups.setdefault((level, shape, kinds), len(groups)), _order(name))
         # Intermediate values get slots of w group by group, in natural name order.
         self.w_names: list[str] = []
         for group in self._groups(list(self.assignments.values())):
