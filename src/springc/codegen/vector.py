@@ -49,6 +49,8 @@ class _Assignment:
     kinds: tuple[str, ...]
     level: int
     comment: str
+    group: int  # assignments of one level, shape and operand kinds share it
+    order: tuple[str, tuple[int, ...], tuple[int, ...]]  # loop order (see _order)
     out: tuple[str, int] = ("w", -1)
     operands: list[tuple[str, int]] = field(default_factory=list)
 
@@ -101,6 +103,7 @@ class VectorLayout:
         self.location.update({q: ("p", i) for i, q in enumerate(m.params)})
         self.location.update({d: ("d", i) for i, d in enumerate(m.derivatives)})
         self.assignments: dict[str, _Assignment] = {}
+        groups: dict[tuple[object, ...], int] = {}  # compared once here, not per grouping
         for name, e, span in statements:
             slots: list[str] = []
             if lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
@@ -118,7 +121,9 @@ class VectorLayout:
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
             comment = f"{name} := {to_text(e)}  {span.file}:{span.line}"
-            self.assignments[name] = _Assignment(name, shape, slots, kinds, level, comment)
+            self.assignments[name] = _Assignment(
+                name, shape, slots, kinds, level, comment,
+                groups.setdefault((level, shape, kinds), len(groups)), _order(name))
         # Intermediate values get slots of w group by group, in natural name order.
         self.w_names: list[str] = []
         for group in self._groups(list(self.assignments.values())):
@@ -139,11 +144,11 @@ class VectorLayout:
 
     @staticmethod
     def _groups(assignments: list[_Assignment]) -> list[list[_Assignment]]:
-        groups: dict[tuple[object, ...], list[_Assignment]] = {}
+        groups: dict[int, list[_Assignment]] = {}
         for a in assignments:
-            groups.setdefault((a.level, a.shape, a.kinds), []).append(a)
+            groups.setdefault(a.group, []).append(a)
         ordered = sorted(groups.values(), key=lambda g: g[0].level)
-        return [sorted(g, key=lambda a: _order(a.name)) for g in ordered]
+        return [sorted(g, key=lambda a: a.order) for g in ordered]
 
     def needed(self, targets: Sequence[str]) -> list[_Assignment]:
         """The assignments that ``targets`` depend on."""

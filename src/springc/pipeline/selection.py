@@ -48,14 +48,21 @@ def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> l
     """``candidates`` matching any of ``patterns`` (all when ``None``), in model order."""
     if patterns is None:
         return list(candidates)
+    # A pattern without * or ? matches its own name only: a set lookup, so that a list
+    # of thousands of names does not cost names x candidates matches.
+    literal = {p for p in patterns if "*" not in p and "?" not in p}
+    wild = [p for p in patterns if p not in literal]
+    known = set(candidates)
     for text in patterns:
-        if not any(wildcard_match(text, c) for c in candidates):
+        if text in literal and text in known:
+            continue
+        if text in literal or not any(wildcard_match(text, c) for c in candidates):
             close = difflib.get_close_matches(text, candidates, 3)
             raise SimulationError(
                 f"--vars '{text}' matches no state or observed variable",
                 hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
                       "use flat names such as 'mass.pos[1]', with * and ? as wildcards"))
-    return [c for c in candidates if any(wildcard_match(p, c) for p in patterns)]
+    return [c for c in candidates if c in literal or any(wildcard_match(p, c) for p in wild)]
 
 
 def selected_observed(names: tuple[tuple[str, ...], tuple[str, ...]],
