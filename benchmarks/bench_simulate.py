@@ -144,7 +144,7 @@ def first_run(env: dict[str, str]) -> tuple[float, float]:
 
 def bench_engines(repeats: int) -> None:
     numba_model = springc.compile_model(SEED, backend="numba")
-    python_model = springc.compile_model(SEED)
+    python_model = springc.compile_model(SEED, backend="python")
     compiled, run = best_run(repeats, model=numba_model, engine="compiled")
     scipy_numba, _ = best_run(repeats, model=numba_model, engine="scipy")
     scipy_python, _ = best_run(repeats, model=python_model, engine="scipy")

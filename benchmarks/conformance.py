@@ -226,7 +226,8 @@ def _simulate(model: TestModel, suite: str, timeout: float) -> tuple[str, str, b
     signal.setitimer(signal.ITIMER_REAL, timeout)
     try:
         with recursion_room():
-            compiled = springc.compile_model([], model.name, libraries=[suite], cache=False)
+            compiled = springc.compile_model([], model.name, libraries=[suite], cache=False,
+                                             backend="python")  # coverage, not speed
             springc.simulate(compiled)
         return "sim-ok", "", False
     except _Timeout:

@@ -274,8 +274,11 @@ class StepLoop:
         A ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` integrator run to the end on the
         compiled engine continues there (see :func:`springc.simulation.compiled.finish_dop853`).
         """
+        # (an integrator whose first step underflowed to 0, at extreme parameters, fails
+        # on scipy with scipy's words: the compiled kernels need a positive first step)
         if self.finish is not None and max_steps is None and not self.done \
-                and type(integrator).__name__ in COMPILED_CLASSES:
+                and type(integrator).__name__ in COMPILED_CLASSES \
+                and float(getattr(integrator, "h_abs", 0.0)) > 0:
             return self.finish(self, integrator)
         problem, grid, states = self.problem, self.grid, self.states
         began, taken = time.perf_counter(), 0
