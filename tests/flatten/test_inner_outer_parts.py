@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rule_outcome import outcome
 from springc.ir.flat import format_flat
 from springc.pipeline.files import flatten_files
 
@@ -65,3 +66,25 @@ def test_a_function_sees_its_imports(tmp_path: Path) -> None:
   Real y = f(time);
 end M;
 """) == "model M\n  Real y;\nequation\n  y = 2.5 * time;\nend M;\n"
+
+
+def test_outer_elements_of_two_classes_without_inner(tmp_path: Path) -> None:
+    assert outcome(tmp_path, """model M
+  model W1
+    parameter Real g = 1;
+  end W1;
+  model W2
+    parameter Real g = 2;
+  end W2;
+  model A
+    outer W1 world;
+  end A;
+  model B
+    outer W2 world;
+  end B;
+  A a;
+  B b;
+end M;
+""") == ("12:14: the outer elements 'world' have no inner element and are of different "
+         "classes\nhelp: an inner element is added at the top of the model only for outer "
+         "elements of one class (Modelica 3.6, section 5.4)")
