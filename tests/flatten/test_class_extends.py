@@ -206,3 +206,21 @@ CASES = {
 def test_class_redeclaration_errors(tmp_path: Path, name: str) -> None:
     text, expected = CASES[name]
     assert outcome(tmp_path, text) == expected
+
+
+def test_classes_extending_a_predefined_type(tmp_path: Path) -> None:
+    """A type extending Real with a modification, a connector extending a short type
+    with a prefix: both read as short definitions (section 4.5.2)."""
+    assert flat(tmp_path, """model M
+  type Length
+    extends Real(unit = "m");
+  end Length;
+  type Out = output Real;
+  connector Signal
+    extends Out;
+  end Signal;
+  Length l = 2 * time;
+  Signal s = l;
+end M;
+""") == ('model M\n  Real l(unit = "m");\n  output Real s;\nequation\n  l = 2 * time;\n'
+         "  s = l;\nend M;\n")

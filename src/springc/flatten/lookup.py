@@ -99,7 +99,7 @@ class ClassLookup(FlattenContext):
         entry = self.resolve_class(ref, scope)
         connector = False
         for _ in range(100):
-            short = entry.defn.short
+            short = entry.defn.short or self._extended_type(entry)
             if entry.defn.enumeration is not None:
                 # Enumeration values are their ordinals (1, 2, ...): an Integer.
                 return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes,
@@ -115,8 +115,45 @@ class ClassLookup(FlattenContext):
             base = short.base.dotted
             if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
                 return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes, connector)
-            entry = self.resolve_class(short.base, entry.parent or entry)
+            entry = self.resolve_class(short.base, entry.parent or entry,
+                                       entry if entry.defn.short is None else None)
         raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
+
+    def _extended_type(self, entry: ClassEntry) -> s.ShortDef | None:
+        """``type T extends Real(unit = "m"); end T;``, ``connector D extends Base;`` with
+        ``type Base = output Real``: a class that only extends a predefined type (its
+        other elements may be classes, such as an ``equalityConstraint``), read as the
+        short definition ``= Base(...)`` (section 4.5.2)."""
+        defn = entry.defn
+        extends = [e for e in defn.elements if isinstance(e, s.Extends)]
+        if len(extends) != 1 or defn.equations or defn.initial_equations or defn.algorithm \
+                or any(isinstance(e, s.Component) for e in defn.elements):
+            return None
+        element = extends[0]
+        ref: s.Ref = element.base
+        scope: ClassEntry = entry.parent or entry
+        owner: ClassEntry | None = entry
+        for _ in range(100):
+            if ref.dotted in PRIMITIVES and lookup_class(ref.dotted, scope) is None:
+                if ref is not element.base:
+                    check_extends(self, entry)  # the kinds that may extend a type (7.1.3)
+                elif defn.kind not in ("type", "connector"):
+                    return None
+                return s.ShortDef(element.base, (), element.modification, "", "", False,
+                                  element.span)
+            try:
+                base = self.resolve_class(ref, scope, owner)
+            except FlattenError:
+                return None
+            nested = base.defn.short or next(
+                (e.base for e in base.defn.elements if isinstance(e, s.Extends)), None)
+            if isinstance(nested, s.ShortDef):
+                ref, scope, owner = nested.base, base.parent or base, None
+            elif nested is not None and base.defn.kind == "type":
+                ref, scope, owner = nested, base.parent or base, base
+            else:
+                return None
+        return None
 
     def follow_short(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:
         """``model M2 = M(k = 2)``: the full class behind a short definition, and the
