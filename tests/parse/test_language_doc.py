@@ -43,8 +43,6 @@ REJECTED = {
     "model M\n  String s;\nequation\n  s = String(time);\nend M;\n":
         "4:14: error: 'String' of a value that changes during the simulation is not "
         "supported yet: it depends on time",
-    "model M\n  type E = enumeration(:);\n  Real x = 1;\nend M;\n":
-        "2:12: error: unspecified enumerations `enumeration(:)` are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n"
     "model M\n  Real x = f(1);\nend M;\n":
         "4:1: error: `external` functions are not supported yet",
