@@ -40,6 +40,12 @@ REJECTED = {
     "    s = \"a\";\n  end when;\n  b = s == \"a\";\nend M;\n":
         "8:7: error: reading the discrete String 's' (assigned in a when-clause) is not "
         "supported yet",
+    "model M\n  type A\n    extends Real;\n    function equalityConstraint\n      input A a1;\n"
+    "      input A a2;\n      output Real residue[0];\n    algorithm\n"
+    "    end equalityConstraint;\n  end A;\n  connector C\n    A theta;\n    Real v;\n"
+    "    flow Real i;\n  end C;\n  C c;\nend M;\n":
+        "12:7: error: overdetermined connectors (the element 'theta' of 'c' has the type "
+        "'M.A' with an equalityConstraint function, section 9.4) are not supported yet",
     "model M\n  String s;\nequation\n  s = String(time);\nend M;\n":
         "4:14: error: 'String' of a value that changes during the simulation is not "
         "supported yet: it depends on time",

@@ -12,9 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import Note
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import syntax as s
+from ..parse import member_class
 from .rules import rule_error
 from .scope import ClassScope, Primitive
 
@@ -119,6 +120,7 @@ def check_connector_size(scope: ClassScope) -> None:
         else:
             potentials += size
     if flows and flows != potentials:
+        _check_overdetermined(scope)
         raise rule_error(f"connector '{scope.prefix}' ({scope.entry.full_name}) has "
                          f"{flows} flow and {potentials} potential variables",
                          scope.span, "a connector has as many flow variables as "
@@ -126,6 +128,23 @@ def check_connector_size(scope: ClassScope) -> None:
                          "nor flow", "9.3.1",
                          (Note(f"'{scope.entry.full_name}' is defined here",
                                scope.entry.defn.span),))
+
+
+def _check_overdetermined(scope: ClassScope) -> None:
+    """A connector with an element of an overdetermined type (one that defines an
+    ``equalityConstraint`` function, section 9.4) counts its potentials otherwise."""
+    for comp in scope.view.components.values():
+        try:
+            entry = scope.flattener.resolve_class(comp.decl.type_name, comp.defined_in)
+        except FlattenError:
+            continue
+        if member_class(entry, "equalityConstraint") is not None:
+            raise FlattenError(f"overdetermined connectors (the element '{comp.decl.name}' "
+                               f"of '{scope.prefix}' has the type '{entry.full_name}' with "
+                               "an equalityConstraint function, section 9.4) are not "
+                               "supported yet", comp.decl.span,
+                               hint="springc supports a subset of Modelica; see \"Not "
+                               "supported yet\" in docs/language.md")
 
 
 def check_reference_form(ref: s.Ref, owner: ClassScope) -> None:
