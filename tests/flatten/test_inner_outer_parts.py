@@ -88,3 +88,60 @@ end M;
 """) == ("12:14: the outer elements 'world' have no inner element and are of different "
          "classes\nhelp: an inner element is added at the top of the model only for outer "
          "elements of one class (Modelica 3.6, section 5.4)")
+
+
+FUNCTIONS = """model M
+  partial function A
+    input Integer u;
+    output Integer y;
+  end A;
+  function B
+    extends A;
+  algorithm
+    y := u;
+  end B;
+  function C
+    extends A;
+  algorithm
+    y := u + 1;
+  end C;
+  model D
+    outer function fc = A;
+    Integer y;
+    parameter Integer u = 1;
+  equation
+    y = fc(u);
+  end D;
+  model E
+    inner function fc = B;
+    D d;
+  end E;
+  model F
+    inner function fc = C;
+    D d;
+  end F;
+  E e;
+  F f;
+end M;
+"""
+
+
+def test_an_outer_function_calls_the_inner_one(tmp_path: Path) -> None:
+    assert flat(tmp_path, FUNCTIONS) == """model M
+  discrete Integer 'e.d.y';
+  parameter Integer 'e.d.u' = 1;
+  discrete Integer 'f.d.y';
+  parameter Integer 'f.d.u' = 1;
+equation
+  'e.d.y' = 'e.d.u';
+  'f.d.y' = 'f.d.u' + 1;
+end M;
+"""
+
+
+def test_an_outer_function_without_inner(tmp_path: Path) -> None:
+    text = FUNCTIONS.replace("  E e;\n  F f;\n", "  D d;\n")
+    assert outcome(tmp_path, text) == (
+        "21:9: the outer class 'M.D.fc' has no inner class 'fc' in an enclosing instance\n"
+        "help: declare `inner ... fc = ...` in a model that contains this one (Modelica "
+        "3.6, section 5.4)")

@@ -46,6 +46,10 @@ REJECTED = {
     "    flow Real i;\n  end C;\n  C c;\nend M;\n":
         "12:7: error: overdetermined connectors (the element 'theta' of 'c' has the type "
         "'M.A' with an equalityConstraint function, section 9.4) are not supported yet",
+    "model M\n  function f\n    input Real x;\n    output Real y;\n  algorithm\n    y := x;\n"
+    "  end f;\n  function f2 = f(x = 3);\n  Real y = f2(1);\nend M;\n":
+        "9:12: error: a function defined by a modification of another (`function f2 = "
+        "f(...)`) is not supported yet",
     "model M\n  String s;\nequation\n  s = String(time);\nend M;\n":
         "4:14: error: 'String' of a value that changes during the simulation is not "
         "supported yet: it depends on time",

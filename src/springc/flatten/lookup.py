@@ -21,6 +21,7 @@ from .class_extends import check_class_redeclarations
 from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
+from .instance_classes import inner_class
 from .modification import Mod, from_syntax, merge_all
 from .rules import check_class, check_extends, rule_error
 from .scope import (
@@ -184,6 +185,18 @@ class ClassLookup(FlattenContext):
                                hint=f"did you mean '{close[0]}'?" if close else
                                "define it as a `function`, or load the file that defines it")
         entry = self.resolve_class(ref, scope.entry)
+        if entry.defn.outer:  # `outer function f = A;`: the inner one (section 5.4)
+            entry = inner_class(scope, entry, ref.span)
+        short = entry.defn.short
+        if short is not None and entry.defn.kind == "function":  # function f = g;
+            if short.modification is not None:
+                raise FlattenError("a function defined by a modification of another "
+                                   f"(`function {entry.name} = "
+                                   f"{short.base.dotted}(...)`) is not supported yet",
+                                   ref.span, [Note("defined here", entry.defn.span)],
+                                   "springc supports a subset of Modelica; see \"Not "
+                                   "supported yet\" in docs/language.md")
+            entry = self.follow_short(entry)[0]
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])

@@ -92,7 +92,8 @@ class ElementRules(RuleBase):
             return [item]
         if isinstance(item, ClassDef):
             return [replace(item, replaceable="replaceable" in words,
-                            redeclare="redeclare" in words, final="final" in words)]
+                            redeclare="redeclare" in words, final="final" in words,
+                            inner="inner" in words, outer="outer" in words)]
         return self._components(item, words, constraint)
 
     def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
