@@ -25,6 +25,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion, guard_assertions
+from .connection_graph import GRAPH_EQUATIONS, misplaced
 from .control import (
     Jumped,
     branch_jumps,
@@ -167,6 +168,8 @@ class _Run:
                 break
 
     def call(self, stmt: s.CallStatement, where: Scope, guard: x.Expr | None) -> None:
+        if stmt.call.func.dotted in GRAPH_EQUATIONS:
+            raise misplaced(stmt.call, "an algorithm section")
         if stmt.call.func.dotted != "assert":
             call_for_effect(self.ev, stmt.call, where, "a statement")
             return

@@ -22,6 +22,7 @@ from ..parse import ClassEntry
 from . import arrays as a
 from .assertions import guard_assertions
 from .builtins import Builtins
+from .connection_graph import GRAPH_FUNCTIONS
 from .enum_rules import check_enum_relation
 from .event_calls import EVENT_CALLS, event_call
 from .event_uses import EventUses
@@ -306,7 +307,7 @@ class Evaluator(ReferenceResolver):
 
     def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
-        if name in UNSUPPORTED_CALLS:
+        if name in UNSUPPORTED_CALLS or name in GRAPH_FUNCTIONS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")

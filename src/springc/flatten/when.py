@@ -18,6 +18,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..ir import when as w
 from . import arrays as a
+from .connection_graph import check_branches
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .strings import string_equation
 
@@ -192,6 +193,7 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     equation with if-expressions (``lhs = if c then r1 else r2`` when the branches
     share the left-hand side, ``0 = if c then l1 - r1 else l2 - r2`` otherwise)."""
     for _, body in [*eq.branches, (None, eq.otherwise)]:
+        check_branches(body, "an if-equation with a variable condition")
         nested = _find_when(body)
         if nested is not None:
             raise FlattenError("a when-equation cannot be inside an if-equation with a "
