@@ -224,3 +224,32 @@ def test_classes_extending_a_predefined_type(tmp_path: Path) -> None:
 end M;
 """) == ('model M\n  Real l(unit = "m");\n  output Real s;\nequation\n  l = 2 * time;\n'
          "  s = l;\nend M;\n")
+
+
+def test_an_inherited_declaration_sees_the_package_its_base_is_named_through(
+        tmp_path: Path) -> None:
+    """v[n] is written in Base.Props; Air extends it as Two.Props, so n is Two's (2);
+    Air's own text may not use n (it is not visible there)."""
+    text = """model M
+  package Base
+    constant Integer n = 1;
+    partial model Props
+      Real v[n];
+    end Props;
+  end Base;
+  package Two
+    extends Base(n = 2);
+  end Two;
+  model Air
+    extends Two.Props;
+  equation
+    v = fill(time, 2);
+  end Air;
+  Air air;
+end M;
+"""
+    assert flat(tmp_path, text) == ("model M\n  Real 'air.v[1]';\n  Real 'air.v[2]';\n"
+                                    "equation\n  'air.v[1]' = time;\n  'air.v[2]' = time;\n"
+                                    "end M;\n")
+    assert outcome(tmp_path, text.replace("fill(time, 2)", "fill(time, n)")) == (
+        "5:14: undefined name 'n'\nhelp: declare it, or check the spelling")

@@ -9,6 +9,7 @@ class they are written in. Output: class entries, resolved types or values. Also
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterator
 from typing import Any
 
 from ..errors import ErrorGroup, FlattenError, FollowUpError, Note, Span
@@ -229,6 +230,31 @@ class ClassLookup(FlattenContext):
             return package.member(name, span)
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
 
+    def inherited_name(self, scope: ClassScope, name: str, span: Span) -> Any:
+        """A name that an inherited element uses, not visible from the instance's class:
+        a constant of the package its base class is named through (``extends
+        Medium.BaseProperties``), or a name visible where a base class is written
+        (sections 5.6.1, 7.1); None if there is none, or if the class itself uses
+        the name (it is not visible there)."""
+        if _names(scope.entry.defn, name):
+            return None
+        for element, writer, base in _bases(self, scope.entry):
+            if len(element.base.parts) > 1:
+                prefix = s.Ref(element.base.parts[:-1], element.base.span)
+                try:
+                    package = self.resolve_class(prefix, writer.parent or writer, writer)
+                except FlattenError:
+                    package = None
+                if package is not None and package.defn.kind == "package" \
+                        and self.package_scope(package).has_member(name):
+                    return self.package_scope(package).member(name, span)
+            try:
+                return self.lookup_global(name, base, span)
+            except FlattenError as err:
+                if not err.message.startswith("undefined name"):
+                    raise
+        return None
+
     def package_scope(self, entry: ClassEntry) -> ClassScope:
         """The instance of a package whose constants are read: ``package M2 = M1(y =
         2)`` is ``M1`` with that modification, and a package extending another with a
@@ -293,6 +319,35 @@ class ClassLookup(FlattenContext):
                 "(Modelica 3.6, section 5.3.1)")
         raise FlattenError(f"undefined name '{name}'", span,
                            hint="declare it, or check the spelling")
+
+
+def _names(node: object, name: str) -> bool:
+    """Whether a reference in ``node`` (a class's own text, nested classes excluded)
+    starts with ``name``."""
+    if isinstance(node, s.Ref):
+        return node.parts[0].name == name or any(
+            _names(sub, name) for part in node.parts for sub in part.subscripts)
+    if isinstance(node, tuple):
+        return any(_names(item, name) for item in node if not isinstance(item, s.ClassDef))
+    fields = getattr(node, "__dataclass_fields__", None)
+    if fields is None or isinstance(node, Span):
+        return False
+    return any(_names(getattr(node, f), name) for f in fields
+               if f != "annotation" and not isinstance(getattr(node, f), s.ClassDef))
+
+
+def _bases(ctx: ClassLookup, entry: ClassEntry, depth: int = 0
+           ) -> Iterator[tuple[s.Extends, ClassEntry, ClassEntry]]:
+    """The extends clauses of ``entry`` and of its base classes, depth first: each with
+    the class that writes it and its base class."""
+    for element in entry.defn.elements:
+        if isinstance(element, s.Extends) and depth < 50:
+            try:
+                base = ctx.resolve_class(element.base, entry.parent or entry, entry)
+            except FlattenError:
+                continue
+            yield element, entry, base
+            yield from _bases(ctx, base, depth + 1)
 
 
 def lookup_global_visible(ctx: ClassLookup, name: str, entry: ClassEntry) -> bool:
