@@ -253,3 +253,30 @@ end M;
                                     "end M;\n")
     assert outcome(tmp_path, text.replace("fill(time, 2)", "fill(time, n)")) == (
         "5:14: undefined name 'n'\nhelp: declare it, or check the spelling")
+
+
+def test_a_function_redeclared_in_an_instance(tmp_path: Path) -> None:
+    """b.f1() and f1() in B call f2, which B's extends clause puts in place of f1."""
+    assert flat(tmp_path, """model M
+  model A
+    replaceable function f1
+      output Integer x;
+    algorithm
+      x := 1;
+    end f1;
+    Integer inside = f1();
+  end A;
+  model B
+    extends A(redeclare function f1 = f2);
+  protected
+    function f2
+      output Integer x;
+    algorithm
+      x := 2;
+    end f2;
+  end B;
+  B b;
+  Integer x = b.f1();
+end M;
+""") == ("model M\n  discrete Integer 'b.inside';\n  discrete Integer x;\nequation\n"
+         "  'b.inside' = 2;\n  x = 2;\nend M;\n")

@@ -43,9 +43,11 @@ def redeclared_package(ctx: FlattenContext, scope: ClassScope, name: str,
     if defn is None or defn.short is None:
         return None
     if defn.short.modification is not None:
-        raise FlattenError("a modification in a redeclared package is not supported yet",
+        raise FlattenError("a modification in a class redeclaration used in this way "
+                           "(`redeclare package Medium = M1(n = 2)`, read as "
+                           f"'{name}.x' or called) is not supported yet",
                            defn.short.modification.span,
-                           hint="define a package with the modification and redeclare it")
+                           hint="define a class with the modification and redeclare it")
     return class_in_instance(ctx, where, defn.short.base, depth + 1)
 
 

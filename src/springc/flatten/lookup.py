@@ -22,7 +22,7 @@ from .class_extends import check_class_redeclarations
 from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
-from .instance_classes import inner_class
+from .instance_classes import class_in_instance, inner_class, instance_scope
 from .modification import Mod, from_syntax, merge_all
 from .rules import check_class, check_extends, rule_error
 from .scope import (
@@ -185,7 +185,9 @@ class ClassLookup(FlattenContext):
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else
                                "define it as a `function`, or load the file that defines it")
-        entry = self.resolve_class(ref, scope.entry)
+        instance = instance_scope(scope)
+        entry = class_in_instance(self, instance, ref) if instance is not None \
+            else self.resolve_class(ref, scope.entry)  # f redeclared in this instance
         if entry.defn.outer:  # `outer function f = A;`: the inner one (section 5.4)
             entry = inner_class(scope, entry, ref.span)
         short = entry.defn.short
