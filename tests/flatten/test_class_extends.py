@@ -206,3 +206,77 @@ CASES = {
 def test_class_redeclaration_errors(tmp_path: Path, name: str) -> None:
     text, expected = CASES[name]
     assert outcome(tmp_path, text) == expected
+
+
+def test_classes_extending_a_predefined_type(tmp_path: Path) -> None:
+    """A type extending Real with a modification, a connector extending a short type
+    with a prefix: both read as short definitions (section 4.5.2)."""
+    assert flat(tmp_path, """model M
+  type Length
+    extends Real(unit = "m");
+  end Length;
+  type Out = output Real;
+  connector Signal
+    extends Out;
+  end Signal;
+  Length l = 2 * time;
+  Signal s = l;
+end M;
+""") == ('model M\n  Real l(unit = "m");\n  output Real s;\nequation\n  l = 2 * time;\n'
+         "  s = l;\nend M;\n")
+
+
+def test_an_inherited_declaration_sees_the_package_its_base_is_named_through(
+        tmp_path: Path) -> None:
+    """v[n] is written in Base.Props; Air extends it as Two.Props, so n is Two's (2);
+    Air's own text may not use n (it is not visible there)."""
+    text = """model M
+  package Base
+    constant Integer n = 1;
+    partial model Props
+      Real v[n];
+    end Props;
+  end Base;
+  package Two
+    extends Base(n = 2);
+  end Two;
+  model Air
+    extends Two.Props;
+  equation
+    v = fill(time, 2);
+  end Air;
+  Air air;
+end M;
+"""
+    assert flat(tmp_path, text) == ("model M\n  Real 'air.v[1]';\n  Real 'air.v[2]';\n"
+                                    "equation\n  'air.v[1]' = time;\n  'air.v[2]' = time;\n"
+                                    "end M;\n")
+    assert outcome(tmp_path, text.replace("fill(time, 2)", "fill(time, n)")) == (
+        "5:14: undefined name 'n'\nhelp: declare it, or check the spelling")
+
+
+def test_a_function_redeclared_in_an_instance(tmp_path: Path) -> None:
+    """b.f1() and f1() in B call f2, which B's extends clause puts in place of f1."""
+    assert flat(tmp_path, """model M
+  model A
+    replaceable function f1
+      output Integer x;
+    algorithm
+      x := 1;
+    end f1;
+    Integer inside = f1();
+  end A;
+  model B
+    extends A(redeclare function f1 = f2);
+  protected
+    function f2
+      output Integer x;
+    algorithm
+      x := 2;
+    end f2;
+  end B;
+  B b;
+  Integer x = b.f1();
+end M;
+""") == ("model M\n  discrete Integer 'b.inside';\n  discrete Integer x;\nequation\n"
+         "  'b.inside' = 2;\n  x = 2;\nend M;\n")

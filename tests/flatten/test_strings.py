@@ -46,6 +46,15 @@ algorithm
   assert(parts[2] <> "b", "algorithm");
 end M;
 ''', "M: 1 unknown, 1 equation, 1 parameter: balanced"),
+    "string_of_a_variable_bound_to_a_constant": ('''\
+model M
+  type E = enumeration(one, two);
+  E e = E.two;
+  Integer k = 2 * 3;
+equation
+  assert(String(e) + String(k) == "two6", "bound values");
+end M;
+''', "M: 2 unknowns, 2 equations, 0 parameters: balanced"),
     "an_assertion_on_strings_that_fails": ('''\
 model M
   String s;

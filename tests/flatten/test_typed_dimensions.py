@@ -150,6 +150,24 @@ model M
 end M;
 """, "4:15: '<' compares a value of enumeration type 'M.E' with a number\n"
         f"{ENUM_HELP}"),
+    "unspecified_enumeration_redeclared": ("""\
+model M
+  model A
+    replaceable type E = enumeration(:);
+    parameter E e;
+  end A;
+  type Colors = enumeration(red, green);
+  A a(redeclare type E = Colors, e = Colors.green);
+end M;
+""", "M: 0 unknowns, 0 equations, 1 parameter: balanced"),
+    "unspecified_enumeration_variable": ("""\
+model M
+  type E = enumeration(:);
+  parameter E e;
+end M;
+""", "3:15: 'e' is of the enumeration type 'M.E', which has no literals\nhelp: a simulated "
+        "model has no variables of an unspecified enumeration `enumeration(:)`: redeclare "
+        "the type (`redeclare type E = Colors`) (Modelica 3.6, section 4.9.5.4)"),
     "two_enumerations_compared": ("""\
 model M
   type E = enumeration(a, b);

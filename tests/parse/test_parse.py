@@ -511,13 +511,13 @@ def test_unsupported_constructs_are_rejected(text: str, what: str) -> None:
 def test_all_unsupported_constructs_are_reported_together() -> None:
     text = (
         "model A\n  Real y;\n  stream Real h;\nend A;\n"
-        "type E = enumeration(:);\n"
+        "expandable connector E\nend E;\n"
     )
     with pytest.raises(ErrorGroup) as info:
         parse_text(text, "t.mo")
     assert [(e.message, e.span.line, e.span.column) for e in info.value.errors] == [
         ("`stream` connectors are not supported yet", 3, 3),
-        ("unspecified enumerations `enumeration(:)` are not supported yet", 5, 10),
+        ("`expandable` connectors are not supported yet", 5, 1),
     ]
 
 

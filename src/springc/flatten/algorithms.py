@@ -26,6 +26,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .assertions import assertion, guard_assertions
+from .connection_graph import GRAPH_EQUATIONS, misplaced
 from .control import (
     Jumped,
     branch_jumps,
@@ -307,6 +308,8 @@ class _Run:
 
     def call(self, stmt: s.CallStatement, where: Scope, guard: x.Expr | None) -> None:
         name = stmt.call.func.dotted
+        if name in GRAPH_EQUATIONS:
+            raise misplaced(stmt.call, "an algorithm section")
         if name == "terminate" and self.parts:
             self.parts[-1].terminates.append(terminate_of(self.ev, stmt, where))
             return

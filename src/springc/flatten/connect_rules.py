@@ -12,9 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import Note
+from ..errors import FlattenError, Note
 from ..ir import expr as x
 from ..ir import syntax as s
+from ..parse import member_class
 from .rules import rule_error
 from .scope import ClassScope, Primitive
 
@@ -110,14 +111,17 @@ def check_connector_size(scope: ClassScope) -> None:
                                      and scope.outer.kind == "connector"):
         return
     flows = potentials = 0
-    for _, prim in primitives(scope):
+    overdetermined = _overdetermined(scope)
+    for name, prim in primitives(scope):
         size = int(np.prod(prim.dims)) if prim.dims else 1
-        if prim.variability in ("parameter", "constant") or prim.causality:
+        if prim.variability in ("parameter", "constant") or prim.causality \
+                or name.split(".")[0].split("[")[0] in overdetermined:
             continue
         if prim.flow:
             flows += size
         else:
             potentials += size
+    potentials += sum(overdetermined.values())
     if flows and flows != potentials:
         raise rule_error(f"connector '{scope.prefix}' ({scope.entry.full_name}) has "
                          f"{flows} flow and {potentials} potential variables",
@@ -126,6 +130,37 @@ def check_connector_size(scope: ClassScope) -> None:
                          "nor flow", "9.3.1",
                          (Note(f"'{scope.entry.full_name}' is defined here",
                                scope.entry.defn.span),))
+
+
+def _overdetermined(scope: ClassScope) -> dict[str, int]:
+    """The elements of a connector of an overdetermined type (one that defines an
+    ``equalityConstraint`` function), each counting as many potential variables as
+    that function has residues (sections 9.3.1, 9.4)."""
+    found: dict[str, int] = {}
+    for comp in scope.view.components.values():
+        if comp.decl.dims or comp.decl.type_dims:
+            continue
+        try:
+            entry = scope.flattener.resolve_class(comp.decl.type_name, comp.defined_in)
+        except FlattenError:
+            continue
+        constraint = member_class(entry, "equalityConstraint")
+        if constraint is None:
+            continue
+        outputs = [e for e in constraint.defn.elements
+                   if isinstance(e, s.Component) and e.causality == "output"]
+        dims = outputs[0].dims if len(outputs) == 1 else ()
+        if len(dims) == 1 and isinstance(dims[0], s.Number) \
+                and isinstance(dims[0].value, int):
+            found[comp.decl.name] = dims[0].value  # residue[n]: n potentials
+            continue
+        raise FlattenError(f"overdetermined connectors (the element '{comp.decl.name}' "
+                               f"of '{scope.prefix}' has the type '{entry.full_name}' with "
+                               "an equalityConstraint function, section 9.4) are not "
+                               "supported yet", comp.decl.span,
+                               hint="springc supports a subset of Modelica; see \"Not "
+                               "supported yet\" in docs/language.md")
+    return found
 
 
 def check_reference_form(ref: s.Ref, owner: ClassScope) -> None:

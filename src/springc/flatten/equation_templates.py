@@ -54,7 +54,10 @@ def reusable(flattener: FlattenContext, view: ClassView) -> bool:
     found = flattener.reusable_views.get(id(view))
     if found is None:
         flattener.reusable_views[id(view)] = False  # a class containing itself
-        found = _equations_only(eq.equation for eq in view.equations) \
+        outer_classes = any(isinstance(e, s.ClassDef) and e.outer  # differ per instance
+                            for e in view.entry.defn.elements)
+        found = not outer_classes \
+            and _equations_only(eq.equation for eq in view.equations) \
             and _equations_only(eq.equation for eq in view.initial_equations) \
             and all(_component_reusable(flattener, comp) for comp in view.components.values())
         flattener.reusable_views[id(view)] = found

@@ -16,6 +16,7 @@ from ..ir import syntax as s
 from . import arrays as a
 from .algorithms import Section, algorithm_section
 from .assertions import assertion
+from .connection_graph import GRAPH_EQUATIONS, graph_equation
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
 from .event_calls import event_dependent
@@ -91,6 +92,8 @@ class EquationFlattening(FlattenContext):
             name = eq.call.func.dotted
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")
+        elif eq.call.func.dotted in GRAPH_EQUATIONS:
+            raise graph_equation(eq.call)
         elif eq.call.func.dotted == "assert":
             kind = "initial" if initial else "equation"
             self.assertions.append(

@@ -24,6 +24,7 @@ from .assertions import guard_assertions
 from .builtins import Builtins
 from .cardinality import NAME as CARDINALITY
 from .cardinality import cardinality_call
+from .connection_graph import GRAPH_FUNCTIONS
 from .delay import NAME as DELAY
 from .delay import delay_call
 from .enum_rules import check_enum_relation
@@ -312,7 +313,7 @@ class Evaluator(ReferenceResolver):
 
     def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
-        if name in UNSUPPORTED_CALLS:
+        if name in UNSUPPORTED_CALLS or name in GRAPH_FUNCTIONS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")

@@ -9,7 +9,7 @@ name in that instance, or None when the name is not redeclared there.
 
 from __future__ import annotations
 
-from ..errors import FlattenError
+from ..errors import FlattenError, Note, Span
 from ..ir import syntax as s
 from ..parse import ClassEntry, member_class
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
@@ -43,9 +43,11 @@ def redeclared_package(ctx: FlattenContext, scope: ClassScope, name: str,
     if defn is None or defn.short is None:
         return None
     if defn.short.modification is not None:
-        raise FlattenError("a modification in a redeclared package is not supported yet",
+        raise FlattenError("a modification in a class redeclaration used in this way "
+                           "(`redeclare package Medium = M1(n = 2)`, read as "
+                           f"'{name}.x' or called) is not supported yet",
                            defn.short.modification.span,
-                           hint="define a package with the modification and redeclare it")
+                           hint="define a class with the modification and redeclare it")
     return class_in_instance(ctx, where, defn.short.base, depth + 1)
 
 
@@ -90,3 +92,21 @@ def named_through(ctx: FlattenContext, scope: ClassScope, decl: s.Component,
     if package is entry.parent or package.defn.kind != "package":
         return None
     return ctx.package_scope(package)
+
+
+def inner_class(scope: Scope, outer: ClassEntry, span: Span) -> ClassEntry:
+    """The ``inner`` class of the name of the ``outer`` class ``outer`` in the nearest
+    enclosing instance (section 5.4): ``outer function fc = A;`` calls the function
+    ``inner function fc = B;`` of an enclosing instance."""
+    instance = instance_scope(scope)
+    enclosing = instance.outer if instance is not None else None
+    while enclosing is not None:
+        found = member_class(enclosing.entry, outer.name)
+        if found is not None and found.defn.inner:
+            return found
+        enclosing = enclosing.outer
+    raise FlattenError(f"the outer class '{outer.full_name}' has no inner class "
+                       f"'{outer.name}' in an enclosing instance", span,
+                       [Note("declared outer here", outer.defn.span)],
+                       f"declare `inner ... {outer.name} = ...` in a model that contains "
+                       "this one (Modelica 3.6, section 5.4)")

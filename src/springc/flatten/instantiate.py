@@ -37,6 +37,7 @@ from .instance_classes import named_through, type_name_package
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .redeclare_rules import check_redeclarations
+from .rules import rule_error
 from .scope import (
     ClassScope,
     ClassView,
@@ -300,6 +301,12 @@ class Instantiation(FlattenContext):
     def _primitive(self, scope: ClassScope, decl: s.Component, rtype: ResolvedType,
                    mod: Mod | None, dims: tuple[int, ...], name: str,
                    kinds: tuple[DimensionKind, ...] = ()) -> Primitive:
+        if rtype.enumeration is not None and not rtype.enumeration.literals:
+            raise rule_error(f"'{name}' is of the enumeration type "
+                             f"'{rtype.enumeration.name}', which has no literals",
+                             decl.span, "a simulated model has no variables of an "
+                             "unspecified enumeration `enumeration(:)`: redeclare the type "
+                             "(`redeclare type E = Colors`)", "4.9.5.4")
         variability = stronger(decl.variability or rtype.prefixes[0] or (
             "discrete" if rtype.primitive in ("Integer", "Boolean") else "continuous"),
             scope.variability)

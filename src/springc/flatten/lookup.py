@@ -9,6 +9,7 @@ class they are written in. Output: class entries, resolved types or values. Also
 from __future__ import annotations
 
 import difflib
+from collections.abc import Iterator
 from typing import Any
 
 from ..errors import ErrorGroup, FlattenError, FollowUpError, Note, Span
@@ -21,6 +22,7 @@ from .class_extends import check_class_redeclarations
 from .conditional_rules import check_conditional_uses
 from .enumerations import BUILTIN_ENUMERATIONS, enumeration_of, literal_value
 from .inherited_rules import check_inherited_names
+from .instance_classes import class_in_instance, inner_class, instance_scope
 from .modification import Mod, from_syntax, merge_all
 from .outer_rules import check_outer_uses
 from .redeclare_rules import check_replaceables
@@ -103,7 +105,7 @@ class ClassLookup(FlattenContext):
         entry = self.resolve_class(ref, scope)
         connector = False
         for _ in range(100):
-            short = entry.defn.short
+            short = entry.defn.short or self._extended_type(entry)
             if entry.defn.enumeration is not None:
                 # Enumeration values are their ordinals (1, 2, ...): an Integer.
                 return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes,
@@ -119,8 +121,45 @@ class ClassLookup(FlattenContext):
             base = short.base.dotted
             if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
                 return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes, connector)
-            entry = self.resolve_class(short.base, entry.parent or entry)
+            entry = self.resolve_class(short.base, entry.parent or entry,
+                                       entry if entry.defn.short is None else None)
         raise FlattenError(f"type '{name}' is defined in terms of itself", ref.span)
+
+    def _extended_type(self, entry: ClassEntry) -> s.ShortDef | None:
+        """``type T extends Real(unit = "m"); end T;``, ``connector D extends Base;`` with
+        ``type Base = output Real``: a class that only extends a predefined type (its
+        other elements may be classes, such as an ``equalityConstraint``), read as the
+        short definition ``= Base(...)`` (section 4.5.2)."""
+        defn = entry.defn
+        extends = [e for e in defn.elements if isinstance(e, s.Extends)]
+        if len(extends) != 1 or defn.equations or defn.initial_equations or defn.algorithm \
+                or any(isinstance(e, s.Component) for e in defn.elements):
+            return None
+        element = extends[0]
+        ref: s.Ref = element.base
+        scope: ClassEntry = entry.parent or entry
+        owner: ClassEntry | None = entry
+        for _ in range(100):
+            if ref.dotted in PRIMITIVES and lookup_class(ref.dotted, scope) is None:
+                if ref is not element.base:
+                    check_extends(self, entry)  # the kinds that may extend a type (7.1.3)
+                elif defn.kind not in ("type", "connector"):
+                    return None
+                return s.ShortDef(element.base, (), element.modification, "", "", False,
+                                  element.span)
+            try:
+                base = self.resolve_class(ref, scope, owner)
+            except FlattenError:
+                return None
+            nested = base.defn.short or next(
+                (e.base for e in base.defn.elements if isinstance(e, s.Extends)), None)
+            if isinstance(nested, s.ShortDef):
+                ref, scope, owner = nested.base, base.parent or base, None
+            elif nested is not None and base.defn.kind == "type":
+                ref, scope, owner = nested, base.parent or base, base
+            else:
+                return None
+        return None
 
     def follow_short(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:
         """``model M2 = M(k = 2)``: the full class behind a short definition, and the
@@ -150,7 +189,21 @@ class ClassLookup(FlattenContext):
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else
                                "define it as a `function`, or load the file that defines it")
-        entry = self.resolve_class(ref, scope.entry)
+        instance = instance_scope(scope)
+        entry = class_in_instance(self, instance, ref) if instance is not None \
+            else self.resolve_class(ref, scope.entry)  # f redeclared in this instance
+        if entry.defn.outer:  # `outer function f = A;`: the inner one (section 5.4)
+            entry = inner_class(scope, entry, ref.span)
+        short = entry.defn.short
+        if short is not None and entry.defn.kind == "function":  # function f = g;
+            if short.modification is not None:
+                raise FlattenError("a function defined by a modification of another "
+                                   f"(`function {entry.name} = "
+                                   f"{short.base.dotted}(...)`) is not supported yet",
+                                   ref.span, [Note("defined here", entry.defn.span)],
+                                   "springc supports a subset of Modelica; see \"Not "
+                                   "supported yet\" in docs/language.md")
+            entry = self.follow_short(entry)[0]
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])
@@ -182,6 +235,31 @@ class ClassLookup(FlattenContext):
             check_inside(entry, name, False, ref)
             return package.member(name, span)
         raise FlattenError(f"'{entry.full_name}' has no element '{name}'", span)
+
+    def inherited_name(self, scope: ClassScope, name: str, span: Span) -> Any:
+        """A name that an inherited element uses, not visible from the instance's class:
+        a constant of the package its base class is named through (``extends
+        Medium.BaseProperties``), or a name visible where a base class is written
+        (sections 5.6.1, 7.1); None if there is none, or if the class itself uses
+        the name (it is not visible there)."""
+        if _names(scope.entry.defn, name):
+            return None
+        for element, writer, base in _bases(self, scope.entry):
+            if len(element.base.parts) > 1:
+                prefix = s.Ref(element.base.parts[:-1], element.base.span)
+                try:
+                    package = self.resolve_class(prefix, writer.parent or writer, writer)
+                except FlattenError:
+                    package = None
+                if package is not None and package.defn.kind == "package" \
+                        and self.package_scope(package).has_member(name):
+                    return self.package_scope(package).member(name, span)
+            try:
+                return self.lookup_global(name, base, span)
+            except FlattenError as err:
+                if not err.message.startswith("undefined name"):
+                    raise
+        return None
 
     def package_scope(self, entry: ClassEntry) -> ClassScope:
         """The instance of a package whose constants are read: ``package M2 = M1(y =
@@ -247,6 +325,35 @@ class ClassLookup(FlattenContext):
                 "(Modelica 3.6, section 5.3.1)")
         raise FlattenError(f"undefined name '{name}'", span,
                            hint="declare it, or check the spelling")
+
+
+def _names(node: object, name: str) -> bool:
+    """Whether a reference in ``node`` (a class's own text, nested classes excluded)
+    starts with ``name``."""
+    if isinstance(node, s.Ref):
+        return node.parts[0].name == name or any(
+            _names(sub, name) for part in node.parts for sub in part.subscripts)
+    if isinstance(node, tuple):
+        return any(_names(item, name) for item in node if not isinstance(item, s.ClassDef))
+    fields = getattr(node, "__dataclass_fields__", None)
+    if fields is None or isinstance(node, Span):
+        return False
+    return any(_names(getattr(node, f), name) for f in fields
+               if f != "annotation" and not isinstance(getattr(node, f), s.ClassDef))
+
+
+def _bases(ctx: ClassLookup, entry: ClassEntry, depth: int = 0
+           ) -> Iterator[tuple[s.Extends, ClassEntry, ClassEntry]]:
+    """The extends clauses of ``entry`` and of its base classes, depth first: each with
+    the class that writes it and its base class."""
+    for element in entry.defn.elements:
+        if isinstance(element, s.Extends) and depth < 50:
+            try:
+                base = ctx.resolve_class(element.base, entry.parent or entry, entry)
+            except FlattenError:
+                continue
+            yield element, entry, base
+            yield from _bases(ctx, base, depth + 1)
 
 
 def lookup_global_visible(ctx: ClassLookup, name: str, entry: ClassEntry) -> bool:

@@ -213,7 +213,15 @@ class ClassScope:
             return self.member(name, span)
         if self.package is not None and self.package.has_member(name):
             return self.package.member(name, span)
-        return self.flattener.lookup_global(name, self.entry, span)
+        try:
+            return self.flattener.lookup_global(name, self.entry, span)
+        except FlattenError as err:
+            if not err.message.startswith("undefined name"):
+                raise
+            found = self.flattener.inherited_name(self, name, span)
+            if found is None:
+                raise
+            return found
 
 
 @dataclass(eq=False)
@@ -360,6 +368,8 @@ class FlattenContext(Protocol):
     def find_function(self, name: str, scope: Scope) -> ClassEntry | None: ...
 
     def lookup_global(self, name: str, entry: ClassEntry, span: Span) -> Any: ...
+
+    def inherited_name(self, scope: ClassScope, name: str, span: Span) -> Any: ...
 
     def class_member(self, entry: ClassEntry, name: str, span: Span) -> Any: ...
 

@@ -30,6 +30,7 @@ from . import arrays as a
 from .enumerations import EnumLiteral
 from .modification import Mod
 from .scope import ExpressionEvaluator, FlattenContext, Primitive, ResolvedType, Scope
+from .type_rules import declared
 from .variables import check_attribute_mods
 
 _HINT = "springc supports a subset of Modelica; see \"Not supported yet\" in docs/language.md"
@@ -177,12 +178,27 @@ def string_call(ev: ExpressionEvaluator, call: s.Call, scope: Scope) -> str:
     try:
         value = ev.fold(arg)
     except KeyError as missing:
+        value = _bound(ev, call.args[0], scope)
+        if value is not None:
+            return _text(value, options, call)
         raise FlattenError(f"'String' of a value that changes during the simulation is not "
                            f"supported yet: it depends on {missing.args[0]}",
                            call.args[0].span, hint=_HINT) from None
     if isinstance(value, np.ndarray):
         raise FlattenError("'String' of an array is not defined", call.args[0].span)
     return _text(value, options, call)
+
+
+def _bound(ev: ExpressionEvaluator, e: s.Expr, scope: Scope) -> Any:
+    """The value of a variable whose binding equation is a parameter expression (``E e1
+    = E.one``: e1 is E.one at all times), else None."""
+    prim = declared(e, scope) if isinstance(e, s.Ref) else None
+    if prim is None or prim.dims or prim.mod is None or prim.mod.value is None:
+        return None
+    try:
+        return ev.fold(ev.flattener.mod_value(prim.mod.value))
+    except (KeyError, ArithmeticError, ValueError, TypeError):
+        return None
 
 
 def _text(value: Any, options: dict[str, Any], call: s.Call) -> str:

@@ -21,6 +21,7 @@ from ..ir import when as w
 from . import arrays as a
 from .assertions import assertion
 from .connect_rules import check_no_connect
+from .connection_graph import check_branches
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .strings import string_equation
 from .when_rules import check_when_target
@@ -229,6 +230,7 @@ def variable_if_equation(ctx: FlattenContext, eq: s.IfEquation, where: Scope,
     share the left-hand side, ``0 = if c then l1 - r1 else l2 - r2`` otherwise)."""
     check_no_connect(eq)
     for _, body in [*eq.branches, (None, eq.otherwise)]:
+        check_branches(body, "an if-equation with a variable condition")
         nested = _find_when(body)
         if nested is not None:
             raise FlattenError("a when-equation cannot be inside an if-equation with a "

@@ -428,6 +428,8 @@ class ClassDef:
     # `constrainedby T(...)` of a replaceable class (Modelica 7.3.2)
     constraint: tuple[Ref, Modification | None] | None = None
     final: bool = False  # declared `final model M ...`: it cannot be redeclared
+    inner: bool = False  # `inner function f = B;` (section 5.4)
+    outer: bool = False  # `outer function f = A;`: the inner class of an enclosing instance
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.
     unsupported: tuple[ParseError, ...] = ()

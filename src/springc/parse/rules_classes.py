@@ -28,7 +28,7 @@ from ..ir.syntax import (
     ShortDef,
     StoredDefinition,
 )
-from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of, tokens
+from .rules_base import Annotation, ClassMod, Rejected, RuleBase, Subs, join, of
 from .rules_elements import causality, variability
 
 #: The attributes of enumeration types, which no literal may be named (section 4.8.5.1).
@@ -223,11 +223,7 @@ class ClassRules(RuleBase):
 
     def enum_class(self, meta: Meta, ch: list[Any]) -> Any:
         name, comment = ch[0], ch[-1]
-        body = of(ch, _EnumBody)
-        if body is not None and body.literals is None:
-            keyword = next(t for t in tokens(ch) if t.type == "ENUMERATION")
-            return self.reject("unspecified enumerations `enumeration(:)` are",
-                               self.token_span(keyword))
+        body = of(ch, _EnumBody)  # `enumeration(:)` (unspecified): no literals
         literals = body.literals if body is not None and body.literals is not None else ()
         if len(set(literals)) != len(literals):
             self.error(f"enumeration '{self.ident(name)}' has a literal twice",

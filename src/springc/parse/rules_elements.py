@@ -94,7 +94,8 @@ class ElementRules(RuleBase):
             return [replace(item, replaceable="replaceable" in words,
                             redeclare="redeclare" in words, final="final" in words,
                             constraint=(constraint.type_name, constraint.modification)
-                            if constraint else None)]
+                            if constraint else None,
+                            inner="inner" in words, outer="outer" in words)]
         return self._components(item, words, constraint)
 
     def _components(self, item: _Clause, words: list[str], constraint: _Constraint | None
