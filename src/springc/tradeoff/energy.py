@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
+from ..simulation import observed_on_grid
 
 ENERGY_UNIT = "J"
 
@@ -43,7 +44,8 @@ def energy_series(model: CompiledModel, p: np.ndarray, grid: np.ndarray,
         return states[:, model.states.index(name)]
     z = np.asarray(model.module.guesses(p), dtype=float)
     with np.errstate(all="ignore"):
-        observed = model.module.observed_grid(grid, np.ascontiguousarray(states), p, z)
+        observed = observed_on_grid(model.module, grid, np.ascontiguousarray(states),
+                                    p, z)
     return np.asarray(observed)[:, model.observed.index(name)]
 
 

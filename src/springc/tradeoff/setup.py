@@ -19,6 +19,7 @@ from ..simulation import (
     LSODA_LIMIT,
     SimulationOptions,
     initial_state,
+    observed_on_grid,
     output_grid,
     resolve,
 )
@@ -131,7 +132,7 @@ def warm_up(model: CompiledModel, p: np.ndarray, x0: np.ndarray) -> None:
         if func is not None:
             func(0.0, x0, p, z)
     if model.observed:
-        mod.observed_grid(np.zeros(1), np.ascontiguousarray(x0[None, :]), p, z)
+        observed_on_grid(mod, np.zeros(1), np.ascontiguousarray(x0[None, :]), p, z)
 
 
 def scipy_outputs(model: CompiledModel, p: np.ndarray, grid: np.ndarray,
@@ -141,7 +142,7 @@ def scipy_outputs(model: CompiledModel, p: np.ndarray, grid: np.ndarray,
     observed = set(model.observed)
     if any(n in observed for n in model.outputs):
         z = np.asarray(model.module.guesses(p), dtype=float)
-        obs = model.module.observed_grid(grid, np.ascontiguousarray(states), p, z)
+        obs = observed_on_grid(model.module, grid, np.ascontiguousarray(states), p, z)
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     return np.column_stack([columns[n] for n in model.outputs]) if model.outputs \
         else np.empty((len(grid), 0))
