@@ -31,7 +31,6 @@ from .control import (
     run_while,
     stray,
 )
-from .instance_classes import redeclared_package
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import (
@@ -126,11 +125,8 @@ def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry
             except FlattenError:
                 k -= 1
         if isinstance(owner, ClassScope):
-            # b.f1() with `redeclare function f1 = f2` in b's modification (section 7.3)
-            found: ClassEntry | None = redeclared_package(ev.flattener, owner,
-                                                          ref.parts[k].name)
-            found = found or member_class(owner.entry, ref.parts[k].name)
-            for part in ref.parts[k + 1:]:
+            found: ClassEntry | None = owner.entry
+            for part in ref.parts[k:]:
                 found = member_class(found, part.name) if found is not None else None
             if found is None or found.defn.kind != "function":
                 raise FlattenError(f"'{owner.entry.full_name}' (the class of "
