@@ -256,7 +256,7 @@ end M;
 
 
 def test_a_function_redeclared_in_an_instance(tmp_path: Path) -> None:
-    """b.f1() and f1() in B call f2, which B's extends clause puts in place of f1."""
+    """f1() in B calls f2, which B's extends clause puts in place of f1."""
     assert flat(tmp_path, """model M
   model A
     replaceable function f1
@@ -276,7 +276,39 @@ def test_a_function_redeclared_in_an_instance(tmp_path: Path) -> None:
     end f2;
   end B;
   B b;
-  Integer x = b.f1();
 end M;
-""") == ("model M\n  discrete Integer 'b.inside';\n  discrete Integer x;\nequation\n"
-         "  'b.inside' = 2;\n  x = 2;\nend M;\n")
+""") == "model M\n  discrete Integer 'b.inside';\nequation\n  'b.inside' = 2;\nend M;\n"
+
+
+def test_a_modification_of_an_inherited_class(tmp_path: Path) -> None:
+    """`extends A(B(x = 4))` modifies the class B: every component of type B (here a
+    protected one, and an array) has x = 4 unless it modifies x itself."""
+    assert flat(tmp_path, """model M
+  model A
+  protected
+    model B
+      Real x = 2;
+    end B;
+    B b;
+    B c[2](each x = 5);
+  end A;
+  extends A(B(x = 4));
+end M;
+""") == ("model M\n  Real 'b.x';\n  Real 'c[1].x';\n  Real 'c[2].x';\nequation\n"
+         "  'b.x' = 4;\n  'c[1].x' = 5;\n  'c[2].x' = 5;\nend M;\n")
+
+
+def test_a_protected_class_modified_from_outside(tmp_path: Path) -> None:
+    assert outcome(tmp_path, """model M
+  model A
+  protected
+    model B
+      Real x = 2;
+    end B;
+    B b;
+  end A;
+  A a(B(x = 4));
+end M;
+""") == ("9:7: class 'B' is protected in 'M.A' and cannot be modified in 'a'\nhelp: a "
+         "protected element may be modified only by its own declaration or by an extends "
+         "clause (Modelica 3.6, section 4.1)")

@@ -89,6 +89,14 @@ def check_modified(view: ClassView, mod: Mod, owner: str) -> None:
                                  "a protected element may be modified only by its own "
                                  "declaration or by an extends clause", "4.1",
                                  (Note("declared protected here", local.span),))
+        modified = member_class(view.entry, name) if child.redeclare is None \
+            and name not in view.components else None
+        if modified is not None and modified.defn.protected:  # a(B(x = 4)), section 7.2
+            raise rule_error(f"class '{name}' is protected in '{view.entry.full_name}' "
+                             f"and cannot be modified in '{owner}'", child.span,
+                             "a protected element may be modified only by its own "
+                             "declaration or by an extends clause", "4.1",
+                             (Note("declared protected here", modified.defn.span),))
         comp = view.components.get(name)
         if comp is not None and comp.decl.protected:
             raise rule_error(f"'{name}' is protected in '{view.entry.full_name}' and cannot be "

@@ -12,6 +12,7 @@ from __future__ import annotations
 from ..errors import FlattenError, Note, Span
 from ..ir import syntax as s
 from ..parse import ClassEntry, member_class
+from .modification import Mod
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 
 
@@ -110,3 +111,15 @@ def inner_class(scope: Scope, outer: ClassEntry, span: Span) -> ClassEntry:
                        [Note("declared outer here", outer.defn.span)],
                        f"declare `inner ... {outer.name} = ...` in a model that contains "
                        "this one (Modelica 3.6, section 5.4)")
+
+
+def class_modification(scope: ClassScope, decl: s.Component) -> Mod | None:
+    """``extends A(B(x = 4))`` or ``a(B(x = 4))``: a modification of the class ``B`` of
+    the instance, which applies to its components of type ``B`` (section 7.2)."""
+    if scope.mod is None or len(decl.type_name.parts) != 1:
+        return None
+    name = decl.type_name.parts[0].name
+    child = scope.mod.children.get(name)
+    if child is None or child.redeclare is not None or name in scope.view.components:
+        return None
+    return Mod(None, child.children, True, child.final, child.span)

@@ -19,7 +19,7 @@ from ..errors import ErrorGroup, FlattenError, Note, ParseError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from ..parse import ClassEntry
+from ..parse import ClassEntry, member_class
 from . import arrays as a
 from .access import check_modified
 from .declarations import (
@@ -33,7 +33,7 @@ from .declarations import (
 from .dimensions import typed_dimension
 from .enum_rules import check_enum_binding
 from .enumerations import DimensionKind
-from .instance_classes import named_through, type_name_package
+from .instance_classes import class_modification, named_through, type_name_package
 from .modification import Mod, ModValue, each, from_syntax, merge_all, select
 from .records import record_mod
 from .redeclare_rules import check_redeclarations
@@ -103,6 +103,9 @@ class Instantiation(FlattenContext):
             rtype = self.resolve_type(s.Ref(rest, decl.type_name.span), package)
             type_mods = [each(from_syntax(m, self.package_scope(e.parent or e)))
                          for m, e in rtype.mods]
+        classmod = class_modification(scope, decl)
+        if classmod is not None:  # `extends A(B(x = 4))` on `B b;` (section 7.2)
+            type_mods = [classmod, *type_mods]
         if outer is None and own is None and len(type_mods) <= 1:
             mod = type_mods[0] if type_mods else None  # nothing to merge
         else:
@@ -237,7 +240,8 @@ class Instantiation(FlattenContext):
             for key, child in scope.mod.children.items():
                 if key not in view.components and not (
                         child.redeclare is not None
-                        and isinstance(child.redeclare.element, s.ClassDef)):
+                        and isinstance(child.redeclare.element, s.ClassDef)) \
+                        and member_class(view.entry, key) is None:
                     self._unknown_target(key, child, view, name)
             if scope.mod.value is not None and view.entry.defn.kind == "record":
                 scope.mod = record_mod(self, scope.mod, view, name)
