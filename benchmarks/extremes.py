@@ -7,8 +7,8 @@ reference of ``tests/extremes/cases.py`` (or the error message springc stopped w
 simulation wall time (compilation excluded: every solver runs once untimed on each
 model first, over a thousandth of the span, numba compiling the compiled engine's loops
 for it; best of two runs, of up to seven for runs under a second; no error estimate),
-all at the default setting (rtol 1e-6). For ``auto``: the ratio of its time to that of the fastest run
-*reaching auto's error*, over every solver of the case at every tolerance 1e-3 ...
+all at the default setting (rtol 1e-6). For ``auto``: the ratio of its time to that of
+the fastest run *reaching auto's error*, over every solver of the case at every tolerance 1e-3 ...
 1e-12 (fixed-step solvers: the case's step halved up to five times), each solver
 swept from loose to tight until it reaches that error or takes longer than auto
 (solvers over 20x slower than auto at their default are not swept).

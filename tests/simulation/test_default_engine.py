@@ -221,3 +221,15 @@ def test_without_numba_the_default_is_scipy_and_says_so(monkeypatch: pytest.Monk
                                           "installed (pip install numba: the compiled "
                                           "loop runs it)")
     assert springc.compile_model(SEED).module.BACKEND == "python"
+
+
+def test_a_short_auto_run_is_dop853_compiled_from_the_start() -> None:
+    """auto's first try on the compiled engine: dop853 within 540 compiled steps (the
+    seed needs 972: no), else its decision as on scipy (40 scipy steps, an estimate)."""
+    short = springc.simulate(SEED, stop=2.0)
+    direct = springc.simulate(SEED, stop=2.0, solver="dop853")
+    assert short.stats.reason == f"non-stiff: dop853 finished in {direct.stats.steps} steps"
+    assert short.stats.steps == direct.stats.steps <= 540
+    np.testing.assert_array_equal(short.values, direct.values)  # the same compiled run
+    long = springc.simulate(SEED)
+    assert long.stats.reason.startswith("non-stiff: spectral radius 100 1/s over 10 s")

@@ -230,6 +230,16 @@ class StepLoop:
     def done(self) -> bool:
         return self.k >= len(self.grid)
 
+    def sprint(self, integrator: Any, steps: int) -> Stretch | None:
+        """On the compiled engine, ``integrator``'s run to the end of the grid in at most
+        ``steps`` compiled steps if it gets there (the grid filled), else None and the
+        loop untouched (``auto`` decides then as on scipy); None on scipy."""
+        if self.finish is None:
+            return None
+        from .compiled import sprint_dop853
+
+        return sprint_dop853(self, integrator, steps)
+
     def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
               ) -> Any:
         """A scipy integrator of ``solver`` from ``(t, y)`` to the end of the grid."""
