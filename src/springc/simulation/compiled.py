@@ -129,8 +129,8 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
                 "numba: the compiled loop runs it)")
     if getattr(module, "BACKEND", "python") != "numba":
         return (f"{solver} ran in {where}: the model was generated for the python "
-                "backend (the numba backend, springc's default, runs it in the compiled "
-                "loop)")
+                "backend (asked for, or springc's choice for code too long for numba to "
+                "compile quickly)")
     return (f"{solver} ran in {where}: the generated functions of a model this "
             "large are plain Python, not numba's")
 
