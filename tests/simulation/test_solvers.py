@@ -115,14 +115,13 @@ def test_auto_keeps_the_explicit_method_while_the_fast_mode_rests(models: str) -
     result = springc.simulate(models, model_name="StiffPair", stop=1.0)
     assert result.stats.solver == "dop853"
     assert re.fullmatch(
-        r"StiffPair: auto -> dop853 \(scipy\) \(non-stiff: dop853 finished in (\d+) steps; "
-        r"dop853 ran in scipy's loop: the model was generated for the python backend "
-        r"\(--backend numba runs it in the compiled loop\)\), \1 "
+        r"StiffPair: auto -> dop853 \(compiled\) \(non-stiff: dop853 finished in (\d+) "
+        r"steps; dop853 ran in the compiled loop \(numba, no Python per step\)\), \1 "
         r"steps, .*", result.stats.summary("StiffPair"))
     assert result.stats.steps <= race.EXPLICIT_PROBE
     assert np.max(np.abs(result["x1"] - np.cos(result.time))) < 1e-5
     chosen = springc.simulate(models, model_name="StiffPair", stop=1.0, solver="bdf")
-    assert chosen.stats.summary("StiffPair").startswith("StiffPair: bdf (scipy), ")
+    assert chosen.stats.summary("StiffPair").startswith("StiffPair: bdf (compiled), ")
 
 
 def test_auto_races_to_the_implicit_method_when_the_explicit_one_is_held(
