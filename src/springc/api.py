@@ -79,7 +79,7 @@ def compile_model(files: Files, model: str | None = None, *,
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
                              backend or default_backend(),
                              tuple(outputs) if outputs is not None else None, (), cache)
-    return _compile(options, parameters)
+    return _compile(options, parameters, chosen=backend is None)
 
 
 STRING_FILE = "<string>"
@@ -112,11 +112,37 @@ def load_model_from_string(text: str, model: str | None = None,
                              backend or default_backend(),
                              tuple(outputs) if outputs is not None else None, (), cache,
                              ((STRING_FILE, text),))
-    return _compile(options, parameters)
+    return _compile(options, parameters, chosen=backend is None)
 
 
-def _compile(options: CompileOptions,
-             parameters: Mapping[str, float] | None) -> CompiledModel:
+NUMBA_LINES = 20_000
+"""A generated module longer than this many lines is generated again for the python
+backend where springc chose numba: numba's compilation grows faster than the code (a
+sum of 20,000 parameters, 60,000 lines, compiled for over 50 minutes) while scipy's
+loop runs such a model in seconds; large scenes in the vector layout stay far below
+(1,000-mass chain: 2,300 lines)."""
+
+
+def default_choice(backend: str | None, engine: str = "auto", solver: str = "auto"
+                   ) -> str | None:
+    """``backend`` as given; else ``None`` where springc would choose numba (for
+    :func:`compile_model`, which also checks the module's size), else ``"python"``."""
+    if backend:
+        return backend
+    return None if default_backend(engine, str(solver).lower()) == "numba" else "python"
+
+
+def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
+             chosen: bool = False) -> CompiledModel:
+    compiled = _compile_as(options, parameters)
+    if chosen and options.backend == "numba" and \
+            compiled.source.count("\n") > NUMBA_LINES:
+        return _compile_as(replace(options, backend="python"), parameters)
+    return compiled
+
+
+def _compile_as(options: CompileOptions,
+                parameters: Mapping[str, float] | None) -> CompiledModel:
     if not parameters:
         return compile_files(options)
     # Which parameters are structural is known once the unmodified model is compiled
@@ -178,7 +204,7 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     if not isinstance(model, CompiledModel):
         choose_engine(engine, str(solver).lower(), backend, "engine", "backend")
         model = compile_model(model, model_name, libraries=libraries,
-                              backend=backend or default_backend(engine, str(solver).lower()),
+                              backend=default_choice(backend, engine, solver),
                               outputs=outputs, cache=cache, parameters=values)
         structural = {k for k, v in model.options.modifications}
     else:
@@ -248,7 +274,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
                                             if k in files.structural})
     else:
         compiled = compile_model(files, model, libraries=libraries,
-                                 backend=backend or default_backend(solver=str(solver).lower()),
+                                 backend=default_choice(backend, solver=solver),
                                  outputs=outputs, parameters=fixed, cache=cache)
     rest = tuple((k, v) for k, v in fixed.items() if k not in compiled.structural)
     protected = tuple(compiled.options.files)

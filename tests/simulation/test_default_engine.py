@@ -93,8 +93,8 @@ def test_the_default_is_the_numba_module_on_the_compiled_loop() -> None:
     ({"solver": "lsoda"}, "scipy", "lsoda ran in scipy's loop: springc has no compiled "
                                    "loop for it"),
     ({"solver": "dop853", "backend": "python"}, "scipy",
-     "dop853 ran in scipy's loop: the model was generated for the python backend (the "
-     "numba backend, springc's default, runs it in the compiled loop)"),
+     "dop853 ran in scipy's loop: the model was generated for the python backend (asked "
+     "for, or springc's choice for code too long for numba to compile quickly)"),
     ({"solver": "dop853", "engine": "scipy"}, "scipy", ""),
     ({"solver": "radau"}, "compiled", ""),
 ])
@@ -221,3 +221,31 @@ def test_without_numba_the_default_is_scipy_and_says_so(monkeypatch: pytest.Monk
                                           "installed (pip install numba: the compiled "
                                           "loop runs it)")
     assert springc.compile_model(SEED).module.BACKEND == "python"
+
+
+def test_a_short_auto_run_is_dop853_compiled_from_the_start() -> None:
+    """auto's first try on the compiled engine: dop853 within 540 compiled steps (the
+    seed needs 972: no), else its decision as on scipy (40 scipy steps, an estimate)."""
+    short = springc.simulate(SEED, stop=2.0)
+    direct = springc.simulate(SEED, stop=2.0, solver="dop853")
+    assert short.stats.reason == f"non-stiff: dop853 finished in {direct.stats.steps} steps"
+    assert short.stats.steps == direct.stats.steps <= 540
+    np.testing.assert_array_equal(short.values, direct.values)  # the same compiled run
+    long = springc.simulate(SEED)
+    assert long.stats.reason.startswith("non-stiff: spectral radius 100 1/s over 10 s")
+
+
+def test_code_too_long_for_numba_is_generated_for_python(monkeypatch: pytest.MonkeyPatch
+                                                         ) -> None:
+    """springc's choice of numba yields to python for a module over NUMBA_LINES lines
+    (the seed has 256: a limit of 100 makes it too long); a backend asked for stays."""
+    import springc.api
+
+    assert springc.compile_model(SEED).module.BACKEND == "numba"
+    monkeypatch.setattr(springc.api, "NUMBA_LINES", 100)
+    assert springc.compile_model(SEED).module.BACKEND == "python"
+    assert springc.compile_model(SEED, backend="numba").module.BACKEND == "numba"
+    result = springc.simulate(SEED, solver="dop853", stop=0.5)
+    assert result.stats.engine == "scipy"
+    assert "generated for the python backend (asked for, or springc's choice" in \
+        result.stats.summary("SpringMass")

@@ -84,10 +84,10 @@ def test_compiled_dop853_equals_scipy(name: str, rtol: float) -> None:
         assert compiled.stats.steps == scipy_run.stats.steps
         # the same generated functions: the same steps and values, bit for bit
         assert csv_text(compiled) == csv_text(scipy_run)
-    # auto picks the compiled engine for the numba backend, scipy for the default
-    # (python) backend; the two agree within 1e-12 (numba vs Python float arithmetic)
-    default = springc.simulate(files, model_name=model_name, rtol=rtol, backend="numba")
-    python = springc.simulate(files, model_name=model_name, rtol=rtol)
+    # auto picks the compiled engine for the numba backend (the default), scipy for
+    # the python backend; the two agree within 1e-12 (numba vs Python float arithmetic)
+    default = springc.simulate(files, model_name=model_name, rtol=rtol)
+    python = springc.simulate(files, model_name=model_name, rtol=rtol, backend="python")
     assert default.stats.engine == "compiled" and python.stats.engine == "scipy"
     assert default.names == python.names
     scale = np.abs(python.values).max(axis=0)

@@ -252,7 +252,8 @@ def test_auto_engine_chooses_compiled_for_numba_hybrid_models(
     assert result.stats.reason == "a hybrid model: dop853 with event location"
     assert result.stats.engine_reason == ("dop853 ran in the compiled loop (numba, no Python "
                                           "per step)")
-    python = springc.load_model_from_string(BALL)  # the python backend: scipy
+    assert springc.load_model_from_string(BALL).module.BACKEND == "numba"  # the default
+    python = springc.load_model_from_string(BALL, backend="python")  # scipy's loop
     assert springc.simulate(python, stop=1.0).stats.engine == "scipy"
     with pytest.raises(UsageError, match="engine compiled: the lsoda solver has no "
                                          "compiled loop"):

@@ -199,7 +199,7 @@ def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
 
 def test_numba_backend_gives_the_python_backend_results(tmp_path: Path) -> None:
     path = write(tmp_path, BALL)
-    python = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8)
+    python = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="python")
     numba = springc.simulate(path, stop=2.0, interval=0.01, rtol=1e-8, backend="numba",
                              engine="scipy")  # the same loop: only the backend differs
     assert np.max(np.abs(python.values - numba.values)) < 1e-12

@@ -53,6 +53,9 @@ class Run:
     def both_failed(self, first: Exception, second: Exception) -> Exception:
         return first
 
+    def sprint(self, integrator: Integrator, steps: int) -> Stretch | None:
+        return None  # scipy's loop: no compiled sprint (test_default_engine.py has one)
+
 
 def estimate(solver: str) -> object:
     return lambda t, x: AutoChoice(solver, f"{solver} estimate", 1.0, 10.0)

@@ -76,11 +76,11 @@ def test_to_xarray_groups_arrays(result: SimulationResult) -> None:
 
 
 def test_repr_and_html(result: SimulationResult) -> None:
-    assert repr(result) == ("<SimulationResult Osc: rk4 (scipy), 100 steps, 5 times from 0 "
+    assert repr(result) == ("<SimulationResult Osc: rk4 (compiled), 100 steps, 5 times from 0 "
                             "to 1 s, variables p[2], v[2], e>")
     page = result._repr_html_()
     for row in ("<th style=\"text-align:left\">model</th><td style=\"text-align:left\">Osc",
-                "<td style=\"text-align:left\">rk4 (scipy)</td>", ">100</td>",
+                "<td style=\"text-align:left\">rk4 (compiled)</td>", ">100</td>",
                 ">5 times from 0 to 1 s</td>",
                 "<td style=\"text-align:left\">p</td><td>2</td>"
                 "<td style=\"text-align:left\">m</td>",

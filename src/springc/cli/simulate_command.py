@@ -76,7 +76,6 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         RESULT_FORMATS,
         check_run_values,
         choose_engine,
-        default_backend,
     )
 
     values = parse_set(assignments)
@@ -88,7 +87,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
     single_threaded_blas()
-    from ..api import compile_model
+    from ..api import compile_model, default_choice
     from ..api import simulate as run
     from ..simulation import (
         SimulationOptions,
@@ -98,7 +97,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     )
 
     compiled = compile_model(files, model, libraries=libraries,
-                             backend=backend or default_backend(engine, solver.lower()),
+                             backend=default_choice(backend, engine, solver),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     if not patterns and (output or not plot):  # the default trajectory of every output

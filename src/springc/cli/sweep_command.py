@@ -101,17 +101,16 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     check_output_options([("-o", output, None), ("--summary", summary_file, None),
                     ("--plot", plot, PLOT_FORMATS)], files)
     single_threaded_blas()
-    from ..api import compile_model
+    from ..api import compile_model, default_choice
     from ..studies import StudyOptions, parameter_table, run_study
 
     options = StudyOptions(specs, samples, method, seed, (), start, stop, interval,
                            solver.lower(), rtol, atol, step, workers, scheduler, energy,
                            max_steps, time_limit)
     parameter_table(options)  # refuse bad specifications before compiling
-    from ..simulation import default_backend
 
     compiled = compile_model(files, model, libraries=libraries,
-                             backend=backend or default_backend(solver=solver.lower()),
+                             backend=default_choice(backend, solver=solver),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)

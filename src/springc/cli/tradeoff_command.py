@@ -132,8 +132,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     check_output_options([("-o", output, {".csv": "csv"}), ("--plot", plot, PLOT_FORMATS),
                     ("--save-reference", save_reference, {".csv": "csv"})], inputs)
     single_threaded_blas()
-    from ..api import compile_model
-    from ..simulation import default_backend
+    from ..api import compile_model, default_choice
     from ..tradeoff import (
         DEFAULT_TARGETS,
         DEFAULT_TOLERANCES,
@@ -148,7 +147,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     # numba by default: the runs of solvers with a compiled loop run there (many runs
     # share one compilation)
     compiled = compile_model(files, model, libraries=libraries,
-                             backend=backend or default_backend(),
+                             backend=default_choice(backend),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
     if not patterns:

@@ -144,8 +144,8 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
                 "numba: the compiled loop runs it)")
     if getattr(module, "BACKEND", "python") != "numba":
         return (f"{solver} ran in {where}: the model was generated for the python "
-                "backend (the numba backend, springc's default, runs it in the compiled "
-                "loop)")
+                "backend (asked for, or springc's choice for code too long for numba to "
+                "compile quickly)")
     return (f"{solver} ran in {where}: the generated functions of a model this "
             "large are plain Python, not numba's")
 
@@ -182,6 +182,35 @@ def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
         return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
                         atol=loop.atol, first_step=first, max_steps=steps)
     return _finish(loop, integrator, "rk45" if explicit is rk45 else EXPLICIT, run_explicit)
+
+
+def sprint_dop853(loop: StepLoop, integrator: Any, steps: int) -> Stretch | None:
+    """The DOP853 ``integrator`` of ``loop`` run compiled to the end of the grid within
+    ``steps`` steps (rejected ones included): the grid filled and the stretch, or None
+    with the loop as it was where the budget ends first or the run fails (its work is
+    then the price of asking: at most ``steps`` compiled steps)."""
+    from springc.integrate import dop853
+
+    problem, grid = loop.problem, loop.grid
+    t, y, h = float(integrator.t), np.array(integrator.y), float(integrator.h_abs)
+    budget = min(steps, loop.limits.max_steps - loop.steps)
+    if not h > 0 or budget < 1:
+        return None
+    rest = grid[loop.k:]
+    times = np.concatenate(([t], rest[rest > t]))
+    began = time.perf_counter()
+    run = dop853(problem.mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                 atol=loop.atol, first_step=min(h, float(times[-1] - t)), max_steps=budget)
+    seconds = time.perf_counter() - began
+    problem.nfev += run.rhs_evaluations
+    loop.loop_time += seconds
+    if not run.ok:
+        return None
+    loop.states[loop.k:loop.k + len(times) - 1] = run.states[1:]
+    loop.k = len(grid)
+    loop.steps += run.accepted_steps
+    loop.compiled_steps += run.accepted_steps
+    return Stretch(run.accepted_steps, seconds, ())
 
 
 def _finish(loop: StepLoop, integrator: Any, solver: str,

@@ -40,6 +40,7 @@ from .compiled import (
     numba_available,
     observed_on_grid,
     run_fixed_compiled,
+    sprint_dop853,
 )
 from .error_estimate import DEFAULT_MODE, ErrorEstimate
 from .failures import Stop, code_location, state_notes
@@ -249,7 +250,8 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             elif solver in FIXED_STEP:
                 states, steps = solvers.run_fixed(problem, grid, x0, step)
             elif solver == AUTO and len(x0):
-                run = StepLoop(problem, grid, x0, rtol, atol, finish)
+                run = StepLoop(problem, grid, x0, rtol, atol, finish,
+                               sprint_dop853 if compiled else None)
                 solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
                     problem.jac(t, x), stop - start))
                 states, steps, loop_time = run.states, run.steps, run.loop_time

@@ -214,7 +214,9 @@ class StepLoop:
     failure = Stop
 
     def __init__(self, problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
-                 atol: float, finish: Finish | None = None) -> None:
+                 atol: float, finish: Finish | None = None,
+                 sprinter: Callable[[StepLoop, Any, int], Stretch | None] | None = None
+                 ) -> None:
         self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
         self.limits = problem.limits
         self.states = np.empty((len(grid), len(x0)))
@@ -223,12 +225,20 @@ class StepLoop:
         #: continues a DOP853 integrator to the end of the grid (the compiled engine's
         #: :func:`springc.simulation.compiled.finish_dop853`); None: scipy steps on
         self.finish = finish
+        #: auto's first try on the compiled engine (compiled.sprint_dop853); None: scipy
+        self.sprinter = sprinter
         self.compiled_steps = 0
         self.loop_time = 0.0  # seconds in the compiled loop
 
     @property
     def done(self) -> bool:
         return self.k >= len(self.grid)
+
+    def sprint(self, integrator: Any, steps: int) -> Stretch | None:
+        """On the compiled engine, ``integrator``'s run to the end of the grid in at most
+        ``steps`` compiled steps if it gets there (the grid filled), else None and the
+        loop untouched (``auto`` decides then as on scipy); None on scipy."""
+        return None if self.sprinter is None else self.sprinter(self, integrator, steps)
 
     def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
               ) -> Any:
