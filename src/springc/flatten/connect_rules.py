@@ -18,6 +18,7 @@ from ..ir import syntax as s
 from ..parse import member_class
 from .rules import rule_error
 from .scope import ClassScope, Primitive
+from .syntax_walk import equations
 
 
 def primitives(scope: ClassScope, prefix: str = "") -> Iterator[tuple[str, Primitive]]:
@@ -202,16 +203,4 @@ def check_no_connect(eq: s.IfEquation) -> None:
 
 
 def _connect_in(body: tuple[s.Equation, ...]) -> s.Connect | None:
-    for item in body:
-        if isinstance(item, s.Connect):
-            return item
-        inner: list[tuple[s.Equation, ...]] = []
-        if isinstance(item, s.ForEquation):
-            inner = [item.body]
-        elif isinstance(item, s.IfEquation):
-            inner = [b for _, b in item.branches] + [item.otherwise]
-        for nested in inner:
-            found = _connect_in(nested)
-            if found is not None:
-                return found
-    return None
+    return next((eq for eq in equations(body) if isinstance(eq, s.Connect)), None)

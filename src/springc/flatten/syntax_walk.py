@@ -1,6 +1,7 @@
 """Walks over syntax trees for the static rules: the statements of an algorithm, the
-expressions of statements and modifications, the component references of an
-expression. Input: ``ir.syntax`` nodes; output: iterators over nodes."""
+equations nested in for- and if-equations, the expressions of statements and
+modifications, the component references of an expression. Input: ``ir.syntax`` nodes;
+output: iterators over nodes."""
 
 from __future__ import annotations
 
@@ -23,6 +24,19 @@ def statements(body: tuple[s.Statement, ...]) -> Iterator[s.Statement]:
             for branch in ([stmt.body] if isinstance(stmt, s.WhileStatement)
                            else [b for _, b in stmt.branches]):
                 yield from statements(branch)
+
+
+def equations(body: tuple[s.Equation, ...]) -> Iterator[s.Equation]:
+    """The equations of ``body`` and those nested in its for- and if-equations, each
+    before the ones inside it (not into when-equations)."""
+    for item in body:
+        yield item
+        if isinstance(item, s.ForEquation):
+            yield from equations(item.body)
+        elif isinstance(item, s.IfEquation):
+            for _, branch in item.branches:
+                yield from equations(branch)
+            yield from equations(item.otherwise)
 
 
 def mod_values(mod: s.Modification | None) -> list[s.Expr]:

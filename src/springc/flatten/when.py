@@ -24,6 +24,7 @@ from .connect_rules import check_no_connect
 from .connection_graph import check_branches
 from .scope import ClassScope, FlattenContext, LocalScope, Scope
 from .strings import string_equation
+from .syntax_walk import equations
 from .when_rules import check_when_target
 
 _EXPRS = (x.Const, x.Var, x.Time, x.Der, x.Neg, x.Not, x.BinOp, x.Call, x.If)
@@ -296,19 +297,7 @@ def _guard_all(assertions: list[tuple[flat.Assertion, Span]], start: int, guard:
 
 
 def _find_when(body: tuple[s.Equation, ...]) -> s.WhenEquation | None:
-    for item in body:
-        if isinstance(item, s.WhenEquation):
-            return item
-        inner: list[tuple[s.Equation, ...]] = []
-        if isinstance(item, s.ForEquation):
-            inner = [item.body]
-        elif isinstance(item, s.IfEquation):
-            inner = [b for _, b in item.branches] + [item.otherwise]
-        for b in inner:
-            found = _find_when(b)
-            if found is not None:
-                return found
-    return None
+    return next((eq for eq in equations(body) if isinstance(eq, s.WhenEquation)), None)
 
 
 # ------------------------------------------------------------------ final checks
