@@ -29,21 +29,9 @@ def _calls(e: x.Expr, out: dict[x.Call, None]) -> None:
 
 
 def _replace(e: x.Expr, names: dict[x.Call, x.Var]) -> x.Expr:
-    if isinstance(e, x.Call):
-        if e in names:
-            return names[e]
-        args = tuple(_replace(a, names) for a in e.args)
-        return e if all(a is b for a, b in zip(args, e.args)) else x.Call(e.name, args)
-    if isinstance(e, x.BinOp):
-        left, right = _replace(e.left, names), _replace(e.right, names)
-        return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
-    if isinstance(e, (x.Neg, x.Not, x.Der)):
-        arg = _replace(e.arg, names)
-        return e if arg is e.arg else type(e)(arg)
-    if isinstance(e, x.If):
-        c, t, o = (_replace(a, names) for a in (e.cond, e.then, e.otherwise))
-        return e if (c, t, o) == (e.cond, e.then, e.otherwise) else x.If(c, t, o)
-    return e
+    if isinstance(e, x.Call) and e in names:
+        return names[e]
+    return x.map_children(e, lambda c: _replace(c, names))
 
 
 class DelayLayout:

@@ -45,19 +45,7 @@ def _replace(e: x.Expr, counts: Counter[str]) -> x.Expr:
     """``e`` with its placeholders replaced (unchanged subtrees shared)."""
     if isinstance(e, x.Call) and e.name == NAME and isinstance(e.args[0], x.Var):
         return x.Const(counts[e.args[0].name])
-    if isinstance(e, x.BinOp):
-        left, right = _replace(e.left, counts), _replace(e.right, counts)
-        return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
-    if isinstance(e, (x.Neg, x.Not, x.Der)):
-        arg = _replace(e.arg, counts)
-        return e if arg is e.arg else type(e)(arg)
-    if isinstance(e, x.Call):
-        args = tuple(_replace(a, counts) for a in e.args)
-        return e if all(a is b for a, b in zip(args, e.args)) else x.Call(e.name, args)
-    if isinstance(e, x.If):
-        c, t, o = (_replace(a, counts) for a in (e.cond, e.then, e.otherwise))
-        return e if (c, t, o) == (e.cond, e.then, e.otherwise) else x.If(c, t, o)
-    return e
+    return x.map_children(e, lambda c: _replace(c, counts))
 
 
 def apply_cardinalities(fl: FlattenContext, counts: Counter[str]) -> None:

@@ -172,6 +172,23 @@ def children(e: Expr) -> tuple[Expr, ...]:
     return ()
 
 
+def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
+    """``e`` with ``f`` applied to each direct sub-expression; ``e`` itself where every
+    child comes back unchanged (unchanged subtrees are shared, not copied)."""
+    old = children(e)
+    new = tuple(f(c) for c in old)
+    if all(a is b for a, b in zip(new, old)):
+        return e
+    if isinstance(e, BinOp):
+        return BinOp(e.op, new[0], new[1])
+    if isinstance(e, (Neg, Not, Der)):
+        return type(e)(new[0])
+    if isinstance(e, Call):
+        return Call(e.name, new)
+    assert isinstance(e, If)
+    return If(new[0], new[1], new[2])
+
+
 def walk(e: Expr) -> Iterator[Expr]:
     """All nodes of ``e``, parents before children."""
     stack = [e]
