@@ -146,8 +146,10 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
         return (f"{solver} ran in {where}: the model was generated for the python "
                 "backend (asked for, or springc's choice for code too long for numba to "
                 "compile quickly)")
-    return (f"{solver} ran in {where}: the generated functions of a model this "
-            "large are plain Python, not numba's")
+    # every numba module springc generates has jitted functions (the vector layout's
+    # too); a module whose functions are not reaches here
+    return (f"{solver} ran in {where}: the module's rhs and jacobian_values are not "
+            "numba functions")
 
 
 def explained(engine: str, reason: str, compiled: bool) -> bool:
