@@ -31,9 +31,10 @@ class Run:
 
     failure = RuntimeError
 
-    def __init__(self, step: dict[str, float], cost: dict[str, float], stop: float = 10.0
-                 ) -> None:
+    def __init__(self, step: dict[str, float], cost: dict[str, float], stop: float = 10.0,
+                 compiled: bool = False, call: float = 0.0) -> None:
         self.step, self.cost, self.stop = step, cost, stop
+        self.compiled, self.call = compiled, call  # call: each advance's fixed cost
         self.done = False
         self.taken: dict[str, int] = {}
 
@@ -48,13 +49,11 @@ class Run:
         integrator.t = min(self.stop, integrator.t + steps * h)
         self.done = self.done or integrator.t >= self.stop
         self.taken[integrator.solver] = self.taken.get(integrator.solver, 0) + steps
-        return Stretch(steps, steps * self.cost[integrator.solver], (h,) * min(steps, 10))
+        return Stretch(steps, self.call + steps * self.cost[integrator.solver],
+                       (h,) * min(steps, 10))
 
     def both_failed(self, first: Exception, second: Exception) -> Exception:
         return first
-
-    def sprint(self, integrator: Integrator, steps: int) -> Stretch | None:
-        return None  # scipy's loop: no compiled sprint (test_default_engine.py has one)
 
 
 def estimate(solver: str) -> object:
@@ -99,3 +98,51 @@ def test_the_implicit_probe_stops_at_its_budget() -> None:
     run = Run({"dop853": 1e-3, "radau": 1e-3}, {"dop853": 1e-4, "radau": 0.02})
     assert _auto(run)[0] == "dop853"
     assert run.taken["radau"] == 3
+
+
+def test_compiled_probes_time_by_differences() -> None:
+    # a small model: 10 compiled steps, and with 490 to go no estimate
+    run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
+    assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 needs ~4.9e+02 more steps")
+    # radau's probe (4 and 16 steps) leaves ~2,000 steps, dop853's ~10,000: the counts
+    # cannot tell, so dop853 is timed on 30 more steps; each call's fixed cost (1 ms,
+    # far over the steps' microseconds) cancels in the differences
+    run = Run({"dop853": 1e-3, "radau": 5e-3}, {"dop853": 1e-6, "radau": 2e-6},
+              compiled=True, call=1e-3)
+    solver, reason = _auto(run)
+    assert solver == "radau" and run.taken == {"dop853": 10 + 30, "radau": 2000}
+    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.01 s"
+
+
+def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
+    # ~180 radau steps against ~1e5 dop853 steps: no radau step of one state costs 20
+    run = Run({"dop853": 1e-4, "radau": 0.05}, {"dop853": 1e-6, "radau": 2e-5},
+              compiled=True)
+    solver, reason = _auto(run)
+    assert solver == "radau" and run.taken == {"dop853": 10, "radau": 200}
+    assert reason == "race estimate; measured: radau ~1.8e+02 steps to go, dop853 ~1e+05"
+    # radau held to 10x smaller steps: no radau step costs under 0.2 dop853 steps
+    run = Run({"dop853": 1e-3, "radau": 1e-4}, {"dop853": 1e-6, "radau": 2e-6},
+              compiled=True)
+    solver, reason = _auto(run)
+    assert solver == "dop853" and run.taken == {"dop853": 10_000, "radau": 20}
+    assert reason == ("race estimate, but the fast modes must be resolved anyway; measured: "
+                      "radau ~1e+05 steps to go, dop853 ~1e+04")
+
+
+def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
+    """Over SPRINT_STATES states, 540 explicit steps come before a (dear) estimate."""
+    run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
+    x0 = np.zeros(race.SPRINT_STATES + 1)
+    assert race.auto(run, 0.0, x0, 10.0, estimate("unused")) == (  # type: ignore[arg-type]
+        "dop853", "non-stiff: dop853 finished in 500 steps")
+
+
+def test_the_compiled_implicit_probe_stops_at_its_budget() -> None:
+    # dop853 projects ~10 s (1e5 steps of 1e-4 s); radau's first 4 steps cost 1 s,
+    # over the 0.5 s budget: its 16-step stretch is not run, and its mean counts
+    run = Run({"dop853": 1e-4, "radau": 1e-3}, {"dop853": 1e-4, "radau": 0.25},
+              compiled=True)
+    solver, reason = _auto(run)
+    assert solver == "dop853" and run.taken["radau"] == 4
+    assert reason.endswith("measured: radau ~2.5e+03 s to go, dop853 ~10 s")

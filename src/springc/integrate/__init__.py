@@ -46,6 +46,7 @@ from .engine import (
     bdf,
     dop853,
     fixed_step,
+    load,
     observed_grid,
     radau,
     rk45,
@@ -54,4 +55,4 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "observed_grid", "radau", "rk45", "run_hybrid"]
+           "fixed_step", "load", "observed_grid", "radau", "rk45", "run_hybrid"]

@@ -76,6 +76,19 @@ class Crossings:
     directions: Sequence[float] | np.ndarray | None = None
 
 
+KERNEL_MODULES = {"dop853": "dop853_kernel", "rk45": "rk45_kernel", "radau": "radau_kernel",
+                  "bdf": "bdf_kernel"}
+
+
+def load(method: str) -> None:
+    """Compile or load from numba's cache the kernel of ``method`` (a key of
+    :data:`KERNEL_MODULES`) now, as its first run would: a caller timing runs leaves
+    the loading out."""
+    import importlib
+
+    importlib.import_module(f"{__package__}.{KERNEL_MODULES[method]}")
+
+
 def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
            atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
            max_step: float = np.inf, first_step: float | None = None,
@@ -225,8 +238,10 @@ def observed_grid(observed: ModelFunction, ts: Any, states: Any, p: Any, z: Any
     ``z[-1]`` on, the rows are NaN (as the module's own ``observed_grid`` does)."""
     from numba.core.dispatcher import Dispatcher
 
+    from .addresses import install
     from .grid_kernel import observed_grid_run
 
+    install()
     if not isinstance(observed, Dispatcher):
         raise TypeError(f"observed must be a numba-jitted function, got "
                         f"{type(observed).__name__}")
@@ -285,8 +300,10 @@ def _functions(rhs: ModelFunction, observed: ModelFunction | None, grid: np.ndar
     """
     from numba.core.dispatcher import Dispatcher
 
+    from .addresses import install
     from .models import no_observed
 
+    install()
     for name, f in (("rhs", rhs), ("observed", observed)):
         if f is not None and not isinstance(f, Dispatcher):
             raise TypeError(f"{name} must be a numba-jitted function, got {type(f).__name__}")

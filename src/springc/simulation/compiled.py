@@ -3,11 +3,10 @@
 - :func:`choose_engine`: ``--engine auto|compiled|scipy`` and the solver -> the engine
   of a run (``compiled`` needs numba, a solver with a compiled loop and the numba
   backend's functions; errors name the option).
-- :func:`finish_dop853`: a scipy ``DOP853`` integrator of the step loop continued to the
-  end of the grid by the compiled DOP853, which takes the same steps (same state, same
-  next step size, same controller), so the run equals the scipy run bit for bit; a
-  scipy ``Radau`` integrator continued by the compiled Radau IIA (the generated sparse
-  Jacobian, a banded LU).
+- :func:`advance_compiled`: the step loop's integrators run compiled, to the end of the
+  grid or for a number of steps (``auto``'s probes): DOP853 and RK45 take scipy's steps
+  (same start, same controller), so a run equals the scipy run bit for bit; Radau IIA
+  and BDF with the generated sparse Jacobian in a banded LU.
 - :func:`run_fixed_compiled`: the fixed-step solvers, compiled.
 
 Failures come back as :class:`springc.integrate.Status` codes and become the scipy
@@ -28,9 +27,9 @@ import numpy as np
 from ..errors import UsageError
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
-from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
+from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, FIXED_STEP
 from .solvers import detect_pairs, non_finite_states
-from .steps import Problem, StepLoop, Stretch, solver_failure
+from .steps import Problem, StepLoop, Stepper, Stretch, solver_failure
 
 if TYPE_CHECKING:
     from springc.integrate import Run
@@ -159,80 +158,35 @@ def explained(engine: str, reason: str, compiled: bool) -> bool:
     return bool(reason) or (not compiled and engine.lower() == AUTO)
 
 
-def finish_dop853(loop: StepLoop, integrator: Any) -> Stretch:
-    """Continue the scipy ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` ``integrator`` of
-    ``loop`` to the end of the grid, compiled: from its state with its next step size,
-    filling the grid from ``loop.k`` (DOP853 and RK45 take scipy's steps exactly; Radau
-    and BDF restart their Jacobian and step-size history there)."""
-    from springc.integrate import bdf, dop853, radau, rk45
-
-    problem = loop.problem
-    mod = problem.mod
-    implicit = {"Radau": (radau, RACE_IMPLICIT), "BDF": (bdf, "bdf")}
-    if type(integrator).__name__ in implicit:
-        method, name = implicit[type(integrator).__name__]
-
-        def run_kernel(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-            return method(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
-                          times, y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
-                          first_step=first, max_steps=steps)
-        return _finish(loop, integrator, name, run_kernel)
-
-    explicit = rk45 if type(integrator).__name__ == "RK45" else dop853
-
-    def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-        return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                        atol=loop.atol, first_step=first, max_steps=steps)
-    return _finish(loop, integrator, "rk45" if explicit is rk45 else EXPLICIT, run_explicit)
-
-
-def sprint_dop853(loop: StepLoop, integrator: Any, steps: int) -> Stretch | None:
-    """The DOP853 ``integrator`` of ``loop`` run compiled to the end of the grid within
-    ``steps`` steps (rejected ones included): the grid filled and the stretch, or None
-    with the loop as it was where the budget ends first or the run fails (its work is
-    then the price of asking: at most ``steps`` compiled steps)."""
-    from springc.integrate import dop853
+def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = None
+                     ) -> Stretch:
+    """Run ``stepper`` in the compiled loop of its method from where it is, with its next
+    step size, filling ``loop``'s grid from ``loop.k``: to the end of the grid, or for
+    ``max_steps`` steps (rejected ones included), after which ``stepper`` is where the
+    run stopped and goes on from there as one uninterrupted run would (the explicit
+    methods take the same steps; Radau and BDF restart their Jacobian and step-size
+    history). The stretch's ``sizes`` hold its mean accepted step size. A failure moves
+    ``stepper`` to its last accepted state before raising the scipy path's error."""
+    from springc.integrate import Status, load
 
     problem, grid = loop.problem, loop.grid
-    t, y, h = float(integrator.t), np.array(integrator.y), float(integrator.h_abs)
-    budget = min(steps, loop.limits.max_steps - loop.steps)
-    if not h > 0 or budget < 1:
-        return None
+    kernel = _kernel(loop, stepper.method)
+    load(stepper.method)  # (numba's cache, once per process: not the stretch's time)
+    t, y = stepper.t, stepper.y
     rest = grid[loop.k:]
     times = np.concatenate(([t], rest[rest > t]))
-    began = time.perf_counter()
-    run = dop853(problem.mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                 atol=loop.atol, first_step=min(h, float(times[-1] - t)), max_steps=budget)
-    seconds = time.perf_counter() - began
-    problem.nfev += run.rhs_evaluations
-    loop.loop_time += seconds
-    if not run.ok:
-        return None
-    loop.states[loop.k:loop.k + len(times) - 1] = run.states[1:]
-    loop.k = len(grid)
-    loop.steps += run.accepted_steps
-    loop.compiled_steps += run.accepted_steps
-    return Stretch(run.accepted_steps, seconds, ())
-
-
-def _finish(loop: StepLoop, integrator: Any, solver: str,
-            run_kernel: Callable[[np.ndarray, np.ndarray, float, int], Run]) -> Stretch:
-    from springc.integrate import Status
-
-    problem, grid = loop.problem, loop.grid
-    t, y = float(integrator.t), np.array(integrator.y)
-    rest = grid[loop.k:]
-    times = np.concatenate(([t], rest[rest > t]))
-    started, first = t, float(integrator.h_abs)
+    started, first = t, stepper.h_abs
     began = time.perf_counter()
     allowed = loop.limits.max_steps - loop.steps  # accepted steps, as scipy's loop counts
-    chunk, accepted = FIRST_CHUNK, 0
+    budget = np.inf if max_steps is None else max_steps
+    chunk, accepted, taken = FIRST_CHUNK, 0, 0
     while True:
-        attempt = max(min(chunk, allowed - accepted), 1)
-        run = run_kernel(times, y, min(first, float(times[-1] - t)), attempt)
+        attempt = int(max(min(chunk, allowed - accepted, budget - taken), 1))
+        run = kernel(times, y, min(first, float(times[-1] - t)), attempt)
         problem.nfev += run.rhs_evaluations
         problem.njev += run.jacobian_evaluations
         accepted += run.accepted_steps
+        taken += run.accepted_steps + run.rejected_steps
         rows = run.filled - 1  # row 0 is the stretch's start
         loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
         loop.k += rows
@@ -240,27 +194,59 @@ def _finish(loop: StepLoop, integrator: Any, solver: str,
             break
         t, y, first = run.failure_time, np.array(run.failure_state), run.next_step
         times = np.concatenate(([t], times[run.filled:]))
+        if taken >= budget:
+            break
         projected = loop.steps + accepted * (float(grid[-1]) - started) / max(t - started,
                                                                                1e-300)
         if projected > HOPELESS * loop.limits.max_steps:
             raise OverLimit(f"at its current step size ({(t - started) / accepted:.3g} s "
-                            f"on average) {solver} needs ~{projected:.3g} steps to the "
-                            f"stop time, far over the step limit (--max-steps "
-                            f"{loop.limits.max_steps})", t, run.failure_state, solver)
+                            f"on average) {stepper.method} needs ~{projected:.3g} steps to "
+                            f"the stop time, far over the step limit (--max-steps "
+                            f"{loop.limits.max_steps})", t, run.failure_state,
+                            stepper.method)
         if time.perf_counter() > problem.deadline:
             raise time_limit_reached(problem, run)
         chunk *= 10
     seconds = time.perf_counter() - began
     loop.loop_time += seconds
     loop.compiled_steps += accepted
-    if not run.ok:
-        raise failure(problem, run, solver, steps=loop.steps + accepted,
+    loop.steps += accepted
+    stepper.t, stepper.y = float(run.failure_time), np.array(run.failure_state)
+    stepper.h_abs = float(run.next_step)
+    if not run.ok and not (run.status == Status.MAX_STEPS and taken >= budget
+                           and accepted < allowed):
+        raise failure(problem, run, stepper.method, steps=loop.steps,
                       limit=loop.limits.max_steps)
     if time.perf_counter() > problem.deadline:
         raise time_limit_reached(problem, run)
-    loop.k = len(grid)
-    loop.steps += accepted
-    return Stretch(accepted, seconds, ())
+    if run.ok:
+        loop.k = len(grid)
+    mean = (stepper.t - started) / accepted if accepted else 0.0
+    return Stretch(accepted, seconds, (mean,) if accepted else ())
+
+
+def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, float, int],
+                                                     Run]:
+    """``run(times, y, first_step, max_steps)``: ``method``'s compiled loop on ``loop``'s
+    model and tolerances."""
+    from springc.integrate import bdf, dop853, radau, rk45
+
+    problem = loop.problem
+    mod = problem.mod
+    if method in ("radau", "bdf"):
+        implicit = radau if method == "radau" else bdf
+
+        def run_implicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+            return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
+                            times, y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
+                            first_step=first, max_steps=steps)
+        return run_implicit
+    explicit = rk45 if method == "rk45" else dop853
+
+    def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
+                        atol=loop.atol, first_step=first, max_steps=steps)
+    return run_explicit
 
 
 def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step: float

@@ -167,9 +167,9 @@ def _fixed_companion(problem: Problem, grid: np.ndarray, x0: np.ndarray, solver:
 
 def _adaptive_companion(problem: Problem, grid: np.ndarray, x0: np.ndarray, solver: str,
                         rtol: float, atol: float, compiled: bool) -> np.ndarray:
-    from .compiled import finish_dop853
+    from .compiled import advance_compiled
     from .steps import integrate
 
     companion = _companion_problem(problem, solver)
-    finish = finish_dop853 if compiled and solver in (EXPLICIT, RACE_IMPLICIT) else None
+    finish = advance_compiled if compiled and solver in (EXPLICIT, RACE_IMPLICIT) else None
     return integrate(companion, grid, x0, rtol, atol, finish).states

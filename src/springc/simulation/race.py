@@ -2,10 +2,7 @@
 
 1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps. If it finishes, or its current step
    size leaves at most :data:`CHEAP_STEPS` steps to go, it finishes the run: a short
-   run costs no stiffness estimate at all. On the compiled engine, where a whole short
-   run costs less than those probe steps on scipy, ``dop853`` first tries the run
-   compiled within ``EXPLICIT_PROBE + CHEAP_STEPS`` steps; if it does not finish there
-   (or fails), that work is dropped and the run goes on as here from the start.
+   run costs no stiffness estimate at all.
 2. Otherwise the stiffness estimate of :func:`springc.simulation.solvers.choose` (``rho * T``
    from the analytic Jacobian at the current state) decides whether ``radau`` could
    be cheaper. If not, ``dop853`` goes on.
@@ -18,6 +15,13 @@
    cheaper one finishes the run from where its probe left off. (``radau`` starts
    afresh rather than from ``dop853``'s state: a state reached at the stability
    limit carries fast-mode noise that would hold ``radau``'s first steps small.)
+
+On the compiled engine steps are cheap and each call of a compiled loop has a fixed
+cost (some 50 microseconds, tens of steps of a small model), so the explicit probe is
+:data:`COMPILED_PROBE` steps (for a model of over :data:`SPRINT_STATES` states, whose
+estimate is dearer than compiled steps, :data:`CHEAP_STEPS` more), and the race times
+each method on two calls of its loop (:data:`COMPILED_STRETCHES`): its time per step
+is their difference in time over their difference in steps, so the fixed cost cancels.
 
 The probes are steps of the real run (the grid points they pass are kept), so
 deciding costs at most the two probes: a few percent of any run long enough to
@@ -32,7 +36,9 @@ a note. Failures after the decision are the run's own.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -48,6 +54,20 @@ method's projected remaining time (a large scene's radau steps are dear)."""
 CHEAP_STEPS = 500
 """Explicit steps to go below which no estimate or implicit probe is worth its cost
 (about what ``rho * T <= 2000`` allows a stability-limited explicit method)."""
+COMPILED_PROBE = 10
+SPRINT_STATES = 32
+"""On the compiled engine, models of more states take :data:`CHEAP_STEPS` more explicit
+steps before an estimate (dense eigenvalues of 32 states take about 0.1 ms, of 400
+some 40 ms: as long as hundreds of compiled steps)."""
+STEP_COST = (0.2, 20.0)
+"""Bounds of a ``radau`` step's cost in ``dop853`` steps: at least one Newton iteration
+of 3 evaluations of the model against 12 (15 with the dense output), and for a model
+of at most :data:`SPRINT_STATES` states at most a few iterations and a dense LU of 32
+unknowns. Where the projected step counts differ by more, they decide the compiled
+race alone (the upper bound only for such small models)."""
+COMPILED_STRETCHES = {EXPLICIT: (30,), RACE_IMPLICIT: (4, 16)}
+"""The steps of each method's timed calls in a compiled race (the explicit method's
+first is its probe)."""
 
 
 class Stretch(Protocol):
@@ -72,6 +92,9 @@ class Run(Protocol):
     @property
     def done(self) -> bool: ...
 
+    @property
+    def compiled(self) -> bool: ...
+
     def start(self, solver: str, t: float, y: np.ndarray,
               first_step: float | None = None) -> Any: ...
 
@@ -79,7 +102,16 @@ class Run(Protocol):
 
     def both_failed(self, first: Any, second: Any) -> Exception: ...
 
-    def sprint(self, integrator: Any, steps: int) -> Stretch | None: ...
+
+@dataclass(frozen=True)
+class Probe:
+    """What a probe measured: its steps, the step size its method settled on, the
+    seconds per step of stepping (and the seconds it cost in all)."""
+
+    steps: int
+    step: float
+    per_step: float
+    seconds: float
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -89,11 +121,11 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
     ``estimate(t, x)`` is the stiffness estimate at a state (only called for long runs).
     """
     explicit = run.start(EXPLICIT, t0, x0)
-    sprint = run.sprint(explicit, EXPLICIT_PROBE + CHEAP_STEPS)
-    if sprint is not None:
-        return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {sprint.steps} steps"
+    first = EXPLICIT_PROBE
+    if run.compiled:
+        first = COMPILED_PROBE + (CHEAP_STEPS if len(x0) > SPRINT_STATES else 0)
     try:
-        probe = run.advance(explicit, EXPLICIT_PROBE)
+        probe = run.advance(explicit, first)
     except run.failure as failure:
         implicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
         try:
@@ -103,24 +135,98 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
         return RACE_IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
     if run.done:
         return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {probe.steps} steps"
-    h_explicit = _step(probe)
-    left = (stop - explicit.t) / h_explicit
+    left = (stop - explicit.t) / _step(probe)
     if left <= CHEAP_STEPS:
         run.advance(explicit)
         return EXPLICIT, f"non-stiff: {EXPLICIT} needs ~{left:.2g} more steps"
     choice = estimate(float(explicit.t), np.array(explicit.y))
     if choice.solver == RACE:
-        return _race(run, explicit, probe, h_explicit, t0, x0, stop, choice.reason)
+        return _race(run, explicit, probe, t0, x0, stop, choice.reason)
     if choice.solver == RACE_IMPLICIT:
         explicit = run.start(RACE_IMPLICIT, float(explicit.t), np.array(explicit.y))
     run.advance(explicit)
     return choice.solver, choice.reason
 
 
-def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
-          x0: np.ndarray, stop: float, stiffness: str) -> tuple[str, str]:
-    explicit_cost = (stop - explicit.t) / h_explicit * probe.seconds / probe.steps
+def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, stop: float,
+          stiffness: str) -> tuple[str, str]:
+    if run.compiled:
+        return _compiled_race(run, explicit, first, t0, x0, stop, stiffness)
+    explicit_cost = (stop - explicit.t) / _step(first) * first.seconds / max(first.steps, 1)
     implicit = run.start(RACE_IMPLICIT, t0, x0)
+    trial = _scipy_implicit_probe(run, implicit, explicit_cost)
+    if run.done:
+        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
+    implicit_cost = (stop - implicit.t) / trial.step * trial.per_step
+    return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
+                   f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
+
+
+def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
+                   stop: float, stiffness: str) -> tuple[str, str]:
+    """The race on the compiled engine: ``radau``'s probe first, and where the step
+    counts alone decide (:data:`STEP_COST`), no timing of ``dop853``."""
+    explicit_steps = (stop - explicit.t) / _step(first)
+    # (an upper bound: the first call's fixed cost counts as stepping)
+    explicit_cost = explicit_steps * first.seconds / max(first.steps, 1)
+    implicit = run.start(RACE_IMPLICIT, t0, x0)
+    trial = _timed(run, implicit, COMPILED_STRETCHES[RACE_IMPLICIT],
+                   PROBE_BUDGET * explicit_cost)
+    if run.done:
+        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
+    implicit_steps = (stop - implicit.t) / trial.step
+    counts = f"~{implicit_steps:.2g} steps to go, {EXPLICIT} ~{explicit_steps:.2g}"
+    least, most = STEP_COST
+    if len(x0) <= SPRINT_STATES and explicit_steps >= most * implicit_steps:
+        return _finish(run, explicit, implicit, True, stiffness, counts)
+    if explicit_steps <= least * implicit_steps:
+        return _finish(run, explicit, implicit, False, stiffness, counts)
+    probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT], math.inf, first)
+    if run.done:
+        return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
+    explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
+    implicit_cost = implicit_steps * trial.per_step
+    return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
+                   f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
+
+
+def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffness: str,
+            measured: str) -> tuple[str, str]:
+    """The race's winner runs to the end; the reason names what was measured."""
+    measured = f"measured: {RACE_IMPLICIT} {measured}"
+    if implicit_wins:
+        run.advance(implicit)
+        return RACE_IMPLICIT, f"{stiffness}; {measured}"
+    run.advance(explicit)
+    return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {measured}"
+
+
+def _timed(run: Run, integrator: Any, stretches: tuple[int, ...], budget: float,
+           before: Stretch | None = None) -> Probe:
+    """Compiled stretches of ``stretches`` steps (after ``before``, a stretch the method
+    ran already) until the run is done or they cost over ``budget`` seconds: the time
+    per step is the difference of the last two stretches over their difference in
+    steps (each call's fixed cost cancels), or the last one's mean where that is not
+    positive."""
+    done: list[Stretch] = [] if before is None else [before]
+    spent = 0.0
+    for steps in stretches:
+        done.append(run.advance(integrator, steps))
+        spent += done[-1].seconds
+        if run.done or spent > budget:
+            break
+    last = done[-1]
+    per_step = last.seconds / max(last.steps, 1)
+    if len(done) >= 2 and last.steps != done[-2].steps:
+        difference = (last.seconds - done[-2].seconds) / (last.steps - done[-2].steps)
+        per_step = difference if difference > 0 else per_step
+    return Probe(sum(s.steps for s in done), _step(last) if last.sizes else math.inf,
+                 per_step, sum(s.seconds for s in done))
+
+
+def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Probe:
+    """The implicit probe on scipy's loop: a step at a time, up to :data:`IMPLICIT_PROBE`
+    or :data:`PROBE_BUDGET` of the explicit method's projected cost."""
     steps, seconds = 0, 0.0
     sizes: list[float] = []
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
@@ -128,17 +234,9 @@ def _race(run: Run, explicit: Any, probe: Stretch, h_explicit: float, t0: float,
         steps, seconds = steps + trial.steps, seconds + trial.seconds
         sizes += trial.sizes
         if run.done:
-            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
-                                   "trial steps")
-    implicit_cost = (stop - implicit.t) / float(np.median(sizes[-5:])) * seconds / steps
-    measured = (f"measured: {RACE_IMPLICIT} ~{implicit_cost:.2g} s to go, {EXPLICIT} "
-                f"~{explicit_cost:.2g} s")
-    if implicit_cost <= explicit_cost:
-        run.advance(implicit)
-        return RACE_IMPLICIT, f"{stiffness}; {measured}"
-    run.advance(explicit)
-    return EXPLICIT, (f"{stiffness}, but the fast modes must be resolved anyway; "
-                      f"{measured}")
+            break
+    return Probe(steps, float(np.median(sizes[-5:])) if sizes else math.inf,
+                 seconds / max(steps, 1), seconds)
 
 
 def _step(stretch: Stretch) -> float:

@@ -32,15 +32,14 @@ from . import error_estimate, solvers
 from .compiled import (
     COMPILED,
     SCIPY,
+    advance_compiled,
     choose_engine,
     engine_reason,
     explained,
-    finish_dop853,
     jitted,
     numba_available,
     observed_on_grid,
     run_fixed_compiled,
-    sprint_dop853,
 )
 from .error_estimate import DEFAULT_MODE, ErrorEstimate
 from .failures import Stop, code_location, state_notes
@@ -243,15 +242,14 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             reason = ""
             # a large model's generated functions may be plain Python: scipy's loop then
             compiled = engine == COMPILED and jitted(model.module)
-            finish = finish_dop853 if compiled else None
+            finish = advance_compiled if compiled else None
             loop_time = 0.0
             if solver in FIXED_STEP and compiled:
                 states, steps, loop_time = run_fixed_compiled(problem, grid, x0, step)
             elif solver in FIXED_STEP:
                 states, steps = solvers.run_fixed(problem, grid, x0, step)
             elif solver == AUTO and len(x0):
-                run = StepLoop(problem, grid, x0, rtol, atol, finish,
-                               sprint_dop853 if compiled else None)
+                run = StepLoop(problem, grid, x0, rtol, atol, finish)
                 solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
                     problem.jac(t, x), stop - start))
                 states, steps, loop_time = run.states, run.steps, run.loop_time

@@ -32,9 +32,8 @@ from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
 from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
-COMPILED_CLASSES = frozenset({"DOP853", "RK45", "Radau", "BDF"})
-"""scipy integrators that ``StepLoop.finish`` continues in a compiled loop."""
-
+COMPILED_CLASSES = {"DOP853": "dop853", "RK45": "rk45", "Radau": "radau", "BDF": "bdf"}
+"""scipy integrator classes whose method ``StepLoop.finish`` runs in a compiled loop."""
 
 
 class Progress:
@@ -186,8 +185,8 @@ class Problem:
 
 def integrate(problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
               atol: float, finish: Finish | None = None) -> StepLoop:
-    """The step loop run over ``grid`` (solve_ivp's loop; ``finish``: see
-    :class:`StepLoop`): its states on the grid and the number of steps taken."""
+    """The step loop run over ``grid`` (solve_ivp's loop, or the compiled one with
+    ``finish``: see :class:`StepLoop`): its states on the grid and its steps."""
     run = StepLoop(problem, grid, x0, rtol, atol, finish)
     if len(x0):
         run.advance(run.start(problem.solver, float(grid[0]), x0))
@@ -203,30 +202,42 @@ class Stretch:
     sizes: tuple[float, ...]
 
 
-Finish = Callable[["StepLoop", Any], Stretch]
-"""``finish(loop, integrator)``: run ``integrator`` to the end of ``loop``'s grid."""
+@dataclass
+class Stepper:
+    """An integrator of the compiled engine: its method, where it is and its next step
+    size (each :meth:`StepLoop.advance` runs the compiled loop from there and moves it)."""
+
+    method: str  # a key of springc.simulation.solver_names.SOLVERS with a compiled loop
+    t: float
+    y: np.ndarray
+    h_abs: float
+
+
+Finish = Callable[["StepLoop", Stepper, "int | None"], Stretch]
+"""``finish(loop, stepper, max_steps)``: run ``stepper`` in its compiled loop until the
+end of ``loop``'s grid or ``max_steps`` steps (rejected ones included), filling the grid
+(``springc.simulation.compiled.advance_compiled``)."""
 
 
 class StepLoop:
     """The output grid filled step by step, by one integrator after another (the
-    ``auto`` race of :mod:`springc.simulation.race` hands the state from one to the next)."""
+    ``auto`` race of :mod:`springc.simulation.race` hands the state from one to the next).
+
+    With ``finish`` (the compiled engine) the integrators of methods with a compiled loop
+    are :class:`Stepper` handles that ``finish`` runs; without it, scipy's integrators
+    stepped from Python.
+    """
 
     failure = Stop
 
     def __init__(self, problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
-                 atol: float, finish: Finish | None = None,
-                 sprinter: Callable[[StepLoop, Any, int], Stretch | None] | None = None
-                 ) -> None:
+                 atol: float, finish: Finish | None = None) -> None:
         self.problem, self.grid, self.rtol, self.atol = problem, grid, rtol, atol
         self.limits = problem.limits
         self.states = np.empty((len(grid), len(x0)))
         self.states[0] = x0
         self.k, self.steps = 1, 0
-        #: continues a DOP853 integrator to the end of the grid (the compiled engine's
-        #: :func:`springc.simulation.compiled.finish_dop853`); None: scipy steps on
         self.finish = finish
-        #: auto's first try on the compiled engine (compiled.sprint_dop853); None: scipy
-        self.sprinter = sprinter
         self.compiled_steps = 0
         self.loop_time = 0.0  # seconds in the compiled loop
 
@@ -234,15 +245,17 @@ class StepLoop:
     def done(self) -> bool:
         return self.k >= len(self.grid)
 
-    def sprint(self, integrator: Any, steps: int) -> Stretch | None:
-        """On the compiled engine, ``integrator``'s run to the end of the grid in at most
-        ``steps`` compiled steps if it gets there (the grid filled), else None and the
-        loop untouched (``auto`` decides then as on scipy); None on scipy."""
-        return None if self.sprinter is None else self.sprinter(self, integrator, steps)
+    @property
+    def compiled(self) -> bool:
+        """Whether the loop runs its integrators compiled (``auto`` probes differently)."""
+        return self.finish is not None
 
     def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
               ) -> Any:
-        """A scipy integrator of ``solver`` from ``(t, y)`` to the end of the grid."""
+        """An integrator of ``solver`` from ``(t, y)`` to the end of the grid: scipy's, or
+        on the compiled engine a :class:`Stepper` starting with scipy's first step (an
+        initial step that underflows to 0, at extreme parameters, stays with scipy, which
+        words that failure)."""
         import scipy.integrate
 
         self.problem.solver = solver
@@ -250,8 +263,13 @@ class StepLoop:
         if first_step is not None:
             kwargs["first_step"] = min(first_step, float(self.grid[-1]) - t)
         cls = getattr(scipy.integrate, SOLVERS[solver])
-        return cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol, atol=self.atol,
-                   **kwargs)
+        integrator = cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol,
+                         atol=self.atol, **kwargs)
+        method = COMPILED_CLASSES.get(type(integrator).__name__)
+        if self.finish is None or method is None or not float(integrator.h_abs) > 0:
+            return integrator
+        return Stepper(method, float(integrator.t), np.array(integrator.y),
+                       float(integrator.h_abs))
 
     @staticmethod
     def both_failed(first: Stop, second: Stop) -> Stop:
@@ -279,18 +297,16 @@ class StepLoop:
                             t, np.array(integrator.y), self.problem.solver)
 
     def advance(self, integrator: Any, max_steps: int | None = None) -> Stretch:
-        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it.
-
-        A ``DOP853``, ``RK45``, ``Radau`` or ``BDF`` integrator run to the end on the
-        compiled engine continues there (see :func:`springc.simulation.compiled.finish_dop853`).
-        """
-        # (an integrator whose first step underflowed to 0, at extreme parameters, fails
-        # on scipy with scipy's words: the compiled kernels need a positive first step)
-        if self.finish is not None and max_steps is None and not self.done \
-                and type(integrator).__name__ in COMPILED_CLASSES \
-                and float(getattr(integrator, "h_abs", 0.0)) > 0:
-            return self.finish(self, integrator)
+        """Step ``integrator`` until the grid is full (or ``max_steps``), filling it (a
+        :class:`Stepper` in its compiled loop, see :attr:`finish`)."""
+        if isinstance(integrator, Stepper):
+            self.problem.solver = integrator.method
+            if self.done or self.finish is None:
+                return Stretch(0, 0.0, ())
+            return self.finish(self, integrator, max_steps)
         problem, grid, states = self.problem, self.grid, self.states
+        problem.solver = next((name for name, cls in SOLVERS.items()
+                               if cls == type(integrator).__name__), problem.solver)
         began, taken = time.perf_counter(), 0
         sizes: deque[float] = deque(maxlen=10)
         while not self.done and taken != max_steps:
