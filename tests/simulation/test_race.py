@@ -105,13 +105,13 @@ def test_compiled_probes_time_by_differences() -> None:
     run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
     assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 needs ~4.9e+02 more steps")
     # radau's probe (4 and 16 steps) leaves ~2,000 steps, dop853's ~10,000: the counts
-    # cannot tell, so dop853 is timed on 30 more steps; each call's fixed cost (1 ms,
-    # far over the steps' microseconds) cancels in the differences
+    # cannot tell, so dop853 is timed on 10 and 40 more steps; each call's fixed cost
+    # (1 ms, far over the steps' microseconds) cancels in the differences
     run = Run({"dop853": 1e-3, "radau": 5e-3}, {"dop853": 1e-6, "radau": 2e-6},
               compiled=True, call=1e-3)
     solver, reason = _auto(run)
-    assert solver == "radau" and run.taken == {"dop853": 10 + 30, "radau": 2000}
-    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.01 s"
+    assert solver == "radau" and run.taken == {"dop853": 10 + 10 + 40, "radau": 2000}
+    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.0099 s"
 
 
 def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
@@ -121,13 +121,19 @@ def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
     solver, reason = _auto(run)
     assert solver == "radau" and run.taken == {"dop853": 10, "radau": 200}
     assert reason == "race estimate; measured: radau ~1.8e+02 steps to go, dop853 ~1e+05"
-    # radau held to 10x smaller steps: no radau step costs under 0.2 dop853 steps
+
+
+
+def test_the_compiled_race_lets_radau_run_up_to_half_of_dop853s_time() -> None:
+    """radau held to 10x smaller steps (each 2x dearer) runs stretches four times longer
+    each (4, 16, 64, 256, 1024, then what the budget leaves) until it has cost half of
+    dop853's ~0.01 s: 2,484 steps of 2 us."""
     run = Run({"dop853": 1e-3, "radau": 1e-4}, {"dop853": 1e-6, "radau": 2e-6},
               compiled=True)
     solver, reason = _auto(run)
-    assert solver == "dop853" and run.taken == {"dop853": 10_000, "radau": 20}
+    assert solver == "dop853" and run.taken == {"dop853": 10_000, "radau": 2484}
     assert reason == ("race estimate, but the fast modes must be resolved anyway; measured: "
-                      "radau ~1e+05 steps to go, dop853 ~1e+04")
+                      "radau ~0.2 s to go, dop853 ~0.0099 s")
 
 
 def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
@@ -139,10 +145,10 @@ def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
 
 
 def test_the_compiled_implicit_probe_stops_at_its_budget() -> None:
-    # dop853 projects ~10 s (1e5 steps of 1e-4 s); radau's first 4 steps cost 1 s,
-    # over the 0.5 s budget: its 16-step stretch is not run, and its mean counts
+    # dop853 projects ~10 s (1e5 steps of 1e-4 s): radau's 4 and 16 steps of 0.25 s
+    # spend the 5 s budget, and no further stretch fits
     run = Run({"dop853": 1e-4, "radau": 1e-3}, {"dop853": 1e-4, "radau": 0.25},
               compiled=True)
     solver, reason = _auto(run)
-    assert solver == "dop853" and run.taken["radau"] == 4
+    assert solver == "dop853" and run.taken["radau"] == 4 + 16
     assert reason.endswith("measured: radau ~2.5e+03 s to go, dop853 ~10 s")

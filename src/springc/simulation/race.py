@@ -59,15 +59,23 @@ SPRINT_STATES = 32
 """On the compiled engine, models of more states take :data:`CHEAP_STEPS` more explicit
 steps before an estimate (dense eigenvalues of 32 states take about 0.1 ms, of 400
 some 40 ms: as long as hundreds of compiled steps)."""
-STEP_COST = (0.2, 20.0)
-"""Bounds of a ``radau`` step's cost in ``dop853`` steps: at least one Newton iteration
-of 3 evaluations of the model against 12 (15 with the dense output), and for a model
-of at most :data:`SPRINT_STATES` states at most a few iterations and a dense LU of 32
-unknowns. Where the projected step counts differ by more, they decide the compiled
-race alone (the upper bound only for such small models)."""
-COMPILED_STRETCHES = {EXPLICIT: (30,), RACE_IMPLICIT: (4, 16)}
-"""The steps of each method's timed calls in a compiled race (the explicit method's
-first is its probe)."""
+STEP_COST = 20.0
+"""A ``radau`` step of a model of at most :data:`SPRINT_STATES` states costs under this
+many ``dop853`` steps (a few Newton iterations of 3 evaluations of the model and a
+dense LU of at most 32 unknowns, against 12 evaluations): where ``dop853`` projects
+more times ``radau``'s steps, the counts decide the compiled race alone."""
+COMPILED_STRETCHES: dict[str, tuple[int, int]] = {EXPLICIT: (10, 40),
+                                                 RACE_IMPLICIT: (4, 16)}
+"""The steps of each method's first timed calls in a compiled race (a call right after
+other work runs cold and is not compared with later ones: the explicit probe is not
+one of them)."""
+COMPILED_BUDGET = 0.5
+"""The compiled race lets ``radau`` run up to this fraction of ``dop853``'s projected
+time (stretches four times longer each): an excited fast mode holds ``radau``'s first
+steps small until its damping removes it, so its early projection can be far too
+dear (the uneven pair at k = 1e8: 0.5 s projected, 12 ms taken); a ``radau`` run that
+costs under half of ``dop853``'s is found, and where ``dop853`` wins the race costs it
+at most half again."""
 
 
 class Stretch(Protocol):
@@ -106,12 +114,13 @@ class Run(Protocol):
 @dataclass(frozen=True)
 class Probe:
     """What a probe measured: its steps, the step size its method settled on, the
-    seconds per step of stepping (and the seconds it cost in all)."""
+    seconds per step of stepping, the seconds it cost in all and its last stretch."""
 
     steps: int
     step: float
     per_step: float
     seconds: float
+    last: Stretch
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -164,30 +173,43 @@ def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, st
 
 def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
                    stop: float, stiffness: str) -> tuple[str, str]:
-    """The race on the compiled engine: ``radau``'s probe first, and where the step
-    counts alone decide (:data:`STEP_COST`), no timing of ``dop853``."""
+    """The race on the compiled engine: ``radau`` runs stretches (4, 16, then four times
+    longer each, within what is left of :data:`COMPILED_BUDGET` of ``dop853``'s
+    projected time) until its projection beats ``dop853``'s or the budget is spent;
+    where the step counts alone decide (:data:`STEP_COST`), ``dop853`` is not timed."""
     explicit_steps = (stop - explicit.t) / _step(first)
-    # (an upper bound: the first call's fixed cost counts as stepping)
+    # (an upper bound until dop853 is timed: the first call's fixed cost counts as steps)
     explicit_cost = explicit_steps * first.seconds / max(first.steps, 1)
+    timed = False
     implicit = run.start(RACE_IMPLICIT, t0, x0)
-    trial = _timed(run, implicit, COMPILED_STRETCHES[RACE_IMPLICIT],
-                   PROBE_BUDGET * explicit_cost)
-    if run.done:
-        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
-    implicit_steps = (stop - implicit.t) / trial.step
-    counts = f"~{implicit_steps:.2g} steps to go, {EXPLICIT} ~{explicit_steps:.2g}"
-    least, most = STEP_COST
-    if len(x0) <= SPRINT_STATES and explicit_steps >= most * implicit_steps:
-        return _finish(run, explicit, implicit, True, stiffness, counts)
-    if explicit_steps <= least * implicit_steps:
-        return _finish(run, explicit, implicit, False, stiffness, counts)
-    probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT], math.inf, first)
-    if run.done:
-        return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
-    explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
-    implicit_cost = implicit_steps * trial.per_step
-    return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
-                   f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
+    done = [run.advance(implicit, COMPILED_STRETCHES[RACE_IMPLICIT][0])]
+    steps = COMPILED_STRETCHES[RACE_IMPLICIT][1]
+    while True:
+        if not run.done:
+            done.append(run.advance(implicit, steps))
+        if run.done:
+            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
+                                   "trial steps")
+        last = done[-1]
+        implicit_steps = (stop - implicit.t) / _step(last)
+        if len(x0) <= SPRINT_STATES and explicit_steps >= STEP_COST * implicit_steps:
+            return _finish(run, explicit, implicit, True, stiffness,
+                           f"~{implicit_steps:.2g} steps to go, {EXPLICIT} "
+                           f"~{explicit_steps:.2g}")
+        if not timed:
+            probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
+            if run.done:
+                return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
+            explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
+            timed = True
+        per_step = _per_step(done[-2], last)
+        implicit_cost = implicit_steps * per_step
+        room = COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done)
+        if implicit_cost <= explicit_cost or room < per_step * COMPILED_STRETCHES[
+                RACE_IMPLICIT][0]:
+            return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
+                           f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
+        steps = int(min(4 * last.steps, room / per_step))
 
 
 def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffness: str,
@@ -201,27 +223,27 @@ def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffne
     return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {measured}"
 
 
-def _timed(run: Run, integrator: Any, stretches: tuple[int, ...], budget: float,
-           before: Stretch | None = None) -> Probe:
-    """Compiled stretches of ``stretches`` steps (after ``before``, a stretch the method
-    ran already) until the run is done or they cost over ``budget`` seconds: the time
-    per step is the difference of the last two stretches over their difference in
-    steps (each call's fixed cost cancels), or the last one's mean where that is not
-    positive."""
-    done: list[Stretch] = [] if before is None else [before]
-    spent = 0.0
-    for steps in stretches:
-        done.append(run.advance(integrator, steps))
-        spent += done[-1].seconds
-        if run.done or spent > budget:
-            break
+def _timed(run: Run, integrator: Any, stretches: tuple[int, int]) -> Probe:
+    """Two compiled stretches of ``stretches`` steps (fewer if the run ends): the time
+    per step from their difference (see :func:`_per_step`), the step size the second
+    settled on."""
+    done = [run.advance(integrator, stretches[0])]
+    if not run.done:
+        done.append(run.advance(integrator, stretches[1]))
     last = done[-1]
-    per_step = last.seconds / max(last.steps, 1)
-    if len(done) >= 2 and last.steps != done[-2].steps:
-        difference = (last.seconds - done[-2].seconds) / (last.steps - done[-2].steps)
-        per_step = difference if difference > 0 else per_step
     return Probe(sum(s.steps for s in done), _step(last) if last.sizes else math.inf,
-                 per_step, sum(s.seconds for s in done))
+                 _per_step(done[0], last), sum(s.seconds for s in done), last)
+
+
+def _per_step(before: Stretch, last: Stretch) -> float:
+    """Seconds per step: the difference of two stretches of a method over their
+    difference in steps (each call's fixed cost cancels), or the last one's mean where
+    that is not positive (or the two are one)."""
+    per_step = last.seconds / max(last.steps, 1)
+    if last is not before and last.steps != before.steps:
+        difference = (last.seconds - before.seconds) / (last.steps - before.steps)
+        per_step = difference if difference > 0 else per_step
+    return per_step
 
 
 def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Probe:
@@ -229,14 +251,16 @@ def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Prob
     or :data:`PROBE_BUDGET` of the explicit method's projected cost."""
     steps, seconds = 0, 0.0
     sizes: list[float] = []
+    trial = None
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
         trial = run.advance(implicit, 1)
         steps, seconds = steps + trial.steps, seconds + trial.seconds
         sizes += trial.sizes
         if run.done:
             break
+    assert trial is not None  # (one step at least: the budget is positive)
     return Probe(steps, float(np.median(sizes[-5:])) if sizes else math.inf,
-                 seconds / max(steps, 1), seconds)
+                 seconds / max(steps, 1), seconds, trial)
 
 
 def _step(stretch: Stretch) -> float:
