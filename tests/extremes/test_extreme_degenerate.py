@@ -47,8 +47,9 @@ SET_CASES = [
     ("k=-1", 0, ""),  # an unstable spring: exponential growth, finite over 10 s
     ("k=1e300", 1, "note: radau, tried next by auto, failed too: the radau solver failed "
                    "at time 0: the Newton matrix is not finite (the Jacobian overflows)"),
-    ("m=1e-300", 1, "note: radau, tried next by auto, failed too: the radau solver failed "
-                    "at time 0: the Newton matrix"),
+    # (dop853's 10 compiled probe steps do not collapse yet: the Jacobian, not finite,
+    # sends auto to radau, whose error is the run's)
+    ("m=1e-300", 1, "the radau solver failed at time 0: the Newton matrix"),
     ("m=1e300", 0, ""),  # a motionless mass
     ("k=abc", 2, "'abc' is not a number"),
 ]

@@ -29,18 +29,20 @@ def test_closed_forms_match_the_matrix_exponential() -> None:
 def test_auto_within_bound(compiled: dict[str, CompiledModel], k: float) -> None:
     result = springc.simulate(compiled["StiffPair"], parameters={"k": k})
     assert np.max(np.abs(result["x1"] - stiff_pair(result.time, k))) < BOUND
-    # rho*T up to 1.4e7, but dop853 is never held to 1/rho: no estimate is needed.
+    # rho*T up to 1.4e7, but dop853 is never held to 1/rho: no estimate is needed (its
+    # 10 compiled probe steps leave under 4 to go).
     assert result.stats.solver == "dop853"
-    assert result.stats.reason == f"non-stiff: dop853 finished in {result.stats.steps} steps"
+    assert result.stats.reason == "non-stiff: dop853 needs ~3.9 more steps"
 
 
 @pytest.mark.parametrize(("k", "stop", "solver"),
-                         [(1e4, 10.0, "dop853"), (1e8, 1.0, "dop853"), (1e12, 10.0, "radau")])
+                         [(1e4, 10.0, "dop853"), (1e8, 10.0, "radau"), (1e12, 10.0, "radau")])
 def test_auto_on_the_excited_stiff_mode(compiled: dict[str, CompiledModel], k: float,
                                         stop: float, solver: str) -> None:
-    # k = 1e8: the vibration's velocity (~5e-5) is above the tolerance, radau must
-    # resolve its first periods too and dop853 stays cheaper; k = 1e12: it is below
-    # the tolerance (~5e-7), radau steps over it while dop853 is held to 1/rho.
+    # k = 1e4: rho*T = 1.4e3, no race. k = 1e8: the vibration's velocity (~5e-5) is
+    # above the tolerance, radau must resolve its first periods, but its steps grow
+    # as it damps them (4,706 steps, 10x cheaper than dop853's 37,112 held to 1/rho);
+    # k = 1e12: below the tolerance (~5e-7), radau steps over it from the start.
     result = springc.simulate(compiled["StiffPair"], parameters={"k": k, "k2": 2.0}, stop=stop)
     assert result.stats.solver == solver
     positions = np.column_stack([result["x1"], result["x2"]])

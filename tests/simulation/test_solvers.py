@@ -131,7 +131,8 @@ def test_auto_races_to_the_implicit_method_when_the_explicit_one_is_held(
     result = springc.simulate(models, model_name="StiffPair",
                               parameters={"k": 1e12, "k2": 2.0})
     assert result.stats.solver == "radau"
-    assert re.search(r"; measured: radau ~\S+ s to go, dop853 ~\S+ s$", result.stats.reason)
+    # (the step counts alone decide: radau ~120 steps to go, dop853 ~6e6)
+    assert re.search(r"; measured: radau ~\S+ steps to go, dop853 ~\S+$", result.stats.reason)
     assert result.stats.steps < 400
     slow = np.sqrt(2 + 3e12) / np.sqrt(1e12) / np.sqrt(2)  # the slow mode, 1 + O(1/k)
     assert np.max(np.abs(result["x1"] - np.cos(slow * result.time))) < 2e-5
