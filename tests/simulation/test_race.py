@@ -105,13 +105,13 @@ def test_compiled_probes_time_by_differences() -> None:
     run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
     assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 needs ~4.9e+02 more steps")
     # radau's probe (4 and 16 steps) leaves ~2,000 steps, dop853's ~10,000: the counts
-    # cannot tell, so dop853 is timed on 10 and 40 more steps; each call's fixed cost
+    # cannot tell, so dop853 is timed on 20 and 200 more steps; each call's fixed cost
     # (1 ms, far over the steps' microseconds) cancels in the differences
     run = Run({"dop853": 1e-3, "radau": 5e-3}, {"dop853": 1e-6, "radau": 2e-6},
               compiled=True, call=1e-3)
     solver, reason = _auto(run)
-    assert solver == "radau" and run.taken == {"dop853": 10 + 10 + 40, "radau": 2000}
-    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.0099 s"
+    assert solver == "radau" and run.taken == {"dop853": 10 + 20 + 200, "radau": 2000}
+    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.0098 s"
 
 
 def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
@@ -124,16 +124,16 @@ def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
 
 
 
-def test_the_compiled_race_lets_radau_run_up_to_half_of_dop853s_time() -> None:
+def test_the_compiled_race_lets_radau_run_up_to_a_fifth_of_dop853s_time() -> None:
     """radau held to 10x smaller steps (each 2x dearer) runs stretches four times longer
-    each (4, 16, 64, 256, 1024, then what the budget leaves) until it has cost half of
-    dop853's ~0.01 s: 2,484 steps of 2 us."""
+    each (4, 16, 64, 256, then what the budget leaves) until it has cost a fifth of
+    dop853's ~0.01 s: 977 steps of 2 us."""
     run = Run({"dop853": 1e-3, "radau": 1e-4}, {"dop853": 1e-6, "radau": 2e-6},
               compiled=True)
     solver, reason = _auto(run)
-    assert solver == "dop853" and run.taken == {"dop853": 10_000, "radau": 2484}
+    assert solver == "dop853" and run.taken == {"dop853": 10_000, "radau": 977}
     assert reason == ("race estimate, but the fast modes must be resolved anyway; measured: "
-                      "radau ~0.2 s to go, dop853 ~0.0099 s")
+                      "radau ~0.2 s to go, dop853 ~0.0098 s")
 
 
 def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
