@@ -133,6 +133,9 @@ def bdf_run(rhs: ModelFunction, jac: ModelFunction, observed: ModelFunction,
         h1 = max(1e-6, h0 * 1e-3) if d1 <= 1e-15 and d2 <= 1e-15 \
             else (0.01 / max(d1, d2)) ** 0.5
         h_abs = min(100 * h0, h1, interval, max_step)
+        if not h_abs > 0.0:  # underflowed (or NaN) at extreme values: no step
+            return (STEP_TOO_SMALL, states, obs, filled, 0, 0, nfev, t, y.copy(), fired,
+                    h_abs, 0)
     newton_tol = max(10 * EPS / rtol, min(0.03, rtol ** 0.5))
     J = jac(t, y, p, z)
     njev += 1

@@ -130,6 +130,9 @@ def dop853_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
         else:
             h1 = (0.01 / max(d1, d2)) ** 0.125
         h_abs = min(100 * h0, h1, interval, max_step)
+        if not h_abs > 0.0:  # underflowed (or NaN) at extreme values: no step
+            return (STEP_TOO_SMALL, states, obs, filled, 0, 0, nfev, t, y.copy(), fired,
+                    h_abs)
 
     # Step 3: steps until the end (or an event), each filling the output times it passes.
     while t < limit:

@@ -6,6 +6,7 @@ numba's on-disk cache, when their module is imported) are imported on first use 
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -176,8 +177,6 @@ def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: 
               first_step: float | None = None, max_steps: int = 0,
               crossings: Crossings | None = None, t_stop: float = np.inf,
               dense_limit: int = 64) -> Run:
-    from .banded_lu import band_layout
-
     grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
     atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
@@ -190,12 +189,25 @@ def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: 
     if values.shape != indices_.shape:
         raise ValueError(f"the Jacobian returns shape {values.shape} for {indices_.size} "
                          "non-zeros")
-    order, kl, ku, positions, diagonal = band_layout(x0_.size, indptr_, indices_, dense_limit)
+    order, kl, ku, positions, diagonal = _band_layout(x0_.size, indptr_.tobytes(),
+                                                      indices_.tobytes(), dense_limit)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
     result = kernel(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_, x0_,
                     p_, z_, float(rtol), atol_, float(max_step), float(first_step or 0.0),
                     int(max_steps), _stop(t_stop, grid_), order, kl, ku, positions, diagonal)
     return _run(grid_, result)
+
+
+@functools.lru_cache(maxsize=16)
+def _band_layout(n: int, indptr: bytes, indices: bytes, dense_limit: int
+                 ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:
+    """:func:`.banded_lu.band_layout` of a sparsity, once per process (a model's runs,
+    and ``auto``'s race, call the implicit kernels again and again on one sparsity;
+    the reordering of a large scene takes milliseconds). The kernels only read it."""
+    from .banded_lu import band_layout
+
+    return band_layout(n, np.frombuffer(indptr, dtype=np.int64),
+                       np.frombuffer(indices, dtype=np.int64), dense_limit)
 
 
 def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *,

@@ -118,6 +118,9 @@ def rk45_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
         h1 = max(1e-6, h0 * 1e-3) if d1 <= 1e-15 and d2 <= 1e-15 \
             else (0.01 / max(d1, d2)) ** (1 / (tableau.ERROR_ESTIMATOR_ORDER + 1))
         h_abs = min(100 * h0, h1, interval, max_step)
+        if not h_abs > 0.0:  # underflowed (or NaN) at extreme values: no step
+            return (STEP_TOO_SMALL, states, obs, filled, 0, 0, nfev, t, y.copy(), fired,
+                    h_abs)
 
     # Step 3: steps until the end (or an event).
     while t < limit:

@@ -208,6 +208,13 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
             raise time_limit_reached(problem, run)
         chunk *= 10
     seconds = time.perf_counter() - began
+    if run.status == Status.STEP_TOO_SMALL and not accepted and not stepper.h_abs > 0 \
+            and not run.next_step > 0:  # no first step: scipy's steps word why
+        integrator = loop.scipy_start(stepper.method, stepper.t, stepper.y)
+        stretch = loop.advance(integrator, max_steps)
+        stepper.t, stepper.y = float(integrator.t), np.array(integrator.y)
+        stepper.h_abs = float(integrator.h_abs)
+        return stretch
     loop.loop_time += seconds
     loop.compiled_steps += accepted
     loop.steps += accepted
@@ -228,7 +235,7 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
 def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, float, int],
                                                      Run]:
     """``run(times, y, first_step, max_steps)``: ``method``'s compiled loop on ``loop``'s
-    model and tolerances."""
+    model and tolerances (``first_step`` 0: the loop selects it)."""
     from springc.integrate import bdf, dop853, radau, rk45
 
     problem = loop.problem
@@ -239,13 +246,13 @@ def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, fl
         def run_implicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
             return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
                             times, y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
-                            first_step=first, max_steps=steps)
+                            first_step=first or None, max_steps=steps)
         return run_implicit
     explicit = rk45 if method == "rk45" else dop853
 
     def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
         return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                        atol=loop.atol, first_step=first, max_steps=steps)
+                        atol=loop.atol, first_step=first or None, max_steps=steps)
     return run_explicit
 
 

@@ -37,6 +37,7 @@ a note. Failures after the decision are the run's own.
 from __future__ import annotations
 
 import math
+import statistics
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -65,10 +66,10 @@ many ``dop853`` steps (a few Newton iterations of 3 evaluations of the model and
 dense LU of at most 32 unknowns, against 12 evaluations): where ``dop853`` projects
 more times ``radau``'s steps, the counts decide the compiled race alone."""
 COMPILED_STRETCHES: dict[str, tuple[int, int]] = {EXPLICIT: (20, 200),
-                                                 RACE_IMPLICIT: (4, 16)}
-"""The steps of each method's first timed calls in a compiled race (a call right after
-other work runs cold and is not compared with later ones: the explicit probe is not
-one of them)."""
+                                                 RACE_IMPLICIT: (16, 64)}
+"""The steps of each method's first two timed calls in a compiled race (a call right
+after other work runs cold and is not compared with later ones: neither probe is
+timed)."""
 COMPILED_BUDGET = 0.2
 """The compiled race lets ``radau`` run up to this fraction of ``dop853``'s projected
 time (stretches four times longer each): an excited fast mode holds ``radau``'s first
@@ -175,43 +176,41 @@ def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, st
 
 def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
                    stop: float, stiffness: str) -> tuple[str, str]:
-    """The race on the compiled engine: ``radau`` runs stretches (4, 16, then four times
-    longer each, within what is left of :data:`COMPILED_BUDGET` of ``dop853``'s
-    projected time) until its projection beats ``dop853``'s or the budget is spent;
-    where the step counts alone decide (:data:`STEP_COST`), ``dop853`` is not timed."""
+    """The race on the compiled engine: ``radau`` takes :data:`IMPLICIT_PROBE` steps from
+    the start, and where the step counts alone decide (:data:`STEP_COST`) nothing is
+    timed; otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then
+    four times longer each, within what is left of :data:`COMPILED_BUDGET` of
+    ``dop853``'s projected time) until its projection beats ``dop853``'s or the budget
+    is spent."""
     explicit_steps = (stop - explicit.t) / _step(first)
-    # (an upper bound until dop853 is timed: the first call's fixed cost counts as steps)
-    explicit_cost = explicit_steps * first.seconds / max(first.steps, 1)
-    timed = False
     implicit = run.start(RACE_IMPLICIT, t0, x0)
-    done = [run.advance(implicit, COMPILED_STRETCHES[RACE_IMPLICIT][0])]
-    steps = COMPILED_STRETCHES[RACE_IMPLICIT][1]
-    while True:
-        if not run.done:
-            done.append(run.advance(implicit, steps))
-        if run.done:
-            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
-                                   "trial steps")
-        last = done[-1]
-        implicit_steps = (stop - implicit.t) / _step(last)
+    done = [run.advance(implicit, IMPLICIT_PROBE)]  # (a call right after other work: untimed)
+    if not run.done:
+        implicit_steps = (stop - implicit.t) / _step(done[-1])
         if len(x0) <= SPRINT_STATES and explicit_steps >= STEP_COST * implicit_steps:
             return _finish(run, explicit, implicit, True, stiffness,
                            f"~{implicit_steps:.2g} steps to go, {EXPLICIT} "
                            f"~{explicit_steps:.2g}")
-        if not timed:
-            probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
-            if run.done:
-                return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
-            explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
-            timed = True
+        probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
+        if run.done:
+            return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
+        explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
+        steps = COMPILED_STRETCHES[RACE_IMPLICIT]
+        done.append(run.advance(implicit, steps[0]))
+        steps_next = steps[1]
+    while not run.done:
+        done.append(run.advance(implicit, steps_next))
+        if run.done:
+            break
+        last = done[-1]
         per_step = _per_step(done[-2], last)
-        implicit_cost = implicit_steps * per_step
+        implicit_cost = (stop - implicit.t) / _step(last) * per_step
         room = COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done)
-        if implicit_cost <= explicit_cost or room < per_step * COMPILED_STRETCHES[
-                RACE_IMPLICIT][0]:
+        if implicit_cost <= explicit_cost or room < per_step * steps[0]:
             return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
                            f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
-        steps = int(min(4 * last.steps, room / per_step))
+        steps_next = int(min(4 * last.steps, room / per_step))
+    return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
 
 
 def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffness: str,
@@ -267,4 +266,4 @@ def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Prob
 
 def _step(stretch: Stretch) -> float:
     """The step size a method has settled on: the median of its last steps."""
-    return float(np.median(stretch.sizes[-5:]))
+    return float(statistics.median(stretch.sizes[-5:]))

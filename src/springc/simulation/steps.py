@@ -32,8 +32,8 @@ from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
 from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
 
 DENSE_JACOBIAN_LIMIT = 64
-COMPILED_CLASSES = {"DOP853": "dop853", "RK45": "rk45", "Radau": "radau", "BDF": "bdf"}
-"""scipy integrator classes whose method ``StepLoop.finish`` runs in a compiled loop."""
+COMPILED_METHODS = frozenset({"dop853", "rk45", "radau", "bdf"})
+"""Solvers whose integrators ``StepLoop.finish`` runs in a compiled loop."""
 
 
 class Progress:
@@ -207,10 +207,10 @@ class Stepper:
     """An integrator of the compiled engine: its method, where it is and its next step
     size (each :meth:`StepLoop.advance` runs the compiled loop from there and moves it)."""
 
-    method: str  # a key of springc.simulation.solver_names.SOLVERS with a compiled loop
+    method: str  # one of COMPILED_METHODS
     t: float
     y: np.ndarray
-    h_abs: float
+    h_abs: float  # 0: the compiled loop selects the first step (as scipy does)
 
 
 Finish = Callable[["StepLoop", Stepper, "int | None"], Stretch]
@@ -253,23 +253,27 @@ class StepLoop:
     def start(self, solver: str, t: float, y: np.ndarray, first_step: float | None = None
               ) -> Any:
         """An integrator of ``solver`` from ``(t, y)`` to the end of the grid: scipy's, or
-        on the compiled engine a :class:`Stepper` starting with scipy's first step (an
-        initial step that underflows to 0, at extreme parameters, stays with scipy, which
-        words that failure)."""
+        on the compiled engine a :class:`Stepper` (whose first call selects the first
+        step as scipy does, where ``first_step`` is None)."""
+        self.problem.solver = solver
+        first = None if first_step is None else min(first_step, float(self.grid[-1]) - t)
+        if self.finish is not None and solver in COMPILED_METHODS:
+            return Stepper(solver, float(t), np.array(y, dtype=float), first or 0.0)
+        return self.scipy_start(solver, t, y, first)
+
+    def scipy_start(self, solver: str, t: float, y: np.ndarray, first: float | None = None
+                    ) -> Any:
+        """scipy's integrator of ``solver`` from ``(t, y)`` (also where the compiled loop
+        finds no first step, at extreme values: scipy's steps word that failure)."""
         import scipy.integrate
 
         self.problem.solver = solver
         kwargs: dict[str, Any] = {"jac": self.problem.jac} if solver in IMPLICIT_SOLVERS else {}
-        if first_step is not None:
-            kwargs["first_step"] = min(first_step, float(self.grid[-1]) - t)
+        if first is not None:
+            kwargs["first_step"] = first
         cls = getattr(scipy.integrate, SOLVERS[solver])
-        integrator = cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol,
-                         atol=self.atol, **kwargs)
-        method = COMPILED_CLASSES.get(type(integrator).__name__)
-        if self.finish is None or method is None or not float(integrator.h_abs) > 0:
-            return integrator
-        return Stepper(method, float(integrator.t), np.array(integrator.y),
-                       float(integrator.h_abs))
+        return cls(self.problem.rhs, t, y, self.grid[-1], rtol=self.rtol, atol=self.atol,
+                   **kwargs)
 
     @staticmethod
     def both_failed(first: Stop, second: Stop) -> Stop:
