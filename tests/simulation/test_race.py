@@ -104,14 +104,15 @@ def test_compiled_probes_time_by_differences() -> None:
     # a small model: 10 compiled steps, and with 490 to go no estimate
     run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
     assert _auto(run, "unused") == ("dop853", "non-stiff: dop853 needs ~4.9e+02 more steps")
-    # radau's probe (4 and 16 steps) leaves ~2,000 steps, dop853's ~10,000: the counts
-    # cannot tell, so dop853 is timed on 20 and 200 more steps; each call's fixed cost
-    # (1 ms, far over the steps' microseconds) cancels in the differences
+    # radau's probe (20 steps) leaves ~2,000 steps, dop853's ~10,000: the counts cannot
+    # tell, so dop853 is timed on 20 and 200 more steps; each call's fixed cost (10 us,
+    # as much as 10 steps) cancels in the difference: ~0.0098 s to go. radau's cost,
+    # the probe's mean with the call's cost in it, is an upper bound: ~0.0049 s.
     run = Run({"dop853": 1e-3, "radau": 5e-3}, {"dop853": 1e-6, "radau": 2e-6},
-              compiled=True, call=1e-3)
+              compiled=True, call=1e-5)
     solver, reason = _auto(run)
     assert solver == "radau" and run.taken == {"dop853": 10 + 20 + 200, "radau": 2000}
-    assert reason == "race estimate; measured: radau ~0.004 s to go, dop853 ~0.0098 s"
+    assert reason == "race estimate; measured: radau ~0.0049 s to go, dop853 ~0.0098 s"
 
 
 def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
@@ -126,8 +127,8 @@ def test_step_counts_alone_decide_a_compiled_race_far_apart() -> None:
 
 def test_the_compiled_race_lets_radau_run_up_to_a_fifth_of_dop853s_time() -> None:
     """radau held to 10x smaller steps (each 2x dearer) runs stretches four times longer
-    each (4, 16, 64, 256, then what the budget leaves) until it has cost a fifth of
-    dop853's ~0.01 s: 977 steps of 2 us."""
+    each (its 20 probe steps, then 16, 64, 256, and what the budget leaves) until it has
+    cost a fifth of dop853's ~0.01 s: 977 steps of 2 us."""
     run = Run({"dop853": 1e-3, "radau": 1e-4}, {"dop853": 1e-6, "radau": 2e-6},
               compiled=True)
     solver, reason = _auto(run)
@@ -137,7 +138,7 @@ def test_the_compiled_race_lets_radau_run_up_to_a_fifth_of_dop853s_time() -> Non
 
 
 def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
-    """Over SPRINT_STATES states, 540 explicit steps come before a (dear) estimate."""
+    """Over SPRINT_STATES states, 510 explicit steps come before a (dear) estimate."""
     run = Run({"dop853": 0.02}, {"dop853": 1e-6}, compiled=True)
     x0 = np.zeros(race.SPRINT_STATES + 1)
     assert race.auto(run, 0.0, x0, 10.0, estimate("unused")) == (  # type: ignore[arg-type]
@@ -145,10 +146,10 @@ def test_a_large_compiled_model_sprints_before_its_estimate() -> None:
 
 
 def test_the_compiled_implicit_probe_stops_at_its_budget() -> None:
-    # dop853 projects ~10 s (1e5 steps of 1e-4 s): radau's 4 and 16 steps of 0.25 s
-    # spend the 5 s budget, and no further stretch fits
+    # dop853 projects ~10 s (1e5 steps of 1e-4 s): radau's 20 probe steps of 0.25 s
+    # (5 s) spend more than the 2 s budget, and no further stretch is run
     run = Run({"dop853": 1e-4, "radau": 1e-3}, {"dop853": 1e-4, "radau": 0.25},
               compiled=True)
     solver, reason = _auto(run)
-    assert solver == "dop853" and run.taken["radau"] == 4 + 16
+    assert solver == "dop853" and run.taken["radau"] == 20
     assert reason.endswith("measured: radau ~2.5e+03 s to go, dop853 ~10 s")

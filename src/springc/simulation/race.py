@@ -69,7 +69,7 @@ COMPILED_STRETCHES: dict[str, tuple[int, int]] = {EXPLICIT: (20, 200),
                                                  RACE_IMPLICIT: (16, 64)}
 """The steps of each method's first two timed calls in a compiled race (a call right
 after other work runs cold and is not compared with later ones: neither probe is
-timed)."""
+timed); ``radau``'s later stretches are four times longer each."""
 COMPILED_BUDGET = 0.2
 """The compiled race lets ``radau`` run up to this fraction of ``dop853``'s projected
 time (stretches four times longer each): an excited fast mode holds ``radau``'s first
@@ -176,41 +176,44 @@ def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, st
 
 def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
                    stop: float, stiffness: str) -> tuple[str, str]:
-    """The race on the compiled engine: ``radau`` takes :data:`IMPLICIT_PROBE` steps from
-    the start, and where the step counts alone decide (:data:`STEP_COST`) nothing is
-    timed; otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then
-    four times longer each, within what is left of :data:`COMPILED_BUDGET` of
-    ``dop853``'s projected time) until its projection beats ``dop853``'s or the budget
-    is spent."""
+    """The race on the compiled engine. ``radau`` takes :data:`IMPLICIT_PROBE` steps from
+    the start (4 for a model of over :data:`SPRINT_STATES` states, whose steps are
+    dear); where the step counts alone decide (:data:`STEP_COST`) nothing is timed.
+    Otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then four times
+    longer each, within what is left of :data:`COMPILED_BUDGET` of ``dop853``'s
+    projected time) until its projection beats ``dop853``'s or the budget is spent."""
+    small = len(x0) <= SPRINT_STATES
     explicit_steps = (stop - explicit.t) / _step(first)
     implicit = run.start(RACE_IMPLICIT, t0, x0)
-    done = [run.advance(implicit, IMPLICIT_PROBE)]  # (a call right after other work: untimed)
-    if not run.done:
-        implicit_steps = (stop - implicit.t) / _step(done[-1])
-        if len(x0) <= SPRINT_STATES and explicit_steps >= STEP_COST * implicit_steps:
-            return _finish(run, explicit, implicit, True, stiffness,
-                           f"~{implicit_steps:.2g} steps to go, {EXPLICIT} "
-                           f"~{explicit_steps:.2g}")
-        probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
-        if run.done:
-            return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
-        explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
-        steps = COMPILED_STRETCHES[RACE_IMPLICIT]
-        done.append(run.advance(implicit, steps[0]))
-        steps_next = steps[1]
-    while not run.done:
-        done.append(run.advance(implicit, steps_next))
-        if run.done:
-            break
+    done = [run.advance(implicit, IMPLICIT_PROBE if small else 4)]  # (untimed: cold)
+    if run.done:
+        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
+    implicit_steps = (stop - implicit.t) / _step(done[-1])
+    if small and explicit_steps >= STEP_COST * implicit_steps:
+        return _finish(run, explicit, implicit, True, stiffness,
+                       f"~{implicit_steps:.2g} steps to go, {EXPLICIT} ~{explicit_steps:.2g}")
+    probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
+    if run.done:
+        return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
+    explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
+    steps = float(COMPILED_STRETCHES[RACE_IMPLICIT][0])
+    while True:
         last = done[-1]
-        per_step = _per_step(done[-2], last)
+        # (two timed stretches: their difference; before, the last one's mean, an upper
+        # bound with the call's fixed cost in it)
+        per_step = _per_step(done[-2], last) if len(done) >= 3 else \
+            last.seconds / max(last.steps, 1)
         implicit_cost = (stop - implicit.t) / _step(last) * per_step
-        room = COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done)
-        if implicit_cost <= explicit_cost or room < per_step * steps[0]:
+        steps = min(steps, (COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done))
+                    / per_step)
+        if implicit_cost <= explicit_cost or steps < 1:
             return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
                            f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
-        steps_next = int(min(4 * last.steps, room / per_step))
-    return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
+        done.append(run.advance(implicit, int(steps)))
+        if run.done:
+            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
+                                   "trial steps")
+        steps = 4.0 * done[-1].steps
 
 
 def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffness: str,

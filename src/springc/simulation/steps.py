@@ -258,6 +258,8 @@ class StepLoop:
         self.problem.solver = solver
         first = None if first_step is None else min(first_step, float(self.grid[-1]) - t)
         if self.finish is not None and solver in COMPILED_METHODS:
+            self.problem.rhs(t, y)  # a start state the model cannot evaluate fails here,
+            # as scipy's integrators fail on their first evaluation (auto tries no other)
             return Stepper(solver, float(t), np.array(y, dtype=float), first or 0.0)
         return self.scipy_start(solver, t, y, first)
 
