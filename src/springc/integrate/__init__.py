@@ -47,6 +47,7 @@ from .engine import (
     dop853,
     fixed_step,
     load,
+    newton_flops,
     observed_grid,
     radau,
     rk45,
@@ -55,4 +56,5 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "load", "observed_grid", "radau", "rk45", "run_hybrid"]
+           "fixed_step", "load", "newton_flops",
+           "observed_grid", "radau", "rk45", "run_hybrid"]

@@ -198,6 +198,18 @@ def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: 
     return _run(grid_, result)
 
 
+def newton_flops(indptr: Any, indices: Any, dense_limit: int = 64) -> float:
+    """Floating-point operations of one factorization of :func:`radau`'s two Newton
+    matrices (the real one and the complex one, 4 real operations per complex one) for
+    a Jacobian of CSC sparsity ``(indptr, indices)``: about ``10 n kl (kl + ku)`` in the
+    band the kernel uses."""
+    indptr_ = np.ascontiguousarray(indptr, dtype=np.int64)
+    indices_ = np.ascontiguousarray(indices, dtype=np.int64)
+    n = indptr_.size - 1
+    _, kl, ku, _, _ = _band_layout(n, indptr_.tobytes(), indices_.tobytes(), dense_limit)
+    return 10.0 * n * max(kl, 1) * (kl + ku + 1)
+
+
 @functools.lru_cache(maxsize=16)
 def _band_layout(n: int, indptr: bytes, indices: bytes, dense_limit: int
                  ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:

@@ -113,6 +113,8 @@ class Run(Protocol):
 
     def both_failed(self, first: Any, second: Any) -> Exception: ...
 
+    def factorization_seconds(self) -> float: ...
+
 
 @dataclass(frozen=True)
 class Probe:
@@ -176,7 +178,10 @@ def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, st
 
 def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
                    stop: float, stiffness: str) -> tuple[str, str]:
-    """The race on the compiled engine. ``radau`` takes :data:`IMPLICIT_PROBE` steps from
+    """The race on the compiled engine. Where one factorization of ``radau``'s Newton
+    matrices (predicted from their band) would cost over :data:`COMPILED_BUDGET` of
+    ``dop853``'s projected time, ``dop853`` goes on. Else ``radau`` takes
+    :data:`IMPLICIT_PROBE` steps from
     the start (4 for a model of over :data:`SPRINT_STATES` states, whose steps are
     dear); where the step counts alone decide (:data:`STEP_COST`) nothing is timed.
     Otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then four times
@@ -184,6 +189,14 @@ def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.nd
     projected time) until its projection beats ``dop853``'s or the budget is spent."""
     small = len(x0) <= SPRINT_STATES
     explicit_steps = (stop - explicit.t) / _step(first)
+    # (an upper bound: the first call's fixed cost counted as stepping)
+    explicit_cost = explicit_steps * first.seconds / max(first.steps, 1)
+    factorization = run.factorization_seconds()
+    if factorization > COMPILED_BUDGET * explicit_cost:
+        run.advance(explicit)
+        return EXPLICIT, (f"{stiffness}, but one factorization of {RACE_IMPLICIT}'s Newton "
+                          f"matrices takes over {factorization:.2g} s, {EXPLICIT} "
+                          f"~{explicit_cost:.2g} s to go")
     implicit = run.start(RACE_IMPLICIT, t0, x0)
     done = [run.advance(implicit, IMPLICIT_PROBE if small else 4)]  # (untimed: cold)
     if run.done:
