@@ -8,6 +8,7 @@ import numpy as np
 import scipy.integrate
 
 import springc
+from same_method import assert_same_method
 from springc.integrate import Status, dop853, fixed_step
 from springc.simulation import initial_state
 
@@ -21,7 +22,7 @@ def test_generated_module_runs_as_simulate_does() -> None:
     grid = np.linspace(0.0, 10.0, 501)
     reference = springc.simulate(model, solver="dop853", stop=10.0, rtol=1e-6)
     run = dop853(mod.rhs, grid, initial_state(model, p), p, mod.guesses(p), rtol=1e-6,
-                 atol=1e-9, observed=mod.observed)
+                 atol=1e-9, observed=mod.observed, scipy_arithmetic=False)  # as simulate
     assert run.status == Status.SUCCESS and run.accepted_steps == reference.stats.steps
     np.testing.assert_array_equal(reference.time, grid)
     for i, name in enumerate(model.states):
@@ -46,10 +47,9 @@ def test_vector_layout_module_runs_on_the_compiled_engine() -> None:
     scipy_run = springc.simulate(model, solver="dop853", stop=2.0, rtol=1e-10,
                                  engine="scipy")
     assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
-    # the same generated functions and scipy's steps: equal bit for bit, observed too
-    assert compiled.stats.steps == scipy_run.stats.steps
-    assert compiled.names == scipy_run.names and len(compiled.names) > 2 * 100
-    np.testing.assert_array_equal(compiled.values, scipy_run.values)
+    # the same generated functions and scipy's method (plain-loop sums), observed too
+    assert len(compiled.names) > 2 * 100
+    assert_same_method(compiled, scipy_run, 1e-10)
     # against an independent tight reference: the same chain as a hand-written ODE
     k, rest, mass, ds, n = 100.0, 1.0, 1.0, 0.5, 100
 

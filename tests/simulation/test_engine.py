@@ -11,9 +11,10 @@ import pytest
 from click.testing import CliRunner
 
 import springc
+from same_method import assert_same_method
 from springc.cli import main
 from springc.errors import SimulationError, UsageError
-from springc.simulation import write_csv
+from springc.simulation import initial_state, write_csv
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -73,25 +74,38 @@ def csv_text(result: springc.SimulationResult) -> str:
 
 @pytest.mark.parametrize("rtol", [1e-6, 1e-9])
 @pytest.mark.parametrize("name", sorted(MODELS))
-def test_compiled_dop853_equals_scipy(name: str, rtol: float) -> None:
+def test_compiled_dop853_is_scipys_method(name: str, rtol: float) -> None:
     files, model_name = MODELS[name]
     model = springc.compile_model(files, model_name, backend="numba")
+    reference = springc.simulate(model, solver="dop853", rtol=1e-13, atol=1e-16)
     for solver in ("auto", "dop853"):
         compiled = springc.simulate(model, solver=solver, rtol=rtol, engine="compiled")
         scipy_run = springc.simulate(model, solver=solver, rtol=rtol, engine="scipy")
         assert compiled.stats.engine == "compiled" and scipy_run.stats.engine == "scipy"
         assert compiled.stats.solver == scipy_run.stats.solver == "dop853"
-        assert compiled.stats.steps == scipy_run.stats.steps
-        # the same generated functions: the same steps and values, bit for bit
-        assert csv_text(compiled) == csv_text(scipy_run)
+        # the same generated functions and controller; sums in plain loops, not BLAS
+        assert_same_method(compiled, scipy_run, rtol, reference)
     # auto picks the compiled engine for the numba backend (the default), scipy for
-    # the python backend; the two agree within 1e-12 (numba vs Python float arithmetic)
+    # the python backend
     default = springc.simulate(files, model_name=model_name, rtol=rtol)
     python = springc.simulate(files, model_name=model_name, rtol=rtol, backend="python")
     assert default.stats.engine == "compiled" and python.stats.engine == "scipy"
-    assert default.names == python.names
-    scale = np.abs(python.values).max(axis=0)
-    assert (np.abs(default.values - python.values) <= 1e-12 * scale).all()
+    assert_same_method(default, python, rtol, reference)
+
+
+def test_the_kernel_with_scipys_sums_equals_scipy_bit_for_bit() -> None:
+    """springc.integrate.dop853(scipy_arithmetic=True) on the generated seed: scipy's
+    steps and values exactly (simulate's plain-loop sums are within rounding of it)."""
+    from springc.integrate import dop853
+
+    model = springc.compile_model(SEED, backend="numba")
+    mod, p = model.module, model.parameters()
+    scipy_run = springc.simulate(model, solver="dop853", engine="scipy")
+    run = dop853(mod.rhs, scipy_run.time, initial_state(model, p), p, mod.guesses(p),
+                 rtol=1e-6, atol=1e-9, scipy_arithmetic=True)
+    assert run.accepted_steps == scipy_run.stats.steps == 972
+    for i, name in enumerate(model.states):
+        np.testing.assert_array_equal(run.states[:, i], scipy_run[name])
 
 
 @pytest.mark.parametrize("name", sorted(MODELS))
@@ -112,23 +126,21 @@ def test_compiled_rk45_equals_scipy(name: str) -> None:
 def test_long_runs_go_on_where_a_stretch_stopped(monkeypatch: pytest.MonkeyPatch,
                                                   solver: str) -> None:
     # stretches of 50 steps (then 500, 5000): each goes on from the time, state and next
-    # step size where the one before stopped, so the run takes scipy's steps and values
-    # exactly, with one more RHS evaluation per stretch (its start), not the whole run
+    # step size where the one before stopped, so the run takes one whole run's steps
+    # and values exactly, with one more RHS evaluation per stretch (its start), not the whole run
     # again per stretch
     import springc.simulation.compiled as compiled_engine
 
-    monkeypatch.setattr(compiled_engine, "FIRST_CHUNK", 50)
     model = springc.compile_model(SEED, backend="numba")
+    whole = springc.simulate(model, solver=solver, rtol=1e-8, engine="compiled")
+    monkeypatch.setattr(compiled_engine, "FIRST_CHUNK", 50)
     compiled = springc.simulate(model, solver=solver, rtol=1e-8, engine="compiled")
-    scipy_run = springc.simulate(model, solver=solver, rtol=1e-8, engine="scipy")
     assert compiled.stats.engine == "compiled"
-    assert compiled.stats.steps == scipy_run.stats.steps > 550
+    assert compiled.stats.steps == whole.stats.steps > 550
     # stretches of 50, 500, 5,000 and 50,000 steps (rejected ones included): 3 to 5
-    extra = compiled.stats.rhs_evaluations - scipy_run.stats.rhs_evaluations
+    extra = compiled.stats.rhs_evaluations - whole.stats.rhs_evaluations
     assert 2 <= extra <= 4, extra
-    scale = np.abs(scipy_run.values).max(axis=0)
-    bound = 0.0 if solver == "dop853" else 1e-13  # rk45: see test_compiled_rk45_equals_scipy
-    assert (np.abs(compiled.values - scipy_run.values) <= bound * np.maximum(scale, 1)).all()
+    np.testing.assert_array_equal(compiled.values, whole.values)  # the same run
 
 
 @pytest.mark.parametrize("solver", ["radau", "bdf"])

@@ -5,8 +5,9 @@
   backend's functions; errors name the option).
 - :func:`advance_compiled`: the step loop's integrators run compiled, to the end of the
   grid or for a number of steps (``auto``'s probes): DOP853 and RK45 take scipy's steps
-  (same start, same controller), so a run equals the scipy run bit for bit; Radau IIA
-  and BDF with the generated sparse Jacobian in a banded LU.
+  (same start, same controller) with plain-loop sums (equal to the scipy run within
+  rounding, faster than numpy's BLAS calls on small systems: the seed 2.7 ms against
+  3.6 ms); Radau IIA and BDF with the generated sparse Jacobian in a banded LU.
 - :func:`run_fixed_compiled`: the fixed-step solvers, compiled.
 
 Failures come back as :class:`springc.integrate.Status` codes and become the scipy
@@ -252,7 +253,8 @@ def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, fl
 
     def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
         return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                        atol=loop.atol, first_step=first or None, max_steps=steps)
+                        atol=loop.atol, first_step=first or None, max_steps=steps,
+                        scipy_arithmetic=False)
     return run_explicit
 
 

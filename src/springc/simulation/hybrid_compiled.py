@@ -165,4 +165,5 @@ def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.
         return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
                         x, p, z, **options)
     explicit = dop853 if solver == EXPLICIT else rk45
-    return explicit(mod.rhs, times, x, p, z, **options)
+    # (plain-loop sums, as the continuous engine: see compiled.advance_compiled)
+    return explicit(mod.rhs, times, x, p, z, scipy_arithmetic=False, **options)
