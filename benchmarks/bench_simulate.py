@@ -142,6 +142,23 @@ def first_run(env: dict[str, str]) -> tuple[float, float]:
     return float(out[0]), float(out[1])
 
 
+def solve_ivp_on_numba_rhs(repeats: int) -> float:
+    """The smallest wall time of scipy's ``solve_ivp(method="DOP853")`` driving the seed's
+    hand-written numba right-hand side (``bench_engine.seed_rhs``), same tolerances and
+    output grid as ``simulate``'s defaults."""
+    from scipy.integrate import solve_ivp
+
+    from bench_engine import ATOL, INTERVALS, NO_Z, RTOL, SEED_P, SEED_X0, STOP, seed_rhs
+
+    grid = np.linspace(0.0, STOP, INTERVALS + 1)
+
+    def run() -> object:
+        return solve_ivp(lambda t, x: seed_rhs(t, x, SEED_P, NO_Z), (0.0, STOP), SEED_X0,
+                         method="DOP853", t_eval=grid, rtol=RTOL, atol=ATOL)
+    run()
+    return min(timeit.repeat(run, number=1, repeat=repeats))
+
+
 def bench_engines(repeats: int) -> None:
     numba_model = springc.compile_model(SEED, backend="numba")
     python_model = springc.compile_model(SEED, backend="python")
@@ -149,13 +166,17 @@ def bench_engines(repeats: int) -> None:
     scipy_numba, _ = best_run(repeats, model=numba_model, engine="scipy")
     scipy_python, _ = best_run(repeats, model=python_model, engine="scipy")
     steps = run.stats.steps  # type: ignore[attr-defined]
+    baseline = solve_ivp_on_numba_rhs(repeats)
+    rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
+                 f"solve_ivp DOP853, hand-written numba rhs {baseline * 1e3:.0f} ms",
+                 f"{baseline / compiled:.0f}x faster", "issue 13: at least 20x"))
     rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
                  f"scipy engine, numba module {scipy_numba * 1e3:.0f} ms",
                  f"{scipy_numba / compiled:.0f}x faster", f"{steps} steps"))
     rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
                  f"scipy engine, python module {scipy_python * 1e3:.0f} ms",
                  f"{scipy_python / compiled:.0f}x faster", "(the scipy engine's default)"))
-    # --solver dop853: no auto probe (40 scipy steps) and no stiffness estimate
+    # --solver dop853: no auto probe and no stiffness estimate
     direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="compiled")
     scipy_direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="scipy")
     rows.append(("(d) seed in process, warm, --solver dop853 compiled",
