@@ -45,6 +45,10 @@ class Run:
 
     def advance(self, integrator: Integrator, max_steps: int | None = None) -> Stretch:
         h = self.step[integrator.solver]
+        if h == 0:  # every step rejected: the attempts cost, no step is accepted
+            assert max_steps is not None, "a method that never steps is run to the end"
+            self.taken[integrator.solver] = self.taken.get(integrator.solver, 0) + max_steps
+            return Stretch(0, self.call + max_steps * self.cost[integrator.solver], ())
         left = int(np.ceil((self.stop - integrator.t) / h - 1e-9))
         steps = left if max_steps is None else min(max_steps, left)
         integrator.t = min(self.stop, integrator.t + steps * h)
@@ -168,3 +172,13 @@ def test_a_compiled_race_skips_radau_whose_factorization_alone_is_over_budget() 
     assert solver == "dop853" and run.taken == {"dop853": 10_000}
     assert reason == ("race estimate, but one factorization of radau's Newton matrices "
                       "takes over 1.6 s, dop853 ~0.1 s to go")
+
+
+def test_a_compiled_stretch_that_accepts_no_step_projects_no_end() -> None:
+    """radau's probe rejecting every step (no step size settled): its projection is
+    infinite and the race keeps dop853, with no error on the empty stretch."""
+    run = Run({"dop853": 1e-3, "radau": 0.0}, {"dop853": 1e-6, "radau": 2e-6},
+              compiled=True)
+    solver, reason = _auto(run)
+    assert solver == "dop853" and run.taken["dop853"] == 10_000
+    assert reason.endswith("measured: radau ~inf s to go, dop853 ~0.0098 s")

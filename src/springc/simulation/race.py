@@ -17,21 +17,23 @@
    limit carries fast-mode noise that would hold ``radau``'s first steps small.)
 
 On the compiled engine steps are cheap and each call of a compiled loop has a fixed
-cost (some 50 microseconds, tens of steps of a small model), so the explicit probe is
-:data:`COMPILED_PROBE` steps (for a model of over :data:`SPRINT_STATES` states, whose
-estimate is dearer than compiled steps, :data:`CHEAP_STEPS` more), and the race times
-each method on two calls of its loop (:data:`COMPILED_STRETCHES`): its time per step
-is their difference in time over their difference in steps, so the fixed cost cancels.
+cost (some 50 microseconds, tens of steps of a small model): the explicit probe is
+:data:`COMPILED_PROBE` steps (:data:`CHEAP_STEPS` more for a model of over
+:data:`SPRINT_STATES` states, whose estimate is dearer than compiled steps), and the
+race is :func:`_compiled_race`: step counts far apart decide alone, each method's time
+per step is the difference of two calls (the fixed cost cancels), and ``radau`` may
+run up to :data:`COMPILED_BUDGET` of ``dop853``'s projected time, since its early
+projection can be far too dear.
 
 The probes are steps of the real run (the grid points they pass are kept), so
-deciding costs at most the two probes: a few percent of any run long enough to
-matter. The projection is taken early, so it sees ``radau`` at its worst when a fast
-mode is excited above the tolerance (it must resolve the first oscillations before
-its damping removes them): the race then keeps ``dop853``, which resolves that
-vibration instead of damping it away. A failure inside the explicit probe (an
-overflow from an unstable step) hands the run to ``radau``; if ``radau`` fails too,
-the explicit probe's error is reported (where the trouble began) with ``radau``'s as
-a note. Failures after the decision are the run's own.
+deciding costs at most the two probes. On scipy's loop the projection is taken early,
+so it sees ``radau`` at its worst when a fast mode is excited above the tolerance (it
+must resolve the first oscillations before its damping removes them): the race then
+keeps ``dop853``, which resolves that vibration instead of damping it away. A failure
+inside the explicit probe (an overflow from an unstable step) hands the run to
+``radau``; if ``radau`` fails too, the explicit probe's error is reported (where the
+trouble began) with ``radau``'s as a note. Failures after the decision are the run's
+own.
 """
 
 from __future__ import annotations
@@ -118,14 +120,15 @@ class Run(Protocol):
 
 @dataclass(frozen=True)
 class Probe:
-    """What a probe measured: its steps, the step size its method settled on, the
-    seconds per step of stepping, the seconds it cost in all and its last stretch."""
+    """What a probe measured: the step size its method settled on (0 where it accepted
+    none) and the seconds per step of stepping."""
 
-    steps: int
     step: float
     per_step: float
-    seconds: float
-    last: Stretch
+
+    def cost(self, span: float) -> float:
+        """Projected seconds for ``span`` at that step size and time per step."""
+        return _steps(span, self.step) * self.per_step
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -149,7 +152,7 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
         return RACE_IMPLICIT, f"{EXPLICIT} failed in its first steps ({failure})"
     if run.done:
         return EXPLICIT, f"non-stiff: {EXPLICIT} finished in {probe.steps} steps"
-    left = (stop - explicit.t) / _step(probe)
+    left = _steps(stop - explicit.t, _step(probe))
     if left <= CHEAP_STEPS:
         run.advance(explicit)
         return EXPLICIT, f"non-stiff: {EXPLICIT} needs ~{left:.2g} more steps"
@@ -166,12 +169,12 @@ def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, st
           stiffness: str) -> tuple[str, str]:
     if run.compiled:
         return _compiled_race(run, explicit, first, t0, x0, stop, stiffness)
-    explicit_cost = (stop - explicit.t) / _step(first) * first.seconds / max(first.steps, 1)
+    explicit_cost = Probe(_step(first), _mean(first)).cost(stop - explicit.t)
     implicit = run.start(RACE_IMPLICIT, t0, x0)
     trial = _scipy_implicit_probe(run, implicit, explicit_cost)
     if run.done:
         return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
-    implicit_cost = (stop - implicit.t) / trial.step * trial.per_step
+    implicit_cost = trial.cost(stop - implicit.t)
     return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
                    f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
 
@@ -181,16 +184,16 @@ def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.nd
     """The race on the compiled engine. Where one factorization of ``radau``'s Newton
     matrices (predicted from their band) would cost over :data:`COMPILED_BUDGET` of
     ``dop853``'s projected time, ``dop853`` goes on. Else ``radau`` takes
-    :data:`IMPLICIT_PROBE` steps from
-    the start (4 for a model of over :data:`SPRINT_STATES` states, whose steps are
-    dear); where the step counts alone decide (:data:`STEP_COST`) nothing is timed.
+    :data:`IMPLICIT_PROBE` steps from the start (4 for a model of over
+    :data:`SPRINT_STATES` states, whose steps are dear); where the step counts alone
+    decide (:data:`STEP_COST`) nothing is timed.
     Otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then four times
     longer each, within what is left of :data:`COMPILED_BUDGET` of ``dop853``'s
     projected time) until its projection beats ``dop853``'s or the budget is spent."""
     small = len(x0) <= SPRINT_STATES
-    explicit_steps = (stop - explicit.t) / _step(first)
+    explicit_steps = _steps(stop - explicit.t, _step(first))
     # (an upper bound: the first call's fixed cost counted as stepping)
-    explicit_cost = explicit_steps * first.seconds / max(first.steps, 1)
+    explicit_cost = explicit_steps * _mean(first)
     factorization = run.factorization_seconds()
     if factorization > COMPILED_BUDGET * explicit_cost:
         run.advance(explicit)
@@ -201,22 +204,21 @@ def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.nd
     done = [run.advance(implicit, IMPLICIT_PROBE if small else 4)]  # (untimed: cold)
     if run.done:
         return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
-    implicit_steps = (stop - implicit.t) / _step(done[-1])
+    implicit_steps = _steps(stop - implicit.t, _step(done[-1]))
     if small and explicit_steps >= STEP_COST * implicit_steps:
         return _finish(run, explicit, implicit, True, stiffness,
                        f"~{implicit_steps:.2g} steps to go, {EXPLICIT} ~{explicit_steps:.2g}")
     probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
     if run.done:
         return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
-    explicit_cost = (stop - explicit.t) / probe.step * probe.per_step
+    explicit_cost = probe.cost(stop - explicit.t)
     steps = float(COMPILED_STRETCHES[RACE_IMPLICIT][0])
     while True:
         last = done[-1]
         # (two timed stretches: their difference; before, the last one's mean, an upper
         # bound with the call's fixed cost in it)
-        per_step = _per_step(done[-2], last) if len(done) >= 3 else \
-            last.seconds / max(last.steps, 1)
-        implicit_cost = (stop - implicit.t) / _step(last) * per_step
+        per_step = _per_step(done[-2], last) if len(done) >= 3 else _mean(last)
+        implicit_cost = Probe(_step(last), per_step).cost(stop - implicit.t)
         steps = min(steps, (COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done))
                     / per_step)
         if implicit_cost <= explicit_cost or steps < 1:
@@ -247,20 +249,18 @@ def _timed(run: Run, integrator: Any, stretches: tuple[int, int]) -> Probe:
     done = [run.advance(integrator, stretches[0])]
     if not run.done:
         done.append(run.advance(integrator, stretches[1]))
-    last = done[-1]
-    return Probe(sum(s.steps for s in done), _step(last) if last.sizes else math.inf,
-                 _per_step(done[0], last), sum(s.seconds for s in done), last)
+    return Probe(_step(done[-1]), _per_step(done[0], done[-1]))
 
 
 def _per_step(before: Stretch, last: Stretch) -> float:
     """Seconds per step: the difference of two stretches of a method over their
     difference in steps (each call's fixed cost cancels), or the last one's mean where
     that is not positive (or the two are one)."""
-    per_step = last.seconds / max(last.steps, 1)
     if last is not before and last.steps != before.steps:
         difference = (last.seconds - before.seconds) / (last.steps - before.steps)
-        per_step = difference if difference > 0 else per_step
-    return per_step
+        if difference > 0:
+            return difference
+    return _mean(last)
 
 
 def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Probe:
@@ -268,18 +268,27 @@ def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Prob
     or :data:`PROBE_BUDGET` of the explicit method's projected cost."""
     steps, seconds = 0, 0.0
     sizes: list[float] = []
-    trial = None
     while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
         trial = run.advance(implicit, 1)
         steps, seconds = steps + trial.steps, seconds + trial.seconds
         sizes += trial.sizes
         if run.done:
             break
-    assert trial is not None  # (one step at least: the budget is positive)
-    return Probe(steps, float(np.median(sizes[-5:])) if sizes else math.inf,
-                 seconds / max(steps, 1), seconds, trial)
+    return Probe(float(statistics.median(sizes[-5:])) if sizes else 0.0,
+                 seconds / max(steps, 1))
 
 
 def _step(stretch: Stretch) -> float:
-    """The step size a method has settled on: the median of its last steps."""
-    return float(statistics.median(stretch.sizes[-5:]))
+    """The step size a method has settled on: the median of its last steps (0 where it
+    accepted none)."""
+    return float(statistics.median(stretch.sizes[-5:])) if stretch.sizes else 0.0
+
+
+def _steps(span: float, step: float) -> float:
+    """Steps of ``step`` over ``span`` (infinitely many where the step is 0)."""
+    return span / step if step > 0 else math.inf
+
+
+def _mean(stretch: Stretch) -> float:
+    """A stretch's seconds per step, with its call's fixed cost in them."""
+    return stretch.seconds / max(stretch.steps, 1)
