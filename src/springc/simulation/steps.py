@@ -3,9 +3,11 @@
 by step by one integrator after another (:class:`StepLoop`, which ``auto``'s race of
 :mod:`springc.simulation.race` drives).
 
-The integrators are ``scipy.integrate``'s solver classes (``RK45``, ``DOP853``,
-``Radau``, ``BDF``, ``LSODA``) stepped one by one, so that springc can show progress,
-stop at the first non-finite value, and name the time and the states at fault.
+On scipy's engine the integrators are ``scipy.integrate``'s solver classes (``RK45``,
+``DOP853``, ``Radau``, ``BDF``, ``LSODA``) stepped one by one, so that springc can show
+progress, stop at the first non-finite value, and name the time and the states at
+fault; on the compiled engine they are :class:`Stepper` handles run in stretches by
+:func:`springc.simulation.compiled.advance_compiled`.
 Output is interpolated with each step's dense output exactly on the grid. Implicit
 methods get the generated analytic Jacobian: dense for small systems, ``scipy.sparse``
 CSC beyond :data:`DENSE_JACOBIAN_LIMIT`.
