@@ -10,7 +10,6 @@ condition is Boolean is checked once the variables' types are known
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -21,6 +20,7 @@ from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
 from .scope import ExpressionEvaluator, Scope
+from .strings import real_text
 
 LEVELS = {"AssertionLevel.error": "error", "AssertionLevel.warning": "warning"}
 _PARAMETERS = ("condition", "message", "level")
@@ -146,18 +146,9 @@ def _string_of(ev: ExpressionEvaluator, call: s.Call, scope: Scope,
     elif isinstance(value, (int, np.integer)):
         text = str(int(value))
     else:
-        digits = int(options.get("significantDigits", 6))
-        text = _real_text(float(value), digits)
+        text = real_text(float(value), int(options.get("significantDigits", 6)))
     width = int(options.get("minimumLength", 0))
     return text.ljust(width) if options.get("leftJustified", True) else text.rjust(width)
-
-
-def _real_text(value: float, digits: int) -> str:
-    if math.isnan(value):
-        return "NaN"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    return f"{value:.{max(1, digits)}g}"
 
 
 def is_boolean(e: x.Expr, types: dict[str, str]) -> bool:
