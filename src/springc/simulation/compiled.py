@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import UsageError
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
-from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, FIXED_STEP
+from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
 from .solvers import detect_pairs, non_finite_states
 from .steps import Problem, StepLoop, Stepper, Stretch, solver_failure
 
@@ -237,25 +237,27 @@ def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, fl
                                                      Run]:
     """``run(times, y, first_step, max_steps)``: ``method``'s compiled loop on ``loop``'s
     model and tolerances (``first_step`` 0: the loop selects it)."""
+    problem = loop.problem
+
+    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        return adaptive_run(method, problem.mod, times, y, problem.p, problem.z,
+                            rtol=loop.rtol, atol=loop.atol, first_step=first or None,
+                            max_steps=steps)
+    return run
+
+
+def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.ndarray,
+                 z: np.ndarray, **options: Any) -> Run:
+    """One kernel run of the adaptive ``solver`` (dop853, rk45 with plain-loop sums;
+    radau and bdf with the generated sparse Jacobian) on the generated module ``mod``."""
     from springc.integrate import bdf, dop853, radau, rk45
 
-    problem = loop.problem
-    mod = problem.mod
-    if method in ("radau", "bdf"):
-        implicit = radau if method == "radau" else bdf
-
-        def run_implicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-            return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
-                            times, y, problem.p, problem.z, rtol=loop.rtol, atol=loop.atol,
-                            first_step=first or None, max_steps=steps)
-        return run_implicit
-    explicit = rk45 if method == "rk45" else dop853
-
-    def run_explicit(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
-        return explicit(mod.rhs, times, y, problem.p, problem.z, rtol=loop.rtol,
-                        atol=loop.atol, first_step=first or None, max_steps=steps,
-                        scipy_arithmetic=False)
-    return run_explicit
+    if solver in (RACE_IMPLICIT, "bdf"):
+        implicit = radau if solver == RACE_IMPLICIT else bdf
+        return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
+                        x, p, z, **options)
+    explicit = dop853 if solver == EXPLICIT else rk45
+    return explicit(mod.rhs, times, x, p, z, scipy_arithmetic=False, **options)
 
 
 def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step: float

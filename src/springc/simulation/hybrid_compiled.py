@@ -34,14 +34,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .compiled import FIXED_CHUNK, failure, time_limit_reached
+from .compiled import FIXED_CHUNK, adaptive_run, failure, time_limit_reached
 from .events import LOCATE_TOLERANCE, EventLoop
 from .limits import OverLimit
-from .solver_names import EXPLICIT, FIXED_STEP, RACE_IMPLICIT
+from .solver_names import FIXED_STEP
 from .solvers import detect_pairs
 
 if TYPE_CHECKING:
-    from springc.integrate import Run
+    pass
 
 ADAPTIVE_CHUNK = 100_000
 """Steps (accepted and rejected) of one adaptive kernel run between checks of the limits."""
@@ -153,17 +153,3 @@ def snaps(grid: np.ndarray, k: int, t_event: float) -> bool:
     j = int(np.searchsorted(grid, t_event)) - 1  # grid[j] < t_event
     return j >= k and t_event <= grid[j] + LOCATE_TOLERANCE * max(1.0, abs(grid[j]))
 
-
-def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.ndarray,
-                 z: np.ndarray, **options: Any) -> Run:
-    """One kernel run of the adaptive ``solver`` (dop853, rk45; radau and bdf with the
-    generated sparse Jacobian) on the generated module ``mod``."""
-    from springc.integrate import bdf, dop853, radau, rk45
-
-    if solver in (RACE_IMPLICIT, "bdf"):
-        implicit = radau if solver == RACE_IMPLICIT else bdf
-        return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
-                        x, p, z, **options)
-    explicit = dop853 if solver == EXPLICIT else rk45
-    # (plain-loop sums, as the continuous engine: see compiled.advance_compiled)
-    return explicit(mod.rhs, times, x, p, z, scipy_arithmetic=False, **options)

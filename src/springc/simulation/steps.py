@@ -31,13 +31,19 @@ from ..simplify import describe_failure
 from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
-from .solver_names import IMPLICIT_SOLVERS, RACE_IMPLICIT, SOLVERS
+from .solver_names import (
+    COMPILED_SOLVERS,
+    FIXED_STEP,
+    IMPLICIT_SOLVERS,
+    RACE_IMPLICIT,
+    SOLVERS,
+)
 
 DENSE_JACOBIAN_LIMIT = 64
 FLOP_RATE = 2e10
 """Operations per second above what the compiled banded LU reaches on one core (about
 7e9 measured on the 50x50 cloth): times predicted at this rate are lower bounds."""
-COMPILED_METHODS = frozenset({"dop853", "rk45", "radau", "bdf"})
+COMPILED_METHODS = frozenset(COMPILED_SOLVERS) - frozenset(FIXED_STEP)
 """Solvers whose integrators ``StepLoop.finish`` runs in a compiled loop."""
 
 
