@@ -40,9 +40,9 @@ def test_nothing_is_written_to_or_read_from_the_shared_temporary_folder(tmp_path
     assert cached.name.startswith("modelica-") and cached.suffix == ".pickle"
 
 
-def test_cache_folder_is_created_private_and_tightened(tmp_path: Path,
-                                                       monkeypatch: pytest.MonkeyPatch
-                                                       ) -> None:
+def test_cache_folder_is_created_private_and_never_changed(tmp_path: Path,
+                                                           monkeypatch: pytest.MonkeyPatch
+                                                           ) -> None:
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path))
     old = os.umask(0)
     try:
@@ -52,8 +52,21 @@ def test_cache_folder_is_created_private_and_tightened(tmp_path: Path,
     assert file is not None and file.parent == tmp_path / "parser"
     assert stat.S_IMODE(file.parent.stat().st_mode) == 0o700
     file.parent.chmod(0o777)
-    assert parser_cache_file(grammar_path()) == file
-    assert stat.S_IMODE(file.parent.stat().st_mode) == 0o700
+    assert parser_cache_file(grammar_path()) is None  # others may write it: not used
+    assert stat.S_IMODE(file.parent.stat().st_mode) == 0o777
+    file.parent.chmod(0o700)
+
+
+def test_no_parser_folder_in_another_users_cache_folder(tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch
+                                                         ) -> None:
+    folder = tmp_path / "cache"
+    folder.mkdir(mode=0o700)
+    uid = os.getuid()
+    monkeypatch.setattr(os, "getuid", lambda: uid + 1)  # springc runs as another user
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(folder))
+    assert parser_cache_file(grammar_path()) is None
+    assert list(folder.iterdir()) == []
 
 
 def test_a_symlink_or_a_file_others_may_write_is_not_loaded(tmp_path: Path,

@@ -123,7 +123,7 @@ def test_cache_folder_is_private_under_umask_0(tmp_path: Path,
     assert compiled.path.parent.parent == folder
 
 
-def test_cache_folder_writable_by_others_is_made_private(
+def test_own_cache_folder_writable_by_others_is_refused_untouched(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
         capsys: pytest.CaptureFixture[str]) -> None:
     model, path = compiled_once(tmp_path, monkeypatch)
@@ -131,11 +131,59 @@ def test_cache_folder_writable_by_others_is_made_private(
     os.chmod(folder, 0o777)
     capsys.readouterr()
     again = springc.compile_model(str(model))
-    assert stat.S_IMODE(folder.stat().st_mode) == 0o700
-    assert not again.cached  # entries written while others could write are dropped
+    assert stat.S_IMODE(folder.stat().st_mode) == 0o777  # springc changes no mode
+    assert path.exists()  # ... and removes nothing
+    assert not again.cached and not again.path.is_relative_to(folder)
     assert capsys.readouterr().err == (
-        f"note: the cache folder {folder} was writable by others: it is private now and "
-        "its entries were removed\n")
+        f"note: cannot use the cache folder: {folder} is writable by others (make it "
+        "private: chmod 700); compiling in a temporary folder\n")
+    os.chmod(folder, 0o700)
+
+
+def test_shared_sticky_cache_folder_is_used_through_a_private_subfolder(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """A folder like /tmp (mode 1777, other users' files inside) keeps its mode and its
+    files; springc creates its own private folder inside it and says so."""
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    os.chmod(shared, 0o1777)
+    others = shared / "someone-else"
+    others.mkdir()
+    (others / "model.py").write_text("x = 1\n")
+    (shared / "notes.txt").write_text("theirs\n")
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(shared))
+    model = tmp_path / "M1.mdl"
+    model.write_text(ONE)
+    first = springc.compile_model(str(model))
+    again = springc.compile_model(str(model))
+    inner = shared / f"springc-{os.getuid()}"
+    assert stat.S_IMODE(shared.stat().st_mode) == 0o1777
+    assert sorted(p.name for p in shared.iterdir()) == sorted(
+        ["someone-else", "notes.txt", inner.name])
+    assert (others / "model.py").read_text() == "x = 1\n"
+    assert stat.S_IMODE(inner.stat().st_mode) == 0o700
+    assert first.path.parent.parent == inner and again.cached
+    note = (f"note: the cache folder {shared} is shared with other users: springc keeps "
+            f"its files in {inner}\n")
+    assert capsys.readouterr().err == 2 * note
+    os.chmod(shared, 0o700)
+
+
+def test_pruning_removes_only_cache_entries(tmp_path: Path) -> None:
+    folder = tmp_path / "cache"
+    project = folder / "project"
+    project.mkdir(parents=True)
+    (project / "model.py").write_text("print('mine')\n")
+    (project / "model.sha256").write_text("0" * 64 + "\n")
+    entries = []
+    for i in range(3):
+        entries.append(folder / f"{i:024x}")
+        cache.write_entry(entries[-1], f"x = {i}\n")
+        os.utime(entries[-1] / "model.py", (i + 1, i + 1))
+    os.utime(project / "model.py", (0, 0))
+    assert cache.prune_cache(folder, keep=entries[2].name, limit=1) == entries[1::-1]
+    assert sorted(p.name for p in folder.iterdir()) == [entries[2].name, "project"]
 
 
 @pytest.mark.parametrize("problem", ["a file", "another user's folder"])

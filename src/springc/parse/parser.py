@@ -28,7 +28,7 @@ from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedTok
 
 from ..errors import LoadError, ParseError, Span
 from ..ir.syntax import Expr, StoredDefinition
-from ..resources import grammar_path, user_cache_dir
+from ..resources import CacheUnusable, grammar_path, private_folder, user_cache_dir
 from .builder import build
 
 __all__ = ["parse_expression", "parse_file", "parse_text"]
@@ -86,20 +86,17 @@ def _lark() -> Lark:
 def parser_cache_file(grammar: Path) -> Path | None:
     """Where the parser tables of ``grammar`` are cached: a file named by the grammar's
     digest and the lark and Python versions, in ``<user cache>/parser``, created 0700.
-    None (build the parser without a cache) unless that folder is a real folder owned
-    by this user (a looser one is tightened to 0700) and the file, if present, is a
-    regular file owned by this user (one that others may write is removed)."""
+    None (build the parser without a cache) unless the cache folder and that folder are
+    usable private folders of this user (:func:`private_folder`: nothing is created in
+    a refused one, no mode is changed) and the file, if present, is a regular file
+    owned by this user (one that others may write is removed)."""
     try:
         home = user_cache_dir()
         if home is None:
             return None
-        folder = home / "parser"
-        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-        info = os.lstat(folder)
-        if not stat.S_ISDIR(info.st_mode) or info.st_uid != os.getuid():
+        folder = private_folder(private_folder(home, quiet=True) / "parser", quiet=True)
+        if os.path.islink(folder):
             return None
-        if info.st_mode & 0o077:
-            os.chmod(folder, 0o700)
         digest = hashlib.sha256(grammar.read_bytes()).hexdigest()[:32]
         version = f"lark{lark.__version__}-py{sys.version_info[0]}{sys.version_info[1]}"
         file = folder / f"modelica-{digest}-{version}.pickle"
@@ -110,7 +107,7 @@ def parser_cache_file(grammar: Path) -> Path | None:
             if info.st_mode & 0o022:
                 file.unlink()
         return file
-    except OSError:
+    except (OSError, CacheUnusable):
         return None
 
 

@@ -7,7 +7,9 @@ model (:func:`cache_key`) combined with the observed variables it computes
 (:func:`selection_key`); the model's key also names an entry holding ``names.json``
 (with ``names.sha256``), its states and observed variables, so that a new ``--vars``
 is resolved to those variables without flattening the model again. The cache folder
-is private (created 0700, whatever the umask). A module is imported only from the
+is private (created 0700, whatever the umask; a shared sticky folder is used through a
+private subfolder, and no folder springc finds has its mode changed or its files
+removed: :func:`springc.resources.private_folder`). A module is imported only from the
 bytes whose hash matched the record: an edited, planted, truncated or unreadable entry
 is regenerated with a one-line note on stderr, never executed. A cache folder that
 cannot be used (not a folder, not writable, owned by another user) gives a note, and
@@ -23,7 +25,6 @@ import hashlib
 import json
 import os
 import shutil
-import stat
 import sys
 import tempfile
 from collections.abc import Sequence
@@ -33,7 +34,13 @@ from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
 from ..parse import library_folders, source_files
-from ..resources import PACKAGE_ROOT, grammar_path, user_cache_dir
+from ..resources import (  # noqa: F401 (re-exported)
+    PACKAGE_ROOT,
+    CacheUnusable,
+    grammar_path,
+    private_folder,
+    user_cache_dir,
+)
 
 CACHE_ENTRIES = 200
 """Generated modules kept in the cache; the least recently used beyond this are removed."""
@@ -42,10 +49,6 @@ MODULE_FILE = "model.py"
 HASH_FILE = "model.sha256"
 NAMES_FILE = "names.json"
 """The record of a model's output names (states, observed), in an entry of its own."""
-
-
-class CacheUnusable(Exception):
-    """The cache folder cannot hold entries (the reason is the message)."""
 
 
 def note(text: str) -> None:
@@ -61,43 +64,6 @@ def cache_dir() -> Path:
     return folder
 
 
-def private_folder(folder: Path) -> Path:
-    """``folder``, created 0700 (missing parents too) and checked: a folder of this user
-    that no one else may write. Raises :class:`CacheUnusable` otherwise."""
-    missing = []
-    parent = folder
-    while not parent.exists() and parent != parent.parent:
-        missing.append(parent)
-        parent = parent.parent
-    try:
-        for path in reversed(missing):
-            path.mkdir(mode=0o700)  # the umask only removes bits: 0700 stays 0700
-        info = folder.stat()
-    except OSError as err:
-        raise CacheUnusable(f"cannot create {folder}: {err.strerror or err}") from err
-    if not stat.S_ISDIR(info.st_mode):
-        raise CacheUnusable(f"{folder} is not a folder")
-    if info.st_uid != os.getuid():
-        raise CacheUnusable(f"{folder} belongs to another user")
-    if info.st_mode & 0o077:
-        # Readable or writable by others (an older springc, or a umask of 000): make
-        # it private; entries written while others could write are not trusted.
-        writable = bool(info.st_mode & 0o022)
-        try:
-            os.chmod(folder, 0o700)
-        except OSError as err:
-            raise CacheUnusable(f"cannot make {folder} private: {err.strerror}") from err
-        if writable:
-            note(f"the cache folder {folder} was writable by others: it is private now "
-                 "and its entries were removed")
-            for entry in folder.iterdir():
-                if (entry / MODULE_FILE).exists() or (entry / NAMES_FILE).exists():
-                    shutil.rmtree(entry, ignore_errors=True)
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise CacheUnusable(f"{folder} is not writable")
-    return folder
-
-
 def touch(path: Path) -> None:
     """Mark a cache entry as used (its modification time orders the pruning)."""
     with contextlib.suppress(OSError):  # a read-only cache still works
@@ -106,12 +72,15 @@ def touch(path: Path) -> None:
 
 def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]:
     """Remove the least recently used entries beyond ``limit`` (never ``keep``): module
-    entries and names records are counted apart."""
+    entries and names records are counted apart. Only folders that look like entries
+    (a key's name, holding the file and its hash record) are counted or removed."""
     limit = CACHE_ENTRIES if limit is None else limit
     removed = []
     for name in (MODULE_FILE, NAMES_FILE):
         entries = []
         for entry in folder.iterdir() if folder.is_dir() else ():
+            if not _is_key(entry.name) or not (entry / _hash_file(name)).is_file():
+                continue
             try:
                 entries.append(((entry / name).stat().st_mtime, entry))
             except OSError:  # not such an entry, or being written
@@ -167,6 +136,10 @@ def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) 
 
 
 # ------------------------------------------------------------------ entries
+
+
+def _is_key(name: str) -> bool:
+    return len(name) == 24 and all(c in "0123456789abcdef" for c in name)
 
 
 def _hash_file(name: str) -> str:
