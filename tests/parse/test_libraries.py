@@ -15,6 +15,7 @@ import springc
 from springc.errors import SpringcError, render
 from springc.ir.flat import format_equation, format_flat
 from springc.parse import load
+from springc.parse.library import source_files as library_sources
 from springc.pipeline import flatten_files
 from springc.pipeline.cache import cache_key
 
@@ -268,12 +269,63 @@ def test_an_older_style_mdl_file_may_hold_several_classes(tmp_path: Path) -> Non
 
 
 def test_a_symbolic_link_back_to_a_parent_folder_is_walked_once(tmp_path: Path) -> None:
-    lib = write(tmp_path / "lib", {"sub/parts.mdl": "package Parts\n  model A\n"
-                                                    "    Real a = 1;\n  end A;\nend Parts;\n"})
-    (lib / "sub" / "loop").symlink_to(lib)
+    lib = write(tmp_path / "lib", {"Parts/package.mo": "package Parts\n  model A\n"
+                                   "    Real a = 1;\n  end A;\nend Parts;\n"})
+    (lib / "Parts" / "Loop").symlink_to(lib / "Parts")
     user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
     assert [format_equation(e) for e in flatten_files([user], None, [lib]).equations] == [
         "'a.a' = 1;"]
+    assert cache_key(("M", "python"), [str(user)], [lib]) == cache_key(
+        ("M", "python"), [str(user)], [lib])
+
+
+def test_an_mdl_file_in_a_folder_that_is_not_a_package_is_not_read(tmp_path: Path) -> None:
+    """Only the top of a root may hold older-style .mdl files: a stray one further down
+    (here one that would replace the bundled Modelica library) is not part of it."""
+    lib = write(tmp_path / "lib", {"junk/deeper/evil.mdl": "package Modelica\n  "
+                                   "constant Real pi = 4;\nend Modelica;\n",
+                                   "Parts.mdl": "package Parts\n  model A\n"
+                                   "    Real a = Modelica.Constants.pi;\n  end A;\nend Parts;\n"})
+    user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
+    (equation,) = flatten_files([user], None, [lib]).equations
+    assert format_equation(equation).startswith("'a.a' = 3.14159265358979")
+    assert not any("junk" in str(p) for p in library_sources(lib))
+
+
+def test_an_unreadable_library_tree_is_skipped_by_the_cache_key(tmp_path: Path) -> None:
+    """A package tree deeper than the longest path the system accepts: loading never
+    reaches its bottom, and the cache key skips what it cannot read."""
+    lib = tmp_path / "lib"
+    lib.mkdir()
+    name = "P" * 100
+    fds = [os.open(lib, os.O_RDONLY)]
+    for _ in range(45):  # 45 levels of 101 characters: past PATH_MAX (4096)
+        os.mkdir(name, dir_fd=fds[-1])
+        fd = os.open(name, os.O_RDONLY, dir_fd=fds[-1])
+        with os.fdopen(os.open("package.mo", os.O_WRONLY | os.O_CREAT, dir_fd=fd),
+                       "w") as file:
+            file.write(f"package {name}\nend {name};\n")
+        fds.append(fd)
+    try:
+        user = write(tmp_path, {"m.mo": "model M\n  Real x = 1;\nend M;\n"}) / "m.mo"
+        first = cache_key(("M", "python"), [str(user)], [lib])
+        assert cache_key(("M", "python"), [str(user)], [lib]) == first
+        assert 30 < len(library_sources(lib)) < 45  # those within PATH_MAX
+    finally:
+        for fd, parent in zip(fds[:0:-1], fds[-2::-1], strict=True):
+            os.unlink("package.mo", dir_fd=fd)
+            os.close(fd)
+            os.rmdir(name, dir_fd=parent)
+        os.close(fds[0])
+
+
+def test_a_type_name_too_long_for_a_file_name_is_an_unknown_class(tmp_path: Path) -> None:
+    name = "A" * 300
+    user = write(tmp_path, {"m.mo": f"model M\n  {name} a;\nend M;\n"}) / "m.mo"
+    with pytest.raises(SpringcError) as exc:
+        flatten_files([user], None, [tmp_path])
+    assert error_text(exc).splitlines()[0] == (
+        f"{user}:2:3: error: unknown class '{name}'")
 
 
 def test_a_missing_member_of_a_package_folder_names_the_folder(tmp_path: Path) -> None:

@@ -64,7 +64,7 @@ def package_file(folder: Path) -> Path | None:
     """``folder/package.mo`` (or ``package.mdl``) if ``folder`` stores a package."""
     for name in PACKAGE_FILES:
         candidate = folder / name
-        if candidate.is_file():
+        if _is_file(candidate):
             return candidate
     return None
 
@@ -75,13 +75,13 @@ def class_file(folder: Path, name: str) -> Path | None:
     if not _FILE_NAME.match(name):
         return None
     sub = folder / name
-    if sub.is_dir():
+    if _is_dir(sub):
         found = package_file(sub)
         if found is not None:
             return found
     for suffix in SUFFIXES:
         candidate = folder / f"{name}{suffix}"
-        if candidate.is_file():
+        if _is_file(candidate):
             return candidate
     return None
 
@@ -104,40 +104,66 @@ def stored_names(folder: Path) -> list[str]:
     names = [p.stem for p in children
              if p.suffix in SUFFIXES and not is_package_file(p) and _FILE_NAME.match(p.stem)]
     names += [p.name for p in children
-              if p.is_dir() and _FILE_NAME.match(p.name) and package_file(p) is not None]
+              if _FILE_NAME.match(p.name) and _is_package_folder(p)]
     return sorted(set(names))
 
 
 def loose_files(root: Path) -> list[Path]:
-    """Files of a root that may not be found by class name: every ``.mdl`` file in the
-    root and in its folders that are not packages (springc's older layout, where
-    ``parts.mdl`` may hold ``package Parts``). Package folders are not entered; ``.mo``
-    files are found by their names only, as the specification says."""
-    found: list[Path] = []
-    pending = [root]
-    visited: set[Path] = set()
-    while pending:
-        folder = pending.pop()
-        if folder.resolve() in visited:  # a symbolic link back to a parent folder
-            continue
-        visited.add(folder.resolve())
-        try:
-            children = sorted(folder.iterdir())
-        except OSError:
-            continue
-        for child in children:
-            if child.is_dir():
-                if package_file(child) is None:
-                    pending.append(child)
-            elif child.suffix == ".mdl" and child.is_file():
-                found.append(child)
-    return sorted(found)
+    """Files of a root that may not be found by class name: every ``.mdl`` file at the
+    top of the root (springc's older layout, where ``parts.mdl`` may hold ``package
+    Parts``). Subfolders are never searched for them: a file in a folder that is not a
+    package is not part of the library, and ``.mo`` files are found by their names only,
+    as the specification says."""
+    return [p for p in _entries(root) if p.suffix == ".mdl" and _is_file(p)]
 
 
 def source_files(folder: Path) -> list[Path]:
-    """Every file below ``folder`` that loading may read (``.mo``, ``.mdl``,
-    ``package.order``), sorted: what a cache key must cover."""
-    if not folder.is_dir():
+    """Every file loading may read below the root or package folder ``folder`` (``.mo``,
+    ``.mdl``, ``package.order`` in it and, recursively, in its subfolders that are
+    packages), sorted: what a cache key must cover. Folders that cannot be read (gone,
+    a path too long, no permission) are skipped: loading cannot read them either."""
+    found: list[Path] = []
+    pending = [folder]
+    visited: set[Path] = set()
+    while pending:
+        current = pending.pop()
+        try:
+            real = current.resolve()
+        except (OSError, RuntimeError):
+            continue
+        if real in visited:  # a symbolic link back to a parent folder
+            continue
+        visited.add(real)
+        for child in _entries(current):
+            if child.suffix in SUFFIXES or child.name == ORDER_FILE:
+                if _is_file(child):
+                    found.append(child)
+            elif _FILE_NAME.match(child.name) and _is_package_folder(child):
+                pending.append(child)
+    return sorted(found)
+
+
+def _entries(folder: Path) -> list[Path]:
+    """The entries of ``folder``, sorted; none if it cannot be read."""
+    try:
+        return sorted(folder.iterdir())
+    except OSError:
         return []
-    return sorted(p for p in folder.rglob("*")
-                  if (p.suffix in SUFFIXES or p.name == ORDER_FILE) and p.is_file())
+
+
+def _is_file(path: Path) -> bool:
+    try:
+        return path.is_file()
+    except OSError:  # a name too long for the file system, no permission
+        return False
+
+
+def _is_dir(path: Path) -> bool:
+    try:
+        return path.is_dir()
+    except OSError:  # a name too long for the file system, no permission
+        return False
+
+
+def _is_package_folder(path: Path) -> bool:
+    return _is_dir(path) and package_file(path) is not None
