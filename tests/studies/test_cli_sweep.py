@@ -3,6 +3,9 @@ on stderr, --quiet, and the exit code and message of bad options."""
 
 from __future__ import annotations
 
+import contextlib
+import socket
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -74,3 +77,69 @@ def test_bad_options_exit_2_naming_the_option(tmp_path: Path, args: list[str],
     result = CliRunner().invoke(main, ["sweep", SEED, *args])
     assert result.exit_code == 2
     assert result.stderr.startswith("error: " + message)
+
+
+class _Service:
+    """A TCP service on the loopback address that is not a Dask scheduler: it greets
+    every connection with ``greeting`` (text of another protocol) or closes it."""
+
+    def __init__(self, greeting: bytes) -> None:
+        self.greeting = greeting
+        self.server = socket.create_server(("127.0.0.1", 0))
+        self.port = self.server.getsockname()[1]
+        self.thread = threading.Thread(target=self.serve, daemon=True)
+        self.thread.start()
+
+    def serve(self) -> None:
+        while True:
+            try:
+                conn, _ = self.server.accept()
+            except OSError:
+                return
+            with conn, contextlib.suppress(OSError):  # the client may reset it
+                if self.greeting:
+                    conn.sendall(self.greeting)
+                    conn.recv(1)  # until the client closes
+
+    def close(self) -> None:
+        self.server.shutdown(socket.SHUT_RDWR)  # wakes the blocked accept()
+        self.server.close()
+        self.thread.join(timeout=10)
+
+
+@pytest.mark.parametrize(("greeting", "reason"), [
+    (b"HTTP/1.1 200 OK\r\nServer: web\r\n\r\n" + b"\xff" * 64,
+     "the service there does not speak Dask's protocol"),
+    (b"", "the service closed the connection without a greeting"),
+])
+def test_a_service_that_is_not_a_scheduler_exits_2_and_leaves_nothing(
+        tmp_path: Path, greeting: bytes, reason: str) -> None:
+    service = _Service(greeting)
+    address = f"tcp://127.0.0.1:{service.port}"
+    output = tmp_path / "study.parquet"
+    try:
+        for _ in range(2):  # the second run is not refused for "partial results"
+            result = CliRunner().invoke(main, [
+                "sweep", SEED, "--param", "spring.k=1e3,1e4", "--stop", "0.2",
+                "--scheduler", address, "-o", str(output)])
+            assert result.exit_code == 2, result.output
+            assert result.stderr.splitlines()[0] == (
+                f"error: --scheduler {address}: cannot connect to a Dask scheduler "
+                f"({reason})")
+            assert sorted(tmp_path.iterdir()) == []
+    finally:
+        service.close()
+
+
+def test_a_port_where_nothing_listens_exits_2_and_leaves_nothing(tmp_path: Path) -> None:
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        port = server.getsockname()[1]  # closed again: nothing listens there
+    output = tmp_path / "study.parquet"
+    result = CliRunner().invoke(main, [
+        "sweep", SEED, "--param", "spring.k=1e3,1e4", "--stop", "0.2",
+        "--scheduler", f"127.0.0.1:{port}", "-o", str(output)])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines()[0] == (
+        f"error: --scheduler 127.0.0.1:{port}: cannot connect to a Dask scheduler "
+        "(Connection refused)")
+    assert sorted(tmp_path.iterdir()) == []

@@ -34,13 +34,7 @@ from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
 from ..parse import library_folders, source_files
-from ..resources import (  # noqa: F401 (re-exported)
-    PACKAGE_ROOT,
-    CacheUnusable,
-    grammar_path,
-    private_folder,
-    user_cache_dir,
-)
+from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, user_cache_dir
 
 CACHE_ENTRIES = 200
 """Generated modules kept in the cache; the least recently used beyond this are removed."""

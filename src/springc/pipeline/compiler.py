@@ -28,16 +28,15 @@ from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
 from ..ir.expr import recursion_room
 from ..parse import ClassEntry, ClassTree, load, parse_text
+from ..resources import CacheUnusable, private_folder
 from ..simplify import simplify
 from .cache import (
-    CacheUnusable,
     Names,
     cache_dir,
     cache_key,
     discard,
     import_module,
     note,
-    private_folder,
     prune_cache,
     read_entry,
     read_names,

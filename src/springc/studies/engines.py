@@ -25,6 +25,8 @@ import contextlib
 import functools
 import multiprocessing
 import os
+import socket
+import struct
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
@@ -97,22 +99,61 @@ def local_batches(job: RunJob, work: Sequence[Batch], workers: int
         yield records
 
 
+CONNECT_SECONDS = 10.0
+"""How long connecting to a scheduler (and reading its greeting) may take."""
+MAX_GREETING = 1 << 24
+"""The largest first message a Dask scheduler is believed to send (its handshake is a
+few hundred bytes): a larger length read from a service is not Dask's protocol."""
+
+
 def connect(address: str) -> Any:
-    """A ``distributed.Client`` of the scheduler at ``address`` (a UsageError naming
-    ``--scheduler`` if there is none)."""
+    """A ``distributed.Client`` of the scheduler at ``address``: a UsageError naming
+    ``--scheduler`` if there is none, or if the service there is not a Dask scheduler
+    (within about ``CONNECT_SECONDS``)."""
     try:
         from distributed import Client
     except ImportError:
         raise UsageError("--scheduler needs Dask distributed: pip install "
                          "'springc[cluster]'", option="--scheduler") from None
+    problem = probe(address)
+    if problem is None:
+        try:
+            return Client(address, timeout=f"{CONNECT_SECONDS}s",  # type: ignore[no-untyped-call]
+                          set_as_default=False)
+        except (OSError, TimeoutError, ValueError, MemoryError) as err:
+            problem = str(err)
+    raise UsageError(f"--scheduler {address}: cannot connect to a Dask scheduler "
+                     f"({problem})", option="--scheduler",
+                     hint="start one with 'dask scheduler' and workers with "
+                     "'dask worker ADDRESS'")
+
+
+def probe(address: str) -> str | None:
+    """Why the TCP service at ``address`` (``tcp://HOST:PORT`` or ``HOST:PORT``) is not a
+    Dask scheduler, read from its first bytes: a scheduler greets every connection with
+    a message whose 8-byte length comes first. ``None`` if it may be one, or if the
+    address is of another kind (Dask's own client judges those)."""
+    scheme, _, rest = address.rpartition("://")
+    host, colon, port = rest.rpartition(":")
+    if scheme not in ("", "tcp") or not colon or not port.isdigit() or int(port) > 65535:
+        return None
     try:
-        return Client(address, timeout="10s",  # type: ignore[no-untyped-call]
-                      set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as err:
-        raise UsageError(f"--scheduler {address}: cannot connect to a Dask scheduler "
-                         f"({err})", option="--scheduler",
-                         hint="start one with 'dask scheduler' and workers with "
-                         "'dask worker ADDRESS'") from None
+        with socket.create_connection((host.strip("[]"), int(port)),
+                                      timeout=CONNECT_SECONDS) as sock:
+            head = b""
+            while len(head) < 8:
+                chunk = sock.recv(8 - len(head))
+                if not chunk:
+                    return "the service closed the connection without a greeting"
+                head += chunk
+    except TimeoutError:
+        return f"no greeting within {CONNECT_SECONDS:g} s: not a Dask scheduler"
+    except OSError as err:
+        return err.strerror or str(err)
+    (length,) = struct.unpack("Q", head)
+    if not 0 < length <= MAX_GREETING:
+        return "the service there does not speak Dask's protocol"
+    return None
 
 
 def dask_workers(client: Any) -> int:

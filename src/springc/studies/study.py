@@ -143,12 +143,11 @@ def job_of(model: CompiledModel, options: StudyOptions) -> RunJob:
 Pending = Sequence[tuple[int, tuple[float, ...]]]
 
 
-def _engine(options: StudyOptions, job: RunJob, pending: Pending
+def _engine(options: StudyOptions, job: RunJob, pending: Pending, client: Any
             ) -> tuple[Iterator[list[Any]], int, str, Callable[[], None]]:
     """The batches' results as they complete, the worker count, the engine's name,
-    and what to call at the end."""
-    if options.scheduler is not None:
-        client = connect(options.scheduler)
+    and what to call at the end (``client``: the connected Dask client, if any)."""
+    if client is not None:
         workers = dask_workers(client)
         work: list[Batch] = batches(pending, workers)
         return (dask_batches(client, job, work), workers,
@@ -180,10 +179,21 @@ def run_study(model: CompiledModel, options: StudyOptions, output: str | None = 
                              option="--set")
     layout = layout_of(model, options, values)
     job = job_of(model, options)
+    if options.workers is not None and options.workers < 1:
+        raise UsageError(f"--workers must be at least 1, not {options.workers}",
+                         option="--workers")
+    # Connect first: a scheduler that cannot be reached leaves no partial results.
+    client = connect(options.scheduler) if options.scheduler is not None else None
+    fresh = output is not None and not os.path.lexists(partial_folder(output))
     shards = None
     if output is not None:
         description = describe(layout, values, model.source)
-        shards = Shards(partial_folder(output), description, resume)
+        try:
+            shards = Shards(partial_folder(output), description, resume)
+        except BaseException:
+            if client is not None:
+                client.close()
+            raise
     done = shards.done() if shards is not None else set()
     pending = [(i, tuple(float(v) for v in values[i])) for i in range(len(values))
                if i not in done]
@@ -191,7 +201,11 @@ def run_study(model: CompiledModel, options: StudyOptions, output: str | None = 
     tables: list[Any] = []
     computed: list[int] = []
     meter = StudyProgress(progress, len(values), len(done))
-    results, workers, engine, close = _engine(options, job, pending)
+    try:
+        results, workers, engine, close = _engine(options, job, pending, client)
+    except BaseException:
+        _drop_empty(shards, fresh, client)
+        raise
     try:
         for records in results:
             table = records_table(layout, records, by_run)
@@ -204,11 +218,23 @@ def run_study(model: CompiledModel, options: StudyOptions, output: str | None = 
             meter.update(len(records) - failed, failed)
             if callback is not None:
                 callback(meter.done, len(values))
+    except BaseException:
+        _drop_empty(shards, fresh, None)
+        raise
     finally:
         meter.close()
         close()
     return _finish(model, layout, values, shards, tables, computed, workers, engine,
                    began, output, summary, protected)
+
+
+def _drop_empty(shards: Shards | None, fresh: bool, client: Any) -> None:
+    """After a failure: close ``client``; remove the shard folder if this run created it
+    and wrote no shard (a study that never ran leaves nothing behind)."""
+    if client is not None:
+        client.close()
+    if shards is not None and fresh and shards.count == 0:
+        shards.remove()
 
 
 def _finish(model: CompiledModel, layout: Layout, values: np.ndarray,
