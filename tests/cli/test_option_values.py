@@ -61,6 +61,10 @@ OPTION_CASES = [
     (["--set", "k=-inf"], "error: --set: the value of 'k' must be a finite number, not -inf"),
     (["--set", "N=2.5"], "error: 'N' is an Integer parameter: 2.5 is not a whole number of "
                          "magnitude at most 2147483647"),
+    (["--start", "-1e308", "--stop", "1e308"], "error: --start -1e+308 to --stop 1e+308: "
+     "the span is too large for a floating-point number"),
+    (["--stop", "1e6", "--interval", "1e-12"], "error: --interval 1e-12: 1e+18 output "
+     "intervals are too many (at most 10,000,000)\nhelp: use a larger --interval"),
 ]
 
 
@@ -73,6 +77,24 @@ def test_bad_values_exit_2_naming_the_option(model: str, tmp_path: Path, args: l
     assert result.exit_code == 2, result.output
     assert result.stderr == message + "\n"
     assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["simulate", "sweep"])
+@pytest.mark.parametrize(("args", "message"), [
+    (["--start", "-1e308", "--stop", "1e308"], "error: --start -1e+308 to --stop 1e+308: "
+     "the span is too large for a floating-point number"),
+    (["--time-limit", "nan"], "Error: Invalid value for '--time-limit': 'nan' is not a "
+     "number"),
+])
+def test_span_and_time_limit_of_simulate_and_sweep(model: str, tmp_path: Path,
+                                                   command: str, args: list[str],
+                                                   message: str) -> None:
+    out = tmp_path / ("out.csv" if command == "simulate" else "out.parquet")
+    extra = ["--param", "k=1,2"] if command == "sweep" else []
+    result = CliRunner().invoke(main, [command, model, "-q", "-o", str(out), *extra, *args])
+    assert result.exit_code == 2, result.output
+    assert result.stderr.splitlines()[-1] == message
+    assert list(tmp_path.iterdir()) == [Path(model)]
 
 
 @pytest.mark.parametrize("item", ["=3", "k", "k=abc"])

@@ -3,6 +3,7 @@ options, ``--set`` values, output paths refused before any work."""
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -10,6 +11,19 @@ from typing import Any
 import click
 
 from ..errors import OutputError, UsageError
+
+
+class NumberRange(click.FloatRange):
+    """``click.FloatRange`` that also refuses ``nan`` (no comparison with a bound fails
+    for it, so ``FloatRange`` lets it through)."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        number = super().convert(value, param, ctx)
+        if math.isnan(number):
+            self.fail(f"{value!r} is not a number", param, ctx)
+        return number
+
 
 CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
              "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}

@@ -10,6 +10,7 @@ from ..simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, F
 from .app import guard, main
 from .options import (
     CLI_NAMES,
+    NumberRange,
     check_output_options,
     compile_options,
     model_options,
@@ -50,7 +51,7 @@ from .options import (
 @click.option("--max-steps", type=click.IntRange(min=1), default=None,
               help="Stop with an error after this many integrator steps (default "
               "20,000,000).")
-@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--time-limit", type=NumberRange(min=0, min_open=True), default=None,
               help="Stop with an error after this many seconds of wall clock (default "
               "3600).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),

@@ -11,6 +11,7 @@ from ..simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
 from .app import guard, main
 from .options import (
     CLI_NAMES,
+    NumberRange,
     check_output_options,
     compile_options,
     model_options,
@@ -47,7 +48,7 @@ from .options import (
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
 @click.option("--max-steps", type=click.IntRange(min=1), default=None,
               help="Integrator steps per run before it fails (as for simulate).")
-@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=None,
+@click.option("--time-limit", type=NumberRange(min=0, min_open=True), default=None,
               help="Seconds of wall clock per run before it fails (as for simulate).")
 @click.option("--energy", metavar="NAME", help="Variable whose drift the summary "
               "reports (default: the only selected variable in J, if any).")

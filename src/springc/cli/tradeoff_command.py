@@ -10,6 +10,7 @@ from ..errors import UsageError
 from .app import guard, main
 from .options import (
     CLI_NAMES,
+    NumberRange,
     check_output_options,
     compile_options,
     model_options,
@@ -83,11 +84,11 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
               "until 0.2 s of timings): a run meeting a --max-error within 5x of the fastest "
               "one known, and scipy's default call; other runs, and runs over 2 s, are "
               "timed once.")
-@click.option("--cost-limit", type=click.FloatRange(min=1), default=10.0, show_default=True,
+@click.option("--cost-limit", type=NumberRange(min=1), default=10.0, show_default=True,
               metavar="FACTOR", help="Skip a solver's tighter settings once one of its runs "
               "takes FACTOR times dop853's fastest run meeting every --max-error (the "
               "table says which); inf runs them all.")
-@click.option("--budget", type=click.FloatRange(min=0, min_open=True), default=30.0,
+@click.option("--budget", type=NumberRange(min=0, min_open=True), default=30.0,
               show_default=True, help="Seconds per run: a longer run is stopped and the "
               "solver's tighter settings are skipped.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False),

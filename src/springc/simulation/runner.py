@@ -63,6 +63,7 @@ from .solver_names import (
     FIXED_STEP,
 )
 from .steps import Problem, Progress, StepLoop, integrate
+from .values import MAX_INTERVALS
 
 DEFAULT_START, DEFAULT_STOP, DEFAULT_INTERVALS = 0.0, 10.0, 500
 DEFAULT_RTOL = 1e-6
@@ -95,12 +96,15 @@ def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
     if not (math.isfinite(start) and math.isfinite(stop)) or stop <= start:
         raise SimulationError(f"the stop time {stop:g} must be after the start time "
                               f"{start:g}")
+    if not math.isfinite(stop - start):
+        raise SimulationError(f"the span from {start:g} to {stop:g} is too large for a "
+                              "floating-point number")
     if not interval > 0:
         raise SimulationError(f"the output interval must be positive, not {interval:g}")
     count = (stop - start) / interval
     n = max(1, round(count)) if abs(count - round(count)) < 1e-9 * max(1.0, count) \
         else math.ceil(count)
-    if n > 10_000_000:
+    if n > MAX_INTERVALS:
         raise SimulationError(f"{n} output intervals are too many",
                               hint="use a larger --interval")
     grid = start + interval * np.arange(n + 1, dtype=float)

@@ -17,6 +17,10 @@ API_NAMES = {"start": "start", "stop": "stop", "interval": "interval", "rtol": "
 """How :func:`check_run_values` names each value: the keywords of :func:`simulate`."""
 
 
+MAX_INTERVALS = 10_000_000
+"""The most output intervals a run may have."""
+
+
 def as_number(value: object, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise UsageError(f"{name} must be a number, not {value!r}", option=name)
@@ -47,11 +51,22 @@ def check_run_values(start: float | None = None, stop: float | None = None,
     if first is not None and last is not None and not last > first:
         raise UsageError(f"{names['stop']} ({last:g}) must be after {names['start']} "
                          f"({first:g})", option=names["stop"])
+    if first is not None and last is not None and not math.isfinite(last - first):
+        raise UsageError(f"{names['start']} {first:g} to {names['stop']} {last:g}: the "
+                         "span is too large for a floating-point number",
+                         option=names["stop"])
     for key, value in (("interval", interval), ("step", step), ("atol", atol)):
         number = finite(value, key)
         if number is not None and not number > 0:
             raise UsageError(f"{names[key]} must be a finite number > 0, not {number!r}",
                              option=names[key])
+    if interval is not None and last is not None:
+        span = last - (first if first is not None else 0.0)
+        if span / float(interval) > MAX_INTERVALS:
+            raise UsageError(f"{names['interval']} {interval:g}: {span / interval:.3g} "
+                             f"output intervals are too many (at most {MAX_INTERVALS:,})",
+                             option=names["interval"], hint=f"use a larger "
+                             f"{names['interval']}")
     if rtol is not None:
         number = as_number(rtol, names["rtol"])
         if not 0 < number < 1:
