@@ -132,3 +132,54 @@ def test_the_command_line_flag_sets_the_cap(tmp_path: Path,
     assert accepted.output == "Big: 10 unknowns, 10 equations, 0 parameters: balanced\n"
     bad = runner.invoke(main, ["--max-size", "0", "check", str(path)])
     assert bad.exit_code == 2 and "'--max-size'" in bad.output
+
+
+DOUBLING = """
+model D
+  function grow
+    input Integer n;
+    output String s;
+  algorithm
+    s := "ab";
+    for i in 1:n loop
+      s := s + s;
+    end for;
+  end grow;
+  parameter String t = grow({n});
+  Real x = 1;
+end D;
+"""
+
+
+def test_a_string_doubled_in_a_function_is_capped_where_it_grows(tmp_path: Path) -> None:
+    """2 * 2^n characters: n = 40 would need 2 TB; the cap stops it at the first
+    concatenation past the limit (2^10 + 2^10 > 2000 characters)."""
+    path = tmp_path / "d.mdl"
+    path.write_text(DOUBLING.format(n=40))
+    tree = load([path])
+    with pytest.raises(FlattenError) as caught:
+        flatten(tree, "D", max_size=2000)
+    err = caught.value
+    assert err.message == "this String has 2048 characters, more than the limit of 2000"
+    assert err.span is not None and (err.span.line, err.span.column) == (9, 12)
+    path.write_text(DOUBLING.format(n=9))  # 1024 characters: within the cap
+    assert len(flatten(load([path]), "D", max_size=2000).equations) == 1
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    ("String(1, minimumLength = 2001)",
+     "the 'minimumLength' of String(...) has 2001 characters, more than the limit of 2000"),
+    ("String(1.5, format = \"3000.3f\")",
+     "the 'format' of String(...) has 3000 characters, more than the limit of 2000"),
+    ("String(1.5, significantDigits = 100000)",
+     "the 'significantDigits' of String(...) has 100000 characters, more than the limit "
+     "of 2000"),
+])
+def test_string_widths_past_the_cap_are_refused(tmp_path: Path, call: str,
+                                                message: str) -> None:
+    path = tmp_path / "w.mdl"
+    path.write_text(f"model W\n  parameter String t = {call};\n  Real x = 1;\nend W;\n")
+    with pytest.raises((FlattenError, ErrorGroup)) as caught:
+        flatten(load([path]), "W", max_size=2000)
+    err = caught.value.errors[0] if isinstance(caught.value, ErrorGroup) else caught.value
+    assert isinstance(err, FlattenError) and err.message == message

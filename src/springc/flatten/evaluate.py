@@ -220,6 +220,9 @@ class Evaluator(ReferenceResolver):
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check
             return scalar(cast(x.Expr, left), cast(x.Expr, right))
+        if type(left) is str and type(right) is str and e.op == "+":
+            self.flattener.limits.check_size(len(left) + len(right), "this String", e.span,
+                                             "characters")
         text = string_binary(e.op, left, right, e.span)
         if text is not None:
             return text

@@ -171,6 +171,7 @@ def string_call(ev: ExpressionEvaluator, call: s.Call, scope: Scope) -> str:
                                hint="its arguments are minimumLength, leftJustified, "
                                "significantDigits and format")
         options[named.name] = ev.constant(named.value, scope, f"'{named.name}'")
+    _check_widths(ev, options, call)
     arg = read(ev.value(call.args[0], scope))
     check_known(arg, call.args[0].span)
     if isinstance(arg, str):
@@ -187,6 +188,21 @@ def string_call(ev: ExpressionEvaluator, call: s.Call, scope: Scope) -> str:
     if isinstance(value, np.ndarray):
         raise FlattenError("'String' of an array is not defined", call.args[0].span)
     return _text(value, options, call)
+
+
+def _check_widths(ev: ExpressionEvaluator, options: dict[str, Any], call: s.Call) -> None:
+    """Refuse a width or a number of digits past the size cap before any text is made
+    (``minimumLength = 10^9`` would make a String of a gigabyte)."""
+    numbers: list[tuple[str, Any]] = [(key, options[key]) for key in (
+        "minimumLength", "significantDigits") if key in options]
+    spec = options.get("format")
+    if isinstance(spec, str):
+        numbers += [("format", float(n) if len(n) < 20 else math.inf)
+                    for n in re.findall(r"\d+", spec)]
+    for key, number in numbers:
+        if isinstance(number, (int, float, np.integer, np.floating)):
+            ev.flattener.limits.check_size(float(number), f"the '{key}' of String(...)",
+                                           call.span, "characters")
 
 
 def _bound(ev: ExpressionEvaluator, e: s.Expr, scope: Scope) -> Any:
