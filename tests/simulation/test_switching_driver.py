@@ -107,3 +107,20 @@ def test_without_t_eval_every_step_is_output_once_with_the_switch_times() -> Non
     assert np.all(np.diff(result.t) > 0) and result.t[-1] == 1.0
     assert len(result.switches) >= 2
     assert all(s.time in result.t for s in result.switches)
+
+
+def test_a_run_that_fails_before_its_first_output_time_says_where(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """g = 1e300 overflows at once: the failure names the time the integrator reached
+    (no output time was reached, so there is no last output to name), with no warnings."""
+    import springc
+    from springc.errors import SimulationError
+
+    with pytest.raises(SimulationError) as caught:
+        springc.simulate(str(SCENES), model_name="Scenes.Pendulum", stop=1.0,
+                         interval=0.5, parameters={"g": 1e300})
+    message = caught.value.message
+    assert message.startswith("the integration failed at t = ")
+    reached = float(message.removeprefix("the integration failed at t = ").split(":")[0])
+    assert 0.0 <= reached < 0.5  # before the first output time after the start
+    assert "Warning" not in capsys.readouterr().err

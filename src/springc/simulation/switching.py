@@ -150,14 +150,16 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
             segment = requested[later & (requested <= t1)]
         rhs = _RejectingRhs(functions, deadline, time_limit, method.lower())
         try:
-            sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment,
-                            rtol=rtol, atol=atol, events=event if choice.blocks else None)
+            with np.errstate(all="ignore"):  # a run that overflows fails with a message
+                sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment, rtol=rtol,
+                                atol=atol, events=event if choice.blocks else None)
         except OverLimit as over:
             raise over_limit(over, t0, t1, partial(numerical_jacobian, functions.rhs)
                              ) from None
         if sol.status == -1:
             cause = f" (last failure: {rhs.failure})" if rhs.failure else ""
-            raise SimulationError(f"the integration failed at t = {sol.t[-1]:g}: "
+            reached = sol.t[-1] if len(sol.t) else rhs.time  # no output time reached
+            raise SimulationError(f"the integration failed at t = {reached:g}: "
                                   f"{sol.message}{cause}")
         # Outputs in time order from the segment's start values: each Newton guess is
         # the previous output's solution, never one from the segment's end.
@@ -191,8 +193,10 @@ class _RejectingRhs:
         self.functions = functions
         self.failure: SimulationError | None = None
         self.deadline, self.time_limit, self.solver = deadline, time_limit, solver
+        self.time = -math.inf  # the last time the right-hand side was asked for
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        self.time = t
         if time.perf_counter() > self.deadline:
             raise OverLimit(f"{self.time_limit:g} s of wall clock reached the time limit "
                             "(--time-limit)", t, np.array(y), self.solver)
