@@ -439,3 +439,36 @@ def test_sign_and_abs_switch_at_events(tmp_path: Path) -> None:
     crossings = [e.time for e in result.events if e.cause in ("x > 0", "x < 0")]
     expected = [tau + 2 * tau * k for k in range(3)]
     assert np.max(np.abs(np.array(crossings) - expected)) < 1e-9
+
+
+SAMPLED = """
+model Sampled
+  Real x(start = 0, fixed = true);
+  discrete Real h(start = 0);
+equation
+  der(x) = 1;
+  when sample(0, 0.001) then
+    h = x;
+  end when;
+end Sampled;
+"""
+
+
+@pytest.mark.parametrize("event_rows", [False, True])
+def test_events_are_counted_and_kept_only_as_the_output_needs(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, event_rows: bool) -> None:
+    """1001 sample instants in [0, 1]: memory follows the output, so without
+    event_rows only the first KEPT_EVENTS events are kept (the rest counted)."""
+    from springc.simulation import events
+
+    monkeypatch.setattr(events, "KEPT_EVENTS", 10)
+    path = tmp_path / "sampled.mo"
+    path.write_text(SAMPLED)
+    result = springc.simulate(str(path), stop=1.0, interval=0.5, event_rows=event_rows)
+    assert result.stats.time_events == 1000  # the one at t = 0 is the initial event
+    kept = [e for e in result.events if e.kind == "time"]
+    assert len(result.events) == (1001 if event_rows else 10)
+    assert result.events[0].kind == "initial"
+    assert abs(kept[-1].time - (1.0 if event_rows else 0.009)) < 1e-12
+    assert len(result.time) == (3 + 2 * 1000 if event_rows else 3)
+    assert abs(result["h"][-1] - 1.0) < 1e-9

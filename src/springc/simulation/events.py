@@ -57,11 +57,18 @@ class Event:
     z_right: np.ndarray
 
 
+KEPT_EVENTS = 10_000
+"""Events (and step times) a run keeps for its result unless the output needs every
+event (``event_rows``): the others are counted, so that memory follows the output grid,
+not the number of events (``sample(0, 1e-6)`` over 10 s has 10 million)."""
+
+
 class EventLoop:
     """One hybrid run over ``grid``: fills ``states`` and ``zs`` (the ``z`` vector
-    in force at each output time) and records the ``events``."""
+    in force at each output time), counts the events by kind (``counts``) and records
+    the first :data:`KEPT_EVENTS` of them (``events``; all with ``keep_events``)."""
 
-    def __init__(self, problem: Problem, grid: np.ndarray) -> None:
+    def __init__(self, problem: Problem, grid: np.ndarray, keep_events: bool = False) -> None:
         self.problem, self.grid = problem, grid
         self.mod: Any = cast(Any, problem.mod)  # a hybrid module (codegen.module_api.HybridModule)
         self.p = problem.p
@@ -71,6 +78,9 @@ class EventLoop:
         self.zs = np.empty((len(grid), len(self.z)))
         self.k = 0  # next grid row to fill
         self.events: list[Event] = []
+        self.keep_events = keep_events
+        self.counts: dict[str, int] = {}
+        self.last_event: Event | None = None
         self.steps = 0
         self.step_times: list[float] = []
         self.recent: deque[float] = deque(maxlen=EVENT_BURST)
@@ -139,13 +149,21 @@ class EventLoop:
             raise self.problem.newton_failure(t, x_left)
         if self.z[int(self.mod.Z_STATUS)] != 0.0:
             raise Stop(self.unsettled(t, x_left, z_left))
-        self.events.append(Event(t, kind, cause, x_left, z_left, x_right, self.z.copy()))
+        self.last_event = Event(t, kind, cause, x_left, z_left, x_right, self.z.copy())
+        self.counts[kind] = self.counts.get(kind, 0) + 1
+        if self.keep_events or len(self.events) < KEPT_EVENTS:
+            self.events.append(self.last_event)
         if kind in ("state", "time"):
             self.check_zeno(t, cause)
         code = int(self.z[int(self.mod.Z_TERMINATE)])
         if code > 0 and self.stopped is None:
             self.stopped = (t, self.mod.TERMINATE_MESSAGES[code - 1])
         return x_right
+
+    def note_step(self, t: float) -> None:
+        """Record the time of an accepted step (the first :data:`KEPT_EVENTS`)."""
+        if self.keep_events or len(self.step_times) < KEPT_EVENTS:
+            self.step_times.append(t)
 
     def unsettled(self, t: float, x: np.ndarray, z_left: np.ndarray) -> SimulationError:
         """The error of an event iteration that does not settle, naming what keeps
@@ -258,7 +276,7 @@ class EventLoop:
                                     f"(--max-steps {max_steps})", float(integrator.t),
                                     np.array(integrator.y), solver)
                 t_new = float(integrator.t)
-                self.step_times.append(t_new)
+                self.note_step(t_new)
                 dense = integrator.dense_output()
                 y = np.asarray(integrator.y, dtype=float)
                 switched = self.switched(t_new, y)

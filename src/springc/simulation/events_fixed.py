@@ -66,7 +66,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
                     t = t_e
                     continue
                 t, x = target, y
-                loop.step_times.append(t)
+                loop.note_step(t)
                 if t == te:  # a time event (at the stop time too, as the adaptive loop)
                     x = loop.event(t, x, "time", f"time = {t:.9g}")
                     cache.clear()

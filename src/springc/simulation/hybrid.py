@@ -42,7 +42,8 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
         solver, reason = EXPLICIT, "a hybrid model: dop853 with event location"
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
-    loop = EventLoop(problem, grid)
+    event_rows = bool(getattr(options, "event_rows", False))
+    loop = EventLoop(problem, grid, keep_events=event_rows)
     compiled, loop_time = False, 0.0
     try:
         with np.errstate(all="ignore"):
@@ -59,7 +60,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
             else:
                 loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
             loop.terminal()
-            times, states, zs = rows(loop, bool(getattr(options, "event_rows", False)))
+            times, states, zs = rows(loop, event_rows)
             check_assertions(problem, times, states, zs)
             outputs = _outputs(model, problem, times, states, zs)
     except Stop as stop_:
@@ -72,8 +73,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
         when, message = loop.stopped
         shown = "".join(c if c.isprintable() else repr(c)[1:-1] for c in message)
         note = "; ".join(filter(None, (note, f"terminate() at time {when:.9g}: {shown}")))
-    state_events = sum(e.kind == "state" for e in loop.events)
-    time_events = sum(e.kind == "time" for e in loop.events)
+    state_events, time_events = loop.counts.get("state", 0), loop.counts.get("time", 0)
     stats = SimulationStats(solver, loop.steps, problem.nfev, problem.njev,
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
@@ -97,7 +97,8 @@ def rows(loop: EventLoop, event_rows: bool) -> tuple[np.ndarray, np.ndarray, np.
     k = loop.k
     times, states, zs = loop.grid[:k], loop.states[:k], loop.zs[:k]
     if loop.stopped is not None and (k == 0 or times[-1] < loop.stopped[0]):
-        last = loop.events[-1]
+        last = loop.last_event
+        assert last is not None  # terminate() acts in an event
         times = np.append(times, last.time)
         states = np.vstack([states, last.x_right])
         zs = np.vstack([zs, last.z_right])

@@ -126,11 +126,11 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
             loop.fill(t, None, t, x, True)
         elif run.status == Status.TIME_EVENT:
             t = run.event_time
-            loop.step_times.append(t)
+            loop.note_step(t)
             x = loop.time_event(t, np.array(run.event_state), stop)
         elif run.status == Status.SUCCESS:
             t, x = float(times[-1]), np.array(run.failure_state)
-            loop.step_times.append(t)
+            loop.note_step(t)
             if t >= stop or snapped:  # the last row again, after its time event
                 loop.k -= 1
                 x = loop.time_event(t, x, stop)
