@@ -55,9 +55,32 @@ def _check_integers(model: CompiledModel, values: Mapping[str, float]) -> None:
 
 
 def _files(files: Files) -> tuple[str, ...]:
+    """The file names of ``files`` (one name or a sequence of names)."""
     if isinstance(files, (str, os.PathLike)):
         return (os.fspath(files),)
-    return tuple(os.fspath(f) for f in files)
+    if isinstance(files, (list, tuple)) and all(isinstance(f, (str, os.PathLike))
+                                                for f in files):
+        return tuple(os.fspath(f) for f in files)
+    raise UsageError(f"files must be a file name or a list of file names, not "
+                     f"{_shown(files)}", option="files")
+
+
+def _patterns(outputs: Sequence[str] | str | None) -> tuple[str, ...] | None:
+    """``outputs`` as a tuple of patterns: a string is one pattern (``"mass.pos[1]"``),
+    never a sequence of one-character patterns."""
+    if outputs is None:
+        return None
+    if isinstance(outputs, str):
+        return (outputs,)
+    if isinstance(outputs, (list, tuple)) and all(isinstance(o, str) for o in outputs):
+        return tuple(outputs)
+    raise UsageError(f"outputs must be a name pattern or a list of them, not "
+                     f"{_shown(outputs)}", option="outputs")
+
+
+def _shown(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 @recursion_room()  # expressions up to ir.expr.MAX_DEPTH deep (docs/language.md, "Limits")
@@ -78,7 +101,7 @@ def compile_model(files: Files, model: str | None = None, *,
     check_run_values(parameters=parameters)
     options = CompileOptions(_files(files), model, tuple(os.fspath(x) for x in libraries),
                              backend or default_backend(),
-                             tuple(outputs) if outputs is not None else None, (), cache)
+                             _patterns(outputs), (), cache)
     return _compile(options, parameters, chosen=backend is None)
 
 
@@ -110,7 +133,7 @@ def load_model_from_string(text: str, model: str | None = None,
     check_run_values(parameters=parameters)
     options = CompileOptions((), model, tuple(os.fspath(x) for x in libraries),
                              backend or default_backend(),
-                             tuple(outputs) if outputs is not None else None, (), cache,
+                             _patterns(outputs), (), cache,
                              ((STRING_FILE, text),))
     return _compile(options, parameters, chosen=backend is None)
 

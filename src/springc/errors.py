@@ -64,6 +64,14 @@ class UsageError(SpringcError):
         self.option = option
 
 
+class UnknownNameError(UsageError, KeyError):
+    """A name that a result does not hold: springc's own error, and a ``KeyError`` too,
+    as a mapping's lookup raises."""
+
+    def __str__(self) -> str:
+        return render(self)
+
+
 class OutputError(SpringcError):
     """An output file that springc refuses to write or cannot write."""
 

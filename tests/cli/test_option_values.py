@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -169,3 +170,26 @@ def test_tradeoff_options_are_checked() -> None:
         TradeoffOptions(interval=float("inf"))
     with pytest.raises(UsageError, match=r"stop \(1\) must be after start \(2\)"):
         TradeoffOptions(start=2.0, stop=1.0)
+
+
+def test_api_misuse_raises_springcs_own_errors(model: str) -> None:
+    """A string of outputs is one pattern; files=None and an unknown result name are
+    springc's errors (an unknown name is a KeyError too), with the CLI's words."""
+    from springc.errors import UnknownNameError
+
+    result = springc.simulate(model, stop=1.0, interval=0.5, outputs="x[2]")
+    assert result.names == ("x[2]",)
+    assert np.allclose(result["x[2]"], np.exp(-2 * np.array([0.0, 0.5, 1.0])), rtol=1e-5)
+    with pytest.raises(UsageError) as caught:
+        springc.compile_model(None)  # type: ignore[arg-type]
+    assert str(caught.value) == ("error: files must be a file name or a list of file "
+                                 "names, not None")
+    assert caught.value.option == "files"
+    with pytest.raises(UsageError, match=r"^error: outputs must be a name pattern or a "
+                                         r"list of them, not 3$"):
+        springc.compile_model(model, outputs=3)  # type: ignore[arg-type]
+    with pytest.raises(UnknownNameError) as unknown:
+        result["x[3]"]
+    assert isinstance(unknown.value, KeyError) and isinstance(unknown.value, SpringcError)
+    assert str(unknown.value) == ("error: 'x[3]' matches no state or observed variable of "
+                                  "this result\nhelp: did you mean 'x[2]'?")

@@ -13,6 +13,7 @@ The writer is chosen by the file's suffix (:data:`RESULT_FORMATS`, :data:`PLOT_F
 from __future__ import annotations
 
 import csv
+import difflib
 import io
 import os
 from collections.abc import Iterable
@@ -22,7 +23,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import OutputError, UsageError
+from ..errors import OutputError, UnknownNameError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
 from .plot_layout import choose_layout
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
@@ -110,10 +111,18 @@ class SimulationResult:
             return self.values[:, self.names.index(name)]
         except ValueError:
             pass
-        for variable in array_variables(self.names, self.units):
+        variables = array_variables(self.names, self.units)
+        for variable in variables:
             if variable.name == name and variable.shape:
                 return array_values(self.values, variable)
-        raise KeyError(name)
+        candidates = [*self.names, *(v.name for v in variables if v.shape)]
+        close = difflib.get_close_matches(str(name), candidates, 3)
+        raise UnknownNameError(
+            f"{name!r} matches no state or observed variable of this result",
+            option="name", hint=(f"did you mean {', '.join(repr(c) for c in close)}?"
+                                 if close else "the result holds " + ", ".join(
+                                     repr(n) for n in self.names[:5])
+                                 + (", ..." if len(self.names) > 5 else "")))
 
     def __contains__(self, name: object) -> bool:
         return name in self.names
