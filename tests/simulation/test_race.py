@@ -140,26 +140,40 @@ def test_far_apart_projections_decide_after_the_probes(compiled: bool) -> None:
     assert run.taken == {"dop853": probe, "radau": 200}
 
 
-def test_a_close_race_settles_dop853_and_spends_radaus_budget() -> None:
+def test_a_radau_projection_that_stays_put_ends_the_race() -> None:
     """radau held to half dop853's steps: its probe projects ~2e4 steps x 11 against
-    ~1e4 x 12, not four times below; dop853 takes 200 more steps, and radau stretches
-    of 16, 64, 256, 1024 steps and what is left of its budget (a fifth of dop853's
-    117,480 to go after its 210 steps: 2,135 steps x 11 in all, the last stretch's
-    755 rounded down), its projection still the dearer."""
+    ~1e4 x 12, not four times below; dop853 takes 200 more steps, radau a stretch of
+    16 that leaves its projection where it was (a mode it must resolve too): dop853."""
     run = Run({"dop853": 1e-3, "radau": 5e-4}, compiled=True)
+    solver, reason = _auto(run)
+    assert solver == "dop853"
+    assert run.taken == {"dop853": 10_000, "radau": 20 + 16}
+    assert reason == ("race estimate, but the fast modes must be resolved anyway; counted: "
+                      "radau ~2e+04 steps x 11 = ~2.2e+05 RHS evaluations to go, dop853 "
+                      "~9.8e+03 steps x 12 = ~1.2e+05")
+
+
+def test_a_slowly_gaining_radau_spends_its_budget() -> None:
+    """radau's steps grow 5 % a stretch (16, 64, 256, 1024 steps, then what is left of
+    a fifth of dop853's 117,480 to go after its 210 steps: 755, rounded down): its
+    projection falls, but not to dop853's before the budget is spent."""
+    growing = [(20, 5e-4), (16, 5.25e-4), (64, 5.5e-4), (256, 5.8e-4), (1024, 6.1e-4),
+               (1, 6.4e-4)]
+    run = Run({"dop853": 1e-3, "radau": growing}, compiled=True)
     solver, reason = _auto(run)
     assert solver == "dop853"
     assert run.taken == {"dop853": 10_000, "radau": 20 + 16 + 64 + 256 + 1024 + 755}
     assert reason == ("race estimate, but the fast modes must be resolved anyway; counted: "
-                      "radau ~1.8e+04 steps x 11 = ~2e+05 RHS evaluations to go, dop853 "
+                      "radau ~1.4e+04 steps x 11 = ~1.5e+05 RHS evaluations to go, dop853 "
                       "~9.8e+03 steps x 12 = ~1.2e+05")
 
 
 def test_radau_damping_its_fast_mode_wins_within_its_budget() -> None:
-    """The excited stiff mode: radau's first 100 steps are small (its probe projects
-    ~2e5 steps), then it steps over the damped mode at 0.005 s, and its stretch of 256
-    steps finds it below dop853's projection, before the budget is spent."""
-    run = Run({"dop853": 1e-4, "radau": [(100, 5e-5), (1, 0.005)]}, compiled=True)
+    """The excited stiff mode: radau's first steps are small (its probe projects ~2e5
+    steps), each stretch lowers its projection as the damping lets its steps grow,
+    and after its stretch of 256 steps at 0.005 s it is below dop853's."""
+    damping = [(20, 5e-5), (16, 7e-5), (64, 8e-5), (1, 0.005)]
+    run = Run({"dop853": 1e-4, "radau": damping}, compiled=True)
     solver, reason = _auto(run)
     assert solver == "radau"
     assert run.taken == {"dop853": 10 + 200, "radau": 100 + 1999}
@@ -204,6 +218,6 @@ def test_radau_finishing_within_its_probe_states_its_work() -> None:
 
 def test_the_decision_is_the_same_every_time() -> None:
     """No clock: the same scripted run decides alike, to the text."""
-    runs = [_auto(Run({"dop853": 1e-3, "radau": [(10_000, 1e-3)]}, compiled=True))
+    runs = [_auto(Run({"dop853": 1e-3, "radau": [(36, 5e-4), (1, 6e-4)]}, compiled=True))
             for _ in range(3)]
     assert runs[0] == runs[1] == runs[2]
