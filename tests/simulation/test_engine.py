@@ -11,6 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 import springc
+from float_text import assert_same_text
 from same_method import assert_same_method
 from springc.cli import main
 from springc.errors import SimulationError, UsageError
@@ -173,6 +174,9 @@ def test_compiled_fixed_step_equals_python_integrators(name: str, solver: str) -
     assert (np.abs(compiled.values - python.values) <= 1e-13 * np.maximum(scale, 1.0)).all()
 
 
+FAILURE_RTOL = 1e-2
+"""The states in a failure's notes near a blow-up (x = 1/(1 - t) at 1.5e14: 1.46726e+14
+compiled, 1.46777e+14 on scipy's loop) differ far more than the runs before it."""
 FAILURES = [
     # (model, simulate's keywords, the start of the message)
     ("Blowup", {"solver": "dop853", "stop": 2.0}, "the step size of dop853 collapsed at time 1"),
@@ -198,7 +202,9 @@ def test_failures_read_as_on_the_scipy_engine(failing: str, model_name: str,
             springc.simulate(failing, model_name=model_name, engine=engine,
                              **keywords)  # type: ignore[arg-type]
         errors.append(str(info.value))
-    assert errors[0] == errors[1]
+    # the same words; the numbers (times, states) within FAILURE_RTOL: two differently
+    # compiled loops reach a blow-up or a singularity by other roundings
+    assert_same_text(errors[0], errors[1], FAILURE_RTOL)
     assert errors[0].startswith(f"error: {message}")
 
 
@@ -208,7 +214,7 @@ def test_step_limit_counts_the_same_steps() -> None:
         with pytest.raises(SimulationError) as info:
             springc.simulate(SEED, solver="dop853", max_steps=100, engine=engine)
         errors.append(str(info.value))
-    assert errors[0] == errors[1]
+    assert_same_text(errors[0], errors[1], 1e-6)  # the states after 100 steps
     assert "100 steps of dop853 reached the step limit (--max-steps 100)" in errors[0]
 
 

@@ -48,6 +48,7 @@ from .engine import (
     fixed_step,
     load,
     newton_flops,
+    newton_solve_flops,
     observed_grid,
     radau,
     rk45,
@@ -56,5 +57,5 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "load", "newton_flops",
+           "fixed_step", "load", "newton_flops", "newton_solve_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]

@@ -210,6 +210,18 @@ def newton_flops(indptr: Any, indices: Any, dense_limit: int = 64) -> float:
     return 10.0 * n * max(kl, 1) * (kl + ku + 1)
 
 
+def newton_solve_flops(indptr: Any, indices: Any, dense_limit: int = 64) -> float:
+    """Floating-point operations of the solves of one Newton iteration of :func:`radau`
+    (a real and a complex solve with the factors of :func:`newton_flops`, forward and
+    back through the band: about ``2 n (2 kl + ku + 1)`` real operations, four times
+    that for the complex one)."""
+    indptr_ = np.ascontiguousarray(indptr, dtype=np.int64)
+    indices_ = np.ascontiguousarray(indices, dtype=np.int64)
+    n = indptr_.size - 1
+    _, kl, ku, _, _ = _band_layout(n, indptr_.tobytes(), indices_.tobytes(), dense_limit)
+    return 10.0 * n * (2 * kl + ku + 1)
+
+
 @functools.lru_cache(maxsize=16)
 def _band_layout(n: int, indptr: bytes, indices: bytes, dense_limit: int
                  ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:

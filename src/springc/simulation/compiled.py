@@ -30,6 +30,7 @@ from .failures import Stop
 from .limits import HOPELESS, OverLimit
 from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
 from .solvers import detect_pairs, non_finite_states
+from .step_cost import Work
 from .steps import Problem, StepLoop, Stepper, Stretch, solver_failure
 
 if TYPE_CHECKING:
@@ -180,12 +181,14 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     began = time.perf_counter()
     allowed = loop.limits.max_steps - loop.steps  # accepted steps, as scipy's loop counts
     budget = np.inf if max_steps is None else max_steps
-    chunk, accepted, taken = FIRST_CHUNK, 0, 0
+    chunk, accepted, taken, nfev, njev = FIRST_CHUNK, 0, 0, 0, 0
     while True:
         attempt = int(max(min(chunk, allowed - accepted, budget - taken), 1))
         run = kernel(times, y, min(first, float(times[-1] - t)), attempt)
         problem.nfev += run.rhs_evaluations
         problem.njev += run.jacobian_evaluations
+        nfev += run.rhs_evaluations
+        njev += run.jacobian_evaluations
         accepted += run.accepted_steps
         taken += run.accepted_steps + run.rejected_steps
         rows = run.filled - 1  # row 0 is the stretch's start
@@ -230,7 +233,8 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     if run.ok:
         loop.k = len(grid)
     mean = (stepper.t - started) / accepted if accepted else 0.0
-    return Stretch(accepted, seconds, (mean,) if accepted else ())
+    # (the compiled loops count no factorizations: the cost model bounds them)
+    return Stretch(Work(accepted, taken, nfev, njev), (mean,) if accepted else ())
 
 
 def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, float, int],

@@ -1,39 +1,49 @@
-"""``--solver auto``: explicit first, and a short race where the run proves long.
+"""``--solver auto``: explicit first, and a short race where the run proves long,
+decided by counts and a cost model fixed in the code, never by the clock.
 
-1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps. If it finishes, or its current step
-   size leaves at most :data:`CHEAP_STEPS` steps to go, it finishes the run: a short
-   run costs no stiffness estimate at all.
-2. Otherwise the stiffness estimate of :func:`springc.simulation.solvers.choose` (``rho * T``
-   from the analytic Jacobian at the current state) decides whether ``radau`` could
-   be cheaper. If not, ``dop853`` goes on.
+1. ``dop853`` takes :data:`EXPLICIT_PROBE` steps on scipy's loop, :data:`COMPILED_PROBE`
+   on the compiled engine (:data:`CHEAP_STEPS` more for a model of over
+   :data:`SPRINT_STATES` states, whose stiffness estimate is dearer than compiled
+   steps). If it finishes, or its current step size leaves at most
+   :data:`CHEAP_STEPS` steps to go, it finishes the run: a short run costs no
+   stiffness estimate at all.
+2. Otherwise the stiffness estimate of :func:`springc.simulation.solvers.choose`
+   (``rho * T`` from the analytic Jacobian at the current state) decides whether
+   ``radau`` could be cheaper. If not, ``dop853`` goes on.
 3. If it could, the estimate alone cannot tell: a very stiff spring whose fast mode
    stays at rest costs ``dop853`` nothing, an excited one must be resolved by every
-   method, and a ``radau`` step costs several ``dop853`` steps. So ``radau`` takes
-   :data:`IMPLICIT_PROBE` steps from the start (fewer if they cost over
-   :data:`PROBE_BUDGET` of ``dop853``'s projected time), each method's remaining cost is
-   projected from its last step sizes and its measured time per step, and the
-   cheaper one finishes the run from where its probe left off. (``radau`` starts
-   afresh rather than from ``dop853``'s state: a state reached at the stability
-   limit carries fast-mode noise that would hold ``radau``'s first steps small.)
+   method, and a ``radau`` step costs several ``dop853`` steps. Each method's remaining
+   work is projected as its steps to go (the span left over its settled step size)
+   times its work per accepted step, in equivalent right-hand side evaluations of the
+   cost model of :mod:`springc.simulation.step_cost` (evaluations, Jacobians,
+   factorizations and solves the stretches counted, priced from the model's size and
+   the band of its Newton matrices). So:
 
-On the compiled engine steps are cheap and each call of a compiled loop has a fixed
-cost (some 50 microseconds, tens of steps of a small model): the explicit probe is
-:data:`COMPILED_PROBE` steps (:data:`CHEAP_STEPS` more for a model of over
-:data:`SPRINT_STATES` states, whose estimate is dearer than compiled steps), and the
-race is :func:`_compiled_race`: step counts far apart decide alone, each method's time
-per step is the difference of two calls (the fixed cost cancels), and ``radau`` may
-run up to :data:`COMPILED_BUDGET` of ``dop853``'s projected time, since its early
-projection can be far too dear.
+   - where one factorization of ``radau``'s Newton matrices alone costs over
+     :data:`BUDGET` of ``dop853``'s projection (a large scene's band), ``dop853`` goes on;
+   - else ``radau`` takes :data:`IMPLICIT_PROBE` steps from the start (4 for a large
+     model); where its projection is :data:`SURE` times below ``dop853``'s, it finishes
+     the run;
+   - else ``dop853`` takes :data:`SETTLE` more steps (its step size settles at the
+     stability limit), and ``radau`` goes on in stretches of 16 steps, then four times
+     longer each, while its projection is the dearer, each stretch lowers it (by
+     :data:`STALL`) and its work so far stays within :data:`BUDGET` of ``dop853``'s
+     projection: an excited fast mode holds ``radau``'s first steps small until its
+     damping removes it, so its early projection can be far too dear, while a
+     projection that stays put is a mode ``radau`` must resolve as well. The cheaper
+     projection finishes the run from where its method stopped.
 
-The probes are steps of the real run (the grid points they pass are kept), so
-deciding costs at most the two probes. On scipy's loop the projection is taken early,
-so it sees ``radau`` at its worst when a fast mode is excited above the tolerance (it
-must resolve the first oscillations before its damping removes them): the race then
-keeps ``dop853``, which resolves that vibration instead of damping it away. A failure
-inside the explicit probe (an overflow from an unstable step) hands the run to
-``radau``; if ``radau`` fails too, the explicit probe's error is reported (where the
-trouble began) with ``radau``'s as a note. Failures after the decision are the run's
-own.
+   (``radau`` starts afresh rather than from ``dop853``'s state: a state reached at the
+   stability limit carries fast-mode noise that would hold ``radau``'s first steps
+   small.) The summary line's reason gives the figures: steps to go, work per step
+   and the product, for both methods.
+
+The probes are steps of the real run (the grid points they pass are kept), so deciding
+costs at most the probes. The same files and options take the same steps and so the
+same decision in every run and process. A failure inside the explicit probe (an
+overflow from an unstable step) hands the run to ``radau``; if ``radau`` fails too, the
+explicit probe's error is reported (where the trouble began) with ``radau``'s as a
+note. Failures after the decision are the run's own.
 """
 
 from __future__ import annotations
@@ -48,49 +58,44 @@ import numpy as np
 
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 from .solvers import AutoChoice
+from .step_cost import StepCosts, Work
 
 EXPLICIT_PROBE = 40
+COMPILED_PROBE = 10
 IMPLICIT_PROBE = 20
-PROBE_BUDGET = 0.05
-"""The implicit probe stops early once it has cost this fraction of the explicit
-method's projected remaining time (a large scene's radau steps are dear)."""
 CHEAP_STEPS = 500
 """Explicit steps to go below which no estimate or implicit probe is worth its cost
 (about what ``rho * T <= 2000`` allows a stability-limited explicit method)."""
-COMPILED_PROBE = 10
 SPRINT_STATES = 32
 """On the compiled engine, models of more states take :data:`CHEAP_STEPS` more explicit
 steps before an estimate (dense eigenvalues of 32 states take about 0.1 ms, of 400
-some 40 ms: as long as hundreds of compiled steps)."""
-STEP_COST = 20.0
-"""A ``radau`` step of a model of at most :data:`SPRINT_STATES` states costs under this
-many ``dop853`` steps (a few Newton iterations of 3 evaluations of the model and a
-dense LU of at most 32 unknowns, against 12 evaluations): where ``dop853`` projects
-more times ``radau``'s steps, the counts decide the compiled race alone."""
-COMPILED_STRETCHES: dict[str, tuple[int, int]] = {EXPLICIT: (20, 200),
-                                                 RACE_IMPLICIT: (16, 64)}
-"""The steps of each method's first two timed calls in a compiled race (a call right
-after other work runs cold and is not compared with later ones: neither probe is
-timed); ``radau``'s later stretches are four times longer each."""
-COMPILED_BUDGET = 0.2
-"""The compiled race lets ``radau`` run up to this fraction of ``dop853``'s projected
-time (stretches four times longer each): an excited fast mode holds ``radau``'s first
-steps small until its damping removes it, so its early projection can be far too
-dear (the uneven pair at k = 1e8 over 10 s: 0.5 s projected, 11 ms taken), and
-``dop853``'s, from its first steps, is too (0.29 s projected, 0.107 s taken). A
-``radau`` run costing under a fifth of ``dop853``'s projection is found; where
-``dop853`` wins, the race costs it at most a fifth more (over 1 s, where ``dop853``
-takes 10 ms and ``radau`` 12 ms, auto takes 15 ms)."""
+some 40 ms: as long as hundreds of compiled steps); their implicit probe is 4 steps."""
+SURE = 4.0
+"""``radau``'s projection from its probe wins at once where it is this many times below
+``dop853``'s from its probe (whose early steps, still growing, make it too dear)."""
+SETTLE = 200
+"""``dop853``'s further steps before a close race is run on: its step size at the end
+is the one it keeps."""
+STALL = 0.98
+"""``radau``'s stretches go on only while each lowers its projection below this
+fraction of the last one's: on the uneven pair at k = 1e8 (its damping at work) each
+stretch lowers it by 6-33 %, on the oscillator over 1000 periods (a mode to resolve)
+by about 1 %, and radau stops there after 100 steps instead of 1,000."""
+BUDGET = 0.2
+"""``radau`` may work up to this fraction of ``dop853``'s projected work in its probe and
+stretches (the uneven pair at k = 1e8 over 10 s: radau's probe projects ~8 times dop853's
+work, it finishes the run for under a tenth of it). Where ``dop853`` wins, the race
+costs it at most a fifth more."""
 
 
 class Stretch(Protocol):
-    """What one stretch of steps measured (``springc.simulation.steps.Stretch``)."""
+    """What one stretch of steps counted (``springc.simulation.steps.Stretch``)."""
+
+    @property
+    def work(self) -> Work: ...
 
     @property
     def steps(self) -> int: ...
-
-    @property
-    def seconds(self) -> float: ...
 
     @property
     def sizes(self) -> tuple[float, ...]: ...
@@ -115,20 +120,24 @@ class Run(Protocol):
 
     def both_failed(self, first: Any, second: Any) -> Exception: ...
 
-    def factorization_seconds(self) -> float: ...
+    def costs(self) -> StepCosts: ...
 
 
 @dataclass(frozen=True)
-class Probe:
-    """What a probe measured: the step size its method settled on (0 where it accepted
-    none) and the seconds per step of stepping."""
+class Projection:
+    """A method's projected remaining work: ``steps`` to go at its settled step size,
+    ``per_step`` equivalent right-hand side evaluations each."""
 
-    step: float
+    steps: float
     per_step: float
 
-    def cost(self, span: float) -> float:
-        """Projected seconds for ``span`` at that step size and time per step."""
-        return _steps(span, self.step) * self.per_step
+    @property
+    def work(self) -> float:
+        """The product (infinite where no step size settled)."""
+        return self.steps * self.per_step if math.isfinite(self.steps) else math.inf
+
+    def text(self) -> str:
+        return f"~{self.steps:.2g} steps x {self.per_step:.3g} = ~{self.work:.2g}"
 
 
 def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
@@ -167,115 +176,71 @@ def auto(run: Run, t0: float, x0: np.ndarray, stop: float,
 
 def _race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray, stop: float,
           stiffness: str) -> tuple[str, str]:
-    if run.compiled:
-        return _compiled_race(run, explicit, first, t0, x0, stop, stiffness)
-    explicit_cost = Probe(_step(first), _mean(first)).cost(stop - explicit.t)
-    implicit = run.start(RACE_IMPLICIT, t0, x0)
-    trial = _scipy_implicit_probe(run, implicit, explicit_cost)
-    if run.done:
-        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
-    implicit_cost = trial.cost(stop - implicit.t)
-    return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
-                   f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
-
-
-def _compiled_race(run: Run, explicit: Any, first: Stretch, t0: float, x0: np.ndarray,
-                   stop: float, stiffness: str) -> tuple[str, str]:
-    """The race on the compiled engine. Where one factorization of ``radau``'s Newton
-    matrices (predicted from their band) would cost over :data:`COMPILED_BUDGET` of
-    ``dop853``'s projected time, ``dop853`` goes on. Else ``radau`` takes
-    :data:`IMPLICIT_PROBE` steps from the start (4 for a model of over
-    :data:`SPRINT_STATES` states, whose steps are dear); where the step counts alone
-    decide (:data:`STEP_COST`) nothing is timed.
-    Otherwise ``dop853`` is timed, and ``radau`` runs stretches (16, 64, then four times
-    longer each, within what is left of :data:`COMPILED_BUDGET` of ``dop853``'s
-    projected time) until its projection beats ``dop853``'s or the budget is spent."""
-    small = len(x0) <= SPRINT_STATES
-    explicit_steps = _steps(stop - explicit.t, _step(first))
-    # (an upper bound: the first call's fixed cost counted as stepping)
-    explicit_cost = explicit_steps * _mean(first)
-    factorization = run.factorization_seconds()
-    if factorization > COMPILED_BUDGET * explicit_cost:
+    """The race (see the module text): every comparison is of two :class:`Projection`
+    objects, from the counts of the stretches run so far."""
+    costs = run.costs()
+    ahead = _projection(costs, False, first, stop - explicit.t)
+    factorization = costs.factorization_evaluations()
+    if factorization > BUDGET * ahead.work:
         run.advance(explicit)
         return EXPLICIT, (f"{stiffness}, but one factorization of {RACE_IMPLICIT}'s Newton "
-                          f"matrices takes over {factorization:.2g} s, {EXPLICIT} "
-                          f"~{explicit_cost:.2g} s to go")
+                          f"matrices costs ~{factorization:.2g} RHS evaluations, {EXPLICIT} "
+                          f"{ahead.text()} to go")
     implicit = run.start(RACE_IMPLICIT, t0, x0)
-    done = [run.advance(implicit, IMPLICIT_PROBE if small else 4)]  # (untimed: cold)
+    last = run.advance(implicit, IMPLICIT_PROBE if len(x0) <= SPRINT_STATES else 4)
+    spent = costs.evaluations(True, last.work)
     if run.done:
-        return RACE_IMPLICIT, f"{stiffness}; {RACE_IMPLICIT} finished the run in its trial steps"
-    implicit_steps = _steps(stop - implicit.t, _step(done[-1]))
-    if small and explicit_steps >= STEP_COST * implicit_steps:
-        return _finish(run, explicit, implicit, True, stiffness,
-                       f"~{implicit_steps:.2g} steps to go, {EXPLICIT} ~{explicit_steps:.2g}")
-    probe = _timed(run, explicit, COMPILED_STRETCHES[EXPLICIT])
+        return RACE_IMPLICIT, _trial(stiffness, spent, ahead)
+    behind = _projection(costs, True, last, stop - implicit.t)
+    if SURE * behind.work <= ahead.work:
+        return _finish(run, explicit, implicit, True, stiffness, behind, ahead)
+    settled = run.advance(explicit, SETTLE)
     if run.done:
-        return EXPLICIT, f"{stiffness}; {EXPLICIT} finished the run in its trial steps"
-    explicit_cost = probe.cost(stop - explicit.t)
-    steps = float(COMPILED_STRETCHES[RACE_IMPLICIT][0])
+        return EXPLICIT, (f"{stiffness}; counted: {EXPLICIT} finished the run in its "
+                          f"{SETTLE} further steps, {RACE_IMPLICIT} {behind.text()} RHS "
+                          "evaluations to go")
+    ahead = _projection(costs, False, settled, stop - explicit.t)
+    steps, before = 16.0, math.inf
     while True:
-        last = done[-1]
-        # (two timed stretches: their difference; before, the last one's mean, an upper
-        # bound with the call's fixed cost in it)
-        per_step = _per_step(done[-2], last) if len(done) >= 3 else _mean(last)
-        implicit_cost = Probe(_step(last), per_step).cost(stop - implicit.t)
-        steps = min(steps, (COMPILED_BUDGET * explicit_cost - sum(s.seconds for s in done))
-                    / per_step)
-        if implicit_cost <= explicit_cost or steps < 1:
-            return _finish(run, explicit, implicit, implicit_cost <= explicit_cost, stiffness,
-                           f"~{implicit_cost:.2g} s to go, {EXPLICIT} ~{explicit_cost:.2g} s")
-        done.append(run.advance(implicit, int(steps)))
+        behind = _projection(costs, True, last, stop - implicit.t)
+        room = BUDGET * ahead.work - spent
+        steps = min(steps, room / behind.per_step) if behind.per_step > 0 else 0.0
+        if behind.work <= ahead.work or not steps >= 1 or behind.work > STALL * before:
+            return _finish(run, explicit, implicit, behind.work <= ahead.work, stiffness,
+                           behind, ahead)
+        last = run.advance(implicit, int(steps))
+        spent += costs.evaluations(True, last.work)
         if run.done:
-            return RACE_IMPLICIT, (f"{stiffness}; {RACE_IMPLICIT} finished the run in its "
-                                   "trial steps")
-        steps = 4.0 * done[-1].steps
+            return RACE_IMPLICIT, _trial(stiffness, spent, ahead)
+        steps, before = 4.0 * last.steps, behind.work
+
+
+def _trial(stiffness: str, spent: float, ahead: Projection) -> str:
+    """The reason of a ``radau`` run that ended within its trial steps."""
+    return (f"{stiffness}; counted: {RACE_IMPLICIT} finished the run in its trial steps, "
+            f"~{spent:.2g} RHS evaluations, {EXPLICIT} {ahead.text()} to go")
 
 
 def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffness: str,
-            measured: str) -> tuple[str, str]:
-    """The race's winner runs to the end; the reason names what was measured."""
-    measured = f"measured: {RACE_IMPLICIT} {measured}"
+            behind: Projection, ahead: Projection) -> tuple[str, str]:
+    """The race's winner runs to the end; the reason gives both projections (steps to go
+    x RHS evaluations per step = work)."""
+    counted = (f"counted: {RACE_IMPLICIT} {behind.text()} RHS evaluations to go, {EXPLICIT} "
+               f"{ahead.text()}")
     if implicit_wins:
         run.advance(implicit)
-        return RACE_IMPLICIT, f"{stiffness}; {measured}"
+        return RACE_IMPLICIT, f"{stiffness}; {counted}"
     run.advance(explicit)
-    return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {measured}"
+    return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {counted}"
 
 
-def _timed(run: Run, integrator: Any, stretches: tuple[int, int]) -> Probe:
-    """Two compiled stretches of ``stretches`` steps (fewer if the run ends): the time
-    per step from their difference (see :func:`_per_step`), the step size the second
-    settled on."""
-    done = [run.advance(integrator, stretches[0])]
-    if not run.done:
-        done.append(run.advance(integrator, stretches[1]))
-    return Probe(_step(done[-1]), _per_step(done[0], done[-1]))
-
-
-def _per_step(before: Stretch, last: Stretch) -> float:
-    """Seconds per step: the difference of two stretches of a method over their
-    difference in steps (each call's fixed cost cancels), or the last one's mean where
-    that is not positive (or the two are one)."""
-    if last is not before and last.steps != before.steps:
-        difference = (last.seconds - before.seconds) / (last.steps - before.steps)
-        if difference > 0:
-            return difference
-    return _mean(last)
-
-
-def _scipy_implicit_probe(run: Run, implicit: Any, explicit_cost: float) -> Probe:
-    """The implicit probe on scipy's loop: a step at a time, up to :data:`IMPLICIT_PROBE`
-    or :data:`PROBE_BUDGET` of the explicit method's projected cost."""
-    steps, seconds = 0, 0.0
-    sizes: list[float] = []
-    while steps < IMPLICIT_PROBE and seconds <= PROBE_BUDGET * explicit_cost:
-        trial = run.advance(implicit, 1)
-        steps, seconds = steps + trial.steps, seconds + trial.seconds
-        sizes += trial.sizes
-        if run.done:
-            break
-    return Probe(float(statistics.median(sizes[-5:])) if sizes else 0.0,
-                 seconds / max(steps, 1))
+def _projection(costs: StepCosts, implicit: bool, stretch: Stretch, span: float
+                ) -> Projection:
+    """A method's work to go over ``span`` from its last ``stretch``: steps at the step
+    size it settled on, each at the stretch's work per accepted step."""
+    steps = _steps(span, _step(stretch))
+    per_step = costs.evaluations(implicit, stretch.work) / max(stretch.steps, 1)
+    return Projection(steps, per_step)
 
 
 def _step(stretch: Stretch) -> float:
@@ -287,8 +252,3 @@ def _step(stretch: Stretch) -> float:
 def _steps(span: float, step: float) -> float:
     """Steps of ``step`` over ``span`` (infinitely many where the step is 0)."""
     return span / step if step > 0 else math.inf
-
-
-def _mean(stretch: Stretch) -> float:
-    """A stretch's seconds per step, with its call's fixed cost in them."""
-    return stretch.seconds / max(stretch.steps, 1)

@@ -16,7 +16,8 @@ Two additions to the adaptive scipy solvers of :mod:`springc.simulation`:
   tell: a stiff spring whose fast mode stays at rest costs an explicit method
   nothing, an excited one costs every method, and per-step costs differ by solver;
   so the two methods race for a few steps and the one whose projected remaining
-  cost is lower finishes the run.
+  work is lower finishes the run (work counted, not timed:
+  :mod:`springc.simulation.step_cost`).
 """
 
 from __future__ import annotations

@@ -38,11 +38,9 @@ from .solver_names import (
     RACE_IMPLICIT,
     SOLVERS,
 )
+from .step_cost import StepCosts, Work, step_costs
 
 DENSE_JACOBIAN_LIMIT = 64
-FLOP_RATE = 2e10
-"""Operations per second above what the compiled banded LU reaches on one core (about
-7e9 measured on the 50x50 cloth): times predicted at this rate are lower bounds."""
 COMPILED_METHODS = frozenset(COMPILED_SOLVERS) - frozenset(FIXED_STEP)
 """Solvers whose integrators ``StepLoop.finish`` runs in a compiled loop."""
 
@@ -206,11 +204,16 @@ def integrate(problem: Problem, grid: np.ndarray, x0: np.ndarray, rtol: float,
 
 @dataclass(frozen=True)
 class Stretch:
-    """What :meth:`StepLoop.advance` measured: steps, wall time, last step sizes."""
+    """What :meth:`StepLoop.advance` counted (its :class:`Work`: steps, evaluations...)
+    and the last step sizes (no wall time: ``auto`` decides from counts)."""
 
-    steps: int
-    seconds: float
+    work: Work
     sizes: tuple[float, ...]
+
+    @property
+    def steps(self) -> int:
+        """Accepted steps."""
+        return self.work.steps
 
 
 @dataclass
@@ -251,20 +254,18 @@ class StepLoop:
         self.finish = finish
         self.compiled_steps = 0
         self.loop_time = 0.0  # seconds in the compiled loop
+        self._costs: StepCosts | None = None
 
     @property
     def done(self) -> bool:
         return self.k >= len(self.grid)
 
-    def factorization_seconds(self) -> float:
-        """A lower bound of the time of one factorization of ``radau``'s Newton matrices
-        in its compiled loop (their operations at :data:`FLOP_RATE`; 0 on scipy)."""
-        if self.finish is None:
-            return 0.0
-        from springc.integrate import newton_flops
-
-        mod = self.problem.mod
-        return newton_flops(mod.JAC_INDPTR, mod.JAC_INDICES) / FLOP_RATE
+    def costs(self) -> StepCosts:
+        """The prices of ``auto``'s cost model for this model on this loop
+        (:mod:`springc.simulation.step_cost`)."""
+        if self._costs is None:
+            self._costs = step_costs(self.problem.mod, self.compiled)
+        return self._costs
 
     @property
     def compiled(self) -> bool:
@@ -329,12 +330,13 @@ class StepLoop:
         if isinstance(integrator, Stepper):
             self.problem.solver = integrator.method
             if self.done or self.finish is None:
-                return Stretch(0, 0.0, ())
+                return Stretch(Work(0, 0, 0), ())
             return self.finish(self, integrator, max_steps)
         problem, grid, states = self.problem, self.grid, self.states
         problem.solver = next((name for name, cls in SOLVERS.items()
                                if cls == type(integrator).__name__), problem.solver)
-        began, taken = time.perf_counter(), 0
+        taken, nfev, njev = 0, problem.nfev, problem.njev
+        nlu = int(getattr(integrator, "nlu", 0))
         sizes: deque[float] = deque(maxlen=10)
         while not self.done and taken != max_steps:
             before = integrator.t
@@ -367,7 +369,10 @@ class StepLoop:
                 states[self.k:] = integrator.y
                 self.k = len(grid)
         self.steps += taken
-        return Stretch(taken, time.perf_counter() - began, tuple(sizes))
+        # (scipy's step() retries a rejected step inside: its attempts are its steps)
+        work = Work(taken, taken, problem.nfev - nfev, problem.njev - njev,
+                    int(getattr(integrator, "nlu", 0)) - nlu)
+        return Stretch(work, tuple(sizes))
 
 
 def solver_failure(problem: Problem, t: float, x: np.ndarray, message: str | None

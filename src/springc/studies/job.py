@@ -14,7 +14,6 @@ the study.
 from __future__ import annotations
 
 import functools
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -93,7 +92,6 @@ class RunRecord:
     steps: int
     rhs_evaluations: int
     jacobian_evaluations: int
-    wall_time: float
     values: np.ndarray | None
 
 
@@ -106,15 +104,13 @@ def worker_model(options: CompileOptions) -> CompiledModel:
 def run_one(model: CompiledModel, job: RunJob, run: int, values: Sequence[float]
             ) -> RunRecord:
     """Simulate one run; a :class:`SpringcError` becomes a failed record."""
-    began = time.perf_counter()
     try:
         result = simulate_model(model, job.options(values))
     except SpringcError as err:
-        return RunRecord(run, str(err), job.solver, 0, 0, 0, time.perf_counter() - began,
-                         None)
+        return RunRecord(run, str(err), job.solver, 0, 0, 0, None)
     stats = result.stats
     return RunRecord(run, None, stats.solver, stats.steps, stats.rhs_evaluations,
-                     stats.jacobian_evaluations, stats.wall_time, result.values)
+                     stats.jacobian_evaluations, result.values)
 
 
 def run_batch(job: RunJob, runs: Sequence[tuple[int, tuple[float, ...]]]

@@ -14,14 +14,17 @@ its rows with null values):
 | ``error`` | string | the error message of a failed run (null if ok) |
 | ``solver`` | string | the solver used (``auto``'s choice) |
 | ``steps``, ``rhs_evaluations``, ``jacobian_evaluations`` | int64 | solver statistics |
-| ``wall_time`` | float64 | seconds the run took in its worker |
+
+No column holds a time measured by the clock: the same study writes the same bytes
+on every run, with any number of workers (the study's duration is in its summary
+line, :meth:`springc.studies.Study.summary_line`).
 
 Variable columns carry their unit as field metadata (``unit``). A parameter or
 variable whose flat name is one of the fixed columns above (a top-level
 ``Real error;``) is stored under its quoted name (``'error'``).
 
 **Summary table** (``study.summary.parquet`` next to it, one row per run): ``run``, the
-parameters, ``status`` to ``wall_time`` as above, then for each output variable
+parameters, ``status`` to ``jacobian_evaluations`` as above, then for each output variable
 ``NAME.final``, ``NAME.min`` and ``NAME.max`` (null if the run failed), and, when an
 energy variable is selected (``--energy NAME``, else the only output in J),
 ``NAME.drift`` = max_t |E(t) - E(t0)| / max_t |E(t)|.
@@ -54,11 +57,12 @@ from ..fileio import OutputSet, atomic_write, check_distinct, check_target
 from .job import RunRecord
 
 FIXED_COLUMNS = ("run", "time", "status", "error", "solver", "steps", "rhs_evaluations",
-                 "jacobian_evaluations", "wall_time")
-STATS = ("solver", "steps", "rhs_evaluations", "jacobian_evaluations", "wall_time")
+                 "jacobian_evaluations")
+STATS = ("solver", "steps", "rhs_evaluations", "jacobian_evaluations")
 SUFFIX = ".parquet"
 MANIFEST = "study.json"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+"""2: no ``wall_time`` column (shards of version 1 are another study's to ``--resume``)."""
 
 
 def column_name(name: str) -> str:
@@ -89,8 +93,7 @@ class Layout:
                    for v, u in zip(self.variables, self.units)]
         fields += [pa.field("status", pa.string()), pa.field("error", pa.string()),
                    pa.field("solver", pa.string())]
-        fields += [pa.field(n, pa.int64()) for n in STATS[1:4]]
-        fields.append(pa.field("wall_time", pa.float64()))
+        fields += [pa.field(n, pa.int64()) for n in STATS[1:]]
         meta = {"springc": json.dumps(dict(self.metadata), sort_keys=True)}
         return pa.schema(fields, metadata=meta)
 

@@ -284,7 +284,7 @@ def to_dataset(study: Study) -> Any:
         data[name] = (("run", "time"), column.reshape(runs, nt), {"units": unit} if unit
                       else {})
     for name in ("status", "error", "solver", "steps", "rhs_evaluations",
-                 "jacobian_evaluations", "wall_time"):
+                 "jacobian_evaluations"):
         data[name] = ("run", np.asarray(study.summary.column(name).to_pylist(),
                                         dtype=object if name in ("status", "error",
                                                                  "solver") else None))
