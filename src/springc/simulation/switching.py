@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..ir import flat
-from ..pipeline import CompiledModel, derive_system
+from ..pipeline import CompiledModel
 from ..simplify import (
     THRESHOLD,
     OdeEvaluator,
@@ -234,14 +234,17 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
     method = solver if solver in SOLVERS else EXPLICIT
-    derived = derive_system(model.options)
-    flat_model = derived.flat_model
+    closed = model.closed_system()  # captured at compile time: never the files again
+    flat_model = closed.flat_model
+    if flat_model is None:
+        raise RuntimeError(f"the compiled model {model.name} holds no flat model for its "
+                           "state selection (a bug in springc)")
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
                              rtol=rtol, atol=atol, method=SOLVERS[method],
                              parameters=parameters,
                              time_limit=(limits or Limits()).time_limit)
     if flat_model.assertions:
-        known = parameter_values(derived.system.parameters, parameters)
+        known = parameter_values(closed.system.parameters, parameters)
         check_trajectory(flat_model.assertions, np.asarray(grid, dtype=float), run.values,
                          known)
     values = np.column_stack([run.values[name] for name in model.outputs])
