@@ -79,7 +79,7 @@ def derive_system(options: CompileOptions) -> Derived:
     flat_model = flatten(tree, model)
     simplified = simplify(flat_model)
     system = simplified.ode
-    switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
+    switchable = any(b.switchable for b in simplified.blocks)
     if base is not None:
         # Keep the simulated model's name, location and experiment (annotations are
         # not inherited).

@@ -214,16 +214,16 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         from .switching import simulate_switching_model
 
         if options.engine == COMPILED:
-            raise SimulationError(f"{model.name} switches its states during the run, which "
-                                  "only the scipy engine does",
-                                  hint="use --engine scipy (or auto)")
+            raise SimulationError(f"{model.name} may switch its states during the run "
+                                  "(dynamic state selection), which only the scipy engine "
+                                  "does", hint="use --engine scipy (or auto)")
 
         result = simulate_switching_model(model, solver, grid, rtol, atol,
                                           dict(options.parameters), limits)
         if options.engine.lower() == AUTO:
             result.stats = replace(result.stats, engine_reason=(
-                f"{result.stats.solver} ran in scipy's loop: the model switches its states "
-                "during the run, which only scipy's loop does"))
+                f"{result.stats.solver} ran in scipy's loop, the only one that switches "
+                "states"))
         if estimate_mode != "on":  # a companion run on scipy doubles the run: not auto
             return result
         return _switching_estimate(model, result, solver, grid, rtol, atol,
