@@ -147,3 +147,18 @@ def test_a_damaged_system_record_is_regenerated(tmp_path: Path, cache: Path,
                                        "match its recorded hash; regenerating it\n")
     assert not again.cached and record.exists()
     assert springc.simulate(again, stop=1.0, interval=1.0)["x"][0] == 4.0
+
+
+def test_a_sweep_in_worker_processes_runs_the_model_as_compiled(tmp_path: Path,
+                                                                cache: Path) -> None:
+    path = tmp_path / "rate.mo"
+    path.write_text("model Rate\n  parameter Real k = 1;\n  Real x;\ninitial equation\n"
+                    "  x = 2;\nequation\n  der(x) = -k*x;\nend Rate;\n")
+    model = springc.compile_model(str(path), backend="python")
+    path.write_text("model Rate\n  parameter Real k = 1;\n  Real x;\ninitial equation\n"
+                    "  x = 7;\nequation\n  der(x) = -k*x;\nend Rate;\n")
+    data = springc.sweep(model, params={"k": [1.0, 3.0]}, stop=1.0, interval=0.5,
+                         rtol=1e-10, atol=1e-12, workers=2, solver="dop853")
+    t = np.array([0.0, 0.5, 1.0])
+    for run, k in enumerate((1.0, 3.0)):  # the workers never saw x = 7
+        assert np.allclose(data["x"].values[run], 2.0 * np.exp(-k * t), rtol=1e-8, atol=0)
