@@ -39,7 +39,7 @@ def main(extra: list[str]) -> None:
     skipped = 0
     for path in files + [Path(p) for p in extra]:
         for name in model_names(path):
-            options = CompileOptions(tuple(str(f) for f in files + [path]), name)
+            options = CompileOptions(tuple(str(f) for f in [*files, path]), name)
             try:
                 derived = derive_system(options)
             except SpringcError:
