@@ -162,3 +162,20 @@ def test_a_sweep_in_worker_processes_runs_the_model_as_compiled(tmp_path: Path,
     t = np.array([0.0, 0.5, 1.0])
     for run, k in enumerate((1.0, 3.0)):  # the workers never saw x = 7
         assert np.allclose(data["x"].values[run], 2.0 * np.exp(-k * t), rtol=1e-8, atol=0)
+
+
+def test_a_structural_value_never_compiles_edited_files(tmp_path: Path, cache: Path) -> None:
+    path = tmp_path / "arr.mo"
+    text = ("model Arr\n  parameter Integer n = 2;\n  Real x[n](each start = {start});\n"
+            "equation\n  der(x) = -x;\nend Arr;\n")
+    path.write_text(text.format(start=1))
+    model = springc.compile_model(str(path), backend="python")
+    assert springc.simulate(model, parameters={"n": 3}, stop=1.0).names == (
+        "x[1]", "x[2]", "x[3]")  # the files unchanged: compiled again with n = 3
+    path.write_text(text.format(start=5))
+    with pytest.raises(SimulationError) as info:
+        springc.simulate(model, parameters={"n": 3}, stop=1.0)
+    assert info.value.message == (
+        "the files of Arr changed since it was compiled: a new value of the structural "
+        "parameter 'n' would compile another model")
+    assert springc.simulate(model, stop=1.0)["x[1]"][0] == 1.0  # itself: unchanged

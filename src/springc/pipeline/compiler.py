@@ -141,13 +141,17 @@ class CompiledModel:
             if run is not None and run.flat_model is not None:
                 self.derived = Derived(run.system, run.flat_model, True)
             else:
-                if self.model_key and model_key_of(self.options) != self.model_key:
-                    raise SimulationError(
-                        f"the files of {self.name} changed since it was compiled: its "
-                        "equations are no longer those of the files",
-                        hint="compile the model again to see its equations")
+                self.check_files("its equations are no longer those of the files",
+                                 "compile the model again to see its equations")
                 self.derived = derive_system(self.options)
         return self.derived
+
+    def check_files(self, consequence: str, hint: str) -> None:
+        """Refuse to read this model's files again (for what a run never needs: its
+        equations, a new structural value) when they changed since it was compiled."""
+        if self.model_key and model_key_of(self.options) != self.model_key:
+            raise SimulationError(f"the files of {self.name} changed since it was "
+                                  f"compiled: {consequence}", hint=hint)
 
     def closed_system(self) -> RunSystem:
         """What runs of this model need beyond its module (see :mod:`.closed`),
