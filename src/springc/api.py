@@ -184,6 +184,11 @@ def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
     if not values:
         return compiled
     mods = tuple(sorted((k, modification_value(compiled, k, v)) for k, v in values.items()))
+    if options is None:  # a compiled model given: compiled again from its files
+        compiled.check_files(f"a new value of the structural parameter '{min(values)}' "
+                             "would compile another model",
+                             "compile the files again with compile_model(files, "
+                             "parameters=...)")
     return compile_files(replace(options or compiled.options, modifications=mods))
 
 

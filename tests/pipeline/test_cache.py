@@ -255,7 +255,7 @@ def test_cache_write_failure_falls_back_to_a_temporary_folder(
     # As root every folder is writable: a read-only file system is simulated instead.
     import springc.pipeline.compiler as compiler
 
-    def read_only(entry: Path, text: str) -> Path:
+    def read_only(entry: Path, text: str, extra: object = None) -> Path:
         raise PermissionError(13, "Permission denied", str(entry))
 
     folder = tmp_path / "cache"

@@ -249,8 +249,9 @@ def test_api_names_the_engine_argument() -> None:
 
 
 def test_switching_models_are_refused_on_the_compiled_engine() -> None:
-    with pytest.raises(SimulationError, match="switches its states during the run, which "
-                                              "only the scipy engine does"):
+    with pytest.raises(SimulationError, match=r"may switch its states during the run "
+                                              r"\(dynamic state selection\), which only "
+                                              "the scipy engine does"):
         springc.simulate(SCENES, model_name="Scenes.RigidPair", stop=0.1, engine="compiled")
 
 

@@ -2,13 +2,12 @@
 
 from .compiler import (
     CompiledModel,
-    CompileOptions,
     check_parameter_names,
     compile_files,
-    derive_system,
     generate_source,
     modification_value,
 )
+from .derive import CompileOptions, derive_system
 from .files import flatten_files
 from .selection import select_names
 

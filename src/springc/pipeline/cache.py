@@ -2,12 +2,14 @@
 
 Entries live in ``$SPRINGC_CACHE_DIR``, else ``$XDG_CACHE_HOME/springc``, else
 ``~/.cache/springc``: one folder per key holding ``model.py`` and ``model.sha256``, the
-SHA-256 of the module recorded when it was written. A module's key is that of the
-model (:func:`cache_key`) combined with the observed variables it computes
+SHA-256 of the module recorded when it was written, and for a model whose runs need more
+than the module (an initial problem, dynamic state selection) ``system.pickle`` with
+``system.sha256``, read only after its hash matched, as the module is. A module's key is
+that of the model (:func:`cache_key`) combined with the observed variables it computes
 (:func:`selection_key`); the model's key also names an entry holding ``names.json``
-(with ``names.sha256``), its states and observed variables, so that a new ``--vars``
-is resolved to those variables without flattening the model again. The cache folder
-is private (created 0700, whatever the umask; a shared sticky folder is used through a
+(with ``names.sha256``), its states and observed variables, so that a new ``--vars`` is
+resolved to those variables without flattening the model again. The cache folder is
+private (created 0700, whatever the umask; a shared sticky folder is used through a
 private subfolder, and no folder springc finds has its mode changed or its files
 removed: :func:`springc.resources.private_folder`). A module is imported only from the
 bytes whose hash matched the record: an edited, planted, truncated or unreadable entry
@@ -27,7 +29,7 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from types import ModuleType
 from typing import cast
@@ -43,6 +45,9 @@ MODULE_FILE = "model.py"
 HASH_FILE = "model.sha256"
 NAMES_FILE = "names.json"
 """The record of a model's output names (states, observed), in an entry of its own."""
+SYSTEM_FILE = "system.pickle"
+"""What a run needs beyond the module (:class:`springc.pipeline.closed.RunSystem`), next
+to ``model.py`` in a module's entry when the model has one, with its hash record."""
 
 
 def note(text: str) -> None:
@@ -164,20 +169,23 @@ def discard(entry: Path, reason: str) -> None:
     shutil.rmtree(entry, ignore_errors=True)
 
 
-def write_entry(entry: Path, text: str, name: str = MODULE_FILE) -> Path:
-    """Write ``text`` as file ``name`` (the module) of ``entry`` with its hash record;
-    the file's path.
+def write_entry(entry: Path, text: str, name: str = MODULE_FILE,
+                extra: Mapping[str, bytes] | None = None) -> Path:
+    """Write ``text`` as file ``name`` (the module) of ``entry`` with its hash record,
+    and each file of ``extra`` (name: bytes, e.g. :data:`SYSTEM_FILE`) with its own;
+    the path of file ``name``.
 
-    Both files are written in a private temporary folder that is then renamed to
+    All files are written in a private temporary folder that is then renamed to
     ``entry``, so a reader sees a complete entry or none. If another process wrote the
     entry first, its entry is kept.
     """
-    data = text.encode("utf-8")
+    files = {name: text.encode("utf-8"), **(extra or {})}
     new = Path(tempfile.mkdtemp(dir=entry.parent, prefix=".new-"))  # created 0700
     try:
-        (new / name).write_bytes(data)
-        (new / _hash_file(name)).write_text(hashlib.sha256(data).hexdigest() + "\n",
-                                            encoding="ascii")
+        for file, data in files.items():
+            (new / file).write_bytes(data)
+            (new / _hash_file(file)).write_text(hashlib.sha256(data).hexdigest() + "\n",
+                                                encoding="ascii")
         os.rename(new, entry)
     except OSError:
         shutil.rmtree(new, ignore_errors=True)

@@ -3,34 +3,29 @@
 Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
 could be loaded, the model name, the options and springc's own code; verified by a
 recorded hash before import). A warm hit imports the module without flattening
-anything. Structural parameters (Integer or Boolean ones, and those the flattener
-evaluated, such as array sizes) are set by re-flattening the selected class with a
-modification (``extends M(N = 100)``), in the same class tree as the user's files.
+anything. Flattening and simplifying is :mod:`.derive`; what a run needs beyond the
+module is captured at compile time (:mod:`.closed`), so a compiled model never reads
+its files again.
 """
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
 import difflib
-import gc
 import shutil
 import tempfile
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..codegen import CodegenOptions, GeneratedModule, generate
 from ..errors import CodegenError, SimulationError
-from ..flatten import flatten, select_model
-from ..ir import flat, ode, syntax
 from ..ir.expr import recursion_room
-from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..resources import CacheUnusable, private_folder
-from ..simplify import simplify
 from .cache import (
+    MODULE_FILE,
+    SYSTEM_FILE,
     Names,
     cache_dir,
     cache_key,
@@ -45,33 +40,29 @@ from .cache import (
     write_entry,
     write_names,
 )
+from .closed import (
+    MODULE_PREFIX,
+    RunSystem,
+    dump,
+    import_text,
+    load_run_system,
+    needs_run_system,
+    run_system_of,
+)
+from .derive import CompileOptions, Derived, derive_system, fewer_collections
 from .equations import Equations
 from .selection import ALL_OBSERVED, select_names, selected_observed
-
-
-@dataclass(frozen=True)
-class CompileOptions:
-    """What to compile: files, model, libraries, backend, outputs, structural values.
-
-    ``outputs`` are ``--vars`` patterns (``*`` and ``?`` wildcards, otherwise exact
-    flat names); ``None`` selects every state and observed variable.
-    ``modifications`` are structural parameter values as Modelica text.
-    """
-
-    files: tuple[str, ...]
-    model: str | None = None
-    libraries: tuple[str, ...] = ()
-    backend: str = "python"
-    outputs: tuple[str, ...] | None = None
-    modifications: tuple[tuple[str, str], ...] = ()
-    cache: bool = True
-    texts: tuple[tuple[str, str], ...] = ()  # models given as text: (pseudo file, text)
 
 
 @dataclass
 class CompiledModel:
     """A generated module, imported, with the options that produced it; ``temporary``
-    keeps the private folder of an uncached module alive as long as the model."""
+    keeps the private folder of an uncached module alive as long as the model.
+
+    A compiled model is closed: what its runs need beyond the module (``run_system``,
+    see :mod:`.closed`) was captured when it was compiled, so it never reads its source
+    files again. It pickles (the module as its text, imported again on unpickling), so
+    that it runs in another process where those files do not exist."""
 
     module: GeneratedModule
     options: CompileOptions
@@ -82,6 +73,21 @@ class CompiledModel:
     temporary: tempfile.TemporaryDirectory[str] | None = None
     text: str = ""  # the module's text as verified and imported (``source``)
     derived: Derived | None = field(default=None, repr=False)  # set by ``equations``
+    run_system: RunSystem | None = field(default=None, repr=False)
+    model_key: str = ""  # the cache key of the model when it was compiled
+
+    def __getstate__(self) -> dict[str, object]:
+        return {"text": self.source, "name": getattr(self.module, "__name__", ""),
+                "options": self.options, "cached": self.cached,
+                "compile_time": self.compile_time, "outputs": self.outputs,
+                "run_system": self.run_system, "model_key": self.model_key}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        imported = import_text(state["text"], state["name"])
+        self.__init__(imported.module, state["options"], imported.path,  # type: ignore[misc]
+                      state["cached"], state["compile_time"], state["outputs"],
+                      imported.temporary, state["text"], None, state["run_system"],
+                      state["model_key"])
 
     @property
     def name(self) -> str:
@@ -116,9 +122,9 @@ class CompiledModel:
         return self.text or self.path.read_text(encoding="utf-8")
 
     def equations(self) -> Equations:
-        """The simplified equations in evaluation order (LaTeX in Jupyter); derived
-        again from the options (the files as they are now) on first use: a module
-        loaded from the cache keeps no equations."""
+        """The simplified equations in evaluation order (LaTeX in Jupyter): those the
+        model holds, else derived again from its files on first use (a module loaded
+        from the cache keeps no equations), which must be unchanged since compiling."""
         return Equations(self.derive().system)
 
     def flat_equations(self) -> Equations:
@@ -127,10 +133,32 @@ class CompiledModel:
 
     @recursion_room()
     def derive(self) -> Derived:
-        """The flat model and simplified system of this model (derived once)."""
+        """The flat model and simplified system of this model (derived once): those it
+        holds, else derived from its files, refused when they changed since compiling."""
         if self.derived is None:
-            self.derived = derive_system(self.options)
+            run = self.run_system
+            if run is not None and run.flat_model is not None:
+                self.derived = Derived(run.system, run.flat_model, True)
+            else:
+                self.check_files("its equations are no longer those of the files",
+                                 "compile the model again to see its equations")
+                self.derived = derive_system(self.options)
         return self.derived
+
+    def check_files(self, consequence: str, hint: str) -> None:
+        """Refuse to read this model's files again (for what a run never needs: its
+        equations, a new structural value) when they changed since it was compiled."""
+        if self.model_key and model_key_of(self.options) != self.model_key:
+            raise SimulationError(f"the files of {self.name} changed since it was "
+                                  f"compiled: {consequence}", hint=hint)
+
+    def closed_system(self) -> RunSystem:
+        """What runs of this model need beyond its module (see :mod:`.closed`),
+        captured when it was compiled."""
+        if self.run_system is None:
+            raise RuntimeError(f"the compiled model {self.name} holds no system for its "
+                               "initial problem or state selection (a bug in springc)")
+        return self.run_system
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
         """The parameter vector with ``values`` (non-structural names) applied."""
@@ -168,10 +196,7 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             folder = private_folder(cache_dir())
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
-    settings: tuple[object, ...] = (options.model, options.backend, options.modifications)
-    if options.texts:  # (the keys of file-only models are unchanged)
-        settings += (options.texts,)
-    model_key = cache_key(settings, options.files, options.libraries)
+    model_key = model_key_of(options)
     derived = None
     observed: object = ALL_OBSERVED
     if options.outputs is not None:
@@ -182,29 +207,22 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
     key = selection_key(model_key, observed)
-    module_name = f"springc_model_{key}"
+    module_name = MODULE_PREFIX + key
     if folder is not None:
-        entry = folder / key
-        data = read_entry(entry)
-        if data is not None:
-            path = entry / "model.py"
-            try:
-                module = import_module(data, path, module_name)
-            except Exception as err:  # a damaged entry: regenerate it
-                discard(entry, f"does not import ({type(err).__name__}: {err})")
-            else:
-                touch(path)
-                return CompiledModel(module, options, path, True,
-                                     time.perf_counter() - began, outputs_of(module, options),
-                                     text=data.decode("utf-8"))
+        hit = _cached(folder / key, module_name, options, model_key)
+        if hit is not None:
+            hit.compile_time = time.perf_counter() - began
+            return hit
     if derived is None:
         derived = derive_system(options)
         write_names(folder, model_key, candidate_names(derived))
     generated = generate_from(derived, options)
+    run = run_system_of(derived.system, derived.flat_model, derived.switchable)
     temporary = None
     if folder is not None:
         try:
-            path = write_entry(folder / key, generated)
+            path = write_entry(folder / key, generated,
+                               extra={SYSTEM_FILE: dump(run)} if run is not None else None)
             prune_cache(folder, keep=key)
         except OSError as err:
             note(f"cannot write to the cache folder {folder} ({err.strerror or err}); "
@@ -221,7 +239,47 @@ def compile_files(options: CompileOptions) -> CompiledModel:
             shutil.rmtree(path.parent, ignore_errors=True)
         raise too_deep_for_python(err) from None
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
-                         outputs_of(module, options), temporary, generated)
+                         outputs_of(module, options), temporary, generated,
+                         run_system=run, model_key=model_key)
+
+
+def model_key_of(options: CompileOptions) -> str:
+    """The cache key of the model of ``options`` (the text of its files as they are now,
+    the model, backend and structural values; not the selected outputs)."""
+    settings: tuple[object, ...] = (options.model, options.backend, options.modifications)
+    if options.texts:  # (the keys of file-only models are unchanged)
+        settings += (options.texts,)
+    return cache_key(settings, options.files, options.libraries)
+
+
+def _cached(entry: Path, module_name: str, options: CompileOptions, model_key: str
+            ) -> CompiledModel | None:
+    """The model of a verified cache entry (its module, and its :class:`RunSystem`
+    when its runs need one); None when there is none, or it is damaged (removed)."""
+    data = read_entry(entry)
+    if data is None:
+        return None
+    path = entry / MODULE_FILE
+    try:
+        module = import_module(data, path, module_name)
+    except Exception as err:  # a damaged entry: regenerate it
+        discard(entry, f"does not import ({type(err).__name__}: {err})")
+        return None
+    run = None
+    if needs_run_system(module):
+        record = read_entry(entry, SYSTEM_FILE)  # a damaged one is removed with a note
+        if record is None:
+            if entry.exists():
+                discard(entry, f"has no {SYSTEM_FILE}")
+            return None
+        try:
+            run = load_run_system(record)
+        except Exception as err:  # any damage: regenerate the entry
+            discard(entry, f"has an unusable {SYSTEM_FILE} ({type(err).__name__}: {err})")
+            return None
+    touch(path)
+    return CompiledModel(module, options, path, True, 0.0, outputs_of(module, options),
+                         text=data.decode("utf-8"), run_system=run, model_key=model_key)
 
 
 def candidate_names(derived: Derived) -> Names:
@@ -247,83 +305,6 @@ def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, .
     """The names ``options.outputs`` selects among the module's states and observed."""
     return tuple(select_names(tuple(module.STATES) + tuple(module.OBSERVED),
                               options.outputs))
-
-
-@dataclass(frozen=True)
-class Derived:
-    """The simplified system of a model, its flat model, and whether index reduction
-    left a choice of states that may turn singular during a run (``switchable``)."""
-
-    system: ode.ODE
-    flat_model: flat.FlatModel
-    switchable: bool
-
-
-WRAPPER_FILE = "<springc: structural parameters>"
-"""The file name of the class that applies ``--set`` values of structural parameters."""
-
-
-@contextlib.contextmanager
-def fewer_collections() -> Iterator[None]:
-    """Python's cyclic garbage collector run less often, restored on exit: compiling a
-    model makes millions of objects that live to its end, which the collector walked
-    every 700 allocations (a third of compile_model's CPU time on the 1,000-mass chain:
-    1.44 s instead of 2.07 s; compiling makes few cycles)."""
-    threshold = gc.get_threshold()
-    gc.set_threshold(100_000, 50, 100)
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-
-
-@fewer_collections()
-def derive_system(options: CompileOptions) -> Derived:
-    """Flatten and simplify the model of ``options`` (structural values applied)."""
-    tree = load(list(options.files), options.libraries, options.texts)
-    model = options.model
-    base = None
-    if options.modifications:
-        entry = select_model(tree, model)
-        base = flatten(tree, model)
-        model = _add_wrapper(tree, entry, options.modifications)
-    flat_model = flatten(tree, model)
-    simplified = simplify(flat_model)
-    system = simplified.ode
-    switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
-    if base is not None:
-        # Keep the simulated model's name, location and experiment (annotations are
-        # not inherited).
-        system = dataclasses.replace(
-            system, name=base.name,
-            dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
-    return Derived(system, flat_model, switchable)
-
-
-def _add_wrapper(tree: ClassTree, entry: ClassEntry,
-                 modifications: Sequence[tuple[str, str]]) -> str:
-    """Add to ``tree`` a model extending the class ``entry`` with ``modifications``;
-    its name. The base is named by its path from the root, each part quoted, so the
-    class of the user's file is used even where a library class has the same dotted
-    name (a flattened file's ``model 'Scenes.Chain'``)."""
-    path = []
-    scope: ClassEntry | None = entry
-    while scope is not None and scope.parent is not None:
-        path.append(flat.quote(scope.name))
-        scope = scope.parent
-    declared = {e.name for e in entry.defn.elements if isinstance(e, syntax.Component)}
-    targets = {name: flat.quote(name) if name in declared
-               else ".".join(map(flat.quote, name.split("."))) for name, _ in modifications}
-    mods = ", ".join(f"{targets[name]} = {value}" for name, value in modifications)
-    wrapper = "SpringcModified"
-    while wrapper in tree.root.classes:
-        wrapper += "_"
-    text = (f"model {wrapper}\n  extends {'.'.join(reversed(path))}({mods});\n"
-            f"end {wrapper};\n")
-    errors = tree.add(parse_text(text, WRAPPER_FILE), override=True)
-    if errors:
-        raise errors[0]
-    return wrapper
 
 
 def generate_source(options: CompileOptions) -> str:

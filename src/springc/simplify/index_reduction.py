@@ -33,6 +33,7 @@ from ..structure import (
 from .isolate import free_variables, partial
 from .lower import differentiate
 from .ode_eval import evaluate_with, parameter_values, start_values
+from .static_choice import static_block
 
 START_BONUS = 0.25
 """Priority added for a (non-fixed) start value: below the fixed-start bonus (0.5)."""
@@ -47,13 +48,21 @@ PIVOT_TIE = 1e-6
 class DummyBlock:
     """One block of the dummy-derivative choice, by name: ``equations`` (residuals of
     the augmented system) are solved for ``dummies``, chosen among ``candidates``
-    (priority order; ``tiers`` numbers their priority classes)."""
+    (priority order; ``tiers`` numbers their priority classes). ``static``: the choice
+    holds for the whole run (:mod:`.static_choice`)."""
 
     level: int
     equations: tuple[x.Expr, ...]
     dummies: tuple[str, ...]
     candidates: tuple[str, ...]
     tiers: tuple[int, ...]
+    static: bool = False
+
+    @property
+    def switchable(self) -> bool:
+        """May the states of this block have to change during a run (dynamic state
+        selection)? Only with a choice among candidates that is not static."""
+        return len(self.candidates) > len(self.dummies) and not self.static
 
 
 @dataclass(frozen=True)
@@ -136,12 +145,27 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
     except NumericallySingular as err:
         raise _numerically_singular(system, err, names, sources, at is not None) from None
     states = tuple(zip(selection.states, selection.state_derivatives))
-    blocks = tuple(DummyBlock(b.level, tuple(exprs[e] for e in b.equations),
-                              tuple(names[v] for v in b.dummies),
-                              tuple(names[v] for v in b.candidates), b.tiers)
-                   for b in selection.blocks)
+    base = {d: v for v, d in enumerate(reduction.var_derivative) if d != -1}
+    known = _parameters_or_none(system)
+    blocks = []
+    for b in selection.blocks:
+        equations = tuple(exprs[e] for e in b.equations)
+        dummies = tuple(names[v] for v in b.dummies)
+        candidates = tuple(names[v] for v in b.candidates)
+        static = at is None and len(candidates) > len(dummies) and static_block(
+            equations, candidates, dummies, [priority[base[v]] for v in b.candidates],
+            known)
+        blocks.append(DummyBlock(b.level, equations, dummies, candidates, b.tiers, static))
     return Reduced(tuple(names), tuple(exprs), tuple(sources), tuple(orders),
-                   reduction.incidence, states, blocks)
+                   reduction.incidence, states, tuple(blocks))
+
+
+def _parameters_or_none(system: dae.DAE) -> dict[str, float] | None:
+    """The parameter values of ``system`` (None when one cannot be evaluated)."""
+    try:
+        return parameter_values(system.parameters)
+    except (SimplifyError, ArithmeticError, ValueError):
+        return None
 
 
 def unknown_priority(u: dae.Unknown) -> float:

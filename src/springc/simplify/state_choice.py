@@ -75,7 +75,7 @@ def select_states(model: flat.FlatModel, at: Mapping[str, float] | None = None
     """``simplify(model, at)`` with the monitor data of its dummy-derivative blocks."""
     simplified = simplify(model, at)
     return StateChoice(simplified.ode, tuple(_monitored(b) for b in simplified.blocks
-                                             if len(b.candidates) > len(b.dummies)))
+                                             if b.switchable))
 
 
 def _monitored(block: DummyBlock) -> MonitoredBlock:

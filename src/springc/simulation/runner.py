@@ -142,8 +142,9 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
     States start at their ``start`` values, as Modelica tools do when nothing else
     fixes them. A model with ``initial equation``s or fixed start values on variables
     that are not states has an initial problem: it is solved by
-    :func:`springc.initialize.initial_state` on the simplified system (derived again
-    here, since the generated module holds only the ODE).
+    :func:`springc.simplify.initial_state` on the simplified system the compiled model
+    captured when it was compiled (:meth:`CompiledModel.closed_system`; the generated
+    module holds only the ODE's functions), never on the files as they are now.
     """
     if not getattr(model.module, "INITIAL_CONDITIONS", 0):
         try:
@@ -153,10 +154,9 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
             raise SimulationError(
                 f"{describe_failure(err)} while computing the start value of {where or 'a state'}",
                 hint="check the parameters the start values use (--set)") from None
-    from ..pipeline import derive_system
     from ..simplify import initial_state as solve_initial
 
-    system = derive_system(model.options).system
+    system = model.closed_system().system
     values = dict(zip(model.parameter_names, (float(v) for v in p)))
     if getattr(model.module, "EVENTS", False):  # discrete variables at their start
         mod: Any = model.module
@@ -218,16 +218,16 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
         from .switching import simulate_switching_model
 
         if options.engine == COMPILED:
-            raise SimulationError(f"{model.name} switches its states during the run, which "
-                                  "only the scipy engine does",
-                                  hint="use --engine scipy (or auto)")
+            raise SimulationError(f"{model.name} may switch its states during the run "
+                                  "(dynamic state selection), which only the scipy engine "
+                                  "does", hint="use --engine scipy (or auto)")
 
         result = simulate_switching_model(model, solver, grid, rtol, atol,
                                           dict(options.parameters), limits)
         if options.engine.lower() == AUTO:
             result.stats = replace(result.stats, engine_reason=(
-                f"{result.stats.solver} ran in scipy's loop: the model switches its states "
-                "during the run, which only scipy's loop does"))
+                f"{result.stats.solver} ran in scipy's loop, the only one that switches "
+                "states"))
         if estimate_mode != "on":  # a companion run on scipy doubles the run: not auto
             return result
         return _switching_estimate(model, result, solver, grid, rtol, atol,

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from typing import Protocol
 
@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..ir import flat
-from ..pipeline import CompiledModel, derive_system
+from ..pipeline import CompiledModel
 from ..simplify import (
     THRESHOLD,
     OdeEvaluator,
@@ -98,11 +98,50 @@ class Switch:
 
 @dataclass(frozen=True)
 class SwitchingResult:
-    """``values[name][k]``: every continuous variable of the flat model at ``t[k]``."""
+    """``values[name][k]``: every continuous variable of the flat model at ``t[k]``;
+    the integrator's accepted steps and its RHS and Jacobian evaluations, over all
+    segments."""
 
     t: np.ndarray
     values: dict[str, np.ndarray]
     switches: tuple[Switch, ...]
+    steps: int = 0
+    rhs_evaluations: int = 0
+    jacobian_evaluations: int = 0
+
+
+@dataclass
+class _Counts:
+    """The steps of every solver of a run, and the solvers (their ``nfev``, ``njev``)."""
+
+    steps: int = 0
+    solvers: list[object] = field(default_factory=list)
+
+    def evaluations(self) -> tuple[int, int]:
+        return (sum(int(getattr(s, "nfev", 0)) for s in self.solvers),
+                sum(int(getattr(s, "njev", 0)) for s in self.solvers))
+
+
+def _counted(method: str, counts: _Counts) -> type:
+    """``scipy.integrate``'s solver class ``method``, counting its accepted steps and
+    keeping its instances in ``counts`` (``solve_ivp`` reports no step count)."""
+    import scipy.integrate
+
+    base = getattr(scipy.integrate, method)
+
+    class Counted(base):  # type: ignore[misc, valid-type]
+        def __init__(self, *args: object, **kwargs: object) -> None:
+            super().__init__(*args, **kwargs)
+            counts.solvers.append(self)
+
+        def step(self) -> str | None:
+            before = self.t
+            message: str | None = super().step()
+            if self.status != "failed" and self.n and self.t != before:
+                counts.steps += 1
+            return message
+
+    return Counted
 
 
 def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
@@ -126,6 +165,9 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
     from scipy.integrate import solve_ivp
 
     deadline = time.perf_counter() + time_limit
+    counts = _Counts()
+    name = method
+    method = _counted(method, counts)  # type: ignore[assignment]
 
     t0, t1 = float(t_span[0]), float(t_span[1])
     choice = select_states(model)
@@ -148,7 +190,7 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         if requested is not None:
             later = (requested >= t) & (requested > times[-1] if times else True)
             segment = requested[later & (requested <= t1)]
-        rhs = _RejectingRhs(functions, deadline, time_limit, method.lower())
+        rhs = _RejectingRhs(functions, deadline, time_limit, name.lower())
         try:
             with np.errstate(all="ignore"):  # a run that overflows fails with a message
                 sol = solve_ivp(rhs, (t, t1), state, method=method, t_eval=segment, rtol=rtol,
@@ -180,7 +222,8 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
         choice = _switch(model, choice, values, t, threshold, switches)
         state = state_vector(choice, values)
     out = {n: np.array([r.get(n, np.nan) for r in rows]) for n in names}
-    return SwitchingResult(np.array(times), out, tuple(switches))
+    return SwitchingResult(np.array(times), out, tuple(switches), counts.steps,
+                           *counts.evaluations())
 
 
 class _RejectingRhs:
@@ -238,14 +281,17 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
     """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
     began = time.perf_counter()
     method = solver if solver in SOLVERS else EXPLICIT
-    derived = derive_system(model.options)
-    flat_model = derived.flat_model
+    closed = model.closed_system()  # captured at compile time: never the files again
+    flat_model = closed.flat_model
+    if flat_model is None:
+        raise RuntimeError(f"the compiled model {model.name} holds no flat model for its "
+                           "state selection (a bug in springc)")
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
                              rtol=rtol, atol=atol, method=SOLVERS[method],
                              parameters=parameters,
                              time_limit=(limits or Limits()).time_limit)
     if flat_model.assertions:
-        known = parameter_values(derived.system.parameters, parameters)
+        known = parameter_values(closed.system.parameters, parameters)
         check_trajectory(flat_model.assertions, np.asarray(grid, dtype=float), run.values,
                          known)
     values = np.column_stack([run.values[name] for name in model.outputs])
@@ -253,11 +299,13 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))
     unit_of = dict(zip(model.states, getattr(model.module, "STATE_UNITS", ())))
     unit_of.update(zip(model.observed, units))
-    switches = ", ".join(f"t = {s.time:.6g}" for s in run.switches) or "none"
+    switches = ", ".join(f"t = {s.time:.6g}" for s in run.switches)
     reason = (f"dynamic state selection, {len(run.switches)} switch"
-              f"{'es' if len(run.switches) != 1 else ''} ({switches})")
-    stats = SimulationStats(method, len(run.t), 0, 0, time.perf_counter() - began, 0.0,
-                            model.compile_time, model.cached, reason)
+              f"{'es' if len(run.switches) != 1 else ''} ({switches})" if switches else
+              "dynamic state selection, no switch in this run")
+    stats = SimulationStats(method, run.steps, run.rhs_evaluations, run.jacobian_evaluations,
+                            time.perf_counter() - began, 0.0, model.compile_time,
+                            model.cached, reason)
     return SimulationResult(model.name, np.asarray(grid, dtype=float), model.outputs,
                             values, tuple(unit_of.get(n, "") for n in model.outputs),
                             stats, dict(parameters))

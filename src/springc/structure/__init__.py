@@ -4,7 +4,13 @@ Input: an incidence (for each equation, the indices of the variables it contains
 Output: matchings, Dulmage-Mendelsohn parts, BLT blocks and tearings of loops.
 """
 
-from .dummy import NumericallySingular, StateSelection, dummy_derivatives, state_priority
+from .dummy import (
+    NumericallySingular,
+    StateSelection,
+    dummy_derivatives,
+    kept_by_preference,
+    state_priority,
+)
 from .graph import Incidence, biadjacency, to_incidence, transpose
 from .index import IndexReduction, StructurallySingular, pantelides
 from .matching import DMParts, Matching, dulmage_mendelsohn, maximum_matching, validate_matching
@@ -24,6 +30,7 @@ __all__ = [
     "blt",
     "dulmage_mendelsohn",
     "dummy_derivatives",
+    "kept_by_preference",
     "maximum_matching",
     "pantelides",
     "state_priority",

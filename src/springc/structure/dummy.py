@@ -134,6 +134,19 @@ def state_priority(state_select: str = "default", fixed_start: bool = False) -> 
     return value + FIXED_START_BONUS if fixed_start else value
 
 
+def kept_by_preference(priorities: Sequence[float], dummies: Sequence[bool]) -> bool:
+    """Are the candidates a block keeps as states exactly its preferred ones?
+
+    ``priorities[k]`` is that of candidate k's state (see :func:`state_priority`),
+    ``dummies[k]`` whether it became a dummy. As Modelica tools do, a block whose
+    ``StateSelect.prefer`` (or ``always``) candidates are as many as the states it keeps,
+    and which the selection could keep (a nonsingular block of the others), is a static
+    choice: its states are never switched during a run.
+    """
+    preferred = [p >= PREFER for p in priorities]
+    return any(preferred) and all(p != d for p, d in zip(preferred, dummies))
+
+
 def dummy_derivatives(
     reduction: IndexReduction,
     priority: Sequence[float] | None = None,

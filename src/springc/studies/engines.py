@@ -12,8 +12,8 @@ the same engines to other callers (``springc tradeoff`` runs its solvers through
   solvers' vectors are small and the processes already use the cores.
 - :func:`dask_map`: a ``distributed.Client`` connected to a running scheduler
   (``dask scheduler`` + ``dask worker ADDRESS``). Dask's nanny pins BLAS to one thread
-  in its workers by default. Workers need springc installed and the model files readable
-  at the same absolute paths (a shared folder).
+  in its workers by default. Workers need springc installed (the same version); the
+  compiled model travels with each batch, so they need no model files.
 
 Leaving the iteration early (an error, Ctrl-C) cancels the batches not started; the
 local pool waits for its running batches, which are short (see :func:`batches`).

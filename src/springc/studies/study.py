@@ -8,10 +8,9 @@ there is an output file so that an interrupted study can resume.
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, TextIO
 
 import numpy as np
@@ -132,12 +131,9 @@ def layout_of(model: CompiledModel, options: StudyOptions, values: np.ndarray) -
 
 
 def job_of(model: CompiledModel, options: StudyOptions) -> RunJob:
-    """The job the workers run: the model's compile options with absolute file names
-    (workers may start in another folder; the cache key is the same)."""
-    compile_options = replace(
-        model.options, files=tuple(os.path.abspath(f) for f in model.options.files),
-        libraries=tuple(os.path.abspath(f) for f in model.options.libraries))
-    return RunJob(compile_options, options)
+    """The job the workers run: the compiled model itself (closed: the workers never
+    read its files) and the study's options."""
+    return RunJob(model, options)
 
 
 Pending = Sequence[tuple[int, tuple[float, ...]]]

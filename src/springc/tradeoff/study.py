@@ -35,14 +35,13 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import os
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 
-from ..pipeline import CompiledModel, CompileOptions, compile_files
+from ..pipeline import CompiledModel
 from ..simulation import FIXED_STEP, SOLVERS
 from .baselines import baseline_runs
 from .chains import Chain, Pilot, cost_ceiling, pilot_solver, solver_runs
@@ -137,7 +136,7 @@ def run_tradeoff(model: CompiledModel, options: TradeoffOptions,
         for i in rest:
             done[i] = chain_runs(setup, ref, scales, energy, chains[i], pilot, setup.log)
     else:
-        job = ChainJob(model.options, model.outputs, dataclasses.replace(options, log=None),
+        job = ChainJob(model, dataclasses.replace(options, log=None),
                        ref, scales, energy, pilot)
         for k, runs in executor.map(functools.partial(run_chain, job),
                                     [chains[i] for i in rest]):
@@ -160,34 +159,22 @@ class Executor(Protocol):
 
 @dataclass(frozen=True)
 class ChainJob:
-    """What a worker needs for any chain: the model (compile options with absolute
-    file names, and the compared outputs), the options (no log stream), the reference,
-    the scales, the energy variable and the pilot's runs."""
+    """What a worker needs for any chain: the compiled model with the compared outputs
+    (pickled: closed, it never reads its files, see :mod:`springc.pipeline.closed`),
+    the options (no log stream), the reference, the scales, the energy variable and the
+    pilot's runs."""
 
-    compile: CompileOptions
-    outputs: tuple[str, ...]
+    model: CompiledModel
     options: TradeoffOptions
     reference: Reference
     scales: np.ndarray
     energy: str | None
     pilot: Pilot | None = None
 
-    def __post_init__(self) -> None:
-        absolute = dataclasses.replace(
-            self.compile, files=tuple(os.path.abspath(f) for f in self.compile.files),
-            libraries=tuple(os.path.abspath(f) for f in self.compile.libraries))
-        object.__setattr__(self, "compile", absolute)
-
-
-@functools.lru_cache(maxsize=4)
-def worker_model(options: CompileOptions) -> CompiledModel:
-    """The compiled model of ``options`` in a worker (loaded from the cache once)."""
-    return compile_files(options)
-
 
 def run_chain(job: ChainJob, chain: Chain) -> list[Run]:
-    """One chain in a worker process: the model from the cache, warmed up, then runs."""
-    model = dataclasses.replace(worker_model(job.compile), outputs=job.outputs)
+    """One chain in a worker process: the job's model, warmed up, then runs."""
+    model = job.model
     setup = study_setup(model, job.options)
     with np.errstate(all="ignore"):
         warm_up(model, setup.p, setup.x0)
