@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import SpringcError
 from ..pipeline import CompiledModel, CompileOptions, compile_files
 from ..simulation import (
+    DEFAULT_ERROR_CONTROL,
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
     SimulationOptions,
@@ -56,6 +57,7 @@ class StudyOptions:
     energy: str | None = None
     max_steps: int | None = None
     time_limit: float | None = None
+    error_control: str = DEFAULT_ERROR_CONTROL  # tighten, warn or off, as for simulate
 
 
 @dataclass(frozen=True)
@@ -79,7 +81,8 @@ class RunJob:
         return SimulationOptions(
             o.start, o.stop, o.interval, o.solver, o.rtol, o.atol, parameters, None, o.step,
             DEFAULT_MAX_STEPS if o.max_steps is None else o.max_steps,
-            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit)
+            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit,
+            error_control=o.error_control)
 
 
 @dataclass(frozen=True)
