@@ -25,10 +25,12 @@ tolerance to meet: its step is what was asked.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -44,7 +46,9 @@ from .solver_names import (
 
 if TYPE_CHECKING:
     from .results import SimulationResult
-    from .runner import SimulationOptions
+
+SimulationOptions = Any
+"""``runner.SimulationOptions`` (a frozen dataclass; the runner imports this module)."""
 
 MODES = ERROR_CONTROLS
 DEFAULT_MODE = DEFAULT_ERROR_CONTROL
@@ -110,7 +114,7 @@ class Asked:
     atol: float
 
 
-Run = Callable[["SimulationOptions"], "SimulationResult"]
+Run = Callable[[SimulationOptions], "SimulationResult"]
 
 
 def controlled(options: SimulationOptions, asked: Asked, run: Run) -> SimulationResult:
@@ -153,17 +157,24 @@ def _estimate(options: SimulationOptions, result: SimulationResult, rtol: float,
     started = time.perf_counter()
     if solver in FIXED_STEP:
         step = float(options.step or 0.0) / 2
-        companion = run(replace(base, solver=solver, rtol=rtol, atol=atol, step=step))
+        companion = _quiet(run, replace(base, solver=solver, rtol=rtol, atol=atol, step=step))
         gain = 2.0 ** ORDERS[solver]
         return companion, compare(result, companion, companion.time,
                                   f"Richardson against {solver} at step {step:.3g} s",
                                   gain / (gain - 1), started), (rtol, atol)
     tight = companion_tolerances(rtol, atol)
     chosen = solver if solver in IMPLICIT_SOLVERS else EXPLICIT
-    companion = run(replace(base, solver=chosen, rtol=tight[0], atol=tight[1]))
+    companion = _quiet(run, replace(base, solver=chosen, rtol=tight[0], atol=tight[1]))
     return companion, compare(result, companion, companion.time,
                               f"companion {chosen} at rtol {short(tight[0])}", 1.0,
                               started), tight
+
+
+def _quiet(run: Run, options: SimulationOptions) -> SimulationResult:
+    """A companion run, its stderr (the warnings of ``assert(..., level = warning)``,
+    which the run has printed once already) discarded."""
+    with contextlib.redirect_stderr(io.StringIO()):
+        return run(options)
 
 
 def _tightened(first: SimulationResult, companion: SimulationResult) -> SimulationResult:

@@ -21,18 +21,24 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .results import SimulationResult
 
 COMPANION_FACTOR = 1000.0
 TIGHTEST_RTOL = 1e-13
 """The companion's rtol is never below this (DOP853's limit is about 100 eps)."""
 ORDERS = {"symplectic-euler": 1, "verlet": 2, "rk4": 4}
 """The order of each fixed-step method (Richardson's gain ``2^q``)."""
+
+
+class Run(Protocol):
+    """What a comparison reads of a run (a ``SimulationResult``)."""
+
+    time: np.ndarray
+    names: tuple[str, ...]
+    values: np.ndarray
+    events: tuple[Any, ...]
 
 
 @dataclass(frozen=True)
@@ -96,8 +102,7 @@ def grid_rows(times: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return np.where(found, rows, -1)
 
 
-def event_windows(run: SimulationResult, companion: SimulationResult
-                  ) -> list[tuple[float, float]]:
+def event_windows(run: Run, companion: Run) -> list[tuple[float, float]]:
     """The time spans where the two runs may be in different modes: between the times
     of each event the two share (paired in order), widened by their distance."""
     ours = [e.time for e in run.events if e.kind == "state"]
@@ -109,7 +114,7 @@ def event_windows(run: SimulationResult, companion: SimulationResult
     return windows
 
 
-def compare(run: SimulationResult, companion: SimulationResult, grid: np.ndarray,
+def compare(run: Run, companion: Run, grid: np.ndarray,
             method: str, gain: float, began: float) -> ErrorEstimate:
     """The estimate of ``run``'s error from ``companion`` (see the module docstring);
     ``gain`` multiplies the difference (1, or Richardson's ``2^q / (2^q - 1)``)."""
