@@ -335,6 +335,14 @@ def test_sweep_carries_the_option_to_every_run() -> None:
                                  error_control=mode)
         np.testing.assert_allclose(frame["mass.v[1]"].to_numpy(), alone["mass.v[1]"],
                                    rtol=0, atol=1e-12)
+        # the table records each run's rtol, estimate and warning
+        assert (frame["rtol"] == alone.stats.rtol).all()
+        if mode == "off":
+            assert frame["estimated_error"].isna().all()
+        else:
+            np.testing.assert_allclose(frame["estimated_error"].to_numpy(),
+                                       alone.stats.estimated_error, rtol=1e-6)
+        assert frame["warning"].isna().all() and alone.stats.warning == ""
     result = CliRunner().invoke(main, ["sweep", SEED, "--param", "spring.k=1e4", "-o",
                                        "x.parquet", "--error-control", "never"])
     assert result.exit_code == 2

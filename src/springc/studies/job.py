@@ -14,6 +14,7 @@ the study.
 from __future__ import annotations
 
 import functools
+import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -98,6 +99,9 @@ class RunRecord:
     jacobian_evaluations: int
     wall_time: float
     values: np.ndarray | None
+    rtol: float = math.nan  # --error-control: the rtol of the run kept
+    estimated_error: float = math.nan  # of the variable furthest from its tolerance
+    warning: str | None = None  # the tolerance still missed (SimulationStats.warning)
 
 
 @functools.lru_cache(maxsize=4)
@@ -117,7 +121,10 @@ def run_one(model: CompiledModel, job: RunJob, run: int, values: Sequence[float]
                          None)
     stats = result.stats
     return RunRecord(run, None, stats.solver, stats.steps, stats.rhs_evaluations,
-                     stats.jacobian_evaluations, stats.wall_time, result.values)
+                     stats.jacobian_evaluations, stats.wall_time, result.values,
+                     math.nan if stats.rtol is None else stats.rtol,
+                     math.nan if stats.estimated_error is None else stats.estimated_error,
+                     stats.warning or None)
 
 
 def run_batch(job: RunJob, runs: Sequence[tuple[int, tuple[float, ...]]]
