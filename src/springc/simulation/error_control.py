@@ -32,8 +32,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from ..errors import SpringcError, UsageError
 from .error_estimate import ORDERS, ErrorEstimate, companion_tolerances, compare
 from .solver_names import (
@@ -94,12 +92,6 @@ def estimate_deprecation(estimate: str, names: tuple[str, str] = ("--error-contr
             f"{ESTIMATE_MODES.get(estimate.lower(), '?')}")
 
 
-def tolerances(values: np.ndarray, rtol: float, atol: float) -> np.ndarray:
-    """The error each column of ``values`` may have: ``FACTOR * (rtol * scale + atol)``."""
-    scale = np.abs(values).max(axis=0) if len(values) else np.zeros(values.shape[1])
-    return FACTOR * (rtol * scale + atol)
-
-
 def short(x: float) -> str:
     """``1e-06`` -> ``1e-6``, ``2.9e-04`` -> ``2.9e-4``: numbers in the summary."""
     return f"{x:.2g}".replace("e-0", "e-").replace("e+0", "e+")
@@ -134,8 +126,8 @@ def controlled(options: SimulationOptions, asked: Asked, run: Run) -> Simulation
         if result.stats.solver in FIXED_STEP:
             return _finish(result, rtol, atol, estimate, _words(estimate, "", "fixed"), "",
                            began)
-        estimate = replace(estimate, tolerance=tolerances(result.values, asked.rtol,
-                                                          asked.atol))
+        estimate = replace(estimate, tolerance=FACTOR * (asked.rtol * estimate.scales
+                                                         + asked.atol))
         if (estimate.met or asked.mode == "warn" or tight[0] < TIGHTEST_RUN_RTOL * 0.999
                 or _round == MAX_ROUNDS - 1):
             break

@@ -12,15 +12,17 @@ output times both runs reached, never at the extra rows ``event_rows`` adds. A h
 run and its companion locate the same state event at slightly different times; an
 output time between the two (widened by their distance on both sides) compares values
 of two different modes, so it is left out; at every other output time the difference
-is the run's error, the effect of its event times included. For each variable: the
-largest ``|error|``, where it occurs, and that divided by the variable's largest
-magnitude over the run (the relative error).
+is the run's error, the effect of its event times included. The event times are one
+more quantity of the estimate (:data:`EVENT_TIMES`): their largest shift against the
+companion's, on the scale of the largest event time. For each variable: the largest
+``|error|``, where it occurs, and that divided by the variable's largest magnitude over
+the run (the relative error).
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -28,6 +30,8 @@ import numpy as np
 COMPANION_FACTOR = 1000.0
 TIGHTEST_RTOL = 1e-13
 """The companion's rtol is never below this (DOP853's limit is about 100 eps)."""
+EVENT_TIMES = "(event times)"
+"""The estimate's name for the times of a hybrid run's state events."""
 ORDERS = {"symplectic-euler": 1, "verlet": 2, "rk4": 4}
 """The order of each fixed-step method (Richardson's gain ``2^q``)."""
 
@@ -52,6 +56,7 @@ class ErrorEstimate:
     times: np.ndarray  # where the largest |error| occurs, per variable
     method: str  # how it was estimated, in words
     seconds: float  # what estimating cost
+    scales: np.ndarray  # the largest |value| of each variable over the run
     tolerance: np.ndarray | None = None  # the error allowed to each variable
 
     @property
@@ -102,16 +107,13 @@ def grid_rows(times: np.ndarray, grid: np.ndarray) -> np.ndarray:
     return np.where(found, rows, -1)
 
 
-def event_windows(run: Run, companion: Run) -> list[tuple[float, float]]:
-    """The time spans where the two runs may be in different modes: between the times
-    of each event the two share (paired in order), widened by their distance."""
+def paired_events(run: Run, companion: Run) -> tuple[np.ndarray, np.ndarray]:
+    """The times of the state events of the two runs, paired in order (the shorter
+    list's length)."""
     ours = [e.time for e in run.events if e.kind == "state"]
     theirs = [e.time for e in companion.events if e.kind == "state"]
-    windows = []
-    for a, b in zip(ours, theirs):
-        gap = abs(a - b)
-        windows.append((min(a, b) - gap, max(a, b) + gap))
-    return windows
+    n = min(len(ours), len(theirs))
+    return np.asarray(ours[:n], dtype=float), np.asarray(theirs[:n], dtype=float)
 
 
 def compare(run: Run, companion: Run, grid: np.ndarray,
@@ -120,24 +122,35 @@ def compare(run: Run, companion: Run, grid: np.ndarray,
     ``gain`` multiplies the difference (1, or Richardson's ``2^q / (2^q - 1)``)."""
     ours, theirs = grid_rows(run.time, grid), grid_rows(companion.time, grid)
     keep = (ours >= 0) & (theirs >= 0)
-    for low, high in event_windows(run, companion):
+    a, b = paired_events(run, companion)
+    for low, high in zip(np.minimum(a, b) - abs(a - b), np.maximum(a, b) + abs(a - b)):
         keep &= ~((grid >= low) & (grid <= high))
     columns = [companion.names.index(n) for n in run.names]
     error = (run.values[ours[keep]] - companion.values[theirs[keep]][:, columns]) * gain
-    magnitude = np.abs(run.values).max(axis=0) if len(run.values) else \
-        np.zeros(len(run.names))
-    return measured(run.names, grid[keep], magnitude, error, method, began)
+    scales = np.abs(run.values).max(axis=0) if len(run.values) else np.zeros(len(run.names))
+    estimate = measured(run.names, grid[keep], scales, error, method, began)
+    if not len(a):
+        return estimate
+    # the event times as one more quantity: their largest shift, on the scale of |t|
+    worst = int(np.argmax(abs(a - b) * gain))
+    shift, scale = float(abs(a - b)[worst] * gain), float(np.abs(a).max())
+    return replace(estimate, names=(*estimate.names, EVENT_TIMES),
+                   absolute=np.append(estimate.absolute, shift),
+                   relative=np.append(estimate.relative, shift / scale if scale else shift),
+                   times=np.append(estimate.times, a[worst]),
+                   scales=np.append(estimate.scales, scale))
 
 
-def measured(names: tuple[str, ...], grid: np.ndarray, magnitude: np.ndarray,
+def measured(names: tuple[str, ...], grid: np.ndarray, scales: np.ndarray,
              error: np.ndarray, method: str, began: float) -> ErrorEstimate:
     """The estimate from the ``error`` of each variable on ``grid`` (rows), its largest
-    ``magnitude`` over the run giving the relative error."""
+    magnitude over the run (``scales``) giving the relative error."""
     if not len(grid):
         zero = np.zeros(len(names))
-        return ErrorEstimate(names, zero, zero, zero, method, time.perf_counter() - began)
+        return ErrorEstimate(names, zero, zero, zero, method, time.perf_counter() - began,
+                             scales)
     absolute = np.abs(error).max(axis=0)
     where = grid[np.abs(error).argmax(axis=0)]
-    relative = absolute / np.where(magnitude > 0, magnitude, 1.0)
+    relative = absolute / np.where(scales > 0, scales, 1.0)
     return ErrorEstimate(names, absolute, relative, where, method,
-                         time.perf_counter() - began)
+                         time.perf_counter() - began, scales)
