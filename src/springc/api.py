@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any, TextIO
@@ -25,6 +26,7 @@ from .pipeline import (
 )
 from .simulation import (
     DEFAULT_ENGINE,
+    DEFAULT_ERROR_CONTROL,
     DEFAULT_MAX_STEPS,
     DEFAULT_SOLVER,
     DEFAULT_TIME_LIMIT,
@@ -33,6 +35,8 @@ from .simulation import (
     check_run_values,
     choose_engine,
     default_backend,
+    error_control_mode,
+    estimate_deprecation,
     simulate_model,
 )
 
@@ -202,8 +206,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              libraries: Sequence[str | os.PathLike[str]] = (), cache: bool = True,
              progress: TextIO | None = None, step: float | None = None,
              max_steps: int | None = None, time_limit: float | None = None,
-             engine: str = DEFAULT_ENGINE,
-             error_estimate: str = "auto", event_rows: bool = False) -> SimulationResult:
+             engine: str = DEFAULT_ENGINE, error_control: str | None = None,
+             error_estimate: str | None = None, event_rows: bool = False) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -218,10 +222,14 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     Python), or ``"auto"`` (the default): compiled where numba is importable, the
     solver has a compiled loop and the model's backend is numba, else scipy (the
     summary, ``result.stats.engine_reason``, says why).
-    ``error_estimate`` (``"off"``, ``"on"``, ``"auto"``): estimate the global error
-    reached on the grid (``result.error_estimate``, a companion run at a tighter
-    tolerance, or Richardson for the fixed-step solvers); ``auto`` where it costs at
-    most about 30 % of the run.
+    ``error_control`` (``"tighten"``, the default; ``"warn"``, ``"off"``): estimate the
+    global error reached on the grid (``result.error_estimate``: a companion run 1000x
+    tighter, or Richardson for the fixed-step solvers) and hold each output variable to
+    ``10 * (rtol * max|v| + atol)``; ``tighten`` runs 1000x tighter until it does (the
+    summary and ``result.stats`` say so), ``warn`` only warns; a rule still broken is an
+    :class:`AccuracyWarning` and ``result.stats.warning`` (see
+    :mod:`springc.simulation.error_control`). ``error_estimate`` (``"off"``, ``"on"``,
+    ``"auto"``) is deprecated: ``"off"``, ``"warn"``, ``"tighten"``.
     ``backend`` (files only) defaults to ``"numba"`` where the run can take the
     compiled loop, else ``"python"`` (``engine="scipy"``, lsoda, no numba).
     ``event_rows``: a model with events gets two more rows at each event, its left and
@@ -246,8 +254,25 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
                                 step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
                                 DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
                                 engine, event_rows=bool(event_rows),
-                                error_estimate=error_estimate)
-    return simulate_model(model, options)
+                                error_control=_error_control(error_control, error_estimate))
+    result = simulate_model(model, options)
+    if result.stats.warning:
+        warnings.warn(f"{result.model}: {result.stats.warning}", AccuracyWarning,
+                      stacklevel=3)  # the caller's line (recursion_room wraps this)
+    return result
+
+
+class AccuracyWarning(UserWarning):
+    """A run whose estimated error breaks its tolerance (``error_control``)."""
+
+
+def _error_control(control: str | None, estimate: str | None) -> str:
+    """``error_control`` from the new argument and the deprecated ``error_estimate``."""
+    names = ("error_control", "error_estimate")
+    mode = error_control_mode(control, estimate, names)
+    if estimate is not None:
+        warnings.warn(estimate_deprecation(estimate, names), DeprecationWarning, stacklevel=4)
+    return mode
 
 
 def sweep(files: CompiledModel | Files, *, model: str | None = None,
@@ -262,7 +287,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
           energy: str | None = None, libraries: Sequence[str | os.PathLike[str]] = (),
           backend: str | None = None, cache: bool = True,
           progress: TextIO | None = None, max_steps: int | None = None,
-          time_limit: float | None = None,
+          time_limit: float | None = None, error_control: str = DEFAULT_ERROR_CONTROL,
           as_: str = "dataset") -> Any:
     """Run a parameter study and return it as an ``xarray.Dataset`` (``as_="dataset"``:
     each output over ``run`` x ``time`` with ``units`` attributes, the swept parameters
@@ -276,7 +301,8 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     core) or to the Dask scheduler at ``scheduler``. ``parameters`` are fixed values
     for every run. With ``output`` (``.parquet``), the study table and its summary
     (``.summary.parquet``) are written, and ``resume`` continues an interrupted study.
-    ``max_steps`` and ``time_limit`` bound each run as in :func:`simulate`;
+    ``max_steps`` and ``time_limit`` bound each run, and ``error_control`` (``"tighten"``,
+    ``"warn"``, ``"off"``) holds it to its tolerance, as in :func:`simulate`;
     ``backend`` defaults as there (numba: the runs take the compiled loop).
     """
     from .studies import (
@@ -291,6 +317,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     if as_ not in ("dataset", "dataframe"):
         raise UsageError(f"as_ must be 'dataset' or 'dataframe', not {as_!r}", option="as_")
     check_run_values(start, stop, interval, rtol, atol, step, parameters)
+    mode = error_control_mode(error_control, None, ("error_control", "error_estimate"))
     specs = tuple(parse_values(name, spec if isinstance(spec, str) else
                                ",".join(repr(float(v)) for v in spec), option="params")
                   for name, spec in params.items())
@@ -311,7 +338,7 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
         check_outputs(target, summary_path(target), protected, ("output", "output"))
     options = StudyOptions(specs, samples, method, seed, rest, start, stop, interval,
                            solver, rtol, atol, step, workers, scheduler, energy, max_steps,
-                           time_limit)
+                           time_limit, mode)
     study = run_study(compiled, options, target, resume=resume, protected=protected,
                       progress=progress)
     if as_ == "dataframe":

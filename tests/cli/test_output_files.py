@@ -327,7 +327,7 @@ def test_flat_output_escapes_quoted_names_and_reads_back(tmp_path: Path) -> None
 def test_api_writers_choose_by_suffix(model: Path, tmp_path: Path) -> None:
     import springc
 
-    result = springc.simulate(model, stop=1.0, interval=0.5, error_estimate="off")
+    result = springc.simulate(model, stop=1.0, interval=0.5, error_control="off")
     with pytest.raises(UsageError, match=r"^error: plot .*p\.gif: the suffix must be one of "
                                          r"\.png, \.svg, \.pdf"):
         result.plot(tmp_path / "p.gif")
@@ -335,7 +335,7 @@ def test_api_writers_choose_by_suffix(model: Path, tmp_path: Path) -> None:
     assert (tmp_path / "r.csv").read_text().startswith("time,x\n0.0,1.0\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv"]
     # with an error estimate, its side file next to the trajectory (r2.error.csv)
-    estimated = springc.simulate(model, stop=1.0, interval=0.5, error_estimate="on")
+    estimated = springc.simulate(model, stop=1.0, interval=0.5, error_control="warn")
     estimated.save(tmp_path / "r2.csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv", "r2.csv",
                                                           "r2.error.csv"]

@@ -57,7 +57,8 @@ def test_sweep_as_dataframe_is_the_study_table() -> None:
                           as_="dataframe")
     assert frame.columns.tolist() == [
         "run", "time", "spring.k", "spring.x", "status", "error", "solver", "steps",
-        "rhs_evaluations", "jacobian_evaluations"]
+        "rhs_evaluations", "jacobian_evaluations", "rtol", "estimated_error",
+        "warning"]
     single = springc.simulate(SEED, stop=0.1, outputs=["spring.x"],
                               parameters={"spring.k": 1e4, "mass.m": 2.0})
     last = frame[frame["run"] == 1]["spring.x"].to_numpy()

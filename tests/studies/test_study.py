@@ -29,7 +29,8 @@ STOP = 2.0
 OUTPUTS = ("mass.pos[1]", "mass.pos[2]", "mass.v[1]", "mass.v[2]", "spring.dir[1]",
            "spring.dir[2]", "spring.x")
 COLUMNS = ["run", "time", "spring.k", *OUTPUTS, "status", "error", "solver", "steps",
-           "rhs_evaluations", "jacobian_evaluations"]
+           "rhs_evaluations", "jacobian_evaluations", "rtol", "estimated_error",
+           "warning"]
 
 
 @pytest.fixture(scope="module")

@@ -3,10 +3,19 @@
 from __future__ import annotations
 
 import sys
+import warnings
 
 import click
 
-from ..simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, FIXED_STEP
+from ..simulation import (
+    ALL_SOLVERS,
+    DEFAULT_ENGINE,
+    DEFAULT_ERROR_CONTROL,
+    DEFAULT_SOLVER,
+    ENGINES,
+    ERROR_CONTROLS,
+    FIXED_STEP,
+)
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -36,13 +45,18 @@ from .options import (
               "Python; auto: compiled where it can run (numba installed, a solver with a "
               "compiled loop, not --backend python), else scipy, and the summary says "
               "why.")
+@click.option("--error-control", type=click.Choice(ERROR_CONTROLS, case_sensitive=False),
+              default=None, help="Estimate the global error on the output grid (a "
+              "companion run 1000x tighter, or half the step for fixed-step solvers: in "
+              "the summary line and in NAME.error.csv next to -o NAME.csv) and hold every "
+              "output variable v to 10 * (rtol * max|v| + atol). tighten: run 1000x "
+              "tighter until it holds (at most rtol 1e-12, within --max-steps and "
+              "--time-limit), else warn; warn: only warn; off: no estimate (fastest). "
+              f"[default: {DEFAULT_ERROR_CONTROL}]")
 @click.option("--error-estimate", type=click.Choice(("off", "on", "auto"),
                                                    case_sensitive=False),
-              default="auto", show_default=True,
-              help="Estimate the global error reached on the output grid (a companion "
-              "run at a 1000x tighter tolerance, or half the step for fixed-step "
-              "solvers): in the summary line and in the side file NAME.error.csv next to "
-              "-o NAME.csv; auto: where it costs at most about 30 % of the run.")
+              default=None, help="Deprecated: off is --error-control off, on is warn, "
+              "auto is tighten.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
@@ -66,8 +80,8 @@ from .options import (
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, engine: str,
-             error_estimate: str, rtol: float | None, step: float | None,
-             atol: float | None,
+             error_control: str | None, error_estimate: str | None, rtol: float | None,
+             step: float | None, atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
              event_rows: bool, quiet: bool) -> None:
@@ -77,6 +91,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         RESULT_FORMATS,
         check_run_values,
         choose_engine,
+        error_control_mode,
+        estimate_deprecation,
     )
 
     values = parse_set(assignments)
@@ -87,8 +103,11 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
                    files)
+    mode = error_control_mode(error_control, error_estimate)
+    if error_estimate is not None:
+        click.echo(f"warning: {estimate_deprecation(error_estimate)}", err=True)
     single_threaded_blas()
-    from ..api import compile_model, default_choice
+    from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
     from ..simulation import (
         SimulationOptions,
@@ -105,12 +124,15 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
                               f"-o {output}" if output else "the CSV on stdout")
     progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-    result = run(compiled, start=start, stop=stop, interval=interval,
-                 solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters={k: v for k, v in values.items() if k not in compiled.structural},
-                 progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
-                 engine=engine.lower(), error_estimate=error_estimate.lower(),
-                 event_rows=event_rows)
+    with warnings.catch_warnings():  # said below as the command's own warning
+        warnings.simplefilter("ignore", AccuracyWarning)
+        result = run(compiled, start=start, stop=stop, interval=interval,
+                     solver=solver.lower(), rtol=rtol, atol=atol,
+                     parameters={k: v for k, v in values.items()
+                                 if k not in compiled.structural},
+                     progress=progress, step=step, max_steps=max_steps,
+                     time_limit=time_limit, engine=engine.lower(), error_control=mode,
+                     event_rows=event_rows)
     if output or plot:
         note = save_outputs(result, output, plot, files)
         if note and not quiet:
@@ -120,3 +142,5 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         sys.stdout.flush()
     if not quiet:
         click.echo(result.stats.summary(result.model), err=True)
+    if result.stats.warning:  # even with --quiet: the answer missed its tolerance
+        click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)

@@ -7,7 +7,13 @@ import sys
 import click
 
 from ..errors import UsageError
-from ..simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
+from ..simulation import (
+    ALL_SOLVERS,
+    DEFAULT_ERROR_CONTROL,
+    DEFAULT_SOLVER,
+    ERROR_CONTROLS,
+    FIXED_STEP,
+)
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -50,6 +56,9 @@ from .options import (
               help="Integrator steps per run before it fails (as for simulate).")
 @click.option("--time-limit", type=NumberRange(min=0, min_open=True), default=None,
               help="Seconds of wall clock per run before it fails (as for simulate).")
+@click.option("--error-control", type=click.Choice(ERROR_CONTROLS, case_sensitive=False),
+              default=DEFAULT_ERROR_CONTROL, show_default=True,
+              help="Each run's error estimate and tolerance, as for simulate.")
 @click.option("--energy", metavar="NAME", help="Variable whose drift the summary "
               "reports (default: the only selected variable in J, if any).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
@@ -72,7 +81,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           params: tuple[str, ...], samples: int | None, method: str, seed: int,
           workers: int | None, scheduler: str | None, solver: str, step: float | None,
           rtol: float | None, atol: float | None, max_steps: int | None,
-          time_limit: float | None, energy: str | None, output: str,
+          time_limit: float | None, error_control: str, energy: str | None, output: str,
           summary_file: str | None, resume: bool, plot: str | None,
           plot_var: str | None, quiet: bool) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
@@ -107,7 +116,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
 
     options = StudyOptions(specs, samples, method, seed, (), start, stop, interval,
                            solver.lower(), rtol, atol, step, workers, scheduler, energy,
-                           max_steps, time_limit)
+                           max_steps, time_limit, error_control.lower())
     parameter_table(options)  # refuse bad specifications before compiling
 
     compiled = compile_model(files, model, libraries=libraries,

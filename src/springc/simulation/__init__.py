@@ -16,8 +16,10 @@ from .solver_names import (
     AUTO,
     COMPILED_SOLVERS,
     DEFAULT_ENGINE,
+    DEFAULT_ERROR_CONTROL,
     DEFAULT_SOLVER,
     ENGINES,
+    ERROR_CONTROLS,
     FIXED_STEP,
     IMPLICIT_SOLVERS,
     SOLVERS,
@@ -26,6 +28,7 @@ from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
     from .compiled import choose_engine, default_backend, observed_on_grid
+    from .error_control import error_control_mode, estimate_deprecation
     from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -46,11 +49,12 @@ if TYPE_CHECKING:
     )
 
 __all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
-           "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER", "DEFAULT_TIME_LIMIT", "ENGINES", "FIXED_STEP",
+           "DEFAULT_ERROR_CONTROL", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER",
+           "DEFAULT_TIME_LIMIT", "ENGINES", "ERROR_CONTROLS", "FIXED_STEP",
            "IMPLICIT_SOLVERS", "LARGE_TRAJECTORY", "LSODA_LIMIT", "PLOT_FORMATS",
            "RESULT_FORMATS", "SOLVERS",
            "SimulationOptions", "SimulationResult", "check_run_values", "check_trajectory_size",
-           "choose_engine", "default_backend",
+           "choose_engine", "default_backend", "error_control_mode", "estimate_deprecation",
            "file_format", "initial_state", "observed_on_grid", "output_grid", "resolve",
            "save_outputs",
            "simulate_model", "write_csv"]
@@ -68,6 +72,10 @@ def __getattr__(name: str) -> Any:
         from . import compiled
 
         return getattr(compiled, name)
+    if name in ("error_control_mode", "estimate_deprecation"):
+        from . import error_control
+
+        return getattr(error_control, name)
     if name in ("LARGE_TRAJECTORY", "check_trajectory_size"):
         from . import output_size
 

@@ -1,175 +1,156 @@
-"""``--error-estimate off|on|auto``: the global error a run reached on its output grid.
+"""The global error a run reached on its output grid: two results -> :class:`ErrorEstimate`.
 
-An adaptive run is compared with a companion run of the same start at a tolerance
-:data:`COMPANION_FACTOR` times tighter (``dop853``, compiled where the module is numba's;
-an implicit run's own solver on scipy otherwise): the companion's error is then about a
-thousandth of the run's, so ``|x_run - x_companion|`` is the run's error. A fixed-step
-run of order ``q`` is compared with the same method at half the step (Richardson):
-``error ~ (x_h - x_h/2) 2^q / (2^q - 1)``.
+A run is compared with a *companion* run of the same model and start (:mod:`.error_control`
+runs it): an adaptive run with one at a tolerance :data:`COMPANION_FACTOR` times tighter
+(``dop853``, or the run's own implicit method), whose error is then about a thousandth
+of the run's, so ``|x_run - x_companion|`` is the run's error; a fixed-step run of order
+``q`` with the same method at half the step (Richardson:
+``error ~ (x_h - x_h/2) 2^q / (2^q - 1)``).
 
-``auto`` estimates where it costs at most :data:`AUTO_BUDGET` of the run so far (the
-companion's time predicted from the run's compiled loop: a DOP853 run at a 1000x
-tighter tolerance takes ``1000^(1/8)`` ~ 2.4x the steps, a half-step run 2x), so a
-warm run whose loop is most of its time is not doubled; ``on`` always estimates.
-
-The estimate is per state: the largest ``|error|`` over the grid, where it occurs,
-and that divided by the state's largest magnitude (the relative error, comparable
-with ``rtol``); the summary names the state with the largest relative error.
+The comparison is per output variable (states and observed variables alike), at the
+output times both runs reached, never at the extra rows ``event_rows`` adds. A hybrid
+run and its companion locate the same state event at slightly different times; an
+output time between the two (widened by their distance on both sides) compares values
+of two different modes, so it is left out; at every other output time the difference
+is the run's error, the effect of its event times included. The event times are one
+more quantity of the estimate (:data:`EVENT_TIMES`): their largest shift against the
+companion's, on the scale of the largest event time. For each variable: the largest
+``|error|``, where it occurs, and that divided by the variable's largest magnitude over
+the run (the relative error).
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, replace
+from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import UsageError
-from .solver_names import EXPLICIT, FIXED_STEP, IMPLICIT_SOLVERS, RACE_IMPLICIT
-
-if TYPE_CHECKING:
-    from .steps import Problem
-
-MODES = ("off", "on", "auto")
-DEFAULT_MODE = "auto"
 COMPANION_FACTOR = 1000.0
 TIGHTEST_RTOL = 1e-13
-AUTO_BUDGET = 0.3
-ORDERS = {"symplectic-euler": 1, "verlet": 2, "rk4": 4, "dop853": 8, "radau": 4}
-"""Fixed-step methods: the order; adaptive ones: how steps grow with tighter tolerances
-(``steps ~ rtol^(-1/q)``: DOP853's error estimator is of order 7, Radau's of order 3)."""
+"""The companion's rtol is never below this (DOP853's limit is about 100 eps)."""
+EVENT_TIMES = "(event times)"
+"""The estimate's name for the times of a hybrid run's state events."""
+ORDERS = {"symplectic-euler": 1, "verlet": 2, "rk4": 4}
+"""The order of each fixed-step method (Richardson's gain ``2^q``)."""
+
+
+class Run(Protocol):
+    """What a comparison reads of a run (a ``SimulationResult``)."""
+
+    time: np.ndarray
+    names: tuple[str, ...]
+    values: np.ndarray
+    events: tuple[Any, ...]
 
 
 @dataclass(frozen=True)
 class ErrorEstimate:
-    """The estimated global error of each state over the output grid."""
+    """The estimated global error of each output variable over the output grid, and
+    (:mod:`.error_control`) the error allowed to each (``tolerance``; None: no rule)."""
 
     names: tuple[str, ...]
-    absolute: np.ndarray  # largest |error| over the grid, per state
-    relative: np.ndarray  # absolute / the state's largest |value| (1 where that is 0)
-    times: np.ndarray  # where the largest |error| occurs, per state
+    absolute: np.ndarray  # largest |error| over the grid, per variable
+    relative: np.ndarray  # absolute / the variable's largest |value| (1 where that is 0)
+    times: np.ndarray  # where the largest |error| occurs, per variable
     method: str  # how it was estimated, in words
     seconds: float  # what estimating cost
+    scales: np.ndarray  # the largest |value| of each variable over the run
+    tolerance: np.ndarray | None = None  # the error allowed to each variable
 
     @property
     def worst(self) -> int:
-        """The state with the largest relative error."""
-        return int(np.argmax(self.relative)) if len(self.relative) else -1
+        """The variable furthest from its tolerance (without one: the largest relative
+        error); -1 without variables."""
+        if not len(self.names):
+            return -1
+        if self.tolerance is not None:
+            return int(np.argmax(self.absolute / self.tolerance))
+        return int(np.argmax(self.relative))
 
     @property
     def error(self) -> float:
-        """The largest relative error of any state (0 without states)."""
+        """The largest relative error of any variable (0 without variables)."""
         return float(self.relative.max()) if len(self.relative) else 0.0
 
-    def summary(self) -> str:
-        """``estimated error 3.1e-06 (relative; 2.4e-05 in mass.v[1] at t = 3.2 s; ...)``."""
-        if not len(self.names):
-            return "estimated error 0 (no states)"
-        i = self.worst
-        return (f"estimated error {self.relative[i]:.2g} (relative; {self.absolute[i]:.2g} "
-                f"in {self.names[i]} at t = {self.times[i]:.4g} s; {self.method}, "
-                f"{self.seconds:.3f} s)")
+    @property
+    def met(self) -> bool | None:
+        """Whether every variable's error is within its tolerance (None: no rule)."""
+        if self.tolerance is None:
+            return None
+        return bool((self.absolute <= self.tolerance).all())
 
     def rows(self) -> list[list[str]]:
-        """The side file's table: a header, then one row per state."""
-        return [["variable", "max_abs_error", "relative_error", "at_time", "method"],
-                *([name, repr(float(a)), repr(float(r)), repr(float(t)), self.method]
-                  for name, a, r, t in zip(self.names, self.absolute, self.relative,
-                                           self.times))]
-
-
-def check_mode(mode: str, option: str = "--error-estimate") -> str:
-    """``mode`` lowered, or a usage error naming ``option``."""
-    name = mode.lower() if isinstance(mode, str) else mode
-    if name not in MODES:
-        raise UsageError(f"{option} must be one of {', '.join(MODES)}, not {mode!r}",
-                         option=option)
-    return str(name)
-
-
-def predicted_cost(solver: str, compiled: bool, loop_time: float) -> float | None:
-    """The seconds an estimate should cost, from the run's compiled loop; None where the
-    run gives no measure (the estimate would run on scipy: auto leaves it off)."""
-    if not compiled or loop_time <= 0:
-        return None
-    if solver in FIXED_STEP:
-        return 2.0 * loop_time
-    if solver in (EXPLICIT, RACE_IMPLICIT):
-        return float(COMPANION_FACTOR ** (1 / ORDERS[solver]) * loop_time)
-    return None
-
-
-def wanted(mode: str, solver: str, compiled: bool, loop_time: float, elapsed: float) -> bool:
-    """Whether to estimate: ``on``, or ``auto`` within :data:`AUTO_BUDGET` of ``elapsed``."""
-    if mode == "on":
-        return True
-    cost = predicted_cost(solver, compiled, loop_time) if mode == "auto" else None
-    return cost is not None and cost <= AUTO_BUDGET * elapsed
-
-
-def estimate(problem: Problem, grid: np.ndarray, x0: np.ndarray, states: np.ndarray,
-             solver: str, rtol: float, atol: float, step: float | None,
-             compiled: bool) -> ErrorEstimate:
-    """The error estimate of a run that produced ``states`` on ``grid`` from ``x0``."""
-    began = time.perf_counter()
-    if solver in FIXED_STEP:
-        assert step is not None
-        finer = _fixed_companion(problem, grid, x0, solver, step / 2, compiled)
-        gain = 2.0 ** ORDERS[solver]
-        error = (states - finer) * gain / (gain - 1)
-        method = f"Richardson against {solver} at step {step / 2:.3g} s"
-    else:
-        tight_rtol, tight_atol = companion_tolerances(rtol, atol)
-        companion_solver = solver if solver in IMPLICIT_SOLVERS else EXPLICIT
-        reference = _adaptive_companion(problem, grid, x0, companion_solver, tight_rtol,
-                                        tight_atol, compiled)
-        error = states - reference
-        method = f"companion {companion_solver} run at rtol {tight_rtol:.3g}"
-    return measured(tuple(problem.names), grid, states, error, method, began)
+        """The side file's table: a header, then one row per variable."""
+        allowed = self.tolerance if self.tolerance is not None else \
+            np.full(len(self.names), np.nan)
+        return [["variable", "max_abs_error", "relative_error", "at_time", "method",
+                 "tolerance"],
+                *([name, repr(float(a)), repr(float(r)), repr(float(t)), self.method,
+                   "" if np.isnan(tol) else repr(float(tol))]
+                  for name, a, r, t, tol in zip(self.names, self.absolute, self.relative,
+                                                self.times, allowed))]
 
 
 def companion_tolerances(rtol: float, atol: float) -> tuple[float, float]:
     """The companion run's rtol and atol: :data:`COMPANION_FACTOR` times tighter."""
-    tight_rtol = max(rtol / COMPANION_FACTOR, TIGHTEST_RTOL)
-    return tight_rtol, atol * tight_rtol / rtol
+    tight_rtol = max(float(f"{rtol / COMPANION_FACTOR:.12g}"), TIGHTEST_RTOL)
+    return tight_rtol, float(f"{atol * tight_rtol / rtol:.12g}")
 
 
-def measured(names: tuple[str, ...], grid: np.ndarray, values: np.ndarray,
+def grid_rows(times: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """The row of each output time in a result's ``times`` (the last row at that time:
+    ``event_rows`` puts an event's limits before it), -1 where the run did not reach it."""
+    rows = np.searchsorted(times, grid, side="right") - 1
+    found = (rows >= 0) & (times[np.maximum(rows, 0)] == grid)
+    return np.where(found, rows, -1)
+
+
+def paired_events(run: Run, companion: Run) -> tuple[np.ndarray, np.ndarray]:
+    """The times of the state events of the two runs, paired in order (the shorter
+    list's length)."""
+    ours = [e.time for e in run.events if e.kind == "state"]
+    theirs = [e.time for e in companion.events if e.kind == "state"]
+    n = min(len(ours), len(theirs))
+    return np.asarray(ours[:n], dtype=float), np.asarray(theirs[:n], dtype=float)
+
+
+def compare(run: Run, companion: Run, grid: np.ndarray,
+            method: str, gain: float, began: float) -> ErrorEstimate:
+    """The estimate of ``run``'s error from ``companion`` (see the module docstring);
+    ``gain`` multiplies the difference (1, or Richardson's ``2^q / (2^q - 1)``)."""
+    ours, theirs = grid_rows(run.time, grid), grid_rows(companion.time, grid)
+    keep = (ours >= 0) & (theirs >= 0)
+    a, b = paired_events(run, companion)
+    for low, high in zip(np.minimum(a, b) - abs(a - b), np.maximum(a, b) + abs(a - b)):
+        keep &= ~((grid >= low) & (grid <= high))
+    columns = [companion.names.index(n) for n in run.names]
+    error = (run.values[ours[keep]] - companion.values[theirs[keep]][:, columns]) * gain
+    scales = np.abs(run.values).max(axis=0) if len(run.values) else np.zeros(len(run.names))
+    estimate = measured(run.names, grid[keep], scales, error, method, began)
+    if not len(a):
+        return estimate
+    # the event times as one more quantity: their largest shift, on the scale of |t|
+    worst = int(np.argmax(abs(a - b) * gain))
+    shift, scale = float(abs(a - b)[worst] * gain), float(np.abs(a).max())
+    return replace(estimate, names=(*estimate.names, EVENT_TIMES),
+                   absolute=np.append(estimate.absolute, shift),
+                   relative=np.append(estimate.relative, shift / scale if scale else shift),
+                   times=np.append(estimate.times, a[worst]),
+                   scales=np.append(estimate.scales, scale))
+
+
+def measured(names: tuple[str, ...], grid: np.ndarray, scales: np.ndarray,
              error: np.ndarray, method: str, began: float) -> ErrorEstimate:
-    """The estimate from the ``error`` of each column of ``values`` on ``grid``."""
-    magnitude = np.abs(values).max(axis=0)
+    """The estimate from the ``error`` of each variable on ``grid`` (rows), its largest
+    magnitude over the run (``scales``) giving the relative error."""
+    if not len(grid):
+        zero = np.zeros(len(names))
+        return ErrorEstimate(names, zero, zero, zero, method, time.perf_counter() - began,
+                             scales)
     absolute = np.abs(error).max(axis=0)
     where = grid[np.abs(error).argmax(axis=0)]
-    relative = absolute / np.where(magnitude > 0, magnitude, 1.0)
+    relative = absolute / np.where(scales > 0, scales, 1.0)
     return ErrorEstimate(names, absolute, relative, where, method,
-                         time.perf_counter() - began)
-
-
-def _companion_problem(problem: Problem, solver: str) -> Problem:
-    from .steps import Problem as StepProblem
-    from .steps import Progress
-
-    return StepProblem(problem.model, problem.p, solver, Progress(None, 0.0, 1.0),
-                       problem.limits)
-
-
-def _fixed_companion(problem: Problem, grid: np.ndarray, x0: np.ndarray, solver: str,
-                     step: float, compiled: bool) -> np.ndarray:
-    from .compiled import run_fixed_compiled
-    from .solvers import run_fixed
-
-    companion = _companion_problem(problem, solver)
-    if compiled:
-        return run_fixed_compiled(companion, grid, x0, step)[0]
-    return run_fixed(companion, grid, x0, step)[0]
-
-
-def _adaptive_companion(problem: Problem, grid: np.ndarray, x0: np.ndarray, solver: str,
-                        rtol: float, atol: float, compiled: bool) -> np.ndarray:
-    from .compiled import advance_compiled
-    from .steps import integrate
-
-    companion = _companion_problem(problem, solver)
-    finish = advance_compiled if compiled and solver in (EXPLICIT, RACE_IMPLICIT) else None
-    return integrate(companion, grid, x0, rtol, atol, finish).states
+                         time.perf_counter() - began, scales)

@@ -64,8 +64,16 @@ class SimulationStats:
     loop_time: float = 0.0  # seconds in the compiled loop (model code included)
     state_events: int = 0  # events of hybrid models (simulation/events.py)
     time_events: int = 0
-    error: str = ""  # the error estimate in words (empty: not estimated)
+    error: str = ""  # the error estimate and its verdict in words (empty: not estimated)
     engine_reason: str = ""  # why auto's run (or a fallback to scipy) used this engine
+    # --error-control (error_control.py): the tolerances of the run returned (tighter
+    # than asked where tightened), the estimated error of the variable furthest from its
+    # tolerance and that tolerance (None: not estimated, or no rule), a broken rule
+    rtol: float | None = None
+    atol: float | None = None
+    estimated_error: float | None = None
+    error_tolerance: float | None = None
+    warning: str = ""
 
     def summary(self, model: str) -> str:
         """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
@@ -101,7 +109,7 @@ class SimulationResult:
     # hybrid models: the events (simulation/events.py Event) and accepted step times
     events: tuple[Any, ...] = ()
     step_times: tuple[float, ...] = ()
-    #: the estimated global error on the grid (``--error-estimate``; None: not estimated)
+    #: the estimated global error on the grid (``--error-control``; None: not estimated)
     error_estimate: ErrorEstimate | None = None
 
     def __getitem__(self, name: str) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import SimulationError
 from ..pipeline import CompiledModel, check_parameter_names
 from ..simplify import describe_failure as describe_failure
-from . import error_estimate, solvers
+from . import error_control, solvers
 from .compiled import (
     COMPILED,
     SCIPY,
@@ -37,11 +37,9 @@ from .compiled import (
     engine_reason,
     explained,
     jitted,
-    numba_available,
     observed_on_grid,
     run_fixed_compiled,
 )
-from .error_estimate import DEFAULT_MODE, ErrorEstimate
 from .failures import Stop, code_location, state_notes
 from .limits import (
     DEFAULT_MAX_STEPS,
@@ -88,7 +86,7 @@ class SimulationOptions:
     time_limit: float = DEFAULT_TIME_LIMIT  # seconds of wall clock
     engine: str = DEFAULT_ENGINE  # auto, compiled (springc.integrate) or scipy
     event_rows: bool = False  # add rows with the left and right limits at each event
-    error_estimate: str = DEFAULT_MODE  # off, on or auto (see .error_estimate)
+    error_control: str = error_control.DEFAULT_MODE  # tighten, warn or off (.error_control)
 
 
 def output_grid(start: float, stop: float, interval: float) -> np.ndarray:
@@ -169,7 +167,16 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
 
 def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
                    ) -> SimulationResult:
-    """Integrate ``model`` and return the selected outputs on the output grid."""
+    """Integrate ``model`` and return the selected outputs on the output grid, with the
+    estimated error and tightened as ``options.error_control`` says (:mod:`.error_control`)."""
+    mode = error_control.check_mode(options.error_control, "error_control")
+    rtol, atol = resolve(model, options)[3:]
+    return error_control.controlled(options, error_control.Asked(mode, rtol, atol),
+                                    lambda run: simulate_once(model, run))
+
+
+def simulate_once(model: CompiledModel, options: SimulationOptions) -> SimulationResult:
+    """One run of ``model`` with ``options`` (no error estimate)."""
     began = time.perf_counter()
     solver = options.solver.lower()
     if solver not in ALL_SOLVERS:
@@ -177,7 +184,6 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                               hint=f"choose one of {', '.join(ALL_SOLVERS)}")
     limits = Limits(options.max_steps, options.time_limit)
     limits.validate()
-    estimate_mode = error_estimate.check_mode(options.error_estimate, "error_estimate")
     engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
@@ -228,10 +234,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
             result.stats = replace(result.stats, engine_reason=(
                 f"{result.stats.solver} ran in scipy's loop, the only one that switches "
                 "states"))
-        if estimate_mode != "on":  # a companion run on scipy doubles the run: not auto
-            return result
-        return _switching_estimate(model, result, solver, grid, rtol, atol,
-                                   dict(options.parameters), limits)
+        return result
     x0 = initial_state(model, p, start)
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
@@ -265,9 +268,6 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                 run = integrate(problem, grid, x0, rtol, atol, finish)
                 states, steps, loop_time = run.states, run.steps, run.loop_time
                 compiled = compiled and len(x0) > 0
-            estimate, error_note = _estimate(estimate_mode, problem, grid, x0, states, solver,
-                                             rtol, atol, step or None, compiled, loop_time,
-                                             time.perf_counter() - began)
             if problem.asserts and (compiled or not len(x0)):
                 problem.asserts.grid(grid, states, problem.z, _locate(
                     problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
@@ -282,7 +282,6 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
                             time.perf_counter() - began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time,
-                            error=estimate.summary() if estimate is not None else error_note,
                             engine_reason=engine_reason(options.engine.lower(), solver,
                                                         model.module, compiled, len(x0))
                             if explained(options.engine, reason, compiled) else "")
@@ -290,8 +289,7 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
-                            dict(zip(model.parameter_names, p.tolist())),
-                            error_estimate=estimate)
+                            dict(zip(model.parameter_names, p.tolist())))
 
 
 def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
@@ -311,50 +309,6 @@ def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
         except (Stop, OverLimit):
             pass
     return locate
-
-
-def _estimate(mode: str, problem: Problem, grid: np.ndarray, x0: np.ndarray,
-              states: np.ndarray, solver: str, rtol: float, atol: float, step: float | None,
-              compiled: bool, loop_time: float, elapsed: float
-              ) -> tuple[ErrorEstimate | None, str]:
-    """The run's error estimate (see :mod:`.error_estimate`), or None and why not when
-    ``on`` asked for it and its companion run failed."""
-    if not len(x0) or not error_estimate.wanted(mode, solver, compiled, loop_time, elapsed):
-        return None, ""
-    fast = model_is_numba(problem) and numba_available()
-    try:
-        return error_estimate.estimate(problem, grid, x0, states, solver, rtol, atol, step,
-                                       fast), ""
-    except Stop as failed:
-        return None, f"error not estimated: its companion run failed ({failed.error.message})"
-    except OverLimit as over:
-        return None, f"error not estimated: its companion run stopped ({over})"
-
-
-def _switching_estimate(model: CompiledModel, result: SimulationResult, solver: str,
-                        grid: np.ndarray, rtol: float, atol: float,
-                        parameters: dict[str, float], limits: Limits) -> SimulationResult:
-    """``result`` of the switching driver with its error estimate (a companion run)."""
-    from dataclasses import replace
-
-    from .switching import simulate_switching_model
-
-    began = time.perf_counter()
-    tight_rtol, tight_atol = error_estimate.companion_tolerances(rtol, atol)
-    companion = simulate_switching_model(model, solver, grid, tight_rtol, tight_atol,
-                                         parameters, limits)
-    columns = [i for i, name in enumerate(result.names) if name in set(model.states)]
-    values = result.values[:, columns]
-    estimate = error_estimate.measured(
-        tuple(result.names[i] for i in columns), grid, values,
-        values - companion.values[:, columns],
-        f"companion {companion.stats.solver} run at rtol {tight_rtol:.3g}", began)
-    stats = replace(result.stats, error=estimate.summary())
-    return replace(result, stats=stats, error_estimate=estimate)
-
-
-def model_is_numba(problem: Problem) -> bool:
-    return getattr(problem.mod, "BACKEND", "") == "numba"
 
 
 def parameter_vector(model: CompiledModel, values: Mapping[str, float]) -> np.ndarray:

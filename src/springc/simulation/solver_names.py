@@ -37,6 +37,9 @@ ENGINES = ("auto", "compiled", "scipy")
 Python per step), ``scipy`` (``scipy.integrate``'s solver classes stepped from Python),
 or ``auto``: compiled where numba is importable and the solver has a compiled loop."""
 DEFAULT_ENGINE = "auto"
+ERROR_CONTROLS = ("tighten", "warn", "off")
+"""What ``--error-control`` accepts (:mod:`springc.simulation.error_control`)."""
+DEFAULT_ERROR_CONTROL = "tighten"
 COMPILED_SOLVERS = ("rk45", EXPLICIT, RACE_IMPLICIT, "bdf", *FIXED_STEP)
 """Solvers with a compiled loop (``auto`` too: it finishes on :data:`EXPLICIT` or
 :data:`RACE_IMPLICIT` compiled)."""

@@ -15,6 +15,7 @@ the study.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -23,6 +24,7 @@ import numpy as np
 from ..errors import SpringcError
 from ..pipeline import CompiledModel
 from ..simulation import (
+    DEFAULT_ERROR_CONTROL,
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
     SimulationOptions,
@@ -56,6 +58,7 @@ class StudyOptions:
     energy: str | None = None
     max_steps: int | None = None
     time_limit: float | None = None
+    error_control: str = DEFAULT_ERROR_CONTROL  # tighten, warn or off, as for simulate
 
 
 @dataclass(frozen=True)
@@ -79,7 +82,8 @@ class RunJob:
         return SimulationOptions(
             o.start, o.stop, o.interval, o.solver, o.rtol, o.atol, parameters, None, o.step,
             DEFAULT_MAX_STEPS if o.max_steps is None else o.max_steps,
-            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit)
+            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit,
+            error_control=o.error_control)
 
 
 @dataclass(frozen=True)
@@ -94,6 +98,9 @@ class RunRecord:
     rhs_evaluations: int
     jacobian_evaluations: int
     values: np.ndarray | None
+    rtol: float = math.nan  # --error-control: the rtol of the run kept
+    estimated_error: float = math.nan  # of the variable furthest from its tolerance
+    warning: str | None = None  # the tolerance still missed (SimulationStats.warning)
 
 
 def run_one(model: CompiledModel, job: RunJob, run: int, values: Sequence[float]
@@ -105,7 +112,10 @@ def run_one(model: CompiledModel, job: RunJob, run: int, values: Sequence[float]
         return RunRecord(run, str(err), job.solver, 0, 0, 0, None)
     stats = result.stats
     return RunRecord(run, None, stats.solver, stats.steps, stats.rhs_evaluations,
-                     stats.jacobian_evaluations, result.values)
+                     stats.jacobian_evaluations, result.values,
+                     math.nan if stats.rtol is None else stats.rtol,
+                     math.nan if stats.estimated_error is None else stats.estimated_error,
+                     stats.warning or None)
 
 
 def run_batch(job: RunJob, runs: Sequence[tuple[int, tuple[float, ...]]]

@@ -14,17 +14,23 @@ its rows with null values):
 | ``error`` | string | the error message of a failed run (null if ok) |
 | ``solver`` | string | the solver used (``auto``'s choice) |
 | ``steps``, ``rhs_evaluations``, ``jacobian_evaluations`` | int64 | solver statistics |
+| ``rtol`` | float64 | the rtol of the run kept (tighter than asked if tightened) |
+| ``estimated_error`` | float64 | the error of the variable furthest from its tolerance |
+| ``warning`` | string | the tolerance missed, or the error not estimated (else null) |
 
-No column holds a time measured by the clock: the same study writes the same bytes
-on every run, with any number of workers (the study's duration is in its summary
-line, :meth:`springc.studies.Study.summary_line`).
+``rtol``, ``estimated_error`` and ``warning`` come from ``--error-control``
+(:mod:`springc.simulation.error_control`); ``estimated_error`` is NaN where the run was
+not estimated (``off``, a failed companion). No column holds a time measured by the
+clock: the same study writes the same bytes on every run, with any number of workers
+(the study's duration is in its summary line,
+:meth:`springc.studies.Study.summary_line`).
 
 Variable columns carry their unit as field metadata (``unit``). A parameter or
 variable whose flat name is one of the fixed columns above (a top-level
 ``Real error;``) is stored under its quoted name (``'error'``).
 
 **Summary table** (``study.summary.parquet`` next to it, one row per run): ``run``, the
-parameters, ``status`` to ``jacobian_evaluations`` as above, then for each output variable
+parameters, ``status`` to ``warning`` as above, then for each output variable
 ``NAME.final``, ``NAME.min`` and ``NAME.max`` (null if the run failed), and, when an
 energy variable is selected (``--energy NAME``, else the only output in J),
 ``NAME.drift`` = max_t |E(t) - E(t0)| / max_t |E(t)|.
@@ -57,12 +63,17 @@ from ..fileio import OutputSet, atomic_write, check_distinct, check_target
 from .job import RunRecord
 
 FIXED_COLUMNS = ("run", "time", "status", "error", "solver", "steps", "rhs_evaluations",
-                 "jacobian_evaluations")
+                 "jacobian_evaluations", "rtol", "estimated_error", "warning")
+ACCURACY = ("rtol", "estimated_error")
+"""Per run (``--error-control``): the rtol of the run kept (tighter than asked where it
+was tightened) and the estimated error of the variable furthest from its tolerance
+(NaN: not estimated); ``warning``: the rule still broken, or null."""
 STATS = ("solver", "steps", "rhs_evaluations", "jacobian_evaluations")
 SUFFIX = ".parquet"
 MANIFEST = "study.json"
 FORMAT_VERSION = 2
-"""2: no ``wall_time`` column (shards of version 1 are another study's to ``--resume``)."""
+"""2: no ``wall_time`` column; ``rtol``, ``estimated_error`` and ``warning`` (shards of version 1
+are another study's to ``--resume``)."""
 
 
 def column_name(name: str) -> str:
@@ -94,6 +105,8 @@ class Layout:
         fields += [pa.field("status", pa.string()), pa.field("error", pa.string()),
                    pa.field("solver", pa.string())]
         fields += [pa.field(n, pa.int64()) for n in STATS[1:]]
+        fields += [pa.field(n, pa.float64()) for n in ACCURACY]
+        fields.append(pa.field("warning", pa.string()))
         meta = {"springc": json.dumps(dict(self.metadata), sort_keys=True)}
         return pa.schema(fields, metadata=meta)
 
@@ -121,8 +134,9 @@ def records_table(layout: Layout, records: Sequence[RunRecord],
         data[column_name(name)] = pa.array(block[:, j], mask=failed)
     data["status"] = np.repeat(["ok" if r.error is None else "failed" for r in records], nt)
     data["error"] = pa.array([r.error for r in records for _ in range(nt)], pa.string())
-    for name in STATS:
+    for name in STATS + ACCURACY:
         data[name] = np.repeat([getattr(r, name) for r in records], nt)
+    data["warning"] = pa.array([r.warning for r in records for _ in range(nt)], pa.string())
     return pa.Table.from_pydict(data, schema=layout.schema())
 
 

@@ -125,7 +125,7 @@ def layout_of(model: CompiledModel, options: StudyOptions, values: np.ndarray) -
         "fixed": dict(options.fixed), "start": start, "stop": stop, "interval": interval,
         "solver": options.solver, "rtol": rtol, "atol": atol, "step": options.step,
         "energy": energy, "runs": len(values), "max_steps": options.max_steps,
-        "time_limit": options.time_limit}
+        "time_limit": options.time_limit, "error_control": options.error_control}
     return Layout(names, model.outputs, tuple(units.get(n, "") for n in model.outputs),
                   output_grid(start, stop, interval), energy, metadata)
 
@@ -280,9 +280,9 @@ def to_dataset(study: Study) -> Any:
         data[name] = (("run", "time"), column.reshape(runs, nt), {"units": unit} if unit
                       else {})
     for name in ("status", "error", "solver", "steps", "rhs_evaluations",
-                 "jacobian_evaluations"):
+                 "jacobian_evaluations", "rtol", "estimated_error", "warning"):
         data[name] = ("run", np.asarray(study.summary.column(name).to_pylist(),
-                                        dtype=object if name in ("status", "error",
-                                                                 "solver") else None))
+                                        dtype=object if name in ("status", "error", "solver",
+                                                                 "warning") else None))
     return xr.Dataset(data, coords=coords, attrs={"model": study.model,
                                                   "method": layout.metadata["method"]})

@@ -93,12 +93,14 @@ class StudySetup:
                     progress: TextIO | Deadline | None = None) -> SimulationOptions:
         """The simulator's options for one run (atol in the study's ratio to rtol; the
         engine is the simulator's default: the compiled loop for a numba module and a
-        solver that has one; the study measures the error itself)."""
+        solver that has one). ``error_control`` is off: the study measures each run's
+        error itself against its reference, and a run tightened behind its back would
+        no longer be the setting its row names."""
         o = self.options
         return SimulationOptions(o.start, o.stop, o.interval, solver, rtol,
                                  None if rtol is None else rtol * self.atol_ratio,
                                  dict(o.parameters), progress,  # type: ignore[arg-type]
-                                 step, error_estimate="off")
+                                 step, error_control="off")
 
     def log(self, text: str) -> None:
         """A line on the study's log stream, if any."""
