@@ -24,6 +24,7 @@ from ..errors import SimulationError
 from ..pipeline import CompiledModel
 from .failures import Stop, state_notes
 from .limits import Limits, OverLimit
+from .observed_rows import observed_at_rows
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP, IMPLICIT_SOLVERS, SOLVERS
 from .steps import Problem, Progress
@@ -185,8 +186,7 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray, states: n
     """The selected outputs at every row, each with its delayed values."""
     columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
     if model.observed:
-        obs = np.array([np.asarray(model.module.observed(float(t), x, problem.p, z))
-                        for t, x, z in zip(grid, states, zs)])
+        obs = observed_at_rows(model.module, problem, grid, states, zs)
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     return np.column_stack([columns[name] for name in model.outputs]) if model.outputs \
         else np.empty((len(grid), 0))

@@ -25,6 +25,7 @@ from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
 from .hybrid_compiled import run_compiled_events
 from .limits import Limits, OverLimit, check_outputs, over_limit
+from .observed_rows import observed_at_rows
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP
 from .steps import Problem, Progress
@@ -145,14 +146,7 @@ def _outputs(model: CompiledModel, problem: Problem, times: np.ndarray, states: 
     selected = set(names)
     wanted = [o for o in model.observed if o in selected]
     if wanted:
-        obs = np.empty((len(times), len(model.observed)))
-        for i in range(len(times)):
-            z = zs[i].copy()
-            try:
-                obs[i] = model.module.observed(float(times[i]), states[i], problem.p, z)
-            except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
-                raise problem.fail(err, float(times[i]), states[i],
-                                   "an observed variable") from err
+        obs = observed_at_rows(model.module, problem, times, states, zs)
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     out = np.empty((len(times), len(names)))
     for i, name in enumerate(names):

@@ -37,7 +37,6 @@ from .compiled import (
     engine_reason,
     explained,
     jitted,
-    observed_on_grid,
     run_fixed_compiled,
 )
 from .failures import Stop, code_location, state_notes
@@ -50,6 +49,7 @@ from .limits import (
     check_parameters,
     over_limit,
 )
+from .observed_rows import observed_on_rows
 from .race import auto
 from .results import SimulationResult, SimulationStats
 from .solver_names import (
@@ -334,7 +334,7 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
     if wanted:
         z = np.asarray(model.module.guesses(problem.p), dtype=float)
         try:
-            obs = observed_on_grid(model.module, grid, states, problem.p, z)
+            obs = observed_on_rows(model.module, grid, states, problem.p, z)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise _first_failure(model, problem, grid, states, err) from err
         if z[-1] != 0.0:
