@@ -105,6 +105,11 @@ class CodegenError(SpringcError):
     """The model uses something the code generator cannot translate."""
 
 
+class UnitError(SpringcError):
+    """Units that do not agree: a warning (:func:`render` with ``kind="warning"``),
+    an error with ``--strict-units``."""
+
+
 class ErrorGroup(Exception):
     """Several independent errors reported together, in source order."""
 
@@ -164,9 +169,11 @@ def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -
     return [head] + (_excerpt(span, lookup) if span else [])
 
 
-def render(error: SpringcError, lookup: SourceLookup = read_source) -> str:
-    """Render one error in the ``file:line:col: error: ...`` format with caret and notes."""
-    lines = _located("error", error.message, error.span, lookup)
+def render(error: SpringcError, lookup: SourceLookup = read_source,
+           kind: str = "error") -> str:
+    """Render one error in the ``file:line:col: error: ...`` format with caret and notes
+    (``kind="warning"``: a diagnostic that is not an error, in the same format)."""
+    lines = _located(kind, error.message, error.span, lookup)
     for note in error.notes:
         lines += _located("note", note.message, note.span, lookup)
     if error.hint:

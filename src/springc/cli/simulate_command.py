@@ -14,8 +14,10 @@ from .options import (
     compile_options,
     model_options,
     parse_set,
+    report_units,
     run_options,
     single_threaded_blas,
+    units_option,
 )
 
 
@@ -61,6 +63,7 @@ from .options import (
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@units_option
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -69,7 +72,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
-             event_rows: bool, quiet: bool) -> None:
+             event_rows: bool, quiet: bool, strict_units: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from ..simulation import (
         PLOT_FORMATS,
@@ -100,6 +103,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                              backend=default_choice(backend, engine, solver),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
+    report_units(compiled.warnings, strict_units)
     if not patterns and (output or not plot):  # the default trajectory of every output
         check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
                               f"-o {output}" if output else "the CSV on stdout")

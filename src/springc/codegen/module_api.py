@@ -39,6 +39,7 @@ class GeneratedModule(Protocol):
     EXPERIMENT: dict[str, Any]  # start, stop, interval, tolerance: float or None
     INITIAL_CONDITIONS: int
     SWITCHABLE: bool
+    WARNINGS: tuple[str, ...]  # diagnostics that are not errors, as the pipeline wrote them
     JAC_ROWS: IntArray
     JAC_COLS: IntArray
     JAC_INDICES: IntArray

@@ -23,12 +23,13 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen import CodegenOptions, GeneratedModule, generate
-from ..errors import CodegenError, SimulationError
+from ..errors import CodegenError, SimulationError, UnitError
 from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
 from ..ir.expr import recursion_room
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
+from ..units import check_units
 from .cache import (
     CacheUnusable,
     Names,
@@ -46,6 +47,7 @@ from .cache import (
     write_entry,
     write_names,
 )
+from .diagnostics import decode_warnings, encode_warnings
 from .equations import Equations
 from .selection import ALL_OBSERVED, select_names, selected_observed
 
@@ -106,6 +108,11 @@ class CompiledModel:
         units = dict(zip(self.states, self.module.STATE_UNITS))
         units.update(zip(self.observed, self.module.OBSERVED_UNITS))
         return units
+
+    @property
+    def warnings(self) -> tuple[UnitError, ...]:
+        """The unit mismatches of the model (warnings; errors with ``--strict-units``)."""
+        return decode_warnings(getattr(self.module, "WARNINGS", ()))
 
     @property
     def structural(self) -> tuple[str, ...]:
@@ -252,12 +259,14 @@ def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, .
 
 @dataclass(frozen=True)
 class Derived:
-    """The simplified system of a model, its flat model, and whether index reduction
-    left a choice of states that may turn singular during a run (``switchable``)."""
+    """The simplified system of a model, its flat model, whether index reduction
+    left a choice of states that may turn singular during a run (``switchable``), and
+    the unit mismatches of the flat model."""
 
     system: ode.ODE
     flat_model: flat.FlatModel
     switchable: bool
+    warnings: tuple[UnitError, ...] = ()
 
 
 WRAPPER_FILE = "<springc: structural parameters>"
@@ -289,6 +298,7 @@ def derive_system(options: CompileOptions) -> Derived:
         base = flatten(tree, model)
         model = _add_wrapper(tree, entry, options.modifications)
     flat_model = flatten(tree, model)
+    warnings = check_units(flat_model)
     simplified = simplify(flat_model)
     system = simplified.ode
     switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
@@ -298,7 +308,7 @@ def derive_system(options: CompileOptions) -> Derived:
         system = dataclasses.replace(
             system, name=base.name,
             dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
-    return Derived(system, flat_model, switchable)
+    return Derived(system, flat_model, switchable, warnings)
 
 
 def _add_wrapper(tree: ClassTree, entry: ClassEntry,
@@ -339,7 +349,8 @@ def generate_from(derived: Derived, options: CompileOptions) -> str:
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)
-    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable)
+    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
+                             warnings=encode_warnings(derived.warnings))
     return generate(system, flat_model, codegen).source
 
 
