@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import difflib
 import gc
 import shutil
 import tempfile
@@ -23,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen import CodegenOptions, GeneratedModule, generate
-from ..errors import CodegenError, SimulationError, UnitError
+from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
 from ..ir.expr import recursion_room
@@ -151,11 +150,10 @@ def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) ->
     known = model.parameter_names
     for name in values:
         if name not in known:
-            close = difflib.get_close_matches(name, known, 3)
             raise SimulationError(
                 f"'{name}' is not a parameter of {model.name}",
-                hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
-                      "parameters are named by their flat names, e.g. 'spring.k'"))
+                hint=did_you_mean(name, known)
+                or "parameters are named by their flat names, e.g. 'spring.k'")
 
 
 # ------------------------------------------------------------------ compile
