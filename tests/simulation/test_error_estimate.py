@@ -101,16 +101,18 @@ def test_bad_mode_names_the_option() -> None:
     assert result.exit_code == 2 and "--error-estimate" in result.stderr
 
 
-def test_csv_side_file_and_unchanged_csv(tmp_path: Path) -> None:
+def test_error_output_table_and_unchanged_csv(tmp_path: Path) -> None:
     out = tmp_path / "run.csv"
     result = CliRunner().invoke(main, ["simulate", SEED, "--backend", "numba", "--solver",
-                                       "dop853", "--error-estimate", "on", "-o", str(out)])
+                                       "dop853", "-o", str(out), "--error-output",
+                                       str(tmp_path / "errors.csv")])
     assert result.exit_code == 0, result.output
     assert "; estimated error " in result.stderr
     with out.open() as f:
         rows = list(csv.reader(f))
     assert rows[0][:5] == ["time", "mass.pos[1]", "mass.pos[2]", "mass.v[1]", "mass.v[2]"]
-    with (tmp_path / "run.error.csv").open() as f:
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["errors.csv", "run.csv"]
+    with (tmp_path / "errors.csv").open() as f:
         side = list(csv.reader(f))
     assert side[0] == ["variable", "max_abs_error", "relative_error", "at_time", "method"]
     assert [row[0] for row in side[1:]] == list(model("seed").states)
@@ -120,6 +122,9 @@ def test_csv_side_file_and_unchanged_csv(tmp_path: Path) -> None:
     np.testing.assert_allclose(table[:, 1], table[:, 0] / np.abs(values[:, 1:5]).max(axis=0),
                                rtol=1e-12)
     assert all(row[4] == "companion dop853 run at rtol 1e-09" for row in side[1:])
-    off = tmp_path / "off.csv"
-    CliRunner().invoke(main, ["simulate", SEED, "--error-estimate", "off", "-o", str(off)])
-    assert off.exists() and not (tmp_path / "off.error.csv").exists()
+    refused = CliRunner().invoke(main, ["simulate", SEED, "--error-estimate", "off",
+                                        "--error-output", str(tmp_path / "off.csv")])
+    assert refused.exit_code == 2 and refused.stderr.endswith(
+        "Error: --error-output needs an error estimate, which --error-estimate off turns "
+        "off\n")
+    assert not (tmp_path / "off.csv").exists()

@@ -42,8 +42,11 @@ from .options import (
               default="auto", show_default=True,
               help="Estimate the global error reached on the output grid (a companion "
               "run at a 1000x tighter tolerance, or half the step for fixed-step "
-              "solvers): in the summary line and in the side file NAME.error.csv next to "
-              "-o NAME.csv; auto: where it costs at most about 30 % of the run.")
+              "solvers): in the summary line, in a .mat trajectory, and as a table in "
+              "--error-output; auto: where it costs at most about 30 % of the run.")
+@click.option("--error-output", type=click.Path(dir_okay=False),
+              help="Write the error estimate per state (CSV: variable, max_abs_error, "
+              "relative_error, at_time, method) here.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
@@ -68,7 +71,8 @@ from .options import (
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, engine: str,
-             error_estimate: str, rtol: float | None, step: float | None,
+             error_estimate: str, error_output: str | None, rtol: float | None,
+             step: float | None,
              atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
@@ -82,13 +86,18 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     )
 
     values = parse_set(assignments)
+    if error_output:  # the table asked for needs the estimate
+        if error_estimate.lower() == "off":
+            raise click.UsageError("--error-output needs an error estimate, which "
+                                   "--error-estimate off turns off")
+        error_estimate = "on"
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
                                "needs --step H (e.g. --step 1e-3)")
     choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
-    check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
-                   files)
+    check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS),
+                          ("--error-output", error_output, {".csv": "csv"})], files)
     single_threaded_blas()
     from ..api import compile_model, default_choice
     from ..api import simulate as run
@@ -114,8 +123,11 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                  progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
                  engine=engine.lower(), error_estimate=error_estimate.lower(),
                  event_rows=event_rows)
-    if output or plot:
-        note = save_outputs(result, output, plot, files)
+    if error_output and result.error_estimate is None:
+        raise click.UsageError(f"--error-output {error_output}: this run made no error "
+                               "estimate (a model without states)")
+    if output or plot or error_output:
+        note = save_outputs(result, output, plot, files, error_output)
         if note and not quiet:
             click.echo(f"note: plot {plot}: {note}", err=True)
     else:

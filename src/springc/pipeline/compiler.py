@@ -109,6 +109,12 @@ class CompiledModel:
         return units
 
     @property
+    def descriptions(self) -> dict[str, str]:
+        """The description strings of the variables and parameters that have one."""
+        flat_list = tuple(getattr(self.module, "DESCRIPTIONS", ()))
+        return dict(zip(flat_list[::2], flat_list[1::2]))
+
+    @property
     def warnings(self) -> tuple[UnitError, ...]:
         """The unit mismatches of the model (warnings; errors with ``--strict-units``)."""
         return decode_warnings(getattr(self.module, "WARNINGS", ()))

@@ -165,7 +165,15 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
 
 def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
                    ) -> SimulationResult:
-    """Integrate ``model`` and return the selected outputs on the output grid."""
+    """Integrate ``model`` and return the selected outputs on the output grid (with the
+    model's description strings)."""
+    result = _simulate_model(model, options)
+    result.descriptions = model.descriptions
+    return result
+
+
+def _simulate_model(model: CompiledModel, options: SimulationOptions) -> SimulationResult:
+    """The run of :func:`simulate_model`."""
     began = time.perf_counter()
     solver = options.solver.lower()
     if solver not in ALL_SOLVERS:
