@@ -117,7 +117,7 @@ def test_prefixes_are_different_units(tmp_path: Path) -> None:
 def test_functions_of_dimensionless_arguments(tmp_path: Path) -> None:
     found = warnings_of(tmp_path, '  Real x(unit = "m");\n  Real w(unit = "rad/s");\n'
                         '  Real y;\n',
-                        "  x = time;\n  w = 1;\n  y = sin(w*time) + exp(x);\n")
+                        "  x = time;\n  w = 1;\n  y = sin(w*time) + exp(x) + cos(time);\n")
     assert [w.splitlines()[0].split(": ", 1)[1] for w in found] == [
         "warning: unit mismatch: 'm' = 's'",
         "warning: unit mismatch: 'm' given to exp, which takes a dimensionless argument "

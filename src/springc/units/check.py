@@ -5,7 +5,8 @@ parameter binding and every ``start`` value is checked: both sides of ``=``, the
 operands of ``+``, ``-`` and the relations, the branches of an ``if`` and the arguments
 of ``min``/``max``/``atan2``/... must have the same unit; ``sin``/``exp``/``log``/...
 take dimensionless arguments. Units combine through ``*``, ``/``, ``^`` with a literal
-exponent, ``sqrt`` and ``der`` (unit/s); ``time`` is in seconds.
+exponent, ``sqrt`` and ``der`` (unit/s); ``time`` is in seconds (but ``sin(time)``
+passes: an argument in which no variable has a unit is not checked).
 
 An expression whose unit is not known (a literal, which takes whatever unit it is
 needed in, as OpenModelica and Dymola treat literals; a variable without a ``unit``;
@@ -72,6 +73,11 @@ class UnitChecker:
             return self.call(e)
         return None  # a literal takes the unit it is needed in
 
+    def declared(self, e: x.Expr) -> bool:
+        """Whether a variable with a known unit occurs in ``e``."""
+        return any(isinstance(sub, x.Var) and self.units.get(sub.name) is not None
+                   for sub in x.walk(e))
+
     def binop(self, e: x.BinOp) -> Unit | None:
         a, b = self.unit(e.left), self.unit(e.right)
         if e.op in ("+", "-") or e.op in x.RELATIONS:
@@ -96,7 +102,9 @@ class UnitChecker:
             return ONE
         if name in DIMENSIONLESS:
             given = args[0]
-            if given is not None and not given.dimensionless:
+            # sin(time) is how one writes sin(w*time) with w = 1 rad/s: an argument
+            # with no variable of declared unit in it is not checked
+            if given is not None and not given.dimensionless and self.declared(e.args[0]):
                 raise Mismatch(f"'{given}' given to {name}, which takes a dimensionless "
                                "argument ('1' or 'rad')")
             return ONE
