@@ -22,7 +22,7 @@ MODELS = ROOT / "models"
 def unit(text: str) -> tuple[tuple[Fraction, ...], float]:
     parsed = parse_unit(text)
     assert parsed is not None
-    return parsed.dims, parsed.scale
+    return parsed.exponents, parsed.scale
 
 
 def si(scale: float = 1.0, **exponents: int) -> tuple[tuple[Fraction, ...], float]:

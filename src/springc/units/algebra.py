@@ -12,6 +12,7 @@ count as kelvin (their differences are, and an offset is not a unit).
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass, field
@@ -20,18 +21,22 @@ from fractions import Fraction
 BASE = ("kg", "m", "s", "A", "K", "mol", "cd")
 """The SI base units, in the order of :attr:`Unit.dims`."""
 
-Dims = tuple[Fraction, ...]
+STEP = 60
+"""Exponents are kept as integer multiples of 1/STEP (halves, thirds, quarters, fifths
+and sixths are exact; integer arithmetic keeps the check of a large model fast)."""
+
+Dims = tuple[int, ...]
 
 
 def _dims(**exponents: int) -> Dims:
-    return tuple(Fraction(exponents.get(b, 0)) for b in BASE)
+    return tuple(STEP * exponents.get(b, 0) for b in BASE)
 
 
 @dataclass(frozen=True)
 class Unit:
-    """A unit: exponents of the SI base units (:data:`BASE`) and a scale factor
-    (``mm``: metre, 0.001). ``text`` is how it is shown (the unit string it was
-    written as, or a canonical form) and takes no part in comparisons."""
+    """A unit: exponents of the SI base units (:data:`BASE`, in steps of 1/:data:`STEP`)
+    and a scale factor (``mm``: metre, 0.001). ``text`` is how it is shown (the unit
+    string it was written as, or a canonical form) and takes no part in comparisons."""
 
     dims: Dims
     scale: float = 1.0
@@ -49,6 +54,11 @@ class Unit:
     def dimensionless(self) -> bool:
         return not any(self.dims)
 
+    @property
+    def exponents(self) -> tuple[Fraction, ...]:
+        """The exponent of each base unit of :data:`BASE`."""
+        return tuple(Fraction(d, STEP) for d in self.dims)
+
     def __mul__(self, other: Unit) -> Unit:
         return Unit(tuple(a + b for a, b in zip(self.dims, other.dims)),
                     self.scale * other.scale)
@@ -57,9 +67,13 @@ class Unit:
         return Unit(tuple(a - b for a, b in zip(self.dims, other.dims)),
                     self.scale / other.scale)
 
-    def __pow__(self, exponent: Fraction) -> Unit:
-        scale = self.scale ** float(exponent)
-        return Unit(tuple(a * exponent for a in self.dims), scale)
+    def power(self, exponent: Fraction) -> Unit | None:
+        """The unit raised to ``exponent``; ``None`` where an exponent would not be a
+        multiple of 1/:data:`STEP`."""
+        dims = tuple(d * exponent for d in self.dims)
+        if any(d.denominator != 1 for d in dims):
+            return None
+        return Unit(tuple(int(d) for d in dims), self.scale ** float(exponent))
 
 
 ONE = Unit(_dims(), 1.0, "1")
@@ -105,6 +119,7 @@ class UnitSyntaxError(ValueError):
     """A unit string springc cannot read (its variables are then left unchecked)."""
 
 
+@functools.lru_cache(maxsize=4096)
 def parse_unit(text: str) -> Unit | None:
     """The unit written as ``text`` (``None`` for ``""``: no unit given);
     :class:`UnitSyntaxError` when it is not a unit expression springc knows."""
@@ -167,7 +182,9 @@ def _factor(tokens: Tokens) -> tuple[Unit, Tokens]:
         return unit, rest[1:]
     if kind != "word":
         raise UnitSyntaxError(f"unexpected '{value}'")
-    return _operand(value) ** Fraction(exponent), tokens[1:]
+    powered = _operand(value).power(Fraction(exponent))
+    assert powered is not None  # an integer power
+    return powered, tokens[1:]
 
 
 def _operand(word: str) -> Unit:
@@ -186,8 +203,8 @@ def _operand(word: str) -> Unit:
 def canonical(unit: Unit) -> str:
     """The unit in SI base units, as Modelica writes it: ``kg.m/s2``, ``1/s``, ``1``
     (a scale other than 1 is written before it: ``0.001*m``)."""
-    top = [_power(b, e) for b, e in zip(BASE, unit.dims) if e > 0]
-    bottom = [_power(b, -e) for b, e in zip(BASE, unit.dims) if e < 0]
+    top = [_power(b, e) for b, e in zip(BASE, unit.exponents) if e > 0]
+    bottom = [_power(b, -e) for b, e in zip(BASE, unit.exponents) if e < 0]
     text = ".".join(top) or "1"
     if bottom:
         below = ".".join(bottom)

@@ -17,8 +17,9 @@ warns. The first mismatch of each equation is reported, once per place in the so
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from fractions import Fraction
+from functools import partial
 
 from ..errors import Note, Span, UnitError
 from ..ir import expr as x
@@ -89,7 +90,7 @@ class UnitChecker:
             if a.dimensionless and a.same(ONE):
                 return ONE
             exponent = _literal(e.right)
-            return None if exponent is None else _named(a ** exponent)
+            return None if exponent is None else _named(a.power(exponent))
         if b is None:
             return None
         return _named(a * b if e.op == "*" else a / b)
@@ -109,7 +110,7 @@ class UnitChecker:
                                "argument ('1' or 'rad')")
             return ONE
         if name == "sqrt":
-            return None if args[0] is None else _named(args[0] ** Fraction(1, 2))
+            return None if args[0] is None else _named(args[0].power(Fraction(1, 2)))
         if name == "sign":
             return ONE
         if name == "div" and len(args) == 2:
@@ -155,9 +156,9 @@ def _literal(e: x.Expr) -> Fraction | None:
     return None
 
 
-def _named(unit: Unit) -> Unit:
+def _named(unit: Unit | None) -> Unit | None:
     """A computed unit, shown in SI base units."""
-    return Unit(unit.dims, unit.scale)
+    return None if unit is None else Unit(unit.dims, unit.scale)
 
 
 def check_units(model: FlatModel) -> tuple[UnitError, ...]:
@@ -183,7 +184,7 @@ def _mismatches(checker: UnitChecker, model: FlatModel) -> Iterator[UnitError]:
         for what, value in sides:
             if value is not None:
                 yield from _pair(checker, x.Var(v.name), value, v.span,
-                                 f"the {what} of {v.name}", unit)
+                                 partial(_text, f"the {what} of {v.name}"), unit)
     for eq in model.equations + model.initial_equations:
         yield from _equation(checker, eq)
     for when in model.whens:
@@ -192,7 +193,7 @@ def _mismatches(checker: UnitChecker, model: FlatModel) -> Iterator[UnitError]:
 
 def _equation(checker: UnitChecker, eq: Equation) -> Iterator[UnitError]:
     yield from _pair(checker, eq.lhs, eq.rhs, eq.span,
-                     f"`{x.to_text(eq.lhs, quote)} = {x.to_text(eq.rhs, quote)}`")
+                     lambda: f"`{x.to_text(eq.lhs, quote)} = {x.to_text(eq.rhs, quote)}`")
 
 
 def _when(checker: UnitChecker, when: When) -> Iterator[UnitError]:
@@ -205,18 +206,27 @@ def _when(checker: UnitChecker, when: When) -> Iterator[UnitError]:
                              f"`{x.to_text(condition, quote)}`")
         for item in branch.assignments + branch.reinits:
             yield from _pair(checker, x.Var(item.name), item.value, item.span,
-                             f"`{quote(item.name)} = {x.to_text(item.value, quote)}`")
+                             partial(_assignment, item.name, item.value))
 
 
-def _pair(checker: UnitChecker, left: x.Expr, right: x.Expr, span: Span, where: str,
-          left_unit: Unit | None = None) -> Iterator[UnitError]:
-    """The mismatch of ``left = right`` (inside either side first), if any."""
+def _text(text: str) -> str:
+    return text
+
+
+def _assignment(name: str, value: x.Expr) -> str:
+    return f"`{quote(name)} = {x.to_text(value, quote)}`"
+
+
+def _pair(checker: UnitChecker, left: x.Expr, right: x.Expr, span: Span,
+          where: Callable[[], str], left_unit: Unit | None = None) -> Iterator[UnitError]:
+    """The mismatch of ``left = right`` (inside either side first), if any; ``where``
+    words the place (only written for a mismatch)."""
     try:
         a = left_unit if left_unit is not None else checker.unit(left)
         b = checker.unit(right)
         agree(a, b, "", "=")
     except Mismatch as err:
-        yield _error(str(err), span, f"in {where}")
+        yield _error(str(err), span, f"in {where()}")
 
 
 def _error(message: str, span: Span, note: str) -> UnitError:
