@@ -186,6 +186,21 @@ def test_mat_file_in_the_openmodelica_layout(model: Path, tmp_path: Path) -> Non
     np.testing.assert_allclose(mat["data_2"][1], np.exp(-2 * time), rtol=1e-5)
 
 
+def test_mat_descriptions_outside_latin_1_are_replaced(tmp_path: Path) -> None:
+    from scipy.io import loadmat
+
+    model = tmp_path / "R.mdl"
+    model.write_text('model R\n  parameter Real r = 2 "Resistance in \u03a9";\n'
+                     '  Real x(start = 1) "\u00b5-scale";\nequation\n  der(x) = -x/r;\n'
+                     'end R;\n', encoding="utf-8")
+    out = tmp_path / "r.mat"
+    code, _, err = simulate(model, "-o", out, "--error-estimate", "off")
+    assert code == 0, err
+    mat = loadmat(str(out), chars_as_strings=False)
+    assert ["".join(c).rstrip() for c in zip(*mat["description"])] == [
+        "Time in [s]", "Resistance in ?", "\u00b5-scale"]
+
+
 def test_mat_file_keeps_the_error_estimate_and_no_side_file(model: Path,
                                                              tmp_path: Path) -> None:
     from scipy.io import loadmat

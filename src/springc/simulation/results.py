@@ -208,7 +208,10 @@ def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
     params = sorted(result.parameters.items())
     names = ["time", *(n for n, _ in params), *result.names]
     units = dict(zip(result.names, result.units))
-    texts = result.descriptions
+    # a description is prose: a character Latin-1 lacks becomes "?" (names and units
+    # must be exact, and are refused below)
+    texts = {n: t.encode("latin-1", "replace").decode("latin-1")
+             for n, t in result.descriptions.items()}
     descriptions = ["Time in [s]", *(texts.get(n, "") for n, _ in params),
                     *(f"{texts.get(n, '')} [{units[n]}]".lstrip() if units.get(n)
                       else texts.get(n, "") for n in result.names)]
