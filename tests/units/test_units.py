@@ -194,3 +194,27 @@ def test_bundled_models_have_no_unit_warnings() -> None:
     assert len(names) == 29 and "EventScenes.BouncingBall" in names
     assert {name: [str(w) for w in check_units(flatten_files(files, name))]
             for name in names} == {name: [] for name in names}
+
+
+def test_an_expression_deeper_than_the_stack_is_left_unchecked() -> None:
+    from springc.errors import Span
+    from springc.ir import expr as x
+    from springc.ir import flat
+
+    def span(line: int) -> Span:
+        return Span("m.mo", line, 1, line, 2)
+
+    def variable(name: str, unit: str) -> flat.Variable:
+        return flat.Variable(name, "Real", "continuous", "", False, None,
+                             flat.Attributes(unit=unit), "", "", span(1))
+
+    deep: x.Expr = x.Var("f")
+    for _ in range(50_000):
+        deep = x.Neg(deep)
+    origin = flat.Origin("equation", "")
+    model = flat.FlatModel("M", (variable("f", "N"), variable("y", "m")),
+                           (flat.Equation(x.Var("y"), deep, span(2), origin),
+                            flat.Equation(x.Var("y"), x.Var("f"), span(3), origin)),
+                           (), flat.Experiment(), span(1))
+    assert [(str(w.span), w.message) for w in check_units(model)] == [
+        ("m.mo:3:1", "unit mismatch: 'm' = 'N'")]

@@ -227,6 +227,8 @@ def _pair(checker: UnitChecker, left: x.Expr, right: x.Expr, span: Span,
         agree(a, b, "", "=")
     except Mismatch as err:
         yield _error(str(err), span, f"in {where()}")
+    except RecursionError:  # nested deeper than Python's stack: left unchecked
+        return
 
 
 def _error(message: str, span: Span, note: str) -> UnitError:
