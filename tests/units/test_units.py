@@ -218,3 +218,27 @@ def test_an_expression_deeper_than_the_stack_is_left_unchecked() -> None:
                            (), flat.Experiment(), span(1))
     assert [(str(w.span), w.message) for w in check_units(model)] == [
         ("m.mo:3:1", "unit mismatch: 'm' = 'N'")]
+
+
+def library_models() -> list[str]:
+    """The models and blocks of the bundled Modelica library (none is partial)."""
+    names = []
+    for path in sorted((MODELS / "Modelica").rglob("*.mo")):
+        parts = path.relative_to(MODELS).with_suffix("").parts
+        package = ".".join(parts[:-1] if path.name == "package.mo" else parts)
+        names += [f"{package}.{m[2]}" for m in re.finditer(
+            r"^\s*(partial\s+)?(?:model|block)\s+(\w+)", path.read_text(encoding="utf-8"),
+            re.M) if not m[1]]
+    return names
+
+
+def test_bundled_library_has_no_unit_warnings(tmp_path: Path,
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_PATH", "")
+    monkeypatch.setenv("MODELICAPATH", "")
+    user = tmp_path / "Use.mo"
+    user.write_text("model Use\nend Use;\n")
+    names = library_models()
+    assert len(names) == 54 and "Modelica.Blocks.Sources.Sine" in names
+    assert {name: [str(w) for w in check_units(flatten_files([user], name))]
+            for name in names} == {name: [] for name in names}
