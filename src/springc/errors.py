@@ -113,6 +113,11 @@ class CodegenError(SpringcError):
     """The model uses something the code generator cannot translate."""
 
 
+class UnitError(SpringcError):
+    """Units that do not agree: a warning (:func:`render` with ``kind="warning"``),
+    an error with ``--strict-units``."""
+
+
 class ErrorGroup(Exception):
     """Several independent errors reported together, in source order."""
 
@@ -172,14 +177,59 @@ def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -
     return [head] + (_excerpt(span, lookup) if span else [])
 
 
-def render(error: SpringcError, lookup: SourceLookup = read_source) -> str:
-    """Render one error in the ``file:line:col: error: ...`` format with caret and notes."""
-    lines = _located("error", error.message, error.span, lookup)
+def render(error: SpringcError, lookup: SourceLookup = read_source,
+           kind: str = "error") -> str:
+    """Render one error in the ``file:line:col: error: ...`` format with caret and notes
+    (``kind="warning"``: a diagnostic that is not an error, in the same format)."""
+    lines = _located(kind, error.message, error.span, lookup)
     for note in error.notes:
         lines += _located("note", note.message, note.span, lookup)
     if error.hint:
         lines.append(f"help: {error.hint}")
     return "\n".join(lines)
+
+
+def edit_distance(a: str, b: str) -> int:
+    """The Damerau-Levenshtein distance of ``a`` and ``b`` (insertions, deletions,
+    substitutions and swaps of neighbours, each 1; the optimal-string-alignment form)."""
+    previous2: list[int] = []
+    previous = list(range(len(b) + 1))
+    for i, ca in enumerate(a, 1):
+        row = [i] + [0] * len(b)
+        for j, cb in enumerate(b, 1):
+            row[j] = min(previous[j] + 1, row[j - 1] + 1, previous[j - 1] + (ca != cb))
+            if i > 1 and j > 1 and ca == b[j - 2] and a[i - 2] == cb:
+                row[j] = min(row[j], previous2[j - 2] + 1)
+        previous2, previous = previous, row
+    return previous[-1]
+
+
+def close_names(name: str, candidates: Iterable[str], limit: int = 3) -> list[str]:
+    """The ``candidates`` nearest to ``name``, nearest first: within an edit distance
+    (ignoring case) of a third of the length of the name's last part, rounded (none for
+    a one-letter name, one for a dotted name whose prefix holds); a dotted candidate
+    also matches by its last part (``Wall`` finds ``Mech.Wall``)."""
+    allowed = max((len(name.rsplit(".", 1)[-1]) + 1) // 3, int("." in name))
+    scored = []
+    for candidate in dict.fromkeys(candidates):
+        if candidate == name:
+            continue
+        last = candidate.rsplit(".", 1)[-1] if "." not in name else candidate
+        distance = min(edit_distance(name.lower(), candidate.lower()),
+                       edit_distance(name.lower(), last.lower()))
+        if distance <= allowed:
+            scored.append((distance, candidate))
+    return [candidate for _, candidate in sorted(scored)[:limit]]
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str | None:
+    """``did you mean 'a' or 'b'?`` for the :func:`close_names` of ``name``, if any."""
+    close = close_names(name, candidates)
+    if not close:
+        return None
+    quoted = [f"'{c}'" for c in close]
+    listed = ", ".join(quoted[:-1]) + " or " + quoted[-1] if len(quoted) > 1 else quoted[0]
+    return f"did you mean {listed}?"
 
 
 def render_all(exc: SpringcError | ErrorGroup, lookup: SourceLookup = read_source) -> str:

@@ -22,8 +22,8 @@ from springc.errors import UsageError
 
 MODEL = """
 model Decay
-  parameter Real k = 2;
-  Real x(start = 1, unit = "m");
+  parameter Real k = 2 "Decay rate";
+  Real x(start = 1, unit = "m") "Amount left";
 equation
   der(x) = -k*x;
 end Decay;
@@ -176,13 +176,44 @@ def test_mat_file_in_the_openmodelica_layout(model: Path, tmp_path: Path) -> Non
     assert ["".join(row).rstrip() for row in mat["Aclass"]] == [
         "Atrajectory", "1.1", "", "binTrans"]
     assert strings(mat["name"]) == ["time", "k", "x"]
-    assert strings(mat["description"]) == ["Time in [s]", "", "[m]"]
+    # the model's description strings, units in brackets (as Dymola writes them)
+    assert strings(mat["description"]) == ["Time in [s]", "Decay rate", "Amount left [m]"]
     # time; the parameter k in data_1 (row 2); x in data_2 (row 2)
     assert mat["dataInfo"].T.tolist() == [[0, 1, 0, -1], [1, 2, 0, 0], [2, 2, 0, -1]]
     assert mat["data_1"].tolist() == [[0.0, 1.0], [2.0, 2.0]]
     time = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
     assert mat["data_2"][0].tolist() == time.tolist()
     np.testing.assert_allclose(mat["data_2"][1], np.exp(-2 * time), rtol=1e-5)
+
+
+def test_mat_descriptions_outside_latin_1_are_replaced(tmp_path: Path) -> None:
+    from scipy.io import loadmat
+
+    model = tmp_path / "R.mdl"
+    model.write_text('model R\n  parameter Real r = 2 "Resistance in \u03a9";\n'
+                     '  Real x(start = 1) "\u00b5-scale";\nequation\n  der(x) = -x/r;\n'
+                     'end R;\n', encoding="utf-8")
+    out = tmp_path / "r.mat"
+    code, _, err = simulate(model, "-o", out, "--error-estimate", "off")
+    assert code == 0, err
+    mat = loadmat(str(out), chars_as_strings=False)
+    assert ["".join(c).rstrip() for c in zip(*mat["description"])] == [
+        "Time in [s]", "Resistance in ?", "\u00b5-scale"]
+
+
+def test_mat_file_keeps_the_error_estimate_and_no_side_file(model: Path,
+                                                             tmp_path: Path) -> None:
+    from scipy.io import loadmat
+
+    out = tmp_path / "x.mat"
+    code, _, err = simulate(model, "-o", out, "--error-estimate", "on")
+    assert code == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "x.mat"]
+    mat = loadmat(str(out), chars_as_strings=False)
+    assert ["".join(c).rstrip() for c in zip(*mat["errorEstimateName"])] == ["x"]
+    absolute, relative, at_time = mat["errorEstimate"][:, 0]
+    # relative to the largest |x| on the grid, x(0) = 1; the error of a 1e-6 run
+    assert relative == absolute and 0 < absolute < 1e-5 and 0 <= at_time <= 1
 
 
 def test_mat_file_with_parameters_in_data_1(model: Path) -> None:
@@ -334,8 +365,8 @@ def test_api_writers_choose_by_suffix(model: Path, tmp_path: Path) -> None:
     result.save(tmp_path / "r.csv")
     assert (tmp_path / "r.csv").read_text().startswith("time,x\n0.0,1.0\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv"]
-    # with an error estimate, its side file next to the trajectory (r2.error.csv)
+    # with an error estimate, still only the file named
     estimated = springc.simulate(model, stop=1.0, interval=0.5, error_control="warn")
+    assert estimated.error_estimate is not None
     estimated.save(tmp_path / "r2.csv")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv", "r2.csv",
-                                                          "r2.error.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv", "r2.csv"]

@@ -138,8 +138,8 @@ end M;
 model M
   String s(unit = "m") = "a";
 end M;
-''', "2:12: 's' is a String and has no attribute 'unit' to modify\nhelp: did you mean "
-        "'quantity'?"),
+''', "2:12: 's' is a String and has no attribute 'unit' to modify\nhelp: the "
+        "attributes of String are: start, fixed, quantity"),
 }
 
 

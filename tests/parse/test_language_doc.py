@@ -26,7 +26,7 @@ def run(tmp_path: Path, source: str, *args: str) -> tuple[int, str, str]:
 
 
 def test_the_document_has_its_examples() -> None:
-    assert len(EXAMPLE.findall(DOC)) == 5
+    assert len(EXAMPLE.findall(DOC)) == 6
 
 
 @pytest.mark.parametrize("options, source, flat", EXAMPLE.findall(DOC))

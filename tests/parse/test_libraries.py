@@ -138,8 +138,10 @@ def test_user_file_takes_precedence_and_named_package_is_not_the_default_model(
     with pytest.raises(SpringcError) as exc:
         flatten_files([package])
     # package.order lists Parts before Oscillator: the first model is Parts.Mass.
-    assert error_text(exc) == ("error: no model found in the given files\n"
-                               "help: choose a model with --model, e.g. --model Mech.Parts.Mass")
+    assert error_text(exc) == (
+        "error: no model at the top level of the given files: their models sit in packages "
+        "(Mech.Parts.Mass, Mech.Parts.Spring, Mech.Oscillator)\n"
+        "help: choose one by its dotted name, e.g. --model Mech.Parts.Mass")
     write(lib, {"Mech/package.order": "Oscillator\nParts\n"})
     with pytest.raises(SpringcError) as exc:
         flatten_files([package])

@@ -129,16 +129,18 @@ def test_deprecated_error_estimate_maps_to_error_control() -> None:
                              "is --error-control off\n")
 
 
-def test_csv_side_file_and_unchanged_csv(tmp_path: Path) -> None:
+def test_error_output_table_and_unchanged_csv(tmp_path: Path) -> None:
     out = tmp_path / "run.csv"
     result = CliRunner().invoke(main, ["simulate", SEED, "--backend", "numba", "--solver",
-                                       "dop853", "--error-control", "warn", "-o", str(out)])
+                                       "dop853", "--error-control", "warn", "-o", str(out),
+                                       "--error-output", str(tmp_path / "errors.csv")])
     assert result.exit_code == 0, result.output
     assert "; est. error " in result.stderr
     with out.open() as f:
         rows = list(csv.reader(f))
     assert rows[0] == ["time", *model("seed").outputs]
-    with (tmp_path / "run.error.csv").open() as f:
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["errors.csv", "run.csv"]
+    with (tmp_path / "errors.csv").open() as f:
         side = list(csv.reader(f))
     assert side[0] == ["variable", "max_abs_error", "relative_error", "at_time", "method",
                        "tolerance"]
@@ -153,3 +155,9 @@ def test_csv_side_file_and_unchanged_csv(tmp_path: Path) -> None:
     off = tmp_path / "off.csv"
     CliRunner().invoke(main, ["simulate", SEED, "--error-control", "off", "-o", str(off)])
     assert off.exists() and not (tmp_path / "off.error.csv").exists()
+    refused = CliRunner().invoke(main, ["simulate", SEED, "--error-control", "off",
+                                        "--error-output", str(tmp_path / "none.csv")])
+    assert refused.exit_code == 2 and refused.stderr.endswith(
+        "Error: --error-output needs an error estimate, which --error-control off turns "
+        "off\n")
+    assert not (tmp_path / "none.csv").exists()

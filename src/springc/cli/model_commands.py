@@ -7,7 +7,13 @@ import json
 import click
 
 from .app import guard, main
-from .options import check_output_options, compile_options, model_options
+from .options import (
+    check_output_options,
+    compile_options,
+    model_options,
+    report_units,
+    units_option,
+)
 
 
 @main.command()
@@ -47,15 +53,20 @@ def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...
 
 @main.command()
 @model_options
+@units_option
 @guard
-def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...]) -> None:
-    """Check that a model flattens and is balanced; print a one-line summary."""
+def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
+          strict_units: bool) -> None:
+    """Check that a model flattens, its units agree and it is balanced; print a
+    one-line summary."""
     from ..pipeline import flatten_files
     from ..simplify import check_balance
+    from ..units import check_units
 
     flat = flatten_files(files, model, libraries)
     for note in flat.notes:  # diagnostics that are not errors
         click.echo(note, err=True)
+    report_units(check_units(flat), strict_units)
     click.echo(check_balance(flat).summary())
 
 

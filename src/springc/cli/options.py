@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from ..errors import OutputError, UsageError
+from ..errors import ErrorGroup, OutputError, UnitError, UsageError, render
 
 
 class NumberRange(click.FloatRange):
@@ -40,6 +40,20 @@ def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
                         "last file).")(func)
     return click.argument("files", nargs=-1, required=True,
                           type=click.Path(exists=True, dir_okay=False))(func)
+
+
+def units_option(func: Callable[..., Any]) -> Callable[..., Any]:
+    return click.option("--strict-units", is_flag=True,
+                        help="Unit mismatches are errors (exit 1), not warnings.")(func)
+
+
+def report_units(warnings: Sequence[UnitError], strict: bool) -> None:
+    """Print the unit mismatches of a model as warnings, or raise them with
+    ``--strict-units``."""
+    if strict and warnings:
+        raise warnings[0] if len(warnings) == 1 else ErrorGroup(warnings)
+    if warnings:  # separated as errors are
+        click.echo("\n\n".join(render(w, kind="warning") for w in warnings), err=True)
 
 
 def parse_set(values: tuple[str, ...]) -> dict[str, float]:

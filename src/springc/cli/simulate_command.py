@@ -24,8 +24,10 @@ from .options import (
     compile_options,
     model_options,
     parse_set,
+    report_units,
     run_options,
     single_threaded_blas,
+    units_option,
 )
 
 
@@ -48,7 +50,7 @@ from .options import (
 @click.option("--error-control", type=click.Choice(ERROR_CONTROLS, case_sensitive=False),
               default=None, help="Estimate the global error on the output grid (a "
               "companion run 1000x tighter, or half the step for fixed-step solvers: in "
-              "the summary line and in NAME.error.csv next to -o NAME.csv) and hold every "
+              "the summary line, in a .mat trajectory and in --error-output) and hold every "
               "output variable v to 10 * (rtol * max|v| + atol). tighten: run 1000x "
               "tighter until it holds (at most rtol 1e-12, within --max-steps and "
               "--time-limit), else warn; warn: only warn; off: no estimate (fastest). "
@@ -57,6 +59,9 @@ from .options import (
                                                    case_sensitive=False),
               default=None, help="Deprecated: off is --error-control off, on is warn, "
               "auto is tighten.")
+@click.option("--error-output", type=click.Path(dir_okay=False),
+              help="Write the error estimate per state (CSV: variable, max_abs_error, "
+              "relative_error, at_time, method) here.")
 @click.option("--step", type=float, help="Step size [s] of the fixed-step solvers "
               "(required for them).")
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
@@ -76,15 +81,17 @@ from .options import (
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
 @click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@units_option
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, solver: str, engine: str,
-             error_control: str | None, error_estimate: str | None, rtol: float | None,
-             step: float | None, atol: float | None,
+             error_control: str | None, error_estimate: str | None,
+             error_output: str | None, rtol: float | None, step: float | None,
+             atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
-             event_rows: bool, quiet: bool) -> None:
+             event_rows: bool, quiet: bool, strict_units: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from ..simulation import (
         PLOT_FORMATS,
@@ -101,9 +108,13 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                                "needs --step H (e.g. --step 1e-3)")
     choose_engine(engine.lower(), solver.lower(), backend)
     check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
-    check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS)],
-                   files)
+    check_output_options([("-o", output, RESULT_FORMATS), ("--plot", plot, PLOT_FORMATS),
+                          ("--error-output", error_output, {".csv": "csv"})], files)
     mode = error_control_mode(error_control, error_estimate)
+    if error_output and mode == "off":  # the table asked for needs the estimate
+        option = "--error-control" if error_control else "--error-estimate"
+        raise click.UsageError(f"--error-output needs an error estimate, which {option} off "
+                               "turns off")
     if error_estimate is not None:
         click.echo(f"warning: {estimate_deprecation(error_estimate)}", err=True)
     single_threaded_blas()
@@ -120,6 +131,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                              backend=default_choice(backend, engine, solver),
                              outputs=patterns or None, parameters=values,
                              cache=not no_cache)
+    report_units(compiled.warnings, strict_units)
     if not patterns and (output or not plot):  # the default trajectory of every output
         check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
                               f"-o {output}" if output else "the CSV on stdout")
@@ -133,8 +145,11 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                      progress=progress, step=step, max_steps=max_steps,
                      time_limit=time_limit, engine=engine.lower(), error_control=mode,
                      event_rows=event_rows)
-    if output or plot:
-        note = save_outputs(result, output, plot, files)
+    if error_output and result.error_estimate is None:
+        raise click.UsageError(f"--error-output {error_output}: this run made no error "
+                               "estimate (--error-control off, or a model without states)")
+    if output or plot or error_output:
+        note = save_outputs(result, output, plot, files, error_output)
         if note and not quiet:
             click.echo(f"note: plot {plot}: {note}", err=True)
     else:

@@ -45,12 +45,15 @@ class CodegenOptions:
     """``outputs``: observed variables to generate (``None``: all of them);
     ``vector``: loops over groups of same-shaped assignments (large systems);
     ``switchable``: index reduction left a choice of states that may turn singular
-    during a run (the module says so; the simulator then switches states)."""
+    during a run (the module says so; the simulator then switches states);
+    ``warnings``: diagnostics of the model that are not errors, as text the module keeps
+    (``WARNINGS``) for whoever loads it from the cache."""
 
     backend: str = "python"
     outputs: tuple[str, ...] | None = None
     vector: bool | None = None  # None: by size (vector.VECTOR_THRESHOLD)
     switchable: bool = False
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

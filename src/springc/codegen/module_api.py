@@ -35,10 +35,12 @@ class GeneratedModule(Protocol):
     OBSERVED: tuple[str, ...]
     OBSERVED_UNITS: tuple[str, ...]
     GUESSES: tuple[str, ...]
+    DESCRIPTIONS: tuple[str, ...]  # name, description, name, ... (those with one)
     NEWTON_SYSTEMS: dict[int, tuple[str, ...]]
     EXPERIMENT: dict[str, Any]  # start, stop, interval, tolerance: float or None
     INITIAL_CONDITIONS: int
     SWITCHABLE: bool
+    WARNINGS: tuple[str, ...]  # diagnostics that are not errors, as the pipeline wrote them
     JAC_ROWS: IntArray
     JAC_COLS: IntArray
     JAC_INDICES: IntArray

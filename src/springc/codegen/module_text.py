@@ -58,6 +58,16 @@ def parameter_value(q: dae.Parameter) -> Expr:
     return q.start if q.start is not None else ZERO
 
 
+def descriptions(m: CodegenContext, outputs: Sequence[str]) -> list[str]:
+    """Name and description of each state, output and parameter that has one."""
+    out: list[str] = []
+    for name in dict.fromkeys([*m.states, *outputs, *m.params]):
+        v = m.variables.get(name)
+        if v is not None and v.description:
+            out += [name, v.description]
+    return out
+
+
 def module_text(m: CodegenContext, options: CodegenOptions,
                  bodies: list[tuple[str, str, list[str], str]], helpers: set[str],
                  pattern: list[tuple[int, int]], outputs: list[str],
@@ -110,6 +120,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         f"STRUCTURAL = {encode_strings(structural)}",
         f"OBSERVED = {encode_strings(outputs)}",
         f"OBSERVED_UNITS = {encode_strings([m.unit(o) for o in outputs])}",
+        "# The description strings of the variables that have one: name, text, name, ...",
+        f"DESCRIPTIONS = {encode_strings(descriptions(m, outputs))}",
         f"GUESSES = {_tuple(list(m.guess_slots))}",
         f"NEWTON_SYSTEMS = {m.newton_systems()!r}",
         f"EXPERIMENT = {experiment!r}",
@@ -119,6 +131,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         "# Index reduction left a choice of states that may turn singular during a run:",
         "# the simulator then switches states.",
         f"SWITCHABLE = {bool(options.switchable)}",
+        "# Diagnostics of the model that are not errors (JSON; the pipeline reads them).",
+        f"WARNINGS = {encode_strings(options.warnings)}",
         f"JAC_ROWS = {encode_ints([r for r, _ in pattern])}",
         f"JAC_COLS = {encode_ints([c for _, c in pattern])}",
         "JAC_INDICES = JAC_ROWS",

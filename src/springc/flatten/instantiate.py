@@ -8,14 +8,13 @@ and parameter bindings recorded), a :class:`ClassScope`, or an array of them.
 
 from __future__ import annotations
 
-import difflib
 import itertools
 import math
 from typing import Any
 
 import numpy as np
 
-from ..errors import ErrorGroup, FlattenError, Note, ParseError
+from ..errors import ErrorGroup, FlattenError, Note, ParseError, close_names
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
@@ -253,7 +252,7 @@ class Instantiation(FlattenContext):
         return scope
 
     def _unknown_target(self, key: str, child: Mod, view: ClassView, name: str) -> None:
-        close = difflib.get_close_matches(key, list(view.components), 1)
+        close = close_names(key, list(view.components), 1)
         raise FlattenError(
             f"'{name}' (of class '{view.entry.full_name}') has no element '{key}' to modify",
             child.span, [Note(f"class '{view.entry.full_name}' is defined here",

@@ -8,11 +8,10 @@ class they are written in. Output: class entries, resolved types or values. Also
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Iterator
 from typing import Any
 
-from ..errors import ErrorGroup, FlattenError, FollowUpError, Note, Span
+from ..errors import ErrorGroup, FlattenError, FollowUpError, Note, Span, close_names, did_you_mean
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
@@ -185,7 +184,7 @@ class ClassLookup(FlattenContext):
 
     def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry:
         if not ref.is_global and lookup_class(ref.parts[0].name, scope.entry) is None:
-            close = difflib.get_close_matches(ref.dotted, sorted(self.evaluator.builtins.table), 1)
+            close = close_names(ref.dotted, sorted(self.evaluator.builtins.table), 1)
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,
                                hint=f"did you mean '{close[0]}'?" if close else
                                "define it as a `function`, or load the file that defines it")
@@ -324,7 +323,23 @@ class ClassLookup(FlattenContext):
                 "name lookup stops at an encapsulated class; import what it needs "
                 "(Modelica 3.6, section 5.3.1)")
         raise FlattenError(f"undefined name '{name}'", span,
-                           hint="declare it, or check the spelling")
+                           hint=did_you_mean(name, self.visible_names(entry))
+                           or "declare it, or check the spelling")
+
+    def visible_names(self, entry: ClassEntry) -> list[str]:
+        """The names a reference in ``entry`` may use: its components, the constants of
+        its enclosing classes, ``time`` (for the hint of an undefined name)."""
+        names = ["time"]
+        enclosing: ClassEntry | None = entry
+        while enclosing is not None and enclosing.parent is not None:
+            try:
+                components = self.view(enclosing).components
+            except (FlattenError, ErrorGroup):
+                break
+            names += [n for n, c in components.items()
+                      if enclosing is entry or c.decl.variability == "constant"]
+            enclosing = enclosing.parent
+        return names
 
 
 def _names(node: object, name: str) -> bool:
@@ -391,9 +406,14 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
                 return _entry_of(tree, stored, defn)
     nested = [name for f in user_files + tree.named_packages for d in f.classes
               for name in _models_below(_entry_of(tree, f, d))]
+    if nested:
+        listed = ", ".join(nested[:5]) + (f" and {len(nested) - 5} more"
+                                          if len(nested) > 5 else "")
+        raise FlattenError("no model at the top level of the given files: their models sit "
+                           f"in packages ({listed})",
+                           hint=f"choose one by its dotted name, e.g. --model {nested[0]}")
     raise FlattenError("no model found in the given files",
-                       hint=f"choose a model with --model, e.g. --model {nested[0]}" if nested
-                       else "name a file that defines a model, or use --model")
+                       hint="name a file that defines a model, or use --model")
 
 
 def _models_below(entry: ClassEntry) -> list[str]:
@@ -414,10 +434,11 @@ def _model_hint(tree: ClassTree, model: str) -> str:
         if entry.defn.kind in ("model", "block", "class"):
             names.append(entry.full_name)
         pending += entry.classes.values()
-    close = difflib.get_close_matches(model, sorted(names), 3, 0.8)
-    if close:
-        return "did you mean " + " or ".join(f"'{n}'" for n in close) + "?"
-    return "give the dotted name of a model in the loaded files, e.g. --model Scenes.Chain"
+    hint = did_you_mean(model, sorted(names))
+    if hint:
+        return hint
+    example = min(names, key=lambda n: (n.count("."), n)) if names else "Scenes.Chain"
+    return f"give the dotted name of a model in the loaded files, e.g. --model {example}"
 
 
 def _from_user(tree: ClassTree, stored: s.StoredDefinition) -> bool:

@@ -5,13 +5,12 @@ errors. A base class of :class:`~springc.flatten.evaluate.Evaluator`.
 
 from __future__ import annotations
 
-import difflib
 import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import FlattenError, Note, Span
+from ..errors import FlattenError, Note, Span, close_names
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
@@ -97,7 +96,7 @@ class ReferenceResolver:
         raise FlattenError(f"'{part.name}' cannot be selected from a value", part.span)
 
     def _no_member(self, owner: ClassScope, part: s.RefPart) -> None:
-        close = difflib.get_close_matches(part.name, list(owner.view.components), 1)
+        close = close_names(part.name, list(owner.view.components), 1)
         hint = f"did you mean '{close[0]}'?" if close else None
         raise FlattenError(
             f"'{owner.prefix}' (of class '{owner.entry.full_name}') has no element "

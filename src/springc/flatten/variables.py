@@ -6,14 +6,13 @@ one :class:`~springc.flat.Variable` per array element, attributes evaluated.
 
 from __future__ import annotations
 
-import difflib
 import itertools
 from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
 
-from ..errors import FlattenError
+from ..errors import FlattenError, close_names
 from ..ir import flat
 from . import arrays as a
 from .modification import Mod, select
@@ -36,7 +35,7 @@ def check_attribute_mods(mod: Mod | None, primitive: str | None, name: str) -> N
     allowed = ATTRIBUTES[primitive]
     for key, child in mod.children.items():
         if key not in allowed:
-            close = difflib.get_close_matches(key, allowed, 1)
+            close = close_names(key, allowed, 1)
             raise FlattenError(
                 f"'{name}' is a {primitive} and has no attribute '{key}' to modify",
                 child.span, hint=f"did you mean '{close[0]}'?" if close else

@@ -11,7 +11,6 @@ earlier roots over later ones.
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,7 @@ from ..errors import (
     Note,
     Span,
     SpringcError,
+    close_names,
 )
 from ..ir import syntax as s
 from .library import (
@@ -440,7 +440,7 @@ def _unknown_class_hint(name: str, scope: ClassEntry) -> str:
         root = entry
         entry = entry.parent
     searched = f"; searched {root.tree.searched()}" if root.tree is not None else ""
-    close = difflib.get_close_matches(name, sorted(visible), 1)
+    close = close_names(name, sorted(visible), 1)
     if close:
         return f"did you mean '{close[0]}'? (searched {root.tree.searched()})" \
             if root.tree is not None else f"did you mean '{close[0]}'?"

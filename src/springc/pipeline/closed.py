@@ -34,8 +34,8 @@ from pathlib import Path
 from ..codegen import GeneratedModule
 from ..ir import flat, ode
 from ..ir.expr import recursion_room
-from ..simplify import conditions
 from ..resources import CacheUnusable, private_folder
+from ..simplify import conditions
 from .cache import MODULE_FILE, cache_dir, import_module, read_entry
 
 MODULE_PREFIX = "springc_model_"

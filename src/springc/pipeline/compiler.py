@@ -10,7 +10,6 @@ its files again.
 
 from __future__ import annotations
 
-import difflib
 import shutil
 import tempfile
 import time
@@ -20,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen import CodegenOptions, GeneratedModule, generate
-from ..errors import CodegenError, SimulationError
+from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
 from .cache import (
@@ -50,6 +49,7 @@ from .closed import (
     run_system_of,
 )
 from .derive import CompileOptions, Derived, derive_system, fewer_collections
+from .diagnostics import decode_warnings, encode_warnings
 from .equations import Equations
 from .selection import ALL_OBSERVED, select_names, selected_observed
 
@@ -113,6 +113,17 @@ class CompiledModel:
         return units
 
     @property
+    def descriptions(self) -> dict[str, str]:
+        """The description strings of the variables and parameters that have one."""
+        flat_list = tuple(getattr(self.module, "DESCRIPTIONS", ()))
+        return dict(zip(flat_list[::2], flat_list[1::2]))
+
+    @property
+    def warnings(self) -> tuple[UnitError, ...]:
+        """The unit mismatches of the model (warnings; errors with ``--strict-units``)."""
+        return decode_warnings(getattr(self.module, "WARNINGS", ()))
+
+    @property
     def structural(self) -> tuple[str, ...]:
         return tuple(self.module.STRUCTURAL)
 
@@ -171,11 +182,10 @@ def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) ->
     known = model.parameter_names
     for name in values:
         if name not in known:
-            close = difflib.get_close_matches(name, known, 3)
             raise SimulationError(
                 f"'{name}' is not a parameter of {model.name}",
-                hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
-                      "parameters are named by their flat names, e.g. 'spring.k'"))
+                hint=did_you_mean(name, known)
+                or "parameters are named by their flat names, e.g. 'spring.k'")
 
 
 # ------------------------------------------------------------------ compile
@@ -319,7 +329,8 @@ def generate_from(derived: Derived, options: CompileOptions) -> str:
     candidates = [s.name for s in system.states] + system.observed_names()
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)
-    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable)
+    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
+                             warnings=encode_warnings(derived.warnings))
     return generate(system, flat_model, codegen).source
 
 

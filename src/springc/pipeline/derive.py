@@ -13,10 +13,12 @@ import gc
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
+from ..errors import UnitError
 from ..flatten import flatten, select_model
 from ..ir import flat, ode, syntax
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
+from ..units import check_units
 
 
 @dataclass(frozen=True)
@@ -40,12 +42,14 @@ class CompileOptions:
 
 @dataclass(frozen=True)
 class Derived:
-    """The simplified system of a model, its flat model, and whether index reduction
-    left a choice of states that may turn singular during a run (``switchable``)."""
+    """The simplified system of a model, its flat model, whether index reduction
+    left a choice of states that may turn singular during a run (``switchable``), and
+    the unit mismatches of the flat model."""
 
     system: ode.ODE
     flat_model: flat.FlatModel
     switchable: bool
+    warnings: tuple[UnitError, ...] = ()
 
 
 WRAPPER_FILE = "<springc: structural parameters>"
@@ -77,6 +81,7 @@ def derive_system(options: CompileOptions) -> Derived:
         base = flatten(tree, model)
         model = _add_wrapper(tree, entry, options.modifications)
     flat_model = flatten(tree, model)
+    warnings = check_units(flat_model)
     simplified = simplify(flat_model)
     system = simplified.ode
     switchable = any(b.switchable for b in simplified.blocks)
@@ -86,7 +91,7 @@ def derive_system(options: CompileOptions) -> Derived:
         system = dataclasses.replace(
             system, name=base.name,
             dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
-    return Derived(system, flat_model, switchable)
+    return Derived(system, flat_model, switchable, warnings)
 
 
 def _add_wrapper(tree: ClassTree, entry: ClassEntry,

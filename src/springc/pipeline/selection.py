@@ -7,11 +7,10 @@ computes (:func:`selected_observed`), and thus the module's cache key.
 
 from __future__ import annotations
 
-import difflib
 import re
 from collections.abc import Sequence
 
-from ..errors import SimulationError
+from ..errors import SimulationError, did_you_mean
 
 ALL_OBSERVED = "all"
 """The selection of a module that computes every observed variable (no ``--vars``)."""
@@ -57,11 +56,10 @@ def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> l
         if text in literal and text in known:
             continue
         if text in literal or not any(wildcard_match(text, c) for c in candidates):
-            close = difflib.get_close_matches(text, candidates, 3)
             raise SimulationError(
                 f"--vars '{text}' matches no state or observed variable",
-                hint=(f"did you mean {', '.join(repr(c) for c in close)}?" if close else
-                      "use flat names such as 'mass.pos[1]', with * and ? as wildcards"))
+                hint=did_you_mean(text, candidates)
+                or "use flat names such as 'mass.pos[1]', with * and ? as wildcards")
     return [c for c in candidates if c in literal or any(wildcard_match(p, c) for p in wild)]
 
 

@@ -31,14 +31,18 @@ class Balance:
     equations: int
     parameters: int
     parameter_arrays: int
+    discrete: int = 0  # of the unknowns: discrete ones (Integer, Boolean, when-assigned)
+    when_equations: int = 0  # of the equations: the when-equations (one per variable)
 
     def summary(self) -> str:
         arrays = (f", {self.parameter_arrays} parameter array"
                   f"{'s' if self.parameter_arrays != 1 else ''}") if self.parameter_arrays else ""
         # a quoted name with a line break or other control character is shown escaped
         name = self.model if self.model.isprintable() else flat.quote(self.model)
-        return (f"{name}: {_count(self.unknowns, 'unknown')}, "
-                f"{_count(self.equations, 'equation')}, "
+        discrete = f" ({self.discrete} discrete)" if self.discrete else ""
+        whens = f" ({self.when_equations} in when-clauses)" if self.when_equations else ""
+        return (f"{name}: {_count(self.unknowns, 'unknown')}{discrete}, "
+                f"{_count(self.equations, 'equation')}{whens}, "
                 f"{_count(self.parameters, 'parameter')}{arrays}: balanced")
 
 
@@ -75,15 +79,20 @@ def check_balance(model: flat.FlatModel, rows: Sequence[Sequence[int]] | None = 
                   ) -> Balance:
     """The counts of a balanced ``model``; otherwise a :class:`BalanceError` naming the
     undetermined variables and the surplus equations. ``rows``: the model's
-    :func:`incidence`, when already known. Variables assigned in when-clauses count
-    with their when-equations, so neither is counted here."""
+    :func:`incidence`, when already known. Variables assigned in when-clauses are
+    matched with their when-equations, and only counted with them (as discrete
+    unknowns and when-equations) in the :class:`Balance`."""
+    full = model
     model = continuous_part(model)
     unknowns = model.unknowns
     rows = [list(r) for r in rows] if rows is not None else incidence(model)
     matching = maximum_matching(rows, len(unknowns))
     n_eq, n_var = len(model.equations), len(unknowns)
     if n_eq == n_var and matching.is_perfect:
-        return Balance(model.name, n_var, n_eq, *count_parameters(model))
+        held = len(full.unknowns) - n_var
+        discrete = sum(1 for v in full.unknowns if v.variability == "discrete")
+        return Balance(model.name, n_var + held, n_eq + held, *count_parameters(model),
+                       discrete=max(discrete, held), when_equations=held)
     parts = dulmage_mendelsohn(rows, n_var, matching)
     notes: list[Note] = []
     for eqs, var_ids in _blocks(rows, parts.under_equations, parts.under_variables):

@@ -111,6 +111,8 @@ class SimulationResult:
     step_times: tuple[float, ...] = ()
     #: the estimated global error on the grid (``--error-control``; None: not estimated)
     error_estimate: ErrorEstimate | None = None
+    #: the description strings of the model's variables and parameters, by flat name
+    descriptions: dict[str, str] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -208,19 +210,28 @@ def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
     1.1, binTrans), as DyMat, OMPython and Dymola read it:
 
     - ``name``, ``description``: one column of characters per variable, ``time`` first;
-      the description is the unit in brackets;
+      the description is the model's description string and the unit in brackets
+      (``Position of the mass [m]``), as Dymola writes it;
     - ``dataInfo`` (4 x variables, int32): data block, 1-based row in that block
       (negative: negated), interpolation 0, extrapolation -1 (0 for parameters);
     - ``data_1``: the parameters, one row each (``time`` first), at start and stop;
-    - ``data_2``: the trajectories, one row each (``time`` first), one column per time.
+    - ``data_2``: the trajectories, one row each (``time`` first), one column per time;
+    - with an error estimate (which readers of the layout ignore): ``errorEstimate``
+      (3 x states: largest absolute error, relative error, its time) and
+      ``errorEstimateName`` (the states, one column of characters each).
     """
     from scipy.io import savemat
 
     params = sorted(result.parameters.items())
     names = ["time", *(n for n, _ in params), *result.names]
     units = dict(zip(result.names, result.units))
-    descriptions = ["Time in [s]", *("" for _ in params),
-                    *(f"[{units[n]}]" if units.get(n) else "" for n in result.names)]
+    # a description is prose: a character Latin-1 lacks becomes "?" (names and units
+    # must be exact, and are refused below)
+    texts = {n: t.encode("latin-1", "replace").decode("latin-1")
+             for n, t in result.descriptions.items()}
+    descriptions = ["Time in [s]", *(texts.get(n, "") for n, _ in params),
+                    *(f"{texts.get(n, '')} [{units[n]}]".lstrip() if units.get(n)
+                      else texts.get(n, "") for n in result.names)]
     info = [(0, 1, 0, -1)]
     info += [(1, i + 2, 0, 0) for i in range(len(params))]
     info += [(2, i + 2, 0, -1) for i in range(len(result.names))]
@@ -239,22 +250,22 @@ def write_mat(result: SimulationResult, f: IO[bytes]) -> None:
                           hint="write the trajectory as .csv (UTF-8) instead") from None
     matrices.update({"dataInfo": np.ascontiguousarray(np.array(info, dtype=np.int32).T),
                      "data_1": data_1, "data_2": np.ascontiguousarray(data_2)})
+    estimate = result.error_estimate
+    if estimate is not None and estimate.names:
+        matrices["errorEstimate"] = np.array(
+            [estimate.absolute, estimate.relative, estimate.times], dtype=float)
+        matrices["errorEstimateName"] = _char_matrix(list(estimate.names))
     savemat(f, matrices, format="4")
 
 
-def error_file(output: PathLike) -> Path:
-    """The side file of a trajectory's error estimate: ``run.csv`` -> ``run.error.csv``
-    (the trajectory's own CSV keeps its plain header, so readers are unchanged)."""
-    path = Path(output)
-    return path.with_name(path.stem + ".error.csv")
-
-
 def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLike | None,
-                 protected: Iterable[PathLike] = ()) -> str:
-    """Write the trajectory to ``output`` (CSV or MAT by suffix; with an error estimate,
-    also :func:`error_file`) and the plot to ``plot`` (PNG, SVG or PDF): all are
-    rendered before any is put in place, and files in ``protected`` (the inputs) are
-    never replaced. Returns the plot's note (which variables it shows, see
+                 protected: Iterable[PathLike] = (), error_output: PathLike | None = None
+                 ) -> str:
+    """Write the trajectory to ``output`` (CSV or MAT by suffix; a MAT file keeps the
+    error estimate too), the plot to ``plot`` (PNG, SVG or PDF) and the error estimate's
+    table to ``error_output`` (CSV; nothing without an estimate): only the files named,
+    all rendered before any is put in place, and files in ``protected`` (the inputs)
+    are never replaced. Returns the plot's note (which variables it shows, see
     :mod:`.plot_layout`; empty: all of them)."""
     kind = file_format(output, RESULT_FORMATS, "output") if output is not None else None
     plot_kind = file_format(plot, PLOT_FORMATS, "plot") if plot is not None else None
@@ -266,9 +277,9 @@ def save_outputs(result: SimulationResult, output: PathLike | None, plot: PathLi
                     write_csv(result, f)
                 else:
                     write_mat(result, f)
-            if result.error_estimate is not None:
-                with outputs.open(error_file(output), "w") as f:
-                    csv.writer(f, lineterminator="\n").writerows(result.error_estimate.rows())
+        if error_output is not None and result.error_estimate is not None:
+            with outputs.open(error_output, "w") as f:
+                csv.writer(f, lineterminator="\n").writerows(result.error_estimate.rows())
         if plot is not None and picture is not None:
             with outputs.open(plot, "wb") as f:
                 f.write(picture)

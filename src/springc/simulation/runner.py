@@ -167,12 +167,15 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
 
 def simulate_model(model: CompiledModel, options: SimulationOptions = SimulationOptions()
                    ) -> SimulationResult:
-    """Integrate ``model`` and return the selected outputs on the output grid, with the
-    estimated error and tightened as ``options.error_control`` says (:mod:`.error_control`)."""
+    """Integrate ``model`` and return the selected outputs on the output grid (with the
+    model's description strings), with the estimated error and tightened as
+    ``options.error_control`` says (:mod:`.error_control`)."""
     mode = error_control.check_mode(options.error_control, "error_control")
     rtol, atol = resolve(model, options)[3:]
-    return error_control.controlled(options, error_control.Asked(mode, rtol, atol),
-                                    lambda run: simulate_once(model, run))
+    result = error_control.controlled(options, error_control.Asked(mode, rtol, atol),
+                                      lambda run: simulate_once(model, run))
+    result.descriptions = model.descriptions
+    return result
 
 
 def simulate_once(model: CompiledModel, options: SimulationOptions) -> SimulationResult:
