@@ -8,6 +8,7 @@ there is an output file so that an interrupted study can resume.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
