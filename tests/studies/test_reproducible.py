@@ -28,9 +28,11 @@ def test_a_study_is_byte_identical_on_one_and_two_workers(cache: Path,
     source = tmp_path / "extremes.mdl"
     source.write_text(MODELS)
     model = springc.compile_model(source, "StiffPair")
-    # uneven walls: k = 1e4 is not stiff (dop853), k = 1e8 and 1e12 race to radau
+    # uneven walls: k = 1e4 is not stiff (dop853), k = 1e8 and 1e12 race to radau; the
+    # race's own runs (error control off: tightening would rerun them to resolve the
+    # excited fast mode, a question of tolerance, not of reproducibility)
     options = [StudyOptions((parse_parameter("k=1e4,1e8,1e12"),), fixed=(("k2", 2.0),),
-                            workers=workers) for workers in (1, 2, 2)]
+                            workers=workers, error_control="off") for workers in (1, 2, 2)]
     files = [str(tmp_path / f"study{i}.parquet") for i in range(3)]
     studies = [run_study(model, o, f) for o, f in zip(options, files)]
     assert studies[0].summary.column("solver").to_pylist() == ["dop853", "radau", "radau"]
