@@ -23,7 +23,7 @@ from .printer import HELPERS, function_lines
 from .statements import Let, Namer, Raw, Stmt, Store, escaped
 from .vector import VECTOR_THRESHOLD, VectorLayout
 
-CODEGEN_VERSION = 4
+CODEGEN_VERSION = 5
 FROZEN_BYTES = 10**6
 """numba's limit for freezing a global array into compiled code (``make_constant_array``)."""
 
