@@ -436,7 +436,7 @@ model M
   Integer x = F(2);
 end M;
 """,
-        'M: 1 unknown, 1 equation, 0 parameters: balanced'),
+        'M: 1 unknown (1 discrete), 1 equation, 0 parameters: balanced'),
 }
 
 

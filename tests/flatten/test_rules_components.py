@@ -372,7 +372,7 @@ model M
   Integer s = size({x, x}, 1);
 end M;
 """,
-        'M: 3 unknowns, 3 equations, 0 parameters: balanced'),
+        'M: 3 unknowns (2 discrete), 3 equations, 0 parameters: balanced'),
     "boolean_of_no_event_relation": ("""\
 model M
   Real x = 2.5;

@@ -25,7 +25,7 @@ equation
   end when;
 end M;
 """,
-        "M: 1 unknown, 1 equation, 1 parameter: balanced"),
+        "M: 2 unknowns (2 discrete), 2 equations (1 in when-clauses), 1 parameter: balanced"),
     "binding": ("""\
 model M
   discrete Real x = 1.0;

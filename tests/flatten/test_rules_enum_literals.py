@@ -22,7 +22,8 @@ model M
   E e = E.fixedPoint;
 end M;
 """
-    assert outcome(tmp_path, text) == "M: 1 unknown, 1 equation, 0 parameters: balanced"
+    assert outcome(tmp_path, text) == ("M: 1 unknown (1 discrete), 1 equation, "
+                                       "0 parameters: balanced")
 
 
 @pytest.mark.parametrize("literal", ["quantity", "min", "max", "start", "fixed"])

@@ -28,7 +28,7 @@ CASES = {
     "same_type_and_sizes": (MODEL.format(outer="Real", dims="[3]", inner="Real"),
                             "M: 4 unknowns, 4 equations, 0 parameters: balanced"),
     "same_integer_type": (MODEL.format(outer="Integer", dims="[3]", inner="Integer"),
-                          "M: 4 unknowns, 4 equations, 0 parameters: balanced"),
+                          "M: 4 unknowns (3 discrete), 4 equations, 0 parameters: balanced"),
     "other_size": (MODEL.format(outer="Real", dims="[2]", inner="Real"),
                    "3:16: the outer element 'p' is of type Real[2], but its inner element "
                    f"is of type Real[3]\n{HELP}"),

@@ -191,7 +191,7 @@ model M
   Derived d;
 end M;
 """,
-        'M: 1 unknown, 1 equation, 1 parameter: balanced'),
+        'M: 1 unknown (1 discrete), 1 equation, 1 parameter: balanced'),
     "component_named_as_its_type": ("""\
 model M
   type x = Real;

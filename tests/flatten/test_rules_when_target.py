@@ -24,7 +24,7 @@ equation
     x = pre(x) + 1;
   end when;
 end M;
-""", "M: 0 unknowns, 0 equations, 0 parameters: balanced"),
+""", "M: 1 unknown (1 discrete), 1 equation (1 in when-clauses), 0 parameters: balanced"),
     "record_element": ("""\
 model M
   record R
@@ -36,7 +36,7 @@ equation
     r.a = pre(r.a) + 1;
   end when;
 end M;
-""", "M: 0 unknowns, 0 equations, 0 parameters: balanced"),
+""", "M: 1 unknown (1 discrete), 1 equation (1 in when-clauses), 0 parameters: balanced"),
     "model_component": ("""\
 model M
   model Sub

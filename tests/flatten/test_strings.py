@@ -54,7 +54,7 @@ model M
 equation
   assert(String(e) + String(k) == "two6", "bound values");
 end M;
-''', "M: 2 unknowns, 2 equations, 0 parameters: balanced"),
+''', "M: 2 unknowns (2 discrete), 2 equations, 0 parameters: balanced"),
     "an_assertion_on_strings_that_fails": ('''\
 model M
   String s;

@@ -51,7 +51,7 @@ equation
     w[e, i] = i;
   end for;
 end M;
-""", "M: 11 unknowns, 11 equations, 0 parameters: balanced"),
+""", "M: 11 unknowns (2 discrete), 11 equations, 0 parameters: balanced"),
     "integer_index_of_an_enumeration_dimension": ("""\
 model M
   type E = enumeration(a, b, c);
