@@ -6,6 +6,7 @@ Each stage raises its own subclass of :class:`SpringcError`; the CLI renders the
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -158,34 +159,59 @@ def read_source(path: str) -> str | None:
         return None
 
 
+def printable(text: str) -> str:
+    """``text`` safe to print on one line: control characters and line or paragraph
+    separators (a newline in a quoted name, U+2028 in a comment) escaped as Python
+    writes them, so that model text never forges a line of springc's output."""
+    return "".join(_escaped(c) for c in text)
+
+
+def _escaped(c: str) -> str:
+    if c.isprintable() or c == " ":
+        return c
+    return repr(c)[1:-1] if unicodedata.category(c) == "Cc" else f"\\u{ord(c):04x}"
+
+
 def _excerpt(span: Span, lookup: SourceLookup) -> list[str]:
     text = lookup(span.file)
     if text is None:
         return []
-    lines = text.splitlines()
+    lines = text.split("\n")  # lines as the lexer counts them (\n only, not U+2028)
     if not 1 <= span.line <= len(lines):
         return []
-    line = lines[span.line - 1].expandtabs(1)
-    end = span.end_column if span.end_line == span.line else len(line) + 1
-    width = max(1, end - span.column)
+    raw = lines[span.line - 1].removesuffix("\r").expandtabs(1)
+    pieces = [_escaped(c) for c in raw]
+    starts = [0]
+    for piece in pieces:
+        starts.append(starts[-1] + len(piece))
+    line = "".join(pieces)
+
+    def at(column: int) -> int:  # 0-based position of a 1-based column in the shown line
+        return starts[min(max(column - 1, 0), len(pieces))]
+
+    end = at(span.end_column) if span.end_line == span.line else len(line)
+    width = max(1, end - at(span.column))
     gutter = f"{span.line:>5} | "
-    return [gutter + line, " " * (len(gutter) - 2) + "| " + " " * (span.column - 1) + "^" * width]
+    return [gutter + line,
+            " " * (len(gutter) - 2) + "| " + " " * at(span.column) + "^" * width]
 
 
 def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -> list[str]:
-    head = f"{span}: {kind}: {message}" if span else f"{kind}: {message}"
+    where = printable(str(span)) if span else ""
+    head = f"{where}: {kind}: {printable(message)}" if span else f"{kind}: {printable(message)}"
     return [head] + (_excerpt(span, lookup) if span else [])
 
 
 def render(error: SpringcError, lookup: SourceLookup = read_source,
            kind: str = "error") -> str:
     """Render one error in the ``file:line:col: error: ...`` format with caret and notes
-    (``kind="warning"``: a diagnostic that is not an error, in the same format)."""
+    (``kind="warning"``: a diagnostic that is not an error, in the same format); names
+    and source text are shown :func:`printable`."""
     lines = _located(kind, error.message, error.span, lookup)
     for note in error.notes:
         lines += _located("note", note.message, note.span, lookup)
     if error.hint:
-        lines.append(f"help: {error.hint}")
+        lines.append(f"help: {printable(error.hint)}")
     return "\n".join(lines)
 
 

@@ -283,14 +283,16 @@ def test_a_symbolic_link_back_to_a_parent_folder_is_walked_once(tmp_path: Path) 
 
 def test_an_mdl_file_in_a_folder_that_is_not_a_package_is_not_read(tmp_path: Path) -> None:
     """Only the top of a root may hold older-style .mdl files: a stray one further down
-    (here one that would replace the bundled Modelica library) is not part of it."""
-    lib = write(tmp_path / "lib", {"junk/deeper/evil.mdl": "package Modelica\n  "
-                                   "constant Real pi = 4;\nend Modelica;\n",
+    is not part of the library (it could define package Modelica)."""
+    lib = write(tmp_path / "lib", {"junk/deeper/evil.mdl": "package Evil\n  "
+                                   "constant Real k = 4;\nend Evil;\n",
                                    "Parts.mdl": "package Parts\n  model A\n"
-                                   "    Real a = Modelica.Constants.pi;\n  end A;\nend Parts;\n"})
-    user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
-    (equation,) = flatten_files([user], None, [lib]).equations
-    assert format_equation(equation).startswith("'a.a' = 3.14159265358979")
+                                   "    Real a = 1;\n  end A;\nend Parts;\n"})
+    user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\n  Real b = Evil.k;\n"
+                                    "end M;\n"}) / "m.mo"
+    with pytest.raises(SpringcError) as exc:
+        flatten_files([user], None, [lib])
+    assert error_text(exc).splitlines()[0] == f"{user}:3:12: error: undefined name 'Evil'"
     assert not any("junk" in str(p) for p in library_sources(lib))
 
 
@@ -355,3 +357,19 @@ def test_the_command_line_simulates_the_users_model_not_the_librarys(tmp_path: P
                                     env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
         assert (result.exit_code, result.output) == (
             0, "M: 3 unknowns, 3 equations, 1 parameter: balanced\n")
+
+
+def test_a_top_level_class_hiding_another_gets_a_note(tmp_path: Path) -> None:
+    """An older-style .mdl at the top of a -L root defines package Modelica: it is used
+    (the library path's order), with a note naming both files."""
+    from springc.resources import models_dir
+
+    lib = write(tmp_path / "lib", {"mine.mdl": "package Modelica\n  package Mine\n"
+                                   "    constant Real k = 4;\n  end Mine;\n"
+                                   "end Modelica;\n"})
+    user = write(tmp_path, {"m.mo": "model M\n  Real a = Modelica.Mine.k;\nend M;\n"})
+    flat = flatten_files([user / "m.mo"], None, [lib])
+    assert [format_equation(e) for e in flat.equations] == ["a = 4;"]
+    assert flat.notes == (
+        f"note: the top-level class 'Modelica' is taken from {lib / 'mine.mdl'}; it hides "
+        f"{models_dir() / 'Modelica' / 'package.mo'} (the bundled models)",)

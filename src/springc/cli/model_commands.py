@@ -6,6 +6,7 @@ import json
 
 import click
 
+from ..errors import printable
 from .app import guard, main
 from .options import (
     check_output_options,
@@ -41,8 +42,9 @@ def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...
         result = simplify(flat_model)
         click.echo((format_ode_latex if as_latex else format_ode)(result.ode), nl=False)
         for note in result.warnings:
-            click.echo(f"{note.span}: warning: {note.message}" if note.span
-                       else f"warning: {note.message}", err=True)
+            message = printable(note.message)
+            click.echo(f"{printable(str(note.span))}: warning: {message}" if note.span
+                       else f"warning: {message}", err=True)
     elif as_json:
         click.echo(json.dumps(to_json_dict(flat_model), indent=1))
     elif as_latex:
@@ -65,9 +67,9 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
 
     flat = flatten_files(files, model, libraries)
     for note in flat.notes:  # diagnostics that are not errors
-        click.echo(note, err=True)
+        click.echo("\n".join(printable(line) for line in str(note).split("\n")), err=True)
     report_units(check_units(flat), strict_units)
-    click.echo(check_balance(flat).summary())
+    click.echo(printable(check_balance(flat).summary()))
 
 
 @main.command(name="compile")

@@ -200,7 +200,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                           tuple(flattener.initial_equations),
                           experiment_of(flattener, entry, top), entry.defn.span,
-                          notes=tuple(added_inner_notes(top)),
+                          notes=(*tree.notes, *added_inner_notes(top)),
                           whens=tuple(flattener.whens),
                           assertions=unique(flattener.assertions))
 

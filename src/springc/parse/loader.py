@@ -111,6 +111,8 @@ class ClassTree:
         self.parsed_paths: list[Path] = []
         self._loose_done: set[Path] = set()
         self._missing: set[tuple[int, str]] = set()
+        #: Diagnostics that are not errors (a top-level class hiding another one).
+        self.notes: list[str] = []
 
     def add(self, stored: s.StoredDefinition, override: bool,
             folder: Path | None = None) -> list[SpringcError]:
@@ -165,7 +167,9 @@ class ClassTree:
                     for loose in loose_files(root.folder):
                         self._load_library_file(loose, None, None)
                 if name in self.root.classes:
-                    return self.root.classes[name]
+                    found = self.root.classes[name]
+                    self._note_shadowed(found, root)
+                    return found
             return None
         if package.folder is None:
             return None
@@ -174,6 +178,16 @@ class ClassTree:
             return None
         self._load_library_file(path, tuple(package.full_name.split(".")), name)
         return package.classes.get(name)
+
+    def _note_shadowed(self, found: ClassEntry, taken: LibraryRoot) -> None:
+        """A note for each later root that also stores the top-level class ``found``
+        (taken from ``taken``): the library path's order hides it."""
+        name, first = found.defn.name, found.defn.span.file
+        for root in self.roots[self.roots.index(taken) + 1:]:
+            other = class_file(root.folder, name)
+            if other is not None and Path(first).resolve() != other.resolve():
+                self.notes.append(f"note: the top-level class '{name}' is taken from "
+                                  f"{first}; it hides {other} ({root.describe()})")
 
     def _load_library_file(self, path: Path, within: tuple[str, ...] | None,
                            name: str | None) -> None:

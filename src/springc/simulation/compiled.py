@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import UsageError
+from ..errors import SimulationError, UsageError
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
 from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
@@ -256,12 +256,18 @@ def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.
     radau and bdf with the generated sparse Jacobian) on the generated module ``mod``."""
     from springc.integrate import bdf, dop853, radau, rk45
 
-    if solver in (RACE_IMPLICIT, "bdf"):
-        implicit = radau if solver == RACE_IMPLICIT else bdf
-        return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES, times,
-                        x, p, z, **options)
-    explicit = dop853 if solver == EXPLICIT else rk45
-    return explicit(mod.rhs, times, x, p, z, scipy_arithmetic=False, **options)
+    try:
+        if solver in (RACE_IMPLICIT, "bdf"):
+            implicit = radau if solver == RACE_IMPLICIT else bdf
+            return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
+                            times, x, p, z, **options)
+        explicit = dop853 if solver == EXPLICIT else rk45
+        return explicit(mod.rhs, times, x, p, z, scipy_arithmetic=False, **options)
+    except np.linalg.LinAlgError as err:  # numba's solve of a singular linear system
+        raise Stop(SimulationError(
+            f"a linear system of the model is singular ({err}) in the stretch from time "
+            f"{float(times[0]):g}", hint="the model may have reached a singular "
+            "configuration; check the parameters (--set) and start values")) from None
 
 
 def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step: float

@@ -23,7 +23,7 @@ from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import OutputError, UnknownNameError, UsageError
+from ..errors import OutputError, UnknownNameError, UsageError, printable
 from ..fileio import OutputSet, PathLike, atomic_write
 from .plot_layout import choose_layout
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
@@ -85,7 +85,7 @@ class SimulationStats:
         elif self.engine_reason:  # the default engine fell back to scipy's loop
             solver = f"{solver} ({self.engine_reason})"
         inside = f"compiled loop {self.loop_time:.3f} s, " if self.loop_time else ""
-        return (f"{model}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
+        return (f"{printable(model)}: {solver}, {self.steps} steps, {self.rhs_evaluations} RHS "
                 f"and {self.jacobian_evaluations} Jacobian evaluations, "
                 f"{self.wall_time:.3f} s ({inside}model code {self.model_time:.3f} s; "
                 f"{'cached' if self.cached else 'compiled'} in {self.compile_time:.3f} s)"

@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import SimulationError, UsageError
+from ..errors import SimulationError, UsageError, printable
 from ..pipeline import CompiledModel, check_parameter_names
 from ..simulation import SimulationOptions, output_grid, resolve
 from .engines import (
@@ -70,7 +70,7 @@ class Study:
     def summary_line(self) -> str:
         """One line: runs, failures, engine, time, files written."""
         runs = len(self.values)
-        text = (f"{self.model}: {runs} runs ({runs - self.failed} ok, {self.failed} "
+        text = (f"{printable(self.model)}: {runs} runs ({runs - self.failed} ok, {self.failed} "
                 f"failed), {len(self.computed)} simulated on {self.engine} in "
                 f"{duration(self.wall_time)}")
         return text + (f"; wrote {' and '.join(self.files)}" if self.files else "")

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import IO
 
-from ..errors import Note
+from ..errors import Note, printable
 from ..fileio import atomic_write
 from .model import (
     BUDGET_SKIP,
@@ -138,8 +138,8 @@ def format_table(tradeoff: Tradeoff, markdown: bool = False) -> str:
 def summary(tradeoff: Tradeoff) -> str:
     """Reference line, table, then one recommendation per target."""
     ref = tradeoff.reference
-    lines = [f"{tradeoff.model}: {tradeoff.states} states, {len(ref.time)} output times, "
-             f"{len(ref.names)} variables compared",
+    lines = [f"{printable(tradeoff.model)}: {tradeoff.states} states, {len(ref.time)} "
+             f"output times, {len(ref.names)} variables compared",
              f"reference: {ref.description}", "", format_table(tradeoff).rstrip(), ""]
     for note in (*skipped_notes(tradeoff), unresolved_note(tradeoff)):
         if note is not None:
