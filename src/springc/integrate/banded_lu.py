@@ -9,7 +9,8 @@ factorisation and ``n (2 kl + ku)`` per solve, so a chain's Newton matrix (bandw
 2-3 after a reverse Cuthill-McKee ordering) factorises in linear time; a small dense
 system is the band ``kl = ku = n - 1``.
 
-:func:`band_layout` (Python, scipy) chooses the ordering and the bandwidths from a
+:func:`band_layout` (Python, scipy, in :mod:`.ordering`: no numba, so that springc can
+price a factorization without it) chooses the ordering and the bandwidths from a
 Jacobian's CSC sparsity, and where each non-zero lands in ``B``.
 """
 
@@ -17,6 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from .ordering import band_layout
+
+__all__ = ["band_factor", "band_layout", "band_solve"]
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -70,40 +75,3 @@ def band_solve(B: np.ndarray, kl: int, ku: int, pivots: np.ndarray, b: np.ndarra
         for j in range(k + 1, min(n - 1, k + width) + 1):
             s -= B[k, j - k + kl] * b[j]
         b[k] = s / B[k, kl]
-
-
-def band_layout(n: int, indptr: np.ndarray, indices: np.ndarray, dense_limit: int = 64
-                ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:
-    """The ordering and band of ``c I - J`` for a Jacobian with CSC sparsity
-    ``(indptr, indices)``: ``order`` (new index -> state), ``kl``, ``ku``, the flat
-    position in ``B`` of each non-zero (CSC order) and of each diagonal entry.
-
-    Up to ``dense_limit`` states the band is the whole matrix (a dense LU); above, the
-    states are reordered by reverse Cuthill-McKee on the symmetrised pattern, which
-    brings a chain's band down to a few entries.
-    """
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
-
-    indptr = np.asarray(indptr, dtype=np.int64)
-    rows = np.asarray(indices, dtype=np.int64)
-    cols = np.repeat(np.arange(n, dtype=np.int64), np.diff(indptr))
-    if n <= dense_limit:
-        order = np.arange(n, dtype=np.int64)
-    else:
-        pattern = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
-        pattern = (pattern + pattern.T + sp.identity(n, format="csr")).tocsr()
-        order = np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True),
-                           dtype=np.int64)
-    where = np.empty(n, dtype=np.int64)
-    where[order] = np.arange(n, dtype=np.int64)
-    i, j = where[rows], where[cols]
-    if n <= dense_limit:
-        kl = ku = max(n - 1, 0)
-    else:
-        kl = int(max(0, (i - j).max(initial=0)))
-        ku = int(max(0, (j - i).max(initial=0)))
-    width = 2 * kl + ku + 1
-    positions = i * width + (j - i + kl)
-    diagonal = np.arange(n, dtype=np.int64) * width + kl
-    return order, kl, ku, positions, diagonal

@@ -225,10 +225,10 @@ def newton_solve_flops(indptr: Any, indices: Any, dense_limit: int = 64) -> floa
 @functools.lru_cache(maxsize=16)
 def _band_layout(n: int, indptr: bytes, indices: bytes, dense_limit: int
                  ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:
-    """:func:`.banded_lu.band_layout` of a sparsity, once per process (a model's runs,
+    """:func:`.ordering.band_layout` of a sparsity, once per process (a model's runs,
     and ``auto``'s race, call the implicit kernels again and again on one sparsity;
     the reordering of a large scene takes milliseconds). The kernels only read it."""
-    from .banded_lu import band_layout
+    from .ordering import band_layout
 
     return band_layout(n, np.frombuffer(indptr, dtype=np.int64),
                        np.frombuffer(indices, dtype=np.int64), dense_limit)
