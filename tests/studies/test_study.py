@@ -74,7 +74,7 @@ def test_parquet_files_have_the_documented_columns(study: tuple[Study, Path]) ->
     assert table["error"].isna().all()
     summary = pd.read_parquet(output.with_name("study.summary.parquet"))
     metrics = [f"{n}.{m}" for n in OUTPUTS for m in ("final", "min", "max")]
-    assert summary.columns.tolist() == ["run", "spring.k", *COLUMNS[-7:], *metrics]
+    assert summary.columns.tolist() == ["run", "spring.k", *COLUMNS[-10:], *metrics]
     pos = table["mass.pos[1]"].to_numpy().reshape(6, 501)
     assert np.array_equal(summary["mass.pos[1].final"], pos[:, -1])
     assert np.array_equal(summary["mass.pos[1].max"], pos.max(axis=1))
