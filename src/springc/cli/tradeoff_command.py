@@ -119,7 +119,9 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     a tight dop853 solve checked by a second method (VODE Adams). By default the states
     are compared; --vars selects other variables. dop853 runs first, then each other
     solver's runs are one task of the studies executor (local processes, or Dask with
-    --scheduler), its tighter settings skipped past --cost-limit.
+    --scheduler), its tighter settings skipped past --cost-limit. Every run is at the
+    setting its row names: no --error-control (simulate's companion runs and
+    tightening): the table measures each run's error itself.
     """
     from ..simulation import PLOT_FORMATS, check_run_values
 

@@ -125,8 +125,11 @@ def compare(run: Run, companion: Run, grid: np.ndarray,
     a, b = paired_events(run, companion)
     for low, high in zip(np.minimum(a, b) - abs(a - b), np.maximum(a, b) + abs(a - b)):
         keep &= ~((grid >= low) & (grid <= high))
-    columns = [companion.names.index(n) for n in run.names]
-    error = (run.values[ours[keep]] - companion.values[theirs[keep]][:, columns]) * gain
+    theirs_values = companion.values[theirs[keep]]
+    if companion.names != run.names:  # the same selection: the same columns, in order
+        where = {name: j for j, name in enumerate(companion.names)}
+        theirs_values = theirs_values[:, [where[n] for n in run.names]]
+    error = (run.values[ours[keep]] - theirs_values) * gain
     scales = np.abs(run.values).max(axis=0) if len(run.values) else np.zeros(len(run.names))
     estimate = measured(run.names, grid[keep], scales, error, method, began)
     if not len(a):
