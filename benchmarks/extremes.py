@@ -164,7 +164,7 @@ def _rows(case: str, model: springc.CompiledModel, solvers: list[str], error: Er
             best, label, setting = found
             winner = {"solver": solver, **setting}
     if winner:
-        plain = {"error_estimate": "off", **kwargs}
+        plain = {"error_control": "off", **kwargs}
         auto_time, best = _interleaved(model, [{"solver": "auto", **plain},
                                                {**plain, **winner}])
     index = [s for s, *_ in runs].index("auto")
