@@ -60,6 +60,6 @@ from .ensemble import Ensemble, ensemble
 from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "ensemble", "fixed_step", "load", "newton_flops",
+__all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
+           "bdf", "dop853", "ensemble", "fixed_step", "load", "newton_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]

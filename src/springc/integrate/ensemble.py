@@ -96,7 +96,8 @@ def ensemble(rhs: ModelFunction, grid: Any, X0: Any, P: Any, Z: Any, *, rtol: fl
     counts = np.empty((runs, 4), dtype=np.int64)
     failure_time = np.empty(runs)
     if runs:
-        ensemble_run(rhs, observed if n_observed else no_observed, n_observed, no_observed,
+        ensemble_run(rhs, observed if observed is not None and n_observed else no_observed,
+                     n_observed, no_observed,
                      grid_, X0_, P_, Z_, float(rtol), atol_, float(max_step),
                      int(max_steps), columns_, finals, summary, status, counts, failure_time)
     return Ensemble(finals, summary, status, counts[:, 0] + counts[:, 1], counts[:, 2],

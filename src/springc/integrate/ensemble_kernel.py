@@ -19,10 +19,10 @@ editing ``dop853_kernel`` or ``status``.
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, types
 
 from .dop853_kernel import dop853_run
-from .signatures import ModelFunction
+from .signatures import INDICES, MATRIX, MODEL_FUNCTION, VECTOR, ModelFunction
 from .status import Status
 
 SUCCESS = int(Status.SUCCESS)
@@ -54,7 +54,10 @@ def summarise(grid: np.ndarray, states: np.ndarray, obs: np.ndarray, columns: np
         out[c, 4] = t_high
 
 
-@njit(cache=True, error_model="numpy", nogil=True, parallel=True)
+@njit(types.void(MODEL_FUNCTION, MODEL_FUNCTION, types.int64, MODEL_FUNCTION, VECTOR, MATRIX,
+                 MATRIX, MATRIX, types.float64, VECTOR, types.float64, types.int64, INDICES,
+                 MATRIX, types.float64[:, :, ::1], INDICES, types.int64[:, ::1], VECTOR),
+      cache=True, error_model="numpy", nogil=True, parallel=True)
 def ensemble_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
                  no_crossing: ModelFunction, grid: np.ndarray, X0: np.ndarray,
                  P: np.ndarray, Z: np.ndarray, rtol: float, atol: np.ndarray,
