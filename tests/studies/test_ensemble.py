@@ -130,3 +130,16 @@ def test_a_table_of_runs_from_csv(model: CompiledModel, tmp_path: Path) -> None:
         read_table(csv)
     assert str(bad.value) == (f"error: --table {csv}: run 1, spring.k: 'stiff' is not a "
                               "finite number")
+
+
+def test_a_model_with_events_is_refused_by_name(tmp_path: Path) -> None:
+    ball = springc.load_model_from_string(
+        "model Ball\n  Real h(start = 1);\n  Real v;\nequation\n  der(h) = v;\n"
+        "  der(v) = -9.81;\n  when h < 0 then\n    reinit(v, -0.8 * pre(v));\n"
+        "  end when;\nend Ball;\n")
+    with pytest.raises(SimulationError) as refused:
+        run_ensemble(ball, EnsembleOptions((parse_parameter("h=1,2"),)),
+                     str(tmp_path / "e.parquet"))
+    assert refused.value.message == ("Ball has events (when, if on a state, sample...), "
+                                     "which the ensemble engine does not run yet")
+    assert not (tmp_path / "e.parquet").exists()

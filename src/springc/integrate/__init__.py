@@ -35,7 +35,7 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
 - ``ensemble(rhs, grid, X0, P, Z, rtol=..., atol=..., columns=...)``: many runs (a row
   of ``P`` each) with compiled DOP853 in parallel over the rows (``numba.prange``), each
   with its own steps and status; the final states and per-run statistics (final, min,
-  max, time-weighted mean, time of the max) of chosen columns (:mod:`.ensemble_kernel`).
+  max, time-weighted mean, time of the max) of chosen columns (:mod:`.batch`).
 - Failures never raise inside the loop: :class:`Status` says what happened
   (step too small, NaN/inf derivative or state, max steps, the model's failure flag
   ``z[-1]``) and the run carries the time and the state where it happened.
@@ -43,6 +43,7 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
 """
 
+from .batch import Ensemble, ensemble
 from .engine import (
     FIXED_STEP_METHODS,
     Crossings,
@@ -56,7 +57,6 @@ from .engine import (
     radau,
     rk45,
 )
-from .ensemble import Ensemble, ensemble
 from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
