@@ -143,3 +143,17 @@ def test_a_model_with_events_is_refused_by_name(tmp_path: Path) -> None:
     assert refused.value.message == ("Ball has events (when, if on a state, sample...), "
                                      "which the ensemble engine does not run yet")
     assert not (tmp_path / "e.parquet").exists()
+
+
+def test_a_variable_that_is_not_finite_fails_its_run(tmp_path: Path) -> None:
+    text = ("model Decay\n  parameter Real a = 2;\n  Real x(start = 1);\n  Real y;\n"
+            "equation\n  der(x) = -x;\n  y = sqrt(a - x);\nend Decay;\n")
+    decay = springc.load_model_from_string(text)
+    run_ensemble(decay, EnsembleOptions((parse_parameter("a=2,0.5"),), stop=1.0),
+                 str(tmp_path / "e.parquet"))
+    table = pq.read_table(tmp_path / "e.parquet").to_pydict()
+    with pytest.raises(SimulationError) as single:
+        springc.simulate(decay, stop=1.0, solver="dop853", parameters={"a": 0.5})
+    assert table["status"] == ["ok", "failed"]
+    assert table["error"] == [None, str(single.value)]
+    np.testing.assert_allclose(table["y.final"][0], np.sqrt(2 - np.exp(-1.0)), rtol=1e-6)

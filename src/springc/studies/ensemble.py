@@ -58,6 +58,7 @@ STATISTICS = {"final": "final", "min": "min", "max": "max", "mean": "mean",
 """The kernel's statistic -> its column suffix."""
 DEFAULT_CHUNK = 10_000
 FAILED_PREPARATION = -1  # a run whose parameters or start values could not be computed
+NON_FINITE_OUTPUT = 3  # Status.NON_FINITE_STATE: a chosen variable NaN or inf on the grid
 
 
 @dataclass(frozen=True)
@@ -173,6 +174,7 @@ def settings_of(model: CompiledModel, options: EnsembleOptions
 
 WORDS = {1: "Required step size is less than spacing between numbers.",
          2: "the derivatives are not finite",
+         3: "a variable is not finite",
          4: "the run reached the step limit (--max-steps {limit})",
          5: "a nonlinear system did not converge"}
 """The words of a failure's kind (:class:`springc.integrate.Status`), when the run is
@@ -291,6 +293,8 @@ def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
                               observed=model.module.observed, columns=columns,
                               max_steps=max_steps)
             status = result.status.copy()
+            finite = np.isfinite(result.summary).all(axis=(1, 2))
+            status[(status == 0) & ~finite] = NON_FINITE_OUTPUT
             status[list(prepared)] = FAILED_PREPARATION
             result = _with_status(result, status)
             errors = messages(model, options, names, chunk, result, prepared, max_steps)
