@@ -1,7 +1,8 @@
 """Command-line interface: click options -> checked values and frozen options objects ->
 library calls -> text on stdout. One module per command group: ``app`` (the group,
 errors to exit codes), ``options`` (shared options and checks), ``model_commands``
-(check, flatten, compile), ``simulate_command``, ``tradeoff_command``, ``sweep_command``.
+(check, flatten, compile), ``simulate_command``, ``tradeoff_command``, ``sweep_command``,
+``ensemble_command``.
 
 Exit codes: 0 success, 1 model errors (diagnostics on stderr), 2 usage errors (a bad
 option value, an output file springc refuses to write), 3 internal errors (traceback
@@ -11,9 +12,10 @@ are removed in every case (:mod:`springc.fileio`).
 """
 
 from .app import main
+from .ensemble_command import ensemble
 from .model_commands import check, compile_, flatten
 from .simulate_command import simulate
 from .sweep_command import sweep
 from .tradeoff_command import tradeoff
 
-__all__ = ["check", "compile_", "flatten", "main", "simulate", "sweep", "tradeoff"]
+__all__ = ["check", "compile_", "ensemble", "flatten", "main", "simulate", "sweep", "tradeoff"]

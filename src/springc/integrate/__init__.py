@@ -32,6 +32,10 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   :func:`run_hybrid` is that loop with a Python ``update(t, x_left, fired)``.
 - ``observed_grid(observed, ts, states, p, z)``: the observed variables at states on a
   grid (a run's states after the fact), compiled once per machine like the loops.
+- ``ensemble(rhs, grid, X0, P, Z, rtol=..., atol=..., columns=...)``: many runs (a row
+  of ``P`` each) with compiled DOP853 in parallel over the rows (``numba.prange``), each
+  with its own steps and status; the final states and per-run statistics (final, min,
+  max, time-weighted mean, time of the max) of chosen columns (:mod:`.batch`).
 - Failures never raise inside the loop: :class:`Status` says what happened
   (step too small, NaN/inf derivative or state, max steps, the model's failure flag
   ``z[-1]``) and the run carries the time and the state where it happened.
@@ -39,6 +43,7 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
 """
 
+from .batch import Ensemble, ensemble
 from .engine import (
     FIXED_STEP_METHODS,
     Crossings,
@@ -56,6 +61,6 @@ from .engine import (
 from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "load", "newton_flops", "newton_solve_flops",
+__all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
+           "bdf", "dop853", "ensemble", "fixed_step", "load", "newton_flops", "newton_solve_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]
