@@ -257,7 +257,7 @@ def _equation_dict(eq: Equation) -> dict[str, object]:
 
 
 def to_json_dict(model: FlatModel) -> dict[str, object]:
-    """The machine-readable form of ``springc flatten --json`` (README, "JSON output")."""
+    """The machine-readable form of ``springc flatten --json`` (docs/commands.md, "JSON output")."""
     def attrs(a: Attributes) -> dict[str, object]:
         out: dict[str, object] = {}
         for key in ("start", "nominal", "min", "max"):
