@@ -68,7 +68,7 @@ def test_a_broken_invariant_is_an_internal_error() -> None:
 
 def test_cli_reports_a_codegen_bug_with_exit_code_3(monkeypatch: pytest.MonkeyPatch,
                                                     tmp_path: Path) -> None:
-    import springc.pipeline.compiler as compiler
+    import springc.pipeline.generation as compiler
 
     def broken(*args: object, **kwargs: object) -> object:
         raise CodegenBug("nothing computes der(x)")

@@ -249,7 +249,7 @@ def test_changing_vars_reuses_the_cached_module(tmp_path: Path,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     """--vars that select other states, or the same observed variables, load the module
     already cached, without flattening; a new observed variable generates one."""
-    import springc.pipeline.compiler as compiler
+    import springc.pipeline.generation as compiler
 
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
     first = springc.compile_model(SEED, outputs=["mass.pos[1]"])

@@ -17,6 +17,10 @@ import numpy.typing as npt
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
+CODEGEN_VERSION = 4
+"""The version of the generated code's layout: part of every cache key (here, not with
+the module text, so that the cache reads it without loading the generator)."""
+
 
 class GeneratedModule(Protocol):
     """A generated module: constants over the state vector ``x``, the parameter vector

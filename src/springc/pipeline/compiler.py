@@ -1,37 +1,28 @@
-"""Source files -> CompiledModel: flatten, simplify, generate, cache on disk, import.
+"""CompileOptions -> CompiledModel: the cache lookup, and the compiled model itself.
 
 Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
 could be loaded, the model name, the options and springc's own code; verified by a
 recorded hash before import). A warm hit imports the module without flattening
-anything. Structural parameters (Integer or Boolean ones, and those the flattener
-evaluated, such as array sizes) are set by re-flattening the selected class with a
-modification (``extends M(N = 100)``), in the same class tree as the user's files.
+anything, and without importing the compile path (:mod:`.generation`: the parser,
+the flattener, simplify and codegen's generator), which loads only on a miss.
 """
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
 import difflib
-import gc
 import shutil
 import tempfile
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..codegen import CodegenOptions, GeneratedModule, generate
+from ..codegen import GeneratedModule
 from ..errors import CodegenError, SimulationError
-from ..flatten import flatten, select_model
-from ..ir import flat, ode, syntax
 from ..ir.expr import recursion_room
-from ..parse import ClassEntry, ClassTree, load, parse_text
-from ..simplify import simplify
 from .cache import (
     CacheUnusable,
-    Names,
     cache_dir,
     cache_key,
     discard,
@@ -47,26 +38,14 @@ from .cache import (
     write_names,
 )
 from .equations import Equations
+from .options import CompileOptions
 from .selection import ALL_OBSERVED, select_names, selected_observed
 
+if TYPE_CHECKING:
+    from .generation import Derived
 
-@dataclass(frozen=True)
-class CompileOptions:
-    """What to compile: files, model, libraries, backend, outputs, structural values.
-
-    ``outputs`` are ``--vars`` patterns (``*`` and ``?`` wildcards, otherwise exact
-    flat names); ``None`` selects every state and observed variable.
-    ``modifications`` are structural parameter values as Modelica text.
-    """
-
-    files: tuple[str, ...]
-    model: str | None = None
-    libraries: tuple[str, ...] = ()
-    backend: str = "python"
-    outputs: tuple[str, ...] | None = None
-    modifications: tuple[tuple[str, str], ...] = ()
-    cache: bool = True
-    texts: tuple[tuple[str, str], ...] = ()  # models given as text: (pseudo file, text)
+__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
+           "modification_value"]
 
 
 @dataclass
@@ -130,7 +109,9 @@ class CompiledModel:
     def derive(self) -> Derived:
         """The flat model and simplified system of this model (derived once)."""
         if self.derived is None:
-            self.derived = derive_system(self.options)
+            from . import generation  # the compile path (not loaded for a cached model)
+
+            self.derived = generation.derive_system(self.options)
         return self.derived
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
@@ -178,8 +159,10 @@ def compile_files(options: CompileOptions) -> CompiledModel:
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
-            derived = derive_system(options)
-            names = candidate_names(derived)
+            from . import generation  # the compile path, loaded on a miss only
+
+            derived = generation.derive_system(options)
+            names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
     key = selection_key(model_key, observed)
@@ -198,10 +181,12 @@ def compile_files(options: CompileOptions) -> CompiledModel:
                 return CompiledModel(module, options, path, True,
                                      time.perf_counter() - began, outputs_of(module, options),
                                      text=data.decode("utf-8"))
+    from . import generation  # the compile path, loaded on a miss only
+
     if derived is None:
-        derived = derive_system(options)
-        write_names(folder, model_key, candidate_names(derived))
-    generated = generate_from(derived, options)
+        derived = generation.derive_system(options)
+        write_names(folder, model_key, generation.candidate_names(derived))
+    generated = generation.generate_from(derived, options)
     temporary = None
     if folder is not None:
         try:
@@ -225,12 +210,6 @@ def compile_files(options: CompileOptions) -> CompiledModel:
                          outputs_of(module, options), temporary, generated)
 
 
-def candidate_names(derived: Derived) -> Names:
-    """The states and the observed variables of a derived model."""
-    system = derived.system
-    return tuple(s.name for s in system.states), tuple(system.observed_names())
-
-
 def too_deep_for_python(err: BaseException) -> BaseException:
     """The error for a generated module that Python's compiler refuses: a located
     :class:`CodegenError` when it nests too deeply (more than about 200 parentheses or
@@ -248,99 +227,6 @@ def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, .
     """The names ``options.outputs`` selects among the module's states and observed."""
     return tuple(select_names(tuple(module.STATES) + tuple(module.OBSERVED),
                               options.outputs))
-
-
-@dataclass(frozen=True)
-class Derived:
-    """The simplified system of a model, its flat model, and whether index reduction
-    left a choice of states that may turn singular during a run (``switchable``)."""
-
-    system: ode.ODE
-    flat_model: flat.FlatModel
-    switchable: bool
-
-
-WRAPPER_FILE = "<springc: structural parameters>"
-"""The file name of the class that applies ``--set`` values of structural parameters."""
-
-
-@contextlib.contextmanager
-def fewer_collections() -> Iterator[None]:
-    """Python's cyclic garbage collector run less often, restored on exit: compiling a
-    model makes millions of objects that live to its end, which the collector walked
-    every 700 allocations (a third of compile_model's CPU time on the 1,000-mass chain:
-    1.44 s instead of 2.07 s; compiling makes few cycles)."""
-    threshold = gc.get_threshold()
-    gc.set_threshold(100_000, 50, 100)
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-
-
-@fewer_collections()
-def derive_system(options: CompileOptions) -> Derived:
-    """Flatten and simplify the model of ``options`` (structural values applied)."""
-    tree = load(list(options.files), options.libraries, options.texts)
-    model = options.model
-    base = None
-    if options.modifications:
-        entry = select_model(tree, model)
-        base = flatten(tree, model)
-        model = _add_wrapper(tree, entry, options.modifications)
-    flat_model = flatten(tree, model)
-    simplified = simplify(flat_model)
-    system = simplified.ode
-    switchable = any(len(b.candidates) > len(b.dummies) for b in simplified.blocks)
-    if base is not None:
-        # Keep the simulated model's name, location and experiment (annotations are
-        # not inherited).
-        system = dataclasses.replace(
-            system, name=base.name,
-            dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
-    return Derived(system, flat_model, switchable)
-
-
-def _add_wrapper(tree: ClassTree, entry: ClassEntry,
-                 modifications: Sequence[tuple[str, str]]) -> str:
-    """Add to ``tree`` a model extending the class ``entry`` with ``modifications``;
-    its name. The base is named by its path from the root, each part quoted, so the
-    class of the user's file is used even where a library class has the same dotted
-    name (a flattened file's ``model 'Scenes.Chain'``)."""
-    path = []
-    scope: ClassEntry | None = entry
-    while scope is not None and scope.parent is not None:
-        path.append(flat.quote(scope.name))
-        scope = scope.parent
-    declared = {e.name for e in entry.defn.elements if isinstance(e, syntax.Component)}
-    targets = {name: flat.quote(name) if name in declared
-               else ".".join(map(flat.quote, name.split("."))) for name, _ in modifications}
-    mods = ", ".join(f"{targets[name]} = {value}" for name, value in modifications)
-    wrapper = "SpringcModified"
-    while wrapper in tree.root.classes:
-        wrapper += "_"
-    text = (f"model {wrapper}\n  extends {'.'.join(reversed(path))}({mods});\n"
-            f"end {wrapper};\n")
-    errors = tree.add(parse_text(text, WRAPPER_FILE), override=True)
-    if errors:
-        raise errors[0]
-    return wrapper
-
-
-def generate_source(options: CompileOptions) -> str:
-    """Flatten, simplify and generate the module text for ``options``."""
-    return generate_from(derive_system(options), options)
-
-
-@fewer_collections()
-def generate_from(derived: Derived, options: CompileOptions) -> str:
-    """The module text of a derived model with the outputs ``options`` selects."""
-    system, flat_model = derived.system, derived.flat_model
-    candidates = [s.name for s in system.states] + system.observed_names()
-    selected = set(select_names(candidates, options.outputs))
-    observed = tuple(n for n in system.observed_names() if n in selected)
-    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable)
-    return generate(system, flat_model, codegen).source
 
 
 def modification_value(model: CompiledModel, name: str, value: float) -> str:

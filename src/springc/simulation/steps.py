@@ -24,10 +24,9 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import Note, SimulationError
+from ..errors import Note, SimulationError, describe_failure
 from ..ir.dae import derivative_name
 from ..pipeline import CompiledModel
-from ..simplify import describe_failure
 from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps

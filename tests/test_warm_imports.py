@@ -1,0 +1,64 @@
+"""A warm run imports only what it uses (docs/architecture.md, "Dependency rules").
+
+``springc simulate`` of a model already in the cache loads the module and runs it: the
+compile path (the parser and lark, the flattener, simplify, codegen's generator) and
+the libraries a small run never needs (scipy.sparse, sympy, matplotlib) stay unloaded.
+The test asserts which modules a fresh process holds after such a run, not a time.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import springc
+
+ROOT = Path(__file__).resolve().parents[1]
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+
+FORBIDDEN = ("lark", "springc.flatten", "springc.simplify", "springc.codegen.generator",
+             "springc.pipeline.generation", "scipy.sparse", "sympy", "matplotlib")
+"""Packages (with their submodules) that a warm simulate of the seed must not import."""
+
+PARSE_ALLOWED = {"springc.parse", "springc.parse.library"}
+"""Of ``springc.parse``, the face and the library file walk (the cache key reads the
+library folders' files) load; the parser does not."""
+
+WARM_RUN = """
+import sys
+from springc.cli import main
+main(["simulate", sys.argv[1], "-o", sys.argv[2], "-q"], standalone_mode=False)
+print("\\n".join(sorted(sys.modules)))
+"""
+
+
+def _loaded(name: str, modules: set[str]) -> list[str]:
+    return sorted(m for m in modules if m == name or m.startswith(name + "."))
+
+
+def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
+    first = springc.compile_model(SEED)  # fills the cache as the CLI's run would
+    assert not first.cached
+    out = tmp_path / "seed.csv"
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache),
+           "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    run = subprocess.run([sys.executable, "-c", WARM_RUN, SEED, str(out)], env=env,
+                         capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stderr
+    modules = set(run.stdout.split())
+    assert "springc.pipeline.compiler" in modules  # the run went through the pipeline
+    assert {name: _loaded(name, modules) for name in FORBIDDEN} == \
+        {name: [] for name in FORBIDDEN}
+    assert set(_loaded("springc.parse", modules)) == PARSE_ALLOWED
+    with out.open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][:5] == ["time", "mass.pos[1]", "mass.pos[2]", "mass.v[1]", "mass.v[2]"]
+    assert [float(v) for v in rows[1][:5]] == [0.0, 1.0, -1.0, 0.0, 0.0]  # the start values
