@@ -7,6 +7,7 @@ import sys
 import click
 
 from ..simulation import ALL_SOLVERS, DEFAULT_ENGINE, DEFAULT_SOLVER, ENGINES, FIXED_STEP
+from ..status_line import silenced
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -60,7 +61,9 @@ from .options import (
               help="Write a plot: .png, .svg or .pdf.")
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar, no summary line and "
+              "no status lines (\"springc: compiling ...\" before a step that compiles, "
+              "once).")
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -96,26 +99,27 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         write_csv,
     )
 
-    compiled = compile_model(files, model, libraries=libraries,
-                             backend=default_choice(backend, engine, solver),
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
-    if not patterns and (output or not plot):  # the default trajectory of every output
-        check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
-                              f"-o {output}" if output else "the CSV on stdout")
-    progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-    result = run(compiled, start=start, stop=stop, interval=interval,
-                 solver=solver.lower(), rtol=rtol, atol=atol,
-                 parameters={k: v for k, v in values.items() if k not in compiled.structural},
-                 progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
-                 engine=engine.lower(), error_estimate=error_estimate.lower(),
-                 event_rows=event_rows)
-    if output or plot:
-        note = save_outputs(result, output, plot, files)
-        if note and not quiet:
-            click.echo(f"note: plot {plot}: {note}", err=True)
-    else:
-        write_csv(result, sys.stdout)
-        sys.stdout.flush()
-    if not quiet:
-        click.echo(result.stats.summary(result.model), err=True)
+    with silenced(quiet):  # the status lines of long steps (compiling)
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend, engine, solver),
+                                 outputs=patterns or None, parameters=values,
+                                 cache=not no_cache)
+        if not patterns and (output or not plot):  # the default trajectory of every output
+            check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
+                                  f"-o {output}" if output else "the CSV on stdout")
+        progress = None if quiet or not sys.stderr.isatty() else sys.stderr
+        result = run(compiled, start=start, stop=stop, interval=interval,
+                     solver=solver.lower(), rtol=rtol, atol=atol,
+                     parameters={k: v for k, v in values.items() if k not in compiled.structural},
+                     progress=progress, step=step, max_steps=max_steps, time_limit=time_limit,
+                     engine=engine.lower(), error_estimate=error_estimate.lower(),
+                     event_rows=event_rows)
+        if output or plot:
+            note = save_outputs(result, output, plot, files)
+            if note and not quiet:
+                click.echo(f"note: plot {plot}: {note}", err=True)
+        else:
+            write_csv(result, sys.stdout)
+            sys.stdout.flush()
+        if not quiet:
+            click.echo(result.stats.summary(result.model), err=True)

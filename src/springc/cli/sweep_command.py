@@ -8,6 +8,7 @@ import click
 
 from ..errors import UsageError
 from ..simulation import ALL_SOLVERS, DEFAULT_SOLVER, FIXED_STEP
+from ..status_line import silenced
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -63,7 +64,8 @@ from .options import (
               "(median, percentile bands).")
 @click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
               "study's first variable).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress and no summary line.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress, no summary line and no "
+              "status line (\"springc: compiling ...\").")
 @guard
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -109,10 +111,11 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
                            max_steps, time_limit)
     parameter_table(options)  # refuse bad specifications before compiling
 
-    compiled = compile_model(files, model, libraries=libraries,
-                             backend=default_choice(backend, solver=solver),
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
+    with silenced(quiet):  # the status line of a model that compiles
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend, solver=solver),
+                                 outputs=patterns or None, parameters=values,
+                                 cache=not no_cache)
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
     from dataclasses import replace
 
