@@ -15,7 +15,7 @@ from click.testing import CliRunner
 
 import springc.integrate
 from springc.cli import main
-from springc.pipeline.compiler import functions_cached
+from springc.pipeline.notes import announce_functions, functions_cached
 from springc.simulation.compiled import load_kernel
 from springc.status_line import silenced
 
@@ -88,3 +88,17 @@ def test_numba_functions_are_cached_where_their_index_is(tmp_path: Path,
     assert functions_cached(types.SimpleNamespace(BACKEND="python"), path)  # type: ignore[arg-type]
     (path.parent / "__pycache__" / "model.rhs-129.py311.nbi").write_bytes(b"")
     assert functions_cached(numba_module, path)  # type: ignore[arg-type]
+
+
+def test_a_cached_module_whose_functions_numba_has_not_cached_says_so(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    path = tmp_path / "entry" / "model.py"
+    (path.parent / "__pycache__").mkdir(parents=True)
+    module = types.SimpleNamespace(BACKEND="numba", MODEL="Decay")
+    announce_functions(module, path, cached=False)  # type: ignore[arg-type]
+    assert capsys.readouterr().err == ""  # compiled just now: announced as a model
+    announce_functions(module, path, cached=True)  # type: ignore[arg-type]
+    assert capsys.readouterr().err == ("springc: compiling the functions of Decay for this "
+                                       "machine (once)\n")

@@ -17,13 +17,15 @@ from .compiler import (
     compile_files,
     modification_value,
 )
+from .notes import announce_functions
 from .selection import select_names
 
 if TYPE_CHECKING:
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
-__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
+__all__ = ["CompileOptions", "CompiledModel", "announce_functions", "check_parameter_names",
+           "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",
            "select_names"]
 
