@@ -48,8 +48,8 @@ def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
     first = springc.compile_model(SEED)  # fills the cache as the CLI's run would
     assert not first.cached
     out = tmp_path / "seed.csv"
-    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache),
-           "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), os.environ.get("PYTHONPATH", "")])}
+    paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}
     run = subprocess.run([sys.executable, "-c", WARM_RUN, SEED, str(out)], env=env,
                          capture_output=True, text=True, timeout=600, check=False)
     assert run.returncode == 0, run.stderr
