@@ -46,6 +46,7 @@ from .engine import (
     bdf,
     dop853,
     fixed_step,
+    kernel_cached,
     load,
     newton_flops,
     newton_solve_flops,
@@ -57,5 +58,5 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "HybridRun", "Run", "Status", "bdf", "dop853",
-           "fixed_step", "load", "newton_flops", "newton_solve_flops",
+           "fixed_step", "kernel_cached", "load", "newton_flops", "newton_solve_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]
