@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
+
+# springc's status lines ("springc: compiling ...", springc.status_line) stay off in the
+# suite (subprocesses inherit it), so that outputs compared exactly do not depend on
+# which test compiled a model or a kernel first; tests/test_status_lines.py turns them on.
+os.environ["SPRINGC_QUIET"] = "1"
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

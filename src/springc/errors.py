@@ -130,6 +130,16 @@ class ErrorGroup(Exception):
         return render_all(self)
 
 
+def describe_failure(err: BaseException) -> str:
+    """An arithmetic failure in words: ``division by zero``, ``overflow`` or the error's
+    own text (the reference evaluator and the simulator word them alike)."""
+    if isinstance(err, ZeroDivisionError):
+        return "division by zero"
+    if isinstance(err, OverflowError):
+        return "overflow"
+    return str(err) or type(err).__name__
+
+
 def errors_of(exc: SpringcError | ErrorGroup) -> tuple[SpringcError, ...]:
     """The individual errors carried by ``exc``."""
     return exc.errors if isinstance(exc, ErrorGroup) else (exc,)

@@ -68,12 +68,12 @@ def test_a_broken_invariant_is_an_internal_error() -> None:
 
 def test_cli_reports_a_codegen_bug_with_exit_code_3(monkeypatch: pytest.MonkeyPatch,
                                                     tmp_path: Path) -> None:
-    import springc.pipeline.compiler as compiler
+    import springc.pipeline.generation as generation
 
     def broken(*args: object, **kwargs: object) -> object:
         raise CodegenBug("nothing computes der(x)")
 
-    monkeypatch.setattr(compiler, "generate", broken)
+    monkeypatch.setattr(generation, "generate", broken)
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
     run = CliRunner().invoke(main, ["compile", SCENES, "--model", "Scenes.Oscillator"])
     assert run.exit_code == 3

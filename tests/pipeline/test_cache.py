@@ -297,17 +297,17 @@ def test_changing_vars_reuses_the_cached_module(tmp_path: Path,
                                                 monkeypatch: pytest.MonkeyPatch) -> None:
     """--vars that select other states, or the same observed variables, load the module
     already cached, without flattening; a new observed variable generates one."""
-    import springc.pipeline.compiler as compiler
+    import springc.pipeline.generation as generation
 
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
     first = springc.compile_model(SEED, outputs=["mass.pos[1]"])
     assert not first.cached and first.module.OBSERVED == ()
-    derive = compiler.derive_system
+    derive = generation.derive_system
 
     def no_flattening(options: object) -> object:
         raise AssertionError("the model was flattened again")
 
-    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    monkeypatch.setattr(generation, "derive_system", no_flattening)
     for patterns, outputs in ((["mass.v[*]"], ("mass.v[1]", "mass.v[2]")),
                               (["mass.*"], ("mass.pos[1]", "mass.pos[2]", "mass.v[1]",
                                             "mass.v[2]"))):
@@ -316,15 +316,15 @@ def test_changing_vars_reuses_the_cached_module(tmp_path: Path,
     with pytest.raises(springc.errors.SimulationError) as info:
         springc.compile_model(SEED, outputs=["mass.w"])
     assert info.value.message == "--vars 'mass.w' matches no state or observed variable"
-    monkeypatch.setattr(compiler, "derive_system", derive)
+    monkeypatch.setattr(generation, "derive_system", derive)
     spring = springc.compile_model(SEED, outputs=["mass.pos[1]", "spring.x"])
     assert not spring.cached and spring.module.OBSERVED == ("spring.x",)
-    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    monkeypatch.setattr(generation, "derive_system", no_flattening)
     assert springc.compile_model(SEED, outputs=["spring.x"]).path == spring.path
-    monkeypatch.setattr(compiler, "derive_system", derive)
+    monkeypatch.setattr(generation, "derive_system", derive)
     everything = springc.compile_model(SEED, outputs=["*"])  # all observed: the default
     assert not everything.cached
-    monkeypatch.setattr(compiler, "derive_system", no_flattening)
+    monkeypatch.setattr(generation, "derive_system", no_flattening)
     assert springc.compile_model(SEED).path == everything.path
     result = springc.simulate(SEED, outputs=["mass.v[2]"], stop=0.5)
     assert result.names == ("mass.v[2]",) and result.stats.cached

@@ -16,6 +16,7 @@ from ..simulation import (
     ERROR_CONTROLS,
     FIXED_STEP,
 )
+from ..status_line import silenced
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -80,7 +81,9 @@ from .options import (
               help="Write a plot: .png, .svg or .pdf.")
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress bar, no summary line and "
+              "no status lines (\"springc: compiling ...\" before a step that compiles, "
+              "once).")
 @units_option
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -127,35 +130,36 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         write_csv,
     )
 
-    compiled = compile_model(files, model, libraries=libraries,
-                             backend=default_choice(backend, engine, solver),
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
-    report_units(compiled.warnings, strict_units)
-    if not patterns and (output or not plot):  # the default trajectory of every output
-        check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
-                              f"-o {output}" if output else "the CSV on stdout")
-    progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-    with warnings.catch_warnings():  # said below as the command's own warning
-        warnings.simplefilter("ignore", AccuracyWarning)
-        result = run(compiled, start=start, stop=stop, interval=interval,
-                     solver=solver.lower(), rtol=rtol, atol=atol,
-                     parameters={k: v for k, v in values.items()
-                                 if k not in compiled.structural},
-                     progress=progress, step=step, max_steps=max_steps,
-                     time_limit=time_limit, engine=engine.lower(), error_control=mode,
-                     event_rows=event_rows)
-    if error_output and result.error_estimate is None:
-        raise click.UsageError(f"--error-output {error_output}: this run made no error "
-                               "estimate (--error-control off, or a model without states)")
-    if output or plot or error_output:
-        note = save_outputs(result, output, plot, files, error_output)
-        if note and not quiet:
-            click.echo(f"note: plot {plot}: {note}", err=True)
-    else:
-        write_csv(result, sys.stdout)
-        sys.stdout.flush()
-    if not quiet:
-        click.echo(result.stats.summary(result.model), err=True)
-    if result.stats.warning:  # even with --quiet: the answer missed its tolerance
-        click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)
+    with silenced(quiet):  # the status lines of long steps (compiling)
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend, engine, solver),
+                                 outputs=patterns or None, parameters=values,
+                                 cache=not no_cache)
+        report_units(compiled.warnings, strict_units)
+        if not patterns and (output or not plot):  # the default trajectory of every output
+            check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
+                                  f"-o {output}" if output else "the CSV on stdout")
+        progress = None if quiet or not sys.stderr.isatty() else sys.stderr
+        with warnings.catch_warnings():  # said below as the command's own warning
+            warnings.simplefilter("ignore", AccuracyWarning)
+            result = run(compiled, start=start, stop=stop, interval=interval,
+                         solver=solver.lower(), rtol=rtol, atol=atol,
+                         parameters={k: v for k, v in values.items()
+                                     if k not in compiled.structural},
+                         progress=progress, step=step, max_steps=max_steps,
+                         time_limit=time_limit, engine=engine.lower(), error_control=mode,
+                         event_rows=event_rows)
+        if error_output and result.error_estimate is None:
+            raise click.UsageError(f"--error-output {error_output}: this run made no error "
+                                   "estimate (--error-control off, or a model without states)")
+        if output or plot or error_output:
+            note = save_outputs(result, output, plot, files, error_output)
+            if note and not quiet:
+                click.echo(f"note: plot {plot}: {note}", err=True)
+        else:
+            write_csv(result, sys.stdout)
+            sys.stdout.flush()
+        if not quiet:
+            click.echo(result.stats.summary(result.model), err=True)
+        if result.stats.warning:  # even with --quiet: the answer missed its tolerance
+            click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)

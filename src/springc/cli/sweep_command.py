@@ -14,6 +14,7 @@ from ..simulation import (
     ERROR_CONTROLS,
     FIXED_STEP,
 )
+from ..status_line import silenced
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -73,7 +74,8 @@ from .options import (
               "(median, percentile bands).")
 @click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
               "study's first variable).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress and no summary line.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress, no summary line and no "
+              "status line (\"springc: compiling ...\").")
 @guard
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -119,10 +121,11 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
                            max_steps, time_limit, error_control.lower())
     parameter_table(options)  # refuse bad specifications before compiling
 
-    compiled = compile_model(files, model, libraries=libraries,
-                             backend=default_choice(backend, solver=solver),
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
+    with silenced(quiet):  # the status line of a model that compiles
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend, solver=solver),
+                                 outputs=patterns or None, parameters=values,
+                                 cache=not no_cache)
     fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
     from dataclasses import replace
 

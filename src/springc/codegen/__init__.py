@@ -1,9 +1,39 @@
-"""Codegen: ``ir.ode.ODE`` -> the text of a standalone Python/numba module."""
+"""Codegen: ``ir.ode.ODE`` -> the text of a standalone Python/numba module.
 
-from .context import BACKENDS, CodegenBug, CodegenOptions, GeneratedModel
-from .generator import generate
-from .module_api import HYBRID_NAMES, MODULE_NAMES, GeneratedModule, HybridModule
-from .module_text import CODEGEN_VERSION
+The contract of a generated module (:mod:`.module_api`: ``GeneratedModule``,
+``MODULE_NAMES``, ``CODEGEN_VERSION``) loads with the package; the generator and its
+options load on first use (PEP 562), so that the cache can check a cached module
+without importing the generator (a warm run never generates).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from .module_api import (
+    CODEGEN_VERSION,
+    HYBRID_NAMES,
+    MODULE_NAMES,
+    GeneratedModule,
+    HybridModule,
+)
+
+if TYPE_CHECKING:
+    from .context import BACKENDS, CodegenBug, CodegenOptions, GeneratedModel
+    from .generator import generate
 
 __all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CodegenBug",
            "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule", "generate"]
+
+
+def __getattr__(name: str) -> Any:
+    # Lazy (see the docstring): the generator loads with its first name.
+    if name in ("BACKENDS", "CodegenBug", "CodegenOptions", "GeneratedModel"):
+        from . import context
+
+        return getattr(context, name)
+    if name == "generate":
+        from . import generator
+
+        return generator.generate
+    raise AttributeError(f"module 'springc.codegen' has no attribute {name!r}")

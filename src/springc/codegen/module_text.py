@@ -19,11 +19,11 @@ from .context import CodegenContext, CodegenOptions, source_comment, source_loca
 from .encoding import encode_floats, encode_ints, encode_strings
 from .events import EVENT_UPDATE, NO_EVENTS
 from .events import constants as event_constants
+from .module_api import CODEGEN_VERSION
 from .printer import HELPERS, function_lines
 from .statements import Let, Namer, Raw, Stmt, Store, escaped
 from .vector import VECTOR_THRESHOLD, VectorLayout
 
-CODEGEN_VERSION = 5
 FROZEN_BYTES = 10**6
 """numba's limit for freezing a global array into compiled code (``make_constant_array``)."""
 

@@ -51,6 +51,7 @@ from .engine import (
     bdf,
     dop853,
     fixed_step,
+    kernel_cached,
     load,
     newton_flops,
     newton_solve_flops,
@@ -62,5 +63,6 @@ from .hybrid import HybridRun, run_hybrid
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
-           "bdf", "dop853", "ensemble", "fixed_step", "load", "newton_flops", "newton_solve_flops",
+           "bdf", "dop853", "ensemble", "fixed_step", "kernel_cached", "load", "newton_flops",
+           "newton_solve_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]

@@ -78,7 +78,7 @@ class Crossings:
 
 
 KERNEL_MODULES = {"dop853": "dop853_kernel", "rk45": "rk45_kernel", "radau": "radau_kernel",
-                  "bdf": "bdf_kernel"}
+                  "bdf": "bdf_kernel", **{m: "fixed_step_kernel" for m in FIXED_STEP_METHODS}}
 
 
 def load(method: str) -> None:
@@ -88,6 +88,26 @@ def load(method: str) -> None:
     import importlib
 
     importlib.import_module(f"{__package__}.{KERNEL_MODULES[method]}")
+
+
+def kernel_cached(method: str) -> bool:
+    """Whether the kernel of ``method`` loads at once: already loaded in this process,
+    or numba's on-disk cache holds an index of its module (in the package's
+    ``__pycache__``, or below ``NUMBA_CACHE_DIR``). If not, loading it compiles it for
+    this machine (seconds to minutes, once). Read from the files, without importing
+    the kernel."""
+    import os
+    import sys
+    from pathlib import Path
+
+    module = KERNEL_MODULES[method]
+    if f"{__package__}.{module}" in sys.modules:
+        return True
+    pattern = f"{module}.*.nbi"
+    if any((Path(__file__).parent / "__pycache__").glob(pattern)):
+        return True
+    custom = os.environ.get("NUMBA_CACHE_DIR", "")
+    return bool(custom) and any(Path(custom).rglob(pattern))
 
 
 def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,

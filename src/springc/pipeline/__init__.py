@@ -1,16 +1,43 @@
-"""Pipeline: source files -> ``CompiledModel`` (flatten, simplify, generate, cache, import)."""
+"""Pipeline: source files -> ``CompiledModel`` (flatten, simplify, generate, cache, import).
+
+The compiled model and the cache lookup load with the package; the compile path
+(``derive_system``, ``generate_source``: :mod:`.generation`) and ``flatten_files`` load
+on first use (PEP 562), so that a model found in the cache is simulated without
+importing the parser, lark, the flattener, simplify or codegen's generator.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
 
 from .compiler import (
     CompiledModel,
     check_parameter_names,
     compile_files,
-    generate_source,
     modification_value,
 )
-from .derive import CompileOptions, derive_system
-from .files import flatten_files
+from .notes import announce_functions
+from .options import CompileOptions
 from .selection import select_names
 
-__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
+if TYPE_CHECKING:
+    from .files import flatten_files
+    from .generation import derive_system, generate_source
+
+__all__ = ["CompileOptions", "CompiledModel", "announce_functions", "check_parameter_names",
+           "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",
            "select_names"]
+
+
+def __getattr__(name: str) -> Any:
+    # Lazy (see the docstring): the compile path loads with its first name.
+    if name in ("derive_system", "generate_source"):
+        from . import generation
+
+        return getattr(generation, name)
+    if name == "flatten_files":
+        from . import files
+
+        return files.flatten_files
+    raise AttributeError(f"module 'springc.pipeline' has no attribute {name!r}")

@@ -35,7 +35,6 @@ from ..codegen import GeneratedModule
 from ..ir import flat, ode
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
-from ..simplify import conditions
 from .cache import MODULE_FILE, cache_dir, import_module, read_entry
 
 MODULE_PREFIX = "springc_model_"
@@ -53,7 +52,10 @@ class RunSystem:
 
 def run_system_of(system: ode.ODE, flat_model: flat.FlatModel, switchable: bool
                   ) -> RunSystem | None:
-    """What runs of this model need beyond its module; None when nothing."""
+    """What runs of this model need beyond its module; None when nothing. (Called on
+    the compile path only: simplify is not imported to load a cached model.)"""
+    from ..simplify import conditions
+
     if switchable:
         return RunSystem(system, flat_model)
     if conditions(system):

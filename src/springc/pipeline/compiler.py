@@ -1,11 +1,12 @@
-"""Source files -> CompiledModel: flatten, simplify, generate, cache on disk, import.
+"""CompileOptions -> CompiledModel: the cache lookup, and the compiled model itself.
 
 Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
 could be loaded, the model name, the options and springc's own code; verified by a
 recorded hash before import). A warm hit imports the module without flattening
-anything. Flattening and simplifying is :mod:`.derive`; what a run needs beyond the
-module is captured at compile time (:mod:`.closed`), so a compiled model never reads
-its files again.
+anything, and without importing the compile path (:mod:`.derive`: the parser, the
+flattener, unit checks and simplify; :mod:`.generation`: codegen's generator), which
+loads only on a miss. What a run needs beyond the module is captured at compile time
+(:mod:`.closed`), so a compiled model never reads its files again.
 """
 
 from __future__ import annotations
@@ -18,14 +19,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..codegen import CodegenOptions, GeneratedModule, generate
+from ..codegen import GeneratedModule
 from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
+from ..status_line import say
 from .cache import (
     MODULE_FILE,
     SYSTEM_FILE,
-    Names,
     cache_dir,
     cache_key,
     discard,
@@ -48,10 +49,14 @@ from .closed import (
     needs_run_system,
     run_system_of,
 )
-from .derive import CompileOptions, Derived, derive_system, fewer_collections
-from .diagnostics import decode_warnings, encode_warnings
+from .diagnostics import decode_warnings
 from .equations import Equations
+from .notes import compiling_note
+from .options import CompileOptions, Derived
 from .selection import ALL_OBSERVED, select_names, selected_observed
+
+__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
+           "modification_value"]
 
 
 @dataclass
@@ -153,7 +158,9 @@ class CompiledModel:
             else:
                 self.check_files("its equations are no longer those of the files",
                                  "compile the model again to see its equations")
-                self.derived = derive_system(self.options)
+                from . import generation  # the compile path (not loaded for a cached model)
+
+                self.derived = generation.derive_system(self.options)
         return self.derived
 
     def check_files(self, consequence: str, hint: str) -> None:
@@ -212,8 +219,11 @@ def compile_files(options: CompileOptions) -> CompiledModel:
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
-            derived = derive_system(options)
-            names = candidate_names(derived)
+            from . import generation  # the compile path, loaded on a miss only
+
+            say(compiling_note(options, folder))
+            derived = generation.derive_system(options)
+            names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
     key = selection_key(model_key, observed)
@@ -223,10 +233,13 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         if hit is not None:
             hit.compile_time = time.perf_counter() - began
             return hit
+    from . import generation  # the compile path, loaded on a miss only
+
     if derived is None:
-        derived = derive_system(options)
-        write_names(folder, model_key, candidate_names(derived))
-    generated = generate_from(derived, options)
+        say(compiling_note(options, folder))
+        derived = generation.derive_system(options)
+        write_names(folder, model_key, generation.candidate_names(derived))
+    generated = generation.generate_from(derived, options)
     run = run_system_of(derived.system, derived.flat_model, derived.switchable)
     temporary = None
     if folder is not None:
@@ -292,12 +305,6 @@ def _cached(entry: Path, module_name: str, options: CompileOptions, model_key: s
                          text=data.decode("utf-8"), run_system=run, model_key=model_key)
 
 
-def candidate_names(derived: Derived) -> Names:
-    """The states and the observed variables of a derived model."""
-    system = derived.system
-    return tuple(s.name for s in system.states), tuple(system.observed_names())
-
-
 def too_deep_for_python(err: BaseException) -> BaseException:
     """The error for a generated module that Python's compiler refuses: a located
     :class:`CodegenError` when it nests too deeply (more than about 200 parentheses or
@@ -315,23 +322,6 @@ def outputs_of(module: GeneratedModule, options: CompileOptions) -> tuple[str, .
     """The names ``options.outputs`` selects among the module's states and observed."""
     return tuple(select_names(tuple(module.STATES) + tuple(module.OBSERVED),
                               options.outputs))
-
-
-def generate_source(options: CompileOptions) -> str:
-    """Flatten, simplify and generate the module text for ``options``."""
-    return generate_from(derive_system(options), options)
-
-
-@fewer_collections()
-def generate_from(derived: Derived, options: CompileOptions) -> str:
-    """The module text of a derived model with the outputs ``options`` selects."""
-    system, flat_model = derived.system, derived.flat_model
-    candidates = [s.name for s in system.states] + system.observed_names()
-    selected = set(select_names(candidates, options.outputs))
-    observed = tuple(n for n in system.observed_names() if n in selected)
-    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
-                             warnings=encode_warnings(derived.warnings))
-    return generate(system, flat_model, codegen).source
 
 
 def modification_value(model: CompiledModel, name: str, value: float) -> str:

@@ -1,4 +1,6 @@
-"""Compile options -> the flat model and simplified system of a model (``Derived``).
+"""Compile options -> the flat model and simplified system of a model (``Derived``):
+the first half of the compile path, imported only on a cache miss (or for the equations
+of a model whose run captured no flat model).
 
 Loads the files (and libraries), flattens the selected class (with structural
 parameter values applied by a wrapper class ``extends M(N = 100)``, in the same class
@@ -11,46 +13,13 @@ import contextlib
 import dataclasses
 import gc
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 
-from ..errors import UnitError
 from ..flatten import flatten, select_model
-from ..ir import flat, ode, syntax
+from ..ir import flat, syntax
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
 from ..units import check_units
-
-
-@dataclass(frozen=True)
-class CompileOptions:
-    """What to compile: files, model, libraries, backend, outputs, structural values.
-
-    ``outputs`` are ``--vars`` patterns (``*`` and ``?`` wildcards, otherwise exact
-    flat names); ``None`` selects every state and observed variable.
-    ``modifications`` are structural parameter values as Modelica text.
-    """
-
-    files: tuple[str, ...]
-    model: str | None = None
-    libraries: tuple[str, ...] = ()
-    backend: str = "python"
-    outputs: tuple[str, ...] | None = None
-    modifications: tuple[tuple[str, str], ...] = ()
-    cache: bool = True
-    texts: tuple[tuple[str, str], ...] = ()  # models given as text: (pseudo file, text)
-
-
-@dataclass(frozen=True)
-class Derived:
-    """The simplified system of a model, its flat model, whether index reduction
-    left a choice of states that may turn singular during a run (``switchable``), and
-    the unit mismatches of the flat model."""
-
-    system: ode.ODE
-    flat_model: flat.FlatModel
-    switchable: bool
-    warnings: tuple[UnitError, ...] = ()
-
+from .options import CompileOptions, Derived
 
 WRAPPER_FILE = "<springc: structural parameters>"
 """The file name of the class that applies ``--set`` values of structural parameters."""

@@ -1,9 +1,10 @@
 """Simplify: ``ir.flat`` -> ``ir.dae`` -> ``ir.ode`` (aliases, index reduction,
 causalization), plus the balance check, the initial problem and state choice."""
 
+from ..errors import describe_failure
 from .balance import check_balance
 from .initialize import conditions, initial_state
-from .ode_eval import OdeEvaluator, describe_failure, parameter_values
+from .ode_eval import OdeEvaluator, parameter_values
 from .passes import simplify
 from .state_choice import (
     THRESHOLD,

@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
-from ..errors import Note, SimplifyError, SimulationError
+from ..errors import Note, SimplifyError, SimulationError, describe_failure
 from ..ir import dae, ode
 from ..ir import expr as x
 
@@ -92,15 +92,6 @@ def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
                                 hint="check the parameters it uses (--set)")
         out[u.name] = value
     return out
-
-
-def describe_failure(err: BaseException) -> str:
-    """``division by zero``, ``overflow`` or the error's own text."""
-    if isinstance(err, ZeroDivisionError):
-        return "division by zero"
-    if isinstance(err, OverflowError):
-        return "overflow"
-    return str(err) or type(err).__name__
 
 
 class OdeEvaluator:

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import SimulationError, UsageError
+from ..status_line import say
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
 from .solver_names import AUTO, COMPILED_SOLVERS, ENGINES, EXPLICIT, FIXED_STEP, RACE_IMPLICIT
@@ -169,11 +170,11 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     methods take the same steps; Radau and BDF restart their Jacobian and step-size
     history). The stretch's ``sizes`` hold its mean accepted step size. A failure moves
     ``stepper`` to its last accepted state before raising the scipy path's error."""
-    from springc.integrate import Status, load
+    from springc.integrate import Status
 
     problem, grid = loop.problem, loop.grid
     kernel = _kernel(loop, stepper.method)
-    load(stepper.method)  # (numba's cache, once per process: not the stretch's time)
+    load_kernel(stepper.method)  # (numba's cache, once per process: not the stretch's time)
     t, y = stepper.t, stepper.y
     rest = grid[loop.k:]
     times = np.concatenate(([t], rest[rest > t]))
@@ -237,6 +238,21 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     return Stretch(Work(accepted, taken, nfev, njev), (mean,) if accepted else ())
 
 
+KERNEL_NOTE = "compiling the {method} loop for this machine (once; this may take a minute)"
+"""The status line before a kernel compiles (numba has not cached it on this machine)."""
+
+
+def load_kernel(method: str, cached: Callable[[str], bool] | None = None) -> None:
+    """Load the compiled loop of ``method``, first saying on stderr that it compiles
+    where numba's cache does not hold it (``cached``: the check, by default
+    :func:`springc.integrate.kernel_cached`)."""
+    from springc.integrate import kernel_cached, load
+
+    if not (cached or kernel_cached)(method):
+        say(KERNEL_NOTE.format(method=method))
+    load(method)
+
+
 def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, float, int],
                                                      Run]:
     """``run(times, y, first_step, max_steps)``: ``method``'s compiled loop on ``loop``'s
@@ -286,6 +302,7 @@ def run_fixed_compiled(problem: Problem, grid: np.ndarray, x0: np.ndarray, step:
 
     if len(x0) == 0:
         return np.tile(x0, (len(grid), 1)), 0, 0.0
+    load_kernel(problem.solver)
     pairs = detect_pairs(problem.mod, problem.p, x0, float(grid[0]))
     index_pairs = list(zip(pairs.positions.tolist(), pairs.velocities.tolist()))
     counts = np.maximum(1, np.ceil(np.diff(grid) / step - 1e-9))

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .compiled import FIXED_CHUNK, adaptive_run, failure, time_limit_reached
+from .compiled import FIXED_CHUNK, adaptive_run, failure, load_kernel, time_limit_reached
 from .events import LOCATE_TOLERANCE, EventLoop
 from .limits import OverLimit
 from .solver_names import FIXED_STEP
@@ -65,6 +65,7 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
 
     problem, grid = loop.problem, loop.grid
     mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
+    load_kernel(solver)
     limit = problem.limits.max_steps
     t, stop = float(grid[0]), float(grid[-1])
     x = loop.initial(t, np.asarray(x0, dtype=float))

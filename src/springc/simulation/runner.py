@@ -25,9 +25,8 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import SimulationError
+from ..errors import SimulationError, describe_failure
 from ..pipeline import CompiledModel, check_parameter_names
-from ..simplify import describe_failure as describe_failure
 from . import error_control, solvers
 from .compiled import (
     COMPILED,

@@ -25,16 +25,18 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import Note, SimulationError
 from ..ir import dae, ode
 from ..ir.expr import Var
 from .integrators import NonFiniteState, Pairs, integrate
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
+
+if TYPE_CHECKING:
+    from scipy.sparse import spmatrix
 
 T = TypeVar("T")
 
@@ -111,7 +113,7 @@ class AutoChoice:
     span: float
 
 
-def choose(jac: np.ndarray | sp.spmatrix, span: float) -> AutoChoice:
+def choose(jac: np.ndarray | spmatrix, span: float) -> AutoChoice:
     """``dop853`` if ``rho * span`` is small, else a race (``radau`` outright if the
     Jacobian is not finite)."""
     from .stiffness import choose_solver

@@ -24,10 +24,9 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import Note, SimulationError
+from ..errors import Note, SimulationError, describe_failure
 from ..ir.dae import derivative_name
-from ..pipeline import CompiledModel
-from ..simplify import describe_failure
+from ..pipeline import CompiledModel, announce_functions
 from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
@@ -78,6 +77,7 @@ class Problem:
     def __init__(self, model: CompiledModel, p: np.ndarray, solver: str,
                  progress: Progress, limits: Limits | None = None) -> None:
         mod = model.module
+        announce_functions(mod, model.path, model.cached)  # before their first call
         self.model, self.mod, self.p, self.solver = model, mod, p, solver
         self.z = np.asarray(mod.guesses(p), dtype=float)
         self.names = tuple(mod.STATES)

@@ -11,14 +11,17 @@ Jacobian), so the estimate costs a few dozen Jacobian-vector products.
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import ArpackNoConvergence, eigs
 
 from .solver_names import EXPLICIT, RACE_IMPLICIT
+
+if TYPE_CHECKING:
+    from scipy.sparse import spmatrix
 
 STIFF_THRESHOLD = 2000.0
 """``rho * T`` above which the implicit solver is chosen."""
@@ -38,21 +41,41 @@ class Choice:
     reason: str
 
 
-def spectral_radius(jac: np.ndarray | sp.spmatrix) -> float:
+def is_sparse(jac: object) -> bool:
+    """Whether ``jac`` is a scipy.sparse matrix, without importing scipy.sparse (a
+    third of a second): no sparse matrix exists before it is imported, and a small
+    model's Jacobian is dense."""
+    sparse = sys.modules.get("scipy.sparse")
+    return sparse is not None and bool(sparse.issparse(jac))
+
+
+def as_dense(jac: np.ndarray | spmatrix) -> np.ndarray:
+    """``jac`` as a dense float array."""
+    if is_sparse(jac):
+        import scipy.sparse as sp  # already loaded: ``jac`` is one of its matrices
+
+        return np.asarray(sp.csr_matrix(jac).toarray(), dtype=float)
+    return np.asarray(jac, dtype=float)
+
+
+def spectral_radius(jac: np.ndarray | spmatrix) -> float:
     """Largest eigenvalue magnitude: exact for small Jacobians, ARPACK for large ones.
 
     (A singular-value bound would be useless here: for a mass-spring system it is
     about ``omega**2`` while the spectral radius is ``omega``.)
     """
     n = jac.shape[0]
-    values = jac.data if sp.issparse(jac) else np.asarray(jac)
+    values = jac.data if is_sparse(jac) else np.asarray(jac)
     if not np.all(np.isfinite(values)):
         return float("inf")
     if n == 0:
         return 0.0
     if n <= DENSE_LIMIT:
-        dense = sp.csr_matrix(jac).toarray() if sp.issparse(jac) else np.asarray(jac, dtype=float)
+        dense = as_dense(jac)
         return float(np.max(np.abs(np.linalg.eigvals(dense))))
+    import scipy.sparse as sp  # a large Jacobian: ARPACK
+    from scipy.sparse.linalg import ArpackNoConvergence, eigs
+
     operator = sp.csr_matrix(jac, dtype=float)
     # ARPACK's own start vector comes from a generator that runs on from call to call
     # in a process: a fixed one gives the same estimate in every process
@@ -82,7 +105,7 @@ def numerical_jacobian(rhs: Callable[[float, np.ndarray], np.ndarray], t: float,
     return jac
 
 
-def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
+def choose_solver(jac: np.ndarray | spmatrix, span: float,
                   explicit: str = EXPLICIT, implicit: str = RACE_IMPLICIT) -> Choice:
     """Pick ``explicit`` or ``implicit`` from ``rho * span`` and say why.
 
@@ -109,9 +132,11 @@ def choose_solver(jac: np.ndarray | sp.spmatrix, span: float,
     return Choice(explicit, rho, stiffness, reason)
 
 
-def _row_sum_bound(jac: np.ndarray | sp.spmatrix) -> float:
+def _row_sum_bound(jac: np.ndarray | spmatrix) -> float:
     """``||J||_inf``, an upper bound of the spectral radius."""
-    if sp.issparse(jac):
+    if is_sparse(jac):
+        import scipy.sparse as sp  # already loaded: ``jac`` is one of its matrices
+
         sums = np.asarray(abs(sp.csr_matrix(jac)).sum(axis=1)).ravel()
         return float(np.max(sums, initial=0.0))
     return float(np.max(np.abs(np.asarray(jac)).sum(axis=1), initial=0.0))

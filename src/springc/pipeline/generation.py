@@ -1,0 +1,42 @@
+"""CompileOptions -> module text: the compile path's entry (derive, then generate).
+
+Loaded only on a cache miss (by :func:`springc.pipeline.compile_files`), or when a
+model's equations are asked for and its run captured no flat model: a cached model is
+simulated without importing the parser, lark, the flattener, the unit checks,
+simplify or codegen's generator. Flattening and simplifying is :mod:`.derive`; this
+module generates the text of a derived model's module.
+"""
+
+from __future__ import annotations
+
+from ..codegen import CodegenOptions, generate
+from .cache import Names
+from .derive import derive_system, fewer_collections
+from .diagnostics import encode_warnings
+from .options import CompileOptions, Derived
+from .selection import select_names
+
+__all__ = ["candidate_names", "derive_system", "generate_from", "generate_source"]
+
+
+def candidate_names(derived: Derived) -> Names:
+    """The states and the observed variables of a derived model."""
+    system = derived.system
+    return tuple(s.name for s in system.states), tuple(system.observed_names())
+
+
+def generate_source(options: CompileOptions) -> str:
+    """Flatten, simplify and generate the module text for ``options``."""
+    return generate_from(derive_system(options), options)
+
+
+@fewer_collections()
+def generate_from(derived: Derived, options: CompileOptions) -> str:
+    """The module text of a derived model with the outputs ``options`` selects."""
+    system, flat_model = derived.system, derived.flat_model
+    candidates = [s.name for s in system.states] + system.observed_names()
+    selected = set(select_names(candidates, options.outputs))
+    observed = tuple(n for n in system.observed_names() if n in selected)
+    codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
+                             warnings=encode_warnings(derived.warnings))
+    return generate(system, flat_model, codegen).source

@@ -1,0 +1,46 @@
+"""The status lines of the pipeline's long steps (:mod:`springc.status_line`).
+
+Decided from the disk, never the clock: a model not in the cache is compiled now
+(flattened, simplified, generated; :func:`compiling_note`, said by
+:func:`~springc.pipeline.compile_files`); a cached numba module whose functions numba
+has not cached compiles them at their first call (:func:`announce_functions`, said by
+the simulation before it calls them: ``springc compile`` never calls them).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from ..codegen import GeneratedModule
+from ..status_line import say
+from .options import CompileOptions
+
+FUNCTIONS_NOTE = "compiling the functions of {name} for this machine (once)"
+"""The status line before a cached numba module's functions compile."""
+
+
+def compiling_note(options: CompileOptions, folder: Path | None) -> str:
+    """The status line of a model that is not in the cache (``folder``: the cache
+    folder, None where none is used), before it is compiled."""
+    name = options.model or (Path(options.files[0]).stem if options.files else "the model")
+    if folder is None:
+        return f"compiling {name} (not cached: every run compiles it)"
+    return f"compiling {name} for this machine (once; later runs load it from the cache)"
+
+
+def functions_cached(module: GeneratedModule, path: Path) -> bool:
+    """Whether the numba functions of the module imported from ``path`` load from
+    numba's cache (an index next to the module; assumed where ``NUMBA_CACHE_DIR`` moves
+    numba's cache elsewhere); a python module's always do (nothing compiles)."""
+    if module.BACKEND != "numba" or os.environ.get("NUMBA_CACHE_DIR"):
+        return True
+    return any((path.parent / "__pycache__").glob("model.*.nbi"))
+
+
+def announce_functions(module: GeneratedModule, path: Path, cached: bool) -> None:
+    """Say that the functions of a module loaded from the cache (``cached``) compile at
+    their first call, where numba has not cached them (a model compiled just now was
+    announced by :func:`compiling_note` already)."""
+    if cached and not functions_cached(module, path):
+        say(FUNCTIONS_NOTE.format(name=module.MODEL))

@@ -1,0 +1,111 @@
+"""A warm run imports only what it uses (docs/architecture.md, "Dependency rules").
+
+``springc simulate`` of a model already in the cache loads the module and runs it: the
+compile path (the parser and lark, the flattener, the unit check, simplify, codegen's
+generator; pipeline.derive and pipeline.generation) and the libraries a small run never
+needs (scipy.sparse, sympy, matplotlib) stay unloaded.
+The test asserts which modules a fresh process holds after such a run, not a time.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import springc
+
+ROOT = Path(__file__).resolve().parents[1]
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+
+FORBIDDEN = ("lark", "springc.flatten", "springc.units", "springc.simplify",
+             "springc.codegen.generator", "springc.pipeline.derive",
+             "springc.pipeline.generation", "scipy.sparse", "sympy", "matplotlib")
+"""Packages (with their submodules) that a warm simulate of the seed must not import."""
+
+PARSE_ALLOWED = {"springc.parse", "springc.parse.library"}
+"""Of ``springc.parse``, the face and the library file walk (the cache key reads the
+library folders' files) load; the parser does not."""
+
+WARM_RUN = """
+import sys
+from springc.cli import main
+main(["simulate", sys.argv[1], "-o", sys.argv[2], "-q"], standalone_mode=False)
+print("\\n".join(sorted(sys.modules)))
+"""
+
+
+def _loaded(name: str, modules: set[str]) -> list[str]:
+    return sorted(m for m in modules if m == name or m.startswith(name + "."))
+
+
+def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
+    first = springc.compile_model(SEED)  # fills the cache as the CLI's run would
+    assert not first.cached
+    out = tmp_path / "seed.csv"
+    paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}
+    run = subprocess.run([sys.executable, "-c", WARM_RUN, SEED, str(out)], env=env,
+                         capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stderr
+    modules = set(run.stdout.split())
+    assert "springc.pipeline.compiler" in modules  # the run went through the pipeline
+    assert {name: _loaded(name, modules) for name in FORBIDDEN} == \
+        {name: [] for name in FORBIDDEN}
+    assert set(_loaded("springc.parse", modules)) == PARSE_ALLOWED
+    with out.open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][:5] == ["time", "mass.pos[1]", "mass.pos[2]", "mass.v[1]", "mass.v[2]"]
+    assert [float(v) for v in rows[1][:5]] == [0.0, 1.0, -1.0, 0.0, 0.0]  # the start values
+
+
+PENDULUM = """model Pendulum
+  parameter Real L = 1, g = 9.81;
+  Real x(start = 0.6), y(start = -0.8), vx(start = 0), vy(start = 0), F;
+equation
+  der(x) = vx;
+  der(y) = vy;
+  der(vx) = -F*x;
+  der(vy) = -F*y - g;
+  x^2 + y^2 = L^2;
+end Pendulum;
+"""
+"""Index 3: dynamic state selection, so its cache entry holds a captured system."""
+
+WARM_LOAD = """
+import sys
+import springc
+model = springc.compile_model(sys.argv[1], backend="python")
+derived = model.derive()
+print(model.cached, model.run_system is not None, derived.flat_model.name,
+      derived.switchable)
+print("\\n".join(sorted(sys.modules)))
+"""
+
+
+def test_a_cached_model_with_a_captured_system_loads_without_the_compile_path(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
+    path = tmp_path / "pendulum.mo"
+    path.write_text(PENDULUM)
+    first = springc.compile_model(str(path), backend="python")
+    assert not first.cached and first.run_system is not None
+    paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}
+    run = subprocess.run([sys.executable, "-c", WARM_LOAD, str(path)], env=env,
+                         capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stderr
+    first_line, *names = run.stdout.splitlines()
+    assert first_line == "True True Pendulum True"  # its equations from the captured system
+    modules = set(names)
+    assert {name: _loaded(name, modules) for name in FORBIDDEN} == \
+        {name: [] for name in FORBIDDEN}
+    assert set(_loaded("springc.parse", modules)) == PARSE_ALLOWED
