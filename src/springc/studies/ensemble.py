@@ -192,7 +192,7 @@ def explain(model: CompiledModel, options: EnsembleOptions, settings: Mapping[st
     """The single-run path's message for a run (``None`` if it does not fail there)."""
     single = SimulationOptions(options.start, options.stop, options.interval, SOLVER,
                                options.rtol, options.atol, dict(settings),
-                               max_steps=max_steps, engine="compiled", error_estimate="off")
+                               max_steps=max_steps, engine="compiled", error_control="off")
     try:
         simulate_model(model, single)
     except SpringcError as err:
