@@ -17,7 +17,7 @@ from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
-from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
+from .statements import Block, Let, Load, Loop, Raw, Stmt, Store, guarded_solve
 
 
 class CodegenBug(RuntimeError):
@@ -64,6 +64,7 @@ class GeneratedModel:
     observed: tuple[str, ...]
     parameters: tuple[str, ...]
     structural: tuple[str, ...]
+
 
 
 class CodegenContext:
@@ -154,7 +155,7 @@ class CodegenContext:
         body += [Store(f"_A{index}[{i}, {j}]", e) for i, j, e in block.matrix]
         body.append(Raw(f"_b{index} = np.empty({n})"))
         body += [Store(f"_b{index}[{i}]", e) for i, e in enumerate(block.rhs)]
-        body.append(Raw(f"_y{index} = np.linalg.solve(_A{index}, _b{index})"))
+        body.append(Raw(guarded_solve(f"_y{index}", f"_A{index}", f"_b{index}", f"{n}")))
         body += [Load(name, f"_y{index}[{k}]", name) for k, name in enumerate(block.names)]
         return Block(body, comment, {*block.names, f"_A{index}"})
 
@@ -178,7 +179,7 @@ class CodegenContext:
             loop += [Store(f"_J{index}[{i}, {j}]", e) for (i, j), e in entries.items()]
             loop.append(Raw(f"_R{index} = np.empty({k})"))
             loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
-            loop.append(Raw(f"_D{index} = np.linalg.solve(_J{index}, _R{index})"))
+            loop.append(Raw(guarded_solve(f"_D{index}", f"_J{index}", f"_R{index}", f"{k}")))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
         done: Expr | None = None
         for i, t in enumerate(block.tearing):

@@ -31,6 +31,7 @@ from .delays import used_names
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
 from .jacobian import jacobian_statements
+from .locate import at_initialization, locate
 from .module_text import module_text, parameter_value, topological
 from .printer import function_lines
 from .statements import Let, Namer, Raw, Store, reserved_name
@@ -70,7 +71,19 @@ def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) ->
 def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
              options: CodegenOptions | None = None) -> GeneratedModel:
     """The Python module of ``system`` for ``options.backend`` (default options: the
-    python backend, every observed variable)."""
+    python backend, every observed variable). An expression that cannot be translated
+    is a :class:`CodegenError` located at the model element it comes from."""
+    try:
+        return _generate(at_initialization(system), flat_model, options)
+    except CodegenError as err:
+        located = locate(err, system)
+        if located is None:
+            raise
+        raise located from None
+
+
+def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
+              options: CodegenOptions | None) -> GeneratedModel:
     options = options or CodegenOptions()
     if options.backend not in BACKENDS:
         raise CodegenError(f"unknown backend '{options.backend}'",

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from ..errors import CodegenError
 from ..ir import ode
 from ..ir.expr import ONE, ZERO, BinOp, Const, Expr, Neg, Var, add, diff, mul, neg, sub, variables
-from .statements import Block, Let, Load, Raw, Stmt, Store
+from .statements import Block, Let, Load, Raw, Stmt, Store, guarded_solve
 
 Grad = dict[int, Expr]
 
@@ -98,7 +98,8 @@ class JacobianBuilder:
         for c, j in enumerate(order):
             body += [Store(f"_C{index}[{i}, {c}]", e) for i, e in enumerate(columns[j])
                      if e != ZERO]
-        body.append(Raw(f"_Y{index} = np.linalg.solve(_A{index}, _C{index})"))
+        body.append(Raw(guarded_solve(f"_Y{index}", f"_A{index}", f"_C{index}",
+                                      f"({n}, {len(order)})")))
         defines = set()
         for k, name in enumerate(block.names):
             grad: Grad = {}
@@ -146,7 +147,8 @@ class JacobianBuilder:
             for i, residual in enumerate(residual_grads):
                 body += [Store(f"_R{index}[{i}, {c}]", residual[j])
                          for c, j in enumerate(order) if j in residual]
-            body.append(Raw(f"_S{index} = np.linalg.solve(_J{index}, _R{index})"))
+            body.append(Raw(guarded_solve(f"_S{index}", f"_J{index}", f"_R{index}",
+                                          f"({k}, {len(order)})")))
             for i, t in enumerate(block.tearing):
                 grad = {}
                 for c, j in enumerate(order):

@@ -15,8 +15,8 @@ import math
 from collections.abc import Callable, Iterator, Sequence
 from typing import ClassVar
 
-from ..errors import CodegenError
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
+from .locate import untranslatable
 from .statements import (
     Block,
     Let,
@@ -98,7 +98,7 @@ class FunctionWriter:
         elif isinstance(e, If):
             key = ("I", self._id(e.cond), self._id(e.then), self._id(e.otherwise))
         else:
-            raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+            raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
         cid = self._keys.get(key)
         if cid is None:
             cid = len(self._count)
@@ -211,7 +211,7 @@ class FunctionWriter:
         method: Callable[[Expr], tuple[str, int]] | None = getattr(
             self, "_print_" + type(e).__name__, None)
         if method is None:
-            raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+            raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
         return method(e)
 
     def _print_Const(self, e: Const) -> tuple[str, int]:
@@ -263,7 +263,7 @@ class FunctionWriter:
             if helper.startswith("_"):
                 self.helpers.add(helper)
             return f"{helper}({args})", 9
-        raise CodegenError(f"cannot generate code for the function '{name}'")
+        raise untranslatable(f"cannot generate code for the function '{name}'", e)
 
     def _print_If(self, e: If) -> tuple[str, int]:
         cond = self.expr(e.cond, 1)
@@ -321,7 +321,7 @@ class NumpyWriter(FunctionWriter):
             return f"np.{e.name}({args})", 9
         if e.name in self._UFUNC:
             return f"np.{self._UFUNC[e.name]}({args})", 9
-        raise CodegenError(f"cannot generate code for the function '{e.name}'")
+        raise untranslatable(f"cannot generate code for the function '{e.name}'", e)
 
     def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
         if e.op in ("and", "or"):

@@ -74,6 +74,15 @@ class Block:
 
 Stmt = Let | Load | Store | Raw | Loop | Block
 
+
+def guarded_solve(result: str, matrix: str, rhs: str, shape: str) -> str:
+    """``result = np.linalg.solve(matrix, rhs)``, or NaN where an entry is NaN or
+    infinite: numba's solve raises on those inside the compiled loop, while NaN
+    derivatives are a failure the loops report with the time and the states."""
+    return (f"{result} = np.linalg.solve({matrix}, {rhs}) if np.isfinite({matrix}).all() "
+            f"and np.isfinite({rhs}).all() else np.full({shape}, np.nan)")
+
+
 # ------------------------------------------------------------------ names
 
 # Every identifier the module templates define or use (locals, loop variables, module

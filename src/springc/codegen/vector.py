@@ -27,9 +27,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import CodegenError, Span
+from ..errors import Span
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
 from .context import CodegenBug, CodegenContext
+from .locate import untranslatable
 from .printer import NumpyWriter, function_lines
 from .statements import Store, escaped
 
@@ -87,7 +88,7 @@ def _shape(e: Expr, slots: list[str]) -> Expr:
         return Call(e.name, tuple(_shape(a, slots) for a in e.args))
     if isinstance(e, If):
         return If(_shape(e.cond, slots), _shape(e.then, slots), _shape(e.otherwise, slots))
-    raise CodegenError(f"cannot generate code for {type(e).__name__} expressions")
+    raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
 
 
 class VectorLayout:

@@ -46,7 +46,7 @@ class ParameterValues(Mapping[str, Any]):
         self.active.add(name)
         try:
             check_powers(binding, self)
-            value = x.evaluate(binding, self)
+            value = x.evaluate(binding, self, initial=True)  # computed in initialization
         finally:
             self.active.discard(name)
         self.cache[name] = value

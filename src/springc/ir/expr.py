@@ -229,26 +229,75 @@ def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
     raise TypeError(f"not an expression: {e!r}")
 
 
-def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0) -> Any:
-    """Numeric value of ``e``; raises ``KeyError`` for a variable missing from ``env``."""
+INITIAL = "initial()"
+"""The key of an environment whose value says whether ``initial()`` holds (during
+initialization); absent, it does not (the continuous phase)."""
+
+
+class NotEvaluable(ValueError):
+    """An operator that :func:`evaluate` has no value for (callers locate it)."""
+
+
+def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0,
+             initial: bool | None = None) -> Any:
+    """Numeric value of ``e``; raises ``KeyError`` for a variable missing from ``env``
+    and :class:`NotEvaluable` for an operator without a value here.
+
+    The event operators take the values of the instant ``env`` describes: ``initial()``
+    is ``initial`` (else ``env[INITIAL]``, else false), ``terminal()`` false, ``pre(v)``
+    is ``env["pre(v)"]`` if given, else ``v`` (away from an event a variable equals its
+    left limit), ``edge`` and ``change`` follow from ``pre``, and ``sample(start,
+    interval)`` holds at ``start + k interval``."""
     if isinstance(e, Const):
         return e.value
     if isinstance(e, Var):
         return env[e.name]
     if isinstance(e, BinOp):
-        return _BINARY[e.op](evaluate(e.left, env, time), evaluate(e.right, env, time))
+        return _BINARY[e.op](evaluate(e.left, env, time, initial),
+                             evaluate(e.right, env, time, initial))
     if isinstance(e, Neg):
-        return -evaluate(e.arg, env, time)
+        return -evaluate(e.arg, env, time, initial)
     if isinstance(e, Not):
-        return not evaluate(e.arg, env, time)
+        return not evaluate(e.arg, env, time, initial)
     if isinstance(e, Call):
-        return MATH[e.name](*(evaluate(a, env, time) for a in e.args))
+        function = MATH.get(e.name)
+        if function is None:
+            return _event_call(e, env, time, initial)
+        return function(*(evaluate(a, env, time, initial) for a in e.args))
     if isinstance(e, If):
-        branch = e.then if evaluate(e.cond, env, time) else e.otherwise
-        return evaluate(branch, env, time)
+        branch = e.then if evaluate(e.cond, env, time, initial) else e.otherwise
+        return evaluate(branch, env, time, initial)
     if isinstance(e, Time):
         return time
     raise KeyError(f"der({to_text(e.arg)})")
+
+
+def _event_call(e: Call, env: Mapping[str, object], time: float,
+                initial: bool | None) -> Any:
+    """The value of the event operator ``e`` at the instant ``env`` describes."""
+    def value(a: Expr) -> Any:
+        return evaluate(a, env, time, initial)
+
+    def previous(a: Expr) -> Any:
+        key = f"pre({a.name})" if isinstance(a, Var) else None
+        return env[key] if key is not None and key in env else value(a)
+
+    name, args = e.name, e.args
+    if name == "initial" and not args:
+        return bool(env.get(INITIAL, False)) if initial is None else initial
+    if name == "terminal" and not args:
+        return False
+    if name == "pre" and len(args) == 1:
+        return previous(args[0])
+    if name == "edge" and len(args) == 1:
+        return bool(value(args[0])) and not bool(previous(args[0]))
+    if name == "change" and len(args) == 1:
+        return value(args[0]) != previous(args[0])
+    if name == "sample" and len(args) >= 2:
+        start, interval = float(value(args[0])), float(value(args[1]))
+        k = round((time - start) / interval) if interval > 0 else -1
+        return k >= 0 and abs(start + k * interval - time) <= 1e-12 * max(1.0, abs(time))
+    raise NotEvaluable(f"{name}(...) has no value here")
 
 
 # ------------------------------------------------------------- construction

@@ -81,7 +81,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     Raises :class:`InitializationError` (over-/under-determined, no convergence).
     """
     params = parameter_values(model.parameters, parameters)
-    evaluator = OdeEvaluator(model, params)
+    evaluator = OdeEvaluator(model, params, initial=True)
     starts = start_values(model.dae.unknowns, params)
     x0 = np.array([starts.get(s.name, 0.0) for s in model.states])
     fixed = [i for i, s in enumerate(model.states) if s.fixed and s.start is not None]
@@ -92,7 +92,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
         trial = x0.copy()
         trial[chosen] = z
         env = evaluator.values(t0, trial)
-        return np.array([float(x.evaluate(c.residual, env, t0)) for c in conds])
+        return np.array([float(x.evaluate(c.residual, env, t0, True)) for c in conds])
 
     chosen: list[int] = []
     if conds:
@@ -102,7 +102,7 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
         chosen = _choose_states(model, conds, free, x0, lambda z, c: residuals(z, c))
         x0[chosen] = _solve(model, conds, chosen, x0, lambda z: residuals(z, chosen), tol)
     env = evaluator.values(t0, x0)
-    worst = max((abs(float(x.evaluate(c.residual, env, t0))) for c in conds),
+    worst = max((abs(float(x.evaluate(c.residual, env, t0, True))) for c in conds),
                 default=0.0)
     names = [s.name for s in model.states]
     info = InitialInfo(env, evaluator.observed(env, t0), conds,
@@ -116,7 +116,11 @@ def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Od
     env = evaluator.values(t0, x0)
     for c in conds:
         try:
-            x.evaluate(c.residual, env, t0)
+            x.evaluate(c.residual, env, t0, True)
+        except x.NotEvaluable as err:
+            raise InitializationError(f"the initial equation cannot be evaluated: {err}",
+                                      c.span, [], "springc evaluates initial equations "
+                                      "numerically at the start time") from None
         except KeyError as err:
             raise InitializationError(
                 f"the initial equation uses {err}, which the simplified model does not "

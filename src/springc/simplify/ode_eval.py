@@ -40,7 +40,8 @@ def parameter_values(parameters: Iterable[dae.Parameter],
         active.add(name)
         e = p.binding if p.binding is not None else p.start
         try:
-            values[name] = 0.0 if e is None else evaluate_with(e, value)
+            # Parameters are computed in initialization: initial() holds.
+            values[name] = 0.0 if e is None else evaluate_with(e, value, initial=True)
         except (ArithmeticError, ValueError) as err:
             raise SimplifyError(f"the value of parameter '{name}' cannot be computed: "
                                 f"{describe_failure(err)}", p.span,
@@ -64,9 +65,11 @@ class _Lazy(dict[str, float]):
         return result
 
 
-def evaluate_with(e: x.Expr, lookup: Callable[[str], float], time: float = 0.0) -> float:
-    """Evaluate ``e``, asking ``lookup(name)`` for each variable it needs."""
-    return float(x.evaluate(e, _Lazy(lookup), time))
+def evaluate_with(e: x.Expr, lookup: Callable[[str], float], time: float = 0.0,
+                  initial: bool | None = None) -> float:
+    """Evaluate ``e``, asking ``lookup(name)`` for each variable it needs (``initial``:
+    whether ``initial()`` holds, see :func:`springc.ir.expr.evaluate`)."""
+    return float(x.evaluate(e, _Lazy(lookup), time, initial))
 
 
 def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
@@ -75,7 +78,8 @@ def start_values(unknowns: Iterable[dae.Unknown], params: Mapping[str, float]
     out = {}
     for u in unknowns:
         try:
-            value = 0.0 if u.start is None else float(x.evaluate(u.start, params))
+            value = 0.0 if u.start is None else float(x.evaluate(u.start, params,
+                                                                 initial=True))
         except KeyError as err:
             raise SimplifyError(f"the start value of '{u.name}' must be a parameter "
                                 f"expression, but it uses {err}", u.span) from None
@@ -102,6 +106,7 @@ def describe_failure(err: BaseException) -> str:
 class OdeEvaluator:
     """Evaluates the steps of ``model`` for given parameter values.
 
+    ``initial``: the evaluation is that of initialization (``initial()`` holds).
     ``guess`` (by name) overrides the start values as the first Newton guess of the
     tearing variables: after a switch of states, the current values keep Newton on the
     branch the simulation is on (e.g. the sign of a coordinate solved from a length).
@@ -109,8 +114,9 @@ class OdeEvaluator:
 
     def __init__(self, model: ode.ODE, params: Mapping[str, float],
                  newton_tol: float = 1e-10, max_iterations: int = 50,
-                 guess: Mapping[str, float] | None = None) -> None:
+                 guess: Mapping[str, float] | None = None, initial: bool = False) -> None:
         self.model = model
+        self.initial = initial  # evaluating in initialization: initial() holds
         self.params = dict(params)
         self.names = [s.name for s in model.states]
         self.derivatives = [s.derivative for s in model.states]
@@ -127,7 +133,7 @@ class OdeEvaluator:
         for step in self.model.steps:
             try:
                 if isinstance(step, ode.Assign):
-                    env[step.name] = float(x.evaluate(step.expr, env, t))
+                    env[step.name] = float(x.evaluate(step.expr, env, t, self.initial))
                 elif isinstance(step, ode.LinearBlock):
                     self._linear(step, env, t)
                 else:
@@ -150,14 +156,15 @@ class OdeEvaluator:
 
     def observed(self, env: Mapping[str, float], t: float = 0.0) -> dict[str, float]:
         """The eliminated aliases, from a ``values`` result."""
-        return {a.name: float(x.evaluate(a.expr, env, t)) for a in self.model.observed}
+        return {a.name: float(x.evaluate(a.expr, env, t, self.initial))
+                for a in self.model.observed}
 
     def _linear(self, step: ode.LinearBlock, env: dict[str, float], t: float) -> None:
         n = len(step.names)
         rows = [r for r, _, _ in step.matrix]
         cols = [c for _, c, _ in step.matrix]
-        data = [float(x.evaluate(e, env, t)) for _, _, e in step.matrix]
-        b = np.array([float(x.evaluate(e, env, t)) for e in step.rhs])
+        data = [float(x.evaluate(e, env, t, self.initial)) for _, _, e in step.matrix]
+        b = np.array([float(x.evaluate(e, env, t, self.initial)) for e in step.rhs])
         try:
             if n >= SPARSE_FROM:
                 from scipy.sparse import csc_matrix
@@ -182,11 +189,11 @@ class OdeEvaluator:
         for _ in range(self.max_iterations):
             env.update(zip(step.tearing, z.tolist()))
             for a in step.inner + step.sensitivities:
-                env[a.name] = float(x.evaluate(a.expr, env, t))
-            f = np.array([float(x.evaluate(r, env, t)) for r in step.residuals])
+                env[a.name] = float(x.evaluate(a.expr, env, t, self.initial))
+            f = np.array([float(x.evaluate(r, env, t, self.initial)) for r in step.residuals])
             jac = np.zeros((n, n))
             for i, j, e in step.jacobian:
-                jac[i, j] = float(x.evaluate(e, env, t))
+                jac[i, j] = float(x.evaluate(e, env, t, self.initial))
             try:
                 dz = np.linalg.solve(jac, -f)
             except np.linalg.LinAlgError:
@@ -195,7 +202,7 @@ class OdeEvaluator:
             if np.max(np.abs(dz)) <= self.newton_tol * (1 + np.max(np.abs(z))):
                 env.update(zip(step.tearing, z.tolist()))
                 for a in step.inner:
-                    env[a.name] = float(x.evaluate(a.expr, env, t))
+                    env[a.name] = float(x.evaluate(a.expr, env, t, self.initial))
                 self.guess.update(zip(step.tearing, z.tolist()))
                 return
         raise SimulationError(
