@@ -35,6 +35,7 @@ from .control import (
 from .declarations import redeclared_class
 from .loops import check_loop_nest
 from .ranges import with_range
+from .tables import native_call, native_function
 from .scope import (
     ClassScope,
     ClassView,
@@ -87,6 +88,8 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        if native_function(entry) is not None:
+            return native_call(ev, entry, scope.names, call)
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):

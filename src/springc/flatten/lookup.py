@@ -27,6 +27,7 @@ from .modification import Mod, from_syntax, merge_all
 from .outer_rules import check_outer_uses
 from .redeclare_rules import check_replaceables
 from .rules import check_class, check_extends, rule_error
+from .tables import is_external_object
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -204,6 +205,10 @@ class ClassLookup(FlattenContext):
                                    "springc supports a subset of Modelica; see \"Not "
                                    "supported yet\" in docs/language.md")
             entry = self.follow_short(entry)[0]
+        constructor = member_class(entry, "constructor") \
+            if entry.defn.kind == "class" and is_external_object(entry) else None
+        if constructor is not None:  # `E(...)` of an external object (section 12.9.7)
+            entry = constructor
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])
