@@ -84,8 +84,8 @@ def native_call(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, Any
 def _construct(ev: ExpressionEvaluator, kind: str, given: dict[str, Any], call: s.Call
                ) -> Table:
     for name in ("fileName", "tableName"):
-        text = given.get(name, NO_NAME)
-        if isinstance(text, str) and text.strip() not in ("", NO_NAME):
+        text = _text(ev, given.get(name, NO_NAME), call)
+        if text.strip() not in ("", NO_NAME):
             raise FlattenError(
                 "tables read from files (tableOnFile = true) are not supported yet",
                 call.span, hint="give the table inline: table = [...]")
@@ -116,6 +116,16 @@ def _construct(ev: ExpressionEvaluator, kind: str, given: dict[str, Any], call: 
                  call.span)
     _check(made)
     return made
+
+
+def _text(ev: ExpressionEvaluator, value: Any, call: s.Call) -> str:
+    """A String argument: a string, or an if-expression on a parameter choosing one."""
+    while isinstance(value, x.If):
+        value = value.then if _number(ev, value.cond, call, "a condition") \
+            else value.otherwise
+    if not isinstance(value, str):
+        raise FlattenError("a file or table name of a table must be a String", call.span)
+    return value
 
 
 def _number(ev: ExpressionEvaluator, value: Any, call: s.Call, what: str) -> float:
@@ -203,7 +213,7 @@ def next_event(table: Table, t: x.Expr) -> x.Expr:
         event = _first_after(t, [p + shift for p in points])
     if math.isfinite(table.start_time):
         early = x.Call("noEvent", (x.BinOp("<", t, x.Const(table.start_time)),))
-        later = x.BinOp("<", x.Const(table.start_time), event)
+        later = x.Call("noEvent", (x.BinOp("<", x.Const(table.start_time), event),))
         event = x.If(early, x.If(later, x.Const(table.start_time), event), event)
     return event
 
