@@ -166,8 +166,10 @@ def test_table_2d_bilinear(tmp_path: Path) -> None:
 
 
 def test_constant_segments_integrate_exactly_with_time_events(tmp_path: Path) -> None:
-    """x = integral of a table of constant segments 1, 2, 3 on [0, 1), [1, 2), [2, 3]:
-    the time events at 1 and 2 restart the integration, so x(3) = 6 to the tolerance."""
+    """x = integral of a table of constant segments 1, 2 on [0, 1), [1, 2), and from 2
+    on the line through the last two points (3 + (t - 2), LastTwoPoints as documented):
+    the time events at 1 and 2 restart the integration, so x follows the exact integral
+    (x(3) = 6.5) to the tolerance."""
     path = tmp_path / "M.mo"
     path.write_text(
         "model M\n  Modelica.Blocks.Sources.CombiTimeTable s(table = [0, 1; 1, 2; 2, 3],"
@@ -177,7 +179,8 @@ def test_constant_segments_integrate_exactly_with_time_events(tmp_path: Path) ->
                                   cache=False)
     result = springc.simulate(model, stop=3.0, engine="scipy", rtol=1e-8)
     exact = np.where(result.time < 1, result.time, np.where(
-        result.time < 2, 1 + 2 * (result.time - 1), 3 + 3 * (result.time - 2)))
+        result.time < 2, 1 + 2 * (result.time - 1),
+        3 + 3 * (result.time - 2) + (result.time - 2) ** 2 / 2))
     assert np.max(np.abs(result["x"] - exact)) < 1e-6
 
 

@@ -35,7 +35,6 @@ from .control import (
 from .declarations import redeclared_class
 from .loops import check_loop_nest
 from .ranges import with_range
-from .tables import native_call, native_function
 from .scope import (
     ClassScope,
     ClassView,
@@ -44,6 +43,7 @@ from .scope import (
     Scope,
     ViewComponent,
 )
+from .tables import native_call, native_function
 
 MAX_DEPTH = 50
 
@@ -89,7 +89,8 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         for comp in comps:
             _declare(ev, scope, comp, given, call)
         if native_function(entry) is not None:
-            return native_call(ev, entry, scope.names, call)
+            native: a.Value = native_call(ev, entry, scope.names, call)
+            return native
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):

@@ -27,7 +27,6 @@ from .modification import Mod, from_syntax, merge_all
 from .outer_rules import check_outer_uses
 from .redeclare_rules import check_replaceables
 from .rules import check_class, check_extends, rule_error
-from .tables import is_external_object
 from .scope import (
     PRIMITIVES,
     ClassScope,
@@ -38,6 +37,7 @@ from .scope import (
     build_view,
     instance_mod,
 )
+from .tables import is_external_object
 
 
 class ClassLookup(FlattenContext):

@@ -18,8 +18,8 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from .class_extends import inherited_class
 from .scope import PRIMITIVES, ClassView, FlattenContext, ResolvedType, ViewComponent
-from .tables import is_external_object
 from .syntax_walk import mod_values, refs, same_text, statement_exprs, statements
+from .tables import is_external_object
 
 #: The kinds of base class each kind of class may extend (section 7.1.3's table).
 BASE_KINDS: dict[str, frozenset[str]] = {

@@ -16,6 +16,7 @@ than linear or constant segments are located errors naming the missing feature.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -92,8 +93,9 @@ def _construct(ev: ExpressionEvaluator, kind: str, given: dict[str, Any], call: 
     table = given.get("table")
     if not a.is_array(table) or table.ndim != 2:
         raise FlattenError("the table must be a matrix", call.span)
+    rows, width = int(table.shape[0]), int(table.shape[1])
     numbers = np.array([[_number(ev, v, call, "the table") for v in row] for row in table],
-                       dtype=float).reshape(table.shape)
+                       dtype=float).reshape((rows, width))
     if numbers.size == 0:
         raise FlattenError("the table is an empty matrix", call.span,
                            hint="give the table rows: table = [0, 0; 1, 1]")
@@ -103,9 +105,9 @@ def _construct(ev: ExpressionEvaluator, kind: str, given: dict[str, Any], call: 
         values = list(raw.flat) if a.is_array(raw) else [raw]
         columns = tuple(int(_number(ev, v, call, "columns")) for v in values)
         for c in columns:
-            if not 1 <= c <= numbers.shape[1]:
+            if not 1 <= c <= width:
                 raise FlattenError(f"column {c} is not a column of the table, which has "
-                                   f"{numbers.shape[1]}", call.span)
+                                   f"{width}", call.span)
     made = Table(kind, numbers, columns,
                  int(_number(ev, given.get("smoothness", x.ONE), call, "smoothness")),
                  int(_number(ev, given.get("extrapolation", x.Const(2)), call,
@@ -193,7 +195,7 @@ def next_event(table: Table, t: x.Expr) -> x.Expr:
     if table.time_events == NO_TIME_EVENTS or len(xs) < 2:
         points: list[float] = []
     elif table.time_events == AT_DISCONTINUITIES:
-        points = sorted({float(v) for v, w in zip(xs[:-1], xs[1:]) if v == w})
+        points = sorted({float(v) for v, w in itertools.pairwise(xs) if v == w})
     else:
         points = sorted({float(v) for v in xs})
     shift = table.shift_time
