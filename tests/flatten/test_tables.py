@@ -184,6 +184,19 @@ def test_constant_segments_integrate_exactly_with_time_events(tmp_path: Path) ->
     assert np.max(np.abs(result["x"] - exact)) < 1e-6
 
 
+def test_no_extrapolation_is_an_assertion(tmp_path: Path) -> None:
+    path = tmp_path / "M.mo"
+    path.write_text("model M\n  Modelica.Blocks.Tables.CombiTable1Ds t(table = [0, 0; 2, 1],"
+                    " u = time, extrapolation = Modelica.Blocks.Types.Extrapolation."
+                    "NoExtrapolation);\nend M;\n")
+    model = flatten_files([LIBRARY, path], "M")
+    (check,) = [a for a in model.assertions if "Extrapolation" in a.message]
+    assert check.message == ("Extrapolation error: the input u of the table must lie in "
+                             "[0, 2] (extrapolation = NoExtrapolation)")
+    holds = {u: bool(x.evaluate(check.condition, {"t.u": u}, u)) for u in (-0.1, 0, 2, 2.1)}
+    assert holds == {-0.1: False, 0: True, 2: True, 2.1: False}
+
+
 ERRORS = {
     "tableOnFile": ("tableOnFile = true, fileName = \"tab.txt\"",
                     "tables read from files (tableOnFile = true) are not supported yet"),

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import FlattenError, Note, Span
 from ..ir import expr as x
+from ..ir import flat
 from ..ir import syntax as s
 from ..ir.native_externals import NATIVE_EXTERNALS
 from ..parse import ClassEntry
@@ -172,14 +173,30 @@ def _getter(ev: ExpressionEvaluator, operation: str, table: Table, given: dict[s
                            f"{icol} is asked for", call.span)
     ys = table.table[:, table.columns[icol - 1] - 1]
     if operation == "value1D":
+        _inside(ev, table, given["u"], "the input u", call)
         return _interpolated(table, xs, ys, given["u"])
     t = given["t"]
     shifted = x.sub(t, x.Const(table.shift_time)) if table.shift_time else t
+    _inside(ev, table, shifted, "the time (less shiftTime)", call)
     value = _interpolated(table, xs, ys, shifted)
     if table.start_time <= -INF or not math.isfinite(table.start_time):
         return value
     before = x.Call("noEvent", (x.BinOp("<", t, x.Const(table.start_time)),))
     return x.If(before, x.ZERO, value)
+
+
+def _inside(ev: ExpressionEvaluator, table: Table, u: x.Expr, what: str, call: s.Call
+            ) -> None:
+    """NoExtrapolation: an assertion that ``u`` stays in the table's range."""
+    if table.extrapolation != ip.NO_EXTRAPOLATION:
+        return
+    low, high = float(table.table[0, 0]), float(table.table[-1, 0])
+    inside = x.BinOp("and", x.BinOp(">=", u, x.Const(low)), x.BinOp("<=", u, x.Const(high)))
+    message = (f"Extrapolation error: {what} of the table must lie in [{low:g}, {high:g}] "
+               "(extrapolation = NoExtrapolation)")
+    ev.flattener.assertions.append((flat.Assertion(
+        x.Call("noEvent", (inside,)), message, "error", call.span,
+        flat.Origin("equation", "", "table")), call.span))
 
 
 def _interpolated(table: Table, xs: np.ndarray, ys: np.ndarray, u: x.Expr) -> x.Expr:
