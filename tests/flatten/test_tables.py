@@ -221,3 +221,15 @@ def test_errors_are_located(tmp_path: Path, modifiers: str, message: str) -> Non
         flatten_files([LIBRARY, path], "M")
     text = str(caught.value)
     assert f"MslTables.mo:146:11: error: {message}" in text
+
+
+def test_each_instance_has_its_own_table(tmp_path: Path) -> None:
+    """An array of table blocks is not copied from one instance (templates): each
+    element's table comes from its own parameters."""
+    path = tmp_path / "M.mo"
+    path.write_text("model M\n  Modelica.Blocks.Tables.CombiTable1Ds t[3](table = {[0, 0; "
+                    "1, 1], [0, 0; 1, 2], [0, 0; 1, 3]}, each u = time);\nend M;\n")
+    model = flatten_files([LIBRARY, path], "M")
+    values = [float(x.evaluate(e.rhs, {f"t[{i}].u": 1.0 for i in (1, 2, 3)}, 1.0))
+              for i in (1, 2, 3) for e in model.equations if e.lhs == x.Var(f"t[{i}].y[1]")]
+    assert values == [1.0, 2.0, 3.0]
