@@ -233,3 +233,25 @@ def test_each_instance_has_its_own_table(tmp_path: Path) -> None:
     values = [float(x.evaluate(e.rhs, {f"t[{i}].u": 1.0 for i in (1, 2, 3)}, 1.0))
               for i in (1, 2, 3) for e in model.equations if e.lhs == x.Var(f"t[{i}].y[1]")]
     assert values == [1.0, 2.0, 3.0]
+
+
+def test_false_and_skips_an_operand_that_cannot_be_evaluated(tmp_path: Path) -> None:
+    """`tableOnFile and not Strings.isEmpty(fileName)`, as the MSL's table blocks
+    write it: with tableOnFile false the external string function is never needed."""
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "Lib.mo").write_text(
+        "package Lib\n  function isEmpty\n    input String s;\n    output Boolean b;\n"
+        "  external \"C\" b = ModelicaStrings_isEmpty(s);\n  end isEmpty;\nend Lib;\n")
+    path = tmp_path / "M.mo"
+    path.write_text("model M\n  parameter Boolean onFile = false;\n"
+                    "  parameter Boolean b = onFile and not Lib.isEmpty(\"x\");\n"
+                    "  parameter Boolean c = not onFile or Lib.isEmpty(\"x\");\n"
+                    "  parameter Boolean d = not onFile and Lib.isEmpty(\"x\");\nend M;\n")
+    with pytest.raises(SpringcError) as caught:
+        flatten_files([path], "M", [tmp_path / "lib"])
+    assert "Lib.mo:5:3: error: `external` functions are not supported yet" in str(
+        caught.value)
+    path.write_text(path.read_text().replace("  parameter Boolean d", "  // "))
+    model = flatten_files([path], "M", [tmp_path / "lib"])
+    bindings = {v.name: v.binding for v in model.variables if v.name in ("b", "c")}
+    assert bindings == {"b": x.Const(False), "c": x.Const(True)}
