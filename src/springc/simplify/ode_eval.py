@@ -134,8 +134,11 @@ class OdeEvaluator:
             return {}
         held: dict[str, float] = {}
         for d in model.events.discrete:
-            held[d.name] = 0.0 if d.start is None else float(
-                x.evaluate(d.start, self.params))
+            try:
+                held[d.name] = 0.0 if d.start is None else float(
+                    x.evaluate(d.start, self.params, initial=True))
+            except (KeyError, ArithmeticError, ValueError):
+                continue  # a start value that is not a parameter expression: unknown
         for name in model.events.pre:
             held[f"pre({name})"] = held.get(name, starts.get(name, 0.0))
         return held
