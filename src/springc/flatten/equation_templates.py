@@ -18,6 +18,7 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from .scope import ClassView, FlattenContext, ViewComponent
+from .tables import is_external_object
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,8 @@ def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
         return False
     if rtype.entry is None:
         return True
+    if is_external_object(rtype.entry):
+        return False  # a table: numbers folded from each instance's parameters
     return rtype.entry.defn.kind not in ("function", "package") \
         and class_ok(flattener.view(rtype.entry))
 

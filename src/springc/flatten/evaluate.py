@@ -15,7 +15,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..errors import FlattenError, Span
+from ..errors import FlattenError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
@@ -213,7 +213,16 @@ class Evaluator(ReferenceResolver):
 
     def _Binary(self, e: s.Binary, scope: Scope) -> a.Value:
         left = self.value(e.left, scope)
-        right = self.value(e.right, scope)
+        try:
+            right = self.value(e.right, scope)
+        except SpringcError:
+            # `false and f(...)`: the result is known without the right operand, as
+            # the MSL's tables write `tableOnFile and not Strings.isEmpty(fileName)`
+            decided = self._folded(left) if e.op in ("and", "or") and isinstance(
+                left, x.Expr) else None
+            if decided is None or decided != (e.op == "or"):
+                raise
+            return x.Const(decided)
         scalar = _ARITHMETIC.get(e.op)
         if scalar is not None and (type(left) is x.Call or type(right) is x.Call):
             check_arithmetic_operands(e.op, (left, right), e)

@@ -43,6 +43,7 @@ from .scope import (
     Scope,
     ViewComponent,
 )
+from .tables import native_call, native_function
 
 MAX_DEPTH = 50
 
@@ -87,6 +88,9 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
+        if native_function(entry) is not None:
+            native: a.Value = native_call(ev, entry, scope.names, call)
+            return native
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):

@@ -32,7 +32,15 @@ from ..ir import flat
 from . import arrays as a
 from .equation_templates import fixed_shape, renamer
 from .modification import Mod
-from .scope import ClassScope, ClassView, Disabled, FlattenContext, Primitive, ViewComponent
+from .scope import (
+    ClassScope,
+    ClassView,
+    Disabled,
+    FlattenContext,
+    ObjectMember,
+    Primitive,
+    ViewComponent,
+)
 
 Shape = tuple[Any, ...]
 
@@ -239,7 +247,7 @@ def _copy_members(source: ClassScope, target: ClassScope, rename: Callable[[x.Ex
             target.members[name] = _copy_primitive(member, rename, prefix, cut)
         elif isinstance(member, ClassScope):
             target.members[name] = _copy_scope(member, target, rename, prefix, cut)
-        elif isinstance(member, Disabled):
+        elif isinstance(member, Disabled | ObjectMember):
             target.members[name] = member
         else:
             items = [_copy_scope(m, target, rename, prefix, cut) for m in member.flat]

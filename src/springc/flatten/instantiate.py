@@ -49,6 +49,7 @@ from .scope import (
     instance_mod,
 )
 from .strings import string_component
+from .tables import is_external_object, table_object
 from .type_rules import (
     check_constant_binding,
     check_discrete_binding,
@@ -132,6 +133,10 @@ class Instantiation(FlattenContext):
                                [Note(f"'{rtype.entry.full_name}' is declared partial here",
                                      rtype.entry.defn.span)],
                                "use a class that extends it")
+        if is_external_object(rtype.entry):
+            value = self.mod_value(mod.value) if mod is not None and mod.value is not None \
+                else None
+            return table_object(self.evaluator, rtype.entry, value, name, decl.span)
         self._check_containment(scope, rtype.entry, decl, name)
         view = self._used_view(rtype.entry, decl, name)
         through = named_through(self, scope, comp.decl, package, rtype.entry)

@@ -36,6 +36,7 @@ from .scope import (
     build_view,
     instance_mod,
 )
+from .tables import is_external_object
 
 
 class ClassLookup(FlattenContext):
@@ -203,6 +204,10 @@ class ClassLookup(FlattenContext):
                                    "springc supports a subset of Modelica; see \"Not "
                                    "supported yet\" in docs/language.md")
             entry = self.follow_short(entry)[0]
+        constructor = member_class(entry, "constructor") \
+            if entry.defn.kind == "class" and is_external_object(entry) else None
+        if constructor is not None:  # `E(...)` of an external object (section 12.9.7)
+            entry = constructor
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])

@@ -19,6 +19,7 @@ from ..parse import ClassEntry
 from .class_extends import inherited_class
 from .scope import PRIMITIVES, ClassView, FlattenContext, ResolvedType, ViewComponent
 from .syntax_walk import mod_values, refs, same_text, statement_exprs, statements
+from .tables import is_external_object
 
 #: The kinds of base class each kind of class may extend (section 7.1.3's table).
 BASE_KINDS: dict[str, frozenset[str]] = {
@@ -107,7 +108,8 @@ def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
     class, has type prefixes or is a simple type (4.5.2)."""
     kind = entry.defn.kind
     allowed = BASE_KINDS.get(kind)
-    clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)]
+    clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)
+               and e.base.dotted != "ExternalObject"]  # predefined (section 12.9.7)
     for element in clauses:
         inherited = entry.defn.class_extends and element is entry.defn.elements[0]
         base = inherited_class(ctx.resolve_class, entry, element.span) if inherited \
@@ -258,8 +260,10 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
                 + ("a record or type" if kind == "record" else "a connector, record or type"),
                 "4.6")
     prefixes = [p for p in (variability, causality, "flow" if flow else "") if p]
+    external = type_kind == "class" and is_external_object(rtype.entry)
     if prefixes and type_kind not in ("record", "type", "connector") and not (
-            type_kind == "function" and causality == "input" and not variability):
+            type_kind == "function" and causality == "input" and not variability) and not (
+            external and not flow):  # parameters, constants, inputs (section 12.9.7)
         raise rule_error(
             f"the prefix `{prefixes[0]}` cannot be applied to '{decl.name}', a component "
             f"of the {type_kind} '{rtype.entry.full_name}'", decl.span,

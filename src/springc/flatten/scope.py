@@ -107,6 +107,11 @@ class Disabled:
     name: str
 
 
+class ObjectMember:
+    """A member that is a value of its own and no variables: an external object
+    (``flatten/tables.py``: a ModelicaStandardTables table)."""
+
+
 class DisabledReference(FlattenError):
     """A reference to a disabled conditional component (see :class:`Disabled`)."""
 
@@ -203,7 +208,7 @@ class ClassScope:
             if comp.decl.outer and not comp.decl.inner:
                 continue
             member = self.inner_part(name) if comp.decl.outer else self.member(name)
-            if not isinstance(member, Disabled):
+            if not isinstance(member, Disabled | ObjectMember):
                 yield name, member
         for name, (added, _) in self.added_inners.items():
             yield name, added  # type: ignore[misc]
@@ -267,7 +272,7 @@ class FunctionScope:
 #: Where a name is looked up: an instance, loop indices over one, or a function call.
 Scope = ClassScope | LocalScope | FunctionScope
 #: A member of an instance: a primitive variable, a component, or an array of components.
-Member = Primitive | ClassScope | np.ndarray | Disabled
+Member = Primitive | ClassScope | np.ndarray | Disabled | ObjectMember
 
 
 @dataclass(frozen=True, slots=True)
@@ -402,8 +407,8 @@ def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEn
     initial: list[ViewEquation] = []
     mods: list[tuple[s.Modification, ClassEntry]] = []
     for element in entry.defn.elements:
-        if not isinstance(element, s.Extends):
-            continue
+        if not isinstance(element, s.Extends) or element.base.dotted == "ExternalObject":
+            continue  # the predefined base of external objects has no elements (12.9.7)
         if entry.defn.class_extends and element is entry.defn.elements[0]:
             base = inherited_class(flattener.resolve_class, entry, element.span)
         else:

@@ -433,9 +433,24 @@ class ClassDef:
     # Constructs outside springc's subset written in this class (``... not supported
     # yet`` errors, errors.ParseError), reported when a model uses the class.
     unsupported: tuple[ParseError, ...] = ()
+    # `external "C" ...` of a function springc evaluates natively (ir.native_externals)
+    external: ExternalCall | None = None
 
 
 Element = Component | Extends | Import | ClassDef
+
+
+@dataclass(frozen=True, slots=True)
+class ExternalCall:
+    """The external clause of a function springc evaluates natively
+    (``external "C" y = name(a, b)``, section 12.9): the foreign function's name, the
+    output it assigns, and its arguments as written."""
+
+    language: str
+    name: str
+    output: str | None
+    args: tuple[Expr, ...]
+    span: Span
 
 
 @dataclass(frozen=True, slots=True)

@@ -18,13 +18,16 @@ from lark import Token
 from lark.tree import Meta
 
 from ..errors import Note, Span
+from ..ir.native_externals import NATIVE_EXTERNALS
 from ..ir.syntax import (
     AlgorithmSection,
     ClassDef,
     Component,
     Element,
     Extends,
+    ExternalCall,
     Modification,
+    Ref,
     ShortDef,
     StoredDefinition,
 )
@@ -145,6 +148,7 @@ class ClassRules(RuleBase):
             protected=False, span=span, enumeration=spec.enumeration,
             class_extends=spec.class_extends,
             unsupported=self.take_deferred(span) if self.defer else (),
+            external=body["external"][0] if body["external"] else None,
         )
 
     def short_class_definition(self, meta: Meta, ch: list[Any]) -> Any:
@@ -154,7 +158,7 @@ class ClassRules(RuleBase):
     def _body(self, sections: tuple[_Section, ...], kind: str) -> dict[str, tuple[Any, ...]]:
         body: dict[str, list[Any]] = {"elements": [], "equation": [], "initial equation": [],
                                       "algorithm": [], "annotations": [],
-                                      "algorithm_sections": []}
+                                      "algorithm_sections": [], "external": []}
         for section in sections:
             if section.kind in ("algorithm", "initial algorithm") and kind != "function":
                 statements = tuple(i for i in section.items
@@ -167,6 +171,9 @@ class ClassRules(RuleBase):
                            "`algorithm` section, and has no equations and no initial "
                            "algorithms (Modelica 3.6, section 12.2)")
             elif section.kind == "external":
+                if section.items and section.items[0].name in NATIVE_EXTERNALS:
+                    body["external"].append(section.items[0])
+                    continue
                 self.reject("`external` functions are", section.span)
             elif section.kind == "algorithm" and body["algorithm_sections"]:
                 self.error("a function can have at most one `algorithm` section",
@@ -268,10 +275,18 @@ class ClassRules(RuleBase):
     initial_algorithm_section = _section_rule("initial algorithm")
 
     def external_part(self, meta: Meta, ch: list[Any]) -> Any:
-        return _Section("external", (), self.keyword_span(meta, "external"))
+        call = ch[0] if ch and isinstance(ch[0], ExternalCall) else None
+        return _Section("external", (call,) if call is not None else (),
+                        self.keyword_span(meta, "external"))
 
     def external_clause(self, meta: Meta, ch: list[Any]) -> Any:
-        return None
+        language = next((str(c)[1:-1] for c in ch if isinstance(c, Token)
+                         and c.type == "STRING"), "C")
+        call = next((c for c in ch if isinstance(c, ExternalCall)), None)
+        return replace(call, language=language) if call is not None else None
 
     def external_call(self, meta: Meta, ch: list[Any]) -> Any:
-        return None
+        output = None
+        if ch and isinstance(ch[0], Ref):
+            output, ch = ch[0].dotted, ch[1:]
+        return ExternalCall("C", str(ch[0]), output, tuple(ch[1:]), self.span_of(meta))

@@ -65,9 +65,13 @@ class InitialInfo:
 def conditions(model: ode.ODE) -> tuple[Condition, ...]:
     """The conditions of step 2 of the module docstring."""
     state_names = {s.name for s in model.states}
+    # fixed = true on a variable that pre() reads sets its pre value (section 8.6):
+    # the value held before the first event, not a condition on the continuous start
+    held = set(model.events.pre) if model.events is not None else set()
     out = [Condition(r.describe(), r.expr, r.span) for r in model.dae.initial_equations]
     for u in model.dae.unknowns:
-        if u.fixed and u.start is not None and u.name not in state_names:
+        if u.fixed and u.start is not None and u.name not in state_names \
+                and u.name not in held:
             out.append(Condition(f"{u.name} = {x.to_text(u.start)} (fixed start value)",
                                  x.sub(x.Var(u.name), u.start), u.span))
     return tuple(out)

@@ -112,14 +112,33 @@ class OdeEvaluator:
         self.names = [s.name for s in model.states]
         self.derivatives = [s.derivative for s in model.states]
         self.guess = start_values(model.dae.unknowns, self.params)
+        self.held = self._held_starts(model, self.guess)
         self.guess.update(guess or {})
         self.newton_tol = newton_tol
         self.max_iterations = max_iterations
+
+    def _held_starts(self, model: ode.ODE, starts: Mapping[str, float]
+                     ) -> dict[str, float]:
+        """The discrete variables and the ``pre`` values at their start values, as
+        they are before the first event (``pre(v)`` is read as ``env['pre(v)']``)."""
+        if model.events is None:
+            return {}
+        held: dict[str, float] = {}
+        for d in model.events.discrete:
+            try:
+                held[d.name] = 0.0 if d.start is None else float(
+                    x.evaluate(d.start, self.params, initial=True))
+            except (KeyError, ArithmeticError, ValueError):
+                continue  # a start value that is not a parameter expression: unknown
+        for name in model.events.pre:
+            held[f"pre({name})"] = held.get(name, starts.get(name, 0.0))
+        return held
 
     def values(self, t: float, states: Iterable[float]) -> dict[str, float]:
         """All parameters, states and step variables at time ``t``; a step that leaves
         the domain of an operation raises :class:`SimulationError` naming it."""
         env: dict[str, float] = dict(self.params)
+        env.update(self.held)
         env.update(zip(self.names, (float(v) for v in states)))
         for step in self.model.steps:
             try:
