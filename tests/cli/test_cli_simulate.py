@@ -129,7 +129,7 @@ def test_set_structural_parameter(tmp_path: Path) -> None:
 def test_set_unknown_parameter(tmp_path: Path) -> None:
     code, _, stderr = run("simulate", SEED, "--set", "spring.kk=1")
     assert code == 1
-    assert "error: 'spring.kk' is not a parameter of SpringMass" in stderr
+    assert "error: 'spring.kk' is not a parameter or a state of SpringMass" in stderr
     assert "help: did you mean 'spring.k'" in stderr
 
 

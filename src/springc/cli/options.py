@@ -99,8 +99,11 @@ def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str]
 def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """The options of a run shared by ``simulate`` and ``tradeoff``."""
     func = click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
-                        help="Set a parameter (repeatable); array sizes re-flatten the "
-                        "model.")(func)
+                        help="Set a parameter or the start value of a state "
+                        "(repeatable; as OpenModelica's -override). A fixed start "
+                        "(fixed=true) is the initial value; a free one is the guess of "
+                        "the initial equations. Array sizes re-flatten the model; start "
+                        "values never recompile it.")(func)
     func = click.option("--interval", type=float,
                         help="Output interval [s] (default: experiment, else "
                         "(stop-start)/500).")(func)
