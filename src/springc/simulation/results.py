@@ -16,16 +16,16 @@ import csv
 import difflib
 import io
 import os
-from collections.abc import Iterable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import OutputError, UnknownNameError, UsageError
+from ..errors import OutputError, SpringcError, UnknownNameError, UsageError
 from ..fileio import OutputSet, PathLike, atomic_write
-from .plot_layout import choose_layout
+from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
@@ -113,6 +113,11 @@ class SimulationResult:
     error_estimate: ErrorEstimate | None = None
     #: the description strings of the model's variables and parameters, by flat name
     descriptions: dict[str, str] = field(default_factory=dict)
+    #: the discrete variables (drawn as steps)
+    discrete: tuple[str, ...] = ()
+    #: the same run on another grid (``runner.Rerun``: a plot's finer grid); None: none
+    rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False,
+                                                            compare=False)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -295,8 +300,32 @@ def draw_figure(result: SimulationResult) -> Any:
     legend; per family with heat maps for a large result), its note under the title."""
     from .figure import draw_layout  # matplotlib loads with the first plot
 
-    layout = choose_layout(result.names, result.units, result.values)
-    return draw_layout(result.model, result.time, result.values, layout, result.names)
+    layout = choose_layout(result.names, result.units, result.values, result.discrete)
+    drawn = _finer(result, layout)
+    if drawn is not result:
+        layout = replace(layout, note="; ".join(filter(None, (
+            f"drawn on {len(drawn.time):,} times (the output grid has {len(result.time):,})",
+            layout.note))))
+    return draw_layout(result.model, drawn.time, drawn.values, layout, result.names)
+
+
+def _finer(result: SimulationResult, layout: PlotLayout) -> SimulationResult:
+    """``result``, or its run again on the finer grid its curves need
+    (:func:`.plot_layout.plot_points`) and, with events, with rows at both sides of
+    each event (a jump drawn upright); heat maps are drawn from the output grid, and a
+    run that fails leaves it."""
+    if result.rerun is None or any(p.kind == HEATMAP for p in layout.panels):
+        return result
+    smooth = [c for p in layout.panels for c in p.columns if c not in p.steps]
+    points = plot_points(result.values, smooth)
+    if not points and not result.events:
+        return result
+    points = max(points, len(result.time))  # events: their left and right limits too
+    try:
+        fine = result.rerun(points)
+    except SpringcError:
+        return result
+    return fine if fine.names == result.names else result
 
 
 def render_plot(result: SimulationResult, kind: str = "png") -> tuple[bytes, str]:

@@ -182,7 +182,28 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     result = error_control.controlled(options, error_control.Asked(mode, rtol, atol),
                                       lambda run: simulate_once(model, run))
     result.descriptions = model.descriptions
+    result.discrete = tuple(getattr(model.module, "DISCRETE", ()))
+    result.rerun = Rerun(model, replace(
+        options, progress=None, error_control="off",
+        rtol=result.stats.rtol if result.stats.rtol is not None else options.rtol,
+        atol=result.stats.atol if result.stats.atol is not None else options.atol))
     return result
+
+
+@dataclass(frozen=True)
+class Rerun:
+    """The run of a result again on a grid of other ``points`` (a plot's finer grid:
+    :func:`.plot_layout.plot_points`), at the tolerances the result was run at, without
+    error control, with the rows at both sides of each event: the result itself and
+    its grid stay as they are."""
+
+    model: CompiledModel
+    options: SimulationOptions
+
+    def __call__(self, points: int) -> SimulationResult:
+        start, stop = resolve(self.model, self.options)[:2]
+        return simulate_once(self.model, replace(
+            self.options, interval=(stop - start) / (points - 1), event_rows=True))
 
 
 def simulate_once(model: CompiledModel, options: SimulationOptions) -> SimulationResult:
