@@ -28,6 +28,8 @@ from .options import (
     run_options,
     single_threaded_blas,
     units_option,
+    verbosity,
+    verbosity_options,
 )
 
 
@@ -80,7 +82,7 @@ from .options import (
               help="Write a plot: .png, .svg or .pdf.")
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress bar and no summary line.")
+@verbosity_options("No progress bar and no summary line.")
 @units_option
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -91,7 +93,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
-             event_rows: bool, quiet: bool, strict_units: bool) -> None:
+             event_rows: bool, strict_units: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from ..simulation import (
         PLOT_FORMATS,
@@ -135,6 +137,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if not patterns and (output or not plot):  # the default trajectory of every output
         check_trajectory_size(compiled, SimulationOptions(start, stop, interval),
                               f"-o {output}" if output else "the CSV on stdout")
+    level = verbosity()
+    quiet = level < 0
     progress = None if quiet or not sys.stderr.isatty() else sys.stderr
     with warnings.catch_warnings():  # said below as the command's own warning
         warnings.simplefilter("ignore", AccuracyWarning)
@@ -155,7 +159,11 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     else:
         write_csv(result, sys.stdout)
         sys.stdout.flush()
-    if not quiet:
+    if level == 0:
+        click.echo(result.stats.brief(result.model), err=True)
+    elif level > 0:
         click.echo(result.stats.summary(result.model), err=True)
+    if level > 1:
+        click.echo(f"note: generated module {compiled.path}", err=True)
     if result.stats.warning:  # even with --quiet: the answer missed its tolerance
         click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)

@@ -75,9 +75,28 @@ class SimulationStats:
     error_tolerance: float | None = None
     warning: str = ""
 
+    def brief(self, model: str) -> str:
+        """The short summary line (about 100 characters): model, solver, steps, events,
+        the estimated error against its tolerance and the rtol it was reached at, wall
+        time (``SpringMass: dop853 (auto), 2,268 steps, est. error 4e-06 <= 0.0003 at
+        rtol 1e-09, 3.41 s``); :meth:`summary` has the full detail (``-v``)."""
+        parts = [f"{model}: {self.solver}{' (auto)' if self.reason else ''}",
+                 f"{self.steps:,} steps"]
+        events = self.state_events + self.time_events
+        if events:
+            parts.append(f"{events:,} event{'s' if events != 1 else ''}")
+        if self.estimated_error is not None:
+            text = f"est. error {_short(self.estimated_error)}"
+            if self.error_tolerance is not None:
+                within = self.estimated_error <= self.error_tolerance
+                text += f" {'<=' if within else '>'} {_short(self.error_tolerance)}"
+            parts.append(text + (f" at rtol {_short(self.rtol)}" if self.rtol else ""))
+        parts.append(f"{self.wall_time:.2f} s")
+        return ", ".join(parts)
+
     def summary(self, model: str) -> str:
-        """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
-        evaluations, wall time."""
+        """One line with the full detail (``-v``): solver and engine (``auto -> dop853
+        (compiled) (why)``), steps, evaluations, wall time, the error estimate, notes."""
         solver = f"{self.solver} ({self.engine})"
         why = f"{self.reason}; {self.engine_reason}" if self.engine_reason else self.reason
         if self.reason:
@@ -93,6 +112,11 @@ class SimulationStats:
                    if self.state_events or self.time_events else "")
                 + (f"; {self.error}" if self.error else "")
                 + (f"; note: {self.note}" if self.note else ""))
+
+
+def _short(value: float) -> str:
+    """One significant digit, the exponent without a leading zero (``4e-6``)."""
+    return f"{value:.1g}".replace("e-0", "e-").replace("e+0", "e+")
 
 
 @dataclass
