@@ -44,7 +44,7 @@ def test_internal_error_exit_3_without_traceback(monkeypatch: pytest.MonkeyPatch
     code, out, err = run("check", SEED)
     assert (code, out) == (3, "")
     assert err == ("internal error: ZeroDivisionError: boom\n"
-                   "this is a bug in springc; rerun with --debug for the traceback and "
+                   "this is a bug in springc; rerun with -vv for the traceback and "
                    "report it\n")
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -57,18 +58,31 @@ def test_seed_csv_and_png(tmp_path: Path) -> None:
     for line in out.read_text().splitlines()[1:5]:
         assert all(repr(float(v)) == v for v in line.split(","))
     assert stdout == ""
-    # the default engine: the numba module in the compiled loop, and why
-    assert "SpringMass: auto -> dop853 (compiled) (non-stiff: " in stderr
-    assert "; dop853 ran in the compiled loop (numba, no Python per step))" in stderr
-    assert " steps, " in stderr
-    # dop853 at the default rtol 1e-6 misses the rule by 26x: rerun at 1e-9, and said so
-    assert "; tightened rtol 1e-6 -> 1e-9: est. error " in stderr
+    # the short summary: dop853 at the default rtol 1e-6 misses the rule by 26x, so the
+    # run kept is at 1e-9
+    summary = stderr.splitlines()[-1]
+    assert re.fullmatch(r"SpringMass: dop853 \(auto\), [\d,]+ steps, est\. error \S+ <= "
+                        r"0\.0003 at rtol 1e-9, [\d.]+ s", summary), summary
+    assert len(summary) <= 120
     import matplotlib.image
 
     image = matplotlib.image.imread(str(png))
     assert image.shape[0] > 300 and image.shape[1] > 300
     assert image[..., :3].std() > 0.05  # not blank
     assert not list(tmp_path.glob(".*part"))
+
+
+def test_verbose_summary_has_the_detail(tmp_path: Path) -> None:
+    code, _, stderr = run("simulate", SEED, "-o", str(tmp_path / "seed.csv"), "-v")
+    assert code == 0, stderr
+    # the default engine: the numba module in the compiled loop, and why
+    assert "SpringMass: auto -> dop853 (compiled) (non-stiff: " in stderr
+    assert "; dop853 ran in the compiled loop (numba, no Python per step))" in stderr
+    assert " steps, " in stderr
+    # dop853 at the default rtol 1e-6 misses the rule by 26x: rerun at 1e-9, and said so
+    assert "; tightened rtol 1e-6 -> 1e-9: est. error " in stderr
+    code, _, stderr = run("simulate", SEED, "-o", str(tmp_path / "seed.csv"), "-vv", "-q")
+    assert (code, stderr) == (0, "")  # --quiet wins
 
 
 def test_csv_to_stdout_and_quiet() -> None:
@@ -129,7 +143,7 @@ def test_set_structural_parameter(tmp_path: Path) -> None:
 def test_set_unknown_parameter(tmp_path: Path) -> None:
     code, _, stderr = run("simulate", SEED, "--set", "spring.kk=1")
     assert code == 1
-    assert "error: 'spring.kk' is not a parameter of SpringMass" in stderr
+    assert "error: 'spring.kk' is not a parameter or a state of SpringMass" in stderr
     assert "help: did you mean 'spring.k'" in stderr
 
 
@@ -162,7 +176,7 @@ def test_each_solver_runs() -> None:
         step = ["--step", "1e-4"] if solver in FIXED_STEP else []
         for backend in ("python", "numba"):  # auto's engine: scipy, then compiled
             code, _, stderr = run("simulate", SEED, "--solver", solver, "--stop", "0.2",
-                                  "--vars", "spring.x", "--backend", backend, *step)
+                                  "--vars", "spring.x", "--backend", backend, "-v", *step)
             assert code == 0, stderr
             compiled = backend == "numba" and solver in COMPILED_SOLVERS
             engine = "compiled" if compiled else "scipy"
@@ -177,9 +191,10 @@ def test_each_solver_runs() -> None:
 
 def test_cache_and_no_cache() -> None:
     run("simulate", SEED, "--stop", "0.1", "--vars", "spring.x")
-    _, _, stderr = run("simulate", SEED, "--stop", "0.1", "--vars", "spring.x")
+    _, _, stderr = run("simulate", SEED, "--stop", "0.1", "--vars", "spring.x", "-v")
     assert "cached in" in stderr
-    _, _, stderr = run("simulate", SEED, "--stop", "0.1", "--vars", "spring.x", "--no-cache")
+    _, _, stderr = run("simulate", SEED, "--stop", "0.1", "--vars", "spring.x", "--no-cache",
+                       "-v")
     assert "compiled in" in stderr
 
 

@@ -57,6 +57,6 @@ def test_variables_asked_for_and_plots_are_written(tmp_path: Path,
 def test_changing_vars_does_not_compile_again() -> None:
     code, _, err = run("simulate", SEED, "--vars", "mass.pos[*]", "--stop", "0.1")
     assert code == 0
-    code, out, err = run("simulate", SEED, "--vars", "mass.v[2]", "--stop", "0.1")
+    code, out, err = run("simulate", SEED, "--vars", "mass.v[2]", "--stop", "0.1", "-v")
     assert code == 0 and out.splitlines()[0] == "time,mass.v[2]"
     assert "; cached in " in err.splitlines()[-1]

@@ -200,11 +200,12 @@ def test_hybrid_model_on_the_default_engine(models: str) -> None:
 
 def test_cli_defaults_to_the_compiled_engine(tmp_path: Path) -> None:
     out = tmp_path / "seed.csv"
-    result = CliRunner().invoke(main, ["simulate", SEED, "--stop", "0.5", "-o", str(out)])
+    result = CliRunner().invoke(main, ["simulate", SEED, "--stop", "0.5", "-o", str(out),
+                                       "-v"])
     assert result.exit_code == 0, result.output
     assert "SpringMass: auto -> dop853 (compiled) (" in result.output
     scipy_run = CliRunner().invoke(main, ["simulate", SEED, "--stop", "0.5", "--engine",
-                                          "scipy", "-o", str(tmp_path / "scipy.csv")])
+                                          "scipy", "-o", str(tmp_path / "scipy.csv"), "-v"])
     assert scipy_run.exit_code == 0, scipy_run.output
     assert "auto -> dop853 (scipy) (" in scipy_run.output
     assert "dop853 ran in scipy's loop, as --engine scipy asks" in scipy_run.output

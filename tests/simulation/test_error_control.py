@@ -308,7 +308,7 @@ def test_cli_summary_and_warning(tmp_path: Path) -> None:
     api = springc.simulate(model, stop=2.0)
     estimate = api.error_estimate
     assert estimate is not None and api.stats.rtol == 1e-9
-    result = CliRunner().invoke(main, ["simulate", SEED, "--stop", "2", "-o",
+    result = CliRunner().invoke(main, ["simulate", SEED, "--stop", "2", "-v", "-o",
                                        str(tmp_path / "r.csv")])
     assert result.exit_code == 0, result.output
     i = estimate.worst

@@ -133,7 +133,7 @@ def test_error_output_table_and_unchanged_csv(tmp_path: Path) -> None:
     out = tmp_path / "run.csv"
     result = CliRunner().invoke(main, ["simulate", SEED, "--backend", "numba", "--solver",
                                        "dop853", "--error-control", "warn", "-o", str(out),
-                                       "--error-output", str(tmp_path / "errors.csv")])
+                                       "--error-output", str(tmp_path / "errors.csv"), "-v"])
     assert result.exit_code == 0, result.output
     assert "; est. error " in result.stderr
     with out.open() as f:

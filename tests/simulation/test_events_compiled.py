@@ -267,7 +267,7 @@ def test_auto_engine_chooses_compiled_for_numba_hybrid_models(
     for engine in ("scipy", "compiled"):
         out = CliRunner().invoke(main, ["simulate", str(path), "--backend", "numba",
                                         "--solver", "rk4", "--step", "0.001", "--stop", "1.5",
-                                        "--engine", engine, "--error-control", "off"])
+                                        "--engine", engine, "--error-control", "off", "-v"])
         assert out.exit_code == 0, out.output
         lines.append(out.output.splitlines()[-1])
     # the same steps (1500 and one more after each event) and events on both engines

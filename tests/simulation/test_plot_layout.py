@@ -16,10 +16,13 @@ from springc.simulation.plot_layout import (
     HEATMAP,
     LINES,
     MAX_LEGEND,
+    MAX_PLOT_POINTS,
+    SAMPLES_PER_PERIOD,
     Panel,
     choose_layout,
     copies_of,
     families,
+    plot_points,
 )
 
 SCENES = str(Path(__file__).resolve().parents[2] / "models" / "Scenes.mdl")
@@ -80,7 +83,7 @@ def test_a_quantity_of_more_than_a_legend_makes_family_panels() -> None:
     values = np.column_stack([t * i for i in range(1, n + 1)] + [t ** 3, t ** 4])
     layout = choose_layout(names, ["m"] * n + ["J", "J"], values)
     assert layout.panels == (
-        Panel(HEATMAP, f"c[:].s: {n} variables, c[1].s (bottom) to c[{n}].s (top)",
+        Panel(HEATMAP, f"c[:].s: {n} variables, c[1].s (top) to c[{n}].s (bottom)",
               "position [m]", tuple(range(n))),
         Panel(LINES, "e (energy)", "energy [J]", (n,), ("e",)),
         Panel(LINES, "f (energy)", "energy [J]", (n + 1,), ("f",)))
@@ -92,7 +95,7 @@ def test_the_cloth_gets_heat_maps_of_positions_and_velocities(cloth: SimulationR
                                                              ) -> None:
     layout = choose_layout(cloth.names, cloth.units, cloth.values)
     assert [(p.kind, p.title, p.label) for p in layout.panels] == [
-        (HEATMAP, f"p[:].{q}: 16 variables, p[1,1].{q} (bottom) to p[4,4].{q} (top)", label)
+        (HEATMAP, f"p[:].{q}: 16 variables, p[1,1].{q} (top) to p[4,4].{q} (bottom)", label)
         for q, label in (("pos[1]", "position [m]"), ("pos[2]", "position [m]"),
                          ("v[1]", "velocity [m/s]"), ("v[2]", "velocity [m/s]"))]
     assert [cloth.names[c] for c in layout.panels[1].columns] == [
@@ -143,3 +146,84 @@ def test_a_legend_entry_names_at_most_two_copies() -> None:
     layout = choose_layout(["a", "b", "c", "d", "e"], [""] * 5, values)
     assert layout.panels[0].labels == ("a = b = -c (+1 more)",)
     assert layout.copies == {1: (0, 1), 2: (0, -1), 3: (0, 1)}
+
+
+SEED = str(Path(__file__).resolve().parents[2] / "models" / "SpringMass.mdl")
+
+
+def test_the_seed_draws_direction_once_as_a_copy_of_position() -> None:
+    result = springc.simulate(SEED)
+    layout = choose_layout(result.names, result.units, result.values)
+    assert [(p.title, p.labels) for p in layout.panels] == [
+        ("position", ("mass.pos[1] = spring.dir[1]", "mass.pos[2] = spring.dir[2]")),
+        ("velocity", ("mass.v[1]", "mass.v[2]")), ("x", ("spring.x",))]
+    assert layout.copies == {4: (0, 1), 5: (1, 1)}
+
+
+def test_copies_of_wide_random_columns_are_found_whatever_their_position() -> None:
+    # a BLAS product may sum equal columns in different orders; the row-by-row sums do not
+    values = np.random.default_rng(1).standard_normal((501, 40))
+    values[:, 37] = values[:, 3]
+    values[:, 38] = -values[:, 11]
+    assert copies_of(values) == {37: (3, 1), 38: (11, -1)}
+
+
+def test_an_under_sampled_oscillation_asks_for_a_finer_grid() -> None:
+    t = np.linspace(0.0, 10.0, 501)  # the seed's grid: 3 rows per period of 16 Hz
+    fast, slow = np.sin(2 * np.pi * 16 * t), np.sin(2 * np.pi * 0.5 * t)
+    values = np.column_stack([slow, fast, np.floor(t)])
+    assert plot_points(values, [0]) == 0  # 100 rows per period: enough
+    assert plot_points(values, [0, 2]) == 0  # a staircase has no extrema
+    points = plot_points(values, [0, 1])
+    assert 2 * 501 <= points <= MAX_PLOT_POINTS
+    fine = np.linspace(0.0, 10.0, MAX_PLOT_POINTS)
+    assert plot_points(np.sin(2 * np.pi * 16 * fine)[:, None], [0]) == 0
+    # 160 periods on the fine grid need 16 rows each: 2,560 <= 8,000
+    assert 160 * SAMPLES_PER_PERIOD <= MAX_PLOT_POINTS
+
+
+def test_discrete_variables_are_drawn_as_steps() -> None:
+    t = np.linspace(0.0, 1.0, 5)
+    values = np.column_stack([t, np.floor(4 * t), t * t])
+    layout = choose_layout(["h", "n", "m.s"], ["m", "", "m"], values, discrete=("n",))
+    assert layout.panels == (
+        Panel(LINES, "position", "position [m]", (0, 2), ("h", "m.s")),
+        Panel(LINES, "n", "n", (1,), ("n",), (1,)))
+
+
+BOUNCE = """model Bounce
+  parameter Real g(unit = "m/s2") = 9.81;
+  Real h(start = 1, fixed = true, unit = "m");
+  Real v(start = 0, fixed = true, unit = "m/s");
+  Integer n(start = 0, fixed = true);
+equation
+  der(h) = v;
+  der(v) = -g;
+  when h < 0 then
+    reinit(v, -0.8*pre(v));
+    n = pre(n) + 1;
+  end when;
+end Bounce;
+"""
+
+
+def test_a_plot_is_drawn_from_a_finer_run_and_the_result_keeps_its_grid(tmp_path: Path
+                                                                        ) -> None:
+    path = tmp_path / "bounce.mo"
+    path.write_text(BOUNCE)
+    result = springc.simulate(str(path), stop=1.0, interval=0.1, rtol=1e-9)
+    assert result.discrete == ("n",) and len(result.time) == 11
+    figure = result.plot()
+    assert len(result.time) == 11  # the result's grid is the user's
+    lines = [ax.lines for ax in figure.axes]
+    assert [[line.get_drawstyle() for line in group] for group in lines] == [
+        ["default"], ["default"], ["steps-post"]]
+    time = lines[0][0].get_xdata()
+    # the first bounce, at sqrt(2/g): rows there from its left to its right limit
+    bounce = np.sqrt(2 / 9.81)
+    at = np.flatnonzero(np.abs(time - bounce) < 1e-6)
+    assert len(at) >= 2 and len(time) > 11
+    v = lines[1][0].get_ydata()
+    assert abs(v[at[0]] + 9.81 * bounce) < 1e-6
+    assert abs(v[at[-1]] - 0.8 * 9.81 * bounce) < 1e-6
+    assert figure.layout.note == f"drawn on {len(time)} times (the output grid has 11)"

@@ -173,7 +173,8 @@ def test_parameters_change_the_solution_without_recompiling(models: str) -> None
 
 
 def test_unknown_parameter_names_close_matches(models: str) -> None:
-    with pytest.raises(SimulationError, match="'kk' is not a parameter") as info:
+    with pytest.raises(SimulationError,
+                       match="'kk' is not a parameter or a state of Harmonic") as info:
         springc.simulate(models, model_name="Harmonic", parameters={"kk": 1.0})
     assert "'k'" in (info.value.hint or "")
 

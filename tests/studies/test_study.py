@@ -161,7 +161,7 @@ def test_resume_refuses_the_partial_results_of_another_study(cache: Path,
 
 def test_bad_studies_are_refused_before_any_run(cache: Path) -> None:
     model = springc.compile_model(SEED)
-    with pytest.raises(SimulationError, match=r"'spring\.q' is not a parameter of "
+    with pytest.raises(SimulationError, match=r"'spring\.q' is not a parameter or a state of "
                        "SpringMass"):
         run_study(model, StudyOptions((parse_parameter("spring.q=1,2"),)))
     with pytest.raises(UsageError, match="both swept"):

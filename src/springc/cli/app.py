@@ -22,6 +22,7 @@ import click
 
 from ..errors import ErrorGroup, SpringcError, UsageError, render_all
 from ..ir.expr import recursion_room
+from .options import LEVEL_KEY
 
 EXIT_MODEL_ERROR = 1
 EXIT_USAGE = 2
@@ -51,7 +52,8 @@ def guard(func: Callable[..., Any]) -> Callable[..., Any]:
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        debug = click.get_current_context().find_root().params.get("debug", False)
+        ctx = click.get_current_context()
+        debug = ctx.find_root().params.get("debug", False) or ctx.meta.get(LEVEL_KEY, 0) >= 2
         try:
             with recursion_room():  # expressions up to ir.expr.MAX_DEPTH deep
                 return func(*args, **kwargs)
@@ -74,7 +76,7 @@ def guard(func: Callable[..., Any]) -> Callable[..., Any]:
                 traceback.print_exc()
             else:
                 click.echo(f"internal error: {type(err).__name__}: {err}\n"
-                           "this is a bug in springc; rerun with --debug for the traceback "
+                           "this is a bug in springc; rerun with -vv for the traceback "
                            "and report it", err=True)
             sys.exit(EXIT_INTERNAL)
 

@@ -14,11 +14,14 @@ from .options import (
     model_options,
     report_units,
     units_option,
+    verbosity,
+    verbosity_options,
 )
 
 
 @main.command()
 @model_options
+@verbosity_options("Nothing on stderr but warnings and errors.")
 @click.option("--origins", is_flag=True, help="Show where each equation comes from.")
 @click.option("--json", "as_json", is_flag=True, help="Print the flat model as JSON.")
 @click.option("--simplify", "simplified", is_flag=True,
@@ -56,6 +59,7 @@ def flatten(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...
 @main.command()
 @model_options
 @units_option
+@verbosity_options("No notes on stderr (warnings and errors still).")
 @guard
 def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           strict_units: bool) -> None:
@@ -66,7 +70,7 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     from ..units import check_units
 
     flat = flatten_files(files, model, libraries)
-    for note in flat.notes:  # diagnostics that are not errors
+    for note in flat.notes if verbosity() >= 0 else ():  # diagnostics, not errors
         click.echo("\n".join(printable(line) for line in str(note).split("\n")), err=True)
     report_units(check_units(flat), strict_units)
     click.echo(printable(check_balance(flat).summary()))
@@ -77,6 +81,7 @@ def check(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
 @compile_options
 @click.option("-o", "--output", type=click.Path(dir_okay=False),
               help="Write the generated Python module here (default: stdout).")
+@verbosity_options("Nothing on stderr but warnings and errors.")
 @guard
 def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool,
@@ -96,3 +101,10 @@ def compile_(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             f.write(compiled.source)
     else:
         click.echo(compiled.source, nl=False)
+    if verbosity() > 0:
+        click.echo(f"{compiled.name}: {len(compiled.states)} states, "
+                   f"{len(compiled.observed)} observed, {compiled.module.BACKEND} module "
+                   f"{'from the cache' if compiled.cached else 'generated'} in "
+                   f"{compiled.compile_time:.2f} s", err=True)
+    if verbosity() > 1:
+        click.echo(f"note: generated module {compiled.path}", err=True)

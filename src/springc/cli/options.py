@@ -25,6 +25,39 @@ class NumberRange(click.FloatRange):
         return number
 
 
+LEVEL_KEY = "springc.verbosity"
+"""Where the ``-v``/``-q`` level of a command is kept (``click.Context.meta``)."""
+
+
+def _remember(level: int) -> Callable[[click.Context, click.Parameter, Any], Any]:
+    def callback(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
+        if value and (level < 0 or ctx.meta.get(LEVEL_KEY, 0) >= 0):
+            ctx.meta[LEVEL_KEY] = -1 if level < 0 else int(value)
+        return value
+    return callback
+
+
+def verbosity_options(quiet_help: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``-v``/``-vv``/``-q``, the same levels for every command (:func:`verbosity`)."""
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        func = click.option("-q", "--quiet", is_flag=True, expose_value=False,
+                            callback=_remember(-1), help=quiet_help)(func)
+        return click.option("-v", "--verbose", count=True, expose_value=False,
+                            callback=_remember(1),
+                            help="More on stderr: -v the full detail (a run's solver "
+                            "choice, engine, evaluations, timings), -vv also what helps "
+                            "debugging (tracebacks of internal errors, the generated "
+                            "module's path).")(func)
+    return decorate
+
+
+def verbosity() -> int:
+    """The level of the running command: -1 ``--quiet``, 0 the default (a short summary),
+    1 ``-v``, 2 ``-vv`` and more; ``--quiet`` wins over ``-v``."""
+    ctx = click.get_current_context(silent=True)
+    return int(ctx.meta.get(LEVEL_KEY, 0)) if ctx is not None else 0
+
+
 CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
              "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}
 """How the checks of :func:`springc.simulation.check_run_values` name the options."""
@@ -99,8 +132,11 @@ def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str]
 def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """The options of a run shared by ``simulate`` and ``tradeoff``."""
     func = click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
-                        help="Set a parameter (repeatable); array sizes re-flatten the "
-                        "model.")(func)
+                        help="Set a parameter or the start value of a state "
+                        "(repeatable; as OpenModelica's -override). A fixed start "
+                        "(fixed=true) is the initial value; a free one is the guess of "
+                        "the initial equations. Array sizes re-flatten the model; start "
+                        "values never recompile it.")(func)
     func = click.option("--interval", type=float,
                         help="Output interval [s] (default: experiment, else "
                         "(stop-start)/500).")(func)

@@ -29,6 +29,8 @@ from .options import (
     run_options,
     single_threaded_blas,
     units_option,
+    verbosity,
+    verbosity_options,
 )
 
 
@@ -81,9 +83,8 @@ from .options import (
               help="Write a plot: .png, .svg or .pdf.")
 @click.option("--event-rows", is_flag=True, help="For a model with events: add two rows at "
               "each event, its left and right limits (default: one row per output time).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress bar, no summary line and "
-              "no status lines (\"springc: compiling ...\" before a step that compiles, "
-              "once).")
+@verbosity_options("No progress bar, no summary line and no status lines (\"springc: "
+                   "compiling ...\" before a step that compiles, once).")
 @units_option
 @guard
 def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
@@ -94,7 +95,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              atol: float | None,
              assignments: tuple[str, ...], max_steps: int | None,
              time_limit: float | None, output: str | None, plot: str | None,
-             event_rows: bool, quiet: bool, strict_units: bool) -> None:
+             event_rows: bool, strict_units: bool) -> None:
     """Simulate a model and write its trajectory (CSV or MAT) and/or a plot."""
     from ..simulation import (
         PLOT_FORMATS,
@@ -130,6 +131,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         write_csv,
     )
 
+    level = verbosity()
+    quiet = level < 0
     with silenced(quiet):  # the status lines of long steps (compiling)
         compiled = compile_model(files, model, libraries=libraries,
                                  backend=default_choice(backend, engine, solver),
@@ -159,7 +162,11 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         else:
             write_csv(result, sys.stdout)
             sys.stdout.flush()
-        if not quiet:
+        if level == 0:
+            click.echo(result.stats.brief(result.model), err=True)
+        elif level > 0:
             click.echo(result.stats.summary(result.model), err=True)
+        if level > 1:
+            click.echo(f"note: generated module {compiled.path}", err=True)
         if result.stats.warning:  # even with --quiet: the answer missed its tolerance
             click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)

@@ -25,6 +25,8 @@ from .options import (
     parse_set,
     run_options,
     single_threaded_blas,
+    verbosity,
+    verbosity_options,
 )
 
 
@@ -74,8 +76,8 @@ from .options import (
               "(median, percentile bands).")
 @click.option("--plot-var", metavar="NAME", help="The variable of --plot (default: the "
               "study's first variable).")
-@click.option("--quiet", "-q", is_flag=True, help="No progress, no summary line and no "
-              "status line (\"springc: compiling ...\").")
+@verbosity_options("No progress, no summary line and no status line (\"springc: "
+                   "compiling ...\").")
 @guard
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -85,7 +87,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
           rtol: float | None, atol: float | None, max_steps: int | None,
           time_limit: float | None, error_control: str, energy: str | None, output: str,
           summary_file: str | None, resume: bool, plot: str | None,
-          plot_var: str | None, quiet: bool) -> None:
+          plot_var: str | None) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
 
     The model is compiled once; runs go to local processes (or a Dask scheduler); each
@@ -97,6 +99,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     from ..simulation import check_run_values
     from ..studies import check_outputs, parse_parameter, summary_path
 
+    quiet = verbosity() < 0
     values = parse_set(assignments)
     if solver.lower() in FIXED_STEP and step is None:
         raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "

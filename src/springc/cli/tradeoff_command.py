@@ -17,6 +17,8 @@ from .options import (
     parse_set,
     run_options,
     single_threaded_blas,
+    verbosity,
+    verbosity_options,
 )
 
 
@@ -102,7 +104,7 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
               help="Local worker processes running the solvers (default: one per core).")
 @click.option("--scheduler", metavar="ADDRESS", help="Run the solvers on the Dask "
               "scheduler at ADDRESS instead of local processes (as for sweep).")
-@click.option("--quiet", "-q", is_flag=True, help="No line per run on stderr.")
+@verbosity_options("No line per run on stderr.")
 @guard
 def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
@@ -112,7 +114,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              reference: str | None, save_reference: str | None, repeats: int,
              cost_limit: float, budget: float, output: str | None, plot: str | None,
              energy: str | None,
-             workers: int | None, scheduler: str | None, quiet: bool) -> None:
+             workers: int | None, scheduler: str | None) -> None:
     """Accuracy vs cost of the solvers: a table, a work-precision plot, a recommendation.
 
     The error of each run is measured on the output grid against REFERENCE, or against
@@ -125,6 +127,7 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     """
     from ..simulation import PLOT_FORMATS, check_run_values
 
+    quiet = verbosity() < 0
     if workers is not None and scheduler is not None:
         raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
                          "has its own workers)", option="--workers")

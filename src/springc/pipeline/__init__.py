@@ -15,6 +15,7 @@ from .compiler import (
     check_parameter_names,
     compile_files,
     modification_value,
+    split_values,
 )
 from .notes import announce_functions
 from .options import CompileOptions
@@ -27,7 +28,7 @@ if TYPE_CHECKING:
 __all__ = ["CompileOptions", "CompiledModel", "announce_functions", "check_parameter_names",
            "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",
-           "select_names"]
+           "select_names", "split_values"]
 
 
 def __getattr__(name: str) -> Any:

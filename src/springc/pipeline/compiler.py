@@ -111,6 +111,18 @@ class CompiledModel:
         return tuple(self.module.PARAMETERS)
 
     @property
+    def start_names(self) -> tuple[str, ...]:
+        """The variables whose ``start`` value a run may set (``--set``, ``parameters=``):
+        the states and, in a model with an initial problem, the other variables with a
+        fixed start value (conditions of that problem)."""
+        names = self.states
+        run = self.run_system
+        if run is None or not getattr(self.module, "INITIAL_CONDITIONS", 0):
+            return names
+        return names + tuple(u.name for u in run.system.dae.unknowns
+                             if u.fixed and u.start is not None and u.name not in names)
+
+    @property
     def units(self) -> dict[str, str]:
         """The unit of every state and observed variable, by flat name ("" for none)."""
         units = dict(zip(self.states, self.module.STATE_UNITS))
@@ -179,20 +191,43 @@ class CompiledModel:
         return self.run_system
 
     def parameters(self, values: Mapping[str, float] | None = None) -> Any:
-        """The parameter vector with ``values`` (non-structural names) applied."""
-        check_parameter_names(self, values or {})
-        return self.module.parameters(dict(values or {}))
+        """The parameter vector with ``values`` (non-structural names) applied; start
+        values among them are not parameters and leave it unchanged."""
+        return self.module.parameters(split_values(self, values or {})[0])
 
 
 def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) -> None:
-    """Reject names that are not parameters, suggesting close matches."""
+    """Reject names that are neither parameters nor start values a run may set
+    (:attr:`CompiledModel.start_names`), suggesting close matches."""
     known = model.parameter_names
+    starts = model.start_names
     for name in values:
-        if name not in known:
+        if name in known or name in starts:
+            continue
+        if name in model.observed:
             raise SimulationError(
-                f"'{name}' is not a parameter of {model.name}",
-                hint=did_you_mean(name, known)
-                or "parameters are named by their flat names, e.g. 'spring.k'")
+                f"'{name}' is not a parameter or a state of {model.name}: it is computed "
+                "from the states, so its start value is not an initial value",
+                hint=f"set a parameter or the start of a state ({_listed(starts)})")
+        raise SimulationError(
+            f"'{name}' is not a parameter or a state of {model.name}",
+            hint=did_you_mean(name, known + starts)
+            or "parameters and states are named by their flat names, e.g. 'spring.k'")
+
+
+def _listed(names: tuple[str, ...], limit: int = 4) -> str:
+    shown = ", ".join(names[:limit])
+    return shown + (", ..." if len(names) > limit else "") if names else "it has none"
+
+
+def split_values(model: CompiledModel, values: Mapping[str, float]
+                 ) -> tuple[dict[str, float], dict[str, float]]:
+    """``values`` (checked by :func:`check_parameter_names`) as parameter values and
+    start values; a name that is both (none in a flat model) is a parameter."""
+    check_parameter_names(model, values)
+    known = set(model.parameter_names)
+    params = {k: v for k, v in values.items() if k in known}
+    return params, {k: v for k, v in values.items() if k not in known}
 
 
 # ------------------------------------------------------------------ compile

@@ -62,35 +62,43 @@ class InitialInfo:
     residual: float
 
 
-def conditions(model: ode.ODE) -> tuple[Condition, ...]:
-    """The conditions of step 2 of the module docstring."""
+def conditions(model: ode.ODE, starts: Mapping[str, float] | None = None
+               ) -> tuple[Condition, ...]:
+    """The conditions of step 2 of the module docstring; ``starts`` replaces the start
+    values of those it names (set at run time: ``--set``)."""
     state_names = {s.name for s in model.states}
     # fixed = true on a variable that pre() reads sets its pre value (section 8.6):
     # the value held before the first event, not a condition on the continuous start
     held = set(model.events.pre) if model.events is not None else set()
     out = [Condition(r.describe(), r.expr, r.span) for r in model.dae.initial_equations]
+    given = starts or {}
     for u in model.dae.unknowns:
         if u.fixed and u.start is not None and u.name not in state_names \
                 and u.name not in held:
-            out.append(Condition(f"{u.name} = {x.to_text(u.start)} (fixed start value)",
-                                 x.sub(x.Var(u.name), u.start), u.span))
+            start = x.Const(float(given[u.name])) if u.name in given else u.start
+            out.append(Condition(f"{u.name} = {x.to_text(start)} (fixed start value)",
+                                 x.sub(x.Var(u.name), start), u.span))
     return tuple(out)
 
 
 def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
-                  t0: float = 0.0, tol: float = 1e-9) -> tuple[np.ndarray, InitialInfo]:
+                  t0: float = 0.0, tol: float = 1e-9,
+                  starts: Mapping[str, float] | None = None) -> tuple[np.ndarray, InitialInfo]:
     """Consistent initial values of ``model.states`` (in that order) at ``t0``.
 
-    ``parameters`` overrides parameter values (others come from their bindings).
-    Raises :class:`InitializationError` (over-/under-determined, no convergence).
+    ``parameters`` overrides parameter values (others come from their bindings),
+    ``starts`` start values (a fixed one is then the initial value, a free one the
+    guess the solve starts from). Raises :class:`InitializationError`
+    (over-/under-determined, no convergence).
     """
     params = parameter_values(model.parameters, parameters)
     evaluator = OdeEvaluator(model, params, initial=True)
-    starts = start_values(model.dae.unknowns, params)
-    x0 = np.array([starts.get(s.name, 0.0) for s in model.states])
+    values = start_values(model.dae.unknowns, params)
+    values.update((k, float(v)) for k, v in (starts or {}).items())
+    x0 = np.array([values.get(s.name, 0.0) for s in model.states])
     fixed = [i for i, s in enumerate(model.states) if s.fixed and s.start is not None]
     free = [i for i, s in enumerate(model.states) if i not in set(fixed)]
-    conds = conditions(model)
+    conds = conditions(model, starts)
 
     def residuals(z: np.ndarray, chosen: list[int]) -> np.ndarray:
         trial = x0.copy()

@@ -19,12 +19,16 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .plot_layout import HEATMAP, PlotLayout
+from .plot_layout import HEATMAP, Panel, PlotLayout
 
 NOTE_WIDTH = 150
 """Characters per line of the note under the title."""
 NOTE_LINE = 0.2
 """Inches per line of the note."""
+AXES_WIDTH = 8.9
+"""Inches of a panel's width (the legends go to its right, outside the curves)."""
+LEGEND_CHAR = 0.065
+"""Inches per character of a legend entry (8 points)."""
 
 
 class ResultFigure(Figure):
@@ -50,20 +54,25 @@ def plain_text(text: str) -> str:
 
 def draw_layout(model: str, time: np.ndarray, values: np.ndarray,
                 layout: PlotLayout, names: Sequence[str]) -> ResultFigure:
-    """``layout`` as a figure: one row per panel, a colour bar beside each heat map, the
-    note under the title. Names and units are shown literally."""
+    """``layout`` as a figure: one row per panel, the legends to the right of the
+    curves, a colour bar beside each heat map, the note under the title. Names and
+    units are shown literally."""
     panels = layout.panels
     note = textwrap.wrap(layout.note, NOTE_WIDTH)
     top = 0.55 + NOTE_LINE * len(note)
     height = 1.2 + 2.3 * max(1, len(panels)) + NOTE_LINE * len(note)
-    fig = ResultFigure(10, height)
+    longest = max((len(label) for panel in panels for label in panel.labels), default=0)
+    legend = 0.6 + LEGEND_CHAR * min(longest, 60) if longest else 0.0
+    bars = any(panel.kind == HEATMAP for panel in panels)
+    side = max(legend, 0.9 if bars else 0.2)
+    width = 0.9 + AXES_WIDTH + side
+    fig = ResultFigure(width, height)
     # Fixed margins (in inches) instead of tight_layout, which costs a quarter second;
     # with heat maps, a narrow second column holds the colour bars, so that every time
     # axis lines up.
-    bars = any(panel.kind == HEATMAP for panel in panels)
     grid = fig.add_gridspec(max(1, len(panels)), 2 if bars else 1,
                             width_ratios=(60, 1) if bars else None, wspace=0.02,
-                            left=0.09, right=0.93 if bars else 0.98, top=1 - top / height,
+                            left=0.9 / width, right=1 - side / width, top=1 - top / height,
                             bottom=0.6 / height, hspace=0.45 if note or bars else 0.35)
     axes: list[Any] = []
     for row, panel in enumerate(panels):
@@ -71,19 +80,9 @@ def draw_layout(model: str, time: np.ndarray, values: np.ndarray,
         axes.append(ax)
         ax.set_title(plain_text(panel.title), fontsize=10, loc="left", y=1.0)  # no search
         if panel.kind == HEATMAP:
-            rows = len(panel.columns)
-            image = ax.imshow(values[:, list(panel.columns)].T, aspect="auto",
-                              origin="lower", interpolation="nearest", cmap="viridis",
-                              extent=(float(time[0]), float(time[-1]), 0.5, rows + 0.5))
-            ax.set_ylabel("variable (model order)")
-            bar = fig.colorbar(image, cax=fig.add_subplot(grid[row, 1]))
-            bar.set_label(plain_text(panel.label), fontsize=8)
-            continue
-        for column, label in zip(panel.columns, panel.labels):
-            ax.plot(time, values[:, column], label=plain_text(label), linewidth=1.2)
-        ax.set_ylabel(plain_text(panel.label))
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8, loc="upper right", ncol=min(3, len(panel.columns)))
+            _heat_map(fig, ax, grid[row, 1], panel, time, values)
+        else:
+            _lines(ax, panel, time, values)
     if not axes:
         axes.append(fig.add_subplot(grid[0, 0]))
         axes[0].text(0.5, 0.5, "no variables selected", ha="center")
@@ -96,3 +95,28 @@ def draw_layout(model: str, time: np.ndarray, values: np.ndarray,
                  va="top", fontsize=8)
     fig.layout = layout
     return fig
+
+
+def _lines(ax: Any, panel: Panel, time: np.ndarray, values: np.ndarray) -> None:
+    """One line per column (steps for a discrete one), the legend outside at the right."""
+    for column, label in zip(panel.columns, panel.labels):
+        style = "steps-post" if column in panel.steps else "default"
+        ax.plot(time, values[:, column], label=plain_text(label), linewidth=1.2,
+                drawstyle=style)
+    ax.set_ylabel(plain_text(panel.label))
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0,
+              frameon=False)
+
+
+def _heat_map(fig: Figure, ax: Any, bar_cell: Any, panel: Panel, time: np.ndarray,
+              values: np.ndarray) -> None:
+    """The columns as image rows, the first at the top (a cloth's first row hangs
+    there), and the colour bar in ``bar_cell``."""
+    rows = len(panel.columns)
+    image = ax.imshow(values[:, list(panel.columns)].T, aspect="auto", origin="upper",
+                      interpolation="nearest", cmap="viridis",
+                      extent=(float(time[0]), float(time[-1]), rows + 0.5, 0.5))
+    ax.set_ylabel("variable (model order)")
+    bar = fig.colorbar(image, cax=fig.add_subplot(bar_cell))
+    bar.set_label(plain_text(panel.label), fontsize=8)

@@ -16,16 +16,16 @@ import csv
 import difflib
 import io
 import os
-from collections.abc import Iterable
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import OutputError, UnknownNameError, UsageError, printable
+from ..errors import OutputError, SpringcError, UnknownNameError, UsageError, printable
 from ..fileio import OutputSet, PathLike, atomic_write
-from .plot_layout import choose_layout
+from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
@@ -75,9 +75,28 @@ class SimulationStats:
     error_tolerance: float | None = None
     warning: str = ""
 
+    def brief(self, model: str) -> str:
+        """The short summary line (about 100 characters): model, solver, steps, events,
+        the estimated error against its tolerance and the rtol it was reached at, wall
+        time (``SpringMass: dop853 (auto), 2,268 steps, est. error 4e-06 <= 0.0003 at
+        rtol 1e-09, 3.41 s``); :meth:`summary` has the full detail (``-v``)."""
+        parts = [f"{model}: {self.solver}{' (auto)' if self.reason else ''}",
+                 f"{self.steps:,} steps"]
+        events = self.state_events + self.time_events
+        if events:
+            parts.append(f"{events:,} event{'s' if events != 1 else ''}")
+        if self.estimated_error is not None:
+            text = f"est. error {_short(self.estimated_error)}"
+            if self.error_tolerance is not None:
+                within = self.estimated_error <= self.error_tolerance
+                text += f" {'<=' if within else '>'} {_short(self.error_tolerance)}"
+            parts.append(text + (f" at rtol {_short(self.rtol)}" if self.rtol else ""))
+        parts.append(f"{self.wall_time:.2f} s")
+        return ", ".join(parts)
+
     def summary(self, model: str) -> str:
-        """One line: solver and engine (``auto -> dop853 (compiled) (why)``), steps,
-        evaluations, wall time."""
+        """One line with the full detail (``-v``): solver and engine (``auto -> dop853
+        (compiled) (why)``), steps, evaluations, wall time, the error estimate, notes."""
         solver = f"{self.solver} ({self.engine})"
         why = f"{self.reason}; {self.engine_reason}" if self.engine_reason else self.reason
         if self.reason:
@@ -93,6 +112,11 @@ class SimulationStats:
                    if self.state_events or self.time_events else "")
                 + (f"; {self.error}" if self.error else "")
                 + (f"; note: {self.note}" if self.note else ""))
+
+
+def _short(value: float) -> str:
+    """One significant digit, the exponent without a leading zero (``4e-6``)."""
+    return f"{value:.1g}".replace("e-0", "e-").replace("e+0", "e+")
 
 
 @dataclass
@@ -113,6 +137,11 @@ class SimulationResult:
     error_estimate: ErrorEstimate | None = None
     #: the description strings of the model's variables and parameters, by flat name
     descriptions: dict[str, str] = field(default_factory=dict)
+    #: the discrete variables (drawn as steps)
+    discrete: tuple[str, ...] = ()
+    #: the same run on another grid (``runner.Rerun``: a plot's finer grid); None: none
+    rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False,
+                                                            compare=False)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -295,8 +324,32 @@ def draw_figure(result: SimulationResult) -> Any:
     legend; per family with heat maps for a large result), its note under the title."""
     from .figure import draw_layout  # matplotlib loads with the first plot
 
-    layout = choose_layout(result.names, result.units, result.values)
-    return draw_layout(result.model, result.time, result.values, layout, result.names)
+    layout = choose_layout(result.names, result.units, result.values, result.discrete)
+    drawn = _finer(result, layout)
+    if drawn is not result:
+        layout = replace(layout, note="; ".join(filter(None, (
+            f"drawn on {len(drawn.time):,} times (the output grid has {len(result.time):,})",
+            layout.note))))
+    return draw_layout(result.model, drawn.time, drawn.values, layout, result.names)
+
+
+def _finer(result: SimulationResult, layout: PlotLayout) -> SimulationResult:
+    """``result``, or its run again on the finer grid its curves need
+    (:func:`.plot_layout.plot_points`) and, with events, with rows at both sides of
+    each event (a jump drawn upright); heat maps are drawn from the output grid, and a
+    run that fails leaves it."""
+    if result.rerun is None or any(p.kind == HEATMAP for p in layout.panels):
+        return result
+    smooth = [c for p in layout.panels for c in p.columns if c not in p.steps]
+    points = plot_points(result.values, smooth)
+    if not points and not result.events:
+        return result
+    points = max(points, len(result.time))  # events: their left and right limits too
+    try:
+        fine = result.rerun(points)
+    except SpringcError:
+        return result
+    return fine if fine.names == result.names else result
 
 
 def render_plot(result: SimulationResult, kind: str = "png") -> tuple[bytes, str]:

@@ -26,7 +26,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from ..errors import SimulationError, describe_failure
-from ..pipeline import CompiledModel, check_parameter_names
+from ..pipeline import CompiledModel, split_values
 from . import error_control, solvers
 from .compiled import (
     COMPILED,
@@ -78,7 +78,7 @@ class SimulationOptions:
     solver: str = DEFAULT_SOLVER
     rtol: float | None = None
     atol: float | None = None
-    parameters: Mapping[str, float] = field(default_factory=dict)
+    parameters: Mapping[str, float] = field(default_factory=dict)  # and start values
     progress: TextIO | None = None
     step: float | None = None  # fixed-step solvers only
     max_steps: int = DEFAULT_MAX_STEPS
@@ -133,11 +133,14 @@ def _first(*values: float | None) -> float:
     raise AssertionError("no default")
 
 
-def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.ndarray:
+def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0,
+                  starts: Mapping[str, float] | None = None) -> np.ndarray:
     """The states at the start time.
 
     States start at their ``start`` values, as Modelica tools do when nothing else
-    fixes them. A model with ``initial equation``s or fixed start values on variables
+    fixes them; ``starts`` replaces the start values it names (run-time data, never a
+    new compilation: a fixed start is then the initial value, a free one a guess of
+    the initial problem). A model with ``initial equation``s or fixed start values on variables
     that are not states has an initial problem: it is solved by
     :func:`springc.simplify.initial_state` on the simplified system the compiled model
     captured when it was compiled (:meth:`CompiledModel.closed_system`; the generated
@@ -145,7 +148,11 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
     """
     if not getattr(model.module, "INITIAL_CONDITIONS", 0):
         try:
-            return np.asarray(model.module.start(p), dtype=float)
+            x0 = np.array(model.module.start(p), dtype=float)
+            index = {name: i for i, name in enumerate(model.states)}
+            for name, value in (starts or {}).items():
+                x0[index[name]] = value
+            return x0
         except (ArithmeticError, ValueError) as err:
             where = code_location(err, str(model.path))
             raise SimulationError(
@@ -159,7 +166,7 @@ def initial_state(model: CompiledModel, p: np.ndarray, t0: float = 0.0) -> np.nd
         mod: Any = model.module
         z = mod.guesses(p)
         values.update((name, float(z[slot])) for name, slot in zip(mod.DISCRETE, mod.Z_DISCRETE))
-    x0, _info = solve_initial(system, values, t0)
+    x0, _info = solve_initial(system, values, t0, starts=starts)
     order = {s.name: i for i, s in enumerate(system.states)}
     return np.array([x0[order[name]] for name in model.states], dtype=float)
 
@@ -174,7 +181,28 @@ def simulate_model(model: CompiledModel, options: SimulationOptions = Simulation
     result = error_control.controlled(options, error_control.Asked(mode, rtol, atol),
                                       lambda run: simulate_once(model, run))
     result.descriptions = model.descriptions
+    result.discrete = tuple(getattr(model.module, "DISCRETE", ()))
+    result.rerun = Rerun(model, replace(
+        options, progress=None, error_control="off",
+        rtol=result.stats.rtol if result.stats.rtol is not None else options.rtol,
+        atol=result.stats.atol if result.stats.atol is not None else options.atol))
     return result
+
+
+@dataclass(frozen=True)
+class Rerun:
+    """The run of a result again on a grid of other ``points`` (a plot's finer grid:
+    :func:`.plot_layout.plot_points`), at the tolerances the result was run at, without
+    error control, with the rows at both sides of each event: the result itself and
+    its grid stay as they are."""
+
+    model: CompiledModel
+    options: SimulationOptions
+
+    def __call__(self, points: int) -> SimulationResult:
+        start, stop = resolve(self.model, self.options)[:2]
+        return simulate_once(self.model, replace(
+            self.options, interval=(stop - start) / (points - 1), event_rows=True))
 
 
 def simulate_once(model: CompiledModel, options: SimulationOptions) -> SimulationResult:
@@ -189,8 +217,8 @@ def simulate_once(model: CompiledModel, options: SimulationOptions) -> Simulatio
     engine = choose_engine(options.engine, solver, model.module.BACKEND, "engine", "backend")
     start, stop, interval, rtol, atol = resolve(model, options)
     grid = output_grid(start, stop, interval)
-    check_parameter_names(model, options.parameters)
-    structural = [n for n in options.parameters if n in model.structural]
+    parameters, starts = split_values(model, options.parameters)
+    structural = [n for n in parameters if n in model.structural]
     if structural:
         raise SimulationError(f"'{structural[0]}' is a structural parameter: changing it "
                               "needs a new compilation",
@@ -210,18 +238,18 @@ def simulate_once(model: CompiledModel, options: SimulationOptions) -> Simulatio
     step = 0.0  # fixed-step solvers only
     if solver in FIXED_STEP:
         step, note = solvers.check_step(solver, options.step, grid, limits.max_steps)
-    p = parameter_vector(model, options.parameters)
+    p = parameter_vector(model, parameters)
     if getattr(model.module, "DELAYS", 0):  # the history of delay(...) (delays.py)
         from .delays import simulate_delayed
 
-        return simulate_delayed(model, options, solver, grid, initial_state(model, p, start),
-                                p, rtol, atol, limits, began)
+        x0 = initial_state(model, p, start, starts)
+        return simulate_delayed(model, options, solver, grid, x0, p, rtol, atol, limits, began)
     if getattr(model.module, "EVENTS", False):  # the states chosen at compile time
         from .hybrid import simulate_hybrid
 
-        return simulate_hybrid(model, options, solver, grid, initial_state(model, p, start),
-                               p, rtol, atol, limits, step if solver in FIXED_STEP else None,
-                               note, began, engine)
+        x0 = initial_state(model, p, start, starts)
+        return simulate_hybrid(model, options, solver, grid, x0, p, rtol, atol, limits,
+                               step if solver in FIXED_STEP else None, note, began, engine)
     if getattr(model.module, "SWITCHABLE", False) and solver not in FIXED_STEP:
         from .switching import simulate_switching_model
 
@@ -230,14 +258,19 @@ def simulate_once(model: CompiledModel, options: SimulationOptions) -> Simulatio
                                   "(dynamic state selection), which only the scipy engine "
                                   "does", hint="use --engine scipy (or auto)")
 
+        if starts:
+            raise SimulationError(f"{model.name} may switch its states during the run "
+                                  f"(dynamic state selection): the start of "
+                                  f"'{min(starts)}' cannot be set from outside",
+                                  hint="set it in the model (start = ...)")
         result = simulate_switching_model(model, solver, grid, rtol, atol,
-                                          dict(options.parameters), limits)
+                                          parameters, limits)
         if options.engine.lower() == AUTO:
             result.stats = replace(result.stats, engine_reason=(
                 f"{result.stats.solver} ran in scipy's loop, the only one that switches "
                 "states"))
         return result
-    x0 = initial_state(model, p, start)
+    x0 = initial_state(model, p, start, starts)
     progress = Progress(options.progress, start, stop)
     problem = Problem(model, p, solver, progress, limits)
     try:

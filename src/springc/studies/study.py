@@ -85,9 +85,15 @@ def parameter_table(options: StudyOptions) -> np.ndarray:
 
 def check_names(model: CompiledModel, names: Sequence[str]) -> None:
     """Swept parameters must be parameters of ``model`` and not structural (Integer and
-    Boolean parameters, array sizes: they change the equations)."""
+    Boolean parameters, array sizes: they change the equations). A start value is
+    set for every run (``--set``), not swept: its column would be its variable's."""
     check_parameter_names(model, dict.fromkeys(names, 0.0))
     for name in names:
+        if name not in model.parameter_names:
+            raise UsageError(f"--param {name}: '{name}' is a start value, not a parameter; "
+                             "a study sweeps parameters", option="--param",
+                             hint=f"set it for every run with --set {name}=VALUE, or bind "
+                             "its start to a parameter in the model (start = p)")
         if name in model.structural:
             raise UsageError(f"--param {name}: '{name}' is a structural parameter (it "
                              "changes the equations); a study varies the others",

@@ -14,7 +14,7 @@ from typing import TextIO
 
 import numpy as np
 
-from ..pipeline import CompiledModel
+from ..pipeline import CompiledModel, split_values
 from ..simulation import (
     LSODA_LIMIT,
     SimulationOptions,
@@ -115,10 +115,11 @@ def study_setup(model: CompiledModel, options: TradeoffOptions) -> StudySetup:
     base = SimulationOptions(options.start, options.stop, options.interval,
                              parameters=dict(options.parameters))
     start, stop, interval, rtol, atol = resolve(model, base)
-    p = np.asarray(model.module.parameters(dict(options.parameters)), dtype=float)
+    parameters, starts = split_values(model, options.parameters)
+    p = np.asarray(model.module.parameters(parameters), dtype=float)
     units = model.units
     return StudySetup(model, options, output_grid(start, stop, interval), atol / rtol, p,
-                      initial_state(model, p, start),
+                      initial_state(model, p, start, starts),
                       tuple(units.get(n, "") for n in model.outputs))
 
 
