@@ -1,8 +1,8 @@
 """Simulation of a hybrid model: CompiledModel with events -> SimulationResult.
 
 Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, the
-fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
-models; on the compiled engine, chosen as for continuous models, the solvers with a
+fixed-step scene integrators, or ``auto``: capped probes of dop853 and radau decide,
+:mod:`.hybrid_auto`; on the compiled engine, chosen as for continuous models, the solvers with a
 compiled loop run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
 then computes the outputs row by row with the discrete values in force at each row,
 and checks the model's assertions there. By default the result has one row per output
