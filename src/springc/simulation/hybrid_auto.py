@@ -19,7 +19,8 @@ takes exactly the first steps of the full one, so ``auto -> X`` gives ``X``'s re
    projections (steps to go x RHS evaluations per step = work).
 
 The probes cost at most ``CHEAP_STEPS + IMPLICIT_PROBE`` steps more than the run. A
-failure in a probe is the run's own (as with ``--solver dop853``).
+failure in ``dop853``'s probe is the run's own (as with ``--solver dop853``); one in
+``radau``'s hands the run to ``dop853``.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .failures import Stop
 from .limits import OverLimit
 from .race import CHEAP_STEPS, SURE, Projection, counted
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
@@ -70,7 +72,11 @@ def choose(attempt: Callable[[str, int | None], Attempt], x0: np.ndarray, start:
     choice = estimate(first.problem.jac(over.t, np.asarray(over.y, dtype=float)), stop - start)
     if choice.solver != RACE:
         return attempt(choice.solver, None), choice.reason
-    second = attempt(RACE_IMPLICIT, IMPLICIT_PROBE)
+    try:
+        second = attempt(RACE_IMPLICIT, IMPLICIT_PROBE)
+    except Stop as failure:
+        return attempt(EXPLICIT, None), (f"{choice.reason}, but {RACE_IMPLICIT} failed in "
+                                         f"its trial steps ({failure})")
     if second.capped is None:
         return second, (f"{choice.reason}; counted: {RACE_IMPLICIT} finished the run in "
                         f"its {IMPLICIT_PROBE} trial steps, {EXPLICIT} {ahead.text()} to go")
