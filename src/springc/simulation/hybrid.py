@@ -1,8 +1,8 @@
 """Simulation of a hybrid model: CompiledModel with events -> SimulationResult.
 
 Runs :class:`.events.EventLoop` with the chosen solver (scipy's adaptive ones, the
-fixed-step scene integrators, or ``auto``: dop853, the race being for continuous
-models; on the compiled engine, chosen as for continuous models, the solvers with a
+fixed-step scene integrators, or ``auto``: capped probes of dop853 and radau decide,
+:mod:`.hybrid_auto`; on the compiled engine, chosen as for continuous models, the solvers with a
 compiled loop run in the kernels of ``springc.integrate``: :mod:`.hybrid_compiled`),
 then computes the outputs row by row with the discrete values in force at each row,
 and checks the model's assertions there. By default the result has one row per output
@@ -13,6 +13,7 @@ event, its left and right limits, as OpenModelica's result files do.
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from typing import Any, cast
 
 import numpy as np
@@ -23,6 +24,7 @@ from .compiled import COMPILED, SCIPY, engine_reason, explained, jitted
 from .events import EventLoop
 from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
+from .hybrid_auto import Attempt, choose
 from .hybrid_compiled import run_compiled_events
 from .limits import Limits, OverLimit, check_outputs, over_limit
 from .observed_rows import observed_at_rows
@@ -39,27 +41,42 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
     ``engine`` (:data:`.compiled.COMPILED`: :mod:`.hybrid_compiled`)."""
     start, stop = float(grid[0]), float(grid[-1])
     reason = ""
-    if solver == AUTO:
-        solver, reason = EXPLICIT, "a hybrid model: dop853 with event location"
     progress = Progress(options.progress, start, stop)
-    problem = Problem(model, p, solver, progress, limits)
     event_rows = bool(getattr(options, "event_rows", False))
-    loop = EventLoop(problem, grid, keep_events=event_rows)
-    compiled, loop_time = False, 0.0
-    try:
-        with np.errstate(all="ignore"):
-            if not np.isfinite(x0).all():
-                raise Stop(SimulationError(
-                    f"the start values are not finite at time {start}",
-                    notes=state_notes(problem.names, x0, None)))
-            compiled = engine == COMPILED and len(x0) > 0 and jitted(model.module)
+
+    def attempt(solver: str, cap: int | None = None) -> Attempt:
+        """A run of ``solver`` from the start, of at most ``cap`` steps."""
+        capped = limits if cap is None else replace(limits, max_steps=cap)
+        problem = Problem(model, p, solver, progress, capped)
+        loop = EventLoop(problem, grid, keep_events=event_rows)
+        compiled, loop_time = engine == COMPILED and len(x0) > 0 and jitted(model.module), 0.0
+        try:
             if compiled:
                 loop_time = run_compiled_events(loop, solver, x0, rtol, atol, step)
             elif solver in FIXED_STEP:
                 assert step is not None
                 run_fixed_events(loop, solver, x0, step)
             else:
-                loop.run_adaptive(solver, x0, rtol, atol, limits.max_steps)
+                loop.run_adaptive(solver, x0, rtol, atol, capped.max_steps)
+        except OverLimit as over:
+            if cap is None:
+                raise
+            return Attempt(problem, loop, compiled, loop_time, over)
+        return Attempt(problem, loop, compiled, loop_time)
+
+    problem = Problem(model, p, EXPLICIT if solver == AUTO else solver, progress, limits)
+    try:
+        with np.errstate(all="ignore"):
+            if not np.isfinite(x0).all():
+                raise Stop(SimulationError(
+                    f"the start values are not finite at time {start}",
+                    notes=state_notes(problem.names, x0, None)))
+            if solver == AUTO:
+                run, reason = choose(attempt, x0, start, stop, limits.max_steps)
+            else:
+                run = attempt(solver)
+            problem, loop, compiled, loop_time, _ = run
+            solver = problem.solver
             loop.terminal()
             times, states, zs = rows(loop, event_rows)
             check_assertions(problem, times, states, zs)

@@ -225,13 +225,18 @@ def _finish(run: Run, explicit: Any, implicit: Any, implicit_wins: bool, stiffne
             behind: Projection, ahead: Projection) -> tuple[str, str]:
     """The race's winner runs to the end; the reason gives both projections (steps to go
     x RHS evaluations per step = work)."""
-    counted = (f"counted: {RACE_IMPLICIT} {behind.text()} RHS evaluations to go, {EXPLICIT} "
-               f"{ahead.text()}")
+    text = counted(behind, ahead)
     if implicit_wins:
         run.advance(implicit)
-        return RACE_IMPLICIT, f"{stiffness}; {counted}"
+        return RACE_IMPLICIT, f"{stiffness}; {text}"
     run.advance(explicit)
-    return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {counted}"
+    return EXPLICIT, f"{stiffness}, but the fast modes must be resolved anyway; {text}"
+
+
+def counted(behind: Projection, ahead: Projection) -> str:
+    """The reason's figures: ``radau``'s projection (``behind``), then ``dop853``'s."""
+    return (f"counted: {RACE_IMPLICIT} {behind.text()} RHS evaluations to go, {EXPLICIT} "
+            f"{ahead.text()}")
 
 
 def _projection(costs: StepCosts, implicit: bool, stretch: Stretch, span: float

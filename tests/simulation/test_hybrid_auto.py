@@ -1,0 +1,103 @@
+"""``--solver auto`` on hybrid models (springc.simulation.hybrid_auto): a stiff RC
+circuit switched by ``sample`` goes to radau for its counted work, the bouncing ball
+and a long sampled oscillator keep dop853 with its very steps."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from simulation.test_hybrid import BALL, ball_exact, write
+
+TAU = 1e-5
+RC = f"""
+model StiffRC
+  parameter Real tau = {TAU};
+  Real v(start = 0, fixed = true);
+  discrete Real u(start = 0);
+equation
+  der(v) = (u - v) / tau;
+  when sample(0.05, 0.1) then
+    u = 1 - pre(u);
+  end when;
+end StiffRC;
+"""
+
+OSCILLATOR = """
+model SampledOscillator
+  Real x(start = 1, fixed = true);
+  Real y(start = 0, fixed = true);
+  discrete Integer n(start = 0);
+equation
+  der(x) = y;
+  der(y) = -x;
+  when sample(0.5, 1) then
+    n = pre(n) + 1;
+  end when;
+end SampledOscillator;
+"""
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def rc_exact(t: np.ndarray) -> np.ndarray:
+    """v of the RC circuit: u toggles at 0.05 + 0.1 k, v follows with time constant
+    TAU from the level before (reached to within exp(-0.1 / TAU))."""
+    k = np.floor((t - 0.05) / 0.1 + 1e-9)  # events up to t (-1: none yet)
+    u = np.where(k >= 0, (k + 1) % 2, 0.0)
+    before = np.where(k >= 1, k % 2, 0.0)
+    since = np.maximum(t - (0.05 + 0.1 * np.maximum(k, 0)), 0.0)
+    return np.where(k >= 0, u + (before - u) * np.exp(-since / TAU), 0.0)
+
+
+@pytest.mark.parametrize("engine", ["scipy", "compiled"])
+def test_a_stiff_switched_circuit_goes_to_radau(tmp_path: Path, engine: str) -> None:
+    model = springc.compile_model(write(tmp_path, RC))
+    runs = {solver: springc.simulate(model, solver=solver, engine=engine, stop=1.0,
+                                     interval=1e-5, error_control="off")
+            for solver in ("auto", "radau", "dop853")}
+    auto, radau, dop853 = runs["auto"], runs["radau"], runs["dop853"]
+    assert auto.stats.solver == "radau"
+    assert auto.stats.reason.startswith(
+        "stiff: fastest time scale 1/1e+05 s is 1e+05x shorter than the 1 s span; "
+        "counted: radau ~")
+    assert "RHS evaluations to go, dop853 ~" in auto.stats.reason
+    # auto runs radau afresh: the very run of --solver radau, in a tenth of dop853's steps
+    assert auto.stats.steps == radau.stats.steps < dop853.stats.steps / 10
+    assert np.array_equal(auto["v"], radau["v"])
+    # the closed form, transients included (1e5 rows, 10 switchings)
+    assert np.max(np.abs(auto["v"] - rc_exact(auto.time))) < 2e-4
+
+
+@pytest.mark.parametrize("engine", ["scipy", "compiled"])
+def test_the_bouncing_ball_keeps_dop853(tmp_path: Path, engine: str) -> None:
+    model = springc.compile_model(write(tmp_path, BALL))
+    auto, dop853 = (springc.simulate(model, solver=solver, engine=engine, stop=1.0,
+                                     error_control="off") for solver in ("auto", "dop853"))
+    assert (auto.stats.solver, auto.stats.reason) == (
+        "dop853", "a hybrid model: dop853 with event location")
+    assert auto.stats.steps == dop853.stats.steps
+    assert np.array_equal(auto.values, dop853.values)
+    h, _, _ = ball_exact(auto.time, 3)
+    assert np.max(np.abs(auto["h"] - h)) < 1e-6
+
+
+def test_a_long_non_stiff_run_keeps_dop853_after_its_probe(tmp_path: Path) -> None:
+    model = springc.compile_model(write(tmp_path, OSCILLATOR))
+    auto, dop853 = (springc.simulate(model, solver=solver, engine="scipy", stop=1000.0,
+                                     interval=0.5, error_control="off")
+                    for solver in ("auto", "dop853"))
+    assert auto.stats.solver == "dop853"
+    assert dop853.stats.steps > 500  # past the probe: the estimate decided
+    assert auto.stats.reason == ("non-stiff: spectral radius 1 1/s over 1000 s "
+                                 "(rho*T = 1e+03 <= 2000)")
+    assert auto.stats.steps == dop853.stats.steps
+    assert np.array_equal(auto.values, dop853.values)
+    assert auto["n"][-1] == 1000
+    assert np.max(np.abs(auto["x"] - np.cos(auto.time))) < 1e-3  # 160 periods at rtol 1e-6
