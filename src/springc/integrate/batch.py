@@ -9,12 +9,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .signatures import ModelFunction
 from .status import Status
+
+if TYPE_CHECKING:  # numba loads with the first run, not with the face
+    from .signatures import ModelFunction
 
 STATISTICS = ("final", "min", "max", "mean", "argmax")
 """The summaries of each chosen column (see :mod:`.ensemble_kernel`)."""
