@@ -18,8 +18,9 @@ def test_a_quoted_name_with_a_newline_cannot_forge_a_line(tmp_path: Path) -> Non
                     "  end M;\nend 'P\\nerror: forged line';\n")
     result = CliRunner().invoke(main, ["check", str(path)])
     assert result.exit_code == 1
-    assert result.stderr == ("error: no model found in the given files\n"
-                             "help: choose a model with --model, e.g. --model "
+    assert result.stderr == ("error: no model at the top level of the given files: their "
+                             "models sit in packages (P\\nerror: forged line.M)\n"
+                             "help: choose one by its dotted name, e.g. --model "
                              "P\\nerror: forged line.M\n")
 
 

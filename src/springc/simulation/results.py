@@ -80,7 +80,7 @@ class SimulationStats:
         the estimated error against its tolerance and the rtol it was reached at, wall
         time (``SpringMass: dop853 (auto), 2,268 steps, est. error 4e-06 <= 0.0003 at
         rtol 1e-09, 3.41 s``); :meth:`summary` has the full detail (``-v``)."""
-        parts = [f"{model}: {self.solver}{' (auto)' if self.reason else ''}",
+        parts = [f"{printable(model)}: {self.solver}{' (auto)' if self.reason else ''}",
                  f"{self.steps:,} steps"]
         events = self.state_events + self.time_events
         if events:
