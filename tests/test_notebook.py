@@ -67,6 +67,7 @@ def test_the_plot_is_an_inline_png(executed: list[dict[str, Any]]) -> None:
     png = base64.b64decode(data["image/png"])
     assert png.startswith(b"\x89PNG\r\n\x1a\n")
     width, height = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
-    # 10 x 3.5 inches at 100 dpi: one panel (x and y are both positions, in m)
-    assert (width, height) == (1000, 350)
-    assert data["text/plain"] == "<ResultFigure size 1000x350 with 1 Axes>"
+    # one panel (x and y are both positions, in m) at 100 dpi: 3.5 inches high, 10.465
+    # wide (0.9 margin, 8.9 panel, its legend at the right: 0.6 + 0.065 per character)
+    assert (width, height) == (1046, 350)
+    assert data["text/plain"] == "<ResultFigure size 1046.5x350 with 1 Axes>"
