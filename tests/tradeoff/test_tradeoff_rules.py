@@ -25,7 +25,13 @@ from springc.tradeoff.baselines import baseline_runs, probe_errors
 from springc.tradeoff.chains import Chain, Pilot, cost_ceiling, solver_runs
 from springc.tradeoff.model import SCIPY_DEFAULT, SCIPY_RK45, Run, Tradeoff, TradeoffOptions
 from springc.tradeoff.reference import read_reference
-from springc.tradeoff.report import recommend, skipped_notes, summary
+from springc.tradeoff.report import (
+    format_table,
+    recommend,
+    skipped_notes,
+    summary,
+    table_rows,
+)
 from springc.tradeoff.runs import MAX_REPEATS, retimed
 from springc.tradeoff.setup import study_setup, variable_scales
 from springc.tradeoff.study import available_solvers, compare_states, run_tradeoff
@@ -108,6 +114,11 @@ def test_the_cost_limit_skips_the_tighter_settings_and_says_why(tmp_path: Path,
         "solver took over 10x the fastest dop853 run meeting 1e-04 (rtol 1e-06, 1e-06 s), "
         "and tighter settings cost more (--cost-limit)"]
     assert "\nnote: 2 settings were not run (lsoda rtol 1e-06 to 1e-09): " in summary(study)
+    # the printed table leaves them out (the note names them), the CSV keeps their rows
+    assert [line.split()[:3] for line in format_table(study).splitlines()[1:]] == [
+        ["lsoda", "rtol", "1e-03"]]
+    assert [(row[0], row[1], row[10]) for row in table_rows(study)] == [
+        ("lsoda", "rtol", "ok"), ("lsoda", "rtol", skip), ("lsoda", "rtol", skip)]
     # A pilot that meets no target sets no limit: a slower solver may be the only one
     # to meet it. Errors then fall with the tolerance against the closed form.
     missing = solver_runs(setup, ref, scales, None, chain,
@@ -205,9 +216,9 @@ def test_the_rk45_probe_starts_scipys_sweep_where_it_needs_to(
     # The recommendation quotes the rtol scipy needs, past the skipped rows.
     fast = pilot_run(1e-3, 1e-8)
     seconds = tightened[3].wall_time
-    assert recommend((fast,), rows, 1e-7).endswith(
-        f"; scipy's RK45 needs rtol 1e-07 for it ({seconds:.3g} s: dop853 is "
-        f"{seconds / 1e-3:.1f}x faster)")
+    assert (f"; scipy's RK45 needs rtol 1e-07 for it ({seconds:.3g} s: dop853 is "
+            f"{seconds / 1e-3:.1f}x faster); scipy's default RK45 (rtol 1e-3) reaches "
+            "only ") in recommend((fast,), rows, 1e-7)
     # A probe that scipy's run contradicts is not believed: every rtol is run.
     monkeypatch.setattr(baselines, "probe_errors", lambda *args: [1.0, 1.0, 1.0, 5e-8])
     rows = baseline_runs(setup, ref, scales, None)
