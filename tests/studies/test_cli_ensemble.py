@@ -40,6 +40,18 @@ def test_ensemble_writes_a_row_per_run(tmp_path: Path) -> None:
                                rtol=1e-6)
 
 
+def test_ensemble_takes_the_verbosity_levels_of_every_command(tmp_path: Path) -> None:
+    output = tmp_path / "e.parquet"
+    args = ["ensemble", SEED, "--param", "spring.k=1e3,1e4", "--stop", "0.5",
+            "--interval", "0.5", "-o", str(output)]
+    quiet = CliRunner().invoke(main, [*args, "-q"])
+    assert (quiet.exit_code, quiet.stdout, quiet.stderr) == (0, "", "")
+    assert pd.read_parquet(output)["status"].tolist() == ["ok", "ok"]
+    loud = CliRunner().invoke(main, [*args, "-v"])
+    assert loud.exit_code == 0, loud.output
+    assert loud.stderr == f"SpringMass: 2 runs, 2 ok, 0 failed -> {output}\n"
+
+
 def test_ensemble_refuses_a_table_and_params_together(tmp_path: Path) -> None:
     csv = tmp_path / "runs.csv"
     csv.write_text("spring.k\n1000\n")

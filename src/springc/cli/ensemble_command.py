@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from ..status_line import silenced
 from .app import guard, main
 from .options import (
     CLI_NAMES,
@@ -12,6 +13,9 @@ from .options import (
     model_options,
     parse_set,
     run_options,
+    sampling_options,
+    verbosity,
+    verbosity_options,
 )
 
 
@@ -26,12 +30,7 @@ from .options import (
 @click.option("--table", "table_file", type=click.Path(dir_okay=False),
               help="A CSV file of runs instead of --param: a header line of parameter "
               "names, then one line of values per run.")
-@click.option("--samples", type=click.IntRange(min=1), help="Draw this many runs from "
-              "the --param ranges/distributions instead of a grid.")
-@click.option("--method", type=click.Choice(["lhs", "mc"]), default="lhs",
-              show_default=True, help="With --samples: Latin hypercube or Monte Carlo.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of --samples (the same seed gives the same runs).")
+@sampling_options
 @click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
               "Tolerance, else 1e-6).")
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
@@ -42,14 +41,14 @@ from .options import (
               "with it, not with the number of runs).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
               help="The ensemble table (.parquet): one row per run.")
-@click.option("--quiet", "-q", is_flag=True, help="No summary line.")
+@verbosity_options("No summary line and no status line (\"springc: compiling ...\").")
 @guard
 def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
              backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
              stop: float | None, interval: float | None, assignments: tuple[str, ...],
              params: tuple[str, ...], table_file: str | None, samples: int | None,
              method: str, seed: int, rtol: float | None, atol: float | None,
-             max_steps: int | None, chunk: int, output: str, quiet: bool) -> None:
+             max_steps: int | None, chunk: int, output: str) -> None:
     """Run a continuous model over many parameter sets in compiled code, into Parquet.
 
     Every run is integrated with compiled DOP853 in a loop over the runs on every core
@@ -76,12 +75,14 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     from ..api import compile_model
     from ..studies import run_ensemble
 
-    compiled = compile_model(files, model, libraries=libraries, backend=backend or "numba",
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
-    fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
-    options = EnsembleOptions(specs, samples, method, seed, table, fixed, start, stop,
-                              interval, rtol, atol, max_steps, chunk=chunk)
-    summary = run_ensemble(compiled, options, output, files)
+    quiet = verbosity() < 0
+    with silenced(quiet):  # the status lines of a model or kernel that compiles
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=backend or "numba", outputs=patterns or None,
+                                 parameters=values, cache=not no_cache)
+        fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
+        options = EnsembleOptions(specs, samples, method, seed, table, fixed, start, stop,
+                                  interval, rtol, atol, max_steps, chunk=chunk)
+        summary = run_ensemble(compiled, options, output, files)
     if not quiet:
         click.echo(f"{compiled.name}: {summary.summary_line()}", err=True)

@@ -146,6 +146,20 @@ def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
                         help="Start time [s] (default: experiment, else 0).")(func)
 
 
+def sampling_options(func: Callable[..., Any]) -> Callable[..., Any]:
+    """``--samples``, ``--method``, ``--seed``: the runs drawn from ``--param`` ranges,
+    shared by ``sweep`` and ``ensemble``."""
+    func = click.option("--seed", type=click.IntRange(min=0), default=0,
+                        show_default=True,
+                        help="Seed of --samples (the same seed gives the same runs).")(func)
+    func = click.option("--method", type=click.Choice(["lhs", "mc"]), default="lhs",
+                        show_default=True,
+                        help="With --samples: Latin hypercube or Monte Carlo.")(func)
+    return click.option("--samples", type=click.IntRange(min=1), help="Draw this many "
+                        "runs from the --param ranges/distributions instead of a "
+                        "grid.")(func)
+
+
 def compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
     func = click.option("--no-cache", is_flag=True,
                         help="Regenerate the code instead of using the on-disk cache.")(func)

@@ -24,6 +24,7 @@ from .options import (
     model_options,
     parse_set,
     run_options,
+    sampling_options,
     single_threaded_blas,
     verbosity,
     verbosity_options,
@@ -39,12 +40,7 @@ from .options import (
               "START:STOP[:lin|log]:COUNT; with --samples, a range START:STOP[:log] or a "
               "distribution uniform(a,b), loguniform(a,b), normal(mean,std), "
               "lognormal(mu,sigma), triangular(a,mode,b). Grid: every combination.")
-@click.option("--samples", type=click.IntRange(min=1), help="Draw this many runs from "
-              "the --param ranges/distributions instead of a grid.")
-@click.option("--method", type=click.Choice(["lhs", "mc"]), default="lhs",
-              show_default=True, help="With --samples: Latin hypercube or Monte Carlo.")
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True,
-              help="Seed of --samples (the same seed gives the same runs).")
+@sampling_options
 @click.option("--workers", type=click.IntRange(min=1),
               help="Local worker processes (default: one per core).")
 @click.option("--scheduler", metavar="ADDRESS", help="Run on the Dask scheduler at "
