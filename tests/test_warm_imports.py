@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 import springc
+from pendulum_text import PENDULUM
 
 ROOT = Path(__file__).resolve().parents[1]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -66,18 +67,6 @@ def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
     assert [float(v) for v in rows[1][:5]] == [0.0, 1.0, -1.0, 0.0, 0.0]  # the start values
 
 
-PENDULUM = """model Pendulum
-  parameter Real L = 1, g = 9.81;
-  Real x(start = 0.6), y(start = -0.8), vx(start = 0), vy(start = 0), F;
-equation
-  der(x) = vx;
-  der(y) = vy;
-  der(vx) = -F*x;
-  der(vy) = -F*y - g;
-  x^2 + y^2 = L^2;
-end Pendulum;
-"""
-"""Index 3: dynamic state selection, so its cache entry holds a captured system."""
 
 WARM_LOAD = """
 import sys

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import springc
+from pendulum_text import PENDULUM
 from springc.errors import SimulationError
 from springc.pipeline import CompiledModel
 from springc.pipeline.cache import SYSTEM_FILE
@@ -27,19 +28,6 @@ initial equation
 equation
   der(x) = -x;
 end Decay;
-"""
-
-# Index 3, started at rest 37 degrees from the vertical: dynamic state selection.
-PENDULUM = """model Pendulum
-  parameter Real L = 1, g = 9.81;
-  Real x(start = 0.6), y(start = -0.8), vx(start = 0), vy(start = 0), F;
-equation
-  der(x) = vx;
-  der(y) = vy;
-  der(vx) = -F*x;
-  der(vy) = -F*y - g;
-  x^2 + y^2 = L^2;
-end Pendulum;
 """
 
 SRC = str(Path(springc.__file__).resolve().parents[1])
