@@ -18,7 +18,7 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from .natives import is_external_object
-from .scopes import ClassView, FlattenContext, ViewComponent
+from .scopes import ClassView, FlattenContext, Ident, ViewComponent
 
 
 @dataclass(frozen=True)
@@ -52,16 +52,16 @@ def reusable(flattener: FlattenContext, view: ClassView) -> bool:
     far as the class's text shows: only equalities (loops and ifs of them), no
     constants (their values may be modified per instance) and literal array sizes, in
     the class and in all its components. Parameter reads are checked by the caller."""
-    found = flattener.reusable_views.get(id(view))
+    found = flattener.reusable_views.get(Ident(view))
     if found is None:
-        flattener.reusable_views[id(view)] = False  # a class containing itself
+        flattener.reusable_views[Ident(view)] = False  # a class containing itself
         outer_classes = any(isinstance(e, s.ClassDef) and e.outer  # differ per instance
                             for e in view.entry.defn.elements)
         found = not outer_classes \
             and _equations_only(eq.equation for eq in view.equations) \
             and _equations_only(eq.equation for eq in view.initial_equations) \
             and all(_component_reusable(flattener, comp) for comp in view.components.values())
-        flattener.reusable_views[id(view)] = found
+        flattener.reusable_views[Ident(view)] = found
     return found
 
 

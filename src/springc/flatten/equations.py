@@ -21,15 +21,15 @@ from .connect import GRAPH_EQUATIONS, ConnectionSets, graph_equation
 from .equation_templates import Template, make_template, reusable
 from .events import Section, algorithm_section, event_dependent, flatten_when, variable_if_equation
 from .redeclare import record_equation
-from .scopes import ClassScope, FlattenContext, LocalScope, Scope
+from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
 
 class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
 
     connections: ConnectionSets
-    # Equation templates by (id of the ClassView, initial); None: not reusable.
-    templates: dict[tuple[int, bool], Template | None]
+    # Equation templates by (the ClassView, initial); None: not reusable.
+    templates: dict[tuple[Ident[ClassView], bool], Template | None]
     algorithm_sections: list[Section]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
@@ -39,7 +39,7 @@ class EquationFlattening(FlattenContext):
         if not items:
             return
         target = self.initial_equations if initial else self.equations
-        key = (id(view), initial)
+        key = (Ident(view), initial)
         template = self.templates.get(key) if scope.package is None else None
         if template is not None:
             target += template.instantiate(scope.prefix)

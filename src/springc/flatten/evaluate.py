@@ -32,6 +32,7 @@ from .scopes import (
     ClassScope,
     EventUses,
     FlattenContext,
+    Ident,
     LocalScope,
     Scope,
     check_powers,
@@ -58,9 +59,9 @@ class Evaluator(ReferenceResolver):
         self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)
-        # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
-        # outlives the evaluator, so ids are not reused).
-        self.uses_end: dict[int, bool] = {}
+        # Whether a subscript contains `end`, by syntax node (its identity: equal
+        # subscripts written in two places are two entries).
+        self.uses_end: dict[Ident[s.Expr], bool] = {}
         self.cardinality_used = False  # placeholders to replace (flatten/connect/cardinality.py)
 
     # ------------------------------------------------------------ entry points

@@ -78,7 +78,7 @@ def _kinds_compatible(a: str, b: str) -> bool:
 
 
 def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
-                    seen: frozenset[tuple[int, int]] = frozenset()) -> str | None:
+                    seen: frozenset[tuple[ClassEntry, ClassEntry]] = frozenset()) -> str | None:
     """Why ``a`` is not a subtype of ``b`` (section 6.4), or None if it is."""
     if a.ndims != b.ndims:
         return (f"'{a.name}' has {a.ndims} array dimension(s), '{b.name}' has "
@@ -99,7 +99,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
             return f"'{a.name}' is {what}, '{b.name}' is {other}"
         return None
     assert a.entry is not None and b.entry is not None
-    if a.entry is b.entry or (id(a.entry), id(b.entry)) in seen:
+    if a.entry is b.entry or (a.entry, b.entry) in seen:
         return None
     ka, kb = a.entry.defn.kind, b.entry.defn.kind
     if not _kinds_compatible(ka, kb):
@@ -108,7 +108,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
         va, vb = ctx.view(a.entry), ctx.view(b.entry)
     except (SpringcError, ErrorGroup):
         return None  # reported where the class is used
-    inner_seen = seen | {(id(a.entry), id(b.entry))}
+    inner_seen = seen | {(a.entry, b.entry)}
     for name, cb in vb.components.items():
         if cb.decl.protected:
             continue
@@ -122,7 +122,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
 
 
 def _element_incompatibility(ctx: FlattenContext, ca: ViewComponent, cb: ViewComponent,
-                             seen: frozenset[tuple[int, int]]) -> str | None:
+                             seen: frozenset[tuple[ClassEntry, ClassEntry]]) -> str | None:
     ia = interface(ctx, ca.decl.type_name, ca.defined_in,
                    len(ca.decl.type_dims) + len(ca.decl.dims))
     ib = interface(ctx, cb.decl.type_name, cb.defined_in,

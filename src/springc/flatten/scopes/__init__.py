@@ -20,6 +20,7 @@ from .enumerations import (
     value_kind,
 )
 from .event_uses import EventUses
+from .identity import Ident
 from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .modification import Mod, ModValue, Redeclaration, each, from_syntax, merge, merge_all, select
 from .parameters import ParameterValues, binding_errors, check_powers
@@ -70,6 +71,7 @@ __all__ = [
     "FlattenContext",
     "FunctionScope",
     "Handler",
+    "Ident",
     "Leaf",
     "Limits",
     "LocalScope",

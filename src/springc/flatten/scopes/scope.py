@@ -30,6 +30,7 @@ from .. import arrays as a
 from .class_extends import inherited_class
 from .enumerations import DimensionKind, Enumeration
 from .event_uses import EventUses
+from .identity import Ident
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
@@ -290,14 +291,14 @@ class Declared:
     """What a component declaration contributes independently of the instance: its
     resolved type, the type's modifications, and its sizes when they are literals."""
 
-    comp: ViewComponent  # kept alive: declared_types is keyed by its id
+    comp: ViewComponent
     rtype: ResolvedType
     type_mods: list[Mod | None]
     dims: tuple[int, ...] | None
 
 
 Handler = Callable[[s.Call, Scope], a.Value]
-AttributeCache = dict[tuple[tuple[str, int], ...], tuple[tuple[Mod, ...], flat.Attributes]]
+AttributeCache = dict[tuple[tuple[str, Ident[Mod]], ...], flat.Attributes]
 
 
 class BuiltinFunctions(Protocol):
@@ -357,7 +358,7 @@ class FlattenContext(Protocol):
     # conditions of if-statements, checked to be Boolean once the types are known
     statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
-    reusable_views: dict[int, bool]
+    reusable_views: dict[Ident[ClassView], bool]
 
     def report(self, err: FlattenError) -> None: ...
 
