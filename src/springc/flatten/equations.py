@@ -30,6 +30,7 @@ class EquationFlattening(FlattenContext):
     connections: ConnectionSets
     # Equation templates by (the ClassView, initial); None: not reusable.
     templates: dict[tuple[Ident[ClassView], bool], Template | None]
+    reusable_views: dict[Ident[ClassView], bool]  # whether a view's equations are a template
     algorithm_sections: list[Section]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
@@ -52,7 +53,8 @@ class EquationFlattening(FlattenContext):
                 self.report(err)
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
                 and scope.package is None:
-            independent = self.parameter_values.reads == reads and reusable(self, view)
+            independent = self.parameter_values.reads == reads \
+                and reusable(self, view, self.reusable_views)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
 
