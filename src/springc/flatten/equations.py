@@ -19,7 +19,7 @@ from .assertions import assertion
 from .connection_graph import GRAPH_EQUATIONS, graph_equation
 from .connections import ConnectionSets
 from .equation_templates import Template, make_template, reusable
-from .event_calls import event_dependent
+from .event_calls import EVENT_EQUATIONS, event_dependent
 from .functions import call_for_effect, multiple_outputs
 from .loops import check_loop_nest
 from .ranges import with_range
@@ -88,7 +88,7 @@ class EquationFlattening(FlattenContext):
         elif isinstance(eq, s.AlgorithmSection):
             self.algorithm_sections.append(
                 algorithm_section(self, eq, where, owner, initial))
-        elif eq.call.func.dotted in ("reinit", "terminate"):
+        elif eq.call.func.dotted in EVENT_EQUATIONS:
             name = eq.call.func.dotted
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")

@@ -22,19 +22,20 @@ from .scope import ExpressionEvaluator, Scope
 
 EVENT_CALLS = names(lambda b: b.event)
 """Calls handled here (``reinit`` and ``terminate`` only to refuse them in expressions)."""
+EVENT_EQUATIONS = names(lambda b: b.event and b.kind == EQUATION)
+"""``reinit`` and ``terminate``: equations of when-clauses only."""
 
 
 def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope) -> a.Value:
     """The flat value of the event built-in ``e``."""
     name = e.func.dotted
-    builtin = BUILTINS[name]
-    if builtin.kind == EQUATION:
+    if name in EVENT_EQUATIONS:
         raise FlattenError(f"'{name}' is an equation, not an expression", e.func.span,
                            hint=f"write '{name}(...);' as an equation inside a "
                            "when-clause")
     if e.named:
         raise FlattenError(f"'{name}' takes no named arguments", e.named[0].span)
-    count = builtin.arity[0]
+    count = BUILTINS[name].arity[0]
     if len(e.args) != count:
         raise FlattenError(f"'{name}' takes {count} argument{'s' if count != 1 else ''}, "
                            f"{len(e.args)} given", e.span)
