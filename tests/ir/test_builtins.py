@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 
 from springc.codegen.printer import FunctionWriter, NumpyWriter
-from springc.flatten.builtins import SCALAR_FUNCTIONS, Builtins
+from springc.flatten.calls.builtins import SCALAR_FUNCTIONS, Builtins
 from springc.flatten.evaluate import UNSUPPORTED_CALLS
-from springc.flatten.event_calls import BOOLEAN_CALLS, EVENT_CALLS
+from springc.flatten.events.event_calls import BOOLEAN_CALLS, EVENT_CALLS
 from springc.ir import builtins as b
 from springc.ir import expr as x
 from springc.ir import latex

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
-from .scope import ClassView, FlattenContext, ViewComponent
-from .tables import is_external_object
+from .natives import is_external_object
+from .scopes import ClassView, FlattenContext, ViewComponent
 
 
 @dataclass(frozen=True)

@@ -14,20 +14,21 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from . import arrays as a
-from .algorithms import Section, algorithm_section
-from .assertions import assertion
-from .connection_graph import GRAPH_EQUATIONS, graph_equation
-from .connections import ConnectionSets
+from .array_ops import check_loop_nest, with_range
+from .calls import assertion, call_for_effect, multiple_outputs, string_equation
+from .checks import check_boolean_condition
+from .connect import GRAPH_EQUATIONS, ConnectionSets, graph_equation
 from .equation_templates import Template, make_template, reusable
-from .event_calls import EVENT_EQUATIONS, event_dependent
-from .functions import call_for_effect, multiple_outputs
-from .loops import check_loop_nest
-from .ranges import with_range
-from .records import record_equation
-from .scope import ClassScope, FlattenContext, LocalScope, Scope
-from .strings import string_equation
-from .type_rules import check_boolean_condition
-from .when import flatten_when, variable_if_equation
+from .events import (
+    EVENT_EQUATIONS,
+    Section,
+    algorithm_section,
+    event_dependent,
+    flatten_when,
+    variable_if_equation,
+)
+from .redeclare import record_equation
+from .scopes import ClassScope, FlattenContext, LocalScope, Scope
 
 
 class EquationFlattening(FlattenContext):
@@ -103,7 +104,7 @@ class EquationFlattening(FlattenContext):
 
     def _variable_condition(self, cond: s.Expr, where: Scope) -> bool:
         """Whether an if-equation condition depends on variables (then the branches
-        switch at events: flatten/when.py)."""
+        switch at events: flatten/events/when.py)."""
         value = self.evaluator.value(cond, where)
         return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) and (
             not self.is_parameter_expression(value) or event_dependent(value))
@@ -168,7 +169,7 @@ class EquationFlattening(FlattenContext):
                 f"{a.describe_shape(a.shape(lhs))} and {a.describe_shape(a.shape(rhs))}",
                 eq.span, hint="both sides of an equation must have the same size")
         if string_equation(lhs, rhs, eq.span):
-            return  # known while flattening (flatten/strings.py)
+            return  # known while flattening (flatten/calls/strings.py)
         for side, e in ((lhs, eq.lhs), (rhs, eq.rhs)):
             if isinstance(side, str):
                 raise FlattenError("strings cannot appear in equations", e.span)

@@ -31,12 +31,12 @@ from ..ir import expr as x
 from ..ir import flat
 from . import arrays as a
 from .equation_templates import fixed_shape, renamer
-from .modification import Mod
-from .scope import (
+from .scopes import (
     ClassScope,
     ClassView,
     Disabled,
     FlattenContext,
+    Mod,
     ObjectMember,
     Primitive,
     ViewComponent,

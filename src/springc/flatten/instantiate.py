@@ -20,43 +20,50 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry, member_class
 from . import arrays as a
-from .access import check_modified
-from .declarations import (
+from .array_ops import typed_dimension
+from .calls import string_component
+from .checks import (
+    check_constant_binding,
+    check_discrete_binding,
+    check_enum_binding,
+    check_integer_binding,
+    check_modified,
+    rule_error,
+    stronger,
+)
+from .natives import is_external_object, table_object
+from .redeclare import (
+    check_redeclarations,
+    class_modification,
     condition_holds,
     disabled,
     inner_member,
+    named_through,
+    record_mod,
     redeclared,
     redeclared_class,
     redeclared_class_mod,
+    type_name_package,
 )
-from .dimensions import typed_dimension
-from .enum_rules import check_enum_binding
-from .enumerations import DimensionKind
-from .instance_classes import class_modification, named_through, type_name_package
-from .modification import Mod, ModValue, each, from_syntax, merge_all, select
-from .records import record_mod
-from .redeclare_rules import check_redeclarations
-from .rules import rule_error
-from .scope import (
+from .scopes import (
     ClassScope,
     ClassView,
     Declared,
+    DimensionKind,
     FlattenContext,
     Member,
+    Mod,
+    ModValue,
     Primitive,
     ResolvedType,
     ViewComponent,
+    check_attribute_mods,
+    each,
+    from_syntax,
     instance_mod,
+    merge_all,
+    select,
 )
-from .strings import string_component
-from .tables import is_external_object, table_object
-from .type_rules import (
-    check_constant_binding,
-    check_discrete_binding,
-    check_integer_binding,
-    stronger,
-)
-from .variables import check_attribute_mods
 
 
 class Instantiation(FlattenContext):

@@ -3,7 +3,7 @@
 ModelicaStandardTables (the table blocks of the Modelica Standard Library) are external
 objects built by C functions. springc recognises those functions by their C names, as
 the library declares them (``external "C" y = ModelicaStandardTables_CombiTable1D_getValue
-(tableID, icol, u)``), and evaluates them while flattening (``flatten/tables.py``). Each
+(tableID, icol, u)``), and evaluates them while flattening (``flatten/natives/tables.py``). Each
 entry names the operation and the role of every argument of the external call, in the
 order of the C function's parameters; ``None`` marks an argument springc does not need
 (an array size the table already knows).
