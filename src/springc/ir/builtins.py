@@ -81,8 +81,9 @@ class Builtin:
     numpy: str | None = None
     """Spelling over numpy arrays, as :attr:`python`."""
     c: str | None = None
-    """The C99 ``<math.h>`` function (``abs`` -> ``fabs``); None where C99 has none
-    (:data:`C_HELPERS` defines those of the math built-ins)."""
+    """The C99 ``<math.h>`` function (``abs`` -> ``fabs``); None where C99 has none of
+    the same values (:data:`C_HELPERS` defines those of the math built-ins, see
+    :attr:`c_call`)."""
     sympy: SympyForm | None = None
     transparent: int | None = None
     """The argument whose value this is (``noEvent(x)`` is ``x``, ``smooth(p, x)`` is
@@ -104,6 +105,13 @@ class Builtin:
     """The unit rule (units/check.py): ``dimensionless`` (argument 1, result 1),
     ``same`` (arguments agree, result theirs), ``first`` (the first argument's),
     ``last``, ``sqrt``, ``quotient``, ``one`` (result 1), ``atan2``; empty: none."""
+
+    @property
+    def c_call(self) -> str | None:
+        """The C function a call is printed with: :attr:`c`, else the helper
+        ``springc_<name>`` of :data:`C_HELPERS` (None: neither, not a math built-in)."""
+        helper = f"springc_{self.name}"
+        return self.c if self.c is not None else (helper if helper in C_HELPERS else None)
 
     @property
     def boolean(self) -> bool:
@@ -284,7 +292,7 @@ _MIN_MAX = tuple(
     Builtin(name, MATH, (1, 2), ANY, SAME,
             f"the {'smaller' if name == 'min' else 'larger'} of two values, or the "
             f"{'least' if name == 'min' else 'greatest'} element of an array",
-            fn, _min_max, name, f"np.{name}imum", f"f{name}", _sp(name.capitalize()),
+            fn, _min_max, name, f"np.{name}imum", None, _sp(name.capitalize()),
             switching=True, unit="same")
     for name, fn in (("min", min), ("max", max)))
 
@@ -384,11 +392,19 @@ PYTHON_HELPERS: Mapping[str, str] = {
 """The functions of generated Python that :attr:`Builtin.python` names ``_<name>``."""
 
 C_HELPERS: Mapping[str, str] = {
-    "sign": "static inline double springc_sign(double a)\n"
-            "{ return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0); }\n",
-    "mod": "static inline double springc_mod(double a, double b)\n"
-           "{ return a - floor(a / b) * b; }\n",
-    "div": "static inline double springc_div(double a, double b)\n"
-           "{ return trunc(a / b); }\n",
+    # Python's min and max: the first argument unless the second is smaller (larger);
+    # C99's fmin and fmax differ where an argument is NaN
+    "springc_min": "SPRINGC_FN double springc_min(double a, double b)\n"
+                   "{\n    return b < a ? b : a;\n}",
+    "springc_max": "SPRINGC_FN double springc_max(double a, double b)\n"
+                   "{\n    return b > a ? b : a;\n}",
+    "springc_sign": "SPRINGC_FN double springc_sign(double a)\n"
+                    "{\n    return a > 0.0 ? 1.0 : (a < 0.0 ? -1.0 : 0.0);\n}",
+    "springc_mod": "SPRINGC_FN double springc_mod(double a, double b)\n"
+                   "{\n    return a - floor(a / b) * b;\n}",
+    "springc_div": "SPRINGC_FN double springc_div(double a, double b)\n"
+                   "{\n    return trunc(a / b);\n}",
 }
-"""C definitions (``springc_<name>``) of the math built-ins C99 has no function for."""
+"""C99 definitions of the math built-ins C99 has no function of the same values for,
+by name (``springc_<built-in>``, :attr:`Builtin.c_call`); ``SPRINGC_FN`` is the C
+printer's qualifier macro (``static inline``, or ``__device__`` for CUDA)."""
