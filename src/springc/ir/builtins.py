@@ -1,8 +1,9 @@
 """The one registry of springc's built-in functions and event operators.
 
 Every stage reads :data:`BUILTINS` instead of a name set of its own: flattening its
-arity, argument and result types (``flatten/builtins``, ``type_rules``, ``enum_rules``,
-``event_calls``, ``when``), :mod:`springc.ir.expr` its constant evaluation and
+arity, argument and result types (``flatten/calls/builtins``, ``checks/type_rules``,
+``checks/enum_rules``, ``events/event_calls``, ``events/when``), :mod:`springc.ir.expr`
+its constant evaluation and
 derivative, :mod:`springc.ir.latex` its sympy function, ``codegen`` its Python (numba)
 and numpy spellings, ``simplify/events`` and ``codegen/event_layout`` the event
 properties, ``units`` the unit rule; a C printer its C99 ``<math.h>`` spelling.
@@ -101,6 +102,9 @@ class Builtin:
     """Reads the left limit of its variable (``pre``, ``edge``, ``change``)."""
     phase: bool = False
     """True during one phase of a run (``initial()``, ``terminal()``)."""
+    at_events: bool = False
+    """An event operator, or an equation that acts at events (``reinit``,
+    ``terminate``): its value or effect depends on the instant."""
     unit: str = ""
     """The unit rule (units/check.py): ``dimensionless`` (argument 1, result 1),
     ``same`` (arguments agree, result theirs), ``first`` (the first argument's),
@@ -117,12 +121,6 @@ class Builtin:
     def boolean(self) -> bool:
         """Whether its value is a Boolean (never an operand of arithmetic)."""
         return self.result == BOOLEAN
-
-    @property
-    def event(self) -> bool:
-        """Whether it is an event operator or event equation (its value or effect
-        depends on the instant)."""
-        return self.kind == EVENT or (self.kind == EQUATION and self.name != "print")
 
 
 # ------------------------------------------------------------------ derivatives
@@ -314,33 +312,33 @@ _OPERATORS = (
 _EVENTS = (
     Builtin("pre", EVENT, (1, 1), VARIABLE, SAME,
             "the left limit of a variable at an event", discrete=True, reads_pre=True,
-            unit="same"),
+            unit="same", at_events=True),
     Builtin("edge", EVENT, (1, 1), VARIABLE, BOOLEAN, "b and not pre(b)", discrete=True,
-            reads_pre=True),
+            reads_pre=True, at_events=True),
     Builtin("change", EVENT, (1, 1), VARIABLE, BOOLEAN, "v <> pre(v)", discrete=True,
-            reads_pre=True),
+            reads_pre=True, at_events=True),
     Builtin("initial", EVENT, (0, 0), ANY, BOOLEAN, "true during initialization",
-            discrete=True, phase=True),
+            discrete=True, phase=True, at_events=True),
     Builtin("terminal", EVENT, (0, 0), ANY, BOOLEAN, "true at the end of the run",
-            discrete=True, phase=True),
+            discrete=True, phase=True, at_events=True),
     Builtin("sample", EVENT, (2, 2), PARAMETER, BOOLEAN,
-            "true at start + k*interval (time events)", discrete=True),
+            "true at start + k*interval (time events)", discrete=True, at_events=True),
     Builtin("reinit", EQUATION, (2, 2), ANY, ANY,
-            "reinit(x, value): a state takes a new value at an event"),
-    Builtin("terminate", EQUATION, (1, 1), STRING, ANY, "ends the run at an event"),
+            "reinit(x, value): a state takes a new value at an event", at_events=True),
+    Builtin("terminate", EQUATION, (1, 1), STRING, ANY, "ends the run at an event",
+            at_events=True),
     Builtin("print", EQUATION, (1, 1), STRING, ANY, "prints a String (not supported yet)"),
 )
 
 
 def _array(name: str, arity: tuple[int, int], arguments: str, result: str, doc: str,
-           discrete: bool = False) -> Builtin:
-    return Builtin(name, ARRAY, arity, arguments, result, doc, discrete=discrete,
-                   unit="same" if name == "sum" else "")
+           discrete: bool = False, unit: str = "") -> Builtin:
+    return Builtin(name, ARRAY, arity, arguments, result, doc, discrete=discrete, unit=unit)
 
 
 _MANY = 1 << 16
 _ARRAYS = (
-    _array("sum", (1, 1), NUMBER, NUMBER, "sum of the elements"),
+    _array("sum", (1, 1), NUMBER, NUMBER, "sum of the elements", unit="same"),
     _array("product", (1, 1), NUMBER, NUMBER, "product of the elements"),
     _array("size", (1, 2), ANY, INTEGER, "sizes of an array, or size along a dimension",
            discrete=True),

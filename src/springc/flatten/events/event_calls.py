@@ -19,9 +19,9 @@ from ...ir.builtins import BUILTINS, EQUATION, names
 from .. import arrays as a
 from ..scopes import EventUses, ExpressionEvaluator, Scope
 
-EVENT_CALLS = names(lambda b: b.event)
+EVENT_CALLS = names(lambda b: b.at_events)
 """Calls handled here (``reinit`` and ``terminate`` only to refuse them in expressions)."""
-EVENT_EQUATIONS = names(lambda b: b.event and b.kind == EQUATION)
+EVENT_EQUATIONS = names(lambda b: b.at_events and b.kind == EQUATION)
 """``reinit`` and ``terminate``: equations of when-clauses only."""
 
 
