@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from springc.codegen.printer import FunctionWriter, NumpyWriter
+from springc.errors import CodegenError
 from springc.flatten.calls.builtins import SCALAR_FUNCTIONS, Builtins
 from springc.flatten.evaluate import UNSUPPORTED_CALLS
 from springc.flatten.events.event_calls import BOOLEAN_CALLS, EVENT_CALLS
@@ -207,3 +208,12 @@ def test_unknown_names() -> None:
     assert b.lookup("spline") is None
     with pytest.raises(ValueError, match=r"cannot differentiate pre\(\.\.\.\)"):
         x.diff(x.Call("pre", (x.Var("a"),)), "a")
+
+
+@pytest.mark.parametrize("writer", [FunctionWriter, NumpyWriter])
+@pytest.mark.parametrize("name", ["spline", "pre", "delay", "sum"])
+def test_printers_refuse_what_the_registry_gives_no_spelling(
+        writer: type[FunctionWriter], name: str) -> None:
+    with pytest.raises(CodegenError,
+                       match=rf"\Aerror: cannot generate code for the function '{name}'\Z"):
+        writer(lambda v: v, set()).expr(x.Call(name, (x.Var("a"),)))
