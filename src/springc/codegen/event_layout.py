@@ -21,10 +21,11 @@ import dataclasses
 from collections.abc import Mapping
 
 from ..ir import expr as x
+from ..ir.builtins import names
 from ..ir.hybrid import EventSystem
 from .statements import Load, Stmt
 
-_QUIET = frozenset({"noEvent", "smooth"})
+_QUIET = names(lambda b: b.quiet)
 FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus")
 
 

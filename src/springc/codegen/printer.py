@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator, Sequence
-from typing import ClassVar
 
+from ..ir.builtins import BUILTINS, PYTHON_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
 from .locate import untranslatable
 from .statements import (
@@ -35,18 +35,13 @@ from .statements import (
 _PREC = {"or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
          "+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
 _PY_OP = {"<>": "!=", "^": "**"}
-_MATH = {"sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh",
-         "tanh", "exp", "log", "log10", "floor", "ceil"}
-_BUILTIN = {"abs", "min", "max"}
-_TRANSPARENT = {"noEvent": 0, "smooth": 1, "homotopy": 0}
+HELPERS = PYTHON_HELPERS
+"""The helper functions a generated module defines when it calls them (the registry's)."""
 
-HELPERS = {
-    "_sign": "def _sign(a):\n    return 1.0 if a > 0 else (-1.0 if a < 0 else 0.0)\n",
-    "_mod": "def _mod(a, b):\n    return a - math.floor(a / b) * b\n",
-    "_div": "def _div(a, b):\n    return float(math.trunc(a / b))\n",
-}
-_HELPER_OF = {"sign": "_sign", "mod": "_mod", "div": "_div", "integer": "math.floor",
-              "rem": "math.fmod"}
+
+def _spelled(spelling: str, args: str) -> str:
+    """A call in a printer's spelling: ``math.sqrt`` or a ``{}`` template."""
+    return spelling.format(args) if "{}" in spelling else f"{spelling}({args})"
 
 
 def _trivial(e: Expr) -> bool:
@@ -250,20 +245,21 @@ class FunctionWriter:
         return f"{left} {_PY_OP.get(op, op)} {right}", prec
 
     def _print_Call(self, e: Call) -> tuple[str, int]:
-        name = e.name
-        if name in _TRANSPARENT:
-            return self._shared(e.args[_TRANSPARENT[name]])
+        builtin = BUILTINS.get(e.name)
+        if builtin is not None and builtin.transparent is not None:
+            return self._shared(e.args[builtin.transparent])
+        spelling = self._spelling(e)
         args = ", ".join(self.expr(a) for a in e.args)
-        if name in _MATH:
-            return f"math.{name}({args})", 9
-        if name in _BUILTIN:
-            return f"{name}({args})", 9
-        if name in _HELPER_OF:
-            helper = _HELPER_OF[name]
-            if helper.startswith("_"):
-                self.helpers.add(helper)
-            return f"{helper}({args})", 9
-        raise untranslatable(f"cannot generate code for the function '{name}'", e)
+        if spelling in HELPERS:
+            self.helpers.add(spelling)
+        return _spelled(spelling, args), 9
+
+    def _spelling(self, e: Call) -> str:
+        """How this printer calls the built-in of ``e`` (the registry's ``python``)."""
+        builtin = BUILTINS.get(e.name)
+        if builtin is None or builtin.python is None:
+            raise untranslatable(f"cannot generate code for the function '{e.name}'", e)
+        return builtin.python
 
     def _print_If(self, e: If) -> tuple[str, int]:
         cond = self.expr(e.cond, 1)
@@ -304,24 +300,11 @@ def function_lines(namer: Callable[[str], str], helpers: set[str], stmts: Sequen
 class NumpyWriter(FunctionWriter):
     """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
 
-    _UFUNC: ClassVar[dict[str, str]] = {
-        "asin": "arcsin", "acos": "arccos", "atan": "arctan", "atan2": "arctan2",
-        "min": "minimum", "max": "maximum", "rem": "fmod", "integer": "floor"}
-    _SAME: ClassVar[set[str]] = {
-        "sqrt", "sin", "cos", "tan", "sinh", "cosh", "tanh", "exp", "log", "log10", "abs",
-        "sign", "mod", "floor", "ceil"}
-
-    def _print_Call(self, e: Call) -> tuple[str, int]:
-        if e.name in ("noEvent", "smooth", "homotopy"):
-            return super()._print_Call(e)
-        args = ", ".join(self.expr(a) for a in e.args)
-        if e.name == "div":
-            return f"np.trunc(np.divide({args}))", 9
-        if e.name in self._SAME:
-            return f"np.{e.name}({args})", 9
-        if e.name in self._UFUNC:
-            return f"np.{self._UFUNC[e.name]}({args})", 9
-        raise untranslatable(f"cannot generate code for the function '{e.name}'", e)
+    def _spelling(self, e: Call) -> str:
+        builtin = BUILTINS.get(e.name)
+        if builtin is None or builtin.numpy is None:
+            raise untranslatable(f"cannot generate code for the function '{e.name}'", e)
+        return builtin.numpy
 
     def _print_BinOp(self, e: BinOp) -> tuple[str, int]:
         if e.op in ("and", "or"):

@@ -19,7 +19,14 @@ from .calls import assertion, call_for_effect, multiple_outputs, string_equation
 from .checks import check_boolean_condition
 from .connect import GRAPH_EQUATIONS, ConnectionSets, graph_equation
 from .equation_templates import Template, make_template, reusable
-from .events import Section, algorithm_section, event_dependent, flatten_when, variable_if_equation
+from .events import (
+    EVENT_EQUATIONS,
+    Section,
+    algorithm_section,
+    event_dependent,
+    flatten_when,
+    variable_if_equation,
+)
 from .redeclare import record_equation
 from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
@@ -84,7 +91,7 @@ class EquationFlattening(FlattenContext):
         elif isinstance(eq, s.AlgorithmSection):
             self.algorithm_sections.append(
                 algorithm_section(self, eq, where, owner, initial))
-        elif eq.call.func.dotted in ("reinit", "terminate"):
+        elif eq.call.func.dotted in EVENT_EQUATIONS:
             name = eq.call.func.dotted
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")

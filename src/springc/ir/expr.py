@@ -1,8 +1,11 @@
-"""Scalar expressions of the flat model and later stages.
+"""Scalar expressions of the flat model and later stages: the face of the tree.
 
 A deliberately small, fast tree: flattening builds hundreds of thousands of these, so
 they are plain frozen dataclasses rather than sympy objects (rendering as LaTeX converts
-to sympy on demand, :mod:`springc.ir.latex`).
+to sympy on demand, :mod:`springc.ir.latex`). The nodes, their traversal, construction
+and text live in :mod:`springc.ir.nodes` and are re-exported here with evaluation and
+differentiation, which read the built-ins' values and derivatives from the registry
+(:mod:`springc.ir.builtins`).
 
 Depth: the stages recurse over these trees, so their depth is bounded. The parser
 rejects source expressions nested deeper than :data:`MAX_DEPTH` (a sum of n terms is
@@ -12,13 +15,54 @@ the stack that depth needs.
 
 from __future__ import annotations
 
-import math
 import sys
 import threading
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
-from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any
+
+from .builtins import BUILTINS
+from .nodes import (
+    FOLD_CHUNK,
+    ONE,
+    RELATIONS,
+    TIME,
+    ZERO,
+    BinOp,
+    Call,
+    Const,
+    Der,
+    Expr,
+    If,
+    Neg,
+    Not,
+    Time,
+    Var,
+    add,
+    children,
+    derivatives,
+    div,
+    fold_chunked,
+    format_number,
+    map_children,
+    mul,
+    neg,
+    power,
+    sub,
+    substitute,
+    to_text,
+    variables,
+    walk,
+)
+
+__all__ = [
+    "FOLD_CHUNK", "INITIAL", "MATH", "MAX_DEPTH", "ONE", "RELATIONS", "TIME", "ZERO",
+    "BinOp", "Call", "Const", "Der", "Expr", "If", "Neg", "Not", "NotEvaluable", "Time",
+    "Var", "add", "children", "derivatives", "diff", "div", "evaluate", "fold_chunked",
+    "format_number", "map_children", "mul", "neg", "power", "recursion_limit",
+    "recursion_room", "sub", "substitute", "time_derivative", "to_text", "variables",
+    "walk",
+]
 
 # ------------------------------------------------------------------------ depth
 
@@ -109,83 +153,9 @@ def recursion_room() -> Iterator[None]:
         _ROOM.leave(affordable)
 
 
-@dataclass(frozen=True, slots=True)
-class Const:
-    value: float | int | bool
-
-
-@dataclass(frozen=True, slots=True)
-class Var:
-    """A flat scalar variable or parameter, by its flat name (``mass.pos[1]``)."""
-
-    name: str
-
-
-@dataclass(frozen=True, slots=True)
-class Time:
-    """The built-in variable ``time``."""
-
-
-@dataclass(frozen=True, slots=True)
-class Der:
-    """``der(arg)``; after flattening ``arg`` may be any expression of variables."""
-
-    arg: Expr
-
-
-@dataclass(frozen=True, slots=True)
-class Neg:
-    arg: Expr
-
-
-@dataclass(frozen=True, slots=True)
-class Not:
-    arg: Expr
-
-
-@dataclass(frozen=True, slots=True)
-class BinOp:
-    """``op`` is one of ``+ - * / ^ < <= > >= == <> and or`` (scalar semantics)."""
-
-    op: str
-    left: Expr
-    right: Expr
-
-
-@dataclass(frozen=True, slots=True)
-class Call:
-    """A built-in scalar function (``sqrt``, ``atan2``, ``noEvent``, ...)."""
-
-    name: str
-    args: tuple[Expr, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class If:
-    cond: Expr
-    then: Expr
-    otherwise: Expr
-
-
-Expr = Const | Var | Time | Der | Neg | Not | BinOp | Call | If
-
-ZERO = Const(0)
-ONE = Const(1)
-TIME = Time()
-
-RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
-
-MATH: dict[str, Callable[..., float]] = {
-    "sqrt": math.sqrt, "sin": math.sin, "cos": math.cos, "tan": math.tan,
-    "asin": math.asin, "acos": math.acos, "atan": math.atan, "atan2": math.atan2,
-    "sinh": math.sinh, "cosh": math.cosh, "tanh": math.tanh, "exp": math.exp,
-    "log": math.log, "log10": math.log10, "abs": abs,
-    "sign": lambda x: (x > 0) - (x < 0), "min": min, "max": max,
-    "floor": math.floor, "ceil": math.ceil, "integer": math.floor,
-    "mod": lambda x, y: x - math.floor(x / y) * y, "rem": lambda x, y: math.fmod(x, y),
-    "div": lambda x, y: math.trunc(x / y),
-    "noEvent": lambda x: x, "smooth": lambda p, x: x, "homotopy": lambda a, s: a,
-}
+MATH: Mapping[str, Callable[..., Any]] = {
+    name: b.evaluate for name, b in BUILTINS.items() if b.evaluate is not None}
+"""The built-ins with a value for constant arguments (the registry's ``evaluate``)."""
 
 _BINARY: dict[str, Callable[[Any, Any], Any]] = {
     "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
@@ -194,79 +164,6 @@ _BINARY: dict[str, Callable[[Any, Any], Any]] = {
     ">=": lambda a, b: a >= b, "==": lambda a, b: a == b, "<>": lambda a, b: a != b,
     "and": lambda a, b: bool(a) and bool(b), "or": lambda a, b: bool(a) or bool(b),
 }
-
-# ------------------------------------------------------------------ traversal
-
-
-def children(e: Expr) -> tuple[Expr, ...]:
-    """The direct sub-expressions of ``e``."""
-    if isinstance(e, BinOp):
-        return (e.left, e.right)
-    if isinstance(e, (Neg, Not, Der)):
-        return (e.arg,)
-    if isinstance(e, Call):
-        return e.args
-    if isinstance(e, If):
-        return (e.cond, e.then, e.otherwise)
-    return ()
-
-
-def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
-    """``e`` with ``f`` applied to each direct sub-expression; ``e`` itself where every
-    child comes back unchanged (unchanged subtrees are shared, not copied)."""
-    old = children(e)
-    new = tuple(f(c) for c in old)
-    if all(a is b for a, b in zip(new, old)):
-        return e
-    if isinstance(e, BinOp):
-        return BinOp(e.op, new[0], new[1])
-    if isinstance(e, (Neg, Not, Der)):
-        return type(e)(new[0])
-    if isinstance(e, Call):
-        return Call(e.name, new)
-    assert isinstance(e, If)
-    return If(new[0], new[1], new[2])
-
-
-def walk(e: Expr) -> Iterator[Expr]:
-    """All nodes of ``e``, parents before children."""
-    stack = [e]
-    while stack:
-        node = stack.pop()
-        yield node
-        stack.extend(children(node))
-
-
-def variables(e: Expr) -> set[str]:
-    """Names of all variables referenced in ``e`` (inside ``der`` too)."""
-    return {n.name for n in walk(e) if isinstance(n, Var)}
-
-
-def derivatives(e: Expr) -> set[str]:
-    """Names ``x`` of all ``der(x)`` in ``e`` whose argument is a plain variable."""
-    return {n.arg.name for n in walk(e) if isinstance(n, Der) and isinstance(n.arg, Var)}
-
-
-def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
-    """Replace variables by expressions; unchanged subtrees are shared, not copied."""
-    if isinstance(e, Var):
-        return mapping.get(e.name, e)
-    if isinstance(e, (Const, Time)):
-        return e
-    if isinstance(e, BinOp):
-        left, right = substitute(e.left, mapping), substitute(e.right, mapping)
-        return e if left is e.left and right is e.right else BinOp(e.op, left, right)
-    if isinstance(e, (Neg, Not, Der)):
-        arg = substitute(e.arg, mapping)
-        return e if arg is e.arg else type(e)(arg)
-    if isinstance(e, Call):
-        args = tuple(substitute(a, mapping) for a in e.args)
-        return e if all(a is b for a, b in zip(args, e.args)) else Call(e.name, args)
-    if isinstance(e, If):
-        c, t, o = (substitute(x, mapping) for x in (e.cond, e.then, e.otherwise))
-        return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
-    raise TypeError(f"not an expression: {e!r}")
-
 
 INITIAL = "initial()"
 """The key of an environment whose value says whether ``initial()`` holds (during
@@ -339,95 +236,6 @@ def _event_call(e: Call, env: Mapping[str, object], time: float,
     raise NotEvaluable(f"{name}(...) has no value here")
 
 
-# ------------------------------------------------------------- construction
-
-
-FOLD_CHUNK = 64
-"""Items folded left to right before chunks are combined pairwise (see :func:`fold_chunked`)."""
-
-_Item = TypeVar("_Item")
-
-
-def fold_chunked(items: Sequence[_Item], step: Callable[[Expr, _Item], Expr],
-                 combine: Callable[[Expr, Expr], Expr], identity: Expr) -> Expr:
-    """``step`` folded over ``items`` from ``identity``, shallow for long runs.
-
-    Up to :data:`FOLD_CHUNK` items this is the left fold ``((a + b) + c) + ...`` that the
-    flat text shows; longer runs are folded in chunks of that size whose results are
-    joined pairwise with ``combine``, so the tree stays shallow (depth about
-    64 + log2(n/64)) and every later stage, which recurses over expressions, handles a
-    sum of thousands of terms."""
-    chunks: list[Expr] = []
-    for i in range(0, len(items), FOLD_CHUNK):
-        value = identity
-        for item in items[i:i + FOLD_CHUNK]:
-            value = step(value, item)
-        chunks.append(value)
-    while len(chunks) > 1:
-        pairs = [combine(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
-        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
-    return chunks[0] if chunks else identity
-
-
-def add(a: Expr, b: Expr) -> Expr:
-    """``a + b`` with constant folding and zero elimination."""
-    if isinstance(a, Const) and isinstance(b, Const):
-        return Const(a.value + b.value)
-    if a == ZERO:
-        return b
-    if b == ZERO:
-        return a
-    if isinstance(b, Neg):
-        return BinOp("-", a, b.arg)
-    return BinOp("+", a, b)
-
-
-def sub(a: Expr, b: Expr) -> Expr:
-    if isinstance(a, Const) and isinstance(b, Const):
-        return Const(a.value - b.value)
-    if b == ZERO:
-        return a
-    if a == ZERO:
-        return neg(b)
-    return BinOp("-", a, b)
-
-
-def mul(a: Expr, b: Expr) -> Expr:
-    if isinstance(a, Const) and isinstance(b, Const):
-        return Const(a.value * b.value)
-    if a == ZERO or b == ZERO:
-        return ZERO
-    if a == ONE:
-        return b
-    if b == ONE:
-        return a
-    return BinOp("*", a, b)
-
-
-def div(a: Expr, b: Expr) -> Expr:
-    if b == ONE:
-        return a
-    if a == ZERO:
-        return ZERO
-    return BinOp("/", a, b)
-
-
-def neg(a: Expr) -> Expr:
-    if isinstance(a, Const):
-        return Const(-a.value)
-    if isinstance(a, Neg):
-        return a.arg
-    return Neg(a)
-
-
-def power(a: Expr, b: Expr) -> Expr:
-    if b == ONE:
-        return a
-    if b == ZERO:
-        return ONE
-    return BinOp("^", a, b)
-
-
 # ------------------------------------------------------------ differentiation
 
 
@@ -491,94 +299,7 @@ def _diff_binop(e: BinOp, d: Callable[[Expr], Expr]) -> Expr:
 
 
 def _diff_call(e: Call, d: Callable[[Expr], Expr]) -> Expr:
-    name, args = e.name, e.args
-    x = args[0]
-    dx = d(x)
-    rules: dict[str, Callable[[], Expr]] = {
-        "sqrt": lambda: div(dx, mul(Const(2), e)),
-        "sin": lambda: mul(Call("cos", (x,)), dx),
-        "cos": lambda: neg(mul(Call("sin", (x,)), dx)),
-        "tan": lambda: div(dx, power(Call("cos", (x,)), Const(2))),
-        "asin": lambda: div(dx, Call("sqrt", (sub(ONE, mul(x, x)),))),
-        "acos": lambda: neg(div(dx, Call("sqrt", (sub(ONE, mul(x, x)),)))),
-        "atan": lambda: div(dx, add(ONE, mul(x, x))),
-        "sinh": lambda: mul(Call("cosh", (x,)), dx),
-        "cosh": lambda: mul(Call("sinh", (x,)), dx),
-        "tanh": lambda: mul(sub(ONE, mul(e, e)), dx),
-        "exp": lambda: mul(e, dx),
-        "log": lambda: div(dx, x),
-        "log10": lambda: div(dx, mul(x, Const(math.log(10)))),
-        "abs": lambda: mul(Call("sign", (x,)), dx),
-        "noEvent": lambda: Call("noEvent", (dx,)),
-        "homotopy": lambda: dx,
-    }
-    if name in rules:
-        return rules[name]()
-    if name == "atan2":
-        y, xx = args
-        return div(sub(mul(xx, d(y)), mul(y, d(xx))), add(mul(xx, xx), mul(y, y)))
-    if name in ("min", "max"):
-        a, b = args
-        cond = BinOp("<" if name == "min" else ">", a, b)
-        return If(Call("noEvent", (cond,)), d(a), d(b))
-    if name == "smooth":
-        return Call("smooth", (args[0], d(args[1])))
-    if name in ("sign", "floor", "ceil", "integer", "div"):
-        return ZERO
-    if name in ("mod", "rem"):
-        return dx
-    raise ValueError(f"cannot differentiate {name}(...)")
-
-
-# ------------------------------------------------------------------ printing
-
-_PRECEDENCE = {
-    "or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
-    "+": 5, "-": 5, "*": 6, "/": 6, "^": 8,
-}
-
-
-def format_number(value: float | int | bool) -> str:
-    """Modelica literal for a number; floats round-trip exactly (``repr``)."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if math.isinf(value):
-        return "1e1000" if value > 0 else "-1e1000"
-    return repr(value)
-
-
-def to_text(e: Expr, name: Callable[[str], str] = lambda n: n) -> str:
-    """Modelica text of ``e``; ``name`` renders variable names (e.g. quoting them)."""
-    return _print(e, name, 0)
-
-
-def _print(e: Expr, name: Callable[[str], str], outer: int) -> str:
-    if isinstance(e, Const):
-        text = format_number(e.value)
-        return f"({text})" if text.startswith("-") and outer > 0 else text
-    if isinstance(e, Var):
-        return name(e.name)
-    if isinstance(e, Time):
-        return "time"
-    if isinstance(e, Der):
-        return f"der({_print(e.arg, name, 0)})"
-    if isinstance(e, Call):
-        return f"{e.name}({', '.join(_print(a, name, 0) for a in e.args)})"
-    if isinstance(e, Neg):
-        text = "-" + _print(e.arg, name, 6)
-        return f"({text})" if outer > 5 else text
-    if isinstance(e, Not):
-        text = "not " + _print(e.arg, name, 3)
-        return f"({text})" if outer > 3 else text
-    if isinstance(e, If):
-        text = (f"if {_print(e.cond, name, 0)} then {_print(e.then, name, 0)}"
-                f" else {_print(e.otherwise, name, 0)}")
-        return f"({text})" if outer > 0 else text
-    prec = _PRECEDENCE[e.op]
-    # Left-associative: the right operand needs parentheses at equal precedence
-    # ("^" is non-associative in Modelica, so both sides do).
-    left_prec = prec + 1 if e.op == "^" or prec == 4 else prec
-    text = f"{_print(e.left, name, left_prec)} {e.op} {_print(e.right, name, prec + 1)}"
-    return f"({text})" if prec < outer else text
+    builtin = BUILTINS.get(e.name)
+    if builtin is None or builtin.derivative is None:
+        raise ValueError(f"cannot differentiate {e.name}(...)")
+    return builtin.derivative(e, d)

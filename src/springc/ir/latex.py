@@ -19,6 +19,7 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from . import expr as x
+from .builtins import BUILTINS
 
 __all__ = ["NOTEBOOK_ROWS", "align", "latex_name", "notebook", "to_latex", "to_sympy"]
 
@@ -73,15 +74,6 @@ class _Converter:
         self.time = sympy.Dummy("t")
         self.names: dict[Any, str] = {self.time: "t"}
         self.symbols: dict[str, Any] = {}
-        self.functions: dict[str, Any] = {
-            "sqrt": sympy.sqrt, "sin": sympy.sin, "cos": sympy.cos, "tan": sympy.tan,
-            "asin": sympy.asin, "acos": sympy.acos, "atan": sympy.atan,
-            "atan2": sympy.atan2, "sinh": sympy.sinh, "cosh": sympy.cosh,
-            "tanh": sympy.tanh, "exp": sympy.exp, "log": sympy.log,
-            "log10": lambda a: sympy.log(a, 10), "abs": sympy.Abs, "sign": sympy.sign,
-            "min": sympy.Min, "max": sympy.Max, "floor": sympy.floor,
-            "ceil": sympy.ceiling, "integer": sympy.floor, "mod": sympy.Mod,
-        }
         relations = {"<": sympy.Lt, "<=": sympy.Le, ">": sympy.Gt, ">=": sympy.Ge,
                      "==": sympy.Eq, "<>": sympy.Ne}
         self.binary: dict[str, Any] = {
@@ -134,8 +126,10 @@ class _Converter:
             return self.binary[e.op](*args)
         if isinstance(e, x.If):
             return sp.Piecewise((args[1], args[0]), (args[2], True))
-        function = self.functions.get(e.name) or sp.Function(e.name)
-        return function(*args)
+        builtin = BUILTINS.get(e.name)
+        if builtin is not None and builtin.sympy is not None:
+            return builtin.sympy(sp, tuple(args))
+        return sp.Function(e.name)(*args)
 
     def latex(self, value: Any) -> str:
         return str(self.sp.latex(value, symbol_names=self.names))

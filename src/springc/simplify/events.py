@@ -18,11 +18,13 @@ from dataclasses import dataclass
 from ..ir import expr as x
 from ..ir import flat, ode
 from ..ir import when as w
+from ..ir.builtins import names
 from ..ir.hybrid import Discrete, EventSystem, TimeRelation
 
 STATE_RELATIONS = frozenset({"<", "<=", ">", ">="})
-_QUIET = frozenset({"noEvent", "smooth"})
-_PHASES = frozenset({"initial", "terminal"})
+_QUIET = names(lambda b: b.quiet)
+_PHASES = names(lambda b: b.phase)
+_READS_PRE = names(lambda b: b.reads_pre)
 
 
 def continuous_part(model: flat.FlatModel) -> flat.FlatModel:
@@ -115,7 +117,7 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
                   and _continuous(node, params | held_set)):
                 floors.setdefault(node, None)
         for node in x.walk(e):
-            if isinstance(node, x.Call) and node.name in ("pre", "edge", "change"):
+            if isinstance(node, x.Call) and node.name in _READS_PRE:
                 arg = node.args[0]
                 if isinstance(arg, x.Var):
                     pre.setdefault(arg.name, None)
@@ -200,7 +202,7 @@ def switched_builtins(e: x.Expr, known: frozenset[str] | None = None) -> x.Expr:
     raise TypeError(f"not an expression: {e!r}")
 
 
-_FLOORED = frozenset({"floor", "ceil", "integer", "div", "mod", "rem"})
+_FLOORED = names(lambda b: b.floored)
 
 
 def _floor(u: x.Expr) -> x.Expr:

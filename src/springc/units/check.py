@@ -23,18 +23,10 @@ from functools import partial
 
 from ..errors import Note, Span, UnitError
 from ..ir import expr as x
+from ..ir.builtins import BUILTINS
 from ..ir.flat import Equation, FlatModel, quote
 from ..ir.when import When
 from .algebra import ONE, SECOND, Unit, UnitSyntaxError, parse_unit
-
-DIMENSIONLESS = frozenset({"sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh",
-                           "tanh", "exp", "log", "log10"})
-"""Functions of a dimensionless argument (angles in rad are dimensionless)."""
-SAME = frozenset({"abs", "noEvent", "pre", "floor", "ceil", "integer", "delay", "min",
-                  "max", "mod", "rem", "homotopy", "sum"})
-"""Functions whose result has the unit of their arguments, which must agree (``delay``:
-the first one)."""
-FIRST_ONLY = frozenset({"delay"})
 
 
 class Mismatch(Exception):
@@ -98,10 +90,12 @@ class UnitChecker:
     def call(self, e: x.Call) -> Unit | None:
         args = [self.unit(a) for a in e.args]
         name = e.name
-        if name == "atan2" and len(args) == 2:  # an angle from two lengths, say
+        builtin = BUILTINS.get(name)
+        rule = "" if builtin is None else builtin.unit  # the registry's unit rule
+        if rule == "atan2" and len(args) == 2:  # an angle from two lengths, say
             agree(args[0], args[1], "atan2's arguments", "and")
             return ONE
-        if name in DIMENSIONLESS:
+        if rule == "dimensionless":  # angles in rad are dimensionless
             given = args[0]
             # sin(time) is how one writes sin(w*time) with w = 1 rad/s: an argument
             # with no variable of declared unit in it is not checked
@@ -109,16 +103,16 @@ class UnitChecker:
                 raise Mismatch(f"'{given}' given to {name}, which takes a dimensionless "
                                "argument ('1' or 'rad')")
             return ONE
-        if name == "sqrt":
+        if rule == "sqrt":
             return None if args[0] is None else _named(args[0].power(Fraction(1, 2)))
-        if name == "sign":
+        if rule == "one":
             return ONE
-        if name == "div" and len(args) == 2:
+        if rule == "quotient" and len(args) == 2:
             return None if args[0] is None or args[1] is None else _named(args[0] / args[1])
-        if name == "smooth" and len(args) == 2:
+        if rule == "last" and len(args) == 2:
             return args[1]
-        if name in SAME and args:
-            if name in FIRST_ONLY:
+        if rule in ("same", "first") and args:  # the arguments' unit (delay: the first's)
+            if rule == "first":
                 return args[0]
             result = args[0]
             for other in args[1:]:

@@ -18,6 +18,7 @@ from ...errors import FlattenError, Span
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
+from ...ir.builtins import names
 from .. import arrays as a
 from ..scopes import ExpressionEvaluator, Scope
 from .strings import real_text
@@ -30,6 +31,9 @@ _PARAMETERS = ("condition", "message", "level")
 Pending = tuple[flat.Assertion, Span]
 #: Maps an evaluated value to the one an algorithm section reads (its assignments so far).
 Read = Callable[[a.Value], a.Value]
+
+
+_QUIET_CALLS = names(lambda b: b.quiet)
 
 
 def assertion(ev: ExpressionEvaluator, call: s.Call, scope: Scope, origin: flat.Origin,
@@ -165,7 +169,7 @@ def is_boolean(e: x.Expr, types: dict[str, str]) -> bool:
     if isinstance(e, x.If):
         return is_boolean(e.then, types) and is_boolean(e.otherwise, types)
     if isinstance(e, x.Call):
-        if e.name in ("noEvent", "smooth") and e.args:
+        if e.name in _QUIET_CALLS and e.args:
             return is_boolean(e.args[-1], types)
         return e.name not in x.MATH  # the numeric built-ins; others (pre, edge) may be
     return False

@@ -14,17 +14,16 @@ import numpy as np
 from ...errors import FlattenError
 from ...ir import expr as x
 from ...ir import syntax as s
+from ...ir.builtins import BUILTINS, MATH, NUMBER, names
 from .. import arrays as a
 from ..array_ops import ArrayBuiltins
 from ..checks import check_der_argument, check_numeric_arguments
 from ..scopes import EnumLiteral, ExpressionEvaluator, Handler, Scope
 from .strings import string_call
 
-SCALAR_FUNCTIONS = {
-    "sqrt": 1, "sin": 1, "cos": 1, "tan": 1, "asin": 1, "acos": 1, "atan": 1,
-    "atan2": 2, "sinh": 1, "cosh": 1, "tanh": 1, "exp": 1, "log": 1, "log10": 1,
-    "abs": 1, "sign": 1, "floor": 1, "ceil": 1, "integer": 1, "mod": 2, "rem": 2, "div": 2,
-}
+SCALAR_FUNCTIONS = {name: b.arity[0] for name, b in BUILTINS.items()
+                    if b.kind == MATH and b.arguments == NUMBER}
+"""The scalar math built-ins of numbers and their arity (from the registry)."""
 
 CONSTANTS = {
     "pi": math.pi, "Modelica.Constants.pi": math.pi, "Modelica.Constants.e": math.e,
@@ -245,8 +244,7 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
     return x.Call(name, args)
 
 
-_SWITCHING_CALLS = frozenset({"abs", "sign", "min", "max", "floor", "ceil", "integer", "div",
-                              "mod", "rem"})
+_SWITCHING_CALLS = names(lambda b: b.switching)
 
 
 def _keep_no_event(e: x.Expr) -> x.Expr:

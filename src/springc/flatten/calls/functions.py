@@ -19,6 +19,7 @@ from ...errors import FlattenError, Note, Span
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
+from ...ir.builtins import EQUATION, names
 from ...parse import ClassEntry, lookup_class, member_class
 from .. import arrays as a
 from ..array_ops import check_loop_nest, with_range
@@ -173,7 +174,7 @@ def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int
 
 
 #: Built-in calls that may stand alone but are not supported yet (events).
-STANDALONE_BUILTINS = frozenset({"terminate", "reinit", "print"})
+STANDALONE_BUILTINS = names(lambda b: b.kind == EQUATION)
 
 
 def call_for_effect(ev: ExpressionEvaluator, call: s.Call, scope: Scope, what: str) -> None:

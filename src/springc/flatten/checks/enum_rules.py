@@ -14,6 +14,7 @@ from typing import Any
 from ...errors import FlattenError
 from ...ir import expr as x
 from ...ir import syntax as s
+from ...ir.builtins import ANY, SAME, names
 from ..scopes import Enumeration, EnumLiteral, ExpressionEvaluator, Scope
 from .rules import rule_error
 from .type_rules import declared
@@ -26,8 +27,9 @@ Kind = Enumeration | str | None
 _RULE = ("enumeration values are neither Integers nor Reals: convert with Integer(e), "
          "and compare only values of the same enumeration type")
 _RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
-_NUMBERS = frozenset({"Integer", "String", "size", "ndims", "integer", "floor", "ceil",
-                      "abs", "sum", "product", "sqrt", "sin", "cos", "exp", "log"})
+#: Built-ins whose value is never an enumeration (the registry's result type is no
+#: "the argument's").
+_NUMBERS = names(lambda b: b.result not in (SAME, ANY))
 
 
 def static_kind(e: s.Expr, scope: Scope, ev: ExpressionEvaluator) -> Kind:

@@ -15,6 +15,7 @@ import numpy as np
 from ...errors import Note, Span
 from ...ir import expr as x
 from ...ir import syntax as s
+from ...ir.builtins import MATH, NUMBER, names
 from ..scopes import ClassScope, Primitive, Scope, refs
 from .rules import rule_error
 
@@ -120,9 +121,7 @@ def check_boolean_condition(value: object, span: Span, what: str) -> None:
 
 
 #: Built-in functions whose arguments are numbers (Integer or Real), never Boolean.
-NUMERIC_FUNCTIONS = frozenset({
-    "abs", "sign", "sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh",
-    "cosh", "tanh", "exp", "log", "log10", "floor", "ceil", "integer", "div", "mod", "rem"})
+NUMERIC_FUNCTIONS = names(lambda b: b.kind == MATH and b.arguments == NUMBER)
 
 
 def check_numeric_arguments(name: str, call: s.Call, scope: Scope) -> None:
@@ -141,9 +140,8 @@ def check_numeric_arguments(name: str, call: s.Call, scope: Scope) -> None:
 
 #: Built-in calls whose value is discrete-time whatever their arguments (3.8.4): they
 #: generate events or give sizes.
-_DISCRETE_CALLS = frozenset({"integer", "floor", "ceil", "div", "mod", "rem", "pre", "edge",
-                             "change", "sample", "initial", "terminal", "size", "ndims",
-                             "cardinality"})
+_DISCRETE_CALLS = names(lambda b: b.discrete)
+_QUIET_CALLS = names(lambda b: b.quiet)
 _RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
 
 
@@ -181,7 +179,7 @@ def continuous_part(e: s.Expr, scope: Scope) -> str | None:
         name = e.func.dotted
         if name in _DISCRETE_CALLS:
             return None
-        if name in ("noEvent", "smooth"):  # no events: relations inside are continuous
+        if name in _QUIET_CALLS:  # no events: relations inside are continuous
             return _any_continuous_variable(e, scope)
         for arg in (*e.args, *(n.value for n in e.named)):
             found = continuous_part(arg, scope)

@@ -6,11 +6,17 @@ from __future__ import annotations
 
 from .algorithms import Section, algorithm_section, apply_starts
 from .delay import NAME, delay_call
-from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call, event_dependent
+from .event_calls import (
+    EVENT_CALLS,
+    EVENT_EQUATIONS,
+    check_arithmetic_operands,
+    event_call,
+    event_dependent,
+)
 from .when import check_events, flatten_when, variable_if_equation
 
 __all__ = [
-    "EVENT_CALLS", "NAME", "Section", "algorithm_section", "apply_starts",
+    "EVENT_CALLS", "EVENT_EQUATIONS", "NAME", "Section", "algorithm_section", "apply_starts",
     "check_arithmetic_operands", "check_events", "delay_call", "event_call", "event_dependent",
     "flatten_when", "variable_if_equation",
 ]

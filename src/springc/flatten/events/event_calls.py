@@ -15,24 +15,26 @@ from __future__ import annotations
 from ...errors import FlattenError
 from ...ir import expr as x
 from ...ir import syntax as s
+from ...ir.builtins import BUILTINS, EQUATION, names
 from .. import arrays as a
 from ..scopes import EventUses, ExpressionEvaluator, Scope
 
-EVENT_CALLS = frozenset({"pre", "edge", "change", "initial", "terminal", "sample",
-                         "reinit", "terminate"})
+EVENT_CALLS = names(lambda b: b.at_events)
 """Calls handled here (``reinit`` and ``terminate`` only to refuse them in expressions)."""
+EVENT_EQUATIONS = names(lambda b: b.at_events and b.kind == EQUATION)
+"""``reinit`` and ``terminate``: equations of when-clauses only."""
 
 
 def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope) -> a.Value:
     """The flat value of the event built-in ``e``."""
     name = e.func.dotted
-    if name in ("reinit", "terminate"):
+    if name in EVENT_EQUATIONS:
         raise FlattenError(f"'{name}' is an equation, not an expression", e.func.span,
                            hint=f"write '{name}(...);' as an equation inside a "
                            "when-clause")
     if e.named:
         raise FlattenError(f"'{name}' takes no named arguments", e.named[0].span)
-    count = {"pre": 1, "edge": 1, "change": 1, "initial": 0, "terminal": 0, "sample": 2}[name]
+    count = BUILTINS[name].arity[0]
     if len(e.args) != count:
         raise FlattenError(f"'{name}' takes {count} argument{'s' if count != 1 else ''}, "
                            f"{len(e.args)} given", e.span)
@@ -62,7 +64,7 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
 
 
 #: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.
-BOOLEAN_CALLS = frozenset({"edge", "change", "initial", "terminal", "sample"})
+BOOLEAN_CALLS = names(lambda b: b.boolean)
 
 
 def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary) -> None:

@@ -18,6 +18,7 @@ from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
 from ...ir import when as w
+from ...ir.builtins import BUILTINS, names
 from .. import arrays as a
 from ..calls import assertion, string_equation
 from ..connect import check_branches, check_no_connect
@@ -78,7 +79,7 @@ class _Body:
         self.guard, self.owner = guard, owner  # for assert (see phase_guard)
 
 
-_PHASES = (x.Call("initial", ()), x.Call("terminal", ()))
+_PHASES = tuple(x.Call(name, ()) for name in sorted(names(lambda b: b.phase)))
 
 
 def phase_guard(conditions: list[x.Expr], earlier: list[x.Expr]) -> x.Expr | None:
@@ -103,7 +104,8 @@ def _boolean_shape(e: x.Expr) -> bool:
     if isinstance(e, x.BinOp):
         return e.op in x.RELATIONS or e.op in ("and", "or")
     if isinstance(e, x.Call):
-        return e.name in ("edge", "change", "initial", "terminal", "sample", "noEvent")
+        builtin = BUILTINS.get(e.name)
+        return builtin is not None and (builtin.boolean or e.name == "noEvent")
     if isinstance(e, x.If):
         return _boolean_shape(e.then) and _boolean_shape(e.otherwise)
     return isinstance(e, (x.Not, x.Var))

@@ -1,0 +1,295 @@
+"""The nodes of springc's scalar expressions, their traversal, construction and text.
+
+A deliberately small, fast tree: flattening builds hundreds of thousands of these, so
+they are plain frozen dataclasses rather than sympy objects. :mod:`springc.ir.expr` is
+the face every stage imports (it re-exports these names with evaluation and
+differentiation); this module sits below the registry of built-ins
+(:mod:`springc.ir.builtins`), whose derivative rules build these nodes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TypeVar
+
+
+@dataclass(frozen=True, slots=True)
+class Const:
+    value: float | int | bool
+
+
+@dataclass(frozen=True, slots=True)
+class Var:
+    """A flat scalar variable or parameter, by its flat name (``mass.pos[1]``)."""
+
+    name: str
+
+
+@dataclass(frozen=True, slots=True)
+class Time:
+    """The built-in variable ``time``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Der:
+    """``der(arg)``; after flattening ``arg`` may be any expression of variables."""
+
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Neg:
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Not:
+    arg: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class BinOp:
+    """``op`` is one of ``+ - * / ^ < <= > >= == <> and or`` (scalar semantics)."""
+
+    op: str
+    left: Expr
+    right: Expr
+
+
+@dataclass(frozen=True, slots=True)
+class Call:
+    """A built-in scalar function (``sqrt``, ``atan2``, ``noEvent``, ...)."""
+
+    name: str
+    args: tuple[Expr, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class If:
+    cond: Expr
+    then: Expr
+    otherwise: Expr
+
+
+Expr = Const | Var | Time | Der | Neg | Not | BinOp | Call | If
+
+ZERO = Const(0)
+ONE = Const(1)
+TIME = Time()
+
+RELATIONS = frozenset({"<", "<=", ">", ">=", "==", "<>"})
+# ------------------------------------------------------------------ traversal
+
+
+def children(e: Expr) -> tuple[Expr, ...]:
+    """The direct sub-expressions of ``e``."""
+    if isinstance(e, BinOp):
+        return (e.left, e.right)
+    if isinstance(e, (Neg, Not, Der)):
+        return (e.arg,)
+    if isinstance(e, Call):
+        return e.args
+    if isinstance(e, If):
+        return (e.cond, e.then, e.otherwise)
+    return ()
+
+
+def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
+    """``e`` with ``f`` applied to each direct sub-expression; ``e`` itself where every
+    child comes back unchanged (unchanged subtrees are shared, not copied)."""
+    old = children(e)
+    new = tuple(f(c) for c in old)
+    if all(a is b for a, b in zip(new, old)):
+        return e
+    if isinstance(e, BinOp):
+        return BinOp(e.op, new[0], new[1])
+    if isinstance(e, (Neg, Not, Der)):
+        return type(e)(new[0])
+    if isinstance(e, Call):
+        return Call(e.name, new)
+    assert isinstance(e, If)
+    return If(new[0], new[1], new[2])
+
+
+def walk(e: Expr) -> Iterator[Expr]:
+    """All nodes of ``e``, parents before children."""
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        yield node
+        stack.extend(children(node))
+
+
+def variables(e: Expr) -> set[str]:
+    """Names of all variables referenced in ``e`` (inside ``der`` too)."""
+    return {n.name for n in walk(e) if isinstance(n, Var)}
+
+
+def derivatives(e: Expr) -> set[str]:
+    """Names ``x`` of all ``der(x)`` in ``e`` whose argument is a plain variable."""
+    return {n.arg.name for n in walk(e) if isinstance(n, Der) and isinstance(n.arg, Var)}
+
+
+def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
+    """Replace variables by expressions; unchanged subtrees are shared, not copied."""
+    if isinstance(e, Var):
+        return mapping.get(e.name, e)
+    if isinstance(e, (Const, Time)):
+        return e
+    if isinstance(e, BinOp):
+        left, right = substitute(e.left, mapping), substitute(e.right, mapping)
+        return e if left is e.left and right is e.right else BinOp(e.op, left, right)
+    if isinstance(e, (Neg, Not, Der)):
+        arg = substitute(e.arg, mapping)
+        return e if arg is e.arg else type(e)(arg)
+    if isinstance(e, Call):
+        args = tuple(substitute(a, mapping) for a in e.args)
+        return e if all(a is b for a, b in zip(args, e.args)) else Call(e.name, args)
+    if isinstance(e, If):
+        c, t, o = (substitute(x, mapping) for x in (e.cond, e.then, e.otherwise))
+        return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
+    raise TypeError(f"not an expression: {e!r}")
+
+# ------------------------------------------------------------- construction
+
+
+FOLD_CHUNK = 64
+"""Items folded left to right before chunks are combined pairwise (see :func:`fold_chunked`)."""
+
+_Item = TypeVar("_Item")
+
+
+def fold_chunked(items: Sequence[_Item], step: Callable[[Expr, _Item], Expr],
+                 combine: Callable[[Expr, Expr], Expr], identity: Expr) -> Expr:
+    """``step`` folded over ``items`` from ``identity``, shallow for long runs.
+
+    Up to :data:`FOLD_CHUNK` items this is the left fold ``((a + b) + c) + ...`` that the
+    flat text shows; longer runs are folded in chunks of that size whose results are
+    joined pairwise with ``combine``, so the tree stays shallow (depth about
+    64 + log2(n/64)) and every later stage, which recurses over expressions, handles a
+    sum of thousands of terms."""
+    chunks: list[Expr] = []
+    for i in range(0, len(items), FOLD_CHUNK):
+        value = identity
+        for item in items[i:i + FOLD_CHUNK]:
+            value = step(value, item)
+        chunks.append(value)
+    while len(chunks) > 1:
+        pairs = [combine(chunks[i], chunks[i + 1]) for i in range(0, len(chunks) - 1, 2)]
+        chunks = pairs + chunks[len(chunks) - len(chunks) % 2:]
+    return chunks[0] if chunks else identity
+
+
+def add(a: Expr, b: Expr) -> Expr:
+    """``a + b`` with constant folding and zero elimination."""
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value + b.value)
+    if a == ZERO:
+        return b
+    if b == ZERO:
+        return a
+    if isinstance(b, Neg):
+        return BinOp("-", a, b.arg)
+    return BinOp("+", a, b)
+
+
+def sub(a: Expr, b: Expr) -> Expr:
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value - b.value)
+    if b == ZERO:
+        return a
+    if a == ZERO:
+        return neg(b)
+    return BinOp("-", a, b)
+
+
+def mul(a: Expr, b: Expr) -> Expr:
+    if isinstance(a, Const) and isinstance(b, Const):
+        return Const(a.value * b.value)
+    if a == ZERO or b == ZERO:
+        return ZERO
+    if a == ONE:
+        return b
+    if b == ONE:
+        return a
+    return BinOp("*", a, b)
+
+
+def div(a: Expr, b: Expr) -> Expr:
+    if b == ONE:
+        return a
+    if a == ZERO:
+        return ZERO
+    return BinOp("/", a, b)
+
+
+def neg(a: Expr) -> Expr:
+    if isinstance(a, Const):
+        return Const(-a.value)
+    if isinstance(a, Neg):
+        return a.arg
+    return Neg(a)
+
+
+def power(a: Expr, b: Expr) -> Expr:
+    if b == ONE:
+        return a
+    if b == ZERO:
+        return ONE
+    return BinOp("^", a, b)
+
+
+# ------------------------------------------------------------------ printing
+
+_PRECEDENCE = {
+    "or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
+    "+": 5, "-": 5, "*": 6, "/": 6, "^": 8,
+}
+
+
+def format_number(value: float | int | bool) -> str:
+    """Modelica literal for a number; floats round-trip exactly (``repr``)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if math.isinf(value):
+        return "1e1000" if value > 0 else "-1e1000"
+    return repr(value)
+
+
+def to_text(e: Expr, name: Callable[[str], str] = lambda n: n) -> str:
+    """Modelica text of ``e``; ``name`` renders variable names (e.g. quoting them)."""
+    return _print(e, name, 0)
+
+
+def _print(e: Expr, name: Callable[[str], str], outer: int) -> str:
+    if isinstance(e, Const):
+        text = format_number(e.value)
+        return f"({text})" if text.startswith("-") and outer > 0 else text
+    if isinstance(e, Var):
+        return name(e.name)
+    if isinstance(e, Time):
+        return "time"
+    if isinstance(e, Der):
+        return f"der({_print(e.arg, name, 0)})"
+    if isinstance(e, Call):
+        return f"{e.name}({', '.join(_print(a, name, 0) for a in e.args)})"
+    if isinstance(e, Neg):
+        text = "-" + _print(e.arg, name, 6)
+        return f"({text})" if outer > 5 else text
+    if isinstance(e, Not):
+        text = "not " + _print(e.arg, name, 3)
+        return f"({text})" if outer > 3 else text
+    if isinstance(e, If):
+        text = (f"if {_print(e.cond, name, 0)} then {_print(e.then, name, 0)}"
+                f" else {_print(e.otherwise, name, 0)}")
+        return f"({text})" if outer > 0 else text
+    prec = _PRECEDENCE[e.op]
+    # Left-associative: the right operand needs parentheses at equal precedence
+    # ("^" is non-associative in Modelica, so both sides do).
+    left_prec = prec + 1 if e.op == "^" or prec == 4 else prec
+    text = f"{_print(e.left, name, left_prec)} {e.op} {_print(e.right, name, prec + 1)}"
+    return f"({text})" if prec < outer else text
