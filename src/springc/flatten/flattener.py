@@ -18,7 +18,7 @@ from ..errors import ErrorGroup, FlattenError, FollowUpError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir.when import When
-from ..parse import ClassTree
+from ..parse import ClassEntry, ClassTree
 from .algorithms import Section, apply_starts
 from .assertions import check_conditions, unique
 from .cardinality import apply_cardinalities
@@ -69,6 +69,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.reusable_views = {}
         self.templates = {}
         self.instance_templates = InstanceTemplates(self)
+        self.written_in: ClassEntry | None = None
 
     # ----------------------------------------------------------------- queries
 

@@ -33,6 +33,7 @@ from .control import (
     stray,
 )
 from .declarations import redeclared_class
+from .externals import external_value, is_external
 from .loops import check_loop_nest
 from .ranges import with_range
 from .scope import (
@@ -43,7 +44,6 @@ from .scope import (
     Scope,
     ViewComponent,
 )
-from .tables import native_call, native_function
 
 MAX_DEPTH = 50
 
@@ -88,8 +88,8 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
-        if native_function(entry) is not None:
-            native: a.Value = native_call(ev, entry, scope.names, call)
+        if is_external(entry):
+            native: a.Value = external_value(ev, entry, scope.names, call)
             return native
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:

@@ -358,6 +358,9 @@ class FlattenContext(Protocol):
     statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
     reusable_views: dict[int, bool]
+    # the class that wrote the equation being flattened: an inherited equation finds
+    # the functions of its base class's scope (section 5.6.1)
+    written_in: ClassEntry | None
 
     def report(self, err: FlattenError) -> None: ...
 
