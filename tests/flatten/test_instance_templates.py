@@ -1,5 +1,6 @@
 """Instance templates (springc.flatten.instance_templates) and direct connect references
-(springc.flatten.connections.direct_reference) give exactly the flat model of the general path."""
+(springc.flatten.connect.connections.direct_reference) give exactly the flat model of the
+general path."""
 
 from __future__ import annotations
 
@@ -8,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from springc.errors import FlattenError
-from springc.flatten import connections
 from springc.flatten import flattener as flattening
+from springc.flatten.connect import connections
 from springc.flatten.instance_templates import InstanceTemplates
 from springc.ir import expr as x
 from springc.ir import flat

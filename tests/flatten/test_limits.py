@@ -1,4 +1,4 @@
-"""The flat-size and loop caps (springc.flatten.limits): exact boundaries, and the two ways
+"""The flat-size and loop caps (springc.flatten.scopes.limits): exact boundaries, and the two ways
 to set the cap (the ``max_size`` keyword of ``flatten``, ``$SPRINGC_MAX_SIZE``)."""
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""ModelicaStandardTables evaluated natively (flatten/tables.py, flatten/interpolation.py).
+"""ModelicaStandardTables evaluated natively (flatten/natives/tables.py and
+interpolation.py).
 
 ``models/MslTables.mo`` declares the table classes and functions under the names and
 external C functions of the Modelica Standard Library 4.1.0. Every expected number is

@@ -153,7 +153,7 @@ def limits(seconds: int, memory: int) -> Iterator[None]:
 
 
 # Inputs with numbers of a million or more may run loops up to the size cap (two
-# million iterations, flatten/limits.py), which takes longer than the time limit on a
+# million iterations, flatten/scopes/limits.py), which takes longer than the time limit on a
 # loaded machine: they get a short limit, and running out of it is not a failure.
 HUGE = re.compile(r"(?<![.\w])[1-9][0-9]{6,}(?![.\w])")
 

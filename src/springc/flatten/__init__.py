@@ -2,6 +2,6 @@
 arrays, connections, functions)."""
 
 from .flattener import flatten
-from .lookup import select_model
+from .names import select_model
 
 __all__ = ["flatten", "select_model"]

@@ -15,28 +15,23 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
-from .algorithms import Section, algorithm_section
-from .assertions import assertion
-from .connection_graph import GRAPH_EQUATIONS, graph_equation
-from .connections import ConnectionSets
+from .array_ops import check_loop_nest, with_range
+from .calls import assertion, call_for_effect, multiple_outputs, string_equation
+from .checks import check_boolean_condition
+from .connect import GRAPH_EQUATIONS, ConnectionSets, graph_equation
 from .equation_templates import Template, make_template, reusable
-from .event_calls import event_dependent
-from .functions import call_for_effect, multiple_outputs
-from .loops import check_loop_nest
-from .ranges import with_range
-from .records import record_equation
-from .scope import ClassScope, FlattenContext, LocalScope, Scope
-from .strings import string_equation
-from .type_rules import check_boolean_condition
-from .when import flatten_when, variable_if_equation
+from .events import Section, algorithm_section, event_dependent, flatten_when, variable_if_equation
+from .redeclare import record_equation
+from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
 
 class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
 
     connections: ConnectionSets
-    # Equation templates by (id of the ClassView, initial); None: not reusable.
-    templates: dict[tuple[int, bool], Template | None]
+    # Equation templates by (the ClassView, initial); None: not reusable.
+    templates: dict[tuple[Ident[ClassView], bool], Template | None]
+    reusable_views: dict[Ident[ClassView], bool]  # whether a view's equations are a template
     algorithm_sections: list[Section]
     written_in: ClassEntry | None
 
@@ -47,7 +42,7 @@ class EquationFlattening(FlattenContext):
         if not items:
             return
         target = self.initial_equations if initial else self.equations
-        key = (id(view), initial)
+        key = (Ident(view), initial)
         template = self.templates.get(key) if scope.package is None else None
         if template is not None:
             target += template.instantiate(scope.prefix)
@@ -63,7 +58,8 @@ class EquationFlattening(FlattenContext):
                 self.written_in = None
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
                 and scope.package is None:
-            independent = self.parameter_values.reads == reads and reusable(self, view)
+            independent = self.parameter_values.reads == reads \
+                and reusable(self, view, self.reusable_views)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
 
@@ -108,7 +104,7 @@ class EquationFlattening(FlattenContext):
 
     def _variable_condition(self, cond: s.Expr, where: Scope) -> bool:
         """Whether an if-equation condition depends on variables (then the branches
-        switch at events: flatten/when.py)."""
+        switch at events: flatten/events/when.py)."""
         value = self.evaluator.value(cond, where)
         return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) and (
             not self.is_parameter_expression(value) or event_dependent(value))
@@ -173,7 +169,7 @@ class EquationFlattening(FlattenContext):
                 f"{a.describe_shape(a.shape(lhs))} and {a.describe_shape(a.shape(rhs))}",
                 eq.span, hint="both sides of an equation must have the same size")
         if string_equation(lhs, rhs, eq.span):
-            return  # known while flattening (flatten/strings.py)
+            return  # known while flattening (flatten/calls/strings.py)
         for side, e in ((lhs, eq.lhs), (rhs, eq.rhs)):
             if isinstance(side, str):
                 raise FlattenError("strings cannot appear in equations", e.span)

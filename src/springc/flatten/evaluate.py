@@ -20,27 +20,23 @@ from ..ir import expr as x
 from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
-from .assertions import guard_assertions
-from .builtins import Builtins
-from .cardinality import NAME as CARDINALITY
-from .cardinality import cardinality_call
-from .connection_graph import GRAPH_FUNCTIONS
-from .delay import NAME as DELAY
-from .delay import delay_call
-from .enum_rules import check_enum_relation
-from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call
-from .event_uses import EventUses
-from .functions import call_function, function_of
-from .parameters import check_powers
-from .ranges import type_range, typed_range, typed_range_bounds, with_range
-from .references import ReferenceResolver
-from .scope import (
+from .array_ops import type_range, typed_range, typed_range_bounds, with_range
+from .calls import Builtins, call_function, function_of, guard_assertions, string_binary
+from .checks import check_enum_relation
+from .connect import GRAPH_FUNCTIONS, cardinality_call
+from .connect import NAME as CARDINALITY
+from .events import EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
+from .events import NAME as DELAY
+from .names import ReferenceResolver
+from .scopes import (
     ClassScope,
+    EventUses,
     FlattenContext,
+    Ident,
     LocalScope,
     Scope,
+    check_powers,
 )
-from .strings import string_binary
 
 UNSUPPORTED_CALLS = {
     "hold",
@@ -63,10 +59,10 @@ class Evaluator(ReferenceResolver):
         self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)
-        # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
-        # outlives the evaluator, so ids are not reused).
-        self.uses_end: dict[int, bool] = {}
-        self.cardinality_used = False  # placeholders to replace (flatten/cardinality.py)
+        # Whether a subscript contains `end`, by syntax node (its identity: equal
+        # subscripts written in two places are two entries).
+        self.uses_end: dict[Ident[s.Expr], bool] = {}
+        self.cardinality_used = False  # placeholders to replace (flatten/connect/cardinality.py)
 
     # ------------------------------------------------------------ entry points
 

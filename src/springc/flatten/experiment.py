@@ -8,7 +8,7 @@ from ..errors import FlattenError
 from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry
-from .scope import ClassScope, FlattenContext
+from .scopes import ClassScope, FlattenContext
 
 _FIELDS = {"StartTime": "start", "StopTime": "stop", "Interval": "interval",
            "Tolerance": "tolerance"}

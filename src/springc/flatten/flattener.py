@@ -19,25 +19,30 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir.when import When
 from ..parse import ClassEntry, ClassTree
-from .algorithms import Section, apply_starts
-from .assertions import check_conditions, unique
-from .cardinality import apply_cardinalities
-from .connect_rules import check_connector_size
-from .connections import ConnectionSets
+from .calls import check_conditions, undefined_strings, unique
+from .connect import ConnectionSets, apply_cardinalities, check_connector_size
 from .equations import EquationFlattening
 from .evaluate import Evaluator
+from .events import Section, apply_starts, check_events
 from .experiment import experiment_of
 from .instance_templates import InstanceTemplates
 from .instantiate import Instantiation
-from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
-from .lookup import ClassLookup, select_model
-from .modification import merge_all
-from .parameters import ParameterValues, binding_errors
-from .redeclare_rules import check_redeclarations
-from .scope import ClassScope, ClassView, ExpressionEvaluator, Primitive, instance_mod
-from .strings import undefined_strings
-from .variables import attributes_of
-from .when import check_events
+from .names import ClassLookup, select_model
+from .redeclare import check_redeclarations
+from .scopes import (
+    DEFAULT_MAX_SIZE,
+    ClassScope,
+    ClassView,
+    ExpressionEvaluator,
+    Limits,
+    ParameterValues,
+    Primitive,
+    attributes_of,
+    binding_errors,
+    instance_mod,
+    max_size_setting,
+    merge_all,
+)
 
 __all__ = ["Flattener", "flatten"]
 
@@ -50,9 +55,9 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def __init__(self, tree: ClassTree, max_size: int = DEFAULT_MAX_SIZE) -> None:
         self.tree = tree
         self.limits = Limits(max_size)
-        self.views: dict[int, ClassView] = {}
-        self.package_scopes: dict[int, ClassScope] = {}
-        self.rule_errors: dict[int, FlattenError] = {}
+        self.views: dict[ClassEntry, ClassView] = {}
+        self.package_scopes: dict[ClassEntry, ClassScope] = {}
+        self.rule_errors: dict[ClassEntry, FlattenError] = {}
         self.parameter_values = ParameterValues()
         self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()

@@ -20,43 +20,51 @@ from ..ir import flat
 from ..ir import syntax as s
 from ..parse import ClassEntry, member_class
 from . import arrays as a
-from .access import check_modified
-from .declarations import (
+from .array_ops import typed_dimension
+from .calls import string_component
+from .checks import (
+    check_constant_binding,
+    check_discrete_binding,
+    check_enum_binding,
+    check_integer_binding,
+    check_modified,
+    rule_error,
+    stronger,
+)
+from .natives import is_external_object, table_object
+from .redeclare import (
+    check_redeclarations,
+    class_modification,
     condition_holds,
     disabled,
     inner_member,
+    named_through,
+    record_mod,
     redeclared,
     redeclared_class,
     redeclared_class_mod,
+    type_name_package,
 )
-from .dimensions import typed_dimension
-from .enum_rules import check_enum_binding
-from .enumerations import DimensionKind
-from .instance_classes import class_modification, named_through, type_name_package
-from .modification import Mod, ModValue, each, from_syntax, merge_all, select
-from .records import record_mod
-from .redeclare_rules import check_redeclarations
-from .rules import rule_error
-from .scope import (
+from .scopes import (
     ClassScope,
     ClassView,
     Declared,
+    DimensionKind,
     FlattenContext,
+    Ident,
     Member,
+    Mod,
+    ModValue,
     Primitive,
     ResolvedType,
     ViewComponent,
+    check_attribute_mods,
+    each,
+    from_syntax,
     instance_mod,
+    merge_all,
+    select,
 )
-from .strings import string_component
-from .tables import is_external_object, table_object
-from .type_rules import (
-    check_constant_binding,
-    check_discrete_binding,
-    check_integer_binding,
-    stronger,
-)
-from .variables import check_attribute_mods
 
 
 class Instantiation(FlattenContext):
@@ -65,8 +73,8 @@ class Instantiation(FlattenContext):
 
     # Evaluated modification values by (id of the expression, id of the scope); the
     # scope is kept alive in the entry so that its id cannot be reused.
-    mod_values: dict[tuple[int, int], tuple[object, a.Value]]
-    declared_types: dict[int, Declared]
+    mod_values: dict[tuple[Ident[s.Expr], Ident[object]], a.Value]
+    declared_types: dict[Ident[ViewComponent], Declared]
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
@@ -219,7 +227,7 @@ class Instantiation(FlattenContext):
 
     def declared_type(self, comp: ViewComponent) -> Declared:
         """The resolved type of a declaration and its type modifiers, computed once."""
-        key = id(comp)
+        key = Ident(comp)
         found = self.declared_types.get(key)
         if found is None:
             rtype = self.resolve_type(comp.decl.type_name, comp.defined_in)
@@ -390,11 +398,11 @@ class Instantiation(FlattenContext):
 
     def mod_value(self, mv: ModValue) -> a.Value:
         """Evaluate a modification value where it was written, then pick the element."""
-        key = (id(mv.expr), id(mv.scope))
+        key = (Ident(mv.expr), Ident(mv.scope))
         cached = self.mod_values.get(key)
         if cached is None:
-            cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
-        value: a.Value = cached[1]
+            cached = self.mod_values[key] = self.evaluator.value(mv.expr, mv.scope)
+        value: a.Value = cached
         for i in mv.index:
             if not a.is_array(value) or value.shape[0] < i:
                 raise FlattenError(

@@ -5,7 +5,7 @@ objects built by C functions. The string functions of
 ``Modelica.Utilities.Strings`` (ModelicaStrings) are evaluated the same way. springc
 recognises those functions by their C names, as
 the library declares them (``external "C" y = ModelicaStandardTables_CombiTable1D_getValue
-(tableID, icol, u)``), and evaluates them while flattening (``flatten/tables.py``). Each
+(tableID, icol, u)``), and evaluates them while flattening (``flatten/natives/tables.py``). Each
 entry names the operation and the role of every argument of the external call, in the
 order of the C function's parameters; ``None`` marks an argument springc does not need
 (an array size the table already knows).

@@ -1,0 +1,44 @@
+"""Calls: user-defined functions executed symbolically (``functions``, with ``while``/
+``break``/``return`` in ``control``), the built-ins (``builtins``), ``assert`` and
+``String`` values."""
+
+from __future__ import annotations
+
+from .assertions import assertion, check_conditions, guard_assertions, unique
+from .builtins import CONSTANTS, Builtins
+from .control import Jumped, branch_jumps, check_jumps, folded, run_loop_body, run_while, stray
+from .functions import call_for_effect, call_function, function_of, multiple_outputs
+from .strings import (
+    is_string,
+    read,
+    string_binary,
+    string_component,
+    string_equation,
+    undefined_strings,
+)
+
+__all__ = [
+    "CONSTANTS",
+    "Builtins",
+    "Jumped",
+    "assertion",
+    "branch_jumps",
+    "call_for_effect",
+    "call_function",
+    "check_conditions",
+    "check_jumps",
+    "folded",
+    "function_of",
+    "guard_assertions",
+    "is_string",
+    "multiple_outputs",
+    "read",
+    "run_loop_body",
+    "run_while",
+    "stray",
+    "string_binary",
+    "string_component",
+    "string_equation",
+    "undefined_strings",
+    "unique",
+]

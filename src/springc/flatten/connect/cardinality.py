@@ -1,0 +1,61 @@
+"""``cardinality(c)`` (Modelica 3.6, section 3.7.4.4; deprecated but valid).
+
+``cardinality(c)`` is the number of ``connect`` equations that name the connector
+``c``, from inside or from outside. It is known only once every connect equation of
+the model is flat, but the expression that uses it may be flattened earlier (a
+binding inside the component whose connector the enclosing model connects). So
+:func:`cardinality_call` gives the placeholder call ``cardinality(<connector name>)``
+and :func:`apply_cardinalities`, run after all equations are flat, replaces each by
+its Integer count. A placeholder is a :class:`~springc.ir.expr.Var` of the
+connector's flat name, so that equation templates rename it with their prefix.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import Counter
+
+from ...errors import FlattenError
+from ...ir import expr as x
+from ...ir import flat
+from ...ir import syntax as s
+from ..scopes import ClassScope, ExpressionEvaluator, FlatResults, Leaf, Scope
+
+NAME = "cardinality"
+
+
+def cardinality_call(ev: ExpressionEvaluator, e: s.Call, scope: Scope) -> x.Expr:
+    """The placeholder of ``cardinality(c)`` (its argument checked)."""
+    if len(e.args) != 1 or e.named:
+        raise FlattenError("cardinality takes one argument: cardinality(c) with c a "
+                           "connector", e.span)
+    arg = e.args[0]
+    target = ev.reference(arg, scope) if isinstance(arg, s.Ref) else None
+    if isinstance(target, ClassScope) and target.kind == "connector":
+        return x.Call(NAME, (x.Var(target.prefix),))
+    if isinstance(target, Leaf):
+        return x.Call(NAME, (x.Var(target.name),))
+    raise FlattenError("the argument of cardinality must be a connector",
+                       arg.span, hint="cardinality(c) counts the connect equations "
+                       "that name the connector c, a scalar connector "
+                       "(Modelica 3.6, section 3.7.4.4)")
+
+
+def _replace(e: x.Expr, counts: Counter[str]) -> x.Expr:
+    """``e`` with its placeholders replaced (unchanged subtrees shared)."""
+    if isinstance(e, x.Call) and e.name == NAME and isinstance(e.args[0], x.Var):
+        return x.Const(counts[e.args[0].name])
+    return x.map_children(e, lambda c: _replace(c, counts))
+
+
+def apply_cardinalities(fl: FlatResults, counts: Counter[str]) -> None:
+    """Replace every ``cardinality`` placeholder by the connector's count."""
+    for items in (fl.equations, fl.initial_equations):
+        for i, eq in enumerate(items):
+            lhs, rhs = _replace(eq.lhs, counts), _replace(eq.rhs, counts)
+            if lhs is not eq.lhs or rhs is not eq.rhs:
+                items[i] = flat.Equation(lhs, rhs, eq.span, eq.origin)
+    for i, (item, span) in enumerate(fl.assertions):
+        condition = _replace(item.condition, counts)
+        if condition is not item.condition:
+            fl.assertions[i] = (dataclasses.replace(item, condition=condition), span)

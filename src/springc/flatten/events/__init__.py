@@ -1,0 +1,16 @@
+"""Events and when-rules: when-equations and variable if-equations (``when``), when
+statements, the when-target rule, the event built-ins (``event_calls``), ``delay`` and
+algorithm sections (``algorithms``, ``section_starts``, ``loop_break``)."""
+
+from __future__ import annotations
+
+from .algorithms import Section, algorithm_section, apply_starts
+from .delay import NAME, delay_call
+from .event_calls import EVENT_CALLS, check_arithmetic_operands, event_call, event_dependent
+from .when import check_events, flatten_when, variable_if_equation
+
+__all__ = [
+    "EVENT_CALLS", "NAME", "Section", "algorithm_section", "apply_starts",
+    "check_arithmetic_operands", "check_events", "delay_call", "event_call", "event_dependent",
+    "flatten_when", "variable_if_equation",
+]

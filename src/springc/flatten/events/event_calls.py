@@ -1,0 +1,83 @@
+"""The event built-ins in expressions: syntax call -> ``ir.expr`` call.
+
+``pre(v)``, ``edge(b)``, ``change(v)`` take a variable (element-wise over arrays);
+``initial()`` and ``terminal()`` take nothing; ``sample(start, interval)`` takes
+parameter expressions. They stay calls in the flat model (``pre(x)``,
+``sample(0, 0.1)``); their meaning at events is given by simplify/events.py and the
+generated event update. ``reinit`` and ``terminate`` are equations, not
+expressions (flatten/events/when.py). :class:`EventUses` records what the checks at the
+end of flattening need (``pre`` of continuous variables outside when-clauses,
+non-Boolean when-conditions).
+"""
+
+from __future__ import annotations
+
+from ...errors import FlattenError
+from ...ir import expr as x
+from ...ir import syntax as s
+from .. import arrays as a
+from ..scopes import EventUses, ExpressionEvaluator, Scope
+
+EVENT_CALLS = frozenset({"pre", "edge", "change", "initial", "terminal", "sample",
+                         "reinit", "terminate"})
+"""Calls handled here (``reinit`` and ``terminate`` only to refuse them in expressions)."""
+
+
+def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope) -> a.Value:
+    """The flat value of the event built-in ``e``."""
+    name = e.func.dotted
+    if name in ("reinit", "terminate"):
+        raise FlattenError(f"'{name}' is an equation, not an expression", e.func.span,
+                           hint=f"write '{name}(...);' as an equation inside a "
+                           "when-clause")
+    if e.named:
+        raise FlattenError(f"'{name}' takes no named arguments", e.named[0].span)
+    count = {"pre": 1, "edge": 1, "change": 1, "initial": 0, "terminal": 0, "sample": 2}[name]
+    if len(e.args) != count:
+        raise FlattenError(f"'{name}' takes {count} argument{'s' if count != 1 else ''}, "
+                           f"{len(e.args)} given", e.span)
+    if name in ("initial", "terminal"):
+        return x.Call(name, ())
+    if name == "sample":
+        args = []
+        for arg, what in zip(e.args, ("start", "interval")):
+            value = ev.scalar(arg, scope)
+            if not ev.flattener.is_parameter_expression(value):
+                raise FlattenError(f"the {what} of sample(start, interval) must be a "
+                                   "parameter expression", arg.span)
+            args.append(value)
+        return x.Call("sample", tuple(args))
+    argument = ev.value(e.args[0], scope)
+
+    def one(item: x.Expr) -> x.Expr:
+        if not isinstance(item, x.Var):
+            raise FlattenError(f"the argument of '{name}' must be a variable",
+                               e.args[0].span,
+                               hint=f"write {name}(v) with v a variable, not an expression")
+        if not uses.in_when:
+            uses.pre_uses.append((item.name, e.span))
+        return x.Call(name, (item,))
+
+    return a.elementwise(one, argument)
+
+
+#: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.
+BOOLEAN_CALLS = frozenset({"edge", "change", "initial", "terminal", "sample"})
+
+
+def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary) -> None:
+    """``2.0*terminal()`` is a type error: the Boolean event built-ins are no numbers."""
+    for value, side in zip(operands, (e.left, e.right)):
+        if type(value) is x.Call and value.name in BOOLEAN_CALLS:
+            raise FlattenError(
+                f"'{x.to_text(value)}' is a Boolean and cannot be an operand of '{op}'",
+                side.span, hint=f"{value.name} returns a Boolean, and arithmetic needs "
+                "Integer or Real operands; choose a number with an if-expression "
+                f"('if {x.to_text(value)} then 1.0 else 0.0') (Modelica 3.6, section "
+                "3.7.5)")
+
+
+def event_dependent(e: x.Expr) -> bool:
+    """Whether ``e`` calls an event built-in (``initial()``, ``terminal()``, ``pre``,
+    ...): its value changes during the simulation even without variables."""
+    return any(type(n) is x.Call and n.name in EVENT_CALLS for n in x.walk(e))
