@@ -215,9 +215,6 @@ end M;
     ('assert(x > 0, "m", 2);',
      "4:22: the level of 'assert' must be AssertionLevel.error or AssertionLevel.warning"),
     ("assert(x > 0);", "4:3: 'assert' needs a message"),
-    ('assert(x > 0, "m" + String(x));',
-     "4:30: the argument of 'String' in a message must be a parameter expression, "
-     "but it depends on the variable 'x'"),
 ])
 def test_assert_misuse_is_located(tmp_path: Path, line: str, message: str) -> None:
     assert error_of(tmp_path, f"""model M

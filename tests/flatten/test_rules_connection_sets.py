@@ -84,7 +84,7 @@ model M
 end M;
 """, "11:5: a connection set has 2 sources of its signal: 'a.u' (outside input), 'a.b.y' "
          "(inside output)\nhelp: a set of connected inputs and outputs may contain at most "
-         "one inside output or one outside input (Modelica 3.6, section 9.3)"),
+         "one inside output or one public outside input (Modelica 3.6, section 9.3)"),
     "own_connector_flow_zero": ("""\
 model M
   connector C

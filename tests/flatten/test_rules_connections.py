@@ -176,8 +176,8 @@ end M;
 """,
         "10:3: a connection set has 2 sources of its signal: 's1.o.y' (inside output),"
         " 's2.o.y' (inside output)\nhelp: a set of connected inputs and outputs may"
-        ' contain at most one inside output or one outside input (Modelica 3.6, section'
-        ' 9.3)'),
+        ' contain at most one inside output or one public outside input (Modelica 3.6,'
+        ' section 9.3)'),
     "connector_parameter": ("""\
 model M
   connector C

@@ -52,7 +52,7 @@ REJECTED = {
         "supported yet: it depends on time",
     "function f\n  input Real u;\n  output Real y;\nexternal \"C\";\nend f;\n"
     "model M\n  Real x = f(1);\nend M;\n":
-        "4:1: error: `external` functions are not supported yet",
+        "7:12: error: the external function 'f' (C function 'f') is not supported yet",
     "connector C\n  Real p;\n  flow Real f;\n  stream Real h;\nend C;\nmodel M\n  C c;\nend M;\n":
         "4:3: error: `stream` connectors are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nalgorithm\n  y := u;\n"

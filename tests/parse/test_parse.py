@@ -490,7 +490,6 @@ def test_other_lexical_and_syntax_errors() -> None:
 
 
 UNSUPPORTED = [
-    ('function f external "C"; end f;', "`external` functions are"),
     ("connector C stream Real h; end C;", "`stream` connectors are"),
     ("expandable connector C end C;", "`expandable` connectors are"),
     ("operator record R end R;", "`operator` classes are"),

@@ -13,6 +13,7 @@ from ..errors import FlattenError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
+from ..parse import ClassEntry
 from . import arrays as a
 from .array_ops import check_loop_nest, with_range
 from .calls import assertion, call_for_effect, multiple_outputs, string_equation
@@ -39,6 +40,7 @@ class EquationFlattening(FlattenContext):
     templates: dict[tuple[Ident[ClassView], bool], Template | None]
     reusable_views: dict[Ident[ClassView], bool]  # whether a view's equations are a template
     algorithm_sections: list[Section]
+    written_in: ClassEntry | None
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
         """The equations of one instance; from the class's template when it has one."""
@@ -54,10 +56,13 @@ class EquationFlattening(FlattenContext):
             return
         start, errors, reads = len(target), len(self.errors), self.parameter_values.reads
         for item in items:
+            self.written_in = item.defined_in
             try:
                 self.equation(item.equation, scope, scope, initial)
             except FlattenError as err:
                 self.report(err)
+            finally:
+                self.written_in = None
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
                 and scope.package is None:
             independent = self.parameter_values.reads == reads \

@@ -294,7 +294,15 @@ class Evaluator(ReferenceResolver):
                 result = branches.pop()[1]
         for cond, then in reversed(branches):
             if a.shape(then) != a.shape(result):
-                raise FlattenError("branches of an if-expression differ in size", e.span)
+                # under a parameter condition only the selected branch counts (the
+                # MSL BooleanTable sizes its table so)
+                chosen = self._folded(cond)
+                if chosen is None:
+                    raise FlattenError("branches of an if-expression differ in size",
+                                       e.span, hint="sizes may differ only where the "
+                                       "condition is a parameter expression")
+                result = then if chosen else result
+                continue
             result = a.elementwise(lambda t, o, c=cond: x.If(c, t, o), then, result)
         return result
 

@@ -74,6 +74,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.reusable_views = {}
         self.templates = {}
         self.instance_templates = InstanceTemplates(self)
+        self.written_in: ClassEntry | None = None
 
     # ----------------------------------------------------------------- queries
 

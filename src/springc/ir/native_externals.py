@@ -1,7 +1,9 @@
 """The external functions springc evaluates itself instead of calling foreign code.
 
 ModelicaStandardTables (the table blocks of the Modelica Standard Library) are external
-objects built by C functions. springc recognises those functions by their C names, as
+objects built by C functions. The string functions of
+``Modelica.Utilities.Strings`` (ModelicaStrings) are evaluated the same way. springc
+recognises those functions by their C names, as
 the library declares them (``external "C" y = ModelicaStandardTables_CombiTable1D_getValue
 (tableID, icol, u)``), and evaluates them while flattening (``flatten/natives/tables.py``). Each
 entry names the operation and the role of every argument of the external call, in the
@@ -40,3 +42,12 @@ NATIVE_EXTERNALS: dict[str, tuple[str, tuple[str | None, ...]]] = {
     _PREFIX + "CombiTable2D_getValue": ("value2D", ("tableID", "u1", "u2")),
 }
 """C name -> (operation, the role of each argument of the external call)."""
+
+_STRINGS = "ModelicaStrings_"
+NATIVE_EXTERNALS.update({
+    _STRINGS + "length": ("strings.length", ("string",)),
+    _STRINGS + "substring": ("strings.substring", ("string", "startIndex", "endIndex")),
+    _STRINGS + "compare": ("strings.compare", ("string", "string2", "caseSensitive")),
+    _STRINGS + "skipWhiteSpace": ("strings.skipWhiteSpace", ("string", "startIndex")),
+})
+"""The string functions of ``Modelica.Utilities.Strings`` (``flatten/externals.py``)."""

@@ -18,7 +18,6 @@ from lark import Token
 from lark.tree import Meta
 
 from ..errors import Note, Span
-from ..ir.native_externals import NATIVE_EXTERNALS
 from ..ir.syntax import (
     AlgorithmSection,
     ClassDef,
@@ -171,10 +170,11 @@ class ClassRules(RuleBase):
                            "`algorithm` section, and has no equations and no initial "
                            "algorithms (Modelica 3.6, section 12.2)")
             elif section.kind == "external":
-                if section.items and section.items[0].name in NATIVE_EXTERNALS:
-                    body["external"].append(section.items[0])
-                    continue
-                self.reject("`external` functions are", section.span)
+                # every external clause is kept: flattening evaluates the ones springc
+                # implements (ir.native_externals) and names the others where called
+                body["external"].append(section.items[0] if section.items else ExternalCall(
+                    "C", "", None, (), section.span))
+                continue
             elif section.kind == "algorithm" and body["algorithm_sections"]:
                 self.error("a function can have at most one `algorithm` section",
                            section.span, hint="merge the statements into one section "

@@ -5,7 +5,9 @@ The pipeline is a short list of passes, each in its own module:
 0. ``check_balance`` (:mod:`springc.simplify.balance`): as ``springc check`` does, so
    that a missing or surplus equation is reported with its location, before the
    structural passes would find it less clearly;
-1. ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
+1. ``free_parameters`` (:mod:`springc.simplify.free_parameters`): ``fixed = false``
+   parameters bound by their initial equations, or kept constant as states; then
+   ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
 4. ``causalize`` (:mod:`springc.simplify.causalize`): matching, BLT, solved blocks.
@@ -24,6 +26,7 @@ from .assertions import simplified_assertions
 from .balance import check_balance, dae_incidence
 from .causalize import causalize
 from .events import with_events
+from .free_parameters import free_parameters
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
@@ -63,6 +66,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
+    model = free_parameters(model)
     system = lower(model)
     check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)

@@ -109,8 +109,8 @@ def guard_assertions(assertions: list[Pending], start: int, guard: x.Expr) -> No
 
 def message_text(ev: ExpressionEvaluator, e: s.Expr, scope: Scope,
                  read: Read | None = None) -> str:
-    """The text of a String expression: literals, ``+`` and ``String(e)`` of values
-    known before the simulation (constants and parameters)."""
+    """The text of a String expression: literals, ``+`` and ``String(e)``: the value
+    of a constant or parameter, else ``String(<flat expression>)``."""
     if isinstance(e, s.String):
         return e.value
     if isinstance(e, s.Binary) and e.op == "+":
@@ -133,14 +133,16 @@ def _string_of(ev: ExpressionEvaluator, call: s.Call, scope: Scope,
                            call.span)
     options = {n.name: ev.constant(n.value, scope, f"'{n.name}'") for n in call.named}
     arg = ev.value(call.args[0], scope)
+    source = read(arg) if read is not None else arg
     try:
-        value = ev.fold(read(arg) if read is not None else arg)
-    except KeyError as missing:
-        raise FlattenError(f"the argument of 'String' in a message must be a parameter "
-                           f"expression, but it depends on {missing.args[0]}",
-                           call.args[0].span, hint="messages that show time-varying values "
-                           "are not supported yet; show parameters and constants only"
-                           ) from None
+        value = ev.fold(source)
+    except KeyError:
+        if isinstance(source, (np.ndarray, str)):
+            raise FlattenError("'String' of an array is not defined",
+                               call.args[0].span) from None
+        # a value known only while simulating: the message names it (its flat
+        # expression) instead of showing it (not supported yet, docs/language.md)
+        return f"String({x.to_text(source)})"
     if isinstance(value, np.ndarray):
         raise FlattenError("'String' of an array is not defined", call.args[0].span)
     if isinstance(value, str):

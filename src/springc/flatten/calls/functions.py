@@ -24,7 +24,7 @@ from ...parse import ClassEntry, lookup_class, member_class
 from .. import arrays as a
 from ..array_ops import check_loop_nest, with_range
 from ..checks import check_access_class
-from ..natives import native_call, native_function
+from ..natives import external_value, is_external
 from ..redeclare import redeclared_class
 from ..scopes import (
     ClassScope,
@@ -88,8 +88,8 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
-        if native_function(entry) is not None:
-            native: a.Value = native_call(ev, entry, scope.names, call)
+        if is_external(entry):
+            native: a.Value = external_value(ev, entry, scope.names, call)
             return native
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:

@@ -8,6 +8,7 @@ and its section.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from collections.abc import Set as AbstractSet
 from typing import Any
 
 import numpy as np
@@ -89,18 +90,28 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def check_sources(members: list[tuple[str, bool]], causal: dict[str, str],
-                  spans: dict[tuple[str, bool], Any]) -> None:
+                  spans: dict[tuple[str, bool], Any],
+                  protected: AbstractSet[str] = frozenset()
+                  ) -> None:
     """A connection set of causal variables has at most one source: one inside output
-    or one outside input (9.3)."""
+    or one public outside input (9.3); an input of a protected outside connector
+    (the MSL's ``f_internal`` of a conditional input) is not a source. ``protected``:
+    the flat names of protected outside connectors (a variable of one starts with
+    its name and a dot)."""
+    def hidden(name: str) -> bool:
+        return name in protected or any(name[:i] in protected
+                                        for i, c in enumerate(name) if c == ".")
+
     sources = [(name, outside) for name, outside in members
-               if causal.get(name) == ("input" if outside else "output")]
+               if causal.get(name) == ("input" if outside else "output")
+               and not (outside and hidden(name))]
     if len(sources) > 1:
         names = ", ".join(f"'{n}' ({'outside input' if o else 'inside output'})"
                           for n, o in sources)
         raise rule_error(f"a connection set has {len(sources)} sources of its signal: "
                          f"{names}", spans.get(sources[1]), "a set of connected inputs "
-                         "and outputs may contain at most one inside output or one outside "
-                         "input", "9.3")
+                         "and outputs may contain at most one inside output or one public "
+                         "outside input", "9.3")
 
 
 def check_connector_size(scope: ClassScope) -> None:

@@ -115,6 +115,12 @@ def _integer(e: s.Expr, indices: dict[str, Any]) -> int | None:
     return None
 
 
+def _protected_head(ref: s.Ref, owner: ClassScope) -> bool:
+    """Whether ``ref`` starts at a protected component of ``owner``."""
+    comp = owner.view.components.get(ref.parts[0].name)
+    return comp is not None and comp.decl.protected
+
+
 class ConnectionSets:
     def __init__(self) -> None:
         self.parent: dict[Key, Key] = {}
@@ -122,6 +128,8 @@ class ConnectionSets:
         self.link: dict[Key, Link] = {}
         self.causal: dict[str, str] = {}  # flat name -> input/output, for check_sources
         self.counts: Counter[str] = Counter()  # connect equations per connector (cardinality)
+        # protected outside connectors: a signal's source only when public (9.3)
+        self.protected: set[str] = set()
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -150,6 +158,10 @@ class ConnectionSets:
             raise FlattenError(
                 f"cannot connect arrays of {len(left)} and {len(right)} connectors",
                 eq.span, hint="connect arrays of connectors of the same size")
+        for ref, out, items in ((eq.a, left_out, left), (eq.b, right_out, right)):
+            if out and _protected_head(ref, owner):
+                self.protected.update(c.name if isinstance(c, Leaf) else c.prefix
+                                      for c in items)
         for ca, cb in zip(left, right):
             self._pair(ca, cb, left_out, right_out, eq, owner)
             for c in (ca, cb):
@@ -240,7 +252,8 @@ class ConnectionSets:
             if self.flow[members[0]]:
                 out.append(self._flow_sum(members, first))
             else:
-                check_sources(members, self.causal, {k: self.link[k].span for k in members})
+                check_sources(members, self.causal, {k: self.link[k].span for k in members},
+                              self.protected)
                 out += [flat.Equation(x.Var(members[0][0]), x.Var(k[0]), self.link[k].span,
                                       flat.Origin("connect", self.link[k].owner,
                                                   self.link[k].text))

@@ -193,6 +193,10 @@ class ClassLookup(FlattenContext):
         return entry if entry is not None and entry.defn.kind == "function" else None
 
     def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry:
+        base = self.written_in
+        if not ref.is_global and lookup_class(ref.parts[0].name, scope.entry) is None \
+                and base is not None and lookup_class(ref.parts[0].name, base) is not None:
+            return self.resolve_function(ref, self.package_scope(base))
         if not ref.is_global and lookup_class(ref.parts[0].name, scope.entry) is None:
             close = close_names(ref.dotted, sorted(self.evaluator.builtins.table), 1)
             raise FlattenError(f"unknown function '{ref.dotted}'", ref.span,

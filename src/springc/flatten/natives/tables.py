@@ -56,12 +56,6 @@ class Table(ObjectMember):
     span: Span
 
 
-def native_function(entry: ClassEntry) -> tuple[str, tuple[str | None, ...]] | None:
-    """The operation and argument roles of a function springc evaluates itself."""
-    external = entry.defn.external
-    return NATIVE_EXTERNALS.get(external.name) if external is not None else None
-
-
 def native_call(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, Any],
                 call: s.Call) -> Any:
     """The value of a call of a native table function, its inputs bound in ``names``."""
@@ -281,7 +275,7 @@ def table_object(ev: ExpressionEvaluator, entry: ClassEntry, value: Any, name: s
     constructor = next((c for c in entry.defn.elements if isinstance(c, s.ClassDef)
                         and c.name == "constructor"), None)
     if constructor is None or constructor.external is None or \
-            NATIVE_EXTERNALS[constructor.external.name][0] not in (
+            NATIVE_EXTERNALS.get(constructor.external.name, ("",))[0] not in (
                 "table1D", "timeTable", "table2D"):
         raise FlattenError(f"'{name}' is an external object of '{entry.full_name}', "
                            "which springc does not implement", span,

@@ -378,6 +378,9 @@ class FlattenContext(ClassViews, FlatResults, Protocol):
     # conditions of if-statements, checked to be Boolean once the types are known
     statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
+    # the class that wrote the equation being flattened: an inherited equation finds
+    # the functions of its base class's scope (section 5.6.1)
+    written_in: ClassEntry | None
 
     def report(self, err: FlattenError) -> None: ...
 

@@ -1,0 +1,92 @@
+"""Calls of external functions (section 12.9) while flattening.
+
+springc calls no foreign code: the external functions it knows by their C names
+(``ir.native_externals``) are evaluated here, the ModelicaStandardTables by ``tables``
+and the ModelicaStrings functions of ``Modelica.Utilities.Strings`` on their string
+arguments (which are known while flattening: springc has no string variables). A call
+of any other external function is a located error naming it; declaring one is not.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ...errors import FlattenError, Note
+from ...ir import expr as x
+from ...ir import syntax as s
+from ...ir.native_externals import NATIVE_EXTERNALS
+from ...parse import ClassEntry
+from ..scopes import ExpressionEvaluator
+from .tables import native_call
+
+
+def is_external(entry: ClassEntry) -> bool:
+    """Whether ``entry`` is a function with an ``external`` clause."""
+    return entry.defn.external is not None
+
+
+def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, Any],
+                   call: s.Call) -> Any:
+    """The value of ``call`` of the external function ``entry``, its inputs bound in
+    ``names``; an error naming the function where springc does not implement it."""
+    external = entry.defn.external
+    assert external is not None
+    c_name = external.name or entry.defn.name
+    known = NATIVE_EXTERNALS.get(c_name)
+    if known is None:
+        raise FlattenError(
+            f"the external function '{entry.full_name}' ({external.language} function "
+            f"'{c_name}') is not supported yet", call.span,
+            [Note("its external clause", external.span)],
+            "springc calls no foreign code; it evaluates the tables "
+            "(ModelicaStandardTables) and string functions (ModelicaStrings) of the "
+            "Modelica Standard Library itself")
+    operation, roles = known
+    if not operation.startswith("strings."):
+        return native_call(ev, entry, names, call)
+    given = {role: names[arg.dotted] for role, arg in zip(roles, external.args)
+             if role is not None and isinstance(arg, s.Ref) and arg.dotted in names}
+    return _string_function(ev, operation[len("strings."):], given, call)
+
+
+def _string_function(ev: ExpressionEvaluator, name: str, given: dict[str, Any],
+                     call: s.Call) -> Any:
+    """ModelicaStrings_length, _substring, _compare and _skipWhiteSpace, as
+    the MSL documents them (indices 1-based)."""
+    text = _string(ev, given["string"], call)
+    if name == "length":
+        return x.Const(len(text))
+    if name == "substring":
+        first, last = _index(ev, given, "startIndex", call), _index(ev, given, "endIndex", call)
+        if not 1 <= first <= max(len(text), 1) or last > len(text) or last < first - 1:
+            raise FlattenError(f"Strings.substring: the indices {first}..{last} are not in "
+                               f"the string \"{text}\" (length {len(text)})", call.span)
+        return text[first - 1:last]
+    if name == "compare":
+        other = _string(ev, given["string2"], call)
+        case = bool(ev.fold(given.get("caseSensitive", x.ONE)))
+        a, b = (text, other) if case else (text.lower(), other.lower())
+        return x.Const(1 if a < b else 2 if a == b else 3)  # Types.Compare's ordinals
+    assert name == "skipWhiteSpace", name
+    index = _index(ev, given, "startIndex", call)
+    while index <= len(text) and text[index - 1] in " \t\n\r":
+        index += 1
+    return x.Const(index)
+
+
+def _string(ev: ExpressionEvaluator, value: Any, call: s.Call) -> str:
+    while isinstance(value, x.If):
+        value = value.then if ev.fold(value.cond) else value.otherwise
+    if not isinstance(value, str):
+        raise FlattenError("a string function of Modelica.Utilities.Strings needs a "
+                           "String known before the simulation", call.span)
+    return value
+
+
+def _index(ev: ExpressionEvaluator, given: dict[str, Any], role: str, call: s.Call) -> int:
+    try:
+        return int(ev.fold(given.get(role, x.ONE)))
+    except KeyError as missing:
+        raise FlattenError(f"the {role} of a string function must be known before the "
+                           f"simulation, but it depends on {missing.args[0]}",
+                           call.span) from None
