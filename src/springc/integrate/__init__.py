@@ -45,14 +45,11 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
 
 from .batch import Ensemble, ensemble
 from .engine import (
-    FIXED_STEP_METHODS,
     Crossings,
     Run,
     bdf,
     dop853,
     fixed_step,
-    kernel_cached,
-    load,
     newton_flops,
     newton_solve_flops,
     observed_grid,
@@ -60,9 +57,10 @@ from .engine import (
     rk45,
 )
 from .hybrid import HybridRun, run_hybrid
+from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
-           "bdf", "dop853", "ensemble", "fixed_step", "kernel_cached", "load", "newton_flops",
+           "bdf", "compile_seconds", "dop853", "ensemble", "fixed_step", "kernel_cached", "load", "newton_flops",
            "newton_solve_flops",
            "observed_grid", "radau", "rk45", "run_hybrid"]

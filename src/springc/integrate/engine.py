@@ -13,10 +13,10 @@ from typing import Any
 
 import numpy as np
 
+from .kernels import FIXED_STEP_METHODS, kernel
 from .status import Status
 
 ModelFunction = Callable[[float, np.ndarray, np.ndarray, np.ndarray], np.ndarray]
-FIXED_STEP_METHODS = ("euler", "symplectic-euler", "verlet", "rk4")
 
 
 @dataclass(frozen=True)
@@ -77,39 +77,6 @@ class Crossings:
     directions: Sequence[float] | np.ndarray | None = None
 
 
-KERNEL_MODULES = {"dop853": "dop853_kernel", "rk45": "rk45_kernel", "radau": "radau_kernel",
-                  "bdf": "bdf_kernel", **{m: "fixed_step_kernel" for m in FIXED_STEP_METHODS}}
-
-
-def load(method: str) -> None:
-    """Compile or load from numba's cache the kernel of ``method`` (a key of
-    :data:`KERNEL_MODULES`) now, as its first run would: a caller timing runs leaves
-    the loading out."""
-    import importlib
-
-    importlib.import_module(f"{__package__}.{KERNEL_MODULES[method]}")
-
-
-def kernel_cached(method: str) -> bool:
-    """Whether the kernel of ``method`` loads at once: already loaded in this process,
-    or numba's on-disk cache holds an index of its module (in the package's
-    ``__pycache__``, or below ``NUMBA_CACHE_DIR``). If not, loading it compiles it for
-    this machine (seconds to minutes, once). Read from the files, without importing
-    the kernel."""
-    import os
-    import sys
-    from pathlib import Path
-
-    module = KERNEL_MODULES[method]
-    if f"{__package__}.{module}" in sys.modules:
-        return True
-    pattern = f"{module}.*.nbi"
-    if any((Path(__file__).parent / "__pycache__").glob(pattern)):
-        return True
-    custom = os.environ.get("NUMBA_CACHE_DIR", "")
-    return bool(custom) and any(Path(custom).rglob(pattern))
-
-
 def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
            atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
            max_step: float = np.inf, first_step: float | None = None,
@@ -131,16 +98,8 @@ def dop853(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: floa
     ``crossings`` stops the run at the earliest zero crossing (status STATE_EVENT, located
     on the dense output); a ``t_stop`` inside the grid stops it exactly there (TIME_EVENT).
     """
-    from .dop853_kernel import dop853_run
-
-    grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
-    atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
-    rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
-    g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
-    result = dop853_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
-                        float(rtol), atol_, float(max_step), float(first_step or 0.0),
-                        int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
-    return _run(grid_, result)
+    return _explicit("dop853", rhs, grid, x0, p, z, rtol, atol, observed, max_step,
+                     first_step, max_steps, scipy_arithmetic, crossings, t_stop)
 
 
 def rk45(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
@@ -150,15 +109,25 @@ def rk45(rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
          t_stop: float = np.inf) -> Run:
     """Integrate with compiled RK45 (Dormand-Prince 5(4)), scipy's ``RK45`` method;
     arguments as :func:`dop853`."""
-    from .rk45_kernel import rk45_run
+    return _explicit("rk45", rhs, grid, x0, p, z, rtol, atol, observed, max_step,
+                     first_step, max_steps, scipy_arithmetic, crossings, t_stop)
+
+
+def _explicit(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: Any,
+              rtol: float, atol: Any, observed: ModelFunction | None, max_step: float,
+              first_step: float | None, max_steps: int, scipy_arithmetic: bool,
+              crossings: Crossings | None, t_stop: float) -> Run:
+    from .models import no_observed
 
     grid_, x0_, p_, z_ = _vectors(grid, x0, p, z)
     atol_ = _tolerances(rtol, atol, x0_, grid_, first_step, max_step)
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
-    result = rk45_run(rhs_, observed_, n_observed, g, signs, directions, grid_, x0_, p_, z_,
-                      float(rtol), atol_, float(max_step), float(first_step or 0.0),
-                      int(max_steps), bool(scipy_arithmetic), _stop(t_stop, grid_))
+    none = np.empty(0, dtype=np.int64)
+    loop = kernel(method, bool(scipy_arithmetic))
+    result = loop(rhs_, no_observed, observed_, n_observed, g, signs, directions, grid_, x0_,
+                  p_, z_, float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                  int(max_steps), _stop(t_stop, grid_), (none, 0, 0, none, none))
     return _run(grid_, result)
 
 
@@ -174,9 +143,7 @@ def radau(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any
     options (``observed``, ``max_step``, ``first_step``, ``max_steps``, ``crossings``,
     ``t_stop``) as for :func:`dop853`.
     """
-    from .radau_kernel import radau_run
-
-    return _implicit(radau_run, rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
+    return _implicit("radau", rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
                      **options)
 
 
@@ -185,13 +152,11 @@ def bdf(rhs: ModelFunction, jacobian: ModelFunction, indptr: Any, indices: Any, 
         **options: Any) -> Run:
     """Integrate with compiled BDF (orders 1-5), scipy's ``BDF`` method; arguments as
     :func:`radau`."""
-    from .bdf_kernel import bdf_run
-
-    return _implicit(bdf_run, rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
+    return _implicit("bdf", rhs, jacobian, indptr, indices, grid, x0, p, z, rtol, atol,
                      **options)
 
 
-def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: Any,
+def _implicit(method: str, rhs: ModelFunction, jacobian: ModelFunction, indptr: Any,
               indices: Any, grid: Any, x0: Any, p: Any, z: Any, rtol: float, atol: Any, *,
               observed: ModelFunction | None = None, max_step: float = np.inf,
               first_step: float | None = None, max_steps: int = 0,
@@ -212,9 +177,10 @@ def _implicit(kernel: Any, rhs: ModelFunction, jacobian: ModelFunction, indptr: 
     order, kl, ku, positions, diagonal = _band_layout(x0_.size, indptr_.tobytes(),
                                                       indices_.tobytes(), dense_limit)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
-    result = kernel(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_, x0_,
-                    p_, z_, float(rtol), atol_, float(max_step), float(first_step or 0.0),
-                    int(max_steps), _stop(t_stop, grid_), order, kl, ku, positions, diagonal)
+    loop = kernel(method)
+    result = loop(rhs_, jacobian, observed_, n_observed, g, signs, directions, grid_, x0_,
+                  p_, z_, float(rtol), atol_, float(max_step), float(first_step or 0.0),
+                  int(max_steps), _stop(t_stop, grid_), (order, kl, ku, positions, diagonal))
     return _run(grid_, result)
 
 
@@ -265,7 +231,7 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
     ``crossings`` and ``t_stop`` as for :func:`dop853` (a crossing is located on split
     steps of the method; the steps after an event restart on the output interval).
     """
-    from .fixed_step_kernel import METHOD_CODES, fixed_step_run
+    from .fixed_step_methods import METHOD_CODES
 
     if method not in METHOD_CODES:
         raise ValueError(f"unknown fixed-step method {method!r}; use one of "
@@ -280,7 +246,7 @@ def fixed_step(method: str, rhs: ModelFunction, grid: Any, x0: Any, p: Any, z: A
         raise ValueError("a pair index is outside the state vector")
     rhs_, observed_, n_observed = _functions(rhs, observed, grid_, x0_, p_, z_)
     g, signs, directions = _crossings(crossings, grid_, x0_, p_, z_)
-    result = fixed_step_run(METHOD_CODES[method], rhs_, observed_, n_observed, g, signs,
+    result = kernel(method)(METHOD_CODES[method], rhs_, observed_, n_observed, g, signs,
                             directions, grid_, x0_, p_, z_, float(step), positions,
                             velocities, _stop(t_stop, grid_))
     return _run(grid_, result)

@@ -3,7 +3,7 @@
 The same methods, step rule and arithmetic as ``springc.simulation.integrators`` (the
 tests check equality within rounding): each output interval is cut into
 ``max(1, ceil(span / step - 1e-9))`` equal steps (see :mod:`.fixed_step_methods`).
-Compiled once per machine, whatever the model.
+Compiled once per machine, whatever the model, on first use (:mod:`.kernels`).
 
 Events: after every step the zero-crossing function is checked against the held signs
 (:mod:`.crossings`); a crossing is located by bisection on steps of the method itself
@@ -19,11 +19,11 @@ the cached code, so touch this file after editing those.
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 
 from .crossings import crossings, time_tolerance
 from .fixed_step_methods import METHOD_CODES, VERLET, advance, verdict
-from .signatures import INDICES, MODEL_FUNCTION, RUN_RESULT, VECTOR, ModelFunction, RunTuple
+from .signatures import ModelFunction, RunTuple
 from .status import Status
 
 __all__ = ["METHOD_CODES", "fixed_step_run"]
@@ -35,10 +35,7 @@ STATE_EVENT = int(Status.STATE_EVENT)
 TIME_EVENT = int(Status.TIME_EVENT)
 
 
-@njit(RUN_RESULT(types.int64, MODEL_FUNCTION, MODEL_FUNCTION, types.int64, MODEL_FUNCTION,
-                 VECTOR, VECTOR, VECTOR, VECTOR, VECTOR, VECTOR, types.float64, INDICES,
-                 INDICES, types.float64),
-      cache=True, error_model="numpy", nogil=True)
+@njit(cache=True, error_model="numpy", nogil=True)  # FIXED_STEP_SIGNATURE, on first use
 def fixed_step_run(method: int, rhs: ModelFunction, observed: ModelFunction, n_observed: int,
                    crossing: ModelFunction, signs: np.ndarray, directions: np.ndarray,
                    grid: np.ndarray, x0: np.ndarray, p: np.ndarray, z: np.ndarray, step: float,

@@ -1,10 +1,14 @@
-"""Radau IIA's arithmetic, compiled: the Newton matrices, the simplified Newton iteration
-of the collocation system, the step-size predictor and the dense output.
+"""Radau IIA (order 5), compiled: the method's hooks of the shared loop (:mod:`.loop`),
+the Newton matrices, the simplified Newton iteration of the collocation system, the
+step-size predictor and the dense output.
 
-The pieces of :func:`.radau_kernel.radau_run`, following scipy's ``Radau`` (Hairer and
-Wanner's ``radau5``): the 3n x 3n Newton system is transformed by ``T`` into one real and
-one complex n x n system, factorised by :mod:`.banded_lu` in the ordering of
-:func:`.banded_lu.band_layout` (``order``: position -> state).
+The implicit method for stiff scenes, as scipy's ``Radau`` runs it (Hairer and Wanner's
+``radau5``: same controller, Newton iteration, Jacobian reuse and error estimate; the
+tests compare steps and errors with scipy's on the same problems): the 3n x 3n Newton
+system is transformed by ``T`` into one real and one complex n x n system, factorised
+by :mod:`.banded_lu` in the ordering of :func:`.banded_lu.band_layout` (``order``:
+position -> state), with the generated sparse Jacobian (``jacobian_values`` in CSC
+order) assembled into the band.
 
 numba keys its disk cache on this file's modification time only: touch it after editing
 ``radau_tableau``, ``banded_lu``, ``status``.
@@ -16,12 +20,18 @@ import numpy as np
 from numba import njit
 
 from . import radau_tableau as tableau
+from .arrays import copy
 from .banded_lu import band_factor, band_solve
+from .dop853_steps import verdict
 from .signatures import ModelFunction
-from .status import Status
+from .status import JACOBIAN_CALLS, REJECTED, RHS_CALLS, Status
 
 SUCCESS = int(Status.SUCCESS)
+STEP_TOO_SMALL = int(Status.STEP_TOO_SMALL)
 MODEL_FAILED = int(Status.MODEL_FAILED)
+MIN_FACTOR, MAX_FACTOR = 0.2, 10.0
+EPS = float(np.finfo(float).eps)
+ERROR_ORDER = 3  # of the error estimator: the initial step's exponent is 1 / 4
 C, E, T, TI, P = tableau.C, tableau.E, tableau.T, tableau.TI, tableau.P
 TI_REAL, TI_COMPLEX = tableau.TI_REAL, tableau.TI_COMPLEX
 MU_REAL, MU_COMPLEX = tableau.MU_REAL, tableau.MU_COMPLEX
@@ -101,7 +111,8 @@ def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray
     for r in range(3):
         for c in range(3):
             W[r] += TI[r, c] * Z0[c]
-    Z[:] = Z0
+    for r in range(3):
+        copy(Z[r], Z0[r])
     F = np.empty((3, n))
     stage = np.empty(n)
     dW = np.empty((3, n))
@@ -172,3 +183,227 @@ def dense_state(Q: np.ndarray, y_old: np.ndarray, x: float, out: np.ndarray) -> 
     x3 = x2 * x
     for j in range(y_old.size):
         out[j] = y_old[j] + Q[j, 0] * x + Q[j, 1] * x2 + Q[j, 2] * x3
+
+
+# The hooks of the shared loop (see :mod:`.loop` for their contract).
+
+Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
+Work = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+             np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+             np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+#: the method's scalars between steps (``work[14]``): the Newton tolerance, the last
+#: step size and error norm (-1: none), the start and length of the last step
+NEWTON_TOL, H_ABS_OLD, ERROR_NORM_OLD, T_OLD, H_DENSE = 0, 1, 2, 3, 4
+#: its flags (``work[15]``): the Jacobian is current, the matrices are factorised, the
+#: last step's collocation polynomial is there
+CURRENT_JAC, FACTORED, HAVE_DENSE = 0, 1, 2
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def setup(n: int, layout: Layout) -> Work:
+    """The stage arrays, the band matrices of the Newton systems and their pivots, the
+    Jacobian's non-zeros, the derivative at the step's start and the scalars."""
+    _, kl, ku, positions, _ = layout
+    width = 2 * kl + ku + 1
+    return (np.zeros((3, n)), np.zeros((3, n)), np.zeros((n, 3)), np.empty(n), np.empty(n),
+            np.empty(n), np.empty(n), np.empty(n), np.empty(positions.size),
+            np.zeros((n, width)), np.zeros((n, width), dtype=np.complex128),
+            np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n),
+            np.zeros(5), np.zeros(3, dtype=np.int64))
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np.ndarray,
+          h_abs: float, p: np.ndarray, z: np.ndarray, rtol: float, work: Work,
+          counts: np.ndarray, end: np.ndarray) -> tuple[int, float]:
+    """The Newton tolerance, the Jacobian at the start, no step history."""
+    reals, flags = work[14], work[15]
+    reals[NEWTON_TOL] = max(10 * EPS / rtol, min(0.03, rtol ** 0.5))
+    J = jac(t, y, p, z)
+    counts[JACOBIAN_CALLS] += 1
+    status = verdict(J, z)
+    if status != SUCCESS:
+        copy(end, y)
+        return status, t
+    copy(work[8], J)
+    copy(work[13], f)
+    flags[CURRENT_JAC], flags[FACTORED], flags[HAVE_DENSE] = 1, 0, 0
+    reals[H_ABS_OLD], reals[ERROR_NORM_OLD], reals[T_OLD], reals[H_DENSE] = -1.0, -1.0, t, 0.0
+    return SUCCESS, t
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def converge(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h: float,
+             p: np.ndarray, z: np.ndarray, layout: Layout, work: Work, counts: np.ndarray
+             ) -> tuple[bool, int, float, int]:
+    """The collocation system of the step ``h`` solved by Newton's method, the matrices
+    factorised again (and the Jacobian evaluated again once) where needed: (converged,
+    iterations, rate, status)."""
+    order, kl, ku, positions, diagonal = layout
+    Z0, Z, scale, J = work[0], work[1], work[4], work[8]
+    real, complex_, pivots_real, pivots_complex = work[9], work[10], work[11], work[12]
+    reals, flags = work[14], work[15]
+    converged, n_iter, rate = False, 0, -1.0
+    while not converged:
+        if not flags[FACTORED]:
+            flags[FACTORED] = factor_newton_matrices(h, J, positions, diagonal, kl, ku, real,
+                                                     complex_, pivots_real, pivots_complex)
+        if flags[FACTORED]:
+            converged, n_iter, rate, used, status = newton(
+                rhs, t, y, h, Z0, scale, reals[NEWTON_TOL], real, complex_, pivots_real,
+                pivots_complex, kl, ku, order, p, z, Z)
+            counts[RHS_CALLS] += used
+            if status != SUCCESS:
+                return False, n_iter, rate, status
+        if converged or flags[CURRENT_JAC]:
+            break
+        values = jac(t, y, p, z)
+        counts[JACOBIAN_CALLS] += 1
+        status = verdict(values, z)
+        if status != SUCCESS:
+            return False, n_iter, rate, status
+        copy(J, values)
+        flags[CURRENT_JAC], flags[FACTORED] = 1, 0
+    return converged, n_iter, rate, SUCCESS
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_proposed: float,
+         h_abs: float, min_step: float, limit: float, p: np.ndarray, z: np.ndarray,
+         rtol: float, atol: np.ndarray, layout: Layout, work: Work, counts: np.ndarray,
+         y_new: np.ndarray, end: np.ndarray, blas: bool | None
+         ) -> tuple[int, float, float, float, float]:
+    """One accepted step of Radau IIA from ``(t, y)`` (rejected ones before it), then
+    the next step size, the derivative there and, if Newton converged slowly, the
+    Jacobian."""
+    order, kl, ku = layout[0], layout[1], layout[2]
+    Z0, Z, Q, y_old, scale, error, ZE, stage = work[:8]
+    real, pivots_real, f, reals, flags = work[9], work[11], work[13], work[14], work[15]
+    n = y.size
+    step_h_old, step_error_old = reals[H_ABS_OLD], reals[ERROR_NORM_OLD]
+    if h_abs != h_proposed:  # clamped: no step-size history
+        step_h_old, step_error_old = -1.0, -1.0
+    step_rejected = False
+    n_iter, rate, error_norm, safety = 0, -1.0, 0.0, 0.9
+    while True:
+        if h_abs < min_step:
+            copy(end, y)
+            return STEP_TOO_SMALL, t, 0.0, h_abs, t
+        t_new = t + h_abs
+        if t_new - limit > 0:
+            t_new = limit
+        h = t_new - t
+        h_abs = abs(h)
+        for i in range(3):  # the last step's collocation polynomial, extrapolated
+            if flags[HAVE_DENSE]:
+                dense_state(Q, y_old, (t + h * C[i] - reals[T_OLD]) / reals[H_DENSE], stage)
+                for j in range(n):
+                    Z0[i, j] = stage[j] - y[j]
+            else:
+                for j in range(n):
+                    Z0[i, j] = 0.0
+        for j in range(n):
+            scale[j] = atol[j] + abs(y[j]) * rtol
+        converged, n_iter, rate, status = converge(rhs, jac, t, y, h, p, z, layout, work,
+                                                   counts)
+        if status != SUCCESS:
+            copy(end, y)
+            return status, t, h, h_abs, t
+        if not converged:  # (scipy's Radau: not a rejection of the error test)
+            h_abs *= 0.5
+            flags[FACTORED] = 0
+            counts[REJECTED] += 1
+            continue
+        for j in range(n):
+            y_new[j] = y[j] + Z[2, j]
+            ZE[j] = (Z[0, j] * E[0] + Z[1, j] * E[1] + Z[2, j] * E[2]) / h
+            error[j] = f[j] + ZE[j]
+        solve_in_order(real, kl, ku, pivots_real, order, error, stage)
+        for j in range(n):
+            scale[j] = atol[j] + max(abs(y[j]), abs(y_new[j])) * rtol
+            stage[j] = error[j] / scale[j]
+        error_norm = rms(stage)
+        safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
+        if step_rejected and error_norm > 1:
+            for j in range(n):
+                stage[j] = y[j] + error[j]
+            d = rhs(t, stage, p, z)
+            counts[RHS_CALLS] += 1
+            if z.size > 0 and z[z.size - 1] != 0.0:
+                copy(end, stage)
+                return MODEL_FAILED, t, h, h_abs, t
+            for j in range(n):
+                error[j] = d[j] + ZE[j]
+            solve_in_order(real, kl, ku, pivots_real, order, error, stage)
+            for j in range(n):
+                stage[j] = error[j] / scale[j]
+            error_norm = rms(stage)
+        if error_norm > 1:
+            factor = predict_factor(h_abs, step_h_old, error_norm, step_error_old)
+            h_abs *= max(MIN_FACTOR, safety * factor)
+            flags[FACTORED] = 0
+            step_rejected = True
+            counts[REJECTED] += 1
+            continue
+        break
+    return after_step(rhs, jac, t, y, t_new, h, h_abs, h_proposed, step_h_old,
+                      step_error_old, n_iter, rate, error_norm, safety, p, z, work, counts,
+                      y_new, end)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def after_step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray,
+               t_new: float, h: float, h_abs: float, h_proposed: float, step_h_old: float,
+               step_error_old: float, n_iter: int, rate: float, error_norm: float,
+               safety: float, p: np.ndarray, z: np.ndarray, work: Work, counts: np.ndarray,
+               y_new: np.ndarray, end: np.ndarray) -> tuple[int, float, float, float, float]:
+    """After an accepted step: the next step size, the derivative at the new state, the
+    Jacobian there if Newton converged slowly, and the step's collocation polynomial."""
+    Z, Q, y_old, J, f, reals, flags = work[1], work[2], work[3], work[8], work[13], \
+        work[14], work[15]
+    recompute_jac = n_iter > 2 and rate > 1e-3
+    factor = min(MAX_FACTOR, safety * predict_factor(h_abs, step_h_old, error_norm,
+                                                       step_error_old))
+    if not recompute_jac and factor < 1.2:
+        factor = 1.0
+    else:
+        flags[FACTORED] = 0
+    d = rhs(t_new, y_new, p, z)
+    counts[RHS_CALLS] += 1
+    status = verdict(d, z)
+    if status != SUCCESS:
+        copy(end, y_new)
+        return status, t_new, h, h_abs, t_new
+    copy(f, d)
+    if recompute_jac:
+        values = jac(t_new, y_new, p, z)
+        counts[JACOBIAN_CALLS] += 1
+        status = verdict(values, z)
+        if status != SUCCESS:
+            copy(end, y_new)
+            return status, t_new, h, h_abs, t_new
+        copy(J, values)
+        flags[CURRENT_JAC] = 1
+    else:
+        flags[CURRENT_JAC] = 0
+    reals[H_ABS_OLD], reals[ERROR_NORM_OLD] = h_proposed, error_norm
+    copy(y_old, y)
+    reals[T_OLD], reals[H_DENSE] = t, h
+    dense_coefficients(Z, Q)
+    flags[HAVE_DENSE] = 1
+    return SUCCESS, t_new, h, h_abs * factor, t
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: np.ndarray,
+                  p: np.ndarray, z: np.ndarray, work: Work, counts: np.ndarray,
+                  end: np.ndarray, blas: bool | None) -> tuple[int, float]:
+    """Nothing: the step's collocation polynomial is its dense output."""
+    return SUCCESS, t
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def dense(work: Work, t: float, h: float, y: np.ndarray, at: float, out: np.ndarray,
+          blas: bool | None) -> None:
+    """The collocation polynomial of the step at time ``at``."""
+    dense_state(work[2], y, (at - t) / h, out)

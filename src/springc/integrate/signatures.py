@@ -35,3 +35,15 @@ RUN_RESULT = types.Tuple((types.int64, MATRIX, MATRIX, types.int64,  # type: ign
                           INDICES, types.float64))
 #: RUN_RESULT and the Jacobian evaluations (the implicit kernels)
 IMPLICIT_RESULT = types.Tuple((*RUN_RESULT.types, types.int64))  # type: ignore[no-untyped-call]
+
+#: the band of the implicit methods' Newton matrices: order, kl, ku, positions, diagonal
+LAYOUT = types.Tuple((INDICES, types.int64, types.int64, INDICES, INDICES))  # type: ignore[no-untyped-call]
+#: the shared adaptive loop of :mod:`.loop`, whatever the method
+LOOP_SIGNATURE = IMPLICIT_RESULT(MODEL_FUNCTION, MODEL_FUNCTION, MODEL_FUNCTION, types.int64,
+                                 MODEL_FUNCTION, VECTOR, VECTOR, VECTOR, VECTOR, VECTOR,
+                                 VECTOR, types.float64, VECTOR, types.float64, types.float64,
+                                 types.int64, types.float64, LAYOUT)
+#: :func:`.fixed_step_kernel.fixed_step_run`
+FIXED_STEP_SIGNATURE = RUN_RESULT(types.int64, MODEL_FUNCTION, MODEL_FUNCTION, types.int64,
+                                  MODEL_FUNCTION, VECTOR, VECTOR, VECTOR, VECTOR, VECTOR,
+                                  VECTOR, types.float64, INDICES, INDICES, types.float64)

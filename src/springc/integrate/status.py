@@ -29,3 +29,9 @@ class Status(IntEnum):
     #: the run reached the requested stop time ``t_stop`` exactly (a step ends on it):
     #: time/state = that time and the state there; rows before it are filled
     TIME_EVENT = 7
+
+
+#: the counters a compiled run keeps (indices into its ``counts`` array): accepted
+#: steps, rejected steps, right-hand-side evaluations, Jacobian evaluations
+ACCEPTED, REJECTED, RHS_CALLS, JACOBIAN_CALLS = 0, 1, 2, 3
+COUNTERS = 4

@@ -1,0 +1,107 @@
+"""Cold start: CPU seconds of each compiled loop's first compile, and of the seed's first
+simulate, on a machine whose numba cache is empty.
+
+Each measurement runs in a fresh interpreter with its own empty ``NUMBA_CACHE_DIR``
+(and, for the seed, an empty ``SPRINGC_CACHE_DIR``), so nothing is shared between them:
+
+- ``<method> loop``: ``springc.integrate.load(method)`` (the loop compiled for this
+  machine, as its first run does), CPU seconds of that call alone, numba's import left
+  out; and of the whole process (imports included);
+- ``seed first simulate``: ``python -m springc simulate models/SpringMass.mdl -o CSV``
+  (default solver and engine), CPU seconds of the whole process (the model compiled, its
+  functions and the loops it uses compiled by numba);
+- ``seed warm simulate``: the same command again, caches filled.
+
+CPU seconds (``getrusage``), not wall: the development machine is shared, and CPU time
+is what compiling costs. ``--baseline OTHER/src`` measures another springc tree
+alongside, in the same run (before/after); ``--only dop853,radau`` a subset.
+
+Run: ``PYTHONPATH=src python benchmarks/bench_cold.py [--baseline OTHER/src]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+METHODS = ("dop853", "rk45", "radau", "bdf", "verlet")
+CHILD = """
+import json, resource, sys
+def cpu():
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
+import numba, numpy  # noqa: F401  (imports left out of the compile figure)
+from springc.integrate import load
+before = cpu()
+load(sys.argv[1])
+print(json.dumps({"compile": cpu() - before, "process": cpu()}))
+"""
+
+
+def children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run(command: list[str], src: Path, cache: Path) -> tuple[str, float]:
+    """``command`` in a fresh interpreter on the springc of ``src``: stdout, CPU s."""
+    env = {**os.environ, "PYTHONPATH": str(src), "NUMBA_CACHE_DIR": str(cache / "numba"),
+           "SPRINGC_CACHE_DIR": str(cache / "springc"), "SPRINGC_QUIET": "1"}
+    before = children_cpu()
+    done = subprocess.run(command, env=env, cwd=ROOT, capture_output=True, text=True,
+                          check=False)
+    if done.returncode:
+        raise SystemExit(f"{command} failed:\n{done.stderr}")
+    return done.stdout, children_cpu() - before
+
+
+def loop(method: str, src: Path) -> tuple[float, float]:
+    """CPU s of ``load(method)`` and of the whole process, numba's cache empty."""
+    with tempfile.TemporaryDirectory() as folder:
+        out, _ = run([sys.executable, "-c", CHILD, method], src, Path(folder))
+    figures = json.loads(out.strip().splitlines()[-1])
+    return figures["compile"], figures["process"]
+
+
+def seed(src: Path) -> tuple[float, float]:
+    """CPU s of the seed's first simulate (caches empty) and of the next one."""
+    with tempfile.TemporaryDirectory() as folder:
+        csv = Path(folder) / "seed.csv"
+        command = [sys.executable, "-m", "springc", "simulate", "models/SpringMass.mdl",
+                   "-o", str(csv)]
+        _, first = run(command, src, Path(folder))
+        _, warm = run(command, src, Path(folder))
+    return first, warm
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--baseline", type=Path, help="another springc src tree")
+    parser.add_argument("--only", default=",".join((*METHODS, "seed")))
+    args = parser.parse_args()
+    trees = [("this tree", ROOT / "src")]
+    if args.baseline:
+        trees.insert(0, ("baseline", args.baseline.resolve()))
+    wanted = args.only.split(",")
+    print(f"{'measure':<28}" + "".join(f"{name:>22}" for name, _ in trees))
+    for method in (m for m in METHODS if m in wanted):
+        cells = [loop(method, src) for _, src in trees]
+        print(f"{method + ' loop, CPU s':<28}"
+              + "".join(f"{c:>9.2f} (proc {p:5.2f})" for c, p in cells), flush=True)
+    if "seed" in wanted:
+        cells = [seed(src) for _, src in trees]
+        print(f"{'seed first simulate, CPU s':<28}"
+              + "".join(f"{first:>22.2f}" for first, _ in cells))
+        print(f"{'seed warm simulate, CPU s':<28}"
+              + "".join(f"{warm:>22.2f}" for _, warm in cells), flush=True)
+
+
+if __name__ == "__main__":
+    main()
