@@ -33,13 +33,14 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from ..errors import SpringcError, UsageError
-from .error_estimate import ORDERS, ErrorEstimate, companion_tolerances, compare
+from .error_estimate import ErrorEstimate, companion_tolerances, compare
 from .solver_names import (
     DEFAULT_ERROR_CONTROL,
     ERROR_CONTROLS,
     EXPLICIT,
     FIXED_STEP,
     IMPLICIT_SOLVERS,
+    registered,
 )
 
 if TYPE_CHECKING:
@@ -150,7 +151,7 @@ def _estimate(options: SimulationOptions, result: SimulationResult, rtol: float,
     if solver in FIXED_STEP:
         step = float(options.step or 0.0) / 2
         companion = _quiet(run, replace(base, solver=solver, rtol=rtol, atol=atol, step=step))
-        gain = 2.0 ** ORDERS[solver]
+        gain = 2.0 ** registered(solver).order
         return companion, compare(result, companion, companion.time,
                                   f"Richardson against {solver} at step {step:.3g} s",
                                   gain / (gain - 1), started), (rtol, atol)
