@@ -205,7 +205,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              progress: TextIO | None = None, step: float | None = None,
              max_steps: int | None = None, time_limit: float | None = None,
              engine: str = DEFAULT_ENGINE, error_control: str | None = None,
-             error_estimate: str | None = None, event_rows: bool = False) -> SimulationResult:
+             error_estimate: str | None = None, event_rows: bool = False,
+             settings: RunSettings | None = None) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -232,12 +233,16 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     compiled loop, else ``"python"`` (``engine="scipy"``, lsoda, no numba).
     ``event_rows``: a model with events gets two more rows at each event, its left and
     right limits (default: one row per output time).
+    ``settings``: the run's options as one value (:class:`springc.simulation.RunSettings`,
+    as :func:`springc.simulation.run_settings` builds it from these keywords, which are
+    then not read; the command line passes its own).
     """
-    settings = run_settings(start=start, stop=stop, interval=interval, solver=solver,
-                            rtol=rtol, atol=atol, step=step, parameters=parameters,
-                            max_steps=max_steps, time_limit=time_limit, engine=engine,
-                            error_control=error_control, error_estimate=error_estimate,
-                            event_rows=event_rows, progress=progress)
+    if settings is None:
+        settings = run_settings(
+            start=start, stop=stop, interval=interval, solver=solver, rtol=rtol, atol=atol,
+            step=step, parameters=parameters, max_steps=max_steps, time_limit=time_limit,
+            engine=engine, error_control=error_control, error_estimate=error_estimate,
+            event_rows=event_rows, progress=progress)
     if error_estimate is not None:
         warnings.warn(estimate_deprecation(error_estimate, ("error_control", "error_estimate")),
                       DeprecationWarning, stacklevel=3)  # the caller's line (recursion_room)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import warnings
 from dataclasses import replace
 
 import click
@@ -63,7 +64,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if error_estimate is not None:
         click.echo(f"warning: {estimate_deprecation(error_estimate)}", err=True)
     single_threaded_blas()
-    from ..api import compile_model, default_choice, simulate_with
+    from ..api import AccuracyWarning, compile_model, default_choice
+    from ..api import simulate as run
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()
@@ -79,8 +81,10 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             check_trajectory_size(compiled, settings,
                                   f"-o {output}" if output else "the CSV on stdout")
         progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-        result = simulate_with(compiled, replace(settings, progress=progress, parameters={
-            k: v for k, v in settings.parameters.items() if k not in compiled.structural}))
+        with warnings.catch_warnings():  # said below as the command's own warning
+            warnings.simplefilter("ignore", AccuracyWarning)
+            result = run(compiled, settings=replace(settings, progress=progress, parameters={
+                k: v for k, v in settings.parameters.items() if k not in compiled.structural}))
         if error_output and result.error_estimate is None:
             raise click.UsageError(f"--error-output {error_output}: this run made no error "
                                    "estimate (--error-control off, or a model without states)")
