@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, TextIO
 
 from .errors import UsageError
@@ -27,16 +27,14 @@ from .pipeline import (
 from .simulation import (
     DEFAULT_ENGINE,
     DEFAULT_ERROR_CONTROL,
-    DEFAULT_MAX_STEPS,
     DEFAULT_SOLVER,
-    DEFAULT_TIME_LIMIT,
-    SimulationOptions,
+    RunSettings,
     SimulationResult,
     check_run_values,
     choose_engine,
     default_backend,
-    error_control_mode,
     estimate_deprecation,
+    run_settings,
     simulate_model,
 )
 
@@ -207,7 +205,8 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
              progress: TextIO | None = None, step: float | None = None,
              max_steps: int | None = None, time_limit: float | None = None,
              engine: str = DEFAULT_ENGINE, error_control: str | None = None,
-             error_estimate: str | None = None, event_rows: bool = False) -> SimulationResult:
+             error_estimate: str | None = None, event_rows: bool = False,
+             settings: RunSettings | None = None) -> SimulationResult:
     """Simulate a compiled model (or compile ``model`` files first) on the output grid.
 
     Unset times and tolerances come from the model's ``experiment`` annotation, else
@@ -234,45 +233,74 @@ def simulate(model: CompiledModel | Files, *, model_name: str | None = None,
     compiled loop, else ``"python"`` (``engine="scipy"``, lsoda, no numba).
     ``event_rows``: a model with events gets two more rows at each event, its left and
     right limits (default: one row per output time).
+    ``settings``: the run's options as one value (:class:`springc.simulation.RunSettings`,
+    as :func:`springc.simulation.run_settings` builds it from these keywords, which are
+    then not read; the command line passes its own).
     """
-    check_run_values(start, stop, interval, rtol, atol, step, parameters)
-    values = dict(parameters or {})
-    if not isinstance(model, CompiledModel):
-        choose_engine(engine, str(solver).lower(), backend, "engine", "backend")
-        model = compile_model(model, model_name, libraries=libraries,
-                              backend=default_choice(backend, engine, solver),
-                              outputs=outputs, cache=cache, parameters=values)
-        structural = {k for k, v in model.options.modifications}
-    else:
-        choose_engine(engine, str(solver).lower(), model.module.BACKEND, "engine", "backend")
-        check_parameter_names(model, values)
-        _check_integers(model, values)
-        structural = {k for k in values if k in model.structural}
-        model = _with_structural(model, {k: values[k] for k in structural})
-    rest = {k: v for k, v in values.items() if k not in structural}
-    options = SimulationOptions(start, stop, interval, solver, rtol, atol, rest, progress,
-                                step, DEFAULT_MAX_STEPS if max_steps is None else max_steps,
-                                DEFAULT_TIME_LIMIT if time_limit is None else time_limit,
-                                engine, event_rows=bool(event_rows),
-                                error_control=_error_control(error_control, error_estimate))
-    result = simulate_model(model, options)
+    if settings is None:
+        settings = run_settings(
+            start=start, stop=stop, interval=interval, solver=solver, rtol=rtol, atol=atol,
+            step=step, parameters=parameters, max_steps=max_steps, time_limit=time_limit,
+            engine=engine, error_control=error_control, error_estimate=error_estimate,
+            event_rows=event_rows, progress=progress)
+    if error_estimate is not None:
+        warnings.warn(estimate_deprecation(error_estimate, ("error_control", "error_estimate")),
+                      DeprecationWarning, stacklevel=3)  # the caller's line (recursion_room)
+    result = simulate_with(model, settings, CompileRequest(model_name, libraries, backend,
+                                                           outputs, cache))
     if result.stats.warning:
         warnings.warn(f"{result.model}: {result.stats.warning}", AccuracyWarning,
                       stacklevel=3)  # the caller's line (recursion_room wraps this)
     return result
 
 
+@dataclass(frozen=True)
+class CompileRequest:
+    """How :func:`simulate` compiles files it is given (a compiled model ignores it)."""
+
+    model_name: str | None = None
+    libraries: Sequence[str | os.PathLike[str]] = ()
+    backend: str | None = None
+    outputs: Sequence[str] | None = None
+    cache: bool = True
+
+
+def simulate_with(model: CompiledModel | Files, settings: RunSettings,
+                  request: CompileRequest = CompileRequest()) -> SimulationResult:
+    """The run of ``settings`` (:func:`springc.simulation.run_settings`: the value
+    :func:`simulate`'s keywords and the command line's options build) on ``model``,
+    compiled as ``request`` says where it is files; a broken tolerance is
+    ``result.stats.warning``, left to the caller to say."""
+    model, options = _compiled_for(model, settings, request)
+    return simulate_model(model, options)
+
+
+def _compiled_for(model: CompiledModel | Files, settings: RunSettings,
+                  request: CompileRequest) -> tuple[CompiledModel, RunSettings]:
+    """``model`` compiled for ``settings`` (files compiled; a structural parameter
+    compiles again) and the settings of its run: the parameters that are not structural."""
+    values = dict(settings.parameters)
+    solver = str(settings.solver).lower()
+    if not isinstance(model, CompiledModel):
+        choose_engine(settings.engine, solver, request.backend, "engine", "backend")
+        model = compile_model(model, request.model_name, libraries=request.libraries,
+                              backend=default_choice(request.backend, settings.engine,
+                                                     settings.solver),
+                              outputs=request.outputs, cache=request.cache,
+                              parameters=values)
+        structural = {k for k, v in model.options.modifications}
+    else:
+        choose_engine(settings.engine, solver, model.module.BACKEND, "engine", "backend")
+        check_parameter_names(model, values)
+        _check_integers(model, values)
+        structural = {k for k in values if k in model.structural}
+        model = _with_structural(model, {k: values[k] for k in structural})
+    return model, replace(settings, parameters={k: v for k, v in values.items()
+                                                if k not in structural})
+
+
 class AccuracyWarning(UserWarning):
     """A run whose estimated error breaks its tolerance (``error_control``)."""
-
-
-def _error_control(control: str | None, estimate: str | None) -> str:
-    """``error_control`` from the new argument and the deprecated ``error_estimate``."""
-    names = ("error_control", "error_estimate")
-    mode = error_control_mode(control, estimate, names)
-    if estimate is not None:
-        warnings.warn(estimate_deprecation(estimate, names), DeprecationWarning, stacklevel=4)
-    return mode
 
 
 def sweep(files: CompiledModel | Files, *, model: str | None = None,
@@ -316,12 +344,14 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
 
     if as_ not in ("dataset", "dataframe"):
         raise UsageError(f"as_ must be 'dataset' or 'dataframe', not {as_!r}", option="as_")
-    check_run_values(start, stop, interval, rtol, atol, step, parameters)
-    mode = error_control_mode(error_control, None, ("error_control", "error_estimate"))
+    settings = run_settings(start=start, stop=stop, interval=interval, solver=solver,
+                            rtol=rtol, atol=atol, step=step, parameters=parameters,
+                            max_steps=max_steps, time_limit=time_limit,
+                            error_control=error_control)
     specs = tuple(parse_values(name, spec if isinstance(spec, str) else
                                ",".join(repr(float(v)) for v in spec), option="params")
                   for name, spec in params.items())
-    fixed = dict(parameters or {})
+    fixed = dict(settings.parameters)
     if isinstance(files, CompiledModel):
         check_parameter_names(files, fixed)
         _check_integers(files, fixed)
@@ -336,9 +366,8 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
     target = os.fspath(output) if output is not None else None
     if target is not None:
         check_outputs(target, summary_path(target), protected, ("output", "output"))
-    options = StudyOptions(specs, samples, method, seed, rest, start, stop, interval,
-                           solver, rtol, atol, step, workers, scheduler, energy, max_steps,
-                           time_limit, mode)
+    options = StudyOptions(specs, samples, method, seed, rest, workers=workers,
+                           scheduler=scheduler, energy=energy).running(settings)
     study = run_study(compiled, options, target, resume=resume, protected=protected,
                       progress=progress)
     if as_ == "dataframe":

@@ -3,6 +3,7 @@ options, ``--set`` values, output paths refused before any work."""
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from collections.abc import Callable, Sequence
@@ -11,6 +12,18 @@ from typing import Any
 import click
 
 from ..errors import ErrorGroup, OutputError, UnitError, UsageError, render
+from ..simulation import (
+    ALL_SOLVERS,
+    DEFAULT_ENGINE,
+    DEFAULT_ERROR_CONTROL,
+    DEFAULT_SOLVER,
+    ENGINES,
+    ERROR_CONTROLS,
+    FIXED_STEP,
+    OPTION_NAMES,
+    RunSettings,
+    run_settings,
+)
 
 
 class NumberRange(click.FloatRange):
@@ -58,9 +71,8 @@ def verbosity() -> int:
     return int(ctx.meta.get(LEVEL_KEY, 0)) if ctx is not None else 0
 
 
-CLI_NAMES = {"start": "--start", "stop": "--stop", "interval": "--interval",
-             "rtol": "--rtol", "atol": "--atol", "step": "--step", "parameters": "--set"}
-"""How the checks of :func:`springc.simulation.check_run_values` name the options."""
+CLI_NAMES = OPTION_NAMES
+"""How :func:`springc.simulation.check_run_values` names the options."""
 
 
 def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
@@ -129,21 +141,120 @@ def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str]
         raise UsageError(err.message, hint=err.hint) from None
 
 
+RUN_OPTIONS: dict[str, Callable[[Callable[..., Any]], Callable[..., Any]]] = {
+    "start": click.option("--start", type=float,
+                          help="Start time [s] (default: experiment, else 0)."),
+    "stop": click.option("--stop", type=float,
+                         help="Stop time [s] (default: experiment, else 10)."),
+    "interval": click.option("--interval", type=float,
+                             help="Output interval [s] (default: experiment, else "
+                             "(stop-start)/500)."),
+    "parameters": click.option(
+        "--set", "assignments", multiple=True, metavar="NAME=VALUE",
+        help="Set a parameter or the start value of a state (repeatable; as "
+        "OpenModelica's -override). A fixed start (fixed=true) is the initial value; a "
+        "free one is the guess of the initial equations. Array sizes re-flatten the "
+        "model; start values never recompile it."),
+    "solver": click.option(
+        "--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
+        default=DEFAULT_SOLVER, show_default=True,
+        help="auto: dop853 or radau from a stiffness estimate at the start (the summary "
+        "says why); a scipy solve_ivp method; or a fixed-step one (verlet, "
+        "symplectic-euler, rk4) with --step."),
+    "engine": click.option(
+        "--engine", type=click.Choice(ENGINES, case_sensitive=False),
+        default=DEFAULT_ENGINE, show_default=True,
+        help="compiled: numba loops (springc.integrate) for auto, dop853, rk45, radau, bdf "
+        "and the fixed-step solvers; scipy: scipy's solvers stepped from Python; auto: "
+        "compiled where it can run (numba installed, a solver with a compiled loop, not "
+        "--backend python), else scipy, and the summary says why."),
+    "error_control": click.option(
+        "--error-control", type=click.Choice(ERROR_CONTROLS, case_sensitive=False),
+        default=None, help="Estimate the global error on the output grid (a companion run "
+        "1000x tighter, or half the step for fixed-step solvers: in the summary line, in "
+        "a .mat trajectory and in --error-output) and hold every output variable v to 10 "
+        "* (rtol * max|v| + atol). tighten: run 1000x tighter until it holds (at most "
+        "rtol 1e-12, within --max-steps and --time-limit), else warn; warn: only warn; "
+        f"off: no estimate (fastest). [default: {DEFAULT_ERROR_CONTROL}]"),
+    "error_estimate": click.option(
+        "--error-estimate", type=click.Choice(("off", "on", "auto"), case_sensitive=False),
+        default=None, help="Deprecated: off is --error-control off, on is warn, auto is "
+        "tighten."),
+    "step": click.option("--step", type=float, help="Step size [s] of the fixed-step "
+                         "solvers (required for them)."),
+    "rtol": click.option("--rtol", type=float, help="Relative tolerance (default: "
+                         "experiment Tolerance, else 1e-6)."),
+    "atol": click.option("--atol", type=float,
+                         help="Absolute tolerance (default: rtol/1000)."),
+    "max_steps": click.option(
+        "--max-steps", type=click.IntRange(min=1), default=None,
+        help="Stop a run with an error after this many integrator steps (default "
+        "20,000,000)."),
+    "time_limit": click.option(
+        "--time-limit", type=NumberRange(min=0, min_open=True), default=None,
+        help="Stop a run with an error after this many seconds of wall clock (default "
+        "3600)."),
+    "event_rows": click.option(
+        "--event-rows", is_flag=True, help="For a model with events: add two rows at each "
+        "event, its left and right limits (default: one row per output time)."),
+}
+"""Every run option of the command line, once: the field of
+:class:`springc.simulation.RunSettings` it sets -> its click option. A new run option
+is a field there, a keyword of :func:`springc.simulation.run_settings`, and a row here."""
+
+PARAMETER_NAMES = {"parameters": "assignments"}
+"""The click parameter of a setting where it is not the setting's own name."""
+PASSED_ON = frozenset({"error_estimate"})
+"""Options the command also receives as given (the deprecated ``--error-estimate``:
+the command words its warning)."""
+TIMES = ("start", "stop", "interval", "parameters")
+"""The times and values of a run: every command that runs the model."""
+SOLVING = ("solver", "step", "rtol", "atol", "max_steps", "time_limit", "error_control")
+"""How a single setting runs: the commands that run one (``simulate``, ``sweep``)."""
+
+
 def run_options(func: Callable[..., Any]) -> Callable[..., Any]:
-    """The options of a run shared by ``simulate`` and ``tradeoff``."""
-    func = click.option("--set", "assignments", multiple=True, metavar="NAME=VALUE",
-                        help="Set a parameter or the start value of a state "
-                        "(repeatable; as OpenModelica's -override). A fixed start "
-                        "(fixed=true) is the initial value; a free one is the guess of "
-                        "the initial equations. Array sizes re-flatten the model; start "
-                        "values never recompile it.")(func)
-    func = click.option("--interval", type=float,
-                        help="Output interval [s] (default: experiment, else "
-                        "(stop-start)/500).")(func)
-    func = click.option("--stop", type=float,
-                        help="Stop time [s] (default: experiment, else 10).")(func)
-    return click.option("--start", type=float,
-                        help="Start time [s] (default: experiment, else 0).")(func)
+    """The options of :data:`TIMES` as plain parameters (``ensemble``, which builds its
+    own options)."""
+    for name in reversed(TIMES):
+        func = RUN_OPTIONS[name](func)
+    return func
+
+
+def run_settings_options(*names: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """The shared option group of ``simulate``, ``sweep`` and ``tradeoff``: the options
+    ``names`` of :data:`RUN_OPTIONS`, given to the command as one ``settings``
+    (:class:`springc.simulation.RunSettings`, built by :func:`cli_settings`). Apply it
+    below ``guard``, which words its errors."""
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        @functools.wraps(func)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            given = {name: (kwargs[PARAMETER_NAMES.get(name, name)] if name in PASSED_ON
+                            else kwargs.pop(PARAMETER_NAMES.get(name, name)))
+                     for name in names}
+            return func(*args, settings=cli_settings(given), **kwargs)
+
+        command: Callable[..., Any] = wrapper
+        for name in reversed(names):
+            command = RUN_OPTIONS[name](command)
+        return command
+    return decorate
+
+
+def cli_settings(given: dict[str, Any]) -> RunSettings:
+    """The settings of a command's run options ``given`` (by setting name): ``--set``
+    parsed, a fixed-step solver refused without ``--step``, then the checks of
+    :func:`springc.simulation.run_settings`, which name the options."""
+    values = dict(given)
+    values["parameters"] = parse_set(values.get("parameters", ()))
+    solver = str(values.get("solver", DEFAULT_SOLVER)).lower()
+    if solver in FIXED_STEP and values.get("step") is None:
+        raise click.UsageError(f"--solver {solver} is a fixed-step solver and needs "
+                               "--step H (e.g. --step 1e-3)")
+    values["solver"] = solver
+    if "engine" in values:
+        values["engine"] = str(values["engine"]).lower()
+    return run_settings(**values, cli=True)
 
 
 def sampling_options(func: Callable[..., Any]) -> Callable[..., Any]:

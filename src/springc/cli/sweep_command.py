@@ -7,23 +7,16 @@ import sys
 import click
 
 from ..errors import UsageError
-from ..simulation import (
-    ALL_SOLVERS,
-    DEFAULT_ERROR_CONTROL,
-    DEFAULT_SOLVER,
-    ERROR_CONTROLS,
-    FIXED_STEP,
-)
+from ..simulation import RunSettings
 from ..status_line import silenced
 from .app import guard, main
 from .options import (
-    CLI_NAMES,
-    NumberRange,
+    SOLVING,
+    TIMES,
     check_output_options,
     compile_options,
     model_options,
-    parse_set,
-    run_options,
+    run_settings_options,
     sampling_options,
     single_threaded_blas,
     verbosity,
@@ -34,7 +27,6 @@ from .options import (
 @main.command()
 @model_options
 @compile_options
-@run_options
 @click.option("--param", "params", multiple=True, required=True, metavar="NAME=VALUES",
               help="A parameter to vary (repeatable): a list 0.5,1,2; a range "
               "START:STOP[:lin|log]:COUNT; with --samples, a range START:STOP[:log] or a "
@@ -45,19 +37,6 @@ from .options import (
               help="Local worker processes (default: one per core).")
 @click.option("--scheduler", metavar="ADDRESS", help="Run on the Dask scheduler at "
               "ADDRESS (tcp://host:8786) instead of local processes.")
-@click.option("--solver", type=click.Choice(ALL_SOLVERS, case_sensitive=False),
-              default=DEFAULT_SOLVER, show_default=True, help="As for simulate.")
-@click.option("--step", type=float, help="Step size [s] of the fixed-step solvers.")
-@click.option("--rtol", type=float, help="Relative tolerance (default: experiment "
-              "Tolerance, else 1e-6).")
-@click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
-@click.option("--max-steps", type=click.IntRange(min=1), default=None,
-              help="Integrator steps per run before it fails (as for simulate).")
-@click.option("--time-limit", type=NumberRange(min=0, min_open=True), default=None,
-              help="Seconds of wall clock per run before it fails (as for simulate).")
-@click.option("--error-control", type=click.Choice(ERROR_CONTROLS, case_sensitive=False),
-              default=DEFAULT_ERROR_CONTROL, show_default=True,
-              help="Each run's error estimate and tolerance, as for simulate.")
 @click.option("--energy", metavar="NAME", help="Variable whose drift the summary "
               "reports (default: the only selected variable in J, if any).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
@@ -75,13 +54,11 @@ from .options import (
 @verbosity_options("No progress, no summary line and no status line (\"springc: "
                    "compiling ...\").")
 @guard
+@run_settings_options(*TIMES, *SOLVING)
 def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
-          backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
-          stop: float | None, interval: float | None, assignments: tuple[str, ...],
+          backend: str, patterns: tuple[str, ...], no_cache: bool, settings: RunSettings,
           params: tuple[str, ...], samples: int | None, method: str, seed: int,
-          workers: int | None, scheduler: str | None, solver: str, step: float | None,
-          rtol: float | None, atol: float | None, max_steps: int | None,
-          time_limit: float | None, error_control: str, energy: str | None, output: str,
+          workers: int | None, scheduler: str | None, energy: str | None, output: str,
           summary_file: str | None, resume: bool, plot: str | None,
           plot_var: str | None) -> None:
     """Run a model over a grid or samples of parameter values, in parallel, into Parquet.
@@ -92,18 +69,12 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     variable) next to it. A failing run is recorded with its error; an interrupted
     study continues with --resume.
     """
-    from ..simulation import check_run_values
     from ..studies import check_outputs, parse_parameter, summary_path
 
     quiet = verbosity() < 0
-    values = parse_set(assignments)
-    if solver.lower() in FIXED_STEP and step is None:
-        raise click.UsageError(f"--solver {solver.lower()} is a fixed-step solver and "
-                               "needs --step H (e.g. --step 1e-3)")
     if workers is not None and scheduler is not None:
         raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
                          "has its own workers)", option="--workers")
-    check_run_values(start, stop, interval, rtol, atol, step, values, CLI_NAMES)
     specs = tuple(parse_parameter(item) for item in params)
     summary_file = summary_file or summary_path(output)
     check_outputs(output, summary_file, files)
@@ -115,17 +86,17 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     from ..api import compile_model, default_choice
     from ..studies import StudyOptions, parameter_table, run_study
 
-    options = StudyOptions(specs, samples, method, seed, (), start, stop, interval,
-                           solver.lower(), rtol, atol, step, workers, scheduler, energy,
-                           max_steps, time_limit, error_control.lower())
+    options = StudyOptions(specs, samples, method, seed, workers=workers,
+                           scheduler=scheduler, energy=energy).running(settings)
     parameter_table(options)  # refuse bad specifications before compiling
 
     with silenced(quiet):  # the status line of a model that compiles
         compiled = compile_model(files, model, libraries=libraries,
-                                 backend=default_choice(backend, solver=solver),
-                                 outputs=patterns or None, parameters=values,
+                                 backend=default_choice(backend, solver=settings.solver),
+                                 outputs=patterns or None, parameters=settings.parameters,
                                  cache=not no_cache)
-    fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
+    fixed = tuple((k, v) for k, v in settings.parameters.items()
+                  if k not in compiled.structural)
     from dataclasses import replace
 
     from ..studies import plot_variable

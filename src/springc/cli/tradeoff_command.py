@@ -7,15 +7,15 @@ import sys
 import click
 
 from ..errors import UsageError
+from ..simulation import RunSettings
 from .app import guard, main
 from .options import (
-    CLI_NAMES,
+    TIMES,
     NumberRange,
     check_output_options,
     compile_options,
     model_options,
-    parse_set,
-    run_options,
+    run_settings_options,
     single_threaded_blas,
     verbosity,
     verbosity_options,
@@ -64,7 +64,6 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
 @main.command()
 @model_options
 @compile_options
-@run_options
 @click.option("--solvers", callback=_solver_list, metavar="LIST",
               help="Solvers to compare, e.g. 'dop853,radau' (default: rk45 dop853 radau "
               "bdf lsoda and the fixed-step ones).")
@@ -106,9 +105,9 @@ def _solver_list(ctx: click.Context, param: click.Parameter, value: str | None
               "scheduler at ADDRESS instead of local processes (as for sweep).")
 @verbosity_options("No line per run on stderr.")
 @guard
+@run_settings_options(*TIMES)
 def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
-             backend: str, patterns: tuple[str, ...], no_cache: bool, start: float | None,
-             stop: float | None, interval: float | None, assignments: tuple[str, ...],
+             backend: str, patterns: tuple[str, ...], no_cache: bool, settings: RunSettings,
              solvers: tuple[str, ...] | None, tolerances: tuple[float, ...] | None,
              steps: tuple[float, ...] | None, targets: tuple[float, ...] | None,
              reference: str | None, save_reference: str | None, repeats: int,
@@ -125,15 +124,14 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     setting its row names: no --error-control (simulate's companion runs and
     tightening): the table measures each run's error itself.
     """
-    from ..simulation import PLOT_FORMATS, check_run_values
+    from ..simulation import PLOT_FORMATS
 
     quiet = verbosity() < 0
     if workers is not None and scheduler is not None:
         raise UsageError("--workers and --scheduler exclude each other (a Dask cluster "
                          "has its own workers)", option="--workers")
 
-    values = parse_set(assignments)
-    check_run_values(start, stop, interval, parameters=values, names=CLI_NAMES)
+    values = settings.parameters
     inputs = (*files, *([reference] if reference else []))
     check_output_options([("-o", output, {".csv": "csv"}), ("--plot", plot, PLOT_FORMATS),
                     ("--save-reference", save_reference, {".csv": "csv"})], inputs)
@@ -162,8 +160,8 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     options = TradeoffOptions(
         solvers=solvers, tolerances=tolerances or DEFAULT_TOLERANCES, steps=steps,
         targets=targets or DEFAULT_TARGETS, reference=reference, repeats=repeats,
-        budget=budget, cost_limit=cost_limit, start=start, stop=stop, interval=interval,
-        parameters=rest,
+        budget=budget, cost_limit=cost_limit, start=settings.start, stop=settings.stop,
+        interval=settings.interval, parameters=rest,
         log=None if quiet else sys.stderr, energy=energy)
     from ..studies import Executor
 

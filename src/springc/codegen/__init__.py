@@ -16,6 +16,7 @@ from .module_api import (
     MODULE_NAMES,
     GeneratedModule,
     HybridModule,
+    ModuleKind,
 )
 
 if TYPE_CHECKING:
@@ -23,7 +24,8 @@ if TYPE_CHECKING:
     from .generator import generate
 
 __all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CodegenBug",
-           "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule", "generate"]
+           "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule",
+           "ModuleKind", "generate"]
 
 
 def __getattr__(name: str) -> Any:

@@ -17,11 +17,33 @@ import numpy.typing as npt
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-CODEGEN_VERSION = 5
+CODEGEN_VERSION = 6
 """The version of the generated code's layout and of a cache entry's contents: part of
 every cache key (here, not with the module text, so that the cache reads it without
 loading the generator). 5: a cache entry holds the captured system (``system.pickle``,
-:mod:`springc.pipeline.closed`)."""
+:mod:`springc.pipeline.closed`); 6: a module declares its ``KIND``."""
+
+
+class ModuleKind:
+    """What a generated module declares as ``KIND``: the driver that runs it
+    (``springc.simulation.runner.DRIVERS``)."""
+
+    CONTINUOUS = "continuous"  # an ODE: the step loop, auto's race, the compiled loops
+    HYBRID = "hybrid"  # events (a HybridModule): the event loop
+    DELAY = "delay"  # delay(...) calls: the history of the delayed expressions
+    SWITCHING = "switching"  # dynamic state selection: states that switch in a run
+    ALL = (CONTINUOUS, HYBRID, DELAY, SWITCHING)
+
+    @staticmethod
+    def of(events: bool, delays: int, switchable: bool) -> str:
+        """The kind of a module with ``events``, ``delays`` delay calls and
+        ``switchable`` states (delay calls first: a model with events and delays is
+        refused by that driver)."""
+        if delays:
+            return ModuleKind.DELAY
+        if events:
+            return ModuleKind.HYBRID
+        return ModuleKind.SWITCHING if switchable else ModuleKind.CONTINUOUS
 
 
 class GeneratedModule(Protocol):
@@ -31,6 +53,7 @@ class GeneratedModule(Protocol):
     MODEL: str
     BACKEND: str
     CODEGEN_VERSION: int
+    KIND: str  # one of ModuleKind.ALL: the driver that runs it
     STATES: tuple[str, ...]
     STATE_UNITS: tuple[str, ...]
     DERIVATIVES: tuple[str, ...]

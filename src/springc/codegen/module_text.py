@@ -19,7 +19,7 @@ from .context import CodegenContext, CodegenOptions, source_comment, source_loca
 from .encoding import encode_floats, encode_ints, encode_strings
 from .events import EVENT_UPDATE, NO_EVENTS
 from .events import constants as event_constants
-from .module_api import CODEGEN_VERSION
+from .module_api import CODEGEN_VERSION, ModuleKind
 from .printer import HELPERS, function_lines
 from .statements import Let, Namer, Raw, Stmt, Store, escaped
 from .vector import VECTOR_THRESHOLD, VectorLayout
@@ -78,6 +78,7 @@ def module_text(m: CodegenContext, options: CodegenOptions,
     exp = m.ode.dae.experiment
     experiment = {"start": exp.start, "stop": exp.stop, "interval": exp.interval,
                   "tolerance": exp.tolerance}
+    kind = ModuleKind.of(m.events is not None, len(m.delays), bool(options.switchable))
     # Model text in the docstring is escaped (printer.escaped): it cannot close it.
     lines = [
         f'"""springc-generated model {escaped(m.ode.name)} ({options.backend} backend).',
@@ -131,6 +132,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         "# Index reduction left a choice of states that may turn singular during a run:",
         "# the simulator then switches states.",
         f"SWITCHABLE = {bool(options.switchable)}",
+        "# The driver that runs the module (continuous, hybrid, delay or switching).",
+        f"KIND = {kind!r}",
         "# Diagnostics of the model that are not errors (JSON; the pipeline reads them).",
         f"WARNINGS = {encode_strings(options.warnings)}",
         f"JAC_ROWS = {encode_ints([r for r, _ in pattern])}",

@@ -96,7 +96,7 @@ _RESERVED = frozenset({
     "jacobian_values", "jacobian_dense", "sparsity", "MODEL", "BACKEND", "CODEGEN_VERSION",
     "STATES", "STATE_UNITS", "DERIVATIVES", "PARAMETERS", "PARAMETER_UNITS",
     "PARAMETER_TYPES", "STRUCTURAL", "OBSERVED", "OBSERVED_UNITS", "GUESSES",
-    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "WARNINGS",
+    "NEWTON_SYSTEMS", "EXPERIMENT", "INITIAL_CONDITIONS", "SWITCHABLE", "WARNINGS", "KIND",
     "DESCRIPTIONS", "JAC_ROWS", "JAC_COLS", "JAC_INDICES", "JAC_INDPTR", "ASSERTIONS",
     "assertions", "ok",
 }) | frozenset(keyword.kwlist) | frozenset(dir(builtins))

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 from .compiler import (
     CompiledModel,
+    ModuleKind,
     check_parameter_names,
     compile_files,
     modification_value,
@@ -25,8 +26,8 @@ if TYPE_CHECKING:
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
-__all__ = ["CompileOptions", "CompiledModel", "announce_functions", "check_parameter_names",
-           "compile_files",
+__all__ = ["CompileOptions", "CompiledModel", "ModuleKind", "announce_functions",
+           "check_parameter_names", "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",
            "select_names", "split_values"]
 

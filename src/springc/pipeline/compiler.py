@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..codegen import GeneratedModule
+from ..codegen import GeneratedModule, ModuleKind
 from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
@@ -55,8 +55,8 @@ from .notes import compiling_note
 from .options import CompileOptions, Derived
 from .selection import ALL_OBSERVED, select_names, selected_observed
 
-__all__ = ["CompileOptions", "CompiledModel", "check_parameter_names", "compile_files",
-           "modification_value"]
+__all__ = ["CompileOptions", "CompiledModel", "ModuleKind", "check_parameter_names",
+           "compile_files", "modification_value"]
 
 
 @dataclass
@@ -97,6 +97,12 @@ class CompiledModel:
     @property
     def name(self) -> str:
         return str(self.module.MODEL)
+
+    @property
+    def kind(self) -> str:
+        """The driver that runs the model: one of :class:`ModuleKind` (the generated
+        module declares it as ``KIND``)."""
+        return str(self.module.KIND)
 
     @property
     def states(self) -> tuple[str, ...]:

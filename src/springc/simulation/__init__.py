@@ -11,6 +11,16 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .settings import (  # light: the run options, no numpy
+    DEFAULT_MAX_STEPS,
+    DEFAULT_TIME_LIMIT,
+    OPTION_NAMES,
+    RunSettings,
+    SimulationOptions,
+    error_control_mode,
+    estimate_deprecation,
+    run_settings,
+)
 from .solver_names import (
     ALL_SOLVERS,
     AUTO,
@@ -20,16 +30,21 @@ from .solver_names import (
     DEFAULT_SOLVER,
     ENGINES,
     ERROR_CONTROLS,
+    EXPLICIT,
     FIXED_STEP,
     IMPLICIT_SOLVERS,
+    ORDERS,
+    RACE_IMPLICIT,
+    REGISTRY,
     SOLVERS,
+    Solver,
+    registered,
 )
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
     from .compiled import choose_engine, default_backend, observed_on_grid
-    from .error_control import error_control_mode, estimate_deprecation
-    from .limits import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
+    from .limits import OverBudget
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
         PLOT_FORMATS,
@@ -41,29 +56,69 @@ if TYPE_CHECKING:
     )
     from .runner import (
         LSODA_LIMIT,
-        SimulationOptions,
+        RunPlan,
         initial_state,
         output_grid,
+        plan,
         resolve,
+        run_plan,
         simulate_model,
     )
 
-__all__ = ["ALL_SOLVERS", "AUTO", "COMPILED_SOLVERS", "DEFAULT_ENGINE",
-           "DEFAULT_ERROR_CONTROL", "DEFAULT_MAX_STEPS", "DEFAULT_SOLVER",
-           "DEFAULT_TIME_LIMIT", "ENGINES", "ERROR_CONTROLS", "FIXED_STEP",
-           "IMPLICIT_SOLVERS", "LARGE_TRAJECTORY", "LSODA_LIMIT", "PLOT_FORMATS",
-           "RESULT_FORMATS", "SOLVERS",
-           "SimulationOptions", "SimulationResult", "check_run_values", "check_trajectory_size",
-           "choose_engine", "default_backend", "error_control_mode", "estimate_deprecation",
-           "file_format", "initial_state", "observed_on_grid", "output_grid", "resolve",
-           "save_outputs",
-           "simulate_model", "write_csv"]
+__all__ = [
+    "ALL_SOLVERS",
+    "AUTO",
+    "COMPILED_SOLVERS",
+    "DEFAULT_ENGINE",
+    "DEFAULT_ERROR_CONTROL",
+    "DEFAULT_MAX_STEPS",
+    "DEFAULT_SOLVER",
+    "DEFAULT_TIME_LIMIT",
+    "ENGINES",
+    "ERROR_CONTROLS",
+    "EXPLICIT",
+    "FIXED_STEP",
+    "IMPLICIT_SOLVERS",
+    "LARGE_TRAJECTORY",
+    "LSODA_LIMIT",
+    "OPTION_NAMES",
+    "ORDERS",
+    "PLOT_FORMATS",
+    "RACE_IMPLICIT",
+    "REGISTRY",
+    "RESULT_FORMATS",
+    "SOLVERS",
+    "OverBudget",
+    "RunPlan",
+    "RunSettings",
+    "SimulationOptions",
+    "SimulationResult",
+    "Solver",
+    "check_run_values",
+    "check_trajectory_size",
+    "choose_engine",
+    "default_backend",
+    "error_control_mode",
+    "estimate_deprecation",
+    "file_format",
+    "initial_state",
+    "observed_on_grid",
+    "output_grid",
+    "plan",
+    "registered",
+    "resolve",
+    "run_plan",
+    "run_settings",
+    "save_outputs",
+    "simulate_model",
+    "write_csv",
+]
 
-_LIMITS = frozenset({"DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT"})
+_LIMITS = frozenset({"OverBudget"})
 _RESULTS = frozenset({"PLOT_FORMATS", "RESULT_FORMATS", "SimulationResult", "file_format",
                       "save_outputs", "write_csv"})
-_RUNNER = frozenset({"LSODA_LIMIT", "SimulationOptions", "initial_state", "output_grid",
-                     "resolve", "simulate_model"})
+_RUNNER = frozenset({"LSODA_LIMIT", "RunPlan", "initial_state", "output_grid", "plan",
+                     "resolve", "run_plan", "simulate_model"})
 
 
 def __getattr__(name: str) -> Any:
@@ -72,10 +127,6 @@ def __getattr__(name: str) -> Any:
         from . import compiled
 
         return getattr(compiled, name)
-    if name in ("error_control_mode", "estimate_deprecation"):
-        from . import error_control
-
-        return getattr(error_control, name)
     if name in ("LARGE_TRAJECTORY", "check_trajectory_size"):
         from . import output_size
 

@@ -23,8 +23,9 @@ import numpy as np
 from ..errors import SimulationError
 from ..pipeline import CompiledModel
 from .failures import Stop, state_notes
-from .limits import Limits, OverLimit
+from .limits import OverLimit
 from .observed_rows import observed_at_rows
+from .planning import RunPlan
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP, IMPLICIT_SOLVERS, SOLVERS
 from .steps import Problem, Progress
@@ -89,12 +90,13 @@ class DelayHistory:
         return out
 
 
-def simulate_delayed(model: CompiledModel, options: Any, solver: str, grid: np.ndarray,
-                     x0: np.ndarray, p: np.ndarray, rtol: float, atol: float,
-                     limits: Limits, began: float) -> SimulationResult:
-    """Integrate ``model`` (it has delay calls) over ``grid`` on scipy's integrators."""
+def simulate_delayed(model: CompiledModel, plan: RunPlan) -> SimulationResult:
+    """Integrate ``model`` (it has delay calls) as ``plan`` says, on scipy's integrators."""
     import scipy.integrate
 
+    solver, grid, x0, p, limits = plan.solver, plan.grid, plan.x0, plan.p, plan.limits
+    assert x0 is not None
+    rtol, atol = plan.rtol, plan.atol
     mod = model.module
     if getattr(mod, "EVENTS", False):
         raise SimulationError("delay() in a model with events is not supported yet",
@@ -107,7 +109,7 @@ def simulate_delayed(model: CompiledModel, options: Any, solver: str, grid: np.n
     if solver == AUTO:
         solver, reason = EXPLICIT, "a model with delay(): dop853 with the delayed history"
     start, stop = float(grid[0]), float(grid[-1])
-    progress = Progress(options.progress, start, stop)
+    progress = Progress(plan.settings.progress, start, stop, limits.budget)
     problem = Problem(model, p, solver, progress, limits)
     history = DelayHistory(mod, p)
     z = problem.z
@@ -172,7 +174,7 @@ def simulate_delayed(model: CompiledModel, options: Any, solver: str, grid: np.n
     finally:
         progress.close()
     stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
-                            time.perf_counter() - began, problem.model_time,
+                            time.perf_counter() - plan.began, problem.model_time,
                             model.compile_time, model.cached, reason)
     names = model.outputs
     units = model.units

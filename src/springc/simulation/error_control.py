@@ -30,23 +30,24 @@ import io
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from ..errors import SpringcError, UsageError
-from .error_estimate import ORDERS, ErrorEstimate, companion_tolerances, compare
+from ..errors import SpringcError
+from .error_estimate import ErrorEstimate, companion_tolerances, compare
+from .settings import (
+    RunSettings,
+)
 from .solver_names import (
     DEFAULT_ERROR_CONTROL,
     ERROR_CONTROLS,
     EXPLICIT,
     FIXED_STEP,
     IMPLICIT_SOLVERS,
+    registered,
 )
 
 if TYPE_CHECKING:
     from .results import SimulationResult
-
-SimulationOptions = Any
-"""``runner.SimulationOptions`` (a frozen dataclass; the runner imports this module)."""
 
 MODES = ERROR_CONTROLS
 DEFAULT_MODE = DEFAULT_ERROR_CONTROL
@@ -56,40 +57,6 @@ TIGHTEST_RUN_RTOL = 1e-12
 """``tighten`` runs at no tighter rtol (its companion is then at the solvers' limit)."""
 MAX_ROUNDS = 4
 """At most this many estimates (from rtol 1e-3: runs at 1e-6, 1e-9, 1e-12)."""
-ESTIMATE_MODES = {"off": "off", "on": "warn", "auto": "tighten"}
-"""The deprecated ``--error-estimate`` values and the ``--error-control`` each means."""
-
-
-def check_mode(mode: object, option: str = "--error-control") -> str:
-    """``mode`` lowered, or a usage error naming ``option``."""
-    name = mode.lower() if isinstance(mode, str) else mode
-    if name not in MODES:
-        raise UsageError(f"{option} must be one of {', '.join(MODES)}, not {mode!r}",
-                         option=option)
-    return str(name)
-
-
-def error_control_mode(control: str | None, estimate: str | None,
-                  names: tuple[str, str] = ("--error-control", "--error-estimate")) -> str:
-    """The error-control mode from the new option and the deprecated one (at most one
-    of them given; ``names``: how the caller spells them, for the messages)."""
-    if estimate is None:
-        return check_mode(DEFAULT_MODE if control is None else control, names[0])
-    if control is not None:
-        raise UsageError(f"{names[1]} is deprecated and cannot be combined with "
-                         f"{names[0]}: use {names[0]} alone", option=names[1])
-    value = estimate.lower() if isinstance(estimate, str) else estimate
-    if value not in ESTIMATE_MODES:
-        raise UsageError(f"{names[1]} must be one of {', '.join(ESTIMATE_MODES)}, not "
-                         f"{estimate!r}", option=names[1])
-    return ESTIMATE_MODES[str(value)]
-
-
-def estimate_deprecation(estimate: str, names: tuple[str, str] = ("--error-control",
-                                                           "--error-estimate")) -> str:
-    """The warning of a deprecated ``--error-estimate`` value."""
-    return (f"{names[1]} is deprecated: {names[1]} {estimate.lower()} is {names[0]} "
-            f"{ESTIMATE_MODES.get(estimate.lower(), '?')}")
 
 
 def short(x: float) -> str:
@@ -106,10 +73,10 @@ class Asked:
     atol: float
 
 
-Run = Callable[[SimulationOptions], "SimulationResult"]
+Run = Callable[[RunSettings], "SimulationResult"]
 
 
-def controlled(options: SimulationOptions, asked: Asked, run: Run) -> SimulationResult:
+def controlled(options: RunSettings, asked: Asked, run: Run) -> SimulationResult:
     """``run(options)``, estimated and tightened as ``asked.mode`` says (module docstring)."""
     began = time.perf_counter()
     rtol, atol = asked.rtol, asked.atol
@@ -135,22 +102,22 @@ def controlled(options: SimulationOptions, asked: Asked, run: Run) -> Simulation
     return _verdict(result, estimate, asked, rtol, atol, began)
 
 
-def _estimate(options: SimulationOptions, result: SimulationResult, rtol: float,
+def _estimate(options: RunSettings, result: SimulationResult, rtol: float,
               atol: float, run: Run, began: float
               ) -> tuple[SimulationResult, ErrorEstimate, tuple[float, float]]:
     """The companion of ``result`` (run at ``rtol``), the estimate, the companion's
     tolerances; the companion gets what is left of the time limit."""
     solver = result.stats.solver
-    left = options.time_limit - (time.perf_counter() - began)
+    left = options.seconds_limit - (time.perf_counter() - began)
     if left <= 0:
-        raise SpringcError(f"the time limit of {options.time_limit:g} s is reached")
+        raise SpringcError(f"the time limit of {options.seconds_limit:g} s is reached")
     base = replace(options, progress=None, event_rows=False, time_limit=left,
                    error_control="off")
     started = time.perf_counter()
     if solver in FIXED_STEP:
         step = float(options.step or 0.0) / 2
         companion = _quiet(run, replace(base, solver=solver, rtol=rtol, atol=atol, step=step))
-        gain = 2.0 ** ORDERS[solver]
+        gain = 2.0 ** registered(solver).order
         return companion, compare(result, companion, companion.time,
                                   f"Richardson against {solver} at step {step:.3g} s",
                                   gain / (gain - 1), started), (rtol, atol)
@@ -162,7 +129,7 @@ def _estimate(options: SimulationOptions, result: SimulationResult, rtol: float,
                               started), tight
 
 
-def _quiet(run: Run, options: SimulationOptions) -> SimulationResult:
+def _quiet(run: Run, options: RunSettings) -> SimulationResult:
     """A companion run, its stderr (the warnings of ``assert(..., level = warning)``,
     which the run has printed once already) discarded."""
     with contextlib.redirect_stderr(io.StringIO()):

@@ -32,8 +32,6 @@ TIGHTEST_RTOL = 1e-13
 """The companion's rtol is never below this (DOP853's limit is about 100 eps)."""
 EVENT_TIMES = "(event times)"
 """The estimate's name for the times of a hybrid run's state events."""
-ORDERS = {"symplectic-euler": 1, "verlet": 2, "rk4": 4}
-"""The order of each fixed-step method (Richardson's gain ``2^q``)."""
 
 
 class Run(Protocol):

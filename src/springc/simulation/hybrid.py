@@ -26,23 +26,25 @@ from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
 from .hybrid_auto import Attempt, choose
 from .hybrid_compiled import run_compiled_events
-from .limits import Limits, OverLimit, check_outputs, over_limit
+from .limits import OverLimit, check_outputs, over_limit
 from .observed_rows import observed_at_rows
+from .planning import RunPlan
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP
 from .steps import Problem, Progress
 
 
-def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.ndarray,
-                    x0: np.ndarray, p: np.ndarray, rtol: float, atol: float,
-                    limits: Limits, step: float | None, note: str, began: float,
-                    engine: str = SCIPY) -> SimulationResult:
-    """Integrate the hybrid ``model`` over ``grid`` (see the module docstring) on
-    ``engine`` (:data:`.compiled.COMPILED`: :mod:`.hybrid_compiled`)."""
-    start, stop = float(grid[0]), float(grid[-1])
+def simulate_hybrid(model: CompiledModel, plan: RunPlan) -> SimulationResult:
+    """Integrate the hybrid ``model`` as ``plan`` says (see the module docstring), on
+    its engine (:data:`.compiled.COMPILED`: :mod:`.hybrid_compiled`)."""
+    solver, grid, x0, p, limits = plan.solver, plan.grid, plan.x0, plan.p, plan.limits
+    assert x0 is not None
+    rtol, atol, step, note, engine = plan.rtol, plan.atol, plan.step, plan.note, plan.engine
+    options = plan.settings
+    start, stop = plan.start, plan.stop
     reason = ""
-    progress = Progress(options.progress, start, stop)
-    event_rows = bool(getattr(options, "event_rows", False))
+    progress = Progress(options.progress, start, stop, limits.budget)
+    event_rows = options.event_rows
 
     def attempt(solver: str, cap: int | None = None) -> Attempt:
         """A run of ``solver`` from the start, of at most ``cap`` steps."""
@@ -93,7 +95,7 @@ def simulate_hybrid(model: CompiledModel, options: Any, solver: str, grid: np.nd
         note = "; ".join(filter(None, (note, f"terminate() at time {when:.9g}: {shown}")))
     state_events, time_events = loop.counts.get("state", 0), loop.counts.get("time", 0)
     stats = SimulationStats(solver, loop.steps, problem.nfev, problem.njev,
-                            time.perf_counter() - began, problem.model_time,
+                            time.perf_counter() - plan.began, problem.model_time,
                             model.compile_time, model.cached, reason, note,
                             COMPILED if compiled else SCIPY, loop_time, state_events,
                             time_events, engine_reason=engine_reason(

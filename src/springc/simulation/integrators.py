@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-Rhs = Callable[[float, np.ndarray], np.ndarray]
+from .solver_names import FIXED_STEP, REGISTRY, registered
 
-METHODS = ("euler", "symplectic-euler", "verlet", "rk4")
+Rhs = Callable[[float, np.ndarray], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -70,12 +70,13 @@ def integrate(method: str, rhs: Rhs, times: np.ndarray, x0: np.ndarray, step: fl
               ) -> FixedStepResult:
     """Integrate from ``times[0]`` and record the state at every output time;
     ``after_step(t, x)`` is called after every step (the model's assertions)."""
-    if method not in METHODS:
-        raise ValueError(f"unknown fixed-step method {method!r}; use one of {METHODS}")
+    if method not in STEPPERS:
+        raise ValueError(f"unknown fixed-step method {method!r}; use one of "
+                         f"{tuple(STEPPERS)}")
     if step <= 0 or not np.isfinite(step):
         raise ValueError(f"the step must be positive, got {step!r}")
     advance = STEPPERS[method]
-    if method in ("symplectic-euler", "verlet") and pairs is None:
+    if method in REGISTRY and registered(method).pairs and pairs is None:
         pairs = Pairs(np.array([], dtype=int), np.array([], dtype=int))
     f, count = _counted(rhs)
     out = np.empty((len(times), len(x0)))
@@ -104,6 +105,7 @@ def integrate(method: str, rhs: Rhs, times: np.ndarray, x0: np.ndarray, step: fl
 
 def _euler(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
            cache: dict[str, np.ndarray]) -> np.ndarray:
+    """Explicit Euler: a method of this module, not a solver of the registry."""
     return x + h * f(t, x)
 
 
@@ -151,5 +153,9 @@ def _rk4_step(f: Rhs, t: float, x: np.ndarray, h: float, pairs: Pairs | None,
 
 STEPPERS = {"euler": _euler, "symplectic-euler": _symplectic_euler, "verlet": _verlet,
             "rk4": _rk4_step}
-"""One step of each method: ``(rhs, t, x, h, pairs, cache) -> x(t + h)`` (``cache``
-carries verlet's last derivative; clear it when the states jump)."""
+"""One step of each fixed-step solver of the registry (its facts: order, pairs, in
+:mod:`.solver_names`), and of explicit Euler: ``(rhs, t, x, h, pairs, cache) ->
+x(t + h)`` (``cache`` carries verlet's last derivative; clear it when the states jump)."""
+if set(FIXED_STEP) - set(STEPPERS):  # a registered fixed-step solver without arithmetic
+    raise ImportError(f"fixed-step solvers without a step here: "
+                      f"{sorted(set(FIXED_STEP) - set(STEPPERS))}")

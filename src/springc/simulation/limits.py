@@ -4,7 +4,10 @@
   (``--set g=nan`` names ``g`` instead of failing somewhere inside the solver).
 - :class:`Limits`: at most ``max_steps`` integrator steps (``--max-steps``, default
   :data:`DEFAULT_MAX_STEPS`) and ``time_limit`` seconds of wall clock
-  (``--time-limit``, default :data:`DEFAULT_TIME_LIMIT`). A run whose current step
+  (``--time-limit``, default :data:`DEFAULT_TIME_LIMIT`), both owned by
+  :class:`~.settings.RunSettings` and resolved into the run's plan; and a ``budget``
+  (tradeoff's ``--budget``): past it a run raises :class:`OverBudget`, which is not an
+  error but a verdict its caller records. A run whose current step
   size projects more than :data:`HOPELESS` times ``max_steps`` stops at once (k = 1e29
   on the seed: 1e15 steps to go) rather than after the full budget.
   :func:`over_limit` writes the error: the time reached, the stiffness seen (the
@@ -23,13 +26,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import Note, SimulationError
+from .settings import DEFAULT_MAX_STEPS, DEFAULT_TIME_LIMIT
 from .solver_names import IMPLICIT_SOLVERS
 from .stiffness import STIFF_THRESHOLD, spectral_radius
 
-DEFAULT_MAX_STEPS = 20_000_000
-"""Integrator steps per run (fixed-step runs are refused up front beyond it)."""
-DEFAULT_TIME_LIMIT = 3600.0
-"""Seconds of wall clock per run (integration and outputs)."""
+__all__ = ["CHECK_EVERY", "DEFAULT_MAX_STEPS", "DEFAULT_TIME_LIMIT", "HOPELESS", "Limits",
+           "OverBudget", "OverLimit", "check_outputs", "check_parameters", "over_limit",
+           "projected_steps"]
 HOPELESS = 100
 """A run stops early when its current step size needs this many times ``max_steps``."""
 CHECK_EVERY = 1000
@@ -42,6 +45,7 @@ class Limits:
 
     max_steps: int = DEFAULT_MAX_STEPS
     time_limit: float = DEFAULT_TIME_LIMIT
+    budget: float = math.inf  # seconds; checked with the progress updates (steps.Progress)
 
     def validate(self) -> None:
         """Errors name the option."""
@@ -51,6 +55,12 @@ class Limits:
         if not (self.time_limit > 0):
             raise SimulationError(f"--time-limit must be a positive number of seconds, "
                                   f"not {self.time_limit!r}")
+
+
+class OverBudget(Exception):
+    """Raised from inside a run that has taken longer than its :attr:`Limits.budget`
+    (checked where the progress bar is updated: from the run's first second on, ten
+    times a second); not an error: the caller (tradeoff) records the run as over budget."""
 
 
 class OverLimit(Exception):

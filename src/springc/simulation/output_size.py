@@ -13,7 +13,8 @@ import re
 
 from ..errors import UsageError
 from ..pipeline import CompiledModel
-from .runner import SimulationOptions, output_grid, resolve
+from .planning import output_grid, resolve
+from .settings import RunSettings
 
 LARGE_TRAJECTORY = 10_000_000
 """Output times x variables above which the default trajectory is not written."""
@@ -21,7 +22,7 @@ CSV_BYTES_PER_VALUE = 20
 """About how many characters a number takes in the CSV (``repr`` and a comma)."""
 
 
-def check_trajectory_size(model: CompiledModel, options: SimulationOptions,
+def check_trajectory_size(model: CompiledModel, options: RunSettings,
                           target: str) -> None:
     """Refuse (a UsageError naming ``--vars``) to write every output of ``model`` to
     ``target`` when that is more than :data:`LARGE_TRAJECTORY` values."""

@@ -29,7 +29,7 @@ from ..ir.dae import derivative_name
 from ..pipeline import CompiledModel, announce_functions
 from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
-from .limits import CHECK_EVERY, HOPELESS, Limits, OverLimit, projected_steps
+from .limits import CHECK_EVERY, HOPELESS, Limits, OverBudget, OverLimit, projected_steps
 from .solver_names import (
     COMPILED_SOLVERS,
     FIXED_STEP,
@@ -47,17 +47,24 @@ COMPILED_METHODS = frozenset(COMPILED_SOLVERS) - frozenset(FIXED_STEP)
 class Progress:
     """A progress bar on ``stream``, shown once a run has taken about a second."""
 
-    def __init__(self, stream: TextIO | None, start: float, stop: float) -> None:
+    def __init__(self, stream: TextIO | None, start: float, stop: float,
+                 budget: float = math.inf) -> None:
         self.stream, self.start, self.stop = stream, start, stop
         self.began = time.perf_counter()
-        self.next = self.began + 1.0 if stream is not None else math.inf
+        self.end = self.began + budget  # past it, an update raises OverBudget
+        watched = stream is not None or math.isfinite(budget)
+        self.next = self.began + 1.0 if watched else math.inf
         self.shown = False
 
     def update(self, t: float) -> None:
         now = time.perf_counter()
-        if self.stream is None or now < self.next:
+        if now < self.next:
             return
         self.next = now + 0.1
+        if now > self.end:
+            raise OverBudget
+        if self.stream is None:
+            return
         frac = min(1.0, max(0.0, (t - self.start) / (self.stop - self.start)))
         bar = "#" * int(30 * frac)
         self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  t = {t:.4g} s  "

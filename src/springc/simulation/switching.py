@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Protocol
 
@@ -44,9 +44,11 @@ from ..simplify import (
     switch,
 )
 from .assertions import check_trajectory
+from .compiled import COMPILED
 from .limits import Limits, OverLimit, check_outputs, over_limit
+from .planning import RunPlan
 from .results import SimulationResult, SimulationStats
-from .solver_names import EXPLICIT, SOLVERS
+from .solver_names import AUTO, EXPLICIT, SOLVERS
 from .stiffness import numerical_jacobian
 
 MAX_SWITCHES = 10_000
@@ -275,11 +277,32 @@ def _switch(model: flat.FlatModel, old: StateChoice, values: Mapping[str, float]
     return new
 
 
-def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray,
-                             rtol: float, atol: float, parameters: dict[str, float],
-                             limits: Limits | None = None) -> SimulationResult:
-    """Run ``model`` on ``grid`` with dynamic state selection (adaptive solvers only)."""
+def simulate_switching_model(model: CompiledModel, plan: RunPlan) -> SimulationResult:
+    """Run ``model`` as ``plan`` says with dynamic state selection (adaptive solvers
+    only; on scipy's loop, the only one that switches states)."""
+    settings = plan.settings
+    if settings.engine == COMPILED:
+        raise SimulationError(f"{model.name} may switch its states during the run "
+                              "(dynamic state selection), which only the scipy engine "
+                              "does", hint="use --engine scipy (or auto)")
+    if plan.starts:
+        raise SimulationError(f"{model.name} may switch its states during the run "
+                              f"(dynamic state selection): the start of "
+                              f"'{min(plan.starts)}' cannot be set from outside",
+                              hint="set it in the model (start = ...)")
     began = time.perf_counter()
+    result = _switching_run(model, plan.solver, plan.grid, plan.rtol, plan.atol,
+                            plan.parameters, plan.limits, began)
+    if settings.engine.lower() == AUTO:
+        result.stats = replace(result.stats, engine_reason=(
+            f"{result.stats.solver} ran in scipy's loop, the only one that switches "
+            "states"))
+    return result
+
+
+def _switching_run(model: CompiledModel, solver: str, grid: np.ndarray, rtol: float,
+                   atol: float, parameters: dict[str, float], limits: Limits,
+                   began: float) -> SimulationResult:
     method = solver if solver in SOLVERS else EXPLICIT
     closed = model.closed_system()  # captured at compile time: never the files again
     flat_model = closed.flat_model
@@ -289,7 +312,7 @@ def simulate_switching_model(model: CompiledModel, solver: str, grid: np.ndarray
     run = simulate_switching(flat_model, (float(grid[0]), float(grid[-1])), t_eval=grid,
                              rtol=rtol, atol=atol, method=SOLVERS[method],
                              parameters=parameters,
-                             time_limit=(limits or Limits()).time_limit)
+                             time_limit=limits.time_limit)
     if flat_model.assertions:
         known = parameter_values(closed.system.parameters, parameters)
         check_trajectory(flat_model.assertions, np.asarray(grid, dtype=float), run.values,

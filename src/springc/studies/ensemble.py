@@ -42,7 +42,7 @@ from ..fileio import atomic_write
 from ..pipeline import CompiledModel
 from ..simulation import (
     DEFAULT_MAX_STEPS,
-    SimulationOptions,
+    RunSettings,
     initial_state,
     output_grid,
     resolve,
@@ -165,8 +165,9 @@ def prepare(model: CompiledModel, names: Sequence[str], values: np.ndarray,
 def settings_of(model: CompiledModel, options: EnsembleOptions
                 ) -> tuple[np.ndarray, float, float, int]:
     """The output grid, rtol, atol and step limit of the runs."""
-    timing = SimulationOptions(options.start, options.stop, options.interval, SOLVER,
-                               options.rtol, options.atol)
+    timing = RunSettings(start=options.start, stop=options.stop,
+                         interval=options.interval, solver=SOLVER, rtol=options.rtol,
+                         atol=options.atol)
     start, stop, interval, rtol, atol = resolve(model, timing)
     max_steps = DEFAULT_MAX_STEPS if options.max_steps is None else options.max_steps
     return output_grid(start, stop, interval), rtol, atol, max_steps
@@ -190,9 +191,10 @@ def failure_words(status: int, t: float, limit: int) -> str:
 def explain(model: CompiledModel, options: EnsembleOptions, settings: Mapping[str, float],
             max_steps: int) -> str | None:
     """The single-run path's message for a run (``None`` if it does not fail there)."""
-    single = SimulationOptions(options.start, options.stop, options.interval, SOLVER,
-                               options.rtol, options.atol, dict(settings),
-                               max_steps=max_steps, engine="compiled", error_control="off")
+    single = RunSettings(start=options.start, stop=options.stop,
+                         interval=options.interval, solver=SOLVER, rtol=options.rtol,
+                         atol=options.atol, parameters=dict(settings), max_steps=max_steps,
+                         engine="compiled", error_control="off")
     try:
         simulate_model(model, single)
     except SpringcError as err:

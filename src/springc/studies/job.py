@@ -16,19 +16,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..errors import SpringcError
 from ..pipeline import CompiledModel
-from ..simulation import (
-    DEFAULT_ERROR_CONTROL,
-    DEFAULT_MAX_STEPS,
-    DEFAULT_TIME_LIMIT,
-    SimulationOptions,
-    simulate_model,
-)
+from ..simulation import DEFAULT_ERROR_CONTROL, RunSettings, run_settings, simulate_model
 from .params import ParameterSpec
 
 
@@ -59,6 +53,25 @@ class StudyOptions:
     time_limit: float | None = None
     error_control: str = DEFAULT_ERROR_CONTROL  # tighten, warn or off, as for simulate
 
+    def running(self, settings: RunSettings) -> StudyOptions:
+        """These options with the run settings of ``settings`` (``springc sweep``'s
+        shared options, :func:`springc.sweep`'s keywords; ``None``: the default)."""
+        return replace(self, start=settings.start, stop=settings.stop,
+                       interval=settings.interval, solver=settings.solver,
+                       rtol=settings.rtol, atol=settings.atol, step=settings.step,
+                       max_steps=settings.max_steps, time_limit=settings.time_limit,
+                       error_control=settings.error_control)
+
+    @property
+    def run(self) -> RunSettings:
+        """The settings every run shares, built by the one function the API and the
+        command line build theirs with."""
+        return run_settings(start=self.start, stop=self.stop, interval=self.interval,
+                            solver=self.solver, rtol=self.rtol, atol=self.atol,
+                            step=self.step, parameters=dict(self.fixed),
+                            max_steps=self.max_steps, time_limit=self.time_limit,
+                            error_control=self.error_control)
+
 
 @dataclass(frozen=True)
 class RunJob:
@@ -73,16 +86,13 @@ class RunJob:
     def solver(self) -> str:
         return self.study.solver
 
-    def options(self, values: Sequence[float]) -> SimulationOptions:
-        """The simulation options of the run with the swept ``values``."""
+    def options(self, values: Sequence[float]) -> RunSettings:
+        """The settings of the run with the swept ``values``."""
         o = self.study
-        parameters = dict(o.fixed)
+        base = o.run
+        parameters = dict(base.parameters)
         parameters.update(zip((s.name for s in o.parameters), (float(v) for v in values)))
-        return SimulationOptions(
-            o.start, o.stop, o.interval, o.solver, o.rtol, o.atol, parameters, None, o.step,
-            DEFAULT_MAX_STEPS if o.max_steps is None else o.max_steps,
-            DEFAULT_TIME_LIMIT if o.time_limit is None else o.time_limit,
-            error_control=o.error_control)
+        return replace(base, parameters=parameters)
 
 
 @dataclass(frozen=True)

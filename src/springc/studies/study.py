@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import SimulationError, UsageError, printable
 from ..pipeline import CompiledModel, check_parameter_names
-from ..simulation import SimulationOptions, output_grid, resolve
+from ..simulation import output_grid, resolve
 from .engines import (
     Batch,
     batches,
@@ -116,9 +116,7 @@ def energy_variable(model: CompiledModel, requested: str | None) -> str | None:
 
 def layout_of(model: CompiledModel, options: StudyOptions, values: np.ndarray) -> Layout:
     """The columns and metadata of the study of ``model``."""
-    settings = SimulationOptions(options.start, options.stop, options.interval,
-                                 options.solver, options.rtol, options.atol)
-    start, stop, interval, rtol, atol = resolve(model, settings)
+    start, stop, interval, rtol, atol = resolve(model, options.run)
     units = model.units
     names = tuple(s.name for s in options.parameters)
     energy = energy_variable(model, options.energy)

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..simulation import FIXED_STEP
+from ..simulation import EXPLICIT, registered
 from .model import BUDGET_SKIP, COST_SKIP, Reference, Run
 from .runs import (
     contender,
@@ -34,8 +34,9 @@ from .runs import (
 )
 from .setup import StudySetup
 
-PILOT = "dop853"
-"""The pilot when compared: fast on most models, and the method of the reference."""
+PILOT = EXPLICIT
+"""The pilot when compared: fast on most models, and the method of the reference (the
+registry's explicit method)."""
 
 
 @dataclass(frozen=True)
@@ -78,9 +79,9 @@ def cost_ceiling(pilot: Pilot | None, targets: tuple[float, ...], factor: float
         f"({slowest.label()}, {slowest.wall_time:.3g} s)")
 
 
-def skipped(solver: str, fixed: bool, value: float, status: str) -> Run:
+def skipped(solver: str, value: float, status: str) -> Run:
     """The row of a setting not run, with the reason as status."""
-    return Run(solver, "step" if fixed else "rtol", value, math.nan, 0, -1, -1, -1,
+    return Run(solver, registered(solver).setting, value, math.nan, 0, -1, -1, -1,
                math.nan, math.nan, status)
 
 
@@ -90,7 +91,8 @@ def solver_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: s
     """The runs of ``chain`` (see the module text), each logged with ``log`` when done;
     contenders are timed again at the end (:mod:`.runs`)."""
     options = setup.options
-    fixed = chain.solver in FIXED_STEP
+    facts = registered(chain.solver)
+    fixed = facts.fixed
     add_drift = energy_drift(setup, energy, ref)
     ceiling, _ = cost_ceiling(pilot, options.targets, options.cost_limit)
 
@@ -106,11 +108,10 @@ def solver_runs(setup: StudySetup, ref: Reference, scales: np.ndarray, energy: s
     stop = ""
     for value in chain.settings:
         if stop:
-            runs.append(skipped(chain.solver, fixed, value, stop))
+            runs.append(skipped(chain.solver, value, stop))
             continue
         once = springc_once(setup, chain.solver, *arguments(value))
-        run, values = timed_once(setup, chain.solver, "step" if fixed else "rtol", value,
-                                 once)
+        run, values = timed_once(setup, chain.solver, facts.setting, value, once)
         run = add_drift(with_errors(run, values, ref, scales), values)
         runs.append(run)
         onces.append((len(runs) - 1, once))

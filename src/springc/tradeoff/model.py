@@ -17,6 +17,7 @@ from typing import TextIO
 import numpy as np
 
 from ..errors import SimulationError, UsageError
+from ..simulation import OverBudget as OverBudget  # raised by a run past its budget
 from ..simulation import check_run_values
 
 DEFAULT_TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
@@ -48,10 +49,6 @@ CSV_COLUMNS = ("solver", "setting", "value", "wall_time_s", "repeats", "steps",
 
 class TradeoffError(SimulationError):
     """The reference is unusable (a CSV that does not match, methods that disagree)."""
-
-
-class OverBudget(Exception):
-    """Raised from inside a run that has taken longer than its budget."""
 
 
 def _check_positive(name: str, values: tuple[float, ...] | None, below_one: bool) -> None:

@@ -22,7 +22,8 @@ import numpy as np
 
 from ..errors import Note, SimulationError
 from ..fileio import atomic_write
-from ..simulation import simulate_model
+from ..pipeline import ModuleKind
+from ..simulation import EXPLICIT, RACE_IMPLICIT, simulate_model
 from .model import REFERENCE_RTOL, Reference, TradeoffError
 from .setup import StudySetup, relative_errors, scipy_outputs, variable_scales
 
@@ -55,7 +56,7 @@ def tight_reference(setup: StudySetup, target: float, rtol: float = REFERENCE_RT
     atol = rtol * setup.atol_ratio
     began = time.perf_counter()
     try:
-        primary = simulate_model(setup.model, setup.sim_options("dop853", rtol))
+        primary = simulate_model(setup.model, setup.sim_options(EXPLICIT, rtol))
     except SimulationError as err:
         raise TradeoffError(f"the reference solve (dop853 at rtol {rtol:.0e}) failed: "
                             f"{err.message}", notes=err.notes,
@@ -63,10 +64,10 @@ def tight_reference(setup: StudySetup, target: float, rtol: float = REFERENCE_RT
     first = time.perf_counter() - began
     began = time.perf_counter()
     checker = "VODE Adams"
-    if getattr(setup.model.module, "EVENTS", False):
+    if setup.model.kind == ModuleKind.HYBRID:
         # a hybrid model: the check locates the events too (simulation/events.py)
         checker = "radau with event location"
-        check = simulate_model(setup.model, setup.sim_options("radau", rtol)).values
+        check = simulate_model(setup.model, setup.sim_options(RACE_IMPLICIT, rtol)).values
     else:
         check = scipy_outputs(setup.model, setup.p, setup.grid, _adams(setup, rtol, atol))
     second = time.perf_counter() - began

@@ -28,7 +28,7 @@ from ..errors import SimulationError
 from ..simulation import simulate_model
 from .energy import drift, energy_series
 from .model import REPEAT_LIMIT, REPEAT_MARGIN, OverBudget, Reference, Run
-from .setup import Deadline, StudySetup, relative_errors
+from .setup import StudySetup, relative_errors
 
 STABLE_SECONDS = 0.2
 """A contender is timed until its timings add up to this (at least ``repeats`` times,
@@ -84,8 +84,7 @@ def springc_once(setup: StudySetup, solver: str, rtol: float | None, step: float
                  ) -> Once:
     """One run of springc's ``solver`` at ``rtol`` (adaptive) or ``step`` (fixed)."""
     def once(budget: float) -> Measured:
-        deadline = Deadline(budget) if math.isfinite(budget) else None
-        result = simulate_model(setup.model, setup.sim_options(solver, rtol, step, deadline))
+        result = simulate_model(setup.model, setup.sim_options(solver, rtol, step, budget))
         s = result.stats
         return (s.wall_time, (s.steps, s.rhs_evaluations, s.jacobian_evaluations),
                 result.values, s.engine)

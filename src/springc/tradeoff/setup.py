@@ -1,7 +1,8 @@
 """The setting of a study: CompiledModel + TradeoffOptions -> StudySetup (the output
-grid, parameters, start state, units), and the measures shared by the runs and the
-reference: the per-variable scales, the relative errors, the compared outputs of a
-scipy solve, and the deadline that stops a run over budget.
+grid, parameters, start state, units: the plan of the simulator, resolved once), and the
+measures shared by the runs and the reference: the per-variable scales, the relative
+errors, the compared outputs of a scipy solve, and the deadline of the scipy baselines
+(springc's own runs carry the budget in their settings: ``RunSettings.budget``).
 """
 
 from __future__ import annotations
@@ -10,19 +11,11 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TextIO
 
 import numpy as np
 
-from ..pipeline import CompiledModel, split_values
-from ..simulation import (
-    LSODA_LIMIT,
-    SimulationOptions,
-    initial_state,
-    observed_on_grid,
-    output_grid,
-    resolve,
-)
+from ..pipeline import CompiledModel
+from ..simulation import LSODA_LIMIT, RunSettings, initial_state, observed_on_grid, plan
 from .model import SCALE_FLOOR, OverBudget, TradeoffOptions
 
 # ------------------------------------------------------------------ errors
@@ -54,10 +47,9 @@ def relative_errors(values: np.ndarray, reference: np.ndarray,
 # ------------------------------------------------------------------ budget
 
 class Deadline:
-    """A progress stream that ends the run: ``simulate_model`` writes progress to it
-    about ten times a second once a run has taken a second, and past the deadline the
-    write raises :class:`OverBudget` (a time limit in SimulationOptions would be
-    cleaner)."""
+    """The budget of a scipy baseline (:mod:`.baselines`, which calls ``solve_ivp``
+    itself): :meth:`check` raises :class:`OverBudget` past it. (springc's runs stop
+    themselves: their settings carry the budget.)"""
 
     def __init__(self, seconds: float) -> None:
         self.end = time.perf_counter() + seconds
@@ -67,11 +59,9 @@ class Deadline:
             raise OverBudget
 
     def write(self, text: str) -> int:
+        """:meth:`check`, as a stream's write (the check of a progress update)."""
         self.check()
         return len(text)
-
-    def flush(self) -> None:
-        pass
 
 
 # ------------------------------------------------------------------ the study
@@ -90,17 +80,18 @@ class StudySetup:
     units: tuple[str, ...]
 
     def sim_options(self, solver: str, rtol: float | None = None, step: float | None = None,
-                    progress: TextIO | Deadline | None = None) -> SimulationOptions:
-        """The simulator's options for one run (atol in the study's ratio to rtol; the
+                    budget: float = math.inf) -> RunSettings:
+        """The simulator's settings for one run (atol in the study's ratio to rtol; the
         engine is the simulator's default: the compiled loop for a numba module and a
-        solver that has one). ``error_control`` is off: the study measures each run's
-        error itself against its reference, and a run tightened behind its back would
-        no longer be the setting its row names."""
+        solver that has one); past ``budget`` seconds the run raises ``OverBudget``.
+        ``error_control`` is off: the study measures each run's error itself against
+        its reference, and a run tightened behind its back would no longer be the
+        setting its row names."""
         o = self.options
-        return SimulationOptions(o.start, o.stop, o.interval, solver, rtol,
-                                 None if rtol is None else rtol * self.atol_ratio,
-                                 dict(o.parameters), progress,  # type: ignore[arg-type]
-                                 step, error_control="off")
+        return RunSettings(start=o.start, stop=o.stop, interval=o.interval, solver=solver,
+                           rtol=rtol, atol=None if rtol is None else rtol * self.atol_ratio,
+                           parameters=dict(o.parameters), step=step, budget=budget,
+                           error_control="off")
 
     def log(self, text: str) -> None:
         """A line on the study's log stream, if any."""
@@ -112,15 +103,15 @@ class StudySetup:
 def study_setup(model: CompiledModel, options: TradeoffOptions) -> StudySetup:
     """The setup of a study of ``model``: times and tolerances resolved as the simulator
     resolves them (options, then the experiment annotation, then the defaults)."""
-    base = SimulationOptions(options.start, options.stop, options.interval,
-                             parameters=dict(options.parameters))
-    start, stop, interval, rtol, atol = resolve(model, base)
-    parameters, starts = split_values(model, options.parameters)
-    p = np.asarray(model.module.parameters(parameters), dtype=float)
+    planned = plan(model, RunSettings(start=options.start, stop=options.stop,
+                                      interval=options.interval,
+                                      parameters=dict(options.parameters)))
+    x0 = planned.x0  # the switching driver solves its own start: the module's here
+    if x0 is None:
+        x0 = initial_state(model, planned.p, planned.start, planned.starts)
     units = model.units
-    return StudySetup(model, options, output_grid(start, stop, interval), atol / rtol, p,
-                      initial_state(model, p, start, starts),
-                      tuple(units.get(n, "") for n in model.outputs))
+    return StudySetup(model, options, planned.grid, planned.atol / planned.rtol, planned.p,
+                      x0, tuple(units.get(n, "") for n in model.outputs))
 
 
 def warm_up(model: CompiledModel, p: np.ndarray, x0: np.ndarray) -> None:

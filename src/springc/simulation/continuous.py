@@ -1,0 +1,173 @@
+"""The continuous driver: CompiledModel + RunPlan -> SimulationResult for a model
+without events, delays or switching states (``KIND`` ``continuous``).
+
+The step loop (:mod:`.steps`) on scipy's integrators or the compiled loops
+(:mod:`.compiled`), ``auto``'s race (:mod:`.race`), the fixed-step solvers
+(:mod:`.solvers`), the model's assertions after every step, then the outputs on the
+grid (:func:`.observed_rows.observed_on_rows`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from ..errors import SimulationError
+from ..pipeline import CompiledModel
+from . import solvers
+from .compiled import (
+    COMPILED,
+    SCIPY,
+    advance_compiled,
+    engine_reason,
+    explained,
+    jitted,
+    run_fixed_compiled,
+)
+from .failures import Stop, state_notes
+from .limits import OverLimit, check_outputs, over_limit
+from .observed_rows import observed_on_rows
+from .planning import RunPlan
+from .race import auto
+from .results import SimulationResult, SimulationStats
+from .solver_names import AUTO, EXPLICIT, FIXED_STEP
+from .steps import Problem, Progress, StepLoop, integrate
+
+
+def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult:
+    """Integrate ``model`` as ``plan`` says (see the module docstring)."""
+    solver, grid, x0, p = plan.solver, plan.grid, plan.x0, plan.p
+    assert x0 is not None
+    start, stop, rtol, atol = plan.start, plan.stop, plan.rtol, plan.atol
+    step, note, engine, began = plan.step or 0.0, plan.note, plan.engine, plan.began
+    options = plan.settings
+    progress = Progress(options.progress, start, stop, plan.limits.budget)
+    problem = Problem(model, p, solver, progress, plan.limits)
+    try:
+        with np.errstate(all="ignore"):
+            if not np.isfinite(x0).all():
+                raise Stop(SimulationError(
+                    f"the start values are not finite at time {start}",
+                    notes=state_notes(problem.names, x0, None)))
+            if problem.asserts:
+                problem.asserts.start(start, x0, problem.z)
+            reason = ""
+            # a large model's generated functions may be plain Python: scipy's loop then
+            compiled = engine == COMPILED and jitted(model.module)
+            finish = advance_compiled if compiled else None
+            loop_time = 0.0
+            if solver in FIXED_STEP and compiled:
+                states, steps, loop_time = run_fixed_compiled(problem, grid, x0, step)
+            elif solver in FIXED_STEP:
+                states, steps = solvers.run_fixed(problem, grid, x0, step)
+            elif solver == AUTO and len(x0):
+                run = StepLoop(problem, grid, x0, rtol, atol, finish)
+                solver, reason = auto(run, start, x0, stop, lambda t, x: solvers.choose(
+                    problem.jac(t, x), stop - start))
+                states, steps, loop_time = run.states, run.steps, run.loop_time
+                compiled = run.compiled_steps > 0
+            else:
+                if solver == AUTO:
+                    solver, reason = EXPLICIT, "no states to integrate"
+                problem.solver = solver
+                run = integrate(problem, grid, x0, rtol, atol, finish)
+                states, steps, loop_time = run.states, run.steps, run.loop_time
+                compiled = compiled and len(x0) > 0
+            if problem.asserts and (compiled or not len(x0)):
+                problem.asserts.grid(grid, states, problem.z, _locate(
+                    problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
+            outputs = _outputs(model, problem, grid, states)
+    except Stop as stop_:
+        raise stop_.error from None
+    except OverLimit as over:
+        raise over_limit(over, start, stop, problem.jacobian) from None
+    finally:
+        progress.close()
+    stats = SimulationStats(solver, steps, problem.nfev, problem.njev,
+                            time.perf_counter() - began, problem.model_time,
+                            model.compile_time, model.cached, reason, note,
+                            COMPILED if compiled else SCIPY, loop_time,
+                            engine_reason=engine_reason(options.engine.lower(), solver,
+                                                        model.module, compiled, len(x0))
+                            if explained(options.engine, reason, compiled) else "")
+    units = model.units
+    names = model.outputs
+    return SimulationResult(model.name, grid, names, outputs,
+                            tuple(units.get(n, "") for n in names), stats,
+                            dict(zip(model.parameter_names, p.tolist())))
+
+
+
+def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
+            rtol: float, atol: float, step: float) -> Callable[[int], None]:
+    """Run the output interval ``grid[k - 1], grid[k]`` of a compiled run again on
+    scipy's loop (or the Python fixed-step integrator, the same steps), from the state
+    at ``grid[k - 1]``: its assertion checks after every step locate a failure inside
+    the interval and raise it. A run that fails otherwise is left to the caller."""
+    def locate(k: int) -> None:
+        span = grid[k - 1:k + 1]
+        problem.solver = solver
+        try:
+            if solver in FIXED_STEP:
+                solvers.run_fixed(problem, span, states[k - 1], step)
+            else:
+                integrate(problem, span, states[k - 1], rtol, atol)
+        except (Stop, OverLimit):
+            pass
+    return locate
+
+
+def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
+             states: np.ndarray) -> np.ndarray:
+    names = model.outputs
+    sources = {s: i for i, s in enumerate(model.states)}  # columns of [states | observed]
+    selected = set(names)
+    wanted = [o for o in model.observed if o in selected]
+    obs = np.empty((len(grid), 0))
+    if wanted:
+        z = np.asarray(model.module.guesses(problem.p), dtype=float)
+        try:
+            obs = observed_on_rows(model.module, grid, states, problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
+            raise _first_failure(model, problem, grid, states, err) from err
+        if z[-1] != 0.0:
+            row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
+            problem.z[-1] = z[-1]
+            raise problem.newton_failure(float(grid[row]), states[row])
+        if not np.isfinite(obs).all():
+            _locate_observed(model, problem, grid, states, obs)
+        sources.update({o: len(model.states) + i for i, o in enumerate(model.observed)})
+    both = np.hstack((states, obs))  # copies rows: fast for 10^4 columns, unlike a loop
+    index = np.array([sources[n] for n in names], dtype=np.intp)
+    same = len(index) == both.shape[1] and (index == np.arange(len(index))).all()
+    out = both if same else np.take(both, index, axis=1)
+    check_outputs(names, grid, out)
+    return out
+
+
+def _first_failure(model: CompiledModel, problem: Problem, grid: np.ndarray,
+                   states: np.ndarray, err: BaseException) -> Stop:
+    """The failure of the observed variables at the first output time where it occurs
+    (``observed_grid`` raised for the whole grid)."""
+    z = np.asarray(model.module.guesses(problem.p), dtype=float)
+    for row in range(len(grid)):
+        try:
+            model.module.observed(float(grid[row]), states[row], problem.p, z)
+        except (ArithmeticError, ValueError, np.linalg.LinAlgError) as first:
+            return problem.fail(first, float(grid[row]), states[row], "an observed variable")
+    return problem.fail(err, float(grid[-1]), states[-1], "an observed variable")
+
+
+def _locate_observed(model: CompiledModel, problem: Problem, grid: np.ndarray,
+                     states: np.ndarray, obs: np.ndarray) -> None:
+    """Raise the located error of a numba module's observed variables that are not
+    finite: the first output time up to the first non-finite row where the Python
+    semantics of the same code raise (as the python backend does)."""
+    last = int(np.flatnonzero(~np.isfinite(obs).all(axis=1))[0])
+    for row in range(last + 1):
+        located = problem.locate(model.module.observed, float(grid[row]), states[row],
+                                 "an observed variable")
+        if located is not None:
+            raise located
