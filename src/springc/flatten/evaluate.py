@@ -23,10 +23,8 @@ from . import arrays as a
 from .array_ops import type_range, typed_range, typed_range_bounds, with_range
 from .calls import Builtins, call_function, function_of, guard_assertions, string_binary
 from .checks import check_enum_relation
-from .connect import GRAPH_FUNCTIONS, cardinality_call
-from .connect import NAME as CARDINALITY
-from .events import EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
-from .events import NAME as DELAY
+from .connect import CARDINALITY, GRAPH_FUNCTIONS, cardinality_call
+from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
 from .names import ReferenceResolver
 from .scopes import (
     ClassScope,
