@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from springc.pipeline.files import flatten_files
-from springc.simplify.isolate import COUNTERS, reset_counters
+from springc.simplify.isolate import counting
 from springc.simplify.passes import simplify
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -38,14 +38,14 @@ def run(folder: Path, family: str, size: tuple[int, ...]) -> dict[str, float]:
     t0 = time.perf_counter()
     flat = flatten_files([path], name)
     t1 = time.perf_counter()
-    reset_counters()
     c1 = time.process_time()
-    result = simplify(flat)
+    with counting() as work:
+        result = simplify(flat)
     t2, c2 = time.perf_counter(), time.process_time()
     return {"flatten": t1 - t0, "simplify": t2 - t1, "cpu": c2 - c1,
             "states": len(result.ode.states),
-            "equations": len(flat.equations), "solve": COUNTERS["solve"],
-            "diff": COUNTERS["diff"]}
+            "equations": len(flat.equations), "solve": work.solve,
+            "diff": work.diff}
 
 
 def exponent(rows: list[dict[str, float]]) -> float:

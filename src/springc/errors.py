@@ -148,21 +148,30 @@ def errors_of(exc: SpringcError | ErrorGroup) -> tuple[SpringcError, ...]:
 SourceLookup = Callable[[str], "str | None"]
 
 
-MEMORY_SOURCES: dict[str, str] = {}
-"""The text of pseudo files (``<string>``: models given as text), by name."""
+class SourceName(str):
+    """The name of a pseudo file (``<string>``: a model given as text) that carries its
+    text. Spans located in it hold it as their ``file``, so the excerpts of their errors
+    come from the text they point into (two texts under one name stay apart), and the
+    text lives as long as something points into it: no table of the process keeps it.
+    It is equal to, and hashes as, its name."""
 
+    text: str
 
-def remember_source(name: str, text: str) -> None:
-    """Show ``text`` in the excerpts of errors located in the pseudo file ``name``
-    (the latest text given under that name)."""
-    MEMORY_SOURCES[name] = text
+    def __new__(cls, name: str, text: str) -> SourceName:
+        self = super().__new__(cls, name)
+        self.text = text
+        return self
+
+    def __reduce__(self) -> tuple[type[SourceName], tuple[str, str]]:
+        return SourceName, (str(self), self.text)
 
 
 def read_source(path: str) -> str | None:
-    """Default source lookup: the remembered text of a pseudo file (``<string>``, never
-    read from disk), else the file read from disk; ``None`` if unreadable."""
+    """Default source lookup: the text a pseudo file (``<string>``) carries, never read
+    from disk (:class:`SourceName`), else the file read from disk; ``None`` if
+    unreadable."""
     if path.startswith("<") and path.endswith(">"):
-        return MEMORY_SOURCES.get(path)
+        return path.text if isinstance(path, SourceName) else None
     try:
         return Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):

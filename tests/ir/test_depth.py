@@ -128,3 +128,36 @@ def test_recursion_room_raises_and_restores_the_limit() -> None:
         inside = sys.getrecursionlimit()
     assert inside == expr.recursion_limit() >= before
     assert sys.getrecursionlimit() == before
+
+
+def test_the_recursion_room_is_shared_by_nested_runs_and_threads() -> None:
+    before = sys.getrecursionlimit()
+    main_room = max(before, expr.recursion_limit())
+    seen: dict[str, int] = {}
+    entered, release = threading.Event(), threading.Event()
+
+    def small_stack_run() -> None:
+        with expr.recursion_room():
+            seen["thread"] = sys.getrecursionlimit()
+            entered.set()
+            release.wait(timeout=60)
+
+    with expr.recursion_room():
+        with expr.recursion_room():  # nested: the same limit
+            seen["nested"] = sys.getrecursionlimit()
+        seen["outer"] = sys.getrecursionlimit()
+        previous = threading.stack_size(1 << 20)
+        try:
+            thread = threading.Thread(target=small_stack_run)
+            thread.start()
+        finally:
+            threading.stack_size(previous)
+        entered.wait(timeout=60)
+        seen["while the thread runs"] = sys.getrecursionlimit()
+        release.set()
+        thread.join()
+        seen["after the thread"] = sys.getrecursionlimit()
+    small = max(before, (1 << 20) // 512)  # 2,048 calls on a 1 MiB stack
+    assert seen == {"nested": main_room, "outer": main_room, "thread": small,
+                    "while the thread runs": small, "after the thread": main_room}
+    assert sys.getrecursionlimit() == before

@@ -18,7 +18,7 @@ from ..ir import expr as x
 from ..ir import flat
 from ..ir import syntax as s
 from .natives import is_external_object
-from .scopes import ClassView, FlattenContext, ViewComponent
+from .scopes import ClassView, FlattenContext, Ident, ViewComponent
 
 
 @dataclass(frozen=True)
@@ -47,21 +47,24 @@ def make_template(prefix: str, equations: list[flat.Equation]) -> Template | Non
     return Template(prefix, tuple(equations))
 
 
-def reusable(flattener: FlattenContext, view: ClassView) -> bool:
+def reusable(flattener: FlattenContext, view: ClassView, known: dict[Ident[ClassView], bool]
+             ) -> bool:
     """Whether every instance of ``view`` has the same equations up to its prefix, as
     far as the class's text shows: only equalities (loops and ifs of them), no
     constants (their values may be modified per instance) and literal array sizes, in
-    the class and in all its components. Parameter reads are checked by the caller."""
-    found = flattener.reusable_views.get(id(view))
+    the class and in all its components. Parameter reads are checked by the caller.
+    ``known``: the answers so far (the caller's cache, by view)."""
+    found = known.get(Ident(view))
     if found is None:
-        flattener.reusable_views[id(view)] = False  # a class containing itself
+        known[Ident(view)] = False  # a class containing itself
         outer_classes = any(isinstance(e, s.ClassDef) and e.outer  # differ per instance
                             for e in view.entry.defn.elements)
         found = not outer_classes \
             and _equations_only(eq.equation for eq in view.equations) \
             and _equations_only(eq.equation for eq in view.initial_equations) \
-            and all(_component_reusable(flattener, comp) for comp in view.components.values())
-        flattener.reusable_views[id(view)] = found
+            and all(_component_reusable(flattener, comp, known)
+                    for comp in view.components.values())
+        known[Ident(view)] = found
     return found
 
 
@@ -85,8 +88,9 @@ def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
         and class_ok(flattener.view(rtype.entry))
 
 
-def _component_reusable(flattener: FlattenContext, comp: ViewComponent) -> bool:
-    return fixed_shape(flattener, comp, lambda view: reusable(flattener, view))
+def _component_reusable(flattener: FlattenContext, comp: ViewComponent,
+                        known: dict[Ident[ClassView], bool]) -> bool:
+    return fixed_shape(flattener, comp, lambda view: reusable(flattener, view, known))
 
 
 def _equations_only(equations: Iterable[s.Equation]) -> bool:

@@ -28,15 +28,16 @@ from .events import (
     variable_if_equation,
 )
 from .redeclare import record_equation
-from .scopes import ClassScope, FlattenContext, LocalScope, Scope
+from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
 
 class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
 
     connections: ConnectionSets
-    # Equation templates by (id of the ClassView, initial); None: not reusable.
-    templates: dict[tuple[int, bool], Template | None]
+    # Equation templates by (the ClassView, initial); None: not reusable.
+    templates: dict[tuple[Ident[ClassView], bool], Template | None]
+    reusable_views: dict[Ident[ClassView], bool]  # whether a view's equations are a template
     algorithm_sections: list[Section]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
@@ -46,7 +47,7 @@ class EquationFlattening(FlattenContext):
         if not items:
             return
         target = self.initial_equations if initial else self.equations
-        key = (id(view), initial)
+        key = (Ident(view), initial)
         template = self.templates.get(key) if scope.package is None else None
         if template is not None:
             target += template.instantiate(scope.prefix)
@@ -59,7 +60,8 @@ class EquationFlattening(FlattenContext):
                 self.report(err)
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
                 and scope.package is None:
-            independent = self.parameter_values.reads == reads and reusable(self, view)
+            independent = self.parameter_values.reads == reads \
+                and reusable(self, view, self.reusable_views)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
                 if independent else None
 

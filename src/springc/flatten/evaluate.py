@@ -23,15 +23,14 @@ from . import arrays as a
 from .array_ops import type_range, typed_range, typed_range_bounds, with_range
 from .calls import Builtins, call_function, function_of, guard_assertions, string_binary
 from .checks import check_enum_relation
-from .connect import GRAPH_FUNCTIONS, cardinality_call
-from .connect import NAME as CARDINALITY
-from .events import EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
-from .events import NAME as DELAY
+from .connect import CARDINALITY, GRAPH_FUNCTIONS, cardinality_call
+from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
 from .names import ReferenceResolver
 from .scopes import (
     ClassScope,
     EventUses,
     FlattenContext,
+    Ident,
     LocalScope,
     Scope,
     check_powers,
@@ -58,9 +57,9 @@ class Evaluator(ReferenceResolver):
         self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)
-        # Whether a subscript contains `end`, by id of the syntax node (the syntax tree
-        # outlives the evaluator, so ids are not reused).
-        self.uses_end: dict[int, bool] = {}
+        # Whether a subscript contains `end`, by syntax node (its identity: equal
+        # subscripts written in two places are two entries).
+        self.uses_end: dict[Ident[s.Expr], bool] = {}
         self.cardinality_used = False  # placeholders to replace (flatten/connect/cardinality.py)
 
     # ------------------------------------------------------------ entry points

@@ -18,7 +18,7 @@ from ..errors import ErrorGroup, FlattenError, FollowUpError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
 from ..ir.when import When
-from ..parse import ClassTree
+from ..parse import ClassEntry, ClassTree
 from .calls import check_conditions, undefined_strings, unique
 from .connect import ConnectionSets, apply_cardinalities, check_connector_size
 from .equations import EquationFlattening
@@ -55,9 +55,9 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
     def __init__(self, tree: ClassTree, max_size: int = DEFAULT_MAX_SIZE) -> None:
         self.tree = tree
         self.limits = Limits(max_size)
-        self.views: dict[int, ClassView] = {}
-        self.package_scopes: dict[int, ClassScope] = {}
-        self.rule_errors: dict[int, FlattenError] = {}
+        self.views: dict[ClassEntry, ClassView] = {}
+        self.package_scopes: dict[ClassEntry, ClassScope] = {}
+        self.rule_errors: dict[ClassEntry, FlattenError] = {}
         self.parameter_values = ParameterValues()
         self.evaluator: ExpressionEvaluator = Evaluator(self)
         self.connections = ConnectionSets()

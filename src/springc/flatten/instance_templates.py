@@ -36,6 +36,7 @@ from .scopes import (
     ClassView,
     Disabled,
     FlattenContext,
+    Ident,
     Mod,
     ObjectMember,
     Primitive,
@@ -61,7 +62,7 @@ class Recording:
     """Marks taken before walking the instance a template will be made from."""
 
     scope: ClassScope
-    key: tuple[int, Shape]
+    key: tuple[Ident[ClassView], Shape]
     equations: int
     bindings: int
     reads: int
@@ -73,9 +74,9 @@ class InstanceTemplates:
 
     def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
-        self.seen: dict[tuple[int, Shape], int] = {}  # instances met so far
-        self.templates: dict[tuple[int, Shape], InstanceTemplate | None] = {}
-        self.reusable: dict[int, bool] = {}
+        self.seen: dict[tuple[Ident[ClassView], Shape], int] = {}  # instances met so far
+        self.templates: dict[tuple[Ident[ClassView], Shape], InstanceTemplate | None] = {}
+        self.reusable: dict[Ident[ClassView], bool] = {}
 
     def begin(self, scope: ClassScope) -> Recording | None:
         """Before walking ``scope``: fill it from its template if there is one, or start
@@ -87,7 +88,7 @@ class InstanceTemplates:
         mod_shape = shape(scope.mod, scope, 0)
         if mod_shape is None:
             return None
-        key = (id(scope.view), mod_shape)
+        key = (Ident(scope.view), mod_shape)
         template = self.templates.get(key)
         if template is not None:
             self._fill(scope, template)
@@ -153,10 +154,10 @@ class InstanceTemplates:
         return found
 
     def _class_reusable(self, view: ClassView) -> bool:
-        found = self.reusable.get(id(view))
+        found = self.reusable.get(Ident(view))
         if found is None:
-            self.reusable[id(view)] = False  # a class containing itself
-            found = self.reusable[id(view)] = all(
+            self.reusable[Ident(view)] = False  # a class containing itself
+            found = self.reusable[Ident(view)] = all(
                 self._component_reusable(c) for c in view.components.values())
         return found
 
@@ -227,7 +228,7 @@ def shape(mod: Mod | None, scope: ClassScope, depth: int) -> Shape | None:
     elif mod.value.scope is scope:
         value = "inner"  # an extends modification, evaluated in the instance
     elif depth == 1 and not mod.children:
-        value = (id(mod.value.expr), id(mod.value.scope), len(mod.value.index))
+        value = (Ident(mod.value.expr), Ident(mod.value.scope), len(mod.value.index))
     else:
         return None
     children = []

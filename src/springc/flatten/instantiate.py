@@ -51,6 +51,7 @@ from .scopes import (
     Declared,
     DimensionKind,
     FlattenContext,
+    Ident,
     Member,
     Mod,
     ModValue,
@@ -72,8 +73,8 @@ class Instantiation(FlattenContext):
 
     # Evaluated modification values by (id of the expression, id of the scope); the
     # scope is kept alive in the entry so that its id cannot be reused.
-    mod_values: dict[tuple[int, int], tuple[object, a.Value]]
-    declared_types: dict[int, Declared]
+    mod_values: dict[tuple[Ident[s.Expr], Ident[object]], a.Value]
+    declared_types: dict[Ident[ViewComponent], Declared]
 
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member:
         decl = comp.decl
@@ -226,7 +227,7 @@ class Instantiation(FlattenContext):
 
     def declared_type(self, comp: ViewComponent) -> Declared:
         """The resolved type of a declaration and its type modifiers, computed once."""
-        key = id(comp)
+        key = Ident(comp)
         found = self.declared_types.get(key)
         if found is None:
             rtype = self.resolve_type(comp.decl.type_name, comp.defined_in)
@@ -397,11 +398,11 @@ class Instantiation(FlattenContext):
 
     def mod_value(self, mv: ModValue) -> a.Value:
         """Evaluate a modification value where it was written, then pick the element."""
-        key = (id(mv.expr), id(mv.scope))
+        key = (Ident(mv.expr), Ident(mv.scope))
         cached = self.mod_values.get(key)
         if cached is None:
-            cached = self.mod_values[key] = (mv.scope, self.evaluator.value(mv.expr, mv.scope))
-        value: a.Value = cached[1]
+            cached = self.mod_values[key] = self.evaluator.value(mv.expr, mv.scope)
+        value: a.Value = cached
         for i in mv.index:
             if not a.is_array(value) or value.shape[0] < i:
                 raise FlattenError(

@@ -86,6 +86,11 @@ _RECURSION_CAP = 20_000
 def recursion_limit() -> int:
     """The recursion limit this thread's stack can afford (at least Python's current
     one): the stack size over 512 bytes a call, at most 20,000."""
+    return max(sys.getrecursionlimit(), _affordable())
+
+
+def _affordable() -> int:
+    """The recursion limit this thread's stack can afford, whatever the current one."""
     size = _DEFAULT_STACK
     try:
         import resource
@@ -99,19 +104,53 @@ def recursion_limit() -> int:
         configured = threading.stack_size()
         threading.stack_size(configured)  # reading it also set it (to 0): put it back
         size = configured or size
-    return max(sys.getrecursionlimit(), min(_RECURSION_CAP, size // _STACK_BYTES_PER_CALL))
+    return min(_RECURSION_CAP, size // _STACK_BYTES_PER_CALL)
+
+
+class _RecursionRoom:
+    """The one owner of Python's recursion limit while springc runs. The limit belongs
+    to the interpreter, not to a thread, so the runs inside :func:`recursion_room`
+    (nested calls, threads) share it: it is what the smallest stack among them affords
+    (a deeper recursion than a thread's stack holds is a crash, not an error), never
+    below the limit found before the first entered, which is put back when the last
+    leaves."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._inside: list[int] = []  # what the stack of each run inside affords
+        self._before = 0
+
+    def enter(self) -> int:
+        affordable = _affordable()
+        with self._lock:
+            if not self._inside:
+                self._before = sys.getrecursionlimit()
+            self._inside.append(affordable)
+            self._apply()
+        return affordable
+
+    def leave(self, affordable: int) -> None:
+        with self._lock:
+            self._inside.remove(affordable)
+            self._apply()
+
+    def _apply(self) -> None:
+        sys.setrecursionlimit(max(self._before, min(self._inside, default=0)))
+
+
+_ROOM = _RecursionRoom()
 
 
 @contextmanager
 def recursion_room() -> Iterator[None]:
     """Run the body with :func:`recursion_limit` as Python's recursion limit, so that
-    expressions up to :data:`MAX_DEPTH` deep pass every stage; restores it after."""
-    previous = sys.getrecursionlimit()
-    sys.setrecursionlimit(recursion_limit())
+    expressions up to :data:`MAX_DEPTH` deep pass every stage; the limit found before
+    is put back when the last run inside leaves (see :class:`_RecursionRoom`)."""
+    affordable = _ROOM.enter()
     try:
         yield
     finally:
-        sys.setrecursionlimit(previous)
+        _ROOM.leave(affordable)
 
 
 MATH: Mapping[str, Callable[..., Any]] = {

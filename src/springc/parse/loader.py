@@ -110,7 +110,7 @@ class ClassTree:
         #: Paths (resolved) of the files parsed so far, user's and library's.
         self.parsed_paths: list[Path] = []
         self._loose_done: set[Path] = set()
-        self._missing: set[tuple[int, str]] = set()
+        self._missing: set[tuple[ClassEntry, str]] = set()
         #: Diagnostics that are not errors (a top-level class hiding another one).
         self.notes: list[str] = []
 
@@ -147,11 +147,11 @@ class ClassTree:
     def load_member(self, package: ClassEntry, name: str) -> ClassEntry | None:
         """Parse the file that stores class ``name`` of ``package`` (a package folder,
         or the root: the first library root that has it); ``None`` if none does."""
-        if (id(package), name) in self._missing:
+        if (package, name) in self._missing:
             return None
         found = self._find_member(package, name)
         if found is None:
-            self._missing.add((id(package), name))
+            self._missing.add((package, name))
         return found
 
     def _find_member(self, package: ClassEntry, name: str) -> ClassEntry | None:
@@ -252,13 +252,13 @@ class _LookupCycle(Exception):
 
 
 def member_class(entry: ClassEntry, name: str,
-                 active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
+                 active: frozenset[tuple[ClassEntry, str]] = frozenset()) -> ClassEntry | None:
     """A class named ``name`` declared in ``entry`` or inherited by it. ``active``: the
     (class, name) lookups in progress, to stop a lookup that would need itself."""
     found = entry.child(name)
     if found is not None:
         return found
-    key = (id(entry), name)
+    key = (entry, name)
     if key in active:
         raise _LookupCycle
     short = entry.defn.short
@@ -297,7 +297,7 @@ def member_class(entry: ClassEntry, name: str,
     return None
 
 
-def _resolve_quiet(ref: s.Ref, scope: ClassEntry, active: frozenset[tuple[int, str]],
+def _resolve_quiet(ref: s.Ref, scope: ClassEntry, active: frozenset[tuple[ClassEntry, str]],
                    extends: bool = False) -> ClassEntry | None:
     first = ref.parts[0].name
     entry = (base_lookup(first, scope, active) if extends
@@ -310,7 +310,7 @@ def _resolve_quiet(ref: s.Ref, scope: ClassEntry, active: frozenset[tuple[int, s
 
 
 def lookup_class(name: str, scope: ClassEntry,
-                 active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
+                 active: frozenset[tuple[ClassEntry, str]] = frozenset()) -> ClassEntry | None:
     """Find the class a simple name denotes from ``scope``: local and inherited classes,
     imports, then enclosing classes (stopping at ``encapsulated``, except for the root)."""
     entry: ClassEntry | None = scope
@@ -328,7 +328,7 @@ def lookup_class(name: str, scope: ClassEntry,
 
 
 def base_lookup(name: str, entry: ClassEntry,
-                active: frozenset[tuple[int, str]] = frozenset()) -> ClassEntry | None:
+                active: frozenset[tuple[ClassEntry, str]] = frozenset()) -> ClassEntry | None:
     """The first name of an ``extends`` clause of ``entry`` (Modelica 3.6, section
     5.6.1): a class declared in ``entry`` itself (not inherited, so that the lookup
     does not need the base classes it is resolving) or imported into it, else the
@@ -347,7 +347,7 @@ def base_lookup(name: str, entry: ClassEntry,
 
 
 def _imported(entry: ClassEntry, name: str,
-              active: frozenset[tuple[int, str]]) -> ClassEntry | None:
+              active: frozenset[tuple[ClassEntry, str]]) -> ClassEntry | None:
     """The class ``name`` imported into ``entry``. An import whose package (or, for a
     qualified import of ``name``, whose class) is not loaded is an error at the import."""
     root = entry
@@ -417,7 +417,7 @@ def imported_element(scope: ClassEntry, name: str) -> tuple[ClassEntry, str] | N
 
 
 def _import_path(root: ClassEntry, path: Sequence[str], element: s.Import,
-                 active: frozenset[tuple[int, str]]) -> ClassEntry:
+                 active: frozenset[tuple[ClassEntry, str]]) -> ClassEntry:
     found = root
     for depth, part in enumerate(path):
         member = member_class(found, part, active)

@@ -1,29 +1,79 @@
-"""Parsed files kept while they are unchanged: path -> ``ir.syntax.StoredDefinition``."""
+"""Parsed files kept while they are unchanged: path -> ``ir.syntax.StoredDefinition``.
+
+Syntax trees are immutable, so a process that flattens many models (a test run, a
+sweep's worker, a notebook) parses each library file once. The cache is bounded: it
+keeps the most recently used files up to :data:`MAX_SOURCE_BYTES` of source text
+(a tree takes some tens of times its text in memory), one entry per path (a changed
+file replaces its old tree), and forgets the least recently used ones beyond that.
+"""
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from pathlib import Path
 
 from ..ir import syntax as s
 from .parser import parse_file
 
-_PARSED: dict[tuple[str, int, int], s.StoredDefinition] = {}
+MAX_SOURCE_BYTES = 32 << 20
+"""Source text whose trees the shared cache keeps (32 MiB: the files of the Modelica
+Standard Library that one model reaches, many times over)."""
+
+
+class ParseCache:
+    """Syntax trees of files by path, while the file's modification time and size are
+    those it was parsed at; least recently used first out beyond ``max_bytes`` of
+    source text (a single larger file is parsed and not kept)."""
+
+    def __init__(self, max_bytes: int = MAX_SOURCE_BYTES) -> None:
+        self.max_bytes = max_bytes
+        self.size = 0  # source bytes of the files kept
+        self._trees: OrderedDict[str, tuple[tuple[int, int], s.StoredDefinition]] = \
+            OrderedDict()
+
+    def __len__(self) -> int:
+        return len(self._trees)
+
+    def parse(self, path: Path) -> s.StoredDefinition:
+        """The tree of ``path``, parsed again only where the file changed."""
+        try:
+            stat = path.stat()
+        except OSError:
+            return parse_file(path, defer=True)
+        name, version = str(path), (stat.st_mtime_ns, stat.st_size)
+        found = self._trees.get(name)
+        if found is not None and found[0] == version:
+            self._trees.move_to_end(name)
+            return found[1]
+        stored = parse_file(path, defer=True)
+        self._forget(name)
+        if stat.st_size <= self.max_bytes:
+            self._trees[name] = (version, stored)
+            self.size += stat.st_size
+            while self.size > self.max_bytes:
+                self._forget(next(iter(self._trees)))
+        return stored
+
+    def clear(self) -> None:
+        """Forget every parsed file."""
+        self._trees.clear()
+        self.size = 0
+
+    def _forget(self, name: str) -> None:
+        found = self._trees.pop(name, None)
+        if found is not None:
+            self.size -= found[0][1]
+
+
+SHARED = ParseCache()
+"""The cache of this process, used by :func:`parse_cached`."""
 
 
 def parse_cached(path: Path) -> s.StoredDefinition:
-    """Parse a file, reusing the syntax tree while the file is unchanged (syntax trees
-    are immutable, so a process that flattens many models parses each library once)."""
-    try:
-        stat = path.stat()
-    except OSError:
-        return parse_file(path, defer=True)
-    key = (str(path), stat.st_mtime_ns, stat.st_size)
-    stored = _PARSED.get(key)
-    if stored is None:
-        stored = _PARSED[key] = parse_file(path, defer=True)
-    return stored
+    """Parse a file through the process's :data:`SHARED` cache."""
+    return SHARED.parse(path)
 
 
 def clear_parse_cache() -> None:
     """Forget every parsed file (benchmarks measure loading from scratch with it)."""
-    _PARSED.clear()
+    SHARED.clear()

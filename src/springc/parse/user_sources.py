@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
-from ..errors import ErrorGroup, LoadError, SpringcError, remember_source
+from ..errors import ErrorGroup, LoadError, SourceName, SpringcError
 from ..ir import syntax as s
 from .library import is_package_file, library_roots
 from .loader import ClassTree
@@ -45,9 +45,8 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
         except SpringcError as error:
             errors.append(error)
     for text_name, text in texts:
-        remember_source(text_name, text)
-        try:
-            parsed.append((parse_text(text, text_name, defer=True), None))
+        try:  # its spans carry the text, for the excerpts of their errors
+            parsed.append((parse_text(text, SourceName(text_name, text), defer=True), None))
         except ErrorGroup as group:
             errors += group.errors
         except SpringcError as error:

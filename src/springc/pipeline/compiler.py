@@ -138,7 +138,7 @@ class CompiledModel:
     @property
     def warnings(self) -> tuple[UnitError, ...]:
         """The unit mismatches of the model (warnings; errors with ``--strict-units``)."""
-        return decode_warnings(getattr(self.module, "WARNINGS", ()))
+        return decode_warnings(getattr(self.module, "WARNINGS", ()), dict(self.options.texts))
 
     @property
     def structural(self) -> tuple[str, ...]:

@@ -3,24 +3,52 @@
 ``linear_split(r, v)`` writes a residual as ``a*v + b`` when ``v`` appears linearly
 (``a`` free of ``v``) in one pass over the tree; ``solve_for`` then gives ``v = -b/a``.
 ``fold`` rebuilds an expression with constant folding after a substitution.
-``free_variables`` is a fast ``expr.variables``. ``COUNTERS`` counts the symbolic work
-(``solve``: equations solved for a variable, ``diff``: symbolic differentiations),
-which the benchmark reports to show that it grows linearly with the model.
+``free_variables`` is a fast ``expr.variables``. Inside ``with counting() as work``,
+``work`` counts the symbolic work of the body (``solve``: equations solved for a
+variable, ``diff``: symbolic differentiations), which the benchmark reports to show
+that it grows linearly with the model; outside, nothing is counted.
 """
 
 from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 
 from ..ir import expr as x
 
 _BUILD = {"+": x.add, "-": x.sub, "*": x.mul, "/": x.div, "^": x.power}
 
-COUNTERS = {"solve": 0, "diff": 0}
-"""Symbolic work done so far (reset by the benchmark)."""
+
+@dataclass
+class SymbolicWork:
+    """The symbolic work done inside one :func:`counting` block."""
+
+    solve: int = 0  # equations solved for a variable
+    diff: int = 0  # symbolic differentiations
 
 
-def reset_counters() -> None:
-    for key in COUNTERS:
-        COUNTERS[key] = 0
+# The counts of the innermost ``counting`` block of this thread (or task), if any.
+_WORK: ContextVar[SymbolicWork | None] = ContextVar("springc_symbolic_work", default=None)
+
+
+@contextmanager
+def counting() -> Iterator[SymbolicWork]:
+    """Count the symbolic work done by the body, in this thread (or task) only."""
+    work = SymbolicWork()
+    token = _WORK.set(work)
+    try:
+        yield work
+    finally:
+        _WORK.reset(token)
+
+
+def count_diff() -> None:
+    """One symbolic differentiation, counted where a :func:`counting` block asks."""
+    work = _WORK.get()
+    if work is not None:
+        work.diff += 1
 
 
 def free_variables(e: x.Expr) -> set[str]:
@@ -49,8 +77,8 @@ def free_variables(e: x.Expr) -> set[str]:
 
 
 def partial(e: x.Expr, name: str) -> x.Expr:
-    """``d e / d name``, folded, and counted in ``COUNTERS["diff"]``."""
-    COUNTERS["diff"] += 1
+    """``d e / d name``, folded, and counted (:func:`count_diff`)."""
+    count_diff()
     return fold(x.diff(e, name))
 
 
@@ -160,7 +188,9 @@ def linear_split(r: x.Expr, name: str) -> tuple[x.Expr, x.Expr] | None:
 
 def solve_for(r: x.Expr, name: str) -> x.Expr | None:
     """The value of ``name`` that makes the residual ``r`` zero, if ``r`` is linear in it."""
-    COUNTERS["solve"] += 1
+    work = _WORK.get()
+    if work is not None:
+        work.solve += 1
     split = linear_split(r, name)
     if split is None:
         return None

@@ -16,16 +16,16 @@ from ..scopes import (
     BOOLEAN,
     BUILTIN_ENUMERATIONS,
     ClassScope,
+    ClassViews,
     DimensionKind,
     EnumLiteral,
-    FlattenContext,
     Scope,
     kind_name,
     value_kind,
 )
 
 
-def typed_dimension(ctx: FlattenContext, d: s.Expr, where: Scope
+def typed_dimension(ctx: ClassViews, d: s.Expr, where: Scope
                     ) -> tuple[int, DimensionKind] | None:
     """``[Boolean]`` or ``[E]``: the size and the kind of the dimension; None for a
     dimension that is not a type name."""

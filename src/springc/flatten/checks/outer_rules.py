@@ -15,7 +15,7 @@ from ...ir import syntax as s
 from ...parse import member_class
 from ..scopes import (
     ClassView,
-    FlattenContext,
+    ClassViews,
     ViewComponent,
     mod_values,
     refs,
@@ -25,7 +25,7 @@ from ..scopes import (
 from .rules import rule_error
 
 
-def check_outer_uses(ctx: FlattenContext, view: ClassView) -> None:
+def check_outer_uses(ctx: ClassViews, view: ClassView) -> None:
     """Each ``o.x`` with ``o`` an outer component of ``view`` names an element of
     ``o``'s declared class."""
     outers = {n: c for n, c in view.components.items()
@@ -70,7 +70,7 @@ def _equation_refs(eq: s.Equation) -> Iterator[s.Ref]:
                 yield from _equation_refs(inner)
 
 
-def _check(ctx: FlattenContext, comp: ViewComponent, ref: s.Ref) -> None:
+def _check(ctx: ClassViews, comp: ViewComponent, ref: s.Ref) -> None:
     try:
         rtype = ctx.resolve_type(comp.decl.type_name, comp.defined_in)
         if rtype.entry is None:

@@ -20,7 +20,7 @@ from ..natives import is_external_object
 from ..scopes import (
     PRIMITIVES,
     ClassView,
-    FlattenContext,
+    ClassViews,
     ResolvedType,
     ViewComponent,
     inherited_class,
@@ -66,7 +66,7 @@ def _kinds(kinds: frozenset[str]) -> str:
     return ", ".join(order[:-1]) + f" or {order[-1]}" if len(order) > 1 else order[0]
 
 
-def check_class(ctx: FlattenContext, view: ClassView) -> None:
+def check_class(ctx: ClassViews, view: ClassView) -> None:
     """Every rule of this module for the class of ``view``."""
     entry = view.entry
     defn = entry.defn
@@ -112,7 +112,7 @@ def _check_names(defn: s.ClassDef) -> None:
                                        classes[element.name].span),))
 
 
-def check_extends(ctx: FlattenContext, entry: ClassEntry) -> None:
+def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
     """The extends clauses of ``entry``, before its inheritance is resolved: the kind of
     each base class (7.1.3), and no other element beside a base class that is an array
     class, has type prefixes or is a simple type (4.5.2)."""
@@ -213,7 +213,7 @@ def _check_package(view: ClassView) -> None:
                          "a package may contain only classes and constants", "4.6")
 
 
-def _resolved(ctx: FlattenContext, comp: ViewComponent) -> ResolvedType | None:
+def _resolved(ctx: ClassViews, comp: ViewComponent) -> ResolvedType | None:
     """The type of ``comp``, or None where it cannot be resolved (reported later,
     where the component is instantiated)."""
     try:
@@ -222,7 +222,7 @@ def _resolved(ctx: FlattenContext, comp: ViewComponent) -> ResolvedType | None:
         return None
 
 
-def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent) -> None:
+def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) -> None:
     decl = comp.decl
     if entry.defn.kind in ("record", "connector") and (decl.inner or decl.outer):
         kind = entry.defn.kind
@@ -307,7 +307,7 @@ def _check_component(ctx: FlattenContext, entry: ClassEntry, comp: ViewComponent
                                                   inner_decl.span),))
 
 
-def _elements(ctx: FlattenContext, entry: ClassEntry, prefix: str = "",
+def _elements(ctx: ClassViews, entry: ClassEntry, prefix: str = "",
               depth: int = 0) -> Iterator[tuple[str, s.Component]]:
     """The components of ``entry`` and of its structured components, by relative name
     (short-definition prefixes folded into each declaration's own)."""
@@ -328,7 +328,7 @@ def _elements(ctx: FlattenContext, entry: ClassEntry, prefix: str = "",
             yield from _elements(ctx, rtype.entry, f"{prefix}{name}.", depth + 1)
 
 
-def _check_block(ctx: FlattenContext, view: ClassView) -> None:
+def _check_block(ctx: ClassViews, view: ClassView) -> None:
     """Each public connector component of a block has input or output on all its
     variables."""
     for comp in view.components.values():
@@ -348,14 +348,14 @@ def _check_block(ctx: FlattenContext, view: ClassView) -> None:
                                               inner_decl.span),))
 
 
-def _is_variable(ctx: FlattenContext, decl: s.Component, entry: ClassEntry) -> bool:
+def _is_variable(ctx: ClassViews, decl: s.Component, entry: ClassEntry) -> bool:
     """Whether ``decl`` (of a connector) is a primitive variable, not a structure."""
     comp = ViewComponent(decl, entry)
     rtype = _resolved(ctx, comp)
     return rtype is not None and rtype.primitive is not None
 
 
-def _check_function(ctx: FlattenContext, view: ClassView) -> None:
+def _check_function(ctx: ClassViews, view: ClassView) -> None:
     """Public elements of a function are inputs or outputs; inputs are not assigned."""
     inputs = set()
     for comp in view.components.values():

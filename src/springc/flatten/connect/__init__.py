@@ -4,7 +4,8 @@
 
 from __future__ import annotations
 
-from .cardinality import NAME, apply_cardinalities, cardinality_call
+from .cardinality import NAME as CARDINALITY
+from .cardinality import apply_cardinalities, cardinality_call
 from .connect_rules import check_connector_size, check_no_connect
 from .connection_graph import (
     GRAPH_EQUATIONS,
@@ -16,9 +17,9 @@ from .connection_graph import (
 from .connections import ConnectionSets
 
 __all__ = [
+    "CARDINALITY",
     "GRAPH_EQUATIONS",
     "GRAPH_FUNCTIONS",
-    "NAME",
     "ConnectionSets",
     "apply_cardinalities",
     "cardinality_call",

@@ -19,7 +19,7 @@ from ...errors import FlattenError
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
-from ..scopes import ClassScope, ExpressionEvaluator, FlattenContext, Leaf, Scope
+from ..scopes import ClassScope, ExpressionEvaluator, FlatResults, Leaf, Scope
 
 NAME = "cardinality"
 
@@ -48,7 +48,7 @@ def _replace(e: x.Expr, counts: Counter[str]) -> x.Expr:
     return x.map_children(e, lambda c: _replace(c, counts))
 
 
-def apply_cardinalities(fl: FlattenContext, counts: Counter[str]) -> None:
+def apply_cardinalities(fl: FlatResults, counts: Counter[str]) -> None:
     """Replace every ``cardinality`` placeholder by the connector's count."""
     for items in (fl.equations, fl.initial_equations):
         for i, eq in enumerate(items):

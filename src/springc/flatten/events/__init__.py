@@ -5,7 +5,8 @@ algorithm sections (``algorithms``, ``section_starts``, ``loop_break``)."""
 from __future__ import annotations
 
 from .algorithms import Section, algorithm_section, apply_starts
-from .delay import NAME, delay_call
+from .delay import NAME as DELAY
+from .delay import delay_call
 from .event_calls import (
     EVENT_CALLS,
     EVENT_EQUATIONS,
@@ -16,7 +17,7 @@ from .event_calls import (
 from .when import check_events, flatten_when, variable_if_equation
 
 __all__ = [
-    "EVENT_CALLS", "EVENT_EQUATIONS", "NAME", "Section", "algorithm_section", "apply_starts",
+    "DELAY", "EVENT_CALLS", "EVENT_EQUATIONS", "Section", "algorithm_section", "apply_starts",
     "check_arithmetic_operands", "check_events", "delay_call", "event_call", "event_dependent",
     "flatten_when", "variable_if_equation",
 ]

@@ -42,7 +42,7 @@ from ..calls import (
     string_equation,
 )
 from ..connect import GRAPH_EQUATIONS, misplaced
-from ..scopes import ClassScope, FlattenContext, LocalScope, Scope
+from ..scopes import ClassScope, FlatResults, FlattenContext, LocalScope, Scope
 from .loop_break import (
     BROKEN_TERMS,
     FALSE,
@@ -364,7 +364,7 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
                    frozenset(run.env))
 
 
-def apply_starts(fl: FlattenContext, sections: list[Section],
+def apply_starts(fl: FlatResults, sections: list[Section],
                  variables: tuple[flat.Variable, ...]) -> None:
     """Replace the reads of assigned variables before their assignment (still plain
     variables in the equations of a section) by the variables' start values."""

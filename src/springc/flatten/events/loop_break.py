@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from ...ir import expr as x
+from ..scopes import Ident
 
 TRUE, FALSE = x.Const(True), x.Const(False)
 
@@ -24,12 +25,12 @@ BROKEN_TERMS = 20_000
 def too_large(values: Iterable[x.Expr]) -> bool:
     """Whether an expression tree of ``values`` has more than :data:`BROKEN_TERMS`
     nodes (counted on the shared nodes, in time linear in the distinct ones)."""
-    sizes: dict[int, int] = {}
+    sizes: dict[Ident[x.Expr], int] = {}
 
     def size(e: x.Expr) -> int:
-        found = sizes.get(id(e))
+        found = sizes.get(Ident(e))
         if found is None:
-            found = sizes[id(e)] = 1 + sum(size(c) for c in x.children(e))
+            found = sizes[Ident(e)] = 1 + sum(size(c) for c in x.children(e))
         return found
 
     return any(size(v) > BROKEN_TERMS for v in values)

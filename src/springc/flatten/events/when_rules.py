@@ -13,10 +13,10 @@ from ...errors import ErrorGroup, Note, SpringcError
 from ...ir import syntax as s
 from ...parse import ClassEntry
 from ..checks import rule_error
-from ..scopes import FlattenContext
+from ..scopes import ClassViews
 
 
-def check_when_target(ctx: FlattenContext, lhs: s.Expr, where: ClassEntry) -> None:
+def check_when_target(ctx: ClassViews, lhs: s.Expr, where: ClassEntry) -> None:
     """No proper prefix of the reference ``lhs`` is a model or block component."""
     if not isinstance(lhs, s.Ref) or lhs.is_global:
         return

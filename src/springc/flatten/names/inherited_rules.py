@@ -14,10 +14,10 @@ from ...ir import syntax as s
 from ...parse import ClassEntry, lookup_class
 from ..calls import CONSTANTS
 from ..checks import rule_error
-from ..scopes import ClassView, FlattenContext, mod_values, refs
+from ..scopes import ClassView, ClassViews, mod_values, refs
 
 
-def check_inherited_names(ctx: FlattenContext, view: ClassView) -> None:
+def check_inherited_names(ctx: ClassViews, view: ClassView) -> None:
     """Each inherited binding and equation uses only names visible where written."""
     entry = view.entry
     for comp in view.components.values():
@@ -30,7 +30,7 @@ def check_inherited_names(ctx: FlattenContext, view: ClassView) -> None:
             _check(ctx, view, eq.defined_in, eq.equation.rhs)
 
 
-def _check(ctx: FlattenContext, view: ClassView, declaring: ClassEntry, e: s.Expr) -> None:
+def _check(ctx: ClassViews, view: ClassView, declaring: ClassEntry, e: s.Expr) -> None:
     for ref in refs(e):
         name = ref.parts[0].name
         if ref.is_global or name not in view.components or _visible(ctx, name, declaring):
@@ -43,7 +43,7 @@ def _check(ctx: FlattenContext, view: ClassView, declaring: ClassEntry, e: s.Exp
                   view.components[name].decl.span),))
 
 
-def _visible(ctx: FlattenContext, name: str, declaring: ClassEntry) -> bool:
+def _visible(ctx: ClassViews, name: str, declaring: ClassEntry) -> bool:
     if name in ("time", *CONSTANTS) or lookup_class(name, declaring) is not None:
         return True
     enclosing: ClassEntry | None = declaring

@@ -52,22 +52,22 @@ class ClassLookup(FlattenContext):
     """Class and name lookup; mixed into the Flattener, which provides the caches."""
 
     tree: ClassTree
-    views: dict[int, ClassView]
-    package_scopes: dict[int, ClassScope]
-    rule_errors: dict[int, FlattenError]  # classes breaking a rule of rules.py
+    views: dict[ClassEntry, ClassView]  # a ClassEntry is hashed by identity
+    package_scopes: dict[ClassEntry, ClassScope]
+    rule_errors: dict[ClassEntry, FlattenError]  # classes breaking a rule of rules.py
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView:
-        found = self.views.get(id(entry))
-        if found is None and id(entry) not in self.rule_errors:
+        found = self.views.get(entry)
+        if found is None and entry not in self.rule_errors:
             unsupported = entry.defn.unsupported
             if unsupported:  # a construct outside the subset, in a class the model uses
                 raise unsupported[0] if len(unsupported) == 1 else ErrorGroup(unsupported)
             try:
                 check_extends(self, entry)
             except FlattenError as err:
-                self.rule_errors[id(entry)] = err
+                self.rule_errors[entry] = err
                 raise
-            found = self.views[id(entry)] = build_view(entry, self, seen)
+            found = self.views[entry] = build_view(entry, self, seen)
             try:
                 check_class(self, found)
                 check_class_redeclarations(self.resolve_class, entry)
@@ -76,8 +76,8 @@ class ClassLookup(FlattenContext):
                 check_outer_uses(self, found)
                 check_conditional_uses(found)
             except FlattenError as err:
-                self.rule_errors[id(entry)] = err
-        broken = self.rule_errors.get(id(entry))
+                self.rule_errors[entry] = err
+        broken = self.rule_errors.get(entry)
         if broken is not None:
             raise FollowUpError(broken)
         assert found is not None
@@ -278,14 +278,14 @@ class ClassLookup(FlattenContext):
         """The instance of a package whose constants are read: ``package M2 = M1(y =
         2)`` is ``M1`` with that modification, and a package extending another with a
         modification (``extends Base(n = 3)``) has it."""
-        scope = self.package_scopes.get(id(entry))
+        scope = self.package_scopes.get(entry)
         if scope is None:
             target, mods = self._short_package(entry)
             view = self.view(target)
             scope = ClassScope(self, entry.full_name, view, None, entry.defn.span)
             if view.extends_mods or any(m is not None for m in mods):
                 scope.mod = instance_mod(merge_all(mods), view, scope)
-            self.package_scopes[id(entry)] = scope
+            self.package_scopes[entry] = scope
         return scope
 
     def _short_package(self, entry: ClassEntry) -> tuple[ClassEntry, list[Mod | None]]:

@@ -27,6 +27,7 @@ from ..scopes import (
     Disabled,
     DisabledReference,
     FlattenContext,
+    Ident,
     LocalScope,
     Primitive,
     Scope,
@@ -39,7 +40,7 @@ class ReferenceResolver:
     """Follows component references for the :class:`Evaluator` that derives from it."""
 
     flattener: FlattenContext
-    uses_end: dict[int, bool]
+    uses_end: dict[Ident[s.Expr], bool]
 
     if TYPE_CHECKING:
         def constant(self, e: s.Expr, scope: Scope, what: str,
@@ -145,9 +146,9 @@ class ReferenceResolver:
                kind: DimensionKind = None) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
-        uses_end = self.uses_end.get(id(sub))
+        uses_end = self.uses_end.get(Ident(sub))
         if uses_end is None:
-            uses_end = self.uses_end[id(sub)] = _uses_end(sub)
+            uses_end = self.uses_end[Ident(sub)] = _uses_end(sub)
         if uses_end:
             scope = LocalScope({}, scope, size)
         v = self._loop_index(sub, scope)

@@ -17,7 +17,7 @@ from typing import Any
 from ...errors import FlattenError, Note
 from ...ir import syntax as s
 from ...parse import ClassEntry, lookup_class
-from ..scopes import ClassScope, ClassView, FlattenContext, Mod, ModValue, Scope, merge
+from ..scopes import ClassScope, ClassView, ClassViews, FlattenContext, Mod, ModValue, Scope, merge
 
 HINT = ("a record value is a record constructor call R(...) or another record "
         "component; other record expressions are not supported yet")
@@ -76,7 +76,7 @@ def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
                        hint=HINT)
 
 
-def _constructor(fl: FlattenContext, call: s.Call, where: Any) -> ClassEntry | None:
+def _constructor(fl: ClassViews, call: s.Call, where: Any) -> ClassEntry | None:
     scope_entry = where.entry
     if lookup_class(call.func.parts[0].name, scope_entry) is None:
         return None

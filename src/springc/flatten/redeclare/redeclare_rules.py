@@ -19,7 +19,7 @@ from ...errors import FlattenError, Note, Span
 from ...ir import syntax as s
 from ...parse import ClassEntry, member_class
 from ..checks import rule_error
-from ..scopes import REDECLARE_RULES, ClassView, FlattenContext, Mod, Redeclaration, ViewComponent
+from ..scopes import REDECLARE_RULES, ClassView, ClassViews, Mod, Redeclaration, ViewComponent
 from .subtyping import Interface, incompatibility, interface
 
 _SUBTYPE = ("the type of a replaceable or redeclared element must be a subtype of its "
@@ -32,7 +32,7 @@ _REPLACEABLE = ("only a replaceable element can be redeclared with a new type (a
                 "a final element cannot be redeclared at all")
 
 
-def check_replaceables(ctx: FlattenContext, view: ClassView) -> None:
+def check_replaceables(ctx: ClassViews, view: ClassView) -> None:
     """The replaceable declarations and ``redeclare`` elements of ``view``'s class."""
     entry = view.entry
     for element in entry.defn.elements:
@@ -62,7 +62,7 @@ def check_replaceables(ctx: FlattenContext, view: ClassView) -> None:
                              [(element, entry)])
 
 
-def check_redeclarations(ctx: FlattenContext, view: ClassView, mod: Mod | None) -> None:
+def check_redeclarations(ctx: ClassViews, view: ClassView, mod: Mod | None) -> None:
     """The redeclarations in an instance's merged modification ``mod``, each against
     the declaration it replaces in ``view`` and against the redeclarations it overrides."""
     if mod is None:
@@ -97,7 +97,7 @@ class Bound:
     span: Span | None
 
 
-def component_bound(ctx: FlattenContext, comp: ViewComponent) -> Bound:
+def component_bound(ctx: ClassViews, comp: ViewComponent) -> Bound:
     """What a redeclaration of the component ``comp`` must respect."""
     decl = comp.decl
     current = interface(ctx, decl.type_name, comp.defined_in, len(decl.type_dims))
@@ -109,7 +109,7 @@ def component_bound(ctx: FlattenContext, comp: ViewComponent) -> Bound:
     return Bound(bound, current, True, False, decl.span)
 
 
-def class_bound(ctx: FlattenContext, entry: ClassEntry) -> Bound:
+def class_bound(ctx: ClassViews, entry: ClassEntry) -> Bound:
     """What a redeclaration of the class ``entry`` must respect."""
     defn = entry.defn
     where = entry.parent or entry
@@ -119,7 +119,7 @@ def class_bound(ctx: FlattenContext, entry: ClassEntry) -> Bound:
     return Bound(bound, current, defn.replaceable, defn.final, defn.span)
 
 
-def class_interface(ctx: FlattenContext, defn: s.ClassDef, where: ClassEntry
+def class_interface(ctx: ClassViews, defn: s.ClassDef, where: ClassEntry
                     ) -> Interface | None:
     """The interface of the class ``defn`` declared in ``where`` as a constraining
     type compares it: a short definition's base type without the dimensions the
@@ -134,18 +134,18 @@ def class_interface(ctx: FlattenContext, defn: s.ClassDef, where: ClassEntry
     return Interface(defn.name, None, entry, None, 0, ("", "", False))
 
 
-def _constraint(ctx: FlattenContext, ref: s.Ref, where: ClassEntry) -> Interface | None:
+def _constraint(ctx: ClassViews, ref: s.Ref, where: ClassEntry) -> Interface | None:
     return interface(ctx, ref, where)
 
 
-def _element_interface(ctx: FlattenContext, element: s.Component | s.ClassDef,
+def _element_interface(ctx: ClassViews, element: s.Component | s.ClassDef,
                        where: ClassEntry) -> Interface | None:
     if isinstance(element, s.Component):
         return interface(ctx, element.type_name, where, len(element.type_dims))
     return class_interface(ctx, element, where)
 
 
-def _check_chain(ctx: FlattenContext, name: str, bound: Bound,
+def _check_chain(ctx: ClassViews, name: str, bound: Bound,
                  chain: list[tuple[s.Component | s.ClassDef, ClassEntry]]) -> None:
     """Each redeclaration of ``chain`` (innermost first; the new element and the class
     it is written in) against what it replaces."""
@@ -179,7 +179,7 @@ def _same_type(a: Interface | None, b: Interface | None) -> bool:
     return (a.primitive, a.enumeration) == (b.primitive, b.enumeration) and a.entry is b.entry
 
 
-def _require(ctx: FlattenContext, own: Interface | None, bound: Interface | None,
+def _require(ctx: ClassViews, own: Interface | None, bound: Interface | None,
              span: Span | None, what: str, rule: str) -> None:
     if own is None or bound is None:
         return
@@ -190,7 +190,7 @@ def _require(ctx: FlattenContext, own: Interface | None, bound: Interface | None
                          "7.3.2")
 
 
-def _bases(ctx: FlattenContext, entry: ClassEntry) -> list[ClassEntry]:
+def _bases(ctx: ClassViews, entry: ClassEntry) -> list[ClassEntry]:
     found = []
     for element in entry.defn.elements:
         if isinstance(element, s.Extends):
@@ -201,7 +201,7 @@ def _bases(ctx: FlattenContext, entry: ClassEntry) -> list[ClassEntry]:
     return found
 
 
-def _inherited_component(ctx: FlattenContext, entry: ClassEntry, name: str
+def _inherited_component(ctx: ClassViews, entry: ClassEntry, name: str
                          ) -> ViewComponent | None:
     for base in _bases(ctx, entry):
         try:
@@ -213,7 +213,7 @@ def _inherited_component(ctx: FlattenContext, entry: ClassEntry, name: str
     return None
 
 
-def _inherited_class(ctx: FlattenContext, entry: ClassEntry, name: str) -> ClassEntry | None:
+def _inherited_class(ctx: ClassViews, entry: ClassEntry, name: str) -> ClassEntry | None:
     for base in _bases(ctx, entry):
         try:
             found = member_class(base, name)
@@ -224,7 +224,7 @@ def _inherited_class(ctx: FlattenContext, entry: ClassEntry, name: str) -> Class
     return None
 
 
-def _own_or_inherited_class(ctx: FlattenContext, entry: ClassEntry, name: str
+def _own_or_inherited_class(ctx: ClassViews, entry: ClassEntry, name: str
                             ) -> ClassEntry | None:
     own = entry.child(name)
     if own is not None and not own.defn.redeclare:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from ...errors import ErrorGroup, SpringcError
 from ...ir import syntax as s
 from ...parse import ClassEntry, lookup_class
-from ..scopes import BUILTIN_ENUMERATIONS, PRIMITIVES, FlattenContext, ViewComponent
+from ..scopes import BUILTIN_ENUMERATIONS, PRIMITIVES, ClassViews, ViewComponent
 
 #: Kinds of class that are compatible with each other (section 6.4); ``class`` is
 #: unrestricted and compatible with every kind.
@@ -39,7 +39,7 @@ class Interface:
     prefixes: tuple[str, str, bool]  # variability, causality, flow of short definitions
 
 
-def interface(ctx: FlattenContext, ref: s.Ref, scope: ClassEntry,
+def interface(ctx: ClassViews, ref: s.Ref, scope: ClassEntry,
               extra_dims: int = 0) -> Interface | None:
     """The interface of the type ``ref`` written in ``scope`` (with ``extra_dims``
     dimensions written next to it), or None where it cannot be resolved (an error
@@ -54,7 +54,7 @@ def interface(ctx: FlattenContext, ref: s.Ref, scope: ClassEntry,
                      len(rtype.dims) + extra_dims, rtype.prefixes)
 
 
-def _enumeration(ctx: FlattenContext, ref: s.Ref, scope: ClassEntry) -> tuple[str, ...] | None:
+def _enumeration(ctx: ClassViews, ref: s.Ref, scope: ClassEntry) -> tuple[str, ...] | None:
     """The literals of ``ref`` if it names an enumeration type (through short
     definitions), else None."""
     name = ref.dotted
@@ -77,8 +77,8 @@ def _kinds_compatible(a: str, b: str) -> bool:
     return "class" in (a, b) or a == b or any(a in g and b in g for g in _KIND_GROUPS)
 
 
-def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
-                    seen: frozenset[tuple[int, int]] = frozenset()) -> str | None:
+def incompatibility(ctx: ClassViews, a: Interface, b: Interface,
+                    seen: frozenset[tuple[ClassEntry, ClassEntry]] = frozenset()) -> str | None:
     """Why ``a`` is not a subtype of ``b`` (section 6.4), or None if it is."""
     if a.ndims != b.ndims:
         return (f"'{a.name}' has {a.ndims} array dimension(s), '{b.name}' has "
@@ -99,7 +99,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
             return f"'{a.name}' is {what}, '{b.name}' is {other}"
         return None
     assert a.entry is not None and b.entry is not None
-    if a.entry is b.entry or (id(a.entry), id(b.entry)) in seen:
+    if a.entry is b.entry or (a.entry, b.entry) in seen:
         return None
     ka, kb = a.entry.defn.kind, b.entry.defn.kind
     if not _kinds_compatible(ka, kb):
@@ -108,7 +108,7 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
         va, vb = ctx.view(a.entry), ctx.view(b.entry)
     except (SpringcError, ErrorGroup):
         return None  # reported where the class is used
-    inner_seen = seen | {(id(a.entry), id(b.entry))}
+    inner_seen = seen | {(a.entry, b.entry)}
     for name, cb in vb.components.items():
         if cb.decl.protected:
             continue
@@ -121,8 +121,8 @@ def incompatibility(ctx: FlattenContext, a: Interface, b: Interface,
     return None
 
 
-def _element_incompatibility(ctx: FlattenContext, ca: ViewComponent, cb: ViewComponent,
-                             seen: frozenset[tuple[int, int]]) -> str | None:
+def _element_incompatibility(ctx: ClassViews, ca: ViewComponent, cb: ViewComponent,
+                             seen: frozenset[tuple[ClassEntry, ClassEntry]]) -> str | None:
     ia = interface(ctx, ca.decl.type_name, ca.defined_in,
                    len(ca.decl.type_dims) + len(ca.decl.dims))
     ib = interface(ctx, cb.decl.type_name, cb.defined_in,

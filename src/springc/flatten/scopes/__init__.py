@@ -20,6 +20,7 @@ from .enumerations import (
     value_kind,
 )
 from .event_uses import EventUses
+from .identity import Ident
 from .limits import DEFAULT_MAX_SIZE, Limits, max_size_setting
 from .modification import Mod, ModValue, Redeclaration, each, from_syntax, merge, merge_all, select
 from .parameters import ParameterValues, binding_errors, check_powers
@@ -28,10 +29,12 @@ from .scope import (
     REDECLARE_RULES,
     ClassScope,
     ClassView,
+    ClassViews,
     Declared,
     Disabled,
     DisabledReference,
     ExpressionEvaluator,
+    FlatResults,
     FlattenContext,
     FunctionScope,
     Handler,
@@ -59,6 +62,7 @@ __all__ = [
     "BuiltinEnumeration",
     "ClassScope",
     "ClassView",
+    "ClassViews",
     "Declared",
     "DimensionKind",
     "Disabled",
@@ -67,9 +71,11 @@ __all__ = [
     "Enumeration",
     "EventUses",
     "ExpressionEvaluator",
+    "FlatResults",
     "FlattenContext",
     "FunctionScope",
     "Handler",
+    "Ident",
     "Leaf",
     "Limits",
     "LocalScope",

@@ -30,6 +30,7 @@ from .. import arrays as a
 from .class_extends import inherited_class
 from .enumerations import DimensionKind, Enumeration
 from .event_uses import EventUses
+from .identity import Ident
 from .limits import Limits
 from .modification import Mod, ModValue, from_syntax, merge_all
 from .parameters import ParameterValues
@@ -290,14 +291,14 @@ class Declared:
     """What a component declaration contributes independently of the instance: its
     resolved type, the type's modifications, and its sizes when they are literals."""
 
-    comp: ViewComponent  # kept alive: declared_types is keyed by its id
+    comp: ViewComponent
     rtype: ResolvedType
     type_mods: list[Mod | None]
     dims: tuple[int, ...] | None
 
 
 Handler = Callable[[s.Call, Scope], a.Value]
-AttributeCache = dict[tuple[tuple[str, int], ...], tuple[tuple[Mod, ...], flat.Attributes]]
+AttributeCache = dict[tuple[tuple[str, Ident[Mod]], ...], flat.Attributes]
 
 
 class BuiltinFunctions(Protocol):
@@ -340,26 +341,10 @@ class ExpressionEvaluator(Protocol):
     def range_values(self, index: s.ForIndex, scope: Scope) -> Sequence[x.Expr | str]: ...
 
 
-class FlattenContext(Protocol):
-    """What the flattening helpers call on the driver
-    (:class:`~springc.flatten.flattener.Flattener`): its results so far, its caches,
-    and class lookup and instantiation."""
-
-    parameter_values: ParameterValues
-    evaluator: ExpressionEvaluator
-    limits: Limits
-    errors: list[SpringcError]
-    equations: list[flat.Equation]
-    initial_equations: list[flat.Equation]
-    whens: list[When]
-    # assertions and the spans of their conditions (flatten/calls/assertions.py)
-    assertions: list[tuple[flat.Assertion, Span]]
-    # conditions of if-statements, checked to be Boolean once the types are known
-    statement_conditions: list[tuple[x.Expr, Span]]
-    attribute_cache: AttributeCache
-    reusable_views: dict[int, bool]
-
-    def report(self, err: FlattenError) -> None: ...
+class ClassViews(Protocol):
+    """Classes as the static rules, the redeclaration checks and the class views see
+    them: the view of a class (inheritance resolved) and what class and type names
+    denote. The small face of the driver for :mod:`..checks` and :mod:`..redeclare`."""
 
     def view(self, entry: ClassEntry, seen: tuple[ClassEntry, ...] = ()) -> ClassView: ...
 
@@ -367,6 +352,34 @@ class FlattenContext(Protocol):
                       ) -> ClassEntry: ...
 
     def resolve_type(self, ref: s.Ref, scope: ClassEntry) -> ResolvedType: ...
+
+
+class FlatResults(Protocol):
+    """The flat model built so far: equations, when-clauses and assertions (what
+    connection placeholders and algorithm start values are written into)."""
+
+    equations: list[flat.Equation]
+    initial_equations: list[flat.Equation]
+    whens: list[When]
+    # assertions and the spans of their conditions (flatten/calls/assertions.py)
+    assertions: list[tuple[flat.Assertion, Span]]
+
+
+class FlattenContext(ClassViews, FlatResults, Protocol):
+    """What the flattening helpers call on the driver
+    (:class:`~springc.flatten.flattener.Flattener`): its results so far, its caches,
+    and class lookup and instantiation. Helpers that need less take
+    :class:`ClassViews` or :class:`FlatResults`."""
+
+    parameter_values: ParameterValues
+    evaluator: ExpressionEvaluator
+    limits: Limits
+    errors: list[SpringcError]
+    # conditions of if-statements, checked to be Boolean once the types are known
+    statement_conditions: list[tuple[x.Expr, Span]]
+    attribute_cache: AttributeCache
+
+    def report(self, err: FlattenError) -> None: ...
 
     def resolve_function(self, ref: s.Ref, scope: Scope) -> ClassEntry: ...
 
@@ -397,7 +410,7 @@ class FlattenContext(Protocol):
     def variables(self, scope: ClassScope) -> Iterator[flat.Variable]: ...
 
 
-def build_view(entry: ClassEntry, flattener: FlattenContext, seen: tuple[ClassEntry, ...] = ()
+def build_view(entry: ClassEntry, flattener: ClassViews, seen: tuple[ClassEntry, ...] = ()
                ) -> ClassView:
     """Resolve ``extends`` clauses: base elements first, then the class's own."""
     if entry in seen:

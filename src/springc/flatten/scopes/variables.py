@@ -15,6 +15,7 @@ import numpy as np
 from ...errors import FlattenError, close_names
 from ...ir import flat
 from .. import arrays as a
+from .identity import Ident
 from .modification import Mod, select
 from .scope import ClassScope, FlattenContext, Primitive
 
@@ -68,13 +69,11 @@ def _attributes(flattener: FlattenContext, mod: Mod | None, name: str) -> flat.A
     its variables, also where a merge with a binding built a new ``mod`` around them."""
     if mod is None or not mod.children:
         return _EMPTY
-    key = tuple((k, id(child)) for k, child in mod.children.items())
+    key = tuple((k, Ident(child)) for k, child in mod.children.items())
     cached = flattener.attribute_cache.get(key)
     if cached is None:
-        # The entry keeps the children alive so that their ids are not reused.
-        cached = flattener.attribute_cache[key] = (tuple(mod.children.values()),
-                                                   _evaluate(flattener, mod, name))
-    return cached[1]
+        cached = flattener.attribute_cache[key] = _evaluate(flattener, mod, name)
+    return cached
 
 
 def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes:
