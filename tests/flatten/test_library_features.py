@@ -211,3 +211,25 @@ end M;
 ''')
     (item,) = flatten_files([path], "M").assertions
     assert item.message == "x = String(x), limit 5"
+
+
+def test_a_type_extending_string(tmp_path: Path) -> None:
+    """``type TypeString extends String;`` (the MSL's Icons.TypeString, which
+    MultiBody's AxisLabel and ShapeType are defined by) is a String type."""
+    assert outcome(tmp_path, '''\
+package TS
+  type TypeString
+    extends String;
+  end TypeString;
+  type Label = TypeString;
+  model M
+    parameter Label l = "x";
+    Real y = 1;
+  equation
+    assert(l == "x", "the label");
+  end M;
+end TS;
+model Top
+  TS.M m;
+end Top;
+''') == "Top: 1 unknown, 1 equation, 0 parameters: balanced"
