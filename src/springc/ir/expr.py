@@ -492,6 +492,8 @@ def _diff_binop(e: BinOp, d: Callable[[Expr], Expr]) -> Expr:
 
 def _diff_call(e: Call, d: Callable[[Expr], Expr]) -> Expr:
     name, args = e.name, e.args
+    if name in _PIECEWISE_CONSTANT:  # constant between events (section 3.7.5)
+        return ZERO
     x = args[0]
     dx = d(x)
     rules: dict[str, Callable[[], Expr]] = {
@@ -528,6 +530,9 @@ def _diff_call(e: Call, d: Callable[[Expr], Expr]) -> Expr:
     if name in ("mod", "rem"):
         return dx
     raise ValueError(f"cannot differentiate {name}(...)")
+
+
+_PIECEWISE_CONSTANT = frozenset({"pre", "edge", "change", "initial", "terminal", "sample"})
 
 
 # ------------------------------------------------------------------ printing
