@@ -261,24 +261,3 @@ end BF;
     binding = _bindings(model)["c[1,2]"]
     assert x.evaluate(binding, {"n": 2}) == 2
 
-
-def test_an_output_assigned_only_in_the_branch_a_parameter_selects(tmp_path: Path) -> None:
-    path = tmp_path / "m.mo"
-    path.write_text('''\
-model A
-  function f
-    input Integer order;
-    output Real alpha;
-  algorithm
-    if order == 1 then
-      alpha := 10;
-    elseif order == 2 then
-      alpha := 20;
-    end if;
-  end f;
-  parameter Integer n = 2;
-  parameter Real a = f(n);
-  Real y = a;
-end A;
-''')
-    assert x.evaluate(_bindings(flatten_files([path], "A"))["a"], {"n": 2}) == 20

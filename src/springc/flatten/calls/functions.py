@@ -342,14 +342,11 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         return
     resized = [name for name, value in then_names.items() if name in before
                and a.shape(value) != a.shape(scope.names.get(name))]
-    unassigned = [name for name, value in then_names.items() if name in before
-                  and (value is None) != (scope.names.get(name) is None)]
-    known = _known(ev, cond) if resized or unassigned else None
-    if known is not None:
-        # sizes are fixed before the simulation: so is this branch (10.1); an output
-        # assigned only in the branch a parameter selects is assigned
+    if resized and ev.flattener.is_parameter_expression(cond):
+        # sizes are fixed before the simulation: so is this branch (10.1)
         scope.names = dict(before)
-        _run(ev, body, scope, guard) if known else _if(ev, rest, scope, guard)
+        taken = bool(ev.fold(cond))
+        _run(ev, body, scope, guard) if taken else _if(ev, rest, scope, guard)
         return
     if resized:
         raise FlattenError(f"'{resized[0]}' gets different sizes in the branches of this "
