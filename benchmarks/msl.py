@@ -123,7 +123,13 @@ def read_reference(refs: Path, example: str, guard: float) -> Reference:
                      interval)
 
 
-def one(args: argparse.Namespace) -> dict[str, object]:
+def _stage(out: dict[str, object], stage: str) -> None:
+    """Record the stage reached (printed, so that a capped run still tells it)."""
+    out["stage"] = stage
+    print(f"STAGE {stage}", flush=True)
+
+
+def one(args: argparse.Namespace, out: dict[str, object]) -> None:
     """Check, simulate and compare one example (run in a child process)."""
     import numpy as np
 
@@ -132,10 +138,10 @@ def one(args: argparse.Namespace) -> dict[str, object]:
 
     example = args.one
     files = [str(args.msl / "Modelica" / "package.mo")]
-    out: dict[str, object] = {"example": example, "stage": "check"}
+    _stage(out, "check")
     flat = flatten_files(tuple(files), example, (str(args.msl),))
     check_balance(flat)
-    out["stage"] = "simulate"
+    _stage(out, "simulate")
     refdir = args.refs.joinpath(*example.split("."))
     reference = read_reference(args.refs, example, args.guard) \
         if (refdir / "comparisonSignals.txt").exists() and \
@@ -146,33 +152,32 @@ def one(args: argparse.Namespace) -> dict[str, object]:
                                   backend=args.backend)
     result = springc.simulate(model, interval=reference.interval if reference else None,
                               engine=args.engine, error_control=args.error_control)
-    out["stage"] = "compare"
+    _stage(out, "compare")
     if reference is None:
         out["note"] = "no reference result"
-        return out
+        return
     worst, where = 0.0, ""
     for signal in reference.signals:
         try:
             ours = np.interp(reference.time, result.time, result[signal])
         except KeyError:
             out["error"] = f"signal {signal} not in the result"
-            return out
+            return
         theirs = np.asarray(reference.values[signal])
         error = float(np.max(np.abs(ours - theirs) / np.maximum(1.0, np.abs(theirs)),
                              initial=0.0))
         if not error <= worst:
             worst, where = error, signal
     out.update(stage="match" if worst <= args.tol else "compare", worst=worst, signal=where)
-    return out
 
 
 def child(args: argparse.Namespace) -> int:
+    out: dict[str, object] = {"example": args.one, "stage": "none"}
     try:
-        out = one(args)
-    except BaseException as error:
+        one(args, out)
+    except BaseException as error:  # reported: the parent counts it
         text = str(error).strip().splitlines()
-        out = {"example": args.one, "error": f"{type(error).__name__}: "
-               + (text[0] if text else "")}
+        out["error"] = f"{type(error).__name__}: " + (text[0] if text else "")
         if isinstance(error, KeyboardInterrupt):
             raise
     print("RESULT " + json.dumps(out), flush=True)
@@ -187,9 +192,12 @@ def run_one(example: str, args: argparse.Namespace) -> dict[str, object]:
     began = time.perf_counter()
     try:
         done = subprocess.run(command, capture_output=True, text=True, timeout=args.cap)
-    except subprocess.TimeoutExpired:
+    except subprocess.TimeoutExpired as expired:
+        printed = expired.stdout.decode() if isinstance(expired.stdout, bytes) \
+            else expired.stdout or ""
+        stages = [line[6:] for line in printed.splitlines() if line.startswith("STAGE ")]
         return {"example": example, "error": f"timeout after {args.cap:g} s",
-                "seconds": args.cap}
+                "seconds": args.cap, "stage": stages[-1] if stages else "none"}
     seconds = time.perf_counter() - began
     for line in done.stdout.splitlines():
         if line.startswith("RESULT "):

@@ -211,3 +211,53 @@ end M;
 ''')
     (item,) = flatten_files([path], "M").assertions
     assert item.message == "x = String(x), limit 5"
+
+
+def test_a_type_extending_string(tmp_path: Path) -> None:
+    """``type TypeString extends String;`` (the MSL's Icons.TypeString, which
+    MultiBody's AxisLabel and ShapeType are defined by) is a String type."""
+    assert outcome(tmp_path, '''\
+package TS
+  type TypeString
+    extends String;
+  end TypeString;
+  type Label = TypeString;
+  model M
+    parameter Label l = "x";
+    Real y = 1;
+  equation
+    assert(l == "x", "the label");
+  end M;
+end TS;
+model Top
+  TS.M m;
+end Top;
+''') == "Top: 1 unknown, 1 equation, 0 parameters: balanced"
+
+
+def test_a_function_branch_ruled_out_by_a_parameter_may_be_out_of_bounds(
+        tmp_path: Path) -> None:
+    """Blocks.Continuous.Internal.Filter.Utilities.BesselBaseCoefficients' pattern:
+    the branch for another order writes elements the outputs do not have."""
+    path = tmp_path / "m.mo"
+    path.write_text('''\
+model BF
+  function coeffs
+    input Integer order;
+    output Real c2[integer(order / 2), 2];
+  algorithm
+    if order == 2 then
+      c2[1, 1] := 1; c2[1, 2] := 2;
+    elseif order == 4 then
+      c2[1, 1] := 1; c2[1, 2] := 2; c2[2, 1] := 3; c2[2, 2] := 4;
+    end if;
+  end coeffs;
+  parameter Integer n = 2;
+  parameter Real c[1, 2] = coeffs(n);
+  Real y = c[1, 2];
+end BF;
+''')
+    model = flatten_files([path], "BF")
+    binding = _bindings(model)["c[1,2]"]
+    assert x.evaluate(binding, {"n": 2}) == 2
+

@@ -128,7 +128,11 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     held = set(layout.discrete)
     for name, slot_name in layout.pre.items():
         if name not in held:
-            out.append(Store(f"z[{layout.slot[slot_name]}]", x.Var(name), f"pre({name})"))
+            now: x.Expr = x.Var(name)
+            u = m.unknowns.get(name)
+            if u is not None and u.start is not None:  # at the initialization pre(v)
+                now = x.If(_truth("_zinit"), x.Var(slot_name), now)  # is its start
+            out.append(Store(f"z[{layout.slot[slot_name]}]", now, f"pre({name})"))
     for (start, interval), name in zip(layout.events.samples, layout.samples):
         out.append(Store(f"z[{layout.slot[name]}]", _flag(_sample_hit(x.TIME, start, interval))))
     out.append(Raw("_zdone = 1.0"))

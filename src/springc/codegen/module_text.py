@@ -314,6 +314,13 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
         assert m.events is not None
         guesses.append(Store(f"z[{m.events.slot[d.name]}]", _start_of(m, d.name, d.start),
                              f"{d.name} (start)"))
+    if m.events is not None:  # pre(v) of the other variables before the first event
+        held = set(m.events.discrete)
+        for name, slot_name in m.events.pre.items():
+            u = m.unknowns.get(name)
+            if name not in held and u is not None and u.start is not None:
+                guesses.append(Store(f"z[{m.events.slot[slot_name]}]",
+                                     _start_of(m, name, u.start), f"pre({name}) (start)"))
     lines += ["", "", "def guesses(p):",
               '    """Initial Newton guesses of the tearing variables, then the flag."""']
     lines += function_lines(namer, helpers, m.loads()[:len(m.params)] + guesses)

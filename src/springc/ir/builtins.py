@@ -133,6 +133,11 @@ def _chain(outer: Callable[[n.Expr, n.Call], n.Expr]) -> Derivative:
     return rule
 
 
+def _between_events(call: n.Call, d: Callable[[n.Expr], n.Expr]) -> n.Expr:
+    """An event operator's value is constant between events (section 3.7.5)."""
+    return n.ZERO
+
+
 def _zero(call: n.Call, d: Callable[[n.Expr], n.Expr]) -> n.Expr:
     d(call.args[0])  # refused where its argument cannot be differentiated
     return n.ZERO  # piecewise constant
@@ -312,17 +317,18 @@ _OPERATORS = (
 _EVENTS = (
     Builtin("pre", EVENT, (1, 1), VARIABLE, SAME,
             "the left limit of a variable at an event", discrete=True, reads_pre=True,
-            unit="same", at_events=True),
+            unit="same", at_events=True, derivative=_between_events),
     Builtin("edge", EVENT, (1, 1), VARIABLE, BOOLEAN, "b and not pre(b)", discrete=True,
-            reads_pre=True, at_events=True),
+            reads_pre=True, at_events=True, derivative=_between_events),
     Builtin("change", EVENT, (1, 1), VARIABLE, BOOLEAN, "v <> pre(v)", discrete=True,
-            reads_pre=True, at_events=True),
+            reads_pre=True, at_events=True, derivative=_between_events),
     Builtin("initial", EVENT, (0, 0), ANY, BOOLEAN, "true during initialization",
-            discrete=True, phase=True, at_events=True),
+            discrete=True, phase=True, at_events=True, derivative=_between_events),
     Builtin("terminal", EVENT, (0, 0), ANY, BOOLEAN, "true at the end of the run",
-            discrete=True, phase=True, at_events=True),
+            discrete=True, phase=True, at_events=True, derivative=_between_events),
     Builtin("sample", EVENT, (2, 2), PARAMETER, BOOLEAN,
-            "true at start + k*interval (time events)", discrete=True, at_events=True),
+            "true at start + k*interval (time events)", discrete=True, at_events=True,
+            derivative=_between_events),
     Builtin("reinit", EQUATION, (2, 2), ANY, ANY,
             "reinit(x, value): a state takes a new value at an event", at_events=True),
     Builtin("terminate", EQUATION, (1, 1), STRING, ANY, "ends the run at an event",

@@ -63,12 +63,21 @@ def discrete_starts(model: flat.FlatModel) -> DiscreteStarts:
                 side = side.args[0]
             if (isinstance(side, x.Var) and side.name in held and side.name not in values
                     and x.variables(value) <= params
-                    and not any(isinstance(n, (x.Time, x.Der, x.Call)) and not (
+                    and not any(isinstance(n, (x.Der, x.Call)) and not (
                         isinstance(n, x.Call) and n.name in x.MATH) for n in x.walk(value))):
-                values[side.name] = value
+                # time is the start time during the initialization (the MSL's Pulse
+                # and Trapezoid set their period count from it)
+                values[side.name] = at_time(value, x.Const(model.experiment.start or 0.0))
                 used.add(id(eq))
                 break
     return DiscreteStarts(values, frozenset(used))
+
+
+def at_time(e: x.Expr, t: x.Expr) -> x.Expr:
+    """``e`` with ``time`` replaced by ``t``."""
+    if isinstance(e, x.Time):
+        return t
+    return x.map_children(e, lambda c: at_time(c, t))
 
 
 def when_exprs(whens: Iterable[w.When]) -> Iterator[x.Expr]:

@@ -6,7 +6,9 @@ The pipeline is a short list of passes, each in its own module:
    that a missing or surplus equation is reported with its location, before the
    structural passes would find it less clearly;
 1. ``free_parameters`` (:mod:`springc.simplify.free_parameters`): ``fixed = false``
-   parameters bound by their initial equations, or kept constant as states; then
+   parameters bound by their initial equations, or kept constant as states;
+   ``pre_starts`` (:mod:`springc.simplify.pre_starts`): ``pre(v) = e`` initial equations
+   as start values; then
    ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
@@ -30,6 +32,7 @@ from .free_parameters import free_parameters
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
+from .pre_starts import pre_starts
 from .state_select import check_state_select
 
 
@@ -66,7 +69,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
-    model = free_parameters(model)
+    model = pre_starts(free_parameters(model))
     system = lower(model)
     check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)

@@ -321,12 +321,26 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         return
     before = dict(scope.names)
     then_guard = cond if guard is None else x.BinOp("and", guard, cond)
-    branch_jumps(lambda: _run(ev, body, scope, then_guard), stmt.span)
+    try:
+        branch_jumps(lambda: _run(ev, body, scope, then_guard), stmt.span)
+    except FlattenError:  # a branch a parameter rules out need not be evaluable
+        if _known(ev, cond) is not False:
+            raise
+        scope.names = before
+        _if(ev, rest, scope, guard)
+        return
     then_names = scope.names
     scope.names = dict(before)
     not_cond = x.Not(cond)
     else_guard = not_cond if guard is None else x.BinOp("and", guard, not_cond)
-    branch_jumps(lambda: _if(ev, rest, scope, else_guard), stmt.span)
+    try:
+        branch_jumps(lambda: _if(ev, rest, scope, else_guard), stmt.span)
+    except FlattenError:
+        if _known(ev, cond) is not True:
+            raise
+        scope.names = dict(before)
+        _run(ev, body, scope, guard)
+        return
     resized = [name for name, value in then_names.items() if name in before
                and a.shape(value) != a.shape(scope.names.get(name))]
     if resized and ev.flattener.is_parameter_expression(cond):
@@ -347,6 +361,16 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
             raise FlattenError(f"'{name}' is assigned in only one branch of this if-statement",
                                stmt.span, hint="assign it before the if-statement too")
         scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
+
+
+def _known(ev: ExpressionEvaluator, cond: x.Expr) -> bool | None:
+    """The value of a condition that is a parameter expression, else None."""
+    if not ev.flattener.is_parameter_expression(cond):
+        return None
+    try:
+        return bool(ev.fold(cond))
+    except (KeyError, ArithmeticError, ValueError, TypeError):
+        return None
 
 
 def _assign(ev: ExpressionEvaluator, stmt: s.Assign, scope: FunctionScope) -> None:

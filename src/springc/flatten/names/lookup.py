@@ -128,7 +128,8 @@ class ClassLookup(FlattenContext):
                         prefixes[2] or short.flow)
             connector = connector or entry.defn.kind == "connector"
             base = short.base.dotted
-            if base in PRIMITIVES and lookup_class(base, entry.parent or entry) is None:
+            if (base in PRIMITIVES or base == "String") \
+                    and lookup_class(base, entry.parent or entry) is None:
                 return ResolvedType(base, None, tuple(dims), tuple(mods), prefixes, connector)
             entry = self.resolve_class(short.base, entry.parent or entry,
                                        entry if entry.defn.short is None else None)
@@ -149,7 +150,8 @@ class ClassLookup(FlattenContext):
         scope: ClassEntry = entry.parent or entry
         owner: ClassEntry | None = entry
         for _ in range(100):
-            if ref.dotted in PRIMITIVES and lookup_class(ref.dotted, scope) is None:
+            if (ref.dotted in PRIMITIVES or ref.dotted == "String") \
+                    and lookup_class(ref.dotted, scope) is None:  # String: Icons.TypeString
                 if ref is not element.base:
                     check_extends(self, entry)  # the kinds that may extend a type (7.1.3)
                 elif defn.kind not in ("type", "connector"):

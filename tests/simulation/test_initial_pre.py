@@ -1,0 +1,45 @@
+"""Initial equations that give discrete values (section 8.6): ``pre(v) = e`` of a
+variable no when-clause assigns (simplify/pre_starts.py: the MSL's OnOffController),
+and ``v = e(time)`` of a when-assigned one (the MSL's Pulse: its period count)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+import springc
+
+MODEL = '''\
+model OnOff
+  parameter Boolean startOn = true;
+  Real T(start = 0.5, fixed = true);
+  Boolean on;
+  Integer count;
+initial equation
+  pre(on) = startOn;
+  count = integer(time + 2.5);
+equation
+  on = pre(on) and T < 1 or T < 0;
+  der(T) = if on then 1 else -1;
+  when T > 0.9 then
+    count = pre(count) + 1;
+  end when;
+end OnOff;
+'''
+
+
+def test_pre_and_time_in_initial_equations(tmp_path: Path) -> None:
+    path = tmp_path / "OnOff.mo"
+    path.write_text(MODEL)
+    result = springc.simulate(str(path), backend="python", engine="scipy", stop=2.0,
+                              interval=0.25, rtol=1e-9, error_control="off")
+    # pre(on) = true: on, T rises from 0.5 to 1 (t = 0.5), falls to 0 (t = 1.5), rises
+    t = np.asarray(result.time)
+    expected = np.where(t <= 0.5, 0.5 + t, np.where(t <= 1.5, 1.5 - t, t - 1.5))
+    assert np.allclose(result["T"], expected, rtol=0, atol=1e-6)
+    on = dict(zip(t.tolist(), np.asarray(result["on"]).tolist()))
+    assert (on[0.0], on[0.25], on[1.0], on[1.75]) == (1.0, 1.0, 0.0, 1.0)
+    # count = integer(0 + 2.5) at the start, one more when T passes 0.9 (t = 0.4)
+    count = np.asarray(result["count"])
+    assert (count[0], count[1], count[-1]) == (2.0, 2.0, 3.0)
