@@ -162,7 +162,8 @@ def bench_chain_warm(repeats: int, fused: bool) -> None:
     import springc
     from handwritten import chain_rhs
     from springc.integrate import dop853
-    from springc.integrate.dop853_kernel import dop853_run
+    from springc.integrate import dop853_steps
+    from springc.integrate.loop import specialize
     from springc.integrate.models import no_observed
 
     n = 1000
@@ -190,11 +191,13 @@ def bench_chain_warm(repeats: int, fused: bool) -> None:
     p, z = np.array([100.0, 1.0, 1.0]), np.zeros(1)
     atols = np.full(x0.size, atol)
     if fused:  # the loop specialised by numba on this rhs (minutes to compile under load)
-        kernel = njit(cache=False, error_model="numpy")(dop853_run.py_func)
+        kernel = specialize("dop853_fused", dop853_steps, False)  # the shared loop
+        none = np.empty(0, dtype=np.int64)
 
         def hand_run() -> object:
-            return kernel(hand, no_observed, 0, no_observed, np.empty(0), np.empty(0), grid,
-                          x0.copy(), p, z, rtol, atols, np.inf, 0.0, 0, False, np.inf)
+            return kernel(hand, no_observed, no_observed, 0, no_observed, np.empty(0),
+                          np.empty(0), grid, x0.copy(), p, z, rtol, atols, np.inf, 0.0, 0,
+                          np.inf, (none, 0, 0, none, none))
     else:  # the same compiled loop calling the hand-written rhs through a function pointer
         def hand_run() -> object:
             return dop853(hand, grid, x0, p, z, rtol=rtol, atol=atol,

@@ -77,16 +77,18 @@ def warm(repeats: int, fused: bool) -> None:
     if fused:
         from numba import njit as jit
 
-        from springc.integrate.dop853_kernel import dop853_run  # the kernel's Python source
+        from springc.integrate import dop853_steps
+        from springc.integrate.loop import specialize  # the shared loop, on DOP853's hooks
 
-        fused_run = jit(cache=False, error_model="numpy")(dop853_run.py_func)
-        observed = njit(lambda t, x, p, z: np.empty(0))
+        fused_run = specialize("dop853_fused", dop853_steps, False)
+        observed = jit(lambda t, x, p, z: np.empty(0))
         atol = np.full(4, ATOL)
+        none = np.empty(0, dtype=np.int64)
 
         def call() -> object:
-            return fused_run(seed_rhs, observed, 0, observed, np.empty(0), np.empty(0), grid,
-                             SEED_X0.copy(), SEED_P, NO_Z, RTOL, atol, np.inf, 0.0, 0, False,
-                             np.inf)  # no crossings, no time event
+            return fused_run(seed_rhs, observed, observed, 0, observed, np.empty(0),
+                             np.empty(0), grid, SEED_X0.copy(), SEED_P, NO_Z, RTOL, atol,
+                             np.inf, 0.0, 0, np.inf, (none, 0, 0, none, none))
 
         began = time.perf_counter()
         call()

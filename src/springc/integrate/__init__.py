@@ -61,6 +61,6 @@ from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
 from .status import Status
 
 __all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
-           "bdf", "compile_seconds", "dop853", "ensemble", "fixed_step", "kernel_cached", "load", "newton_flops",
-           "newton_solve_flops",
-           "observed_grid", "radau", "rk45", "run_hybrid"]
+           "bdf", "compile_seconds", "dop853", "ensemble", "fixed_step", "kernel_cached",
+           "load", "newton_flops", "newton_solve_flops", "observed_grid", "radau", "rk45",
+           "run_hybrid"]

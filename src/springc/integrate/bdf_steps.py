@@ -59,7 +59,9 @@ def step_ratio_matrix(order: int, factor: float) -> np.ndarray:
 def change_differences(D: np.ndarray, order: int, factor: float) -> None:
     """``D[:order + 1]`` rescaled to a step ``factor`` times longer (scipy's ``change_D``)."""
     RU = step_ratio_matrix(order, factor) @ step_ratio_matrix(order, 1.0)
-    D[:order + 1] = RU.T @ D[:order + 1]
+    rescaled = RU.T @ D[:order + 1]
+    for i in range(order + 1):
+        copy(D[i], rescaled[i])
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -82,7 +84,8 @@ def newton_bdf(rhs: ModelFunction, t_new: float, y_predict: np.ndarray, c: float
     its correction in ``d``. Returns (converged, iterations, evaluations, status)."""
     n = y.size
     copy(y, y_predict)
-    d[:] = 0.0
+    for j in range(n):
+        d[j] = 0.0
     dy = np.empty(n)
     work = np.empty(n)
     dy_norm_old, rate = -1.0, -1.0
@@ -132,13 +135,16 @@ def bdf_dense_state(D: np.ndarray, order: int, t: float, h: float, at: float,
 
 Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
 Work = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-             np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-#: the method's scalars (``work[9]``): the Newton tolerance, the end and the step size of
+             np.ndarray]
+#: the rows of the vectors ``work[1]``: the predictor, its ``psi``, the correction, the
+#: error weights
+PREDICT, PSI, CORRECTION, SCALE = 0, 1, 2, 3
+#: the method's scalars (``work[5]``): the Newton tolerance, the end and the step size of
 #: the differences (the last step's, after its order and step-size change)
 NEWTON_TOL, T_NEW, H_NOW = 0, 1, 2
-#: its integers (``work[10]``): the order, the steps taken at this size and order, whether
-#: the iteration matrix is factorised
-ORDER, N_EQUAL, FACTORED = 0, 1, 2
+#: its integers (``work[6]``): the order, the steps taken at this size and order, whether
+#: the iteration matrix is factorised, whether the Jacobian was evaluated in this step
+ORDER, N_EQUAL, FACTORED, CURRENT_JAC = 0, 1, 2, 3
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -146,12 +152,14 @@ def factor_iteration_matrix(c: float, J: np.ndarray, positions: np.ndarray,
                             diagonal: np.ndarray, kl: int, ku: int, factors: np.ndarray,
                             pivots: np.ndarray) -> bool:
     """``I - c J`` assembled in its band and factorised; False if singular."""
-    flat = factors.reshape(factors.size)
-    flat[:] = 0.0
+    width = factors.shape[1]  # (positions: flat indices into the band)
+    for i in range(factors.shape[0]):
+        for j in range(width):
+            factors[i, j] = 0.0
     for k in range(diagonal.size):
-        flat[diagonal[k]] = 1.0
+        factors[diagonal[k] // width, diagonal[k] % width] = 1.0
     for k in range(positions.size):
-        flat[positions[k]] -= c * J[k]
+        factors[positions[k] // width, positions[k] % width] -= c * J[k]
     return band_factor(factors, kl, ku, pivots)
 
 
@@ -160,9 +168,9 @@ def setup(n: int, layout: Layout) -> Work:
     """The differences ``D``, the predictor and its ``psi``, the correction, the
     iteration matrix's band and pivots, the Jacobian's non-zeros and the scalars."""
     _, kl, ku, positions, _ = layout
-    return (np.zeros((MAX_ORDER + 3, n)), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
-            np.empty(n), np.empty(positions.size), np.zeros((n, 2 * kl + ku + 1)),
-            np.empty(n, dtype=np.int64), np.zeros(3), np.zeros(3, dtype=np.int64))
+    return (np.zeros((MAX_ORDER + 3, n)), np.empty((4, n)), np.empty(positions.size),
+            np.zeros((n, 2 * kl + ku + 1)), np.empty(n, dtype=np.int64), np.zeros(3),
+            np.zeros(4, dtype=np.int64))
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -170,7 +178,7 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
           h_abs: float, p: np.ndarray, z: np.ndarray, rtol: float, work: Work,
           counts: np.ndarray, end: np.ndarray) -> tuple[int, float]:
     """The Newton tolerance, the Jacobian at the start, the differences of order 1."""
-    D, reals, ints = work[0], work[9], work[10]
+    D, reals, ints = work[0], work[5], work[6]
     reals[NEWTON_TOL] = max(10 * EPS / rtol, min(0.03, rtol ** 0.5))
     J = jac(t, y, p, z)
     counts[JACOBIAN_CALLS] += 1
@@ -178,7 +186,7 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
     if status != SUCCESS:
         copy(end, y)
         return status, t
-    copy(work[6], J)
+    copy(work[2], J)
     copy(D[0], y)
     for i in range(y.size):
         D[1, i] = f[i] * h_abs
@@ -194,9 +202,11 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: 
     factorised again (and the Jacobian evaluated again once) where needed: (converged,
     iterations, status; a failure's state in ``end``)."""
     order_of, kl, ku, positions, diagonal = layout
-    y_predict, psi, d, scale, J = work[1], work[2], work[3], work[4], work[6]
-    factors, pivots, reals, ints = work[7], work[8], work[9], work[10]
-    converged, n_iter, current_jac = False, 0, False
+    vectors, J, factors, pivots, reals, ints = work[1], work[2], work[3], work[4], work[5], \
+        work[6]
+    y_predict, psi, d, scale = vectors[PREDICT], vectors[PSI], vectors[CORRECTION], \
+        vectors[SCALE]
+    converged, n_iter = False, 0
     while True:
         if not ints[FACTORED]:
             ints[FACTORED] = factor_iteration_matrix(c, J, positions, diagonal, kl, ku,
@@ -209,7 +219,7 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: 
             if status != SUCCESS:
                 copy(end, y_new)
                 return False, n_iter, status
-        if converged or current_jac:
+        if converged or ints[CURRENT_JAC]:
             return converged, n_iter, SUCCESS
         values = jac(t_new, y_predict, p, z)
         counts[JACOBIAN_CALLS] += 1
@@ -218,7 +228,7 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: 
             copy(end, y_predict)
             return False, n_iter, status
         copy(J, values)
-        ints[FACTORED], current_jac = 0, True
+        ints[FACTORED], ints[CURRENT_JAC] = 0, 1
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
@@ -229,11 +239,14 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
          ) -> tuple[int, float, float, float, float]:
     """One accepted step of BDF from ``(t, y)`` (rejected ones before it), then the
     differences, and maybe another order and step size."""
-    D, y_predict, psi, d, scale, ints = work[0], work[1], work[2], work[3], work[4], work[10]
+    D, vectors, ints = work[0], work[1], work[6]
+    y_predict, psi, d, scale = vectors[PREDICT], vectors[PSI], vectors[CORRECTION], \
+        vectors[SCALE]
     n = y.size
     if h_abs != h_proposed:  # clamped: the differences rescaled to the step
         change_differences(D, ints[ORDER], h_abs / h_proposed)
         ints[N_EQUAL] = 0
+    ints[CURRENT_JAC] = 0
     while True:
         order = ints[ORDER]
         if h_abs < min_step:
@@ -286,7 +299,8 @@ def new_differences(work: Work, t_new: float, h_abs: float, safety: float,
     """The differences after an accepted step, and maybe another order and step size
     (scipy's choice among the orders one below, equal and one above): the next step
     size."""
-    D, d, scale, reals, ints = work[0], work[3], work[4], work[9], work[10]
+    D, reals, ints = work[0], work[5], work[6]
+    d, scale = work[1][CORRECTION], work[1][SCALE]
     order = ints[ORDER]
     ints[N_EQUAL] += 1
     for i in range(d.size):
@@ -326,5 +340,5 @@ def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: 
 def dense(work: Work, t: float, h: float, y: np.ndarray, at: float, out: np.ndarray,
           blas: bool | None) -> None:
     """The interpolating polynomial of the last step at time ``at``."""
-    reals = work[9]
-    bdf_dense_state(work[0], work[10][ORDER], reals[T_NEW], reals[H_NOW], at, out)
+    reals = work[5]
+    bdf_dense_state(work[0], work[6][ORDER], reals[T_NEW], reals[H_NOW], at, out)

@@ -54,6 +54,8 @@ def index_file(dispatcher: Any) -> Path | None:
 def compile_once(dispatcher: Any, signature: Any) -> None:
     """Compile ``dispatcher`` for ``signature`` (or load it from numba's cache) under the
     lock of its cache folder, then freeze it to that signature."""
+    if tuple(signature.args) in dispatcher.overloads:
+        return
     folder = cache_folder(dispatcher)
     name = dispatcher.py_func.__qualname__
     lock = locked(folder, name) if folder is not None else contextlib.nullcontext()

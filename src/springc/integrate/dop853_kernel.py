@@ -29,8 +29,11 @@ def dop853_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
     none = np.empty(0, dtype=np.int64)
     layout = (none, 0, 0, none, none)
     if blas:
-        return SCIPY_SUMS(rhs, observed, observed, n_observed, crossing, signs, directions,
-                          grid, x0, p, z, rtol, atol, max_step, first_step, max_steps,
-                          t_stop, layout)
-    return PLAIN(rhs, observed, observed, n_observed, crossing, signs, directions, grid, x0,
-                 p, z, rtol, atol, max_step, first_step, max_steps, t_stop, layout)
+        result: ImplicitTuple = SCIPY_SUMS(rhs, observed, observed, n_observed, crossing,
+                                           signs, directions, grid, x0, p, z, rtol, atol,
+                                           max_step, first_step, max_steps, t_stop, layout)
+        return result
+    plain: ImplicitTuple = PLAIN(rhs, observed, observed, n_observed, crossing, signs,
+                                 directions, grid, x0, p, z, rtol, atol, max_step,
+                                 first_step, max_steps, t_stop, layout)
+    return plain

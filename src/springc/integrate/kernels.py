@@ -34,10 +34,10 @@ class Method:
 
 METHODS = {
     "dop853": Method("dop853", "dop853_steps", False, 10),
-    "rk45": Method("rk45", "rk45_steps", False, 10),
-    "radau": Method("radau", "radau_steps", True, 15),
-    "bdf": Method("bdf", "bdf_steps", True, 15),
-    FIXED_STEP: Method(FIXED_STEP, None, False, 8),
+    "rk45": Method("rk45", "rk45_steps", False, 8),
+    "radau": Method("radau", "radau_steps", True, 25),
+    "bdf": Method("bdf", "bdf_steps", True, 20),
+    FIXED_STEP: Method(FIXED_STEP, None, False, 7),
 }
 """The compiled methods by name (the fixed-step methods share :data:`FIXED_STEP`)."""
 

@@ -96,10 +96,8 @@ def initial_step(rhs: ModelFunction, t: float, y: np.ndarray, f: np.ndarray, lim
     for i in range(n):
         scale[i] = (d[i] - f[i]) / scale[i]
     d2 = rms(scale, blas) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** exponent
+    h1 = max(1e-6, h0 * 1e-3) if d1 <= 1e-15 and d2 <= 1e-15 \
+        else (0.01 / max(d1, d2)) ** exponent
     h_abs = min(100 * h0, h1, interval, max_step)
     if not h_abs > 0.0:  # underflowed (or NaN) at extreme values: no step
         copy(end, y)

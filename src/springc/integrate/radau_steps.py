@@ -56,16 +56,17 @@ def factor_newton_matrices(h: float, jacobian: np.ndarray, positions: np.ndarray
                            pivots_complex: np.ndarray) -> bool:
     """``MU_REAL / h I - J`` and ``MU_COMPLEX / h I - J`` assembled in their bands and
     factorised; False if either is singular."""
-    flat_real = real.reshape(real.size)
-    flat_complex = complex_.reshape(complex_.size)
-    flat_real[:] = 0.0
-    flat_complex[:] = 0.0
+    width = real.shape[1]  # (positions: flat indices into the band)
+    for i in range(real.shape[0]):
+        for j in range(width):
+            real[i, j] = 0.0
+            complex_[i, j] = 0.0
     for k in range(diagonal.size):
-        flat_real[diagonal[k]] = MU_REAL / h
-        flat_complex[diagonal[k]] = MU_COMPLEX / h
+        real[diagonal[k] // width, diagonal[k] % width] = MU_REAL / h
+        complex_[diagonal[k] // width, diagonal[k] % width] = MU_COMPLEX / h
     for k in range(positions.size):
-        flat_real[positions[k]] -= jacobian[k]
-        flat_complex[positions[k]] -= jacobian[k]
+        real[positions[k] // width, positions[k] % width] -= jacobian[k]
+        complex_[positions[k] // width, positions[k] % width] -= jacobian[k]
     return (band_factor(real, kl, ku, pivots_real)
             and band_factor(complex_, kl, ku, pivots_complex))
 
@@ -110,7 +111,8 @@ def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray
     W = np.zeros((3, n))
     for r in range(3):
         for c in range(3):
-            W[r] += TI[r, c] * Z0[c]
+            for j in range(n):
+                W[r, j] += TI[r, c] * Z0[c, j]
     for r in range(3):
         copy(Z[r], Z0[r])
     F = np.empty((3, n))
@@ -189,12 +191,15 @@ def dense_state(Q: np.ndarray, y_old: np.ndarray, x: float, out: np.ndarray) -> 
 
 Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
 Work = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-             np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
              np.ndarray, np.ndarray, np.ndarray, np.ndarray]
-#: the method's scalars between steps (``work[14]``): the Newton tolerance, the last
+#: the rows of the vectors ``work[3]`` (few arrays in the tuple: each one a hook takes
+#: costs compile time): the state at the last step's start, the error weights, the error
+#: estimate, its collocation part, a work vector, the derivative at the step's start
+Y_OLD, SCALE, ERROR, ERROR_Z, STAGE, F = 0, 1, 2, 3, 4, 5
+#: the method's scalars between steps (``work[8]``): the Newton tolerance, the last
 #: step size and error norm (-1: none), the start and length of the last step
 NEWTON_TOL, H_ABS_OLD, ERROR_NORM_OLD, T_OLD, H_DENSE = 0, 1, 2, 3, 4
-#: its flags (``work[15]``): the Jacobian is current, the matrices are factorised, the
+#: its flags (``work[9]``): the Jacobian is current, the matrices are factorised, the
 #: last step's collocation polynomial is there
 CURRENT_JAC, FACTORED, HAVE_DENSE = 0, 1, 2
 
@@ -205,10 +210,9 @@ def setup(n: int, layout: Layout) -> Work:
     Jacobian's non-zeros, the derivative at the step's start and the scalars."""
     _, kl, ku, positions, _ = layout
     width = 2 * kl + ku + 1
-    return (np.zeros((3, n)), np.zeros((3, n)), np.zeros((n, 3)), np.empty(n), np.empty(n),
-            np.empty(n), np.empty(n), np.empty(n), np.empty(positions.size),
-            np.zeros((n, width)), np.zeros((n, width), dtype=np.complex128),
-            np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n),
+    return (np.zeros((3, n)), np.zeros((3, n)), np.zeros((n, 3)), np.empty((6, n)),
+            np.empty(positions.size), np.zeros((n, width)),
+            np.zeros((n, width), dtype=np.complex128), np.empty((2, n), dtype=np.int64),
             np.zeros(5), np.zeros(3, dtype=np.int64))
 
 
@@ -217,7 +221,7 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
           h_abs: float, p: np.ndarray, z: np.ndarray, rtol: float, work: Work,
           counts: np.ndarray, end: np.ndarray) -> tuple[int, float]:
     """The Newton tolerance, the Jacobian at the start, no step history."""
-    reals, flags = work[14], work[15]
+    reals, flags = work[8], work[9]
     reals[NEWTON_TOL] = max(10 * EPS / rtol, min(0.03, rtol ** 0.5))
     J = jac(t, y, p, z)
     counts[JACOBIAN_CALLS] += 1
@@ -225,8 +229,8 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
     if status != SUCCESS:
         copy(end, y)
         return status, t
-    copy(work[8], J)
-    copy(work[13], f)
+    copy(work[4], J)
+    copy(work[3][F], f)
     flags[CURRENT_JAC], flags[FACTORED], flags[HAVE_DENSE] = 1, 0, 0
     reals[H_ABS_OLD], reals[ERROR_NORM_OLD], reals[T_OLD], reals[H_DENSE] = -1.0, -1.0, t, 0.0
     return SUCCESS, t
@@ -240,9 +244,9 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h:
     factorised again (and the Jacobian evaluated again once) where needed: (converged,
     iterations, rate, status)."""
     order, kl, ku, positions, diagonal = layout
-    Z0, Z, scale, J = work[0], work[1], work[4], work[8]
-    real, complex_, pivots_real, pivots_complex = work[9], work[10], work[11], work[12]
-    reals, flags = work[14], work[15]
+    Z0, Z, scale, J = work[0], work[1], work[3][SCALE], work[4]
+    real, complex_, pivots_real, pivots_complex = work[5], work[6], work[7][0], work[7][1]
+    reals, flags = work[8], work[9]
     converged, n_iter, rate = False, 0, -1.0
     while not converged:
         if not flags[FACTORED]:
@@ -277,8 +281,10 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
     the next step size, the derivative there and, if Newton converged slowly, the
     Jacobian."""
     order, kl, ku = layout[0], layout[1], layout[2]
-    Z0, Z, Q, y_old, scale, error, ZE, stage = work[:8]
-    real, pivots_real, f, reals, flags = work[9], work[11], work[13], work[14], work[15]
+    Z0, Z, Q, vectors = work[0], work[1], work[2], work[3]
+    y_old, scale, error, ZE = vectors[Y_OLD], vectors[SCALE], vectors[ERROR], vectors[ERROR_Z]
+    stage, f = vectors[STAGE], vectors[F]
+    real, pivots_real, reals, flags = work[5], work[7][0], work[8], work[9]
     n = y.size
     step_h_old, step_error_old = reals[H_ABS_OLD], reals[ERROR_NORM_OLD]
     if h_abs != h_proposed:  # clamped: no step-size history
@@ -359,8 +365,8 @@ def after_step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray,
                y_new: np.ndarray, end: np.ndarray) -> tuple[int, float, float, float, float]:
     """After an accepted step: the next step size, the derivative at the new state, the
     Jacobian there if Newton converged slowly, and the step's collocation polynomial."""
-    Z, Q, y_old, J, f, reals, flags = work[1], work[2], work[3], work[8], work[13], \
-        work[14], work[15]
+    Z, Q, y_old, J, f = work[1], work[2], work[3][Y_OLD], work[4], work[3][F]
+    reals, flags = work[8], work[9]
     recompute_jac = n_iter > 2 and rate > 1e-3
     factor = min(MAX_FACTOR, safety * predict_factor(h_abs, step_h_old, error_norm,
                                                        step_error_old))

@@ -238,18 +238,19 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     return Stretch(Work(accepted, taken, nfev, njev), (mean,) if accepted else ())
 
 
-KERNEL_NOTE = "compiling the {method} loop for this machine (once; this may take a minute)"
-"""The status line before a kernel compiles (numba has not cached it on this machine)."""
+KERNEL_NOTE = "compiling the {method} loop for this machine (once), about {seconds} s"
+"""The status line before a kernel compiles (numba has not cached it on this machine);
+``seconds``: :func:`springc.integrate.compile_seconds`, CPU seconds measured once."""
 
 
 def load_kernel(method: str, cached: Callable[[str], bool] | None = None) -> None:
     """Load the compiled loop of ``method``, first saying on stderr that it compiles
     where numba's cache does not hold it (``cached``: the check, by default
     :func:`springc.integrate.kernel_cached`)."""
-    from springc.integrate import kernel_cached, load
+    from springc.integrate import compile_seconds, kernel_cached, load
 
     if not (cached or kernel_cached)(method):
-        say(KERNEL_NOTE.format(method=method))
+        say(KERNEL_NOTE.format(method=method, seconds=compile_seconds(method)))
     load(method)
 
 
