@@ -1,5 +1,6 @@
 """Initial equations that give discrete values (section 8.6): ``pre(v) = e`` of a
-variable no when-clause assigns (simplify/pre_starts.py: the MSL's OnOffController),
+variable no when-clause assigns (simplify/pre_starts.py: the MSL's OnOffController) and
+``fixed = true`` on one (IdealGTOThyristor's ``off``),
 and ``v = e(time)`` of a when-assigned one (the MSL's Pulse: its period count)."""
 
 from __future__ import annotations
@@ -16,12 +17,14 @@ model OnOff
   Real T(start = 0.5, fixed = true);
   Boolean on;
   Integer count;
+  Boolean off(start = true, fixed = true);
 initial equation
   pre(on) = startOn;
   count = integer(time + 2.5);
 equation
   on = pre(on) and T < 1 or T < 0;
   der(T) = if on then 1 else -1;
+  off = not on;
   when T > 0.9 then
     count = pre(count) + 1;
   end when;
@@ -40,6 +43,8 @@ def test_pre_and_time_in_initial_equations(tmp_path: Path) -> None:
     assert np.allclose(result["T"], expected, rtol=0, atol=1e-6)
     on = dict(zip(t.tolist(), np.asarray(result["on"]).tolist()))
     assert (on[0.0], on[0.25], on[1.0], on[1.75]) == (1.0, 1.0, 0.0, 1.0)
+    # fixed = true on off sets pre(off), not off: off = not on = false at the start
+    assert float(np.asarray(result["off"])[0]) == 0.0
     # count = integer(0 + 2.5) at the start, one more when T passes 0.9 (t = 0.4)
     count = np.asarray(result["count"])
     assert (count[0], count[1], count[-1]) == (2.0, 2.0, 3.0)

@@ -5,7 +5,8 @@ equation determines. springc holds the value of ``pre(v)`` before the first even
 the start value of ``v`` (``ode_eval`` seeds ``pre(v)`` from it), so an equation
 ``pre(v) = e`` (or ``e = pre(v)``) whose ``e`` reads only parameters and constants
 (the MSL's ``OnOffController``: ``pre(y) = pre_y_start``) becomes that start value and
-leaves the initial problem of the states. When-assigned variables get the same from
+leaves the initial problem of the states; ``fixed = true`` on such a variable likewise
+sets ``pre(v)`` (its start), not ``v``. When-assigned variables get the same from
 ``events.discrete_starts``.
 """
 
@@ -35,10 +36,15 @@ def pre_starts(model: flat.FlatModel) -> flat.FlatModel:
             continue
         value = eq.rhs if isinstance(eq.lhs, x.Call) and eq.lhs.name == "pre" else eq.lhs
         starts[name] = at_time(value, x.Const(model.experiment.start or 0.0))
-    if not starts:
+    # fixed = true on such a variable also gives pre(v) its start value (8.6), not a
+    # condition on v itself (the MSL's IdealGTOThyristor: Boolean off(fixed = true))
+    fixed = {name for name, v in discrete.items() if v.attributes.fixed is True}
+    if not starts and not fixed:
         return model
-    variables = tuple(replace(v, attributes=replace(v.attributes, start=starts[v.name]))
-                      if v.name in starts else v for v in model.variables)
+    variables = tuple(replace(v, attributes=replace(
+        v.attributes, start=starts.get(v.name, v.attributes.start),
+        fixed=False if v.name in fixed else v.attributes.fixed))
+        if v.name in starts or v.name in fixed else v for v in model.variables)
     return replace(model, variables=variables, initial_equations=tuple(kept))
 
 
