@@ -137,7 +137,7 @@ class FunctionWriter:
             self._stmt(stmt)
 
     # Hooks of the target language (a C writer overrides them: codegen/c_printer.py).
-    block_end: ClassVar[str | None] = None  # the line that closes a loop's body
+    block_end: str | None = None  # the line that closes a loop's body (C: "}")
 
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
