@@ -68,7 +68,10 @@ class FunctionWriter:
         self._keys: dict[tuple[object, ...], int] = {}
         self._count: list[int] = []
         self._temps: dict[int, str] = {}
-        self._temp_vars: dict[int, set[str]] = {}
+        # which remembered values read a name, which a local holds: forgetting them on
+        # a reassignment costs what they are, not the number of temporaries
+        self._readers: dict[str, set[int]] = {}
+        self._holders: dict[str, set[int]] = {}
         self._scopes: list[set[int]] = [set()]
         self._in_branch = 0
         self._indent = indent
@@ -128,11 +131,20 @@ class FunctionWriter:
         for stmt in stmts:
             self._stmt(stmt)
 
+    # Hooks of the target language (a C writer overrides them: codegen/c_printer.py).
+    block_end: str | None = None  # the line that closes a loop's body (C: "}")
+
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
         if comment:
             line += "  # " + escaped(comment)
         self.lines.append(line)
+
+    def _assign(self, target: str, text: str, comment: str = "") -> None:
+        self._emit(f"{target} = {text}", comment)
+
+    def _comment(self, text: str) -> None:
+        self._emit("# " + escaped(text))
 
     def _stmt(self, stmt: Stmt) -> None:
         if isinstance(stmt, Let):
@@ -143,23 +155,23 @@ class FunctionWriter:
                 text, _ = self._print(stmt.expr)
                 self._reassigned(stmt.name)
                 ident = self.name(stmt.name)
-                self._emit(f"{ident} = {text}", stmt.comment)
+                self._assign(ident, text, stmt.comment)
                 self._remember(cid, ident, stmt.expr)
                 return
             text = self.expr(stmt.expr)
             self._reassigned(stmt.name)
-            self._emit(f"{self.name(stmt.name)} = {text}", stmt.comment)
+            self._assign(self.name(stmt.name), text, stmt.comment)
         elif isinstance(stmt, Load):
             self._reassigned(stmt.name)
-            self._emit(f"{self.name(stmt.name)} = {stmt.source}", stmt.comment)
+            self._assign(self.name(stmt.name), stmt.source, stmt.comment)
         elif isinstance(stmt, Store):
-            self._emit(f"{stmt.target} = {self.expr(stmt.expr)}", stmt.comment)
+            self._assign(stmt.target, self.expr(stmt.expr), stmt.comment)
         elif isinstance(stmt, Raw):
             for line in stmt.text.splitlines():
                 self._emit(line)
         elif isinstance(stmt, Block):
             if stmt.comment:
-                self._emit("# " + escaped(stmt.comment))
+                self._comment(stmt.comment)
             self.write(stmt.body)
         else:
             for name in defines_inside(stmt.body):
@@ -172,17 +184,22 @@ class FunctionWriter:
             for cid in self._scopes.pop():
                 self._temps.pop(cid, None)
             self._indent = outer
+            if self.block_end is not None:
+                self._emit(self.block_end)
 
     def _reassigned(self, name: str) -> None:
         ident = self.name(name)
-        stale = [cid for cid, names in self._temp_vars.items()
-                 if cid in self._temps and (name in names or self._temps[cid] == ident)]
-        for cid in stale:
-            del self._temps[cid]
+        for cid in self._readers.pop(name, set()):
+            self._temps.pop(cid, None)
+        for cid in self._holders.pop(ident, set()):
+            if self._temps.get(cid) == ident:
+                del self._temps[cid]
 
     def _remember(self, cid: int, name: str, e: Expr) -> None:
         self._temps[cid] = name
-        self._temp_vars[cid] = variables(e)
+        for v in variables(e):
+            self._readers.setdefault(v, set()).add(cid)
+        self._holders.setdefault(name, set()).add(cid)
         self._scopes[-1].add(cid)
 
     def expr(self, e: Expr, outer: int = 0) -> str:
@@ -197,7 +214,7 @@ class FunctionWriter:
         text, prec = self._print(e)
         if self._count[cid] > 1 and not _trivial(e) and not self._in_branch:
             name = f"_c{cid}"
-            self._emit(f"{name} = {text}")
+            self._assign(name, text)
             self._remember(cid, name, e)
             return name, 9
         return text, prec
