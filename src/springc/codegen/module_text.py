@@ -320,7 +320,7 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
             u = m.unknowns.get(name)
             if name not in held and u is not None and u.start is not None:
                 guesses.append(Store(f"z[{m.events.slot[slot_name]}]",
-                                     _start_of(m, name, u.start), f"pre({name}) (start)"))
+                                     start_of(m, name, u.start), f"pre({name}) (start)"))
     lines += ["", "", "def guesses(p):",
               '    """Initial Newton guesses of the tearing variables, then the flag."""']
     lines += function_lines(namer, helpers, m.loads()[:len(m.params)] + guesses)
