@@ -17,15 +17,16 @@ from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub
 from .context import NEWTON_ITERATIONS, NEWTON_TOLERANCE, CodegenBug, CodegenContext
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
-SOLVE = """SPRINGC_FN void springc_solve(int n, double *a, double *b, double *y)
+SOLVE = """SPRINGC_FN void springc_solve(int n, int m, double *a, double *b, double *y)
 {
-    /* y = a^-1 b (a: n x n, by rows): Gaussian elimination with partial pivoting */
-    /* a and b are overwritten; y is NaN where an entry is not finite or a is singular */
-    int i, j, k;
+    /* y = a^-1 b (a: n x n, b and y: n x m, by rows): Gaussian elimination with */
+    /* partial pivoting; a and b are overwritten; y is NaN where an entry of a or b */
+    /* is not finite or a is singular */
+    int i, j, k, c;
     for (i = 0; i < n * n; i++) {
         if (!(a[i] - a[i] == 0.0)) goto fail;
     }
-    for (i = 0; i < n; i++) {
+    for (i = 0; i < n * m; i++) {
         if (!(b[i] - b[i] == 0.0)) goto fail;
     }
     for (k = 0; k < n; k++) {
@@ -45,24 +46,28 @@ SOLVE = """SPRINGC_FN void springc_solve(int n, double *a, double *b, double *y)
                 a[k * n + j] = a[pivot * n + j];
                 a[pivot * n + j] = swap;
             }
-            swap = b[k];
-            b[k] = b[pivot];
-            b[pivot] = swap;
+            for (c = 0; c < m; c++) {
+                swap = b[k * m + c];
+                b[k * m + c] = b[pivot * m + c];
+                b[pivot * m + c] = swap;
+            }
         }
         for (i = k + 1; i < n; i++) {
             double f = a[i * n + k] / a[k * n + k];
             for (j = k + 1; j < n; j++) a[i * n + j] -= f * a[k * n + j];
-            b[i] -= f * b[k];
+            for (c = 0; c < m; c++) b[i * m + c] -= f * b[k * m + c];
         }
     }
-    for (i = n - 1; i >= 0; i--) {
-        double s = b[i];
-        for (j = i + 1; j < n; j++) s -= a[i * n + j] * y[j];
-        y[i] = s / a[i * n + i];
+    for (c = 0; c < m; c++) {
+        for (i = n - 1; i >= 0; i--) {
+            double s = b[i * m + c];
+            for (j = i + 1; j < n; j++) s -= a[i * n + j] * y[j * m + c];
+            y[i * m + c] = s / a[i * n + i];
+        }
     }
     return;
     fail:
-    for (i = 0; i < n; i++) y[i] = SPRINGC_NAN;
+    for (i = 0; i < n * m; i++) y[i] = SPRINGC_NAN;
 }"""
 
 
@@ -83,8 +88,8 @@ class CContext(CodegenContext):
         body += [Store(f"_A{index}[{i * n + j}]", e) for i, j, e in block.matrix]
         body.append(Raw(f"double _b{index}[{n}];"))
         body += [Store(f"_b{index}[{i}]", e) for i, e in enumerate(block.rhs)]
-        body.append(Raw(f"double _y{index}[{n}];\n"
-                        f"springc_solve({n}, _A{index}, _b{index}, _y{index});"))
+        body.append(Raw(f"double _y{index}[{n}];\n" + _solve(f"_y{index}", f"_A{index}",
+                                                               f"_b{index}", n, 1)))
         body += [Load(name, f"_y{index}[{k}]", name) for k, name in enumerate(block.names)]
         return Block(body, comment, {*block.names, f"_A{index}"})
 
@@ -109,7 +114,7 @@ class CContext(CodegenContext):
             loop.append(Raw(f"double _R{index}[{k}];"))
             loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
             loop.append(Raw(f"double _D{index}[{k}];\n"
-                            f"springc_solve({k}, _J{index}, _R{index}, _D{index});"))
+                            f"springc_solve({k}, 1, _J{index}, _R{index}, _D{index});"))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
         done: Expr | None = None
         for i, t in enumerate(block.tearing):
@@ -128,7 +133,68 @@ class CContext(CodegenContext):
         return Block(body, comment, names)
 
 
+def _solve(result: str, matrix: str, rhs: str, n: int, m: int) -> str:
+    """C lines solving ``matrix result = rhs`` (``rhs`` overwritten, ``matrix`` kept:
+    the Jacobian reads it again)."""
+    return (f"{{\n    double _w[{n * n}];\n"
+            f"    for (int _k = 0; _k < {n * n}; _k++) _w[_k] = {matrix}[_k];\n"
+            f"    springc_solve({n}, {m}, _w, {rhs}, {result});\n}}")
+
+
 _EMPTY = re.compile(r"(\w+) = np\.empty\((\d+)\)\Z")
+_ZEROS = re.compile(r"(\w+) = np\.zeros\(\((\d+), (\d+)\)\)\Z")
+_SOLVE = re.compile(r"(\w+) = np\.linalg\.solve\((\w+), (\w+)\) if ")
+_ENTRY = re.compile(r"(-?)(\w+)\[(\d+), (\d+)\]\Z")
+
+
+def c_jacobian(stmts: Sequence[Stmt]) -> list[Stmt]:
+    """The Jacobian's statements (:mod:`.jacobian`) in C: its matrices (``_C3 =
+    np.zeros((n, m))``) become arrays by rows, their entries ``_C3[i, j]`` flat
+    indices, its solves ``springc_solve``; ``jv = np.empty(n)`` is the argument."""
+    shapes: dict[str, tuple[int, int]] = {}
+
+    def flat(text: str) -> str:
+        found = _ENTRY.match(text)
+        if found is None:
+            return text
+        sign, name, i, j = found.groups()
+        return f"{sign}{name}[{int(i) * shapes[name][1] + int(j)}]"
+
+    def walk(body: Sequence[Stmt]) -> list[Stmt]:
+        out: list[Stmt] = []
+        for s in body:
+            if isinstance(s, Raw):
+                out += _jacobian_raw(s.text, shapes)
+            elif isinstance(s, Store):
+                out.append(Store(flat(s.target), s.expr, s.comment))
+            elif isinstance(s, Load):
+                out.append(Load(s.name, flat(s.source), s.comment))
+            elif isinstance(s, Block):
+                out.append(Block(walk(s.body), s.comment, s.defines, s.uses))
+            elif isinstance(s, Loop):
+                out.append(Loop(s.header, walk(s.body)))
+            else:
+                out.append(s)
+        return out
+
+    return walk(stmts)
+
+
+def _jacobian_raw(text: str, shapes: dict[str, tuple[int, int]]) -> list[Stmt]:
+    if text.startswith("jv = np.empty("):
+        return []
+    zeros = _ZEROS.match(text)
+    if zeros:
+        name, rows, cols = zeros.group(1), int(zeros.group(2)), int(zeros.group(3))
+        shapes[name] = (rows, cols)
+        return [Raw(f"double {name}[{rows * cols}] = {{0.0}};")]
+    solve = _SOLVE.match(text)
+    if solve:  # the matrix is square, of the right-hand side's rows
+        result, matrix, rhs = solve.groups()
+        n, m = shapes[rhs]
+        shapes[result] = (n, m)
+        return [Raw(f"double {result}[{n * m}];\n" + _solve(result, matrix, rhs, n, m))]
+    raise CodegenBug(f"no C for the statement {text!r}")
 
 
 def c_statements(stmts: Sequence[Stmt], outputs: Sequence[str]) -> list[Stmt]:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from ..errors import CodegenError
 from ..ir import flat, ode
 from ..ir.expr import If, Var
-from .c_context import SOLVE, CContext, c_statements
+from .c_context import SOLVE, CContext, c_jacobian, c_statements
 from .c_printer import C_RESERVED, HELPERS, c_function_body
 from .c_tables import c_tables
 from .context import CodegenContext, source_comment
@@ -28,7 +28,7 @@ from .generator import structural_parameters
 from .jacobian import jacobian_statements
 from .locate import at_initialization, locate, untranslatable
 from .module_text import parameter_value, start_of, topological
-from .statements import Block, Let, Load, Loop, Namer, Raw, Stmt, Store, reserved_name
+from .statements import Let, Load, Namer, Raw, Stmt, Store, reserved_name
 
 _SIGNATURE = "double t, const double *x, const double *p, double *z"
 JACOBIAN_LIMIT = 2000
@@ -121,28 +121,17 @@ def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[s
     return lines + _event_functions(m, namer, helpers)
 
 
-def _raw_lines(stmts: Sequence[Stmt]) -> list[str]:
-    out: list[str] = []
-    for s in stmts:
-        if isinstance(s, Raw):
-            out.append(s.text)
-        elif isinstance(s, (Block, Loop)):
-            out += _raw_lines(s.body)
-    return out
-
-
 def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, int, str]],
               namer: Namer, helpers: set[str]) -> list[str]:
     """``springc_jacobian`` (the non-zeros of d(rhs)/dx in CSC order, the analytic
-    Jacobian of :mod:`.jacobian`) and ``springc_jacobian_pattern``, where it is
-    cheap: a system whose linear and torn blocks need no matrix solve for it, with at
-    most :data:`JACOBIAN_LIMIT` non-zeros (else ``SPRINGC_HAS_JACOBIAN`` is 0 and
-    ``springc_jacobian`` returns -3)."""
+    Jacobian of :mod:`.jacobian`, blocks through ``springc_solve``) and
+    ``springc_jacobian_pattern``, where it has at most :data:`JACOBIAN_LIMIT`
+    non-zeros (else ``SPRINGC_HAS_JACOBIAN`` is 0 and ``springc_jacobian`` returns
+    -3)."""
     body, pattern = jacobian_statements(
         m.states, m.derivatives, described,
         {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
-    cheap = len(pattern) <= JACOBIAN_LIMIT and all(
-        text.startswith("jv = np.empty(") for text in _raw_lines(body))
+    cheap = len(pattern) <= JACOBIAN_LIMIT
     m.jacobian_size = len(pattern) if cheap else 0
     m.has_jacobian = cheap
     lines = ["", "SPRINGC_FN void springc_jacobian_pattern(int *rows, int *cols)", "{"]
@@ -153,7 +142,7 @@ def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, in
     if not cheap:
         return lines + _function(f"int springc_jacobian({_SIGNATURE}, double *jv)", [],
                                  "-3")
-    stmts = m.loads() + steps + c_statements(body, ("jv",))
+    stmts = m.loads() + steps + c_jacobian(body)
     return lines + _function(f"int springc_jacobian({_SIGNATURE}, double *jv)",
                              c_function_body(namer, helpers, stmts))
 
