@@ -146,7 +146,12 @@ def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
         return e if arg is e.arg else type(e)(arg)
     if isinstance(e, Call):
         args = tuple(substitute(a, mapping) for a in e.args)
-        return e if all(a is b for a, b in zip(args, e.args)) else Call(e.name, args)
+        if all(a is b for a, b in zip(args, e.args)):
+            return e
+        if e.name in ("pre", "edge", "change") and len(args) == 1 \
+                and isinstance(args[0], Const):  # a variable found to be a constant
+            return args[0] if e.name == "pre" else Const(False)
+        return Call(e.name, args)
     if isinstance(e, If):
         c, t, o = (substitute(x, mapping) for x in (e.cond, e.then, e.otherwise))
         return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
