@@ -76,7 +76,7 @@ def test_the_bouncing_ball_fmi3_description(tmp_path: Path) -> None:
                    for d in structure.iter("ContinuousStateDerivative")}
     assert derivatives == {"3": "2", "4": ""}  # der(h) = v, der(v) = -g
     indicators = [e.get("valueReference") for e in structure.iter("EventIndicator")]
-    assert variables[f"crossing[1]"]["valueReference"] == indicators[0]
+    assert variables["crossing[1]"]["valueReference"] == indicators[0]
     assert variables["crossing[1]"]["description"] == "event indicator: h <= 0"
 
 

@@ -19,4 +19,5 @@ from .simulate_command import simulate
 from .sweep_command import sweep
 from .tradeoff_command import tradeoff
 
-__all__ = ["check", "compile_", "ensemble", "flatten", "fmu", "main", "simulate", "sweep", "tradeoff"]
+__all__ = ["check", "compile_", "ensemble", "flatten", "fmu", "main", "simulate", "sweep",
+           "tradeoff"]

@@ -77,8 +77,8 @@ def _value(e: x.Expr | None, env: dict[str, float], default: float) -> float:
     if e is None:
         return default
     try:
-        value = float(x.evaluate(e, env))  # type: ignore[arg-type]
-    except Exception:  # noqa: BLE001 - a value that cannot be evaluated here
+        value = float(x.evaluate(e, env))
+    except Exception:
         return default
     return value if math.isfinite(value) else default
 

@@ -82,16 +82,6 @@ def state_dependencies(system: ode.ODE) -> dict[str, frozenset[str]]:
     return deps
 
 
-def _number(e: x.Expr | None, env: Mapping[str, object]) -> float | None:
-    if e is None:
-        return None
-    try:
-        value = x.evaluate(e, env)
-    except Exception:  # noqa: BLE001 - a start that reads variables: no start
-        return None
-    return float(value) if isinstance(value, (int, float, bool)) else None
-
-
 @dataclass(frozen=True)
 class ModelTables:
     """What the C model gives in order: names of states, parameters, observed; the
@@ -198,6 +188,6 @@ def per_second(unit: str | None) -> str | None:
         parsed = parse_unit(unit)
     except UnitSyntaxError:
         parsed = None
-    if parsed is None:
+    if parsed is None or SECOND_UNIT is None:
         return f"({unit})/s"
     return canonical(parsed / SECOND_UNIT)
