@@ -26,7 +26,7 @@ from ..pipeline import CompileOptions, derive_system
 from ..simplify import initial_state, parameter_values
 from . import description as xml
 from .glue import glue_source
-from .package import NO_COMPILER_NOTE, assemble, find_compiler, write_fmu
+from .package import NO_COMPILER_NOTE, assemble, compile_sources, find_compiler, write_fmu
 from .variables import ModelTables, interface
 
 FMI_VERSIONS = (3, 2)
@@ -104,9 +104,9 @@ def model_tables(system: ode.ODE, states: Iterable[str], parameters: Iterable[st
 
 
 def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
-               fmi_version: int = 3, compiler: str | None = "") -> FmuExport:
-    """Write the FMU of ``options``' model to ``output``. ``compiler``: the C compiler
-    (``""``: found on the PATH, :func:`.package.find_compiler`; None: sources only)."""
+               fmi_version: int = 3) -> FmuExport:
+    """Write the FMU of ``options``' model to ``output``: with a binary where a C
+    compiler is found (:func:`.package.find_compiler`), else sources only."""
     version = check_version(fmi_version)
     check_target(output, options.files)
     derived = derive_system(options)
@@ -122,12 +122,9 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
     header = xml.Header(system.name, identifier, token, "", experiment, _version())
     text = (xml.model_description_3 if version == 3 else xml.model_description_2)(
         header, face)
-    from .package import compile_sources
-
     build = xml.build_description(identifier, compile_sources(3)) if version == 3 else None
-    chosen = find_compiler() if compiler == "" else compiler
     package = assemble(version, identifier, text, build, source.text,
-                       glue_source(token, nominals, initial), chosen)
+                       glue_source(token, nominals, initial), find_compiler())
     write_fmu(output, package.entries, options.files)
     return FmuExport(os.fspath(output), system.name, version, package.binary,
                      len(tables.states), len(face.variables), tables.crossings,

@@ -11,11 +11,12 @@ A machine without a C compiler gets a sources-only FMU: the caller reports the n
 from __future__ import annotations
 
 import os
+import shlex
 import shutil
 import subprocess
 import tempfile
 import zipfile
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -56,25 +57,29 @@ def compile_sources(version: int) -> tuple[str, ...]:
     return ("springc_glue.c",) + COMMON + WRAPPER[version]
 
 
-def find_compiler(environ: Mapping[str, str] | None = None) -> str | None:
-    """The C compiler: ``$CC``, else the first of cc, gcc, clang on the PATH."""
-    env = os.environ if environ is None else environ
-    for name in ([env["CC"]] if env.get("CC") else []) + ["cc", "gcc", "clang"]:
-        found = shutil.which(name, path=env.get("PATH"))
+def find_compiler() -> list[str] | None:
+    """The C compiler's command: ``$CC`` (split as a shell would, never run by one), else
+    the first of cc, gcc, clang on the PATH; None where there is none (the same rule
+    as the C model's build, ``springc.pipeline.c_build``)."""
+    given = shlex.split(os.environ.get("CC", "").strip())
+    if given and shutil.which(given[0]) is not None:
+        return given
+    for name in ("cc", "gcc", "clang"):
+        found = shutil.which(name)
         if found:
-            return found
+            return [found]
     return None
 
 
 def build_binary(sources: Mapping[str, bytes], version: int, identifier: str,
-                 compiler: str) -> bytes:
+                 compiler: Sequence[str]) -> bytes:
     """The shared library of the FMU, compiled from ``sources`` by ``compiler``."""
     with tempfile.TemporaryDirectory(prefix="springc-fmu-") as folder:
         root = Path(folder)
         for name, data in sources.items():
             (root / name).write_bytes(data)
         target = root / f"{identifier}.so"
-        argv = [compiler, *COMPILER_FLAGS, "-I", str(root),
+        argv = [*compiler, *COMPILER_FLAGS, "-I", str(root),
                 *(str(root / name) for name in compile_sources(version)), "-lm",
                 "-o", str(target)]
         done = subprocess.run(argv, capture_output=True, text=True, check=False)
@@ -105,7 +110,7 @@ class Package:
 
 
 def assemble(version: int, identifier: str, description: str, build_xml: str | None,
-             model_c: str, glue_c: str, compiler: str | None) -> Package:
+             model_c: str, glue_c: str, compiler: Sequence[str] | None) -> Package:
     """The FMU's entries: model description, sources, and the binary where a compiler
     is at hand."""
     sources = wrapper_sources(version)
