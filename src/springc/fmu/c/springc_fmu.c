@@ -79,7 +79,17 @@ void smi_reset(SmInstance *inst) {
     inst->stop_defined = 0;
     inst->tolerance = 1e-6;
     inst->h = 0.0;
+    inst->next_event = SMI_NEVER;
     inst->terminated_by_model = 0;
+}
+
+/* the same instant as the pending time event: an importer's clock may round it */
+static int smi_at_time_event(const SmInstance *inst, double t) {
+    return fabs(inst->next_event - t) <= 1e-12 * (1.0 + fabs(t));
+}
+
+static void smi_ask_next_event(SmInstance *inst) {
+    inst->next_event = sm_next_time_event(inst->v[0], inst->x, inst->p, inst->z);
 }
 
 static void smi_message(SmInstance *inst, int status, const char *text) {
@@ -148,6 +158,7 @@ static void smi_indicators(SmInstance *inst, double *g) {
 static int smi_event(SmInstance *inst, int *states_changed) {
     double *before = inst->work + 10 * sm_nx;
     int code;
+    if (smi_at_time_event(inst, inst->v[0])) inst->v[0] = inst->next_event;
     memcpy(before, inst->x, sizeof(double) * (size_t)sm_nx);
     code = sm_event_update(inst->v[0], inst->x, inst->p, inst->z);
     inst->dirty = 1;
@@ -173,11 +184,9 @@ int smi_event_iteration(SmInstance *inst, int *states_changed, int *next_defined
     if (status != SMI_OK) return status;
     if (smi_refresh(inst) != SMI_OK) return SMI_DISCARD;
     smi_indicators(inst, inst->g_prev);
-    {
-        double next = sm_next_time_event(inst->v[0], inst->x, inst->p, inst->z);
-        *next_defined = next < SMI_NEVER;
-        *next_time = next;
-    }
+    smi_ask_next_event(inst);
+    *next_defined = inst->next_event < SMI_NEVER;
+    *next_time = inst->next_event;
     return SMI_OK;
 }
 
@@ -198,6 +207,7 @@ int smi_exit_initialization(SmInstance *inst) {
     }
     if (smi_refresh(inst) != SMI_OK) return SMI_ERROR;
     smi_indicators(inst, inst->g_prev);
+    smi_ask_next_event(inst);
     inst->mode = inst->cosimulation ? SMI_STEP : SMI_EVENT;
     return SMI_OK;
 }
@@ -313,7 +323,9 @@ int smi_do_step(SmInstance *inst, double t0, double step, int *terminate,
     if (inst->h <= 0.0) inst->h = fmin(step, 1e-3 * fmax(1.0, fabs(step)));
     while (t < t_end - 1e-13 * (1.0 + fabs(t_end))) {
         double next = sm_next_time_event(t, inst->x, inst->p, inst->z);
-        double target = fmin(t_end, next);
+        inst->next_event = next;
+        /* a time event rounded just past the end of the step is taken in it */
+        double target = next <= t_end + 1e-12 * (1.0 + fabs(t_end)) ? next : t_end;
         double h = fmin(inst->h, target - t), err = 0.0;
         int hits_target = h >= target - t;
         if (hits_target) h = target - t;
@@ -340,7 +352,7 @@ int smi_do_step(SmInstance *inst, double t0, double step, int *terminate,
             t = hits_target ? target : t + h;
             smi_set_time(inst, t);
             memcpy(inst->g_prev, g, sizeof(double) * (size_t)sm_ng);
-            if (hits_target && next <= t_end) {
+            if (hits_target && target == next) {
                 if (smi_step_event(inst, terminate) != SMI_OK) return SMI_ERROR;
             }
             if (!hits_target || h == inst->h)

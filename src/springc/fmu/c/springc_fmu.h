@@ -34,6 +34,7 @@ struct SmInstance {
     int dirty;                /* dx and w need computing */
     double start_time, stop_time, tolerance;
     int stop_defined;
+    double next_event;        /* the model's next time event, as last asked */
     double h;                 /* Co-Simulation: the step size carried between steps */
     double *work;             /* Co-Simulation: the Runge-Kutta stages */
     int terminated_by_model;
