@@ -85,3 +85,26 @@ def test_fmpy_validates_and_runs_the_fmu_as_springc_does(
                                    relative_tolerance=1e-9, output=variables,
                                    output_interval=stop / POINTS)
         assert _deviation(result, references[case], variables) < TOLERANCE, kind
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_parameters_set_by_the_importer_move_the_bound_ones_and_the_starts(
+        version: int, tmp_path: Path) -> None:
+    """The chain's spring constant ``k`` binds every ``s[i].c`` (calculated parameters)
+    and ``ds`` the start of ``m[1].s``: set through FMPy, they change the run as
+    ``springc.simulate(parameters=...)`` does."""
+    path = tmp_path / "chain.fmu"
+    springc.export_fmu(str(MODELS / "Scenes.mdl"), path, "Scenes.Chain", fmi_version=version)
+    causality = {v.name: v.causality for v in fmpy.read_model_description(str(path))
+                 .modelVariables}
+    assert (causality["k"], causality["s[3].c"]) == ("parameter", "calculatedParameter")
+    values = {"k": 200.0, "ds": 0.3}
+    reference = springc.simulate(str(MODELS / "Scenes.mdl"), model_name="Scenes.Chain",
+                                 stop=2.0, interval=0.01, rtol=1e-9, atol=1e-9,
+                                 parameters=values, engine="scipy", backend="python")
+    for kind in ("ModelExchange", "CoSimulation"):
+        result = fmpy.simulate_fmu(str(path), fmi_type=kind, stop_time=2.0,
+                                   relative_tolerance=1e-9, output=["m[1].s", "m[5].v"],
+                                   output_interval=0.01, start_values=values)
+        assert result["m[1].s"][0] == pytest.approx(1.3, abs=1e-12)
+        assert _deviation(result, reference, ["m[1].s", "m[5].v"]) < TOLERANCE, kind
