@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 from fmpy.model_description import read_build_description
+from fmpy.validation import validate_fmu
 
 import springc
 from springc.cli import main
@@ -175,3 +176,36 @@ def test_the_api_refuses_to_overwrite_an_input_and_a_bad_version(tmp_path: Path)
     assert info.value.option == "output"
     with pytest.raises(UsageError, match="--fmi must be 3 or 2, not 4"):
         springc.export_fmu(SEED, tmp_path / "x.fmu", fmi_version=4)
+
+
+OUTPUTS = """model WithOutputs
+  parameter Real k = 2;
+  output Real x(start = 1, fixed = true) "decaying state";
+  output Real y "twice x";
+  Real z;
+equation
+  der(x) = -k*x;
+  y = 2*x;
+  z = y + 1;
+end WithOutputs;
+"""
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_the_models_outputs_are_the_fmus_outputs(version: int, tmp_path: Path) -> None:
+    model = tmp_path / "outputs.mo"
+    model.write_text(OUTPUTS)
+    path = tmp_path / "outputs.fmu"
+    springc.export_fmu(str(model), path, fmi_version=version)
+    assert validate_fmu(str(path)) == []
+    description = fmpy.read_model_description(str(path))
+    assert {v.name: v.causality for v in description.modelVariables} == {
+        "time": "independent", "x": "output", "der(x)": "local", "k": "parameter",
+        "y": "output", "z": "local"}
+    assert [(o.variable.name, [d.name for d in o.dependencies])
+            for o in description.outputs] == [("x", ["x"]), ("y", ["x"])]
+    assert sorted(u.variable.name for u in description.initialUnknowns) == ["der(x)", "y"]
+    result = fmpy.simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=1.0,
+                               relative_tolerance=1e-9)
+    assert result.dtype.names == ("time", "x", "y")  # the outputs, recorded by default
+    assert result["y"][-1] == pytest.approx(2 * np.exp(-2.0), rel=1e-7)

@@ -116,9 +116,16 @@ def interface(system: ode.ODE, model: flat.FlatModel, tables: ModelTables) -> Fm
         return variable.attributes.unit or None, variable.description
 
     nx = len(tables.states)
+    outputs: list[int] = []
+    dependencies: dict[int, tuple[int, ...]] = {}
     for i, name in enumerate(tables.states):
         unit, text = described(name)
-        variables.append(FmuVariable(name, 1 + i, "Real", "local", "continuous",
+        if is_output(by_name.get(name)):
+            outputs.append(1 + i)
+            dependencies[1 + i] = (1 + i,)
+        variables.append(FmuVariable(name, 1 + i, "Real",
+                                     "output" if 1 + i in outputs else "local",
+                                     "continuous",
                                      "exact" if fixed.get(name, True) else "approx",
                                      tables.initial_states[i], unit, text))
     for i, name in enumerate(tables.states):
@@ -142,20 +149,16 @@ def interface(system: ode.ODE, model: flat.FlatModel, tables: ModelTables) -> Fm
             "calculated" if bound else "exact",
             None if bound else tables.parameter_values[i], unit, text))
     base += len(tables.parameters)
-    outputs: list[int] = []
-    dependencies: dict[int, tuple[int, ...]] = {}
     state_refs = {name: 1 + i for i, name in enumerate(tables.states)}
     for i, name in enumerate(tables.observed):
         unit, text = described(name)
         variable = by_name.get(name)
-        is_output = variable is not None and variable.causality == "output" and \
-            "." not in name.split("[")[0]
         kind = discrete.get(name, "Real")
         variables.append(FmuVariable(
-            name, base + i, kind, "output" if is_output else "local",
+            name, base + i, kind, "output" if is_output(variable) else "local",
             "discrete" if name in discrete else "continuous", "calculated", None, unit,
             text))
-        if is_output:
+        if is_output(variable):
             outputs.append(base + i)
             dependencies[base + i] = tuple(sorted(state_refs[s]
                                                   for s in deps.get(name, ())))
@@ -173,10 +176,17 @@ def interface(system: ode.ODE, model: flat.FlatModel, tables: ModelTables) -> Fm
     for i, name in enumerate(tables.states):
         dependencies[1 + nx + i] = tuple(sorted(
             state_refs[s] for s in deps.get(derivative_of.get(name, ""), ())))
-    unknowns = set(outputs) | set(calculated) | set(derivatives) | {
+    computed = {v.reference for v in variables if v.initial in ("approx", "calculated")}
+    unknowns = (set(outputs) & computed) | set(calculated) | set(derivatives) | {
         1 + i for i, name in enumerate(tables.states) if not fixed.get(name, True)}
     return FmuInterface(tuple(variables), tuple(outputs), derivatives,
                         tuple(sorted(unknowns)), dependencies, indicators)
+
+
+def is_output(variable: flat.Variable | None) -> bool:
+    """An ``output`` of the model itself (not one of its components' outputs)."""
+    return variable is not None and variable.causality == "output" and \
+        "." not in variable.name.split("[")[0]
 
 
 def per_second(unit: str | None) -> str | None:
