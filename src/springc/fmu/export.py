@@ -124,7 +124,8 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
         header, face)
     build = xml.build_description(identifier, compile_sources(3)) if version == 3 else None
     package = assemble(version, identifier, text, build, source.text,
-                       glue_source(token, nominals, initial), find_compiler())
+                       glue_source(token, nominals, initial, experiment.tolerance),
+                       find_compiler())
     write_fmu(output, package.entries, options.files)
     return FmuExport(os.fspath(output), system.name, version, package.binary,
                      len(tables.states), len(face.variables), tables.crossings,

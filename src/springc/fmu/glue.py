@@ -19,10 +19,16 @@ def _doubles(values: Sequence[float]) -> str:
                            for v in (list(values) or [0.0])) + "}"
 
 
+DEFAULT_TOLERANCE = 1e-6
+"""Co-Simulation's relative tolerance where neither the importer nor the model's
+experiment annotation gives one."""
+
+
 def glue_source(token: str, nominals: Sequence[float],
-                initial: Sequence[float] | None) -> str:
+                initial: Sequence[float] | None, tolerance: float | None = None) -> str:
     """``springc_glue.c``: ``initial`` the consistent initial states springc computed at
-    the default parameters (None: the start values of ``springc_start`` are initial)."""
+    the default parameters (None: the start values of ``springc_start`` are initial);
+    ``tolerance`` the experiment annotation's (None: :data:`DEFAULT_TOLERANCE`)."""
     return f"""/* springc: the FMU's view of the model in {MODEL_FILE} (springc_glue.h). */
 #include <math.h>
 
@@ -46,6 +52,7 @@ const int sm_after_initial = 0;
 const int sm_has_x_initial = {0 if initial is None else 1};
 const double sm_nominals[] = {_doubles(nominals)};
 const double sm_x_initial[] = {_doubles(initial or [])};
+const double sm_tolerance = {float(tolerance or DEFAULT_TOLERANCE)!r};
 const char *const sm_token = "{token}";
 
 void sm_parameters(double *p, const int *given) {{ springc_parameters(p, given); }}

@@ -77,7 +77,7 @@ void smi_reset(SmInstance *inst) {
     inst->start_time = 0.0;
     inst->stop_time = SMI_NEVER;
     inst->stop_defined = 0;
-    inst->tolerance = 1e-6;
+    inst->tolerance = sm_tolerance;
     inst->h = 0.0;
     inst->next_event = SMI_NEVER;
     inst->terminated_by_model = 0;

@@ -20,6 +20,7 @@ extern const int sm_after_initial; /* an event right after the initial one */
 extern const int sm_has_x_initial; /* sm_x_initial holds springc's initial values */
 extern const double sm_nominals[]; /* nominal value of each state (at least one entry) */
 extern const double sm_x_initial[];/* consistent initial states at the default parameters */
+extern const double sm_tolerance; /* Co-Simulation's tolerance where none is given */
 extern const char *const sm_token; /* the instantiation token of modelDescription.xml */
 
 void sm_parameters(double *p, const int *given);
