@@ -108,3 +108,19 @@ def test_parameters_set_by_the_importer_move_the_bound_ones_and_the_starts(
                                    output_interval=0.01, start_values=values)
         assert result["m[1].s"][0] == pytest.approx(1.3, abs=1e-12)
         assert _deviation(result, reference, ["m[1].s", "m[5].v"]) < TOLERANCE, kind
+
+
+def test_a_co_simulation_step_handles_every_event_inside_it(tmp_path: Path) -> None:
+    """Communication steps of 0.5 s over the bouncing ball: each doStep locates and
+    handles the impacts inside it (9 by 3.5 s) with its own solver."""
+    files, model, stop, variables = CASES["bouncing ball"]
+    path = tmp_path / "ball.fmu"
+    springc.export_fmu([str(f) for f in files], path, model)
+    reference = springc.simulate([str(f) for f in files], model_name=model, stop=stop,
+                                 interval=0.5, rtol=1e-9, atol=1e-9, outputs=variables,
+                                 engine="scipy", backend="python")
+    result = fmpy.simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=stop,
+                               relative_tolerance=1e-9, output=variables,
+                               output_interval=0.5)
+    assert list(result["bounces"]) == [0, 1, 1, 2, 3, 4, 6, 9]  # as springc counts them
+    assert _deviation(result, reference, variables) < TOLERANCE

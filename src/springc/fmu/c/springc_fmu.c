@@ -304,8 +304,12 @@ static double dp_locate(SmInstance *inst, double t, const double *x0, double h,
     return t + hi;
 }
 
-static int smi_step_event(SmInstance *inst, int *terminate) {
+/* the event at the current time inside doStep; the solver restarts with a small step,
+ * so that the indicators leave zero before a step could cross one twice (a bounce
+ * whose rise and fall fit in one step would be missed) */
+static int smi_step_event(SmInstance *inst, int *terminate, double step) {
     int changed = 0, status = smi_event(inst, &changed);
+    inst->h = fmin(inst->h, 1e-6 * step);
     if (status == SMI_OK) status = smi_refresh(inst);
     smi_indicators(inst, inst->g_prev);
     if (inst->terminated_by_model) *terminate = 1;
@@ -346,14 +350,14 @@ int smi_do_step(SmInstance *inst, double t0, double step, int *terminate,
             memcpy(inst->x, x1, sizeof(double) * (size_t)n);
             smi_set_time(inst, te);
             t = te;
-            if (smi_step_event(inst, terminate) != SMI_OK) return SMI_ERROR;
+            if (smi_step_event(inst, terminate, step) != SMI_OK) return SMI_ERROR;
         } else {
             memcpy(inst->x, x1, sizeof(double) * (size_t)n);
             t = hits_target ? target : t + h;
             smi_set_time(inst, t);
             memcpy(inst->g_prev, g, sizeof(double) * (size_t)sm_ng);
             if (hits_target && target == next) {
-                if (smi_step_event(inst, terminate) != SMI_OK) return SMI_ERROR;
+                if (smi_step_event(inst, terminate, step) != SMI_OK) return SMI_ERROR;
             }
             if (!hits_target || h == inst->h)
                 inst->h = h * fmin(5.0, 0.9 * pow(fmax(err, 1e-10), -0.2));
