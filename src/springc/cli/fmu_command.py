@@ -30,8 +30,8 @@ def fmu(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
     check_output_options([("-o", output, FMU_SUFFIX)], files)
     done = export_fmu(CompileOptions(files, model, libraries, "python", None, (), False),
                       output, int(fmi_version))
-    if done.note:
-        click.echo(f"warning: {done.note}", err=True)
+    for warning in (done.note, *done.warnings) if done.note else done.warnings:
+        click.echo(printable(f"warning: {warning}"), err=True)
     if verbosity() >= 0:
         click.echo(printable(
             f"{done.path}: FMI {done.fmi_version}.0 FMU of {done.model} (Model Exchange "

@@ -45,6 +45,13 @@ class FmuExport:
     variables: int
     event_indicators: int
     note: str | None      # why the FMU holds no binary
+    warnings: tuple[str, ...] = ()  # what the FMU does differently from springc
+
+
+STATIC_CHOICE_WARNING = (
+    "springc switches the states of this model during a run where the choice made by "
+    "index reduction turns singular; the FMU keeps the states chosen at export ({states})"
+    " and fails where springc would switch")
 
 
 def check_version(version: object) -> int:
@@ -127,6 +134,8 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
                        glue_source(token, nominals, initial, experiment.tolerance),
                        find_compiler())
     write_fmu(output, package.entries, options.files)
+    shown = ", ".join(tables.states[:4]) + (", ..." if len(tables.states) > 4 else "")
+    warnings = (STATIC_CHOICE_WARNING.format(states=shown),) if derived.switchable else ()
     return FmuExport(os.fspath(output), system.name, version, package.binary,
                      len(tables.states), len(face.variables), tables.crossings,
-                     None if package.binary else NO_COMPILER_NOTE)
+                     None if package.binary else NO_COMPILER_NOTE, warnings)
