@@ -222,3 +222,39 @@ def test_a_model_whose_states_springc_switches_is_exported_with_a_warning(
         "made by index reduction turns singular; the FMU keeps the states chosen at export "
         "(x, vx) and fails where springc would switch\n")
     assert path.is_file()
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_directional_derivatives_are_the_jacobian_of_the_state_derivatives(
+        version: int, tmp_path: Path) -> None:
+    """d der(mass.v[2]) / d mass.pos[2] of the seed, through FMI's directional
+    derivative, against central differences of the derivative the FMU computes."""
+    path = tmp_path / "seed.fmu"
+    springc.export_fmu(SEED, path, fmi_version=version)
+    flag = "providesDirectionalDerivatives" if version == 3 else \
+        "providesDirectionalDerivative"
+    assert [e.get(flag) for e in _description(path) if e.tag in (
+        "ModelExchange", "CoSimulation")] == ["true", "true"]
+    description = fmpy.read_model_description(str(path))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    fmu = fmpy.instantiate_fmu(fmpy.extract(str(path)), description,
+                               fmi_type="ModelExchange")
+    if version == 2:
+        fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    get = fmu.getFloat64 if version == 3 else fmu.getReal
+    put = fmu.setFloat64 if version == 3 else fmu.setReal
+    state, unknown = refs["mass.pos[2]"], refs["der(mass.v[2])"]
+    exact = fmu.getDirectionalDerivative([unknown], [state], [1.0])[0]
+    start, step = get([state])[0], 1e-6
+
+    def derivative_at(shift: float) -> float:
+        put([state], [start + shift])
+        return float(get([unknown])[0])
+
+    difference = (derivative_at(step) - derivative_at(-step)) / (2 * step)
+    fmu.terminate()
+    fmu.freeInstance()
+    assert exact == pytest.approx(difference, rel=1e-6)
+    assert abs(exact) > 1e3  # the spring's stiffness (k = 1e4) dominates it

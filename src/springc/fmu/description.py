@@ -31,6 +31,11 @@ class Header:
     description: str
     experiment: flat.Experiment
     version: str  # the springc version
+    directional: bool = False  # the model's Jacobian in C: directional derivatives
+
+
+def _flag(value: bool) -> str:
+    return "true" if value else "false"
 
 
 def _number(value: float) -> str:
@@ -98,7 +103,8 @@ def model_description_3(header: Header, face: FmuInterface) -> str:
     if not header.description:
         del root.attrib["description"]
     common = {"modelIdentifier": header.identifier, "canGetAndSetFMUState": "false",
-              "canSerializeFMUState": "false", "providesDirectionalDerivatives": "false"}
+              "canSerializeFMUState": "false",
+              "providesDirectionalDerivatives": _flag(header.directional)}
     ET.SubElement(root, "ModelExchange", common)
     ET.SubElement(root, "CoSimulation", {**common,
                                          "canHandleVariableCommunicationStepSize": "true",
@@ -143,7 +149,8 @@ def model_description_2(header: Header, face: FmuInterface) -> str:
     if not header.description:
         del root.attrib["description"]
     common = {"modelIdentifier": header.identifier, "canGetAndSetFMUstate": "false",
-              "canSerializeFMUstate": "false", "providesDirectionalDerivative": "false"}
+              "canSerializeFMUstate": "false",
+              "providesDirectionalDerivative": _flag(header.directional)}
     ET.SubElement(root, "ModelExchange", common)
     ET.SubElement(root, "CoSimulation", {**common,
                                          "canHandleVariableCommunicationStepSize": "true"})

@@ -90,6 +90,12 @@ def _value(e: x.Expr | None, env: dict[str, float], default: float) -> float:
     return value if math.isfinite(value) else default
 
 
+def has_jacobian(text: str) -> bool:
+    """Whether the C model computes its Jacobian (``SPRINGC_HAS_JACOBIAN`` 1): the FMU
+    then provides directional derivatives of the state derivatives along the states."""
+    return re.search(r"^#define SPRINGC_HAS_JACOBIAN 1\b", text, re.MULTILINE) is not None
+
+
 def model_tables(system: ode.ODE, states: Iterable[str], parameters: Iterable[str],
                  observed: Iterable[str], crossings: Iterable[str], t0: float
                  ) -> tuple[ModelTables, tuple[float, ...] | None, tuple[float, ...]]:
@@ -126,7 +132,8 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
     face = interface(system, flat_model, tables)
     identifier = identifier_of(system.name)
     token = _token(source.text, repr(face), str(version), repr(experiment))
-    header = xml.Header(system.name, identifier, token, "", experiment, _version())
+    header = xml.Header(system.name, identifier, token, "", experiment, _version(),
+                        has_jacobian(source.text))
     text = (xml.model_description_3 if version == 3 else xml.model_description_2)(
         header, face)
     build = xml.build_description(identifier, compile_sources(3)) if version == 3 else None

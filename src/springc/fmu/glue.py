@@ -52,6 +52,8 @@ const int sm_after_initial = 0;
 const int sm_has_x_initial = {0 if initial is None else 1};
 const double sm_nominals[] = {_doubles(nominals)};
 const double sm_x_initial[] = {_doubles(initial or [])};
+const int sm_has_jacobian = SPRINGC_HAS_JACOBIAN;
+const int sm_njac = SPRINGC_N_JAC;
 const double sm_tolerance = {float(tolerance or DEFAULT_TOLERANCE)!r};
 const char *const sm_token = "{token}";
 
@@ -77,5 +79,11 @@ double sm_next_time_event(double t, const double *x, const double *p, double *z)
 
 int sm_event_update(double t, double *x, const double *p, double *z) {{
     return springc_event_update(t, x, p, z);
+}}
+
+void sm_jacobian_pattern(int *rows, int *cols) {{ springc_jacobian_pattern(rows, cols); }}
+
+int sm_jacobian(double t, const double *x, const double *p, double *z, double *jv) {{
+    return springc_jacobian(t, x, p, z, jv);
 }}
 """

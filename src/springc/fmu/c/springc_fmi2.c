@@ -220,9 +220,8 @@ FMI2_Export fmi2Status fmi2GetDirectionalDerivative(
     fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
     const fmi2ValueReference vKnown_ref[], size_t nKnown, const fmi2Real dvKnown[],
     fmi2Real dvUnknown[]) {
-    (void)vUnknown_ref; (void)nUnknown; (void)vKnown_ref; (void)nKnown; (void)dvKnown;
-    (void)dvUnknown;
-    return refuse(c, "providesDirectionalDerivative is false");
+    return (fmi2Status)smi_directional(INST, vUnknown_ref, nUnknown, vKnown_ref, nKnown,
+                                       dvKnown, dvUnknown);
 }
 
 /* Model Exchange */

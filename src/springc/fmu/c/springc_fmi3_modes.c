@@ -67,11 +67,19 @@ FMI3_Export fmi3Status fmi3DeserializeFMUState(fmi3Instance instance,
                                 fmi3Float64 sensitivity[], size_t nSensitivity) {         \
         (void)unknowns; (void)nUnknowns; (void)knowns; (void)nKnowns; (void)seed;         \
         (void)nSeed; (void)sensitivity; (void)nSensitivity;                               \
-        return unsupported(instance, "providesDirectionalDerivatives is false");           \
+        return unsupported(instance, "providesAdjointDerivatives is false");               \
     }
 
-SPRINGC_NO_DERIVATIVE(fmi3GetDirectionalDerivative)
 SPRINGC_NO_DERIVATIVE(fmi3GetAdjointDerivative)
+
+FMI3_Export fmi3Status fmi3GetDirectionalDerivative(
+    fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,
+    const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],
+    size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity) {
+    if (nSeed != nKnowns || nSensitivity != nUnknowns) return fmi3Error;
+    return (fmi3Status)smi_directional(INST, unknowns, nUnknowns, knowns, nKnowns, seed,
+                                       sensitivity);
+}
 
 FMI3_Export fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
     return unsupported(instance, "the FMU has no structural parameters");

@@ -212,6 +212,52 @@ int smi_exit_initialization(SmInstance *inst) {
     return SMI_OK;
 }
 
+/* the directional derivative of state derivatives (unknowns) along states (knowns):
+ * the model's analytic Jacobian d(dx)/dx times the seed */
+int smi_directional(SmInstance *inst, const unsigned int *unknowns, size_t n_unknowns,
+                    const unsigned int *knowns, size_t n_knowns, const double *seed,
+                    double *sensitivity) {
+    unsigned int first_derivative = 1u + (unsigned int)sm_nx;
+    int k, status = SMI_OK, *rows, *cols;
+    size_t i, j;
+    double *jv;
+    for (i = 0; i < n_unknowns; ++i)
+        if (unknowns[i] < first_derivative || unknowns[i] >= first_derivative + sm_nx) {
+            smi_message(inst, SMI_ERROR, "directional derivatives: the unknowns must be "
+                        "state derivatives");
+            return SMI_ERROR;
+        }
+    for (j = 0; j < n_knowns; ++j)
+        if (knowns[j] < 1u || knowns[j] >= first_derivative) {
+            smi_message(inst, SMI_ERROR, "directional derivatives: the knowns must be "
+                        "continuous states");
+            return SMI_ERROR;
+        }
+    if (!sm_has_jacobian) {
+        smi_message(inst, SMI_ERROR, "the model has no Jacobian in C");
+        return SMI_ERROR;
+    }
+    rows = (int *)malloc(sizeof(int) * ((size_t)sm_njac + 1));
+    cols = (int *)malloc(sizeof(int) * ((size_t)sm_njac + 1));
+    jv = (double *)malloc(sizeof(double) * ((size_t)sm_njac + 1));
+    for (i = 0; i < n_unknowns; ++i) sensitivity[i] = 0.0;
+    if (!rows || !cols || !jv) {
+        status = SMI_ERROR;
+    } else {
+        sm_jacobian_pattern(rows, cols);
+        if (sm_jacobian(inst->v[0], inst->x, inst->p, inst->z, jv) != 0) status = SMI_DISCARD;
+    }
+    for (k = 0; status == SMI_OK && k < sm_njac; ++k)
+        for (i = 0; i < n_unknowns; ++i)
+            if ((int)(unknowns[i] - first_derivative) == rows[k])
+                for (j = 0; j < n_knowns; ++j)
+                    if ((int)(knowns[j] - 1u) == cols[k]) sensitivity[i] += jv[k] * seed[j];
+    free(rows);
+    free(cols);
+    free(jv);
+    return status;
+}
+
 void smi_set_time(SmInstance *inst, double t) {
     inst->v[0] = t;
     inst->dirty = 1;

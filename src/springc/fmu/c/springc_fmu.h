@@ -6,6 +6,8 @@
 #ifndef SPRINGC_FMU_H
 #define SPRINGC_FMU_H
 
+#include <stddef.h>
+
 #include "springc_glue.h"
 
 /* value references: 0 time, then states, derivatives, parameters, observed
@@ -55,6 +57,9 @@ int smi_event_iteration(SmInstance *inst, int *states_changed, int *next_defined
 int smi_completed_step(SmInstance *inst, int *enter_event);
 int smi_do_step(SmInstance *inst, double t0, double step, int *terminate,
                 double *last_time);
+int smi_directional(SmInstance *inst, const unsigned int *unknowns, size_t n_unknowns,
+                    const unsigned int *knowns, size_t n_knowns, const double *seed,
+                    double *sensitivity);
 void smi_set_time(SmInstance *inst, double t);
 void smi_set_states(SmInstance *inst, const double *x);
 

@@ -20,6 +20,8 @@ extern const int sm_after_initial; /* an event right after the initial one */
 extern const int sm_has_x_initial; /* sm_x_initial holds springc's initial values */
 extern const double sm_nominals[]; /* nominal value of each state (at least one entry) */
 extern const double sm_x_initial[];/* consistent initial states at the default parameters */
+extern const int sm_has_jacobian; /* sm_jacobian computes d(dx)/dx */
+extern const int sm_njac;          /* its non-zeros */
 extern const double sm_tolerance; /* Co-Simulation's tolerance where none is given */
 extern const char *const sm_token; /* the instantiation token of modelDescription.xml */
 
@@ -30,5 +32,7 @@ int sm_observed(double t, const double *x, const double *p, double *z, double *w
 int sm_crossings(double t, const double *x, const double *p, double *z, double *g);
 double sm_next_time_event(double t, const double *x, const double *p, double *z);
 int sm_event_update(double t, double *x, const double *p, double *z);
+void sm_jacobian_pattern(int *rows, int *cols);
+int sm_jacobian(double t, const double *x, const double *p, double *z, double *jv);
 
 #endif
