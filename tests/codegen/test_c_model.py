@@ -15,6 +15,7 @@ import springc
 from pendulum_text import PENDULUM
 from springc.errors import CodegenError
 from springc.pipeline import CLibrary, CompiledModel, c_library
+from springc.pipeline.c_build import build_library
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -236,3 +237,26 @@ def test_delay_is_a_located_error(tmp_path: Path) -> None:
     assert error.message == ("cannot generate C code for delay(...) (not supported in "
                              "the C model): delay(x, 0.5) in the equation of 'der(x)'")
     assert error.span is not None and (error.span.line, error.span.column) == (4, 3)
+
+
+STRICT = ("-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror", "-Wno-unused-parameter",
+          "-Wno-unused-variable", "-Wno-unused-const-variable", "-Wno-unused-function",
+          "-Wno-unused-but-set-variable")
+FILE_SCOPE = ("#", "/* ", "static const ", "SPRINGC_FN ", "{", "}", "    ")
+
+
+@pytest.mark.parametrize("text,name", [(PENDULUM, "Pendulum"), (LINEAR, "Lin"),
+                                       (SAMPLER, "Sampler")])
+def test_the_file_is_strict_c99_with_no_mutable_global(tmp_path: Path, text: str,
+                                                         name: str) -> None:
+    _, lib = compiled(tmp_path, text, "", name)
+    source = lib.source
+    # at file scope only directives, comments, constant tables and SPRINGC_FN functions
+    assert all(line.startswith(FILE_SCOPE) for line in source.splitlines() if line)
+    assert "malloc" not in source and "#include <math.h>" in source
+    assert [line for line in source.splitlines() if line.startswith("#include")] == [
+        "#include <math.h>"]
+    for extra in ((), ("-DSPRINGC_NO_TABLES",)):
+        folder = tmp_path / f"strict{len(extra)}"
+        folder.mkdir()
+        assert build_library(source, folder, (*STRICT, *extra))[:4] == b"\x7fELF"

@@ -61,7 +61,7 @@ SOLVE = """SPRINGC_FN void springc_solve(int n, double *a, double *b, double *y)
         y[i] = s / a[i * n + i];
     }
     return;
-fail:
+    fail:
     for (i = 0; i < n; i++) y[i] = SPRINGC_NAN;
 }"""
 

@@ -31,6 +31,10 @@ from .module_text import parameter_value, start_of, topological
 from .statements import Block, Let, Load, Loop, Namer, Raw, Stmt, Store, reserved_name
 
 _SIGNATURE = "double t, const double *x, const double *p, double *z"
+JACOBIAN_LIMIT = 2000
+"""Non-zeros of the largest Jacobian printed in C. The 10 x 10 cloth's 3,300 take 2.5 MB
+of C in one function, and the C compiler minutes at -O2 (about 30 s of CPU without
+it); integrators of the C model (FMI's, the GPU's explicit methods) work without."""
 
 
 @dataclass(frozen=True)
@@ -131,12 +135,14 @@ def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, in
               namer: Namer, helpers: set[str]) -> list[str]:
     """``springc_jacobian`` (the non-zeros of d(rhs)/dx in CSC order, the analytic
     Jacobian of :mod:`.jacobian`) and ``springc_jacobian_pattern``, where it is
-    cheap: a system whose linear and torn blocks need no matrix solve for it (else
-    ``SPRINGC_HAS_JACOBIAN`` is 0 and ``springc_jacobian`` returns -3)."""
+    cheap: a system whose linear and torn blocks need no matrix solve for it, with at
+    most :data:`JACOBIAN_LIMIT` non-zeros (else ``SPRINGC_HAS_JACOBIAN`` is 0 and
+    ``springc_jacobian`` returns -3)."""
     body, pattern = jacobian_statements(
         m.states, m.derivatives, described,
         {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
-    cheap = all(text.startswith("jv = np.empty(") for text in _raw_lines(body))
+    cheap = len(pattern) <= JACOBIAN_LIMIT and all(
+        text.startswith("jv = np.empty(") for text in _raw_lines(body))
     m.jacobian_size = len(pattern) if cheap else 0
     m.has_jacobian = cheap
     lines = ["", "SPRINGC_FN void springc_jacobian_pattern(int *rows, int *cols)", "{"]

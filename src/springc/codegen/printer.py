@@ -73,7 +73,10 @@ class FunctionWriter:
         self._keys: dict[tuple[object, ...], int] = {}
         self._count: list[int] = []
         self._temps: dict[int, str] = {}
-        self._temp_vars: dict[int, set[str]] = {}
+        # which remembered values read a name, which a local holds: forgetting them on
+        # a reassignment costs what they are, not the number of temporaries
+        self._readers: dict[str, set[int]] = {}
+        self._holders: dict[str, set[int]] = {}
         self._scopes: list[set[int]] = [set()]
         self._in_branch = 0
         self._indent = indent
@@ -134,7 +137,7 @@ class FunctionWriter:
             self._stmt(stmt)
 
     # Hooks of the target language (a C writer overrides them: codegen/c_printer.py).
-    block_end: ClassVar[str | None] = None  # the line that closes a loop's body
+    block_end: str | None = None  # the line that closes a loop's body (C: "}")
 
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
@@ -191,14 +194,17 @@ class FunctionWriter:
 
     def _reassigned(self, name: str) -> None:
         ident = self.name(name)
-        stale = [cid for cid, names in self._temp_vars.items()
-                 if cid in self._temps and (name in names or self._temps[cid] == ident)]
-        for cid in stale:
-            del self._temps[cid]
+        for cid in self._readers.pop(name, set()):
+            self._temps.pop(cid, None)
+        for cid in self._holders.pop(ident, set()):
+            if self._temps.get(cid) == ident:
+                del self._temps[cid]
 
     def _remember(self, cid: int, name: str, e: Expr) -> None:
         self._temps[cid] = name
-        self._temp_vars[cid] = variables(e)
+        for v in variables(e):
+            self._readers.setdefault(v, set()).add(cid)
+        self._holders.setdefault(name, set()).add(cid)
         self._scopes[-1].add(cid)
 
     def expr(self, e: Expr, outer: int = 0) -> str:

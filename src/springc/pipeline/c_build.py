@@ -64,10 +64,12 @@ def find_compiler() -> list[str]:
 def build_library(source: str, folder: Path, extra: Sequence[str] = ()) -> bytes:
     """The shared library compiled from the C text ``source`` in ``folder`` (a private
     folder of the caller), with further compiler arguments ``extra``; its bytes."""
-    src, out = folder / "build.c", folder / "build.so"
-    src.write_text(source, encoding="ascii")
-    argv = [*find_compiler(), *C_FLAGS, *extra, "-o", str(out), str(src), "-lm"]
-    done = subprocess.run(argv, capture_output=True, text=True, check=False)
+    out = folder / "build.so"
+    (folder / "build.c").write_text(source, encoding="ascii")
+    # names relative to the folder: the library records "build.c", not a random path,
+    # so two builds of one text give the same bytes
+    argv = [*find_compiler(), *C_FLAGS, *extra, "-o", "build.so", "build.c", "-lm"]
+    done = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=folder)
     if done.returncode != 0 or not out.is_file():
         raise CodegenBug("the C compiler refused springc's C model "
                          f"({' '.join(argv[:1])} exit {done.returncode}): "
