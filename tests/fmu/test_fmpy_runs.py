@@ -124,3 +124,25 @@ def test_a_co_simulation_step_handles_every_event_inside_it(tmp_path: Path) -> N
                                output_interval=0.5)
     assert list(result["bounces"]) == [0, 1, 1, 2, 3, 4, 6, 9]  # as springc counts them
     assert _deviation(result, reference, variables) < TOLERANCE
+
+
+@pytest.mark.parametrize("version", [3, 2])
+def test_a_contact_closing_exactly_at_an_output_point_is_not_missed(
+        version: int, tmp_path: Path) -> None:
+    """Newton's cradle: the first ball closes its gap at t = 1 ms, an output point, where
+    the contact's indicator is exactly 0 and then turns negative; the FMU reads a zero
+    on the side of the relation's held value, so both CVode and the embedded solver see
+    the sign change (before, the balls passed through each other)."""
+    files, model = [MODELS / "EventScenes.mdl"], "EventScenes.NewtonsCradle"
+    variables, stop = ["ball[1].s", "ball[5].v"], 0.02
+    path = tmp_path / "cradle.fmu"
+    springc.export_fmu([str(f) for f in files], path, model, fmi_version=version)
+    reference = springc.simulate([str(f) for f in files], model_name=model, stop=stop,
+                                 interval=1e-4, rtol=1e-9, atol=1e-9, outputs=variables,
+                                 engine="scipy", backend="python")
+    for kind in ("ModelExchange", "CoSimulation"):
+        result = fmpy.simulate_fmu(str(path), fmi_type=kind, stop_time=stop,
+                                   relative_tolerance=1e-9, output=variables,
+                                   output_interval=1e-4)
+        assert result["ball[5].v"][-1] == pytest.approx(1.0, abs=1e-3), kind
+        assert _deviation(result, reference, variables) < TOLERANCE, kind

@@ -90,6 +90,19 @@ def _value(e: x.Expr | None, env: dict[str, float], default: float) -> float:
     return value if math.isfinite(value) else default
 
 
+def relation_sides(system: ode.ODE, crossings: int) -> tuple[bool, ...]:
+    """For each zero crossing of the C model (the event relations, then two bounds per
+    ``floor`` on a state: ``u < k``, ``u >= k + 1``), whether it holds below zero;
+    empty where the count differs from the C model's (no side known)."""
+    events = system.events
+    if events is None:
+        return ()
+    ops = [r.op for r in events.relations]
+    rates = list(events.floor_rates) or [None] * len(events.floors)
+    ops += [op for rate in rates if rate is None for op in ("<", ">=")]
+    return tuple(op in ("<", "<=") for op in ops) if len(ops) == crossings else ()
+
+
 def has_jacobian(text: str) -> bool:
     """Whether the C model computes its Jacobian (``SPRINGC_HAS_JACOBIAN`` 1): the FMU
     then provides directional derivatives of the state derivatives along the states."""
@@ -138,7 +151,8 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
         header, face)
     build = xml.build_description(identifier, compile_sources(3)) if version == 3 else None
     package = assemble(version, identifier, text, build, source.text,
-                       glue_source(token, nominals, initial, experiment.tolerance),
+                       glue_source(token, nominals, initial, experiment.tolerance,
+                                   relation_sides(system, tables.crossings)),
                        find_compiler())
     write_fmu(output, package.entries, options.files)
     shown = ", ".join(tables.states[:4]) + (", ..." if len(tables.states) > 4 else "")

@@ -24,11 +24,19 @@ DEFAULT_TOLERANCE = 1e-6
 experiment annotation gives one."""
 
 
+def _flags(values: Sequence[bool]) -> str:
+    return "{" + ", ".join(str(int(v)) for v in (list(values) or [False])) + "}"
+
+
 def glue_source(token: str, nominals: Sequence[float],
-                initial: Sequence[float] | None, tolerance: float | None = None) -> str:
+                initial: Sequence[float] | None, tolerance: float | None = None,
+                true_below: Sequence[bool] = ()) -> str:
     """``springc_glue.c``: ``initial`` the consistent initial states springc computed at
     the default parameters (None: the start values of ``springc_start`` are initial);
-    ``tolerance`` the experiment annotation's (None: :data:`DEFAULT_TOLERANCE`)."""
+    ``tolerance`` the experiment annotation's (None: :data:`DEFAULT_TOLERANCE`);
+    ``true_below``: for each zero crossing ``g = left - right``, whether its relation
+    holds below zero (``<``, ``<=``), so that an indicator exactly at zero reads on the
+    side of the relation's held value (empty: no relations)."""
     return f"""/* springc: the FMU's view of the model in {MODEL_FILE} (springc_glue.h). */
 #include <math.h>
 
@@ -52,6 +60,8 @@ const int sm_after_initial = 0;
 const int sm_has_x_initial = {0 if initial is None else 1};
 const double sm_nominals[] = {_doubles(nominals)};
 const double sm_x_initial[] = {_doubles(initial or [])};
+const int sm_z_relations = {"SPRINGC_Z_RELATIONS" if true_below else "-1"};
+const unsigned char sm_true_below[] = {_flags(true_below)};
 const int sm_has_jacobian = SPRINGC_HAS_JACOBIAN;
 const int sm_njac = SPRINGC_N_JAC;
 const double sm_tolerance = {float(tolerance or DEFAULT_TOLERANCE)!r};

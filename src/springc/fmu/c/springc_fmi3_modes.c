@@ -186,7 +186,7 @@ FMI3_Export fmi3Status fmi3GetEventIndicators(fmi3Instance instance,
     if (nEventIndicators != (size_t)sm_ng) return fmi3Error;
     status = smi_refresh(INST);
     if (status == SMI_OK && sm_ng > 0
-        && sm_crossings(INST->v[0], INST->x, INST->p, INST->z, eventIndicators) != 0)
+        && smi_crossings(INST, INST->v[0], INST->x, eventIndicators) != 0)
         status = SMI_DISCARD;
     return (fmi3Status)status;
 }

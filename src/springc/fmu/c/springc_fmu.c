@@ -104,6 +104,21 @@ static int smi_failed(SmInstance *inst, int code) {
     return SMI_DISCARD;
 }
 
+/* the zero crossings at (t, x); one exactly at zero reads a tiny value on the side of
+ * its relation's held value, so that leaving zero towards the other side is a sign
+ * change (a contact closing exactly at a step's end, then pressing) */
+int smi_crossings(SmInstance *inst, double t, const double *x, double *g) {
+    int k, code = sm_crossings(t, x, inst->p, inst->z, g);
+    if (sm_z_relations < 0) return code;
+    for (k = 0; k < sm_ng; ++k) {
+        if (g[k] == 0.0) {
+            int held = inst->z[sm_z_relations + k] != 0.0;
+            g[k] = (held == (sm_true_below[k] != 0)) ? -1e-300 : 1e-300;
+        }
+    }
+    return code;
+}
+
 /* dx, w and the event indicators (after w) at the current time and states */
 int smi_refresh(SmInstance *inst) {
     int code;
@@ -111,7 +126,7 @@ int smi_refresh(SmInstance *inst) {
     code = sm_rhs(inst->v[0], inst->x, inst->p, inst->z, inst->dx);
     if (code == 0) code = sm_observed(inst->v[0], inst->x, inst->p, inst->z, inst->w);
     if (code == 0 && sm_ng > 0)
-        code = sm_crossings(inst->v[0], inst->x, inst->p, inst->z, inst->w + sm_nw);
+        code = smi_crossings(inst, inst->v[0], inst->x, inst->w + sm_nw);
     if (code != 0) return smi_failed(inst, code);
     inst->dirty = 0;
     return SMI_OK;
@@ -151,7 +166,7 @@ int smi_enter_initialization(SmInstance *inst, int tolerance_defined, double tol
 }
 
 static void smi_indicators(SmInstance *inst, double *g) {
-    if (sm_ng > 0) sm_crossings(inst->v[0], inst->x, inst->p, inst->z, g);
+    if (sm_ng > 0) smi_crossings(inst, inst->v[0], inst->x, g);
 }
 
 /* one event at the current time (the model iterates to its fixed point) */
@@ -332,7 +347,7 @@ static int dp_probe(SmInstance *inst, double t, const double *x0, double theta,
                     double *x, double *g) {
     double err;
     if (dp_step(inst, t, x0, theta, x, &err) != 0) return 1;
-    return sm_crossings(t + theta, x, inst->p, inst->z, g) != 0;
+    return smi_crossings(inst, t + theta, x, g) != 0;
 }
 
 /* bisection on the step size for the first crossing between t and t + h: the state
@@ -390,7 +405,7 @@ int smi_do_step(SmInstance *inst, double t0, double step, int *terminate,
             continue;
         }
         /* accepted: look for a state event inside the step */
-        if (sm_ng > 0 && sm_crossings(t + h, x1, inst->p, inst->z, g) != 0) break;
+        if (sm_ng > 0 && smi_crossings(inst, t + h, x1, g) != 0) break;
         if (sm_ng > 0 && smi_any_crossing(inst->g_prev, g)) {
             double te = dp_locate(inst, t, x0, h, x1, g);
             memcpy(inst->x, x1, sizeof(double) * (size_t)n);

@@ -48,6 +48,7 @@ SmInstance *smi_new(const char *name, int cosimulation, smi_logger log, void *ap
 void smi_free(SmInstance *inst);
 void smi_reset(SmInstance *inst);
 int smi_refresh(SmInstance *inst);
+int smi_crossings(SmInstance *inst, double t, const double *x, double *g);
 double *smi_slot(SmInstance *inst, unsigned int vr, int for_writing);
 int smi_enter_initialization(SmInstance *inst, int tolerance_defined, double tolerance,
                              double start_time, int stop_defined, double stop_time);

@@ -20,6 +20,8 @@ extern const int sm_after_initial; /* an event right after the initial one */
 extern const int sm_has_x_initial; /* sm_x_initial holds springc's initial values */
 extern const double sm_nominals[]; /* nominal value of each state (at least one entry) */
 extern const double sm_x_initial[];/* consistent initial states at the default parameters */
+extern const int sm_z_relations;  /* the first held relation value in z, -1: none */
+extern const unsigned char sm_true_below[]; /* relation k holds for g[k] < 0 (<, <=) */
 extern const int sm_has_jacobian; /* sm_jacobian computes d(dx)/dx */
 extern const int sm_njac;          /* its non-zeros */
 extern const double sm_tolerance; /* Co-Simulation's tolerance where none is given */
