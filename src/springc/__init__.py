@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["AccuracyWarning", "compile_model", "load_model_from_string", "simulate", "sweep"]
+__all__ = ["AccuracyWarning", "compile_model", "export_fmu", "load_model_from_string",
+           "simulate", "sweep"]
 
 
 def __getattr__(name: str) -> Any:

@@ -13,9 +13,9 @@ import os
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
-from .errors import UsageError
+from .errors import OutputError, UsageError
 from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
@@ -37,6 +37,9 @@ from .simulation import (
     run_settings,
     simulate_model,
 )
+
+if TYPE_CHECKING:
+    from .fmu import FmuExport
 
 Files = str | os.PathLike[str] | Sequence[str | os.PathLike[str]]
 
@@ -374,3 +377,28 @@ def sweep(files: CompiledModel | Files, *, model: str | None = None,
         return study.table.to_pandas()
     return to_dataset(study)
 
+
+
+@recursion_room()
+def export_fmu(files: Files, output: str | os.PathLike[str], model: str | None = None, *,
+               fmi_version: int = 3,
+               libraries: Sequence[str | os.PathLike[str]] = ()) -> FmuExport:
+    """Write the FMU of ``model`` of ``files`` to ``output`` (``springc fmu``): FMI 3.0
+    (``fmi_version=2``: FMI 2.0), Model Exchange and Co-Simulation, the C sources and
+    a linux64 binary (sources only where no C compiler is found: ``.note`` says so).
+
+        >>> springc.export_fmu("models/SpringMass.mdl", "SpringMass.fmu")
+    """
+    from .fileio import check_target
+    from .fmu import check_version
+    from .fmu import export_fmu as fmu_export
+
+    version = check_version(fmi_version)
+    names = _files(files)
+    try:
+        check_target(output, names)
+    except OutputError as err:
+        raise UsageError(err.message, option="output", hint=err.hint) from None
+    options = CompileOptions(names, model, tuple(os.fspath(x) for x in libraries), "python",
+                             None, (), False)
+    return fmu_export(options, output, version)
