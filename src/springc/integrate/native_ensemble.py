@@ -1,0 +1,231 @@
+"""The batched C ensemble: the model's C text + runs -> an :class:`.batch.Ensemble`.
+
+One kernel source (``ensemble_dop853.c``: DOP853 per run, springc's compiled DOP853
+with plain-loop sums, every sum in the same order) is put together with the model's C
+functions (the ``cmodel`` interface: ``springc_parameters``, ``springc_start``,
+``springc_rhs``, ``springc_observed`` and the ``SPRINGC_N_*`` sizes) and compiled in two
+ways from the same text: here by the system C compiler into a shared library (OpenMP
+over the runs, loaded with ctypes), and in :mod:`.gpu_ensemble` by CuPy's NVRTC as a
+CUDA kernel (one thread per run). :func:`kernel_text` is that text; :func:`build` and
+:class:`NativeEnsemble` are the C side. Imports nothing from springc.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from . import dop853_tableau as tableau
+from .status import Status
+
+KERNEL = Path(__file__).with_name("ensemble_dop853.c")
+BAD_START = -1
+"""The status of a run whose parameters or start values are not finite (or whose start
+values' Newton iteration failed): it is not integrated."""
+FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
+"""No fused multiply-adds: the sums round as numba's do."""
+OPENMP = "-fopenmp"
+COMPILERS = ("cc", "gcc", "clang")
+STATISTICS = 5  # final, min, max, mean, time of the max (see .batch.STATISTICS)
+
+
+class CompilerMissing(RuntimeError):
+    """No C compiler was found (``$CC``, ``cc``, ``gcc``, ``clang``)."""
+
+
+class CompileFailed(RuntimeError):
+    """The C compiler refused the kernel text (its messages are the error's text)."""
+
+
+def _array(name: str, values: np.ndarray, qualifier: str) -> str:
+    flat = np.asarray(values, dtype=float).ravel()
+    return (f"{qualifier} double {name}[{flat.size}] = {{"
+            + ", ".join(repr(float(v)) for v in flat) + "};\n")
+
+
+def prelude(cuda: bool) -> str:
+    """The definitions before the kernel: the status codes and the DOP853 tableau."""
+    qualifier = "static __device__ const" if cuda else "static const"
+    lines = [f"#define SC_{s.name} {int(s)}\n" for s in Status]
+    lines.append(f"#define SC_BAD_START {BAD_START}\n")
+    lines += [_array("DOP_A", tableau.A, qualifier), _array("DOP_B", tableau.B, qualifier),
+              _array("DOP_C", tableau.C, qualifier), _array("DOP_E3", tableau.E3, qualifier),
+              _array("DOP_E5", tableau.E5, qualifier), _array("DOP_D", tableau.D, qualifier)]
+    return "".join(lines)
+
+
+def kernel_text(model_c: str, cuda: bool = False) -> str:
+    """The whole translation unit: the model's C text, then the tableau and the kernel.
+
+    For CUDA (``cuda``) the model's functions become ``__device__`` functions
+    (``SPRINGC_FN``), its host-only name tables are left out (``SPRINGC_NO_TABLES``) and
+    its ``#include`` lines are dropped (NVRTC has the math functions built in)."""
+    if cuda:
+        model = "".join(line for line in model_c.splitlines(keepends=True)
+                        if not line.lstrip().startswith("#include"))
+        head = ("#define SC_CUDA 1\n#define SPRINGC_NO_TABLES 1\n"
+                "#define SPRINGC_FN static __device__ __forceinline__\n")
+    else:
+        model, head = model_c, "#include <math.h>\n#define SPRINGC_FN static inline\n"
+    return (head + model + "\n" + prelude(cuda)
+            + KERNEL.read_text(encoding="utf-8"))
+
+
+def compiler() -> str:
+    """The system C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang``."""
+    for name in (os.environ.get("CC"), *COMPILERS):
+        if name:
+            found = shutil.which(name)
+            if found:
+                return found
+    raise CompilerMissing("no C compiler found (looked for $CC, cc, gcc, clang)")
+
+
+def build(text: str, folder: Path) -> Path:
+    """The shared library of ``text`` in ``folder``, compiled once per text (its name
+    is the SHA-256 of the text, the compiler and the flags; written to a temporary
+    name, then renamed). With OpenMP where the compiler has it, else one thread."""
+    cc = compiler()
+    digest = hashlib.sha256("\0".join((text, cc, *FLAGS, OPENMP)).encode()).hexdigest()
+    target = folder / f"ensemble-{digest[:24]}.so"
+    if target.is_file():
+        return target
+    folder.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=folder) as scratch:
+        source = Path(scratch) / "ensemble.c"
+        source.write_text(text, encoding="utf-8")
+        built = Path(scratch) / "ensemble.so"
+        errors = ""
+        for extra in ((OPENMP,), ()):
+            done = subprocess.run([cc, *FLAGS, *extra, str(source), "-o", str(built), "-lm"],
+                                  capture_output=True, text=True, check=False)
+            if done.returncode == 0:
+                os.replace(built, target)
+                return target
+            errors = errors or done.stderr
+        raise CompileFailed(errors.strip())
+
+
+@dataclass(frozen=True)
+class Runs:
+    """The runs of a call. Either ``P``, ``X0`` and ``Z`` (one row per run, computed
+    beforehand), or ``values`` (one row per run) of the parameters at ``index``, put
+    into ``base`` and completed in the kernel (``springc_parameters`` with ``given``
+    marking the parameters set by the user, then ``springc_start``)."""
+
+    values: np.ndarray
+    index: np.ndarray
+    base: np.ndarray
+    given: np.ndarray
+    P: np.ndarray | None = None
+    X0: np.ndarray | None = None
+    Z: np.ndarray | None = None
+
+    @property
+    def count(self) -> int:
+        return len(self.values) if self.P is None else len(self.P)
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What the kernel writes for a chunk (one row per run, see :class:`.batch.Ensemble`
+    for the meaning): summary ``runs x columns x 5``, trajectories ``runs x points x
+    variables`` (NaN where the run did not reach), finals, status, counts (accepted,
+    rejected, evaluations, flag), failure time."""
+
+    summary: np.ndarray
+    trajectories: np.ndarray
+    finals: np.ndarray
+    status: np.ndarray
+    counts: np.ndarray
+    failure_time: np.ndarray
+
+    @classmethod
+    def empty(cls, runs: int, n: int, columns: int, points: int, traj: int) -> Outputs:
+        return cls(np.empty((runs, columns, STATISTICS)), np.full((runs, points, traj), np.nan),
+                   np.empty((runs, n)), np.empty(runs, dtype=np.int64),
+                   np.empty((runs, 4), dtype=np.int64), np.empty(runs))
+
+
+def trajectory_points(m: int, every: int) -> np.ndarray:
+    """The output-grid indices a trajectory keeps: every ``every``-th, and the last."""
+    kept = np.arange(0, m, every)
+    return kept if kept[-1] == m - 1 else np.append(kept, m - 1)
+
+
+def kernel_arguments(runs: Runs, grid: np.ndarray, rtol: float, atol: np.ndarray,
+                     max_step: float, max_steps: int, columns: np.ndarray,
+                     traj_columns: np.ndarray, every: int, n: int,
+                     out: Outputs) -> list[Any]:
+    """The entry's arguments after ``runs`` (arrays as they are; the caller converts)."""
+    dummy = np.zeros(1)
+    prepared = runs.P is not None
+    n_states = n
+    need_observed = int(bool((columns >= n_states).any() or (traj_columns >= n_states).any()))
+    return [int(prepared), runs.values, runs.values.shape[1], runs.index, runs.base,
+            runs.given, runs.P if prepared else dummy, runs.X0 if prepared else dummy,
+            runs.Z if prepared else dummy, grid, grid.size, rtol, atol, max_step, max_steps,
+            columns, columns.size, traj_columns, traj_columns.size, every,
+            out.trajectories.shape[1], need_observed, out.summary, out.trajectories,
+            out.finals, out.status, out.counts, out.failure_time]
+
+
+class NativeEnsemble:
+    """A compiled C ensemble library (:func:`build`), called through ctypes (the call
+    releases the GIL)."""
+
+    def __init__(self, path: Path, n_states: int) -> None:
+        self.path = path
+        self.n = n_states
+        self.library = ctypes.CDLL(str(path))
+        self.entry = self.library.springc_ensemble
+        self.entry.restype = ctypes.c_int
+        self.library.springc_ensemble_threads.restype = ctypes.c_int
+
+    def threads(self) -> int:
+        """The threads a call uses by default (OpenMP's; 1 without OpenMP)."""
+        return int(self.library.springc_ensemble_threads())
+
+    def run(self, runs: Runs, grid: np.ndarray, *, rtol: float, atol: np.ndarray,
+            max_step: float, max_steps: int, columns: Sequence[int] = (),
+            traj_columns: Sequence[int] = (), every: int = 1, threads: int = 0) -> Outputs:
+        """Integrate every run; ``threads`` 0 is OpenMP's default."""
+        columns_ = np.ascontiguousarray(columns, dtype=np.int64).reshape(-1)
+        traj_ = np.ascontiguousarray(traj_columns, dtype=np.int64).reshape(-1)
+        points = len(trajectory_points(grid.size, every)) if traj_.size else 0
+        out = Outputs.empty(runs.count, self.n, columns_.size, points, traj_.size)
+        args = kernel_arguments(runs, grid, rtol, atol, max_step, max_steps, columns_,
+                                traj_, every, self.n, out)
+        converted: list[Any] = [ctypes.c_longlong(runs.count)]
+        keep = []
+        for a in args:
+            if isinstance(a, np.ndarray):
+                a = np.ascontiguousarray(a)
+                keep.append(a)
+                converted.append(ctypes.c_void_p(a.ctypes.data))
+            elif isinstance(a, float):
+                converted.append(ctypes.c_double(a))
+            else:
+                converted.append(ctypes.c_longlong(a))
+        converted = _typed(converted)
+        code = self.entry(*converted, ctypes.c_int(threads))
+        if code != 0:
+            raise MemoryError("the ensemble kernel could not allocate its work arrays")
+        return out
+
+
+def _typed(args: list[Any]) -> list[Any]:
+    """The ``int`` parameters of the entry (prepared, need_observed) as C ints."""
+    for position in (1, 22):
+        args[position] = ctypes.c_int(args[position].value)
+    return args
