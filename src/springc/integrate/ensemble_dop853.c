@@ -5,9 +5,10 @@
      springc_ensemble loops over the runs, in parallel over the cores with OpenMP;
    - CUDA (SC_CUDA defined, through CuPy's NVRTC): the entry is a __global__ kernel,
      one thread per run.
-   Before this text come: the sizes of the model (SPRINGC_N_STATES, SPRINGC_N_PARAMS,
+   Before this text come: the sizes of the model (SPRINGC_N_STATES, as SC_NX and SC_NXS, SPRINGC_N_PARAMS,
    SPRINGC_N_Z, SPRINGC_N_OBSERVED), the tableau of springc.integrate.dop853_tableau
-   (DOP_A, DOP_B, DOP_C, DOP_E3, DOP_E5, DOP_D), the status codes of
+   (DOP_C, and the weighted sums of the stages written out: sc_a_row, sc_b_sum,
+   sc_e5_sum, sc_e3_sum, sc_d_row), the status codes of
    springc.integrate.Status (SC_SUCCESS ...) and the model's C functions
    (springc_parameters, springc_start, springc_rhs, springc_observed: the cmodel
    interface).
@@ -24,8 +25,9 @@
 #define SC_FN static
 #endif
 
-#define SC_NX SPRINGC_N_STATES
-#define SC_NXS (SPRINGC_N_STATES > 0 ? SPRINGC_N_STATES : 1)
+#ifndef SC_LANES
+#define SC_LANES 1
+#endif
 #define SC_NPS (SPRINGC_N_PARAMS > 0 ? SPRINGC_N_PARAMS : 1)
 #define SC_NZS (SPRINGC_N_Z > 0 ? SPRINGC_N_Z : 1)
 #define SC_NOS (SPRINGC_N_OBSERVED > 0 ? SPRINGC_N_OBSERVED : 1)
@@ -84,19 +86,10 @@ SC_FN int sc_verdict(const double *d, const double *z) {
     return SC_SUCCESS;
 }
 
-/* out = sum_{j<s} w[j] K[j], each entry summed over j in order from 0.0 */
-SC_FN void sc_wsum(const double *K, int s, const double *w, double *out) {
-    for (int i = 0; i < SC_NX; i++) out[i] = 0.0;
-    for (int j = 0; j < s; j++) {
-        double wj = w[j];
-        for (int i = 0; i < SC_NX; i++) out[i] += K[j * SC_NXS + i] * wj;
-    }
-}
-
 /* the state of stage s: y + (sum_j A[s, j] K[j]) * h */
 SC_FN void sc_stage(const double *y, const double *K, int s, double h, double *sums,
                     double *out) {
-    sc_wsum(K, s, DOP_A + s * SC_EXTENDED, sums);
+    sc_a_row(s, K, sums);
     for (int i = 0; i < SC_NX; i++) out[i] = y[i] + sums[i] * h;
 }
 
@@ -114,8 +107,8 @@ SC_FN double sc_error_norm(const double *y, const double *y_new, const double *K
                            double *err3) {
     for (int i = 0; i < SC_NX; i++)
         scale[i] = atol[i] + sc_max(fabs(y[i]), fabs(y_new[i])) * rtol;
-    sc_wsum(K, SC_STAGES + 1, DOP_E5, err5);
-    sc_wsum(K, SC_STAGES + 1, DOP_E3, err3);
+    sc_e5_sum(K, err5);
+    sc_e3_sum(K, err3);
     double e5 = 0.0, e3 = 0.0;
     for (int i = 0; i < SC_NX; i++) {
         err5[i] /= scale[i];
@@ -131,7 +124,7 @@ SC_FN double sc_error_norm(const double *y, const double *y_new, const double *K
 SC_FN void sc_interpolant(const double *y, const double *y_new, const double *K, double h,
                           double *F, double *sums) {
     for (int r = 0; r < SC_ROWS - 3; r++) {
-        sc_wsum(K, SC_EXTENDED, DOP_D + r * SC_EXTENDED, sums);
+        sc_d_row(r, K, sums);
         for (int i = 0; i < SC_NX; i++) F[(3 + r) * SC_NXS + i] = h * sums[i];
     }
     for (int i = 0; i < SC_NX; i++) {
@@ -253,163 +246,237 @@ SC_FN double sc_first_step(const sc_settings *s, double t, const double *y, doub
     return h;
 }
 
-/* One run from (grid[0], y): springc.integrate.dop853_kernel.dop853_run without events. */
-SC_FN void sc_run(const sc_settings *s, const sc_outputs *o, double *y, const double *p,
-                  double *z, double *w) {
-    double *K = w, *F = K + SC_EXTENDED * SC_NXS, *y_new = F + SC_ROWS * SC_NXS;
-    double *work = y_new + SC_NXS, *sums = work + SC_NXS, *scale = sums + SC_NXS;
-    double *err5 = scale + SC_NXS, *err3 = err5 + SC_NXS, *xo = err3 + SC_NXS;
-    double *obs = w + SC_AT_OBS;
-    const double *grid = s->grid;
-    double t = grid[0], t_end = grid[s->m - 1], rtol = s->rtol;
-    sc_int accepted = 0, rejected = 0, nfev = 0, filled = 1;
-    int status = SC_SUCCESS;
+/* Where the runs come from: the chunk's inputs, shared by every lane. */
+typedef struct {
+    sc_settings s;
+    sc_outputs all;
+    int prepared;
+    const double *V;
+    sc_int n_v;
+    const sc_int *v_index;
+    const double *base;
+    const int *given;
+    const double *P, *X0, *Z;
+    sc_int runs;
+    sc_int stride;    /* CUDA: the threads of the launch; this thread's runs step by it */
+    sc_int next;      /* CUDA: this thread's next run */
+    sc_int *counter;  /* C: the next run not taken, shared by the threads */
+} sc_job;
 
-    /* Step 1: the start and its outputs. */
-    if (s->need_observed) {
-        springc_observed(t, y, p, z, obs);
-        if (sc_flagged(z)) { sc_finish(s, o, SC_MODEL_FAILED, 0, 0, 0, t, y, z); return; }
-    }
-    sc_emit(s, o, 0, y, obs);
-    if (s->m == 1 || SC_NX == 0) {
-        for (sc_int k = 1; k < s->m; k++) sc_emit(s, o, k, y, obs);
-        sc_finish(s, o, SC_SUCCESS, 0, 0, 0, t, y, z);
-        return;
-    }
-    springc_rhs(t, y, p, z, K);
-    nfev = 1;
-    status = sc_verdict(K, z);
-    if (status != SC_SUCCESS) { sc_finish(s, o, status, 0, 0, nfev, t, y, z); return; }
+/* A run in progress: a lane. A thread keeps SC_LANES of them and takes them through
+   each step together (their model evaluations interleave: independent work for the
+   processor while one waits on a division or a square root). */
+typedef struct {
+    sc_int run;  /* -1: idle */
+    int retry;   /* the last attempt was rejected */
+    int ready;   /* between the start of an attempt and its end */
+    double t, h_abs, h, t_new, min_step;
+    sc_int accepted, rejected, nfev, filled;
+    sc_outputs o;
+    double *w;   /* its work array (layout SC_AT_*) */
+} sc_lane;
 
-    /* Step 2: the initial step. */
-    double h0 = 0.0;
-    double h_abs = sc_first_step(s, t, y, K, work, scale, p, z, fabs(t_end - t), &status,
-                                 &nfev, &h0);
-    if (status != SC_SUCCESS) {
-        int small = status == SC_STEP_TOO_SMALL;
-        sc_finish(s, o, status, 0, 0, nfev, small ? t : t + h0, small ? y : work, z);
-        return;
-    }
-
-    /* Step 3: steps until the end, each filling the output times it passes. */
-    while (t < t_end) {
-        if (s->max_steps > 0 && accepted + rejected >= s->max_steps) {
-            sc_finish(s, o, SC_MAX_STEPS, accepted, rejected, nfev, t, y, z);
-            return;
-        }
-        double min_step = 10 * fabs(nextafter(t, SC_HUGE) - t);
-        if (h_abs > s->max_step) h_abs = s->max_step;
-        else if (h_abs < min_step) h_abs = min_step;
-        int step_rejected = 0;
-        double t_new, h;
-        for (;;) {
-            if (h_abs < min_step) {
-                sc_finish(s, o, SC_STEP_TOO_SMALL, accepted, rejected, nfev, t, y, z);
-                return;
-            }
-            t_new = t + h_abs;
-            if (t_new - t_end > 0) t_new = t_end;
-            h = t_new - t;
-            h_abs = fabs(h);
-            for (int st = 1; st < SC_STAGES; st++) {
-                sc_stage(y, K, st, h, sums, work);
-                springc_rhs(t + DOP_C[st] * h, work, p, z, K + st * SC_NXS);
-                nfev += 1;
-                status = sc_verdict(K + st * SC_NXS, z);
-                if (status != SC_SUCCESS) {
-                    sc_finish(s, o, status, accepted, rejected, nfev, t + DOP_C[st] * h,
-                              work, z);
-                    return;
-                }
-            }
-            sc_wsum(K, SC_STAGES, DOP_B, sums);
-            for (int i = 0; i < SC_NX; i++) y_new[i] = y[i] + h * sums[i];
-            springc_rhs(t + h, y_new, p, z, K + SC_STAGES * SC_NXS);
-            nfev += 1;
-            status = sc_verdict(K + SC_STAGES * SC_NXS, z);
-            if (status != SC_SUCCESS) {
-                sc_finish(s, o, status, accepted, rejected, nfev, t + h, y_new, z);
-                return;
-            }
-            double error = sc_error_norm(y, y_new, K, h, rtol, s->atol, scale, err5, err3);
-            if (error < 1) {
-                double factor = error == 0 ? 10.0 : sc_min(10.0, 0.9 * pow(error, -0.125));
-                if (step_rejected) factor = sc_min(1.0, factor);
-                h_abs *= factor;
-                break;
-            }
-            h_abs *= sc_max(0.2, 0.9 * pow(error, -0.125));
-            step_rejected = 1;
-            rejected += 1;
-        }
-        accepted += 1;
-
-        /* Step 5: the dense output, where an output time falls in the step. */
-        if (filled < s->m && grid[filled] <= t_new) {
-            for (int st = SC_STAGES + 1; st < SC_EXTENDED; st++) {
-                sc_stage(y, K, st, h, sums, work);
-                springc_rhs(t + DOP_C[st] * h, work, p, z, K + st * SC_NXS);
-                nfev += 1;
-                status = sc_verdict(K + st * SC_NXS, z);
-                if (status != SC_SUCCESS) {
-                    sc_finish(s, o, status, accepted, rejected, nfev, t + DOP_C[st] * h,
-                              work, z);
-                    return;
-                }
-            }
-            sc_interpolant(y, y_new, K, h, F, sums);
-            status = sc_outputs_in_step(s, o, &filled, t, t_new, h, y, y_new, F, xo, obs,
-                                        p, z);
-            if (status != SC_SUCCESS) {
-                sc_finish(s, o, status, accepted, rejected, nfev, grid[filled], xo, z);
-                return;
-            }
-        }
-        t = t_new;
-        for (int i = 0; i < SC_NX; i++) {
-            y[i] = y_new[i];
-            K[i] = K[SC_STAGES * SC_NXS + i];
-        }
-    }
-    sc_finish(s, o, SC_SUCCESS, accepted, rejected, nfev, t, y, z);
+SC_FN sc_int sc_take(sc_job *job) {
+#ifdef SC_CUDA
+    sc_int r = job->next;
+    job->next += job->stride;
+#else
+    sc_int r;
+#ifdef _OPENMP
+#pragma omp atomic capture
+#endif
+    r = (*job->counter)++;
+#endif
+    return r < job->runs ? r : -1;
 }
 
-/* Run r: its parameters, start state and work array, then the run. With `prepared`,
-   P, X0 and Z hold every run's rows; else run r's parameters are `base` with the
-   `n_v` varied ones (at `v_index`) from V's row r, completed by springc_parameters
-   (the parameters bound to them follow), and its start by springc_start. A run whose
-   parameters or start are not finite gets status SC_BAD_START. */
-SC_FN void sc_one(sc_int r, const sc_settings *s, int prepared, const double *V, sc_int n_v,
-                  const sc_int *v_index, const double *base, const int *given,
-                  const double *P, const double *X0, const double *Z, const sc_outputs *all,
-                  double *w) {
-    sc_outputs o;
-    o.summary = all->summary + r * 5 * s->n_columns;
-    o.traj = all->traj + r * s->n_traj_points * s->n_traj;
-    o.final = all->final + r * SC_NX;
-    o.status = all->status + r;
-    o.counts = all->counts + 4 * r;
-    o.failure_time = all->failure_time + r;
-    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z;
+SC_FN void sc_end(sc_lane *L, const sc_job *job, int status, double t, const double *x) {
+    sc_finish(&job->s, &L->o, status, L->accepted, L->rejected, L->nfev, t, x,
+              L->w + SC_AT_Z);
+    L->run = -1;
+    L->ready = 0;
+}
+
+/* Run r's parameters and start (see springc_ensemble); 0 if they are not finite. */
+SC_FN int sc_inputs(const sc_job *job, sc_int r, double *y, double *p, double *z) {
     int code = 0;
-    if (prepared) {
-        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = P[r * SPRINGC_N_PARAMS + i];
-        for (int i = 0; i < SC_NX; i++) y[i] = X0[r * SC_NX + i];
-        for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = Z[r * SPRINGC_N_Z + i];
+    if (job->prepared) {
+        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = job->P[r * SPRINGC_N_PARAMS + i];
+        for (int i = 0; i < SC_NX; i++) y[i] = job->X0[r * SC_NX + i];
+        for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = job->Z[r * SPRINGC_N_Z + i];
     } else {
-        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = base[i];
-        for (sc_int j = 0; j < n_v; j++) p[v_index[j]] = V[r * n_v + j];
-        springc_parameters(p, given);
+        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = job->base[i];
+        for (sc_int j = 0; j < job->n_v; j++) p[job->v_index[j]] = job->V[r * job->n_v + j];
+        springc_parameters(p, job->given);
         for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = 0.0;
         code = springc_start(p, y, z);
     }
     for (int i = 0; i < SPRINGC_N_PARAMS; i++) code |= !isfinite(p[i]);
     for (int i = 0; i < SC_NX; i++) code |= !isfinite(y[i]);
-    if (code != 0) {
-        sc_finish(s, &o, SC_BAD_START, 0, 0, 0, s->grid[0], y, z);
-        return;
+    return code == 0;
+}
+
+/* Lane L takes run r: its inputs, outputs at the start, the initial step. 1 if the run
+   needs steps, 0 if it has ended already. */
+SC_FN int sc_start(sc_lane *L, const sc_job *job, sc_int r) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *K = w, *work = w + 24 * SC_NXS, *scale = w + 26 * SC_NXS;
+    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z, *obs = w + SC_AT_OBS;
+    L->run = r;
+    L->retry = 0;
+    L->accepted = L->rejected = L->nfev = 0;
+    L->filled = 1;
+    L->t = s->grid[0];
+    L->o.summary = job->all.summary + r * 5 * s->n_columns;
+    L->o.traj = job->all.traj + r * s->n_traj_points * s->n_traj;
+    L->o.final = job->all.final + r * SC_NX;
+    L->o.status = job->all.status + r;
+    L->o.counts = job->all.counts + 4 * r;
+    L->o.failure_time = job->all.failure_time + r;
+    if (!sc_inputs(job, r, y, p, z)) { sc_end(L, job, SC_BAD_START, L->t, y); return 0; }
+
+    /* Step 1: the start and its outputs. */
+    if (s->need_observed) {
+        springc_observed(L->t, y, p, z, obs);
+        if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return 0; }
     }
-    sc_run(s, &o, y, p, z, w);
+    sc_emit(s, &L->o, 0, y, obs);
+    if (s->m == 1 || SC_NX == 0) {
+        for (sc_int k = 1; k < s->m; k++) sc_emit(s, &L->o, k, y, obs);
+        sc_end(L, job, SC_SUCCESS, L->t, y);
+        return 0;
+    }
+    springc_rhs(L->t, y, p, z, K);
+    L->nfev = 1;
+    int status = sc_verdict(K, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
+
+    /* Step 2: the initial step. */
+    double h0 = 0.0, t_end = s->grid[s->m - 1];
+    L->h_abs = sc_first_step(s, L->t, y, K, work, scale, p, z, fabs(t_end - L->t), &status,
+                             &L->nfev, &h0);
+    if (status != SC_SUCCESS) {
+        int small = status == SC_STEP_TOO_SMALL;
+        sc_end(L, job, status, small ? L->t : L->t + h0, small ? y : work);
+        return 0;
+    }
+    return 1;
+}
+
+/* The start of an attempt (Step 3 of dop853_run): the step limit, the step size. 1 if
+   the lane goes on to the stages, 0 if its run has ended. */
+SC_FN int sc_attempt(sc_lane *L, const sc_job *job) {
+    const sc_settings *s = &job->s;
+    double *y = L->w + SC_AT_Y, t_end = s->grid[s->m - 1];
+    if (!L->retry) {
+        if (s->max_steps > 0 && L->accepted + L->rejected >= s->max_steps) {
+            sc_end(L, job, SC_MAX_STEPS, L->t, y);
+            return 0;
+        }
+        L->min_step = 10 * fabs(nextafter(L->t, SC_HUGE) - L->t);
+        if (L->h_abs > s->max_step) L->h_abs = s->max_step;
+        else if (L->h_abs < L->min_step) L->h_abs = L->min_step;
+    }
+    if (L->h_abs < L->min_step) { sc_end(L, job, SC_STEP_TOO_SMALL, L->t, y); return 0; }
+    L->t_new = L->t + L->h_abs;
+    if (L->t_new - t_end > 0) L->t_new = t_end;
+    L->h = L->t_new - L->t;
+    L->h_abs = fabs(L->h);
+    L->ready = 1;
+    return 1;
+}
+
+/* Stage st of the attempt; 0 if the evaluation failed (the run has ended). */
+SC_FN int sc_stage_of(sc_lane *L, const sc_job *job, int st) {
+    double *w = L->w, *K = w, *sums = w + 25 * SC_NXS, *work = w + 24 * SC_NXS;
+    double *z = w + SC_AT_Z, t = L->t + DOP_C[st] * L->h;
+    sc_stage(w + SC_AT_Y, K, st, L->h, sums, work);
+    springc_rhs(t, work, w + SC_AT_P, z, K + st * SC_NXS);
+    L->nfev += 1;
+    int status = sc_verdict(K + st * SC_NXS, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, t, work); return 0; }
+    return 1;
+}
+
+/* The end of an attempt: the new state, its error, accepted or rejected; an accepted
+   step fills the output times it passes (Steps 5 and 7). 0 if the run has ended. */
+SC_FN int sc_conclude(sc_lane *L, const sc_job *job) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *K = w, *F = w + 16 * SC_NXS, *y_new = w + 23 * SC_NXS;
+    double *sums = w + 25 * SC_NXS, *scale = w + 26 * SC_NXS, *err5 = w + 27 * SC_NXS;
+    double *err3 = w + 28 * SC_NXS, *xo = w + 29 * SC_NXS, *y = w + SC_AT_Y;
+    double *p = w + SC_AT_P, *z = w + SC_AT_Z, h = L->h, t = L->t;
+    L->ready = 0;
+    sc_b_sum(K, sums);
+    for (int i = 0; i < SC_NX; i++) y_new[i] = y[i] + h * sums[i];
+    springc_rhs(t + h, y_new, p, z, K + SC_STAGES * SC_NXS);
+    L->nfev += 1;
+    int status = sc_verdict(K + SC_STAGES * SC_NXS, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, t + h, y_new); return 0; }
+    double error = sc_error_norm(y, y_new, K, h, s->rtol, s->atol, scale, err5, err3);
+    if (!(error < 1)) {
+        L->h_abs *= sc_max(0.2, 0.9 * pow(error, -0.125));
+        L->retry = 1;
+        L->rejected += 1;
+        return 1;
+    }
+    double factor = error == 0 ? 10.0 : sc_min(10.0, 0.9 * pow(error, -0.125));
+    if (L->retry) factor = sc_min(1.0, factor);
+    L->h_abs *= factor;
+    L->retry = 0;
+    L->accepted += 1;
+    if (L->filled < s->m && s->grid[L->filled] <= L->t_new) {
+        for (int st = SC_STAGES + 1; st < SC_EXTENDED; st++)
+            if (!sc_stage_of(L, job, st)) return 0;
+        sc_interpolant(y, y_new, K, h, F, sums);
+        status = sc_outputs_in_step(s, &L->o, &L->filled, t, L->t_new, h, y, y_new, F, xo,
+                                    w + SC_AT_OBS, p, z);
+        if (status != SC_SUCCESS) {
+            sc_end(L, job, status, s->grid[L->filled], xo);
+            return 0;
+        }
+    }
+    L->t = L->t_new;
+    for (int i = 0; i < SC_NX; i++) {
+        y[i] = y_new[i];
+        K[i] = K[SC_STAGES * SC_NXS + i];
+    }
+    if (!(L->t < s->grid[s->m - 1])) { sc_end(L, job, SC_SUCCESS, L->t, y); return 0; }
+    return 1;
+}
+
+/* A thread's share of the runs, SC_LANES at a time: an idle lane takes the next run
+   (and the next, while runs end at their start); the ready lanes go through each
+   stage together. */
+SC_FN void sc_work(sc_job *job, double *block) {
+    sc_lane lanes[SC_LANES];
+    int exhausted = 0;
+    for (int l = 0; l < SC_LANES; l++) {
+        lanes[l].w = block + l * SC_WORK;
+        lanes[l].run = -1;
+        lanes[l].ready = 0;
+    }
+    for (;;) {
+        int any = 0;
+        for (int l = 0; l < SC_LANES; l++) {
+            sc_lane *L = &lanes[l];
+            while (!exhausted || L->run >= 0) {
+                if (L->run < 0) {
+                    sc_int r = sc_take(job);
+                    if (r < 0) { exhausted = 1; break; }
+                    if (!sc_start(L, job, r)) continue;
+                }
+                if (sc_attempt(L, job)) break;
+            }
+            any |= L->ready;
+        }
+        if (!any) return;
+        for (int st = 1; st < SC_STAGES; st++)
+            for (int l = 0; l < SC_LANES; l++)
+                if (lanes[l].ready) lanes[l].ready = sc_stage_of(&lanes[l], job, st);
+        for (int l = 0; l < SC_LANES; l++)
+            if (lanes[l].ready) sc_conclude(&lanes[l], job);
+    }
 }
 
 #define SC_ENTRY_ARGS                                                                     \
@@ -421,19 +488,20 @@ SC_FN void sc_one(sc_int r, const sc_settings *s, int prepared, const double *V,
     int need_observed, double *summary, double *traj, double *final, sc_int *status,        \
     sc_int *counts, double *failure_time
 
-#define SC_SETUP                                                                          \
-    sc_settings s = {grid, m, rtol, atol, max_step, max_steps, columns, n_columns,          \
-                     traj_columns, n_traj, every, n_traj_points, need_observed};           \
-    sc_outputs all = {summary, traj, final, status, counts, failure_time}
+#define SC_SETUP(job)                                                                     \
+    sc_job job = {{grid, m, rtol, atol, max_step, max_steps, columns, n_columns,             \
+                   traj_columns, n_traj, every, n_traj_points, need_observed},              \
+                  {summary, traj, final, status, counts, failure_time},                    \
+                  prepared, V, n_v, v_index, base, given, P, X0, Z, runs, 1, 0, 0}
 
 #ifdef SC_CUDA
-/* One thread per run. */
+/* One thread per run (runs beyond the launch's threads: every stride-th). */
 extern "C" __global__ void springc_ensemble(SC_ENTRY_ARGS) {
-    sc_int r = (sc_int)blockIdx.x * blockDim.x + threadIdx.x;
-    if (r >= runs) return;
-    SC_SETUP;
-    double w[SC_WORK];
-    sc_one(r, &s, prepared, V, n_v, v_index, base, given, P, X0, Z, &all, w);
+    SC_SETUP(job);
+    job.next = (sc_int)blockIdx.x * blockDim.x + threadIdx.x;
+    job.stride = (sc_int)gridDim.x * blockDim.x;
+    double block[SC_LANES * SC_WORK];
+    sc_work(&job, block);
 }
 #else
 #include <stdlib.h>
@@ -448,27 +516,28 @@ int springc_ensemble_threads(void) {
 #endif
 }
 
-/* Every run, in parallel over `threads` threads (0: OpenMP's default). Returns 0, or
-   -1 if a thread could not allocate its work array (its runs are not run). */
+/* Every run: `threads` threads (0: OpenMP's default) take runs one at a time, each
+   keeping SC_LANES in progress. Run r's parameters: with `prepared`, row r of P, X0
+   and Z; else `base` with the n_v varied ones (at v_index) from row r of V, completed
+   by springc_parameters (`given` marks the parameters set by the user: the ones bound
+   to them follow) and springc_start. A run whose parameters or start values are not
+   finite ends with SC_BAD_START. Returns 0, or -1 if runs were left (no thread could
+   allocate its work arrays). */
 int springc_ensemble(SC_ENTRY_ARGS, int threads) {
-    SC_SETUP;
-    int lost = 0;
+    SC_SETUP(job);
+    sc_int counter = 0;
+    job.counter = &counter;
 #ifdef _OPENMP
     if (threads <= 0) threads = omp_get_max_threads();
-#pragma omp parallel num_threads(threads) reduction(|: lost)
+#pragma omp parallel num_threads(threads)
 #endif
     {
-        double *w = (double *)malloc(SC_WORK * sizeof(double));
-#ifdef _OPENMP
-#pragma omp for schedule(dynamic, 4)
-#endif
-        for (sc_int r = 0; r < runs; r++) {
-            if (w == NULL) { lost = 1; continue; }
-            sc_one(r, &s, prepared, V, n_v, v_index, base, given, P, X0, Z, &all, w);
-        }
-        free(w);
+        sc_job mine = job;
+        double *block = (double *)malloc((size_t)SC_LANES * SC_WORK * sizeof(double));
+        if (block != NULL) sc_work(&mine, block);
+        free(block);
     }
     (void)threads;
-    return lost ? -1 : 0;
+    return counter < runs ? -1 : 0;
 }
 #endif

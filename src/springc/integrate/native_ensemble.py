@@ -32,10 +32,12 @@ KERNEL = Path(__file__).with_name("ensemble_dop853.c")
 BAD_START = -1
 """The status of a run whose parameters or start values are not finite (or whose start
 values' Newton iteration failed): it is not integrated."""
-FLAGS = ("-O3", "-march=native", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
+FLAGS = ("-O2", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
 """No fused multiply-adds: the sums round as numba's do."""
 OPENMP = "-fopenmp"
 COMPILERS = ("cc", "gcc", "clang")
+LANES = 4
+"""Runs in progress per thread on the CPU, their steps interleaved (see the kernel)."""
 STATISTICS = 5  # final, min, max, mean, time of the max (see .batch.STATISTICS)
 
 
@@ -53,15 +55,45 @@ def _array(name: str, values: np.ndarray, qualifier: str) -> str:
             + ", ".join(repr(float(v)) for v in flat) + "};\n")
 
 
+def _sum(name: str, weights: np.ndarray, function: str) -> str:
+    """``out[i] = sum_j weights[j] K[j, i]`` as C, summed from 0.0 in the order of j as
+    numba's plain loop does, without the zero weights (the stages are finite, so each
+    of those adds +0.0 or -0.0 to a sum that started at +0.0: the same value)."""
+    terms = "".join(f"        acc += K[{j} * SC_NXS + i] * {float(w)!r};\n"
+                    for j, w in enumerate(weights) if w != 0.0)
+    return (f"{function} void {name}(const double *K, double *out) {{\n"
+            "    for (int i = 0; i < SC_NX; i++) {\n        double acc = 0.0;\n"
+            f"{terms}        out[i] = acc;\n    }}\n}}\n")
+
+
+def _switch(name: str, rows: list[str], function: str) -> str:
+    cases = "".join(f"    case {k}: {row}(K, out); break;\n" for k, row in enumerate(rows)
+                    if row)
+    return (f"{function} void {name}(int row, const double *K, double *out) {{\n"
+            f"    switch (row) {{\n{cases}    default: break;\n    }}\n}}\n")
+
+
 def prelude(cuda: bool) -> str:
-    """The definitions before the kernel: the status codes and the DOP853 tableau."""
+    """The definitions before the kernel: the status codes and the DOP853 tableau, its
+    weighted sums written out (``sc_a_row``, ``sc_b_sum``, ``sc_e5_sum``, ``sc_e3_sum``,
+    ``sc_d_row``) and ``DOP_C``."""
+    function = "static __device__" if cuda else "static inline"
     qualifier = "static __device__ const" if cuda else "static const"
-    lines = [f"#define SC_{s.name} {int(s)}\n" for s in Status]
-    lines.append(f"#define SC_BAD_START {BAD_START}\n")
-    lines += [_array("DOP_A", tableau.A, qualifier), _array("DOP_B", tableau.B, qualifier),
-              _array("DOP_C", tableau.C, qualifier), _array("DOP_E3", tableau.E3, qualifier),
-              _array("DOP_E5", tableau.E5, qualifier), _array("DOP_D", tableau.D, qualifier)]
-    return "".join(lines)
+    parts = ["#define SC_NX SPRINGC_N_STATES\n",
+             "#define SC_NXS (SPRINGC_N_STATES > 0 ? SPRINGC_N_STATES : 1)\n"]
+    parts += [f"#define SC_{s.name} {int(s)}\n" for s in Status]
+    parts.append(f"#define SC_BAD_START {BAD_START}\n")
+    parts.append(_array("DOP_C", tableau.C, qualifier))
+    rows = [""] + [f"sc_a_{s}" for s in range(1, tableau.STAGES_EXTENDED)]
+    parts += [_sum(rows[s], tableau.A[s, :s], function)
+              for s in range(1, tableau.STAGES_EXTENDED)]
+    parts.append(_switch("sc_a_row", rows, function))
+    parts += [_sum("sc_b_sum", tableau.B, function), _sum("sc_e5_sum", tableau.E5, function),
+              _sum("sc_e3_sum", tableau.E3, function)]
+    d_rows = [f"sc_d_{r}" for r in range(len(tableau.D))]
+    parts += [_sum(d_rows[r], tableau.D[r], function) for r in range(len(tableau.D))]
+    parts.append(_switch("sc_d_row", d_rows, function))
+    return "".join(parts)
 
 
 def kernel_text(model_c: str, cuda: bool = False) -> str:
@@ -76,7 +108,8 @@ def kernel_text(model_c: str, cuda: bool = False) -> str:
         head = ("#define SC_CUDA 1\n#define SPRINGC_NO_TABLES 1\n"
                 "#define SPRINGC_FN static __device__ __forceinline__\n")
     else:
-        model, head = model_c, "#include <math.h>\n#define SPRINGC_FN static inline\n"
+        model = model_c
+        head = f"#include <math.h>\n#define SPRINGC_FN static inline\n#define SC_LANES {LANES}\n"
     return (head + model + "\n" + prelude(cuda)
             + KERNEL.read_text(encoding="utf-8"))
 
