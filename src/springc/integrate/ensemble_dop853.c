@@ -488,6 +488,11 @@ SC_FN void sc_work(sc_job *job, double *block) {
     int need_observed, double *summary, double *traj, double *final, sc_int *status,        \
     sc_int *counts, double *failure_time
 
+#define SC_ENTRY_NAMES                                                                    \
+    runs, prepared, V, n_v, v_index, base, given, P, X0, Z, grid, m, rtol, atol, max_step,   \
+    max_steps, columns, n_columns, traj_columns, n_traj, every, n_traj_points,              \
+    need_observed, summary, traj, final, status, counts, failure_time
+
 #define SC_SETUP(job)                                                                     \
     sc_job job = {{grid, m, rtol, atol, max_step, max_steps, columns, n_columns,             \
                    traj_columns, n_traj, every, n_traj_points, need_observed},              \
@@ -503,6 +508,9 @@ extern "C" __global__ void springc_ensemble(SC_ENTRY_ARGS) {
     double block[SC_LANES * SC_WORK];
     sc_work(&job, block);
 }
+#ifdef SC_EMULATE_CUDA
+#include SC_EMULATE_CUDA
+#endif
 #else
 #include <stdlib.h>
 #ifdef _OPENMP

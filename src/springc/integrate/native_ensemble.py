@@ -217,17 +217,18 @@ class NativeEnsemble:
     """A compiled C ensemble library (:func:`build`), called through ctypes (the call
     releases the GIL)."""
 
-    def __init__(self, path: Path, n_states: int) -> None:
+    def __init__(self, path: Path, n_states: int, entry: str = "springc_ensemble") -> None:
         self.path = path
         self.n = n_states
         self.library = ctypes.CDLL(str(path))
-        self.entry = self.library.springc_ensemble
+        self.entry = getattr(self.library, entry)
         self.entry.restype = ctypes.c_int
-        self.library.springc_ensemble_threads.restype = ctypes.c_int
 
     def threads(self) -> int:
         """The threads a call uses by default (OpenMP's; 1 without OpenMP)."""
-        return int(self.library.springc_ensemble_threads())
+        count = self.library.springc_ensemble_threads
+        count.restype = ctypes.c_int
+        return int(count())
 
     def run(self, runs: Runs, grid: np.ndarray, *, rtol: float, atol: np.ndarray,
             max_step: float, max_steps: int, columns: Sequence[int] = (),
