@@ -1,4 +1,5 @@
-"""Codegen: ``ir.ode.ODE`` -> the text of a standalone Python/numba module.
+"""Codegen: ``ir.ode.ODE`` -> the text of a standalone Python/numba module, or of a C
+file (``generate_c``: :mod:`.c_model`).
 
 The contract of a generated module (:mod:`.module_api`: ``GeneratedModule``,
 ``MODULE_NAMES``, ``CODEGEN_VERSION``) loads with the package; the generator and its
@@ -19,11 +20,13 @@ from .module_api import (
 )
 
 if TYPE_CHECKING:
+    from .c_model import CModelSource, generate_c
     from .context import BACKENDS, CodegenBug, CodegenOptions, GeneratedModel
     from .generator import generate
 
-__all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CodegenBug",
-           "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule", "generate"]
+__all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CModelSource",
+           "CodegenBug", "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule",
+           "generate", "generate_c"]
 
 
 def __getattr__(name: str) -> Any:
@@ -36,4 +39,8 @@ def __getattr__(name: str) -> Any:
         from . import generator
 
         return generator.generate
+    if name in ("generate_c", "CModelSource"):  # the C model (c_model.py)
+        from . import c_model
+
+        return getattr(c_model, name)
     raise AttributeError(f"module 'springc.codegen' has no attribute {name!r}")

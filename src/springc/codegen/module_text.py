@@ -232,7 +232,7 @@ def _parameters_vector(m: CodegenContext, helpers: set[str]) -> list[str]:
                           numba=False, table_name="_IP", lift_constants=True)
     given = ["    for i, v in given:", "        p[i] = v"]
     body = params.body(m.params, helpers, given)
-    starts = VectorLayout(m, [(s.name, _start_of(m, s.name, s.start), s.span)
+    starts = VectorLayout(m, [(s.name, start_of(m, s.name, s.start), s.span)
                               for s in m.ode.states],
                           numba=False, table_name="_IS", lift_constants=True)
     start_body = starts.body(m.states, helpers)
@@ -297,7 +297,7 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
     ]
     starts: list[Stmt] = [Raw(f"x0 = np.zeros({len(m.states)})")]
     for i, s in enumerate(m.ode.states):
-        starts.append(Store(f"x0[{i}]", _start_of(m, s.name, s.start), f"{s.name}  "
+        starts.append(Store(f"x0[{i}]", start_of(m, s.name, s.start), f"{s.name}  "
                             + (source_location(s.span))))
     lines += ["", "", "def start(p):",
               '    """Start values of the states (initialization: see springc.simulate)."""']
@@ -306,10 +306,10 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
     guesses: list[Stmt] = [Raw(f"z = np.zeros({m.flag_slot + 1})")]
     for t, slot in m.guess_slots.items():
         u = m.unknowns.get(t)
-        guesses.append(Store(f"z[{slot}]", _start_of(m, t, u.start if u else None), t))
+        guesses.append(Store(f"z[{slot}]", start_of(m, t, u.start if u else None), t))
     for d in m.ode.events.discrete if m.ode.events else ():
         assert m.events is not None
-        guesses.append(Store(f"z[{m.events.slot[d.name]}]", _start_of(m, d.name, d.start),
+        guesses.append(Store(f"z[{m.events.slot[d.name]}]", start_of(m, d.name, d.start),
                              f"{d.name} (start)"))
     lines += ["", "", "def guesses(p):",
               '    """Initial Newton guesses of the tearing variables, then the flag."""']
@@ -318,7 +318,7 @@ def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> l
     return lines
 
 
-def _start_of(m: CodegenContext, name: str, start: Expr | None, depth: int = 0) -> Expr:
+def start_of(m: CodegenContext, name: str, start: Expr | None, depth: int = 0) -> Expr:
     """The start value of ``name`` as an expression of parameters (0 by default)."""
     if start is None:
         return Const(0.0)
@@ -327,5 +327,5 @@ def _start_of(m: CodegenContext, name: str, start: Expr | None, depth: int = 0) 
         if depth > 8 or u is None:
             raise CodegenError(f"the start value of '{name}' reads '{v}', which is not a "
                                "parameter")
-        start = substitute(start, {v: _start_of(m, v, u.start, depth + 1)})
+        start = substitute(start, {v: start_of(m, v, u.start, depth + 1)})
     return start

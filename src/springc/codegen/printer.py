@@ -133,11 +133,20 @@ class FunctionWriter:
         for stmt in stmts:
             self._stmt(stmt)
 
+    # Hooks of the target language (a C writer overrides them: codegen/c_printer.py).
+    block_end: ClassVar[str | None] = None  # the line that closes a loop's body
+
     def _emit(self, text: str, comment: str = "") -> None:
         line = self._indent + text
         if comment:
             line += "  # " + escaped(comment)
         self.lines.append(line)
+
+    def _assign(self, target: str, text: str, comment: str = "") -> None:
+        self._emit(f"{target} = {text}", comment)
+
+    def _comment(self, text: str) -> None:
+        self._emit("# " + escaped(text))
 
     def _stmt(self, stmt: Stmt) -> None:
         if isinstance(stmt, Let):
@@ -148,23 +157,23 @@ class FunctionWriter:
                 text, _ = self._print(stmt.expr)
                 self._reassigned(stmt.name)
                 ident = self.name(stmt.name)
-                self._emit(f"{ident} = {text}", stmt.comment)
+                self._assign(ident, text, stmt.comment)
                 self._remember(cid, ident, stmt.expr)
                 return
             text = self.expr(stmt.expr)
             self._reassigned(stmt.name)
-            self._emit(f"{self.name(stmt.name)} = {text}", stmt.comment)
+            self._assign(self.name(stmt.name), text, stmt.comment)
         elif isinstance(stmt, Load):
             self._reassigned(stmt.name)
-            self._emit(f"{self.name(stmt.name)} = {stmt.source}", stmt.comment)
+            self._assign(self.name(stmt.name), stmt.source, stmt.comment)
         elif isinstance(stmt, Store):
-            self._emit(f"{stmt.target} = {self.expr(stmt.expr)}", stmt.comment)
+            self._assign(stmt.target, self.expr(stmt.expr), stmt.comment)
         elif isinstance(stmt, Raw):
             for line in stmt.text.splitlines():
                 self._emit(line)
         elif isinstance(stmt, Block):
             if stmt.comment:
-                self._emit("# " + escaped(stmt.comment))
+                self._comment(stmt.comment)
             self.write(stmt.body)
         else:
             for name in defines_inside(stmt.body):
@@ -177,6 +186,8 @@ class FunctionWriter:
             for cid in self._scopes.pop():
                 self._temps.pop(cid, None)
             self._indent = outer
+            if self.block_end is not None:
+                self._emit(self.block_end)
 
     def _reassigned(self, name: str) -> None:
         ident = self.name(name)
@@ -202,7 +213,7 @@ class FunctionWriter:
         text, prec = self._print(e)
         if self._count[cid] > 1 and not _trivial(e) and not self._in_branch:
             name = f"_c{cid}"
-            self._emit(f"{name} = {text}")
+            self._assign(name, text)
             self._remember(cid, name, e)
             return name, 9
         return text, prec

@@ -130,10 +130,14 @@ class Namer:
     name that looks internal (Modelica allows ``_x``) is sanitized too.
     """
 
-    def __init__(self, model_names: Iterable[str] = ()) -> None:
+    def __init__(self, model_names: Iterable[str] = (), reserved: Iterable[str] = (),
+                 reserved_prefix: str = "") -> None:
         self.model_names = frozenset(model_names)
         self._ident: dict[str, str] = {}
-        self._used: set[str] = set(_RESERVED)
+        # ``reserved``: further identifiers of another target language (C's keywords);
+        # a name starting with ``reserved_prefix`` (any case) gets ``v_`` in front
+        self._used: set[str] = set(_RESERVED) | set(reserved)
+        self._prefix = reserved_prefix.lower()
 
     def __call__(self, name: str) -> str:
         ident = self._ident.get(name)
@@ -148,7 +152,7 @@ class Namer:
 
     def _fresh(self, name: str) -> str:
         base = re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_") or "v"
-        if base[0].isdigit():
+        if base[0].isdigit() or (self._prefix and base.lower().startswith(self._prefix)):
             base = "v_" + base
         ident, n = base, 1
         while ident in self._used:

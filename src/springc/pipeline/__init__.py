@@ -22,11 +22,12 @@ from .options import CompileOptions
 from .selection import select_names
 
 if TYPE_CHECKING:
+    from .c_build import CCompilerMissing, CLibrary, c_library
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
-__all__ = ["CompileOptions", "CompiledModel", "announce_functions", "check_parameter_names",
-           "compile_files",
+__all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel",
+           "announce_functions", "c_library", "check_parameter_names", "compile_files",
            "derive_system", "flatten_files", "generate_source", "modification_value",
            "select_names", "split_values"]
 
@@ -37,6 +38,10 @@ def __getattr__(name: str) -> Any:
         from . import generation
 
         return getattr(generation, name)
+    if name in ("c_library", "CLibrary", "CCompilerMissing"):  # builds with a C compiler
+        from . import c_build
+
+        return getattr(c_build, name)
     if name == "flatten_files":
         from . import files
 

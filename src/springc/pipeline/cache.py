@@ -194,6 +194,47 @@ def write_entry(entry: Path, text: str, name: str = MODULE_FILE,
     return entry / name
 
 
+def add_to_entry(entry: Path, name: str, data: bytes) -> Path:
+    """Add file ``name`` (e.g. the C library of the entry's model) to an existing
+    ``entry`` with its hash record: both written under temporary names and renamed, the
+    record first, so that a reader sees the old file, the new one with its record, or
+    a mismatch that it rebuilds; the path of the file."""
+    for target, content in ((entry / _hash_file(name),
+                             (hashlib.sha256(data).hexdigest() + "\n").encode("ascii")),
+                            (entry / name, data)):
+        fd, temporary = tempfile.mkstemp(dir=entry, prefix=".new-")  # created 0600
+        try:
+            with os.fdopen(fd, "wb") as out:
+                out.write(content)
+            os.replace(temporary, target)
+        except OSError:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+            raise
+    return entry / name
+
+
+def read_addition(entry: Path, name: str) -> bytes | None:
+    """The bytes of file ``name`` added to ``entry`` (:func:`add_to_entry`) if its hash
+    matches the record; None if there is none, or (with a note) if it is damaged: then
+    only that file and its record are removed, and the caller builds it again."""
+    path, record = entry / name, entry / _hash_file(name)
+    if not path.exists() and not record.exists():
+        return None
+    try:
+        data = path.read_bytes()
+        expected = record.read_text(encoding="ascii").strip()
+    except (OSError, UnicodeDecodeError):
+        expected, data = "", b""
+    if hashlib.sha256(data).hexdigest() != expected:
+        note(f"{path} does not match its recorded hash; building it again")
+        for stale in (path, record):
+            with contextlib.suppress(OSError):
+                stale.unlink()
+        return None
+    return data
+
+
 def import_module(data: bytes, path: Path, name: str) -> GeneratedModule:
     """Execute the module text ``data`` (already verified) as module ``name`` located at
     ``path``; raises ``ImportError`` if it is not a complete generated module."""

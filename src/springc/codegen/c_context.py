@@ -1,0 +1,156 @@
+"""The steps of a system as C statements: linear blocks solved in C, torn nonlinear
+blocks by Newton's method in C (the tolerance and iteration limit of the Python
+module: :data:`.context.NEWTON_TOLERANCE`, :data:`.context.NEWTON_ITERATIONS`).
+
+:class:`CContext` is the generator's :class:`.context.CodegenContext` whose blocks are
+written with fixed-size local arrays and ``springc_solve`` (:data:`SOLVE`) instead of
+numpy; everything else (loads, aliases, the event statements) is shared.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+
+from ..ir import ode
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub
+from .context import NEWTON_ITERATIONS, NEWTON_TOLERANCE, CodegenBug, CodegenContext
+from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
+
+SOLVE = """SPRINGC_FN void springc_solve(int n, double *a, double *b, double *y)
+{
+    /* y = a^-1 b (a: n x n, by rows): Gaussian elimination with partial pivoting */
+    /* a and b are overwritten; y is NaN where an entry is not finite or a is singular */
+    int i, j, k;
+    for (i = 0; i < n * n; i++) {
+        if (!(a[i] - a[i] == 0.0)) goto fail;
+    }
+    for (i = 0; i < n; i++) {
+        if (!(b[i] - b[i] == 0.0)) goto fail;
+    }
+    for (k = 0; k < n; k++) {
+        int pivot = k;
+        double best = fabs(a[k * n + k]);
+        for (i = k + 1; i < n; i++) {
+            if (fabs(a[i * n + k]) > best) {
+                best = fabs(a[i * n + k]);
+                pivot = i;
+            }
+        }
+        if (best == 0.0) goto fail;
+        if (pivot != k) {
+            double swap;
+            for (j = 0; j < n; j++) {
+                swap = a[k * n + j];
+                a[k * n + j] = a[pivot * n + j];
+                a[pivot * n + j] = swap;
+            }
+            swap = b[k];
+            b[k] = b[pivot];
+            b[pivot] = swap;
+        }
+        for (i = k + 1; i < n; i++) {
+            double f = a[i * n + k] / a[k * n + k];
+            for (j = k + 1; j < n; j++) a[i * n + j] -= f * a[k * n + j];
+            b[i] -= f * b[k];
+        }
+    }
+    for (i = n - 1; i >= 0; i--) {
+        double s = b[i];
+        for (j = i + 1; j < n; j++) s -= a[i * n + j] * y[j];
+        y[i] = s / a[i * n + i];
+    }
+    return;
+fail:
+    for (i = 0; i < n; i++) y[i] = NAN;
+}"""
+
+
+class CContext(CodegenContext):
+    """The codegen context whose linear and nonlinear blocks are C statements; a
+    function whose statements contain one declares ``int _code`` (0, or the failure
+    code of the last torn system that did not converge) and defines ``springc_solve``
+    where a block solves a linear system (``uses_solve``)."""
+
+    uses_solve = False
+
+    def _linear(self, block: ode.LinearBlock, index: int, comment: str) -> Stmt:
+        n = len(block.names)
+        self.uses_solve = True
+        body: list[Stmt] = [Raw(f"double _A{index}[{n * n}] = {{0.0}};")]
+        body += [Store(f"_A{index}[{i * n + j}]", e) for i, j, e in block.matrix]
+        body.append(Raw(f"double _b{index}[{n}];"))
+        body += [Store(f"_b{index}[{i}]", e) for i, e in enumerate(block.rhs)]
+        body.append(Raw(f"double _y{index}[{n}];\n"
+                        f"springc_solve({n}, _A{index}, _b{index}, _y{index});"))
+        body += [Load(name, f"_y{index}[{k}]", name) for k, name in enumerate(block.names)]
+        return Block(body, comment, {*block.names, f"_A{index}"})
+
+    def _nonlinear(self, block: ode.NonlinearBlock, index: int, comment: str) -> Stmt:
+        k = len(block.tearing)
+        slots = [self.guess_slots[t] for t in block.tearing]
+        body: list[Stmt] = [Load(t, f"z[{s}]", f"{t} (warm start)")
+                            for t, s in zip(block.tearing, slots)]
+        body.append(Raw(f"int _ok{index} = 0;\n_done{index} = 0.0;"))
+        loop: list[Stmt] = [Let(a.name, a.expr, f"{a.name}") for a in block.inner]
+        loop += [Let(f"_r{index}_{i}", r, "residual") for i, r in enumerate(block.residuals)]
+        loop.append(Raw(f"if (_done{index} != 0.0) {{\n    _ok{index} = 1;\n    break;\n}}"))
+        loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
+        entries = {(i, j): e for i, j, e in block.jacobian}
+        if k == 1:
+            pivot = entries.get((0, 0), ZERO)
+            loop.append(Let(f"_d{index}_0", BinOp("/", Var(f"_r{index}_0"), pivot)))
+        else:
+            self.uses_solve = True
+            loop.append(Raw(f"double _J{index}[{k * k}] = {{0.0}};"))
+            loop += [Store(f"_J{index}[{i * k + j}]", e) for (i, j), e in entries.items()]
+            loop.append(Raw(f"double _R{index}[{k}];"))
+            loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
+            loop.append(Raw(f"double _D{index}[{k}];\n"
+                            f"springc_solve({k}, _J{index}, _R{index}, _D{index});"))
+            loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
+        done: Expr | None = None
+        for i, t in enumerate(block.tearing):
+            loop.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
+            small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
+                          mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
+            done = small if done is None else BinOp("and", done, small)
+        assert done is not None
+        loop.append(Let(f"_done{index}", done))
+        body.append(Loop(f"for (int _it = 0; _it < {NEWTON_ITERATIONS}; _it++) {{", loop))
+        body.append(Raw(f"if (!_ok{index}) {{\n    z[{self.flag_slot}] = {float(index + 1)!r};\n"
+                        f"    _code = {index + 1};\n}}"))
+        body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
+        names = {*block.tearing, *(a.name for a in block.inner),
+                 *(s.name for s in block.sensitivities)}
+        return Block(body, comment, names)
+
+
+_EMPTY = re.compile(r"(\w+) = np\.empty\((\d+)\)\Z")
+
+
+def c_statements(stmts: Sequence[Stmt], outputs: Sequence[str]) -> list[Stmt]:
+    """The event functions' statements (:mod:`.events`) in C: their few lines of
+    Python (``g = np.empty(n)``) become declarations, or nothing for an array the C
+    function takes as its argument (``outputs``)."""
+    out: list[Stmt] = []
+    for s in stmts:
+        if isinstance(s, Raw):
+            found = _EMPTY.match(s.text)
+            if found:
+                name, size = found.group(1), int(found.group(2))
+                if name not in outputs:
+                    out.append(Raw(f"double {name}[{max(size, 1)}];"))
+            elif s.text == "_zdone = 1.0":
+                continue
+            elif not s.text.startswith(("double ", "int ", "if (", "springc_")):
+                raise CodegenBug(f"no C for the statement {s.text!r}")
+            else:
+                out.append(s)
+        elif isinstance(s, Block):
+            out.append(Block(c_statements(s.body, outputs), s.comment, s.defines, s.uses))
+        elif isinstance(s, Loop):
+            out.append(Loop(s.header, c_statements(s.body, outputs)))
+        else:
+            out.append(s)
+    return out
