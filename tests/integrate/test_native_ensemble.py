@@ -19,13 +19,14 @@ from numba import njit
 from springc.integrate import Status, dop853, ensemble
 from springc.integrate.native_ensemble import (
     BAD_START,
+    OPENMP,
     NativeEnsemble,
     Outputs,
     Runs,
-    build,
     kernel_text,
     trajectory_points,
 )
+from springc.pipeline.c_build import build_library
 
 HERE = Path(__file__).resolve().parent
 SEED_C = (HERE / "seed_model.c").read_text(encoding="utf-8")
@@ -56,7 +57,8 @@ def seed_observed(t: float, x: np.ndarray, p: np.ndarray, z: np.ndarray) -> np.n
 
 @pytest.fixture(scope="module")
 def kernel(tmp_path_factory: pytest.TempPathFactory) -> NativeEnsemble:
-    return NativeEnsemble(build(kernel_text(SEED_C), tmp_path_factory.mktemp("c")), 4)
+    data = build_library(kernel_text(SEED_C), tmp_path_factory.mktemp("c"), OPENMP)
+    return NativeEnsemble(data, 4)
 
 
 def _runs(column: int, values: np.ndarray) -> Runs:
@@ -82,16 +84,19 @@ def _run(kernel: NativeEnsemble, runs: Runs, grid: np.ndarray = GRID, **options:
 def test_the_c_kernel_takes_the_numba_ensembles_steps(kernel: NativeEnsemble) -> None:
     ks = np.geomspace(1e3, 1e5, 40)
     columns = [0, 3, 6]  # mass.pos[1], mass.v[2], spring.x (observed)
-    out = _run(kernel, _runs(K, ks), columns=columns)
+    out = _run(kernel, _runs(K, ks), columns=columns, traj_columns=[1, 6], every=3)
     P, X0, Z = _prepared(K, ks)
     reference = ensemble(seed_rhs, GRID, X0, P, Z, rtol=RTOL, atol=ATOL,
-                         observed=seed_observed, columns=columns)
+                         observed=seed_observed, columns=columns, traj_columns=[1, 6],
+                         every=3)
     assert (out.status == 0).all()
     # the same steps: the kernel's sums run in numba's order (no fused multiply-adds)
     assert (out.counts[:, 0] + out.counts[:, 1]).tolist() == reference.steps.tolist()
     assert out.counts[:, 2].tolist() == reference.rhs_evaluations.tolist()
     np.testing.assert_allclose(out.finals, reference.finals, rtol=1e-12, atol=0)
     np.testing.assert_allclose(out.summary, reference.summary, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(out.trajectories, reference.trajectories, rtol=1e-12,
+                               atol=1e-15)
 
 
 def test_trajectories_are_the_single_runs_states_on_the_kept_times(
@@ -159,7 +164,7 @@ def test_the_cuda_text_of_the_kernel_gives_the_c_kernels_results(
     library = tmp_path / "cuda.so"
     subprocess.run([cxx, "-O1", "-ffp-contract=off", "-fPIC", "-shared", f"-I{HERE}",
                     str(source), "-o", str(library)], check=True)
-    emulated = NativeEnsemble(library, 4, entry="sc_emulated_launch")
+    emulated = NativeEnsemble(library.read_bytes(), 4, entry="sc_emulated_launch")
     runs = _runs(K, np.geomspace(1e3, 1e5, 300))  # three blocks of 128 threads
     gpu = _run(emulated, runs, columns=[0, 6], traj_columns=[3], every=4, threads=128)
     cpu = _run(kernel, runs, columns=[0, 6], traj_columns=[3], every=4)

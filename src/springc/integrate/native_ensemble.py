@@ -4,19 +4,16 @@ One kernel source (``ensemble_dop853.c``: DOP853 per run, springc's compiled DOP
 with plain-loop sums, every sum in the same order) is put together with the model's C
 functions (the ``cmodel`` interface: ``springc_parameters``, ``springc_start``,
 ``springc_rhs``, ``springc_observed`` and the ``SPRINGC_N_*`` sizes) and compiled in two
-ways from the same text: here by the system C compiler into a shared library (OpenMP
-over the runs, loaded with ctypes), and in :mod:`.gpu_ensemble` by CuPy's NVRTC as a
-CUDA kernel (one thread per run). :func:`kernel_text` is that text; :func:`build` and
-:class:`NativeEnsemble` are the C side. Imports nothing from springc.
+ways from the same text: by the system C compiler into a shared library (OpenMP over
+the runs, loaded here with ctypes; built by :func:`springc.pipeline.kernel_library`),
+and in :mod:`.gpu_ensemble` by CuPy's NVRTC as a CUDA kernel (one thread per run).
+:func:`kernel_text` is that text, :class:`NativeEnsemble` the C side's call. Imports
+nothing from springc.
 """
 
 from __future__ import annotations
 
 import ctypes
-import hashlib
-import os
-import shutil
-import subprocess
 import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -32,21 +29,18 @@ KERNEL = Path(__file__).with_name("ensemble_dop853.c")
 BAD_START = -1
 """The status of a run whose parameters or start values are not finite (or whose start
 values' Newton iteration failed): it is not integrated."""
-FLAGS = ("-O2", "-ffp-contract=off", "-fPIC", "-shared", "-std=c99")
-"""No fused multiply-adds: the sums round as numba's do."""
-OPENMP = "-fopenmp"
-COMPILERS = ("cc", "gcc", "clang")
+OPENMP = ("-fopenmp",)
+"""The compiler argument of the parallel loop over the runs (the build is tried again
+without it where the compiler has no OpenMP: one thread). The other flags are the C
+model's (:func:`springc.pipeline.kernel_library`): -O2, no fused multiply-adds, so the
+sums round as numba's do."""
 LANES = 4
 """Runs in progress per thread on the CPU, their steps interleaved (see the kernel)."""
 STATISTICS = 5  # final, min, max, mean, time of the max (see .batch.STATISTICS)
 
 
-class CompilerMissing(RuntimeError):
-    """No C compiler was found (``$CC``, ``cc``, ``gcc``, ``clang``)."""
-
-
 class CompileFailed(RuntimeError):
-    """The C compiler refused the kernel text (its messages are the error's text)."""
+    """The CUDA compiler refused the kernel text (its messages are the error's text)."""
 
 
 def _array(name: str, values: np.ndarray, qualifier: str) -> str:
@@ -109,44 +103,10 @@ def kernel_text(model_c: str, cuda: bool = False) -> str:
                 "#define SPRINGC_FN static __device__ __forceinline__\n")
     else:
         model = model_c
-        head = f"#include <math.h>\n#define SPRINGC_FN static inline\n#define SC_LANES {LANES}\n"
+        head = ("#include <math.h>\n#define SPRINGC_NO_TABLES 1\n#undef SPRINGC_FN\n"
+                f"#define SPRINGC_FN static inline\n#define SC_LANES {LANES}\n")
     return (head + model + "\n" + prelude(cuda)
             + KERNEL.read_text(encoding="utf-8"))
-
-
-def compiler() -> str:
-    """The system C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang``."""
-    for name in (os.environ.get("CC"), *COMPILERS):
-        if name:
-            found = shutil.which(name)
-            if found:
-                return found
-    raise CompilerMissing("no C compiler found (looked for $CC, cc, gcc, clang)")
-
-
-def build(text: str, folder: Path) -> Path:
-    """The shared library of ``text`` in ``folder``, compiled once per text (its name
-    is the SHA-256 of the text, the compiler and the flags; written to a temporary
-    name, then renamed). With OpenMP where the compiler has it, else one thread."""
-    cc = compiler()
-    digest = hashlib.sha256("\0".join((text, cc, *FLAGS, OPENMP)).encode()).hexdigest()
-    target = folder / f"ensemble-{digest[:24]}.so"
-    if target.is_file():
-        return target
-    folder.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=folder) as scratch:
-        source = Path(scratch) / "ensemble.c"
-        source.write_text(text, encoding="utf-8")
-        built = Path(scratch) / "ensemble.so"
-        errors = ""
-        for extra in ((OPENMP,), ()):
-            done = subprocess.run([cc, *FLAGS, *extra, str(source), "-o", str(built), "-lm"],
-                                  capture_output=True, text=True, check=False)
-            if done.returncode == 0:
-                os.replace(built, target)
-                return target
-            errors = errors or done.stderr
-        raise CompileFailed(errors.strip())
 
 
 @dataclass(frozen=True)
@@ -214,13 +174,16 @@ def kernel_arguments(runs: Runs, grid: np.ndarray, rtol: float, atol: np.ndarray
 
 
 class NativeEnsemble:
-    """A compiled C ensemble library (:func:`build`), called through ctypes (the call
-    releases the GIL)."""
+    """A compiled C ensemble library (the bytes of a shared library built from
+    :func:`kernel_text`), loaded from a private temporary folder and called through
+    ctypes (the call releases the GIL)."""
 
-    def __init__(self, path: Path, n_states: int, entry: str = "springc_ensemble") -> None:
-        self.path = path
+    def __init__(self, data: bytes, n_states: int, entry: str = "springc_ensemble") -> None:
+        self.folder = tempfile.TemporaryDirectory(prefix="springc-ensemble-")  # 0700
+        self.path = Path(self.folder.name) / "ensemble.so"
+        self.path.write_bytes(data)
         self.n = n_states
-        self.library = ctypes.CDLL(str(path))
+        self.library = ctypes.CDLL(str(self.path))
         self.entry = getattr(self.library, entry)
         self.entry.restype = ctypes.c_int
 
