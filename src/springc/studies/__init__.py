@@ -37,6 +37,6 @@ __all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "Ensembl
            "EnsembleSummary", "Executor",
            "ParameterSpec", "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs",
            "default_workers", "fan_figure", "grid", "parameter_table", "parse_parameter",
-           "parse_values", "partial_folder", "plot_variable", "read_table", "render_fan",
-           "read_trajectories", "run_batch", "run_ensemble", "run_study", "sample",
+           "parse_values", "partial_folder", "plot_variable", "read_table",
+           "read_trajectories", "render_fan", "run_batch", "run_ensemble", "run_study", "sample",
            "summary_path", "to_dataset", "unit_points"]

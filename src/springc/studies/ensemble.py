@@ -52,7 +52,7 @@ from ..simulation import (
     resolve,
     simulate_model,
 )
-from .ensemble_engines import FAILED_PREPARATION, Chunk, Plan, open_engine
+from .ensemble_engines import FAILED_PREPARATION, Chunk, Plan, event_constructs, open_engine
 from .ensemble_outputs import (
     SUFFIXES,
     chunk_table,
@@ -139,37 +139,43 @@ def run_table(options: EnsembleOptions) -> tuple[tuple[str, ...], np.ndarray]:
 
 
 def check_model(model: CompiledModel, device: str = "cpu") -> None:
-    """The ensemble engines run continuous models."""
+    """The ensemble engines run continuous models; on the GPU the error names the
+    model's event constructs (:func:`.ensemble_engines.event_constructs`)."""
     module = model.module
     engine = "the GPU engine" if device == "gpu" else "the ensemble engine"
     for flag, what in (("EVENTS", "events (when, if on a state, sample...)"),
                        ("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch")):
-        if getattr(module, flag, False):
-            raise SimulationError(f"{model.name} has {what}, which {engine} does not run "
-                                  "yet", hint="use springc sweep (one run at a time)")
+        if not getattr(module, flag, False):
+            continue
+        if flag == "EVENTS" and device == "gpu":
+            what = f"events ({event_constructs(model)})"
+        raise SimulationError(f"{model.name} has {what}, which {engine} does not run "
+                              "yet", hint="use springc sweep (one run at a time)")
 
 
 def check_bounds(model: CompiledModel, names: Sequence[str], values: np.ndarray,
                  fixed: Mapping[str, float]) -> None:
     """Refuse, before any run, a value outside its parameter's declared ``min``/``max``
-    (the generated module's ``PARAMETER_BOUNDS``), naming the parameter and the run."""
-    bounds = dict(zip(model.parameter_names,
-                      getattr(model.module, "PARAMETER_BOUNDS", ()) or ()))
-    checks = [(n, values[:, j]) for j, n in enumerate(names)]
-    checks += [(n, np.array([v])) for n, v in fixed.items() if n in bounds]
-    for name, column in checks:
+    (the generated module's ``PARAMETER_BOUNDS``), naming the parameter (and the first
+    run that has it)."""
+    bounds = dict(zip(model.parameter_names, model.module.PARAMETER_BOUNDS))
+    checks = [(f"--param {n}", n, values[:, j], True) for j, n in enumerate(names)]
+    checks += [(f"--set {n}", n, np.array([v]), False) for n, v in fixed.items()]
+    for option, name, column, per_run in checks:
         low, high = bounds.get(name, (None, None))
-        for limit, outside, word in ((low, column < (low if low is not None else 0), "min"),
-                                     (high, column > (high if high is not None else 0),
-                                      "max")):
-            if limit is None or not outside.any():
-                continue
-            r = int(np.flatnonzero(outside)[0])
-            where = f"run {r}: " if name in names else ""
-            raise UsageError(f"{where}{name} = {float(column[r]):g} is outside its declared "
-                             f"range ({word} = {limit:g})", option="--param",
-                             hint=f"{name} is declared with min = {low}, max = {high}; "
-                             "choose values inside it")
+        below = column < low if low is not None else np.zeros(column.shape, dtype=bool)
+        above = column > high if high is not None else np.zeros(column.shape, dtype=bool)
+        outside = np.flatnonzero(below | above)
+        if outside.size:
+            r = int(outside[0])
+            limit = f"min = {low:g}" if below[r] else f"max = {high:g}"
+            where = f" (run {r})" if per_run else ""
+            raise UsageError(f"{option}: {name} = {float(column[r]):g}{where} is outside "
+                             f"its declared range ({limit})",
+                             option=option.split()[0],
+                             hint="the model declares " + ", ".join(
+                                 f"{k} = {v:g}" for k, v in (("min", low), ("max", high))
+                                 if v is not None) + f" for {name}")
 
 
 def columns_of(model: CompiledModel, variables: Sequence[str] | None, option: str = "--vars"

@@ -107,7 +107,7 @@ def numba_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str,
         threads = numba.get_num_threads()
         try:
             if plan.threads:
-                numba.set_num_threads(min(plan.threads, numba.config.NUMBA_NUM_THREADS))
+                numba.set_num_threads(min(plan.threads, numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
             result = ensemble(model.module.rhs, plan.grid, X0, P, Z, rtol=plan.rtol,
                               atol=plan.atol, observed=model.module.observed,
                               columns=plan.columns, max_steps=plan.max_steps,
@@ -199,6 +199,30 @@ def gpu_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, f
         return _chunk(out, prepared)
 
     return run
+
+
+def event_constructs(model: CompiledModel, shown: int = 3) -> str:
+    """The event constructs of a hybrid model, in words: its zero-crossing relations as
+    the C model writes them (``the relation h < 0``), ``sample(...)``, time events."""
+    import re
+
+    from ..pipeline import c_source
+
+    parts = []
+    block = re.search(r"springc_crossing_texts\[[^]]*\] = \{(.*?)\n\};",
+                      c_source(model), re.S)
+    texts = [bytes(re.sub(r"\\([0-7]{3})", lambda m: chr(int(m.group(1), 8)), t),
+                   "latin-1").decode("utf-8", "replace")
+             for t in re.findall(r'"((?:[^"\\]|\\.)*)"', block.group(1))] if block else []
+    if texts:
+        listed = ", ".join(texts[:shown]) + (f" and {len(texts) - shown} more"
+                                             if len(texts) > shown else "")
+        parts.append(f"the relation{'s' if len(texts) > 1 else ''} {listed}")
+    if getattr(model.module, "SAMPLES", ()):
+        parts.append("sample(...)")
+    if getattr(model.module, "TIME_EVENTS", ()):
+        parts.append("time events")
+    return "; ".join(parts) or "when-clauses"
 
 
 def open_engine(model: CompiledModel, engine: str | None, device: str,
