@@ -188,7 +188,7 @@ SC_FN void sc_finish(const sc_settings *s, const sc_outputs *o, int status, sc_i
     for (sc_int c = 0; c < s->n_columns; c++) {
         double *out = o->summary + 5 * c;
         if (status != SC_SUCCESS) {
-            for (int q = 0; q < 5; q++) out[q] = 0.0 / 0.0;
+            for (int q = 0; q < 5; q++) out[q] = NAN;
         } else {
             out[3] = s->m > 1 ? out[3] / span : out[0];
         }

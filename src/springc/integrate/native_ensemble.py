@@ -90,6 +90,16 @@ def prelude(cuda: bool) -> str:
     return "".join(parts)
 
 
+CUDA_MACROS = "".join(f"#ifndef {name}\n#define {name} {value}\n#endif\n" for name, value in (
+    ("HUGE_VAL", "__longlong_as_double(0x7ff0000000000000LL)"),
+    ("INFINITY", "__int_as_float(0x7f800000)"),
+    ("NAN", "__int_as_float(0x7fffffff)"),
+    ("M_PI", "3.14159265358979323846"),
+    ("M_E", "2.7182818284590452354")))
+"""The macros of ``math.h`` the C model may use, which NVRTC does not define (as CUDA's
+``math_constants.h`` writes them)."""
+
+
 def kernel_text(model_c: str, cuda: bool = False) -> str:
     """The whole translation unit: the model's C text, then the tableau and the kernel.
 
@@ -100,7 +110,7 @@ def kernel_text(model_c: str, cuda: bool = False) -> str:
         model = "".join(line for line in model_c.splitlines(keepends=True)
                         if not line.lstrip().startswith("#include"))
         head = ("#define SC_CUDA 1\n#define SPRINGC_NO_TABLES 1\n"
-                "#define SPRINGC_FN static __device__ __forceinline__\n")
+                "#define SPRINGC_FN static __device__ __forceinline__\n" + CUDA_MACROS)
     else:
         model = model_c
         head = ("#include <math.h>\n#define SPRINGC_NO_TABLES 1\n#undef SPRINGC_FN\n"
