@@ -136,3 +136,19 @@ def test_a_hybrid_model_on_the_gpu_is_refused_naming_its_relation(tmp_path: Path
                      str(tmp_path / "e.parquet"))
     assert refused.value.message == ("Ball has events (the relation h < 0), which the GPU "
                                      "engine does not run yet")
+
+
+def test_a_model_with_an_initial_problem_starts_from_its_solution(tmp_path: Path) -> None:
+    text = ("model Start\n  parameter Real k = 1;\n  Real x;\ninitial equation\n"
+            "  x * x * x + x = 10;\nequation\n  der(x) = -k * x;\nend Start;\n")
+    start = springc.load_model_from_string(text)
+    assert start.module.INITIAL_CONDITIONS == 1
+    path = tmp_path / "e.parquet"
+    summary = run_ensemble(start, EnsembleOptions((parse_parameter("k=1,3"),), stop=1.0,
+                                                  engine="c"), str(path))
+    assert summary.engine == "c"
+    finals = pq.read_table(path).column("x.final").to_pylist()
+    single = springc.simulate(start, stop=1.0, parameters={"k": 3.0}, solver="dop853",
+                              error_control="off")
+    np.testing.assert_allclose(finals[1], single.values[-1, 0], rtol=1e-6)
+    np.testing.assert_allclose(finals, [2 * np.exp(-1.0), 2 * np.exp(-3.0)], rtol=1e-5)

@@ -125,7 +125,7 @@ def c_runs(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, float
     """A chunk's values -> the C kernel's :class:`~springc.integrate.native_ensemble.Runs`
     (completed in the kernel, or prepared in Python for a model with an initial
     problem) and the messages of the runs Python could not prepare."""
-    from ..integrate.native_ensemble import Runs
+    from ..integrate import Runs
 
     index = {n: i for i, n in enumerate(model.parameter_names)}
     varied = np.array([index[n] for n in names], dtype=np.int64)
@@ -152,7 +152,7 @@ def _chunk(out: Any, prepared: dict[int, str]) -> Chunk:
 def c_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, float],
              plan: Plan) -> Engine:
     """The batched C kernel on every core (the model's C file)."""
-    from ..integrate.native_ensemble import OPENMP, NativeEnsemble, kernel_text
+    from ..integrate import OPENMP, NativeEnsemble, kernel_text
     from ..pipeline import c_source, kernel_library
 
     text = kernel_text(c_source(model))
@@ -180,7 +180,7 @@ def c_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, flo
 def gpu_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, float],
                plan: Plan) -> Engine:
     """The C kernel on the GPU through CuPy (one thread per run)."""
-    from ..integrate.gpu_ensemble import GpuEnsemble, NoCudaDevice
+    from ..integrate import GpuEnsemble, NoCudaDevice
     from ..pipeline import c_source
 
     try:
