@@ -36,6 +36,41 @@ end Lin;
 """
 
 
+SAMPLER = """model Sampler "sample, a time event, when/elsewhen, edge and terminate"
+  parameter Real T = 0.1;
+  Real x(start = 1, fixed = true);
+  discrete Real y(start = 0);
+  Integer n(start = 0);
+  Boolean high(start = false);
+equation
+  der(x) = -x + y + (if time > 0.35 then 1 else 0);
+  when sample(0, T) then
+    y = pre(y) + 0.5*x;
+    n = pre(n) + 1;
+  end when;
+  when x > 1.2 then
+    high = true;
+  elsewhen x < 0.8 then
+    high = false;
+  end when;
+  when time > 1.0 then
+    terminate("enough");
+  end when;
+end Sampler;
+"""
+
+BUILTINS = """model Builtins "floor, mod, sign, div, abs, max, min, integer, rem, noEvent"
+  Real x(start = 0.2, fixed = true);
+  Real k;
+  Real w(start = 0.3, fixed = true);
+equation
+  der(x) = 1 + 0.5*floor(x*3) - 0.1*mod(x, 0.7) + sign(x - 1) + div(x, 0.3);
+  der(w) = if noEvent(w > 0.5) then -abs(w) else max(w, 0.1) + min(x, 2);
+  k = integer(3*time) + rem(x, 0.4);
+end Builtins;
+"""
+
+
 @pytest.fixture(autouse=True)
 def _cache(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
@@ -80,23 +115,30 @@ def check_continuous(m: CompiledModel, lib: CLibrary, given: dict[str, float]) -
         code, out = lib.observed(t, x, p, z_cc)
         close(out, mod.observed(t, x, p, z_py))
         close(z_cc, z_py)
+        if lib.has_jacobian:
+            code, jac = lib.jacobian_dense(t, x, p, z_cc)
+            close(jac, mod.jacobian_dense(t, x, p, z_py))
 
 
 def test_seed_functions_equal_the_python_module(tmp_path: Path) -> None:
     m, lib = compiled(tmp_path, None, SEED, "SpringMass")
     assert (lib.n_states, lib.n_params, lib.n_observed, lib.n_z) == (4, 11, 3, 1)
+    assert lib.has_jacobian and lib.n_jac == len(m.module.JAC_ROWS) == 6
     check_continuous(m, lib, {})
     check_continuous(m, lib, {"spring.k": 250.0, "mass.m": 0.3})
 
 
 def test_a_hundred_mass_chain_equals_the_python_module(tmp_path: Path) -> None:
     m, lib = compiled(tmp_path, None, SCENES, "Scenes.Chain", parameters={"N": 100})
-    assert lib.n_states == 200
+    assert lib.n_states == 200 and lib.has_jacobian
     check_continuous(m, lib, {"k": 37.0})
 
 
 def test_linear_block_and_bound_parameters(tmp_path: Path) -> None:
     m, lib = compiled(tmp_path, LINEAR, "", "Lin")
+    assert not lib.has_jacobian  # it would need a matrix solve: not printed in C
+    assert lib.jacobian_dense(0.0, np.ones(1), m.module.parameters(), m.module.guesses(
+        m.module.parameters()))[0] == -3
     check_continuous(m, lib, {})
     # c = a + b follows a given a, unless c is given too
     index = {name: i for i, name in enumerate(m.module.PARAMETERS)}
@@ -145,6 +187,42 @@ def test_bouncing_ball_events_equal_the_python_module(tmp_path: Path) -> None:
     assert z_c[mod.Z_DISCRETE[0]] == 1.0  # bounces
     close(lib.observed(0.5, after, p, z_c)[1], mod.observed(0.5, after, p, z_py))
     close(lib.rhs(0.5, after, p, z_c)[1], mod.rhs(0.5, after, p, z_py))
+
+
+def check_hybrid(m: CompiledModel, lib: CLibrary) -> list[int]:
+    """The initial event, then at each point rhs, observed, zero crossings, the next
+    time event and an event: C and Python agree (z included); the event codes."""
+    mod = m.module
+    p = mod.parameters()
+    z_py = mod.guesses(p)
+    z_c = z_py.copy()
+    z_py[mod.Z_INITIAL] = z_c[mod.Z_INITIAL] = 1.0
+    x0 = mod.start(p)
+    codes = [lib.event_update(0.0, x0, p, z_c)[0]]
+    mod.event_update(0.0, x0, p, z_py)
+    for t, x in points(x0):
+        for function in ("rhs", "observed", "zero_crossings"):
+            close(getattr(lib, function)(t, x, p, z_c)[1],
+                  getattr(mod, function)(t, x, p, z_py))
+        assert lib.next_time_event(t, x, p, z_c) == mod.next_time_event(t, x, p, z_py)
+        code, after = lib.event_update(t, x, p, z_c)
+        close(after, mod.event_update(t, x, p, z_py))
+        close(z_c, z_py)
+        codes.append(code)
+    return codes
+
+
+def test_samples_time_events_and_terminate_equal_the_python_module(tmp_path: Path) -> None:
+    m, lib = compiled(tmp_path, SAMPLER, "", "Sampler")
+    codes = check_hybrid(m, lib)
+    assert codes == [0, 0, 0, -2, -2]  # terminate() at t = 1.5 and 2.5
+    assert "springc_terminate_messages" in lib.source and '"enough"' in lib.source
+
+
+def test_builtin_functions_equal_the_python_module(tmp_path: Path) -> None:
+    m, lib = compiled(tmp_path, BUILTINS, "", "Builtins")
+    assert "floor(" in lib.source and "springc_max(" in lib.source
+    assert check_hybrid(m, lib) == [0] * 5
 
 
 def test_delay_is_a_located_error(tmp_path: Path) -> None:

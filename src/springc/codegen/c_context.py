@@ -62,7 +62,7 @@ SOLVE = """SPRINGC_FN void springc_solve(int n, double *a, double *b, double *y)
     }
     return;
 fail:
-    for (i = 0; i < n; i++) y[i] = NAN;
+    for (i = 0; i < n; i++) y[i] = SPRINGC_NAN;
 }"""
 
 
@@ -73,6 +73,8 @@ class CContext(CodegenContext):
     where a block solves a linear system (``uses_solve``)."""
 
     uses_solve = False
+    jacobian_size = 0  # non-zeros of springc_jacobian
+    has_jacobian = False  # whether the C file computes the Jacobian (see c_model)
 
     def _linear(self, block: ode.LinearBlock, index: int, comment: str) -> Stmt:
         n = len(block.names)

@@ -25,9 +25,10 @@ from .context import CodegenContext, source_comment
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
 from .generator import structural_parameters
+from .jacobian import jacobian_statements
 from .locate import at_initialization, locate, untranslatable
 from .module_text import parameter_value, start_of, topological
-from .statements import Let, Load, Namer, Raw, Stmt, Store, reserved_name
+from .statements import Block, Let, Load, Loop, Namer, Raw, Stmt, Store, reserved_name
 
 _SIGNATURE = "double t, const double *x, const double *p, double *z"
 
@@ -98,7 +99,7 @@ def _function(head: str, body: list[str], ret: str = "_code") -> list[str]:
 
 def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str]
                ) -> list[str]:
-    steps, _ = m.step_stmts()
+    steps, described = m.step_stmts()
     loads = m.loads()
     computed = set(m.ode.step_names())
     rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
@@ -112,7 +113,43 @@ def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[s
                        c_function_body(namer, helpers, rhs))
     lines += _function(f"int springc_observed({_SIGNATURE}, double *out)",
                        c_function_body(namer, helpers, obs))
+    lines += _jacobian(m, steps, described, namer, helpers)
     return lines + _event_functions(m, namer, helpers)
+
+
+def _raw_lines(stmts: Sequence[Stmt]) -> list[str]:
+    out: list[str] = []
+    for s in stmts:
+        if isinstance(s, Raw):
+            out.append(s.text)
+        elif isinstance(s, (Block, Loop)):
+            out += _raw_lines(s.body)
+    return out
+
+
+def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, int, str]],
+              namer: Namer, helpers: set[str]) -> list[str]:
+    """``springc_jacobian`` (the non-zeros of d(rhs)/dx in CSC order, the analytic
+    Jacobian of :mod:`.jacobian`) and ``springc_jacobian_pattern``, where it is
+    cheap: a system whose linear and torn blocks need no matrix solve for it (else
+    ``SPRINGC_HAS_JACOBIAN`` is 0 and ``springc_jacobian`` returns -3)."""
+    body, pattern = jacobian_statements(
+        m.states, m.derivatives, described,
+        {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
+    cheap = all(text.startswith("jv = np.empty(") for text in _raw_lines(body))
+    m.jacobian_size = len(pattern) if cheap else 0
+    m.has_jacobian = cheap
+    lines = ["", "SPRINGC_FN void springc_jacobian_pattern(int *rows, int *cols)", "{"]
+    if cheap:
+        lines += [f"    rows[{k}] = {r};\n    cols[{k}] = {c};" for k, (r, c)
+                  in enumerate(pattern)]
+    lines.append("}")
+    if not cheap:
+        return lines + _function(f"int springc_jacobian({_SIGNATURE}, double *jv)", [],
+                                 "-3")
+    stmts = m.loads() + steps + c_statements(body, ("jv",))
+    return lines + _function(f"int springc_jacobian({_SIGNATURE}, double *jv)",
+                             c_function_body(namer, helpers, stmts))
 
 
 def _parameters(m: CContext, namer: Namer, helpers: set[str]) -> list[str]:
@@ -179,7 +216,7 @@ SPRINGC_FN int springc_zero_crossings({_SIGNATURE}, double *g)
 
 SPRINGC_FN double springc_next_time_event({_SIGNATURE})
 {{
-    return HUGE_VAL;
+    return SPRINGC_INF;
 }}
 
 SPRINGC_FN int springc_event_update(double t, double *x, const double *p, double *z)

@@ -100,9 +100,9 @@ def c_comment(text: str) -> str:
 def c_double(value: float) -> str:
     """A C double literal of exactly ``value`` (Python's shortest round-trip text)."""
     if math.isnan(value):
-        return "NAN"
+        return "SPRINGC_NAN"
     if math.isinf(value):
-        return "HUGE_VAL" if value > 0 else "-HUGE_VAL"
+        return "SPRINGC_INF" if value > 0 else "-SPRINGC_INF"
     text = repr(float(value))
     return text if any(c in text for c in ".en") else text + ".0"
 

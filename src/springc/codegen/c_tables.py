@@ -13,14 +13,36 @@ from collections.abc import Sequence
 
 from ..ir.expr import variables
 from ..simplify import conditions as initial_conditions
+from .c_context import CContext
 from .c_printer import c_comment, c_double, c_string
 from .context import CodegenContext
 from .events import EVENT_ITERATIONS, after_initial
 
-_HEADER = """#include <math.h>
+# NVRTC (CUDA C++ compiled at run time) has the math functions built in, no <math.h>,
+# and no host tables; CUDA spells infinity and NaN with its bit-pattern intrinsics.
+_HEADER = """#if defined(__CUDACC_RTC__) && !defined(SPRINGC_NO_TABLES)
+#define SPRINGC_NO_TABLES
+#endif
+#ifndef __CUDACC_RTC__
+#include <math.h>
+#endif
 
 #ifndef SPRINGC_FN
 #define SPRINGC_FN static
+#endif
+#ifndef SPRINGC_INF
+#ifdef __CUDACC__
+#define SPRINGC_INF __longlong_as_double(0x7ff0000000000000LL)
+#else
+#define SPRINGC_INF HUGE_VAL
+#endif
+#endif
+#ifndef SPRINGC_NAN
+#ifdef __CUDACC__
+#define SPRINGC_NAN __longlong_as_double(0x7ff8000000000000LL)
+#else
+#define SPRINGC_NAN NAN
+#endif
 #endif"""
 
 
@@ -34,12 +56,18 @@ def _ints(name: str, size: str, values: Sequence[int]) -> list[str]:
     return [f"static const int {name}[{size} + 1] = {{{items}}};"]
 
 
+def _host_double(value: float | None) -> str:
+    # the tables are host data: <math.h>'s spelling of NaN and infinity
+    text = c_double(value) if value is not None else "NAN"
+    return text.replace("SPRINGC_NAN", "NAN").replace("SPRINGC_INF", "HUGE_VAL")
+
+
 def _description(m: CodegenContext, name: str) -> str:
     v = m.variables.get(name)
     return v.description if v is not None and v.description else ""
 
 
-def _macros(m: CodegenContext, outputs: Sequence[str]) -> list[str]:
+def _macros(m: CContext, outputs: Sequence[str]) -> list[str]:
     layout = m.events
     sizes = [
         ("SPRINGC_N_STATES", len(m.states)), ("SPRINGC_N_PARAMS", len(m.params)),
@@ -49,6 +77,7 @@ def _macros(m: CodegenContext, outputs: Sequence[str]) -> list[str]:
         ("SPRINGC_N_NEWTON", len(m.newton_systems())),
         ("SPRINGC_HYBRID", int(layout is not None)),
         ("SPRINGC_INITIAL_CONDITIONS", len(initial_conditions(m.ode))),
+        ("SPRINGC_HAS_JACOBIAN", int(m.has_jacobian)), ("SPRINGC_N_JAC", m.jacobian_size),
     ]
     if layout is not None:
         s = layout.slot
@@ -66,10 +95,11 @@ def _macros(m: CodegenContext, outputs: Sequence[str]) -> list[str]:
     return [f"#define {name} {value}" for name, value in sizes]
 
 
-def c_tables(m: CodegenContext, outputs: Sequence[str], structural: Sequence[str]
+def c_tables(m: CContext, outputs: Sequence[str], structural: Sequence[str]
              ) -> list[str]:
     """The file's first lines: a comment, ``#include <math.h>``, ``SPRINGC_FN``, the
-    size macros and the name tables of the model ``m`` with observed ``outputs``."""
+    size macros and the name tables of the model ``m`` with observed ``outputs`` (after
+    its functions were printed: they set ``m.has_jacobian``)."""
     exp = m.ode.dae.experiment
     experiment = [exp.start, exp.stop, exp.interval, exp.tolerance]
     fixed = set(structural)
@@ -110,11 +140,12 @@ def c_tables(m: CodegenContext, outputs: Sequence[str], structural: Sequence[str
                       [", ".join(names) for names in newton.values()])
     lines += ["/* start, stop, interval, tolerance of the experiment; NAN: not given */",
               "static const double springc_experiment[4] = {"
-              + ", ".join(c_double(v) if v is not None else "NAN" for v in experiment)
+              + ", ".join(_host_double(v) for v in experiment)
               + "};",
               "#endif", "",
               "SPRINGC_FN void springc_sizes(int *n)", "{",
               "    n[0] = SPRINGC_N_STATES;", "    n[1] = SPRINGC_N_PARAMS;",
               "    n[2] = SPRINGC_N_Z;", "    n[3] = SPRINGC_N_OBSERVED;",
-              "    n[4] = SPRINGC_N_CROSSINGS;", "    n[5] = SPRINGC_HYBRID;", "}"]
+              "    n[4] = SPRINGC_N_CROSSINGS;", "    n[5] = SPRINGC_HYBRID;",
+              "    n[6] = SPRINGC_N_JAC;", "    n[7] = SPRINGC_HAS_JACOBIAN;", "}"]
     return lines

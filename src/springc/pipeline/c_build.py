@@ -85,11 +85,11 @@ class CLibrary:
         self.path = Path(self._folder.name) / C_LIBRARY_FILE
         self.path.write_bytes(data)
         self.lib = ctypes.CDLL(str(self.path))
-        sizes = (ctypes.c_int * 6)()
+        sizes = (ctypes.c_int * 8)()
         self.lib.springc_sizes(sizes)
         self.n_states, self.n_params, self.n_z, self.n_observed, self.n_crossings = (
             sizes[0], sizes[1], sizes[2], sizes[3], sizes[4])
-        self.hybrid = bool(sizes[5])
+        self.hybrid, self.n_jac, self.has_jacobian = bool(sizes[5]), sizes[6], bool(sizes[7])
         array = np.ctypeslib.ndpointer(np.float64, flags="C_CONTIGUOUS")
         model = [ctypes.c_double, array, array, array]
         for name, args, result in (
@@ -99,11 +99,13 @@ class CLibrary:
                 ("springc_observed", [*model, array], ctypes.c_int),
                 ("springc_zero_crossings", [*model, array], ctypes.c_int),
                 ("springc_next_time_event", model, ctypes.c_double),
-                ("springc_event_update", model, ctypes.c_int)):
+                ("springc_event_update", model, ctypes.c_int),
+                ("springc_jacobian", [*model, array], ctypes.c_int),
+                ("springc_jacobian_pattern", [ctypes.c_void_p, ctypes.c_void_p], None)):
             function = getattr(self.lib, name)
             function.argtypes, function.restype = args, result
         self.functions = {name: getattr(self.lib, name) for name in (
-            "springc_rhs", "springc_observed", "springc_zero_crossings")}
+            "springc_rhs", "springc_observed", "springc_zero_crossings", "springc_jacobian")}
 
     def parameters(self, given: Mapping[int, float] | None = None) -> FloatArray:
         """The parameter vector: the model's values, with ``given`` (index: value) kept
@@ -139,6 +141,17 @@ class CLibrary:
     def zero_crossings(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray
                        ) -> tuple[int, FloatArray]:
         return self._call("springc_zero_crossings", self.n_crossings, t, x, p, z)
+
+    def jacobian_dense(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray
+                       ) -> tuple[int, FloatArray]:
+        """(return code, d(rhs)/dx as a dense array); code -3: no Jacobian in C."""
+        code, values = self._call("springc_jacobian", self.n_jac, t, x, p, z)
+        rows = np.zeros(self.n_jac + 1, dtype=np.intc)
+        cols = np.zeros(self.n_jac + 1, dtype=np.intc)
+        self.lib.springc_jacobian_pattern(rows.ctypes.data, cols.ctypes.data)
+        dense = np.zeros((self.n_states, self.n_states))
+        dense[rows[:self.n_jac], cols[:self.n_jac]] = values
+        return code, dense
 
     def next_time_event(self, t: float, x: FloatArray, p: FloatArray, z: FloatArray
                         ) -> float:
