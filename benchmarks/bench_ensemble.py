@@ -1,20 +1,23 @@
-"""The compiled ensemble engine's throughput: N seed runs, final values only.
+"""The ensemble engines' throughput: N seed runs, final values only.
 
 The seed over N stiffness values (``spring.k`` log-spaced from 1e3 to 1e5, the spread
 of issue 29's diffrax anchor), rtol 1e-6, atol 1e-9, from 0 to the stop time (default
 10 s) with one output interval (final values only), measured in the same process:
 
-- ``single``: one compiled DOP853 run (``springc.integrate.dop853``, the same kernel and
-  plain-loop sums) per value of a sample of 200, one at a time: seconds per run;
-- ``kernel``: ``springc.integrate.ensemble`` on all N runs (parameter matrix built
-  beforehand): runs/s, and the ratio to ``cores / single`` (the ideal: every core
-  busy with single runs, no overhead), with ``cores`` the numba threads;
-- ``end to end``: ``springc.studies.run_ensemble`` (parameter vectors and start
-  states in Python per run, the kernel in chunks of 10^4, the Parquet table): runs/s.
+- ``single``: one compiled DOP853 run (``springc.integrate.dop853``, numba, plain-loop
+  sums) per value of a sample of 200, one at a time: seconds per run;
+- per engine (``c``: the batched C kernel, OpenMP; ``numba``: the numba ensemble
+  kernel, parameters prepared in Python per run) and per N: one chunk of all N runs
+  through the engine (:func:`springc.studies.ensemble_engines.open_engine`): wall
+  seconds, CPU seconds of the process (every thread), runs/s, CPU ms per run, and the
+  ratio of runs/s to ``cores / single`` (issue 29's target: at least 0.70);
+- the largest relative difference of the C engine's final states from numba's;
+- ``end to end``: :func:`springc.studies.run_ensemble` with the default engine on the
+  largest N (chunks, the Parquet table): runs/s.
 
 The load average is printed before and after (other jobs on a shared machine take
-cores, which the ratio does not know about). 10^6 runs are extrapolated from the
-measured rate only when ``--runs`` is smaller, and labelled so.
+cores: compare the CPU seconds, which move far less with the load). 10^6 runs are
+projected from the CPU seconds per run only when not measured, and labelled so.
 """
 
 from __future__ import annotations
@@ -34,60 +37,68 @@ RTOL, ATOL = 1e-6, 1e-9
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--runs", type=int, default=10_000, help="number of runs (10^4)")
+    parser.add_argument("--runs", type=int, nargs="+", default=[10_000],
+                        help="numbers of runs (default 10^4)")
+    parser.add_argument("--engines", default="c,numba", help="engines (c,numba)")
     parser.add_argument("--stop", type=float, default=10.0, help="stop time [s]")
     args = parser.parse_args()
     os.environ.setdefault("SPRINGC_CACHE_DIR", tempfile.mkdtemp(prefix="springc-bench-"))
-    import numba
-
     import springc
-    from springc.integrate import dop853, ensemble
+    from springc.integrate import dop853
     from springc.studies import EnsembleOptions, parse_parameter, run_ensemble
+    from springc.studies.ensemble_engines import Plan, open_engine
 
-    print(f"load average before: {os.getloadavg()[0]:.2f}; numba threads: "
-          f"{numba.get_num_threads()}; cpus: {os.cpu_count()}")
+    cores = os.cpu_count() or 1
+    print(f"load average before: {os.getloadavg()[0]:.2f}; cpus: {cores}")
     model = springc.compile_model([str(SEED)])
     mod = model.module
-    ks = np.geomspace(1e3, 1e5, args.runs)
     grid = np.array([0.0, args.stop])
-    P = np.array([mod.parameters({"spring.k": float(k)}) for k in ks])
-    X0 = np.array([mod.start(p) for p in P])
-    Z = np.array([mod.guesses(p) for p in P])
-    ensemble(mod.rhs, grid, X0[:2], P[:2], Z[:2], rtol=RTOL, atol=ATOL)  # load the kernel
-    sample = np.linspace(0, args.runs - 1, min(200, args.runs)).astype(int)
-    dop853(mod.rhs, grid, X0[0], P[0], Z[0].copy(), rtol=RTOL, atol=ATOL,
+    plan = Plan(grid, RTOL, ATOL, 0, tuple(range(4)), (), 1)
+    sample = np.geomspace(1e3, 1e5, 200)
+    P = [mod.parameters({"spring.k": float(k)}) for k in sample]
+    dop853(mod.rhs, grid, mod.start(P[0]), P[0], mod.guesses(P[0]), rtol=RTOL, atol=ATOL,
            scipy_arithmetic=False)
     began = time.perf_counter()
-    singles = [dop853(mod.rhs, grid, X0[r], P[r], Z[r].copy(), rtol=RTOL, atol=ATOL,
-                      scipy_arithmetic=False) for r in sample]
-    single = (time.perf_counter() - began) / len(sample)
-    began = time.perf_counter()
-    result = ensemble(mod.rhs, grid, X0, P, Z, rtol=RTOL, atol=ATOL)
-    kernel = time.perf_counter() - began
-    assert result.ok().all()
-    worst = max(float(np.max(np.abs(result.finals[r] - s.states[-1])
-                             / np.maximum(np.abs(s.states[-1]), 1e-300)))
-                for r, s in zip(sample, singles))
-    cores = numba.get_num_threads()
-    rate = args.runs / kernel
-    print(f"single compiled run: {single * 1e3:.3f} ms (mean of {len(sample)})")
-    print(f"kernel: {args.runs} runs in {kernel:.2f} s = {rate:,.0f} runs/s; ideal "
-          f"{cores} / single = {cores / single:,.0f} runs/s; ratio {rate * single / cores:.2f}")
-    print(f"largest relative difference of the final states from the single runs: "
-          f"{worst:.1e}")
+    for p in P:
+        dop853(mod.rhs, grid, mod.start(p), p, mod.guesses(p), rtol=RTOL, atol=ATOL,
+               scipy_arithmetic=False)
+    single = (time.perf_counter() - began) / len(P)
+    print(f"single compiled run (numba): {single * 1e3:.3f} ms (mean of {len(P)}); "
+          f"ideal {cores} / single = {cores / single:,.0f} runs/s")
+    print("| engine | runs | wall s | CPU s | runs/s | CPU ms/run | ratio to cores/single |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    finals: dict[tuple[str, int], np.ndarray] = {}
+    for n in args.runs:
+        values = np.geomspace(1e3, 1e5, n).reshape(-1, 1)
+        for engine in args.engines.split(","):
+            name, run = open_engine(model, engine, "cpu", ("spring.k",), {}, plan)
+            run(values[:2])  # loaded (and compiled) before the clock starts
+            wall, cpu = time.perf_counter(), time.process_time()
+            result = run(values)
+            wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+            assert (result.status == 0).all()
+            finals[name, n] = result.summary[:, :, 0]
+            print(f"| {name} | {n:,} | {wall:.2f} | {cpu:.2f} | {n / wall:,.0f} | "
+                  f"{cpu / n * 1e3:.3f} | {n / wall * single / cores:.2f} |")
+        if ("c", n) in finals and ("numba", n) in finals:
+            c, nb = finals["c", n], finals["numba", n]
+            worst = float(np.max(np.abs(c - nb) / np.maximum(np.abs(nb), 1e-300)))
+            print(f"N = {n:,}: largest relative difference of the C engine's final states "
+                  f"from numba's: {worst:.1e}")
+    n = max(args.runs)
     with tempfile.TemporaryDirectory() as folder:
-        options = EnsembleOptions((parse_parameter(f"spring.k=1e3:1e5:log:{args.runs}"),),
+        options = EnsembleOptions((parse_parameter(f"spring.k=1e3:1e5:log:{n}"),),
                                   stop=args.stop, interval=args.stop, rtol=RTOL, atol=ATOL,
                                   variables=tuple(model.states))
-        began = time.perf_counter()
+        wall, cpu = time.perf_counter(), time.process_time()
         summary = run_ensemble(model, options, str(Path(folder) / "e.parquet"))
-        total = time.perf_counter() - began
+        wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     assert summary.failed == 0
-    print(f"end to end (run_ensemble, Parquet): {args.runs} runs in {total:.2f} s = "
-          f"{args.runs / total:,.0f} runs/s")
-    if args.runs < 1_000_000:
-        print(f"extrapolated (not measured) 10^6 runs end to end: "
-              f"{1e6 / (args.runs / total):.0f} s at this rate")
+    print(f"end to end ({summary.engine} engine, run_ensemble, Parquet): {n:,} runs in "
+          f"{wall:.2f} s wall, {cpu:.2f} s CPU = {n / wall:,.0f} runs/s")
+    if n < 1_000_000:
+        print(f"projected (not measured) 10^6 runs end to end on {cores} idle cores: "
+              f"{1e6 * cpu / n / cores:.0f} s (CPU seconds per run x 10^6 / cores)")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

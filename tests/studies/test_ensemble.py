@@ -8,7 +8,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 
-import numba
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
@@ -93,18 +92,17 @@ def test_failures_past_the_explained_ones_get_the_words_of_their_kind(
                               "reached the step limit (--max-steps 5)"]
 
 
+@pytest.mark.parametrize("engine", ["c", "numba"])
 def test_the_bytes_do_not_depend_on_the_number_of_threads(model: CompiledModel,
-                                                          tmp_path: Path) -> None:
-    threads = numba.get_num_threads()
+                                                          tmp_path: Path, engine: str) -> None:
     files = []
-    try:
-        for count in (1, min(2, numba.config.NUMBA_NUM_THREADS)):
-            numba.set_num_threads(count)
-            files.append(tmp_path / f"{count}.parquet")
-            _run(model, files[-1], "spring.k=1e3:1e5:log:40", chunk=16)
-    finally:
-        numba.set_num_threads(threads)
+    for count in (1, 2):
+        files.append(tmp_path / f"{count}.parquet")
+        _run(model, files[-1], "spring.k=1e3:1e5:log:40", chunk=16, threads=count,
+             engine=engine)
     assert files[0].read_bytes() == files[1].read_bytes()
+    assert pq.read_table(files[0]).schema.metadata[b"springc"].count(
+        f'"engine": "{engine}"'.encode()) == 1
 
 
 def test_chunks_stream_every_run_in_order(model: CompiledModel, tmp_path: Path) -> None:

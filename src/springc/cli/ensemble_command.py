@@ -36,9 +36,29 @@ from .options import (
 @click.option("--atol", type=float, help="Absolute tolerance (default: rtol/1000).")
 @click.option("--max-steps", type=click.IntRange(min=1), default=None,
               help="Integrator steps per run before it fails (as for simulate).")
-@click.option("--chunk", type=click.IntRange(min=1), default=10_000, show_default=True,
+@click.option("--chunk", type=click.IntRange(min=1), default=None,
               help="Runs per compiled call and per Parquet row group (memory grows "
-              "with it, not with the number of runs).")
+              "with it, not with the number of runs; default: 100,000 for the C engine, "
+              "10,000 for numba, 1,000,000 on a GPU, fewer with trajectories).")
+@click.option("--stats", "stats", default=None, metavar="LIST",
+              help="The statistics of each variable, comma-separated, of final, min, max, "
+              "mean, time_of_max (default: all five).")
+@click.option("--trajectories", "traj_file", type=click.Path(dir_okay=False),
+              help="Also write the trajectories of the --traj-vars variables (.parquet, "
+              "the layout of sweep's study table: one row per run and output time).")
+@click.option("--traj-vars", "traj_patterns", multiple=True, metavar="PATTERN",
+              help="A variable whose trajectory goes to --trajectories (repeatable; * and "
+              "? match; among the states and the --vars variables).")
+@click.option("--every", type=click.IntRange(min=1), default=1, show_default=True,
+              help="Keep every k-th output time of the trajectories (and the last).")
+@click.option("--engine", type=click.Choice(["c", "numba"]), default=None,
+              help="The CPU engine: c (the batched C kernel, the default where a C "
+              "compiler is found) or numba.")
+@click.option("--device", type=click.Choice(["cpu", "gpu"]), default="cpu",
+              show_default=True, help="gpu: the C kernel on an NVIDIA GPU through CuPy, "
+              "one thread per run.")
+@click.option("--threads", type=click.IntRange(min=1), default=None,
+              help="CPU threads (default: every core; the results do not depend on it).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
               help="The ensemble table (.parquet): one row per run.")
 @verbosity_options("No summary line and no status line (\"springc: compiling ...\").")
@@ -48,16 +68,21 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              stop: float | None, interval: float | None, assignments: tuple[str, ...],
              params: tuple[str, ...], table_file: str | None, samples: int | None,
              method: str, seed: int, rtol: float | None, atol: float | None,
-             max_steps: int | None, chunk: int, output: str) -> None:
+             max_steps: int | None, chunk: int | None, stats: str | None,
+             traj_file: str | None, traj_patterns: tuple[str, ...], every: int,
+             engine: str | None, device: str, threads: int | None, output: str) -> None:
     """Run a continuous model over many parameter sets in compiled code, into Parquet.
 
     Every run is integrated with compiled DOP853 in a loop over the runs on every core
-    (no Python per run); each run has its own steps and its own status, and a failed
-    run is recorded with its error. OUTPUT gets one row per run: its parameters,
-    status, error, step counts, and the final value, min, max, time-weighted mean and
-    time of the max of each variable (--vars; default: all). Use --interval to set the
-    grid the statistics are taken on (one interval = final values only, the fastest).
-    Unlike sweep, no trajectories are written.
+    (or one GPU thread per run with --device gpu; no Python per run); each run has its
+    own steps and its own status, and a failed run is recorded with its error. OUTPUT
+    gets one row per run: its parameters, status, error, step counts, and the final
+    value, min, max, time-weighted mean and time of the max of each variable (--vars;
+    default: all; --stats picks among them). Use --interval to set the grid the
+    statistics are taken on (one interval = final values only, the fastest).
+    --trajectories writes the --traj-vars variables on that grid (--every k: every
+    k-th time), chunk by chunk. Values outside a parameter's declared min/max are
+    refused before any run.
     """
     from ..simulation import check_run_values
     from ..studies import EnsembleOptions, parse_parameter, read_table
@@ -69,9 +94,13 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                                "every run's values)")
     if table_file is None and not params:
         raise click.UsageError("give --param NAME=VALUES (repeatable) or --table FILE.csv")
+    if bool(traj_patterns) != (traj_file is not None):
+        raise click.UsageError("--trajectories FILE and --traj-vars PATTERN go together")
     specs = tuple(parse_parameter(item) for item in params)
     table = read_table(table_file) if table_file is not None else None
-    check_output_options([("-o", output, None)], files)
+    statistics = tuple(s.strip() for s in stats.split(",") if s.strip()) \
+        if stats is not None else None
+    check_output_options([("-o", output, None), ("--trajectories", traj_file, None)], files)
     from ..api import compile_model
     from ..studies import run_ensemble
 
@@ -82,7 +111,26 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                                  parameters=values, cache=not no_cache)
         fixed = tuple((k, v) for k, v in values.items() if k not in compiled.structural)
         options = EnsembleOptions(specs, samples, method, seed, table, fixed, start, stop,
-                                  interval, rtol, atol, max_steps, chunk=chunk)
-        summary = run_ensemble(compiled, options, output, files)
+                                  interval, rtol, atol, max_steps, chunk=chunk,
+                                  statistics=statistics,
+                                  trajectories=trajectory_names(compiled, traj_patterns),
+                                  every=every, engine=engine, device=device,
+                                  threads=threads)
+        summary = run_ensemble(compiled, options, output, files, traj_file)
     if not quiet:
         click.echo(f"{compiled.name}: {summary.summary_line()}", err=True)
+
+
+def trajectory_names(compiled: object, patterns: tuple[str, ...]) -> tuple[str, ...]:
+    """The variables ``--traj-vars`` selects among the states and observed variables."""
+    from ..errors import SimulationError, UsageError
+    from ..pipeline import CompiledModel, select_names
+
+    assert isinstance(compiled, CompiledModel)
+    if not patterns:
+        return ()
+    try:
+        return tuple(select_names(compiled.states + compiled.observed, patterns))
+    except SimulationError as err:
+        raise UsageError(err.message.replace("--vars", "--traj-vars", 1),
+                         option="--traj-vars", hint=err.hint) from None

@@ -17,11 +17,12 @@ import numpy.typing as npt
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-CODEGEN_VERSION = 6
+CODEGEN_VERSION = 7
 """The version of the generated code's layout and of a cache entry's contents: part of
 every cache key (here, not with the module text, so that the cache reads it without
 loading the generator). 5: a cache entry holds the captured system (``system.pickle``,
-:mod:`springc.pipeline.closed`); 6: a module declares its ``KIND``."""
+:mod:`springc.pipeline.closed`); 6: a module declares its ``KIND``; 7: a module declares
+``PARAMETER_BOUNDS``."""
 
 
 class ModuleKind:
@@ -60,6 +61,8 @@ class GeneratedModule(Protocol):
     PARAMETERS: tuple[str, ...]
     PARAMETER_UNITS: tuple[str, ...]
     PARAMETER_TYPES: tuple[str, ...]
+    #: per parameter, its declared (min, max) where they are numbers (None: not declared)
+    PARAMETER_BOUNDS: tuple[tuple[float | None, float | None], ...]
     STRUCTURAL: tuple[str, ...]
     OBSERVED: tuple[str, ...]
     OBSERVED_UNITS: tuple[str, ...]

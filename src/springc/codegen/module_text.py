@@ -8,6 +8,7 @@ names, units, the experiment, the sparsity pattern, ``parameters(values)``,
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from ..errors import CodegenError
@@ -68,6 +69,23 @@ def descriptions(m: CodegenContext, outputs: Sequence[str]) -> list[str]:
     return out
 
 
+def parameter_bounds(m: CodegenContext) -> tuple[tuple[float | None, float | None], ...]:
+    """Each parameter's declared ``min`` and ``max`` where they fold to finite numbers
+    (None: not declared, or an expression of other parameters)."""
+    def number(e: Expr | None) -> float | None:
+        if isinstance(e, Const) and not isinstance(e.value, bool) \
+                and math.isfinite(float(e.value)):
+            return float(e.value)
+        return None
+
+    out = []
+    for q in m.params:
+        v = m.variables.get(q)
+        out.append((None, None) if v is None else
+                   (number(v.attributes.min), number(v.attributes.max)))
+    return tuple(out)
+
+
 def module_text(m: CodegenContext, options: CodegenOptions,
                  bodies: list[tuple[str, str, list[str], str]], helpers: set[str],
                  pattern: list[tuple[int, int]], outputs: list[str],
@@ -118,6 +136,8 @@ def module_text(m: CodegenContext, options: CodegenOptions,
         f"PARAMETERS = {encode_strings(m.params)}",
         f"PARAMETER_UNITS = {encode_strings([m.unit(q) for q in m.params])}",
         f"PARAMETER_TYPES = {encode_strings([m.type(q) for q in m.params])}",
+        "# The declared (min, max) of each parameter, where they are numbers.",
+        f"PARAMETER_BOUNDS = {parameter_bounds(m)!r}",
         f"STRUCTURAL = {encode_strings(structural)}",
         f"OBSERVED = {encode_strings(outputs)}",
         f"OBSERVED_UNITS = {encode_strings([m.unit(o) for o in outputs])}",

@@ -36,6 +36,13 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   of ``P`` each) with compiled DOP853 in parallel over the rows (``numba.prange``), each
   with its own steps and status; the final states and per-run statistics (final, min,
   max, time-weighted mean, time of the max) of chosen columns (:mod:`.batch`).
+- ``NativeEnsemble`` (:mod:`.native_ensemble`): the same ensemble as one C kernel text
+  (``ensemble_dop853.c``, numba's DOP853 arithmetic in the same order) around a model's
+  C file, compiled by the system compiler (OpenMP over the runs, loaded with ctypes);
+  each run's parameters and start values computed in the kernel (:class:`Runs`), with
+  trajectories of chosen columns. ``GpuEnsemble`` (:mod:`.gpu_ensemble`): that text as
+  a CUDA kernel through CuPy's NVRTC, one thread per run (:class:`NoCudaDevice`
+  without CuPy or a device).
 - Failures never raise inside the loop: :class:`Status` says what happened
   (step too small, NaN/inf derivative or state, max steps, the model's failure flag
   ``z[-1]``) and the run carries the time and the state where it happened.
@@ -56,11 +63,15 @@ from .engine import (
     radau,
     rk45,
 )
+from .gpu_ensemble import GpuEnsemble, NoCudaDevice
 from .hybrid import HybridRun, run_hybrid
 from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
+from .native_ensemble import OPENMP, NativeEnsemble, Outputs, Runs, kernel_text
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "Crossings", "Ensemble", "HybridRun", "Run", "Status",
+__all__ = ["FIXED_STEP_METHODS", "OPENMP", "Crossings", "Ensemble", "GpuEnsemble",
+           "HybridRun", "NativeEnsemble", "NoCudaDevice", "Outputs", "Run", "Runs", "Status",
            "bdf", "compile_seconds", "dop853", "ensemble", "fixed_step", "kernel_cached",
-           "load", "newton_flops", "newton_solve_flops", "observed_grid", "radau", "rk45",
+           "kernel_text", "load", "newton_flops", "newton_solve_flops", "observed_grid",
+           "radau", "rk45",
            "run_hybrid"]

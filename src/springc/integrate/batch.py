@@ -30,7 +30,9 @@ class Ensemble:
     s]``: statistic ``STATISTICS[s]`` of chosen column ``c`` (NaN unless the run
     succeeded); ``status[r]``: a :class:`Status` code; ``steps[r]`` accepted plus
     rejected steps; ``rhs_evaluations[r]``; ``failure_time[r]``: where the run stopped;
-    ``flag[r]``: the model's failure flag (the Newton system that failed, 0 if none).
+    ``flag[r]``: the model's failure flag (the Newton system that failed, 0 if none);
+    ``trajectories[r, s, c]``: trajectory column ``c`` at kept output time ``s`` (NaN
+    where the run did not get there).
     """
 
     finals: np.ndarray
@@ -40,6 +42,7 @@ class Ensemble:
     rhs_evaluations: np.ndarray
     failure_time: np.ndarray
     flag: np.ndarray
+    trajectories: np.ndarray
 
     def ok(self) -> np.ndarray:
         """Which runs reached the end of the grid."""
@@ -49,13 +52,15 @@ class Ensemble:
 def ensemble(rhs: ModelFunction, grid: Any, X0: Any, P: Any, Z: Any, *, rtol: float,
              atol: float | Sequence[float] | np.ndarray, observed: ModelFunction | None = None,
              columns: Sequence[int] = (), max_step: float = np.inf,
-             max_steps: int = 0) -> Ensemble:
+             max_steps: int = 0, traj_columns: Sequence[int] = (), every: int = 1
+             ) -> Ensemble:
     """Integrate ``x' = rhs(t, x, P[r], z)`` from ``(grid[0], X0[r])`` for every row
     ``r``, each with compiled DOP853 (plain-loop sums) and its own steps.
 
     ``X0``, ``P`` and ``Z`` have one row per run (``Z``: the model's work array of the
-    run, copied). ``columns`` index ``[states | observed]``; observed columns need
-    ``observed``. ``max_steps`` (accepted and rejected, per run) 0 is no limit.
+    run, copied). ``columns`` and ``traj_columns`` index ``[states | observed]``;
+    observed columns need ``observed``. The trajectories keep every ``every``-th output
+    time and the last. ``max_steps`` (accepted and rejected, per run) 0 is no limit.
     """
     from numba.core.dispatcher import Dispatcher
 
@@ -89,9 +94,17 @@ def ensemble(rhs: ModelFunction, grid: Any, X0: Any, P: Any, Z: Any, *, rtol: fl
     if runs and np.asarray(rhs(grid_[0], X0_[0], P_[0], Z_[0].copy())).shape != (n,):
         raise ValueError(f"rhs does not return {n} derivatives")
     columns_ = np.array(columns, dtype=np.int64).ravel()
-    if columns_.size and not 0 <= columns_.min() <= columns_.max() < n + n_observed:
-        raise ValueError(f"a column is outside the {n} states and {n_observed} observed "
-                         "variables")
+    traj_ = np.array(traj_columns, dtype=np.int64).ravel()
+    for chosen in (columns_, traj_):
+        if chosen.size and not 0 <= chosen.min() <= chosen.max() < n + n_observed:
+            raise ValueError(f"a column is outside the {n} states and {n_observed} "
+                             "observed variables")
+    if every < 1:
+        raise ValueError(f"every must be at least 1, got {every}")
+    kept = np.arange(0, grid_.size, every)
+    if kept[-1] != grid_.size - 1:
+        kept = np.append(kept, grid_.size - 1)
+    trajectories = np.full((runs, kept.size if traj_.size else 0, traj_.size), np.nan)
     finals = np.empty((runs, n))
     summary = np.empty((runs, columns_.size, len(STATISTICS)))
     status = np.empty(runs, dtype=np.int64)
@@ -101,6 +114,7 @@ def ensemble(rhs: ModelFunction, grid: Any, X0: Any, P: Any, Z: Any, *, rtol: fl
         ensemble_run(rhs, observed if observed is not None and n_observed else no_observed,
                      n_observed, no_observed,
                      grid_, X0_, P_, Z_, float(rtol), atol_, float(max_step),
-                     int(max_steps), columns_, finals, summary, status, counts, failure_time)
+                     int(max_steps), columns_, finals, summary, status, counts, failure_time,
+                     traj_, kept, trajectories)
     return Ensemble(finals, summary, status, counts[:, 0] + counts[:, 1], counts[:, 2],
-                    failure_time, counts[:, 3])
+                    failure_time, counts[:, 3], trajectories)

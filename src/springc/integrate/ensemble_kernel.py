@@ -54,16 +54,33 @@ def summarise(grid: np.ndarray, states: np.ndarray, obs: np.ndarray, columns: np
         out[c, 4] = t_high
 
 
+@njit(cache=True, error_model="numpy", nogil=True)
+def keep_rows(states: np.ndarray, obs: np.ndarray, filled: int, kept: np.ndarray,
+              columns: np.ndarray, out: np.ndarray) -> None:
+    """``out[s, c]`` = column ``columns[c]`` at output time ``kept[s]`` (rows the run
+    filled; the others stay as they are)."""
+    n = states.shape[1]
+    for s in range(kept.size):
+        k = kept[s]
+        if k >= filled:
+            break
+        for c in range(columns.size):
+            j = columns[c]
+            out[s, c] = states[k, j] if j < n else obs[k, j - n]
+
+
 @njit(types.void(MODEL_FUNCTION, MODEL_FUNCTION, types.int64, MODEL_FUNCTION, VECTOR, MATRIX,
                  MATRIX, MATRIX, types.float64, VECTOR, types.float64, types.int64, INDICES,
-                 MATRIX, types.float64[:, :, ::1], INDICES, types.int64[:, ::1], VECTOR),
+                 MATRIX, types.float64[:, :, ::1], INDICES, types.int64[:, ::1], VECTOR,
+                 INDICES, INDICES, types.float64[:, :, ::1]),
       cache=True, error_model="numpy", nogil=True, parallel=True)
 def ensemble_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
                  no_crossing: ModelFunction, grid: np.ndarray, X0: np.ndarray,
                  P: np.ndarray, Z: np.ndarray, rtol: float, atol: np.ndarray,
                  max_step: float, max_steps: int, columns: np.ndarray, finals: np.ndarray,
                  summary: np.ndarray, status: np.ndarray, counts: np.ndarray,
-                 failure_time: np.ndarray) -> None:
+                 failure_time: np.ndarray, traj_columns: np.ndarray, kept: np.ndarray,
+                 traj: np.ndarray) -> None:
     """Integrate run ``r`` from ``(grid[0], X0[r])`` with parameters ``P[r]`` and work
     array ``Z[r]`` (copied) for every row ``r``, in parallel over the rows.
 
@@ -71,7 +88,9 @@ def ensemble_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
     ``summary[r, c]`` (:data:`STATISTICS` of ``columns[c]``; NaN unless the run
     succeeded), ``status[r]`` (a :class:`Status`), ``counts[r]`` (accepted steps,
     rejected steps, right-hand-side evaluations, and the failure flag ``z[-1]`` as an
-    integer) and ``failure_time[r]`` (the end time, or where the run failed).
+    integer), ``failure_time[r]`` (the end time, or where the run failed) and
+    ``traj[r, s, c]``: column ``traj_columns[c]`` at output time ``kept[s]`` (where the
+    run got there).
     ``no_crossing`` is any model function (no crossings are located).
     """
     runs = P.shape[0]
@@ -89,6 +108,8 @@ def ensemble_run(rhs: ModelFunction, observed: ModelFunction, n_observed: int,
         counts[r, 3] = int(z[z.size - 1]) if z.size > 0 else 0
         failure_time[r] = result[7]
         finals[r] = result[8]
+        if traj_columns.size > 0:
+            keep_rows(result[1], result[2], result[3], kept, traj_columns, traj[r])
         if code == SUCCESS:
             summarise(grid, result[1], result[2], columns, summary[r])
         else:

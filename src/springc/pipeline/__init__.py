@@ -23,13 +23,15 @@ from .options import CompileOptions
 from .selection import select_names
 
 if TYPE_CHECKING:
-    from .c_build import CCompilerMissing, CLibrary, c_library
+    from .c_build import CCompilerMissing, CLibrary, c_library, c_source
+    from .c_kernels import kernel_library
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
 __all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel", "ModuleKind",
-           "announce_functions", "c_library", "check_parameter_names", "compile_files",
-           "derive_system", "flatten_files", "generate_source", "modification_value",
+           "announce_functions", "c_library", "c_source", "check_parameter_names",
+           "compile_files", "derive_system", "flatten_files", "generate_source",
+           "kernel_library", "modification_value",
            "select_names", "split_values"]
 
 
@@ -39,10 +41,14 @@ def __getattr__(name: str) -> Any:
         from . import generation
 
         return getattr(generation, name)
-    if name in ("c_library", "CLibrary", "CCompilerMissing"):  # builds with a C compiler
+    if name in ("c_library", "c_source", "CLibrary", "CCompilerMissing"):  # a C compiler
         from . import c_build
 
         return getattr(c_build, name)
+    if name == "kernel_library":
+        from . import c_kernels
+
+        return c_kernels.kernel_library
     if name == "flatten_files":
         from . import files
 

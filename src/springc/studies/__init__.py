@@ -5,7 +5,9 @@ grids, Monte Carlo and Latin hypercube samples), ``job`` (a batch of runs in a w
 ``engines`` (local processes or Dask), ``progress``, ``store`` (the Parquet layouts,
 shards for resuming), ``study`` (:func:`run_study`, :func:`to_dataset`), ``fan``
 (the plot of one variable across the runs), ``table`` (a user's CSV of runs) and
-``ensemble`` (:func:`run_ensemble`: chunks of runs in the compiled ensemble engine,
+``ensemble`` (:func:`run_ensemble`: chunks of runs in an ensemble engine of
+``ensemble_engines`` (the batched C kernel, numba, or the GPU), written by
+``ensemble_outputs`` (trajectories read back by :func:`read_trajectories`),
 one summary row per run, streamed into Parquet).
 
 (The package is not named ``sweep``: ``springc.sweep`` is the API function.)
@@ -13,6 +15,7 @@ one summary row per run, streamed into Parquet).
 
 from .engines import Executor, default_workers
 from .ensemble import EnsembleOptions, EnsembleSummary, run_ensemble
+from .ensemble_outputs import read_trajectories
 from .fan import fan_figure, plot_variable, render_fan
 from .job import RunJob, RunRecord, StudyOptions, run_batch
 from .params import (
@@ -34,6 +37,6 @@ __all__ = ["DISTRIBUTIONS", "FIXED_COLUMNS", "METHODS", "Distribution", "Ensembl
            "EnsembleSummary", "Executor",
            "ParameterSpec", "RunJob", "RunRecord", "Study", "StudyOptions", "check_outputs",
            "default_workers", "fan_figure", "grid", "parameter_table", "parse_parameter",
-           "parse_values", "partial_folder", "plot_variable", "read_table", "render_fan",
-           "run_batch", "run_ensemble", "run_study", "sample", "summary_path", "to_dataset",
-           "unit_points"]
+           "parse_values", "partial_folder", "plot_variable", "read_table",
+           "read_trajectories", "render_fan", "run_batch", "run_ensemble", "run_study", "sample",
+           "summary_path", "to_dataset", "unit_points"]

@@ -1,10 +1,10 @@
 """Ensembles: CompiledModel + EnsembleOptions -> a Parquet table, one row per run.
 
-The compiled ensemble engine (:func:`springc.integrate.ensemble`) integrates a chunk of
-runs in one call, in parallel over the runs on every core, with no Python per run
-inside the loop; the runs' parameter vectors, start states and work arrays are built
-in Python per chunk, and each chunk's rows are written to the table as one Parquet
-row group, so memory is bounded by the chunk size, never by the number of runs.
+An ensemble engine (:mod:`.ensemble_engines`: the batched C kernel on every core by
+default, the numba kernel, or the C kernel on a GPU) integrates a chunk of runs in one
+call with no Python per run; each chunk's rows are written to the table as one Parquet
+row group (and its trajectories, when asked, to the trajectory file), so memory is
+bounded by the chunk size, never by the number of runs.
 
 **Ensemble table** (``-o ensemble.parquet``, one row per run, in run order):
 
@@ -21,43 +21,56 @@ row group, so memory is bounded by the chunk size, never by the number of runs.
 | ``NAME.mean`` | float64 | its time-weighted mean: the trapezoidal rule on the grid / span |
 | ``NAME.time_of_max`` | float64 | the first output time where it takes its maximum |
 
-The message of a failed run is the single-run path's own (``springc.simulate`` with
+Only the statistics chosen (``statistics``, default all five) get columns. The message
+of a failed run is the single-run path's own (``springc.simulate`` with
 ``solver="dop853"`` on the run's values, run again for that run only) for the first
 ``explain`` failed runs of each chunk; later ones get the words of the failure's kind
 and its time. The file carries the key ``springc`` in its metadata (JSON: the model,
-the parameters, the variables, the options, ``"format": "springc ensemble 1"``).
+the parameters, the variables, the options, the engine, ``"format": "springc ensemble
+1"``). Trajectories: :mod:`.ensemble_outputs`.
+
+Parameter values outside a parameter's declared ``min``/``max`` are refused before any
+run (:func:`check_bounds`), naming the parameter and the run.
 """
 
 from __future__ import annotations
 
-import json
+import contextlib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import SimulationError, SpringcError, UsageError
-from ..fileio import atomic_write
+from ..fileio import OutputSet
 from ..pipeline import CompiledModel
 from ..simulation import (
     DEFAULT_MAX_STEPS,
     RunSettings,
-    initial_state,
     output_grid,
     resolve,
     simulate_model,
+)
+from .ensemble_engines import FAILED_PREPARATION, Chunk, Plan, event_constructs, open_engine
+from .ensemble_outputs import (
+    SUFFIXES,
+    chunk_table,
+    schema_of,
+    statistics_of,
+    trajectory_layout,
+    trajectory_table,
 )
 from .job import StudyOptions
 from .params import ParameterSpec
 from .study import check_names, parameter_table
 
 SOLVER = "dop853"
-STATISTICS = {"final": "final", "min": "min", "max": "max", "mean": "mean",
-              "argmax": "time_of_max"}
-"""The kernel's statistic -> its column suffix."""
-DEFAULT_CHUNK = 10_000
-FAILED_PREPARATION = -1  # a run whose parameters or start values could not be computed
+CHUNKS = {"c": 100_000, "numba": 10_000, "gpu": 1_000_000}
+"""The default runs per chunk of each engine (a chunk is one kernel call and one Parquet
+row group: memory grows with it)."""
+TRAJECTORY_VALUES = 2_000_000
+"""With trajectories, a chunk holds at most this many values (runs x times x variables)."""
 NON_FINITE_OUTPUT = 3  # Status.NON_FINITE_STATE: a chosen variable NaN or inf on the grid
 
 
@@ -67,7 +80,13 @@ class EnsembleOptions:
     per run) if given, else a grid of the ``parameters`` or ``samples`` draws of them
     (as :class:`~springc.studies.StudyOptions`). ``fixed`` values apply to every run;
     times and tolerances as for ``simulate`` (``None``: the model's defaults);
-    ``variables``: the outputs to summarise (``None``: every output of the model)."""
+    ``variables``: the outputs to summarise (``None``: every output of the model), with
+    the ``statistics`` chosen (column suffixes, ``None``: all); ``trajectories``: the
+    variables whose values on the output grid (every ``every``-th time, and the last)
+    go to the trajectory file. ``engine``: ``c`` or ``numba`` (``None``: ``c`` where a
+    C compiler is found); ``device``: ``cpu`` or ``gpu``; ``chunk``: runs per kernel
+    call (``None``: the engine's default); ``threads``: the CPU threads (``None``: every
+    core; the results are the same bytes whatever the number)."""
 
     parameters: tuple[ParameterSpec, ...] = ()
     samples: int | None = None
@@ -82,21 +101,30 @@ class EnsembleOptions:
     atol: float | None = None
     max_steps: int | None = None
     variables: tuple[str, ...] | None = None
-    chunk: int = DEFAULT_CHUNK
+    chunk: int | None = None
     explain: int = 100
+    statistics: tuple[str, ...] | None = None
+    trajectories: tuple[str, ...] = ()
+    every: int = 1
+    engine: str | None = None
+    device: str = "cpu"
+    threads: int | None = None
 
 
 @dataclass(frozen=True)
 class EnsembleSummary:
-    """What a finished ensemble wrote: ``runs`` rows, ``failed`` of them failed."""
+    """What a finished ensemble wrote: ``runs`` rows, ``failed`` of them failed, on
+    ``engine``; ``files``: the ensemble table (and the trajectories)."""
 
     path: str
     runs: int
     failed: int
+    engine: str = ""
+    files: tuple[str, ...] = ()
 
     def summary_line(self) -> str:
         return (f"{self.runs} runs, {self.runs - self.failed} ok, {self.failed} failed "
-                f"-> {self.path}")
+                f"-> {' and '.join(self.files or (self.path,))}")
 
 
 def run_table(options: EnsembleOptions) -> tuple[tuple[str, ...], np.ndarray]:
@@ -110,56 +138,56 @@ def run_table(options: EnsembleOptions) -> tuple[tuple[str, ...], np.ndarray]:
     return tuple(s.name for s in options.parameters), parameter_table(study)
 
 
-def check_model(model: CompiledModel) -> None:
-    """The ensemble engine runs continuous models with compiled (numba) functions."""
+def check_model(model: CompiledModel, device: str = "cpu") -> None:
+    """The ensemble engines run continuous models; on the GPU the error names the
+    model's event constructs (:func:`.ensemble_engines.event_constructs`)."""
     module = model.module
+    engine = "the GPU engine" if device == "gpu" else "the ensemble engine"
     for flag, what in (("EVENTS", "events (when, if on a state, sample...)"),
                        ("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch")):
-        if getattr(module, flag, False):
-            raise SimulationError(f"{model.name} has {what}, which the ensemble engine does "
-                                  "not run yet", hint="use springc sweep (one run at a time)")
-    if getattr(module, "BACKEND", "") != "numba":
-        raise SimulationError(f"the ensemble engine needs the numba backend, not "
-                              f"{module.BACKEND}", hint="compile with --backend numba")
+        if not getattr(module, flag, False):
+            continue
+        if flag == "EVENTS" and device == "gpu":
+            what = f"events ({event_constructs(model)})"
+        raise SimulationError(f"{model.name} has {what}, which {engine} does not run "
+                              "yet", hint="use springc sweep (one run at a time)")
 
 
-def columns_of(model: CompiledModel, variables: Sequence[str] | None) -> tuple[list[str],
-                                                                               list[int]]:
-    """The summarised variables and their indices into ``[states | observed]``."""
+def check_bounds(model: CompiledModel, names: Sequence[str], values: np.ndarray,
+                 fixed: Mapping[str, float]) -> None:
+    """Refuse, before any run, a value outside its parameter's declared ``min``/``max``
+    (the generated module's ``PARAMETER_BOUNDS``), naming the parameter (and the first
+    run that has it)."""
+    bounds = dict(zip(model.parameter_names, model.module.PARAMETER_BOUNDS))
+    checks = [(f"--param {n}", n, values[:, j], True) for j, n in enumerate(names)]
+    checks += [(f"--set {n}", n, np.array([v]), False) for n, v in fixed.items()]
+    for option, name, column, per_run in checks:
+        low, high = bounds.get(name, (None, None))
+        below = column < low if low is not None else np.zeros(column.shape, dtype=bool)
+        above = column > high if high is not None else np.zeros(column.shape, dtype=bool)
+        outside = np.flatnonzero(below | above)
+        if outside.size:
+            r = int(outside[0])
+            limit = f"min = {low:g}" if below[r] else f"max = {high:g}"
+            where = f" (run {r})" if per_run else ""
+            raise UsageError(f"{option}: {name} = {float(column[r]):g}{where} is outside "
+                             f"its declared range ({limit})",
+                             option=option.split()[0],
+                             hint="the model declares " + ", ".join(
+                                 f"{k} = {v:g}" for k, v in (("min", low), ("max", high))
+                                 if v is not None) + f" for {name}")
+
+
+def columns_of(model: CompiledModel, variables: Sequence[str] | None, option: str = "--vars"
+               ) -> tuple[list[str], list[int]]:
+    """The chosen variables and their indices into ``[states | observed]``."""
     names = list(model.outputs if variables is None else variables)
     index = {n: i for i, n in enumerate((*model.states, *model.observed))}
     for name in names:
         if name not in index:
-            raise UsageError(f"--vars {name}: not a variable of {model.name}",
-                             option="--vars")
+            raise UsageError(f"{option} {name}: not a variable of {model.name}",
+                             option=option)
     return names, [index[n] for n in names]
-
-
-def prepare(model: CompiledModel, names: Sequence[str], values: np.ndarray,
-            fixed: Mapping[str, float], t0: float
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict[int, str]]:
-    """Parameter vectors, start states and work arrays of a chunk's runs (Python per
-    run: the generated module's ``parameters``, ``start`` and ``guesses``), and the
-    message of each run whose values could not be computed."""
-    module = model.module
-    n_p, n = len(model.parameter_names), len(model.states)
-    P = np.zeros((len(values), n_p))
-    X0 = np.zeros((len(values), n))
-    Z = np.zeros((len(values), np.asarray(module.guesses(module.parameters(dict(fixed)))).size))
-    failed: dict[int, str] = {}
-    for r, row in enumerate(values):
-        settings = dict(fixed)
-        settings.update(zip(names, (float(v) for v in row)))
-        try:
-            P[r] = module.parameters(settings)
-            if not np.isfinite(P[r]).all():
-                raise SimulationError("a parameter value is not finite")
-            X0[r] = initial_state(model, P[r], t0)
-            Z[r] = module.guesses(P[r])
-        except (ArithmeticError, ValueError, SpringcError) as err:
-            failed[r] = str(err)
-            P[r], X0[r] = np.nan, np.nan
-    return P, X0, Z, failed
 
 
 def settings_of(model: CompiledModel, options: EnsembleOptions
@@ -173,7 +201,8 @@ def settings_of(model: CompiledModel, options: EnsembleOptions
     return output_grid(start, stop, interval), rtol, atol, max_steps
 
 
-WORDS = {1: "Required step size is less than spacing between numbers.",
+WORDS = {FAILED_PREPARATION: "the parameters or start values are not finite",
+         1: "Required step size is less than spacing between numbers.",
          2: "the derivatives are not finite",
          3: "a variable is not finite",
          4: "the run reached the step limit (--max-steps {limit})",
@@ -203,14 +232,13 @@ def explain(model: CompiledModel, options: EnsembleOptions, settings: Mapping[st
 
 
 def messages(model: CompiledModel, options: EnsembleOptions, names: Sequence[str],
-             values: np.ndarray, result: Any, prepared: Mapping[int, str],
-             max_steps: int) -> list[str | None]:
+             values: np.ndarray, result: Chunk, max_steps: int) -> list[str | None]:
     """The error message of every run of a chunk (``None`` for a run that succeeded)."""
     out: list[str | None] = [None] * len(values)
     explained = 0
     for r in np.flatnonzero(result.status != 0).tolist():
-        if r in prepared:
-            out[r] = prepared[r]
+        if r in result.prepared:
+            out[r] = result.prepared[r]
             continue
         text = None
         if explained < options.explain:
@@ -223,60 +251,54 @@ def messages(model: CompiledModel, options: EnsembleOptions, names: Sequence[str
     return out
 
 
-def schema_of(model: CompiledModel, names: Sequence[str], variables: Sequence[str],
-              metadata: Mapping[str, Any]) -> Any:
-    """The ensemble table's Arrow schema (see the module text)."""
-    import pyarrow as pa
+def checked(result: Chunk) -> Chunk:
+    """``result`` with the runs whose chosen values are not finite failed, and the runs
+    Python could not prepare marked so."""
+    status = result.status.copy()
+    finite = np.isfinite(result.summary).all(axis=(1, 2))
+    status[(status == 0) & ~finite] = NON_FINITE_OUTPUT
+    status[list(result.prepared)] = FAILED_PREPARATION
+    return replace(result, status=status)
 
-    units = model.units
-    fields = [pa.field("run", pa.int64()),
-              *(pa.field(n, pa.float64()) for n in names),
-              pa.field("status", pa.string()), pa.field("error", pa.string()),
-              pa.field("solver", pa.string()), pa.field("steps", pa.int64()),
-              pa.field("rhs_evaluations", pa.int64())]
-    for v in variables:
-        unit = units.get(v, "")
-        for suffix in STATISTICS.values():
-            fields.append(pa.field(f"{v}.{suffix}", pa.float64(),
-                                   metadata={"unit": unit} if unit else None))
-    return pa.schema(fields, metadata={"springc": json.dumps(dict(metadata))})
-
-
-def chunk_table(schema: Any, first: int, values: np.ndarray, result: Any,
-                errors: Sequence[str | None]) -> Any:
-    """The rows of a chunk (runs ``first``, ``first + 1``, ...)."""
-    import pyarrow as pa
-
-    runs = len(values)
-    ok = result.status == 0
-    failed = ~ok
-    columns: list[Any] = [np.arange(first, first + runs, dtype=np.int64),
-                          *(values[:, j] for j in range(values.shape[1])),
-                          pa.array(["ok" if good else "failed" for good in ok.tolist()]),
-                          pa.array(list(errors), type=pa.string()),
-                          pa.array([SOLVER] * runs), result.steps, result.rhs_evaluations]
-    for c in range(result.summary.shape[1]):
-        for s in range(len(STATISTICS)):
-            columns.append(pa.array(result.summary[:, c, s], mask=failed))
-    return pa.Table.from_arrays(columns, schema=schema)
+def chunk_size(options: EnsembleOptions, engine: str, values_per_run: int) -> int:
+    """Runs per chunk: as asked, else the engine's default, capped so that a chunk's
+    trajectories hold at most :data:`TRAJECTORY_VALUES` values."""
+    if options.chunk is not None:
+        if options.chunk < 1:
+            raise UsageError(f"--chunk must be at least 1, not {options.chunk}",
+                             option="--chunk")
+        return options.chunk
+    size = CHUNKS[engine]
+    if values_per_run:
+        size = min(size, max(1, TRAJECTORY_VALUES // values_per_run))
+    return size
 
 
 def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
-                 protected: Sequence[str] = ()) -> EnsembleSummary:
+                 protected: Sequence[str] = (), trajectories: str | None = None
+                 ) -> EnsembleSummary:
     """Run every run of ``options`` on ``model`` in chunks and write the ensemble table
-    to ``output`` (through a temporary file, renamed when complete)."""
-    import pyarrow.parquet as pq
-
-    from ..integrate import ensemble
-
-    check_model(model)
+    to ``output`` (and the trajectories of ``options.trajectories`` to
+    ``trajectories``), all or nothing (temporary files, renamed when complete)."""
+    check_model(model, options.device)
     names, values = run_table(options)
     check_names(model, names)
-    if options.chunk < 1:
-        raise UsageError(f"--chunk must be at least 1, not {options.chunk}", option="--chunk")
-    variables, columns = columns_of(model, options.variables)
-    grid, rtol, atol, max_steps = settings_of(model, options)
     fixed = dict(options.fixed)
+    check_bounds(model, names, values, fixed)
+    if options.every < 1:
+        raise UsageError(f"--every must be at least 1, not {options.every}", option="--every")
+    if bool(options.trajectories) != (trajectories is not None):
+        raise UsageError("--traj-vars and --trajectories go together (the variables and "
+                         "their file)", option="--trajectories")
+    variables, columns = columns_of(model, options.variables)
+    traj_names, traj_columns = columns_of(model, options.trajectories, "--traj-vars")
+    statistics = statistics_of(options.statistics)
+    grid, rtol, atol, max_steps = settings_of(model, options)
+    kept = np.arange(0, grid.size, options.every)
+    kept = kept if kept[-1] == grid.size - 1 else np.append(kept, grid.size - 1)
+    plan = Plan(grid, rtol, atol, max_steps, tuple(columns), tuple(traj_columns),
+                options.every, options.threads or 0)
+    engine, run = open_engine(model, options.engine, options.device, names, fixed, plan)
     metadata = {"format": "springc ensemble 1", "model": model.name,
                 "parameters": list(names), "variables": variables,
                 "method": "table" if options.table else
@@ -284,28 +306,42 @@ def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
                 "samples": options.samples, "seed": options.seed, "fixed": fixed,
                 "start": float(grid[0]), "stop": float(grid[-1]), "points": len(grid),
                 "solver": SOLVER, "rtol": rtol, "atol": atol, "max_steps": max_steps,
-                "runs": len(values), "statistics": list(STATISTICS.values())}
-    schema = schema_of(model, names, variables, metadata)
+                "runs": len(values), "statistics": [SUFFIXES[s] for s in statistics],
+                "engine": engine}
+    schema = schema_of(model, names, variables, statistics, metadata)
+    layout = trajectory_layout(model, names, traj_names, grid[kept], metadata)
+    chunk = chunk_size(options, engine, len(kept) * len(traj_names))
+    return _write(model, options, (names, values), run, (schema, layout, statistics),
+                  (output, trajectories), protected, chunk, (engine, rtol, max_steps))
+
+
+def _write(model: CompiledModel, options: EnsembleOptions,
+           runs: tuple[Sequence[str], np.ndarray], run: Any, layouts: tuple[Any, Any, Any],
+           paths: tuple[str, str | None], protected: Sequence[str], chunk: int,
+           settings: tuple[str, float, int]) -> EnsembleSummary:
+    """The chunks, each into the table (and the trajectory file) as a row group."""
+    import pyarrow.parquet as pq
+
+    names, values = runs
+    schema, layout, statistics = layouts
+    output, trajectories = paths
+    engine, rtol, max_steps = settings
     failed = 0
-    with atomic_write(output, "wb", protected) as f, pq.ParquetWriter(f, schema) as writer:
-        for first in range(0, len(values), options.chunk):
-            chunk = values[first:first + options.chunk]
-            P, X0, Z, prepared = prepare(model, names, chunk, fixed, float(grid[0]))
-            result = ensemble(model.module.rhs, grid, X0, P, Z, rtol=rtol, atol=atol,
-                              observed=model.module.observed, columns=columns,
-                              max_steps=max_steps)
-            status = result.status.copy()
-            finite = np.isfinite(result.summary).all(axis=(1, 2))
-            status[(status == 0) & ~finite] = NON_FINITE_OUTPUT
-            status[list(prepared)] = FAILED_PREPARATION
-            result = _with_status(result, status)
-            errors = messages(model, options, names, chunk, result, prepared, max_steps)
-            failed += int((status != 0).sum())
-            writer.write_table(chunk_table(schema, first, chunk, result, errors))
-    return EnsembleSummary(output, len(values), failed)
-
-
-def _with_status(result: Any, status: np.ndarray) -> Any:
-    from dataclasses import replace
-
-    return replace(result, status=status)
+    with OutputSet(protected) as outputs, contextlib.ExitStack() as stack:
+        writer = stack.enter_context(pq.ParquetWriter(
+            stack.enter_context(outputs.open(output, "wb")), schema))
+        traj_writer = None if trajectories is None else stack.enter_context(
+            pq.ParquetWriter(stack.enter_context(outputs.open(trajectories, "wb")),
+                             layout.schema()))
+        for first in range(0, len(values), chunk):
+            part = values[first:first + chunk]
+            result = checked(run(part))
+            errors = messages(model, options, names, part, result, max_steps)
+            failed += int((result.status != 0).sum())
+            writer.write_table(chunk_table(schema, first, part, result, statistics, errors,
+                                           SOLVER))
+            if traj_writer is not None:
+                traj_writer.write_table(trajectory_table(layout, first, part, result,
+                                                         errors, SOLVER, rtol))
+    files = (output,) if trajectories is None else (output, trajectories)
+    return EnsembleSummary(output, len(values), failed, engine, files)

@@ -1,0 +1,551 @@
+/* springc's batched ensemble kernel: DOP853, one run per loop iteration or GPU thread.
+
+   One text, two compilations (springc.integrate.native_ensemble puts it together):
+   - plain C (the system compiler, a shared library loaded with ctypes): the entry
+     springc_ensemble loops over the runs, in parallel over the cores with OpenMP;
+   - CUDA (SC_CUDA defined, through CuPy's NVRTC): the entry is a __global__ kernel,
+     one thread per run.
+   Before this text come: the sizes of the model (SPRINGC_N_STATES, as SC_NX and SC_NXS, SPRINGC_N_PARAMS,
+   SPRINGC_N_Z, SPRINGC_N_OBSERVED), the tableau of springc.integrate.dop853_tableau
+   (DOP_C, and the weighted sums of the stages written out: sc_a_row, sc_b_sum,
+   sc_e5_sum, sc_e3_sum, sc_d_row), the status codes of
+   springc.integrate.Status (SC_SUCCESS ...) and the model's C functions
+   (springc_parameters, springc_start, springc_rhs, springc_observed: the cmodel
+   interface).
+
+   The arithmetic is springc.integrate.dop853_kernel's with plain-loop sums (the same
+   controller, error norm, initial step and dense output, every sum in the same order),
+   without zero crossings. Each run reads its own inputs and writes only its own rows
+   of the outputs; nothing is reduced across runs, so the results are the same bytes
+   whatever the number of threads. */
+
+#ifdef SC_CUDA
+#define SC_FN static __device__
+#else
+#define SC_FN static
+#endif
+
+#ifndef SC_LANES
+#define SC_LANES 1
+#endif
+#define SC_NPS (SPRINGC_N_PARAMS > 0 ? SPRINGC_N_PARAMS : 1)
+#define SC_NZS (SPRINGC_N_Z > 0 ? SPRINGC_N_Z : 1)
+#define SC_NOS (SPRINGC_N_OBSERVED > 0 ? SPRINGC_N_OBSERVED : 1)
+#define SC_STAGES 12
+#define SC_EXTENDED 16
+#define SC_ROWS 7
+/* per-run work: K (16 rows), F (7 rows), y_new, work, sums, scale, err5, err3, the
+   state at an output time, y (30 rows in all); then p, z and the observed variables */
+#define SC_AT_Y (30 * SC_NXS)
+#define SC_AT_P (31 * SC_NXS)
+#define SC_AT_Z (SC_AT_P + SC_NPS)
+#define SC_AT_OBS (SC_AT_Z + SC_NZS)
+#define SC_WORK (SC_AT_OBS + SC_NOS)
+#define SC_HUGE 1.7976931348623157e308
+
+typedef long long sc_int;
+
+/* What every run shares (the settings) and where run r's rows are. */
+typedef struct {
+    const double *grid;
+    sc_int m;
+    double rtol;
+    const double *atol;
+    double max_step;
+    sc_int max_steps;
+    const sc_int *columns;      /* statistics of these [states | observed] columns */
+    sc_int n_columns;
+    const sc_int *traj_columns; /* trajectories of these */
+    sc_int n_traj;
+    sc_int every;               /* every k-th output time (and the last) */
+    sc_int n_traj_points;
+    int need_observed;
+} sc_settings;
+
+typedef struct {
+    double *summary;   /* n_columns x 5: final, min, max, mean, time of the max */
+    double *traj;      /* n_traj_points x n_traj */
+    double *final;     /* the states at the end (or where the run stopped) */
+    sc_int *status;
+    sc_int *counts;    /* accepted, rejected, evaluations, the model's flag */
+    double *failure_time;
+} sc_outputs;
+
+SC_FN double sc_min(double a, double b) { return b < a ? b : a; }  /* Python's min */
+SC_FN double sc_max(double a, double b) { return b > a ? b : a; }  /* Python's max */
+
+SC_FN int sc_flagged(const double *z) {
+    return SPRINGC_N_Z > 0 && z[SC_NZS - 1] != 0.0;
+}
+
+/* SC_SUCCESS, or why the evaluation that wrote d (and set z) is unusable. */
+SC_FN int sc_verdict(const double *d, const double *z) {
+    if (sc_flagged(z)) return SC_MODEL_FAILED;
+    for (int i = 0; i < SC_NX; i++)
+        if (!isfinite(d[i])) return SC_NON_FINITE_DERIVATIVE;
+    return SC_SUCCESS;
+}
+
+/* the state of stage s: y + (sum_j A[s, j] K[j]) * h */
+SC_FN void sc_stage(const double *y, const double *K, int s, double h, double *sums,
+                    double *out) {
+    sc_a_row(s, K, sums);
+    for (int i = 0; i < SC_NX; i++) out[i] = y[i] + sums[i] * h;
+}
+
+SC_FN double sc_rms_scaled(const double *x, const double *scale) {
+    double total = 0.0;
+    for (int i = 0; i < SC_NX; i++) {
+        double v = x[i] / scale[i];
+        total += v * v;
+    }
+    return sqrt(total) / pow((double)SC_NX, 0.5);
+}
+
+SC_FN double sc_error_norm(const double *y, const double *y_new, const double *K, double h,
+                           double rtol, const double *atol, double *scale, double *err5,
+                           double *err3) {
+    for (int i = 0; i < SC_NX; i++)
+        scale[i] = atol[i] + sc_max(fabs(y[i]), fabs(y_new[i])) * rtol;
+    sc_e5_sum(K, err5);
+    sc_e3_sum(K, err3);
+    double e5 = 0.0, e3 = 0.0;
+    for (int i = 0; i < SC_NX; i++) {
+        err5[i] /= scale[i];
+        err3[i] /= scale[i];
+    }
+    for (int i = 0; i < SC_NX; i++) e5 += err5[i] * err5[i];
+    for (int i = 0; i < SC_NX; i++) e3 += err3[i] * err3[i];
+    if (e5 == 0.0 && e3 == 0.0) return 0.0;
+    return fabs(h) * e5 / sqrt((e5 + 0.01 * e3) * SC_NX);
+}
+
+/* the 7 coefficient rows of the dense output over the step (needs K[13..15]) */
+SC_FN void sc_interpolant(const double *y, const double *y_new, const double *K, double h,
+                          double *F, double *sums) {
+    for (int r = 0; r < SC_ROWS - 3; r++) {
+        sc_d_row(r, K, sums);
+        for (int i = 0; i < SC_NX; i++) F[(3 + r) * SC_NXS + i] = h * sums[i];
+    }
+    for (int i = 0; i < SC_NX; i++) {
+        double delta = y_new[i] - y[i];
+        F[i] = delta;
+        F[SC_NXS + i] = h * K[i] - delta;
+        F[2 * SC_NXS + i] = 2 * delta - h * (K[SC_STAGES * SC_NXS + i] + K[i]);
+    }
+}
+
+SC_FN void sc_interpolate(const double *F, const double *y, double theta, double *out) {
+    for (int i = 0; i < SC_NX; i++) {
+        double value = 0.0;
+        for (int r = SC_ROWS - 1; r >= 0; r--) {
+            value += F[r * SC_NXS + i];
+            value *= (SC_ROWS - 1 - r) % 2 == 0 ? theta : 1 - theta;
+        }
+        out[i] = value + y[i];
+    }
+}
+
+/* Output time k reached with states x (observed obs): the statistics and trajectories. */
+SC_FN void sc_emit(const sc_settings *s, const sc_outputs *o, sc_int k, const double *x,
+                   const double *obs) {
+    const double *grid = s->grid;
+    for (sc_int c = 0; c < s->n_columns; c++) {
+        sc_int j = s->columns[c];
+        double v = j < SC_NX ? x[j] : obs[j - SC_NX];
+        double *out = o->summary + 5 * c;  /* final (the last value), min, max, area, t */
+        if (k == 0) {
+            out[0] = v; out[1] = v; out[2] = v; out[3] = 0.0; out[4] = grid[0];
+            continue;
+        }
+        if (v < out[1]) out[1] = v;
+        if (v > out[2]) { out[2] = v; out[4] = grid[k]; }
+        out[3] += 0.5 * (v + out[0]) * (grid[k] - grid[k - 1]);
+        out[0] = v;
+    }
+    if (s->n_traj > 0 && (k % s->every == 0 || k == s->m - 1)) {
+        sc_int slot = k % s->every == 0 ? k / s->every : s->n_traj_points - 1;
+        double *row = o->traj + slot * s->n_traj;
+        for (sc_int c = 0; c < s->n_traj; c++) {
+            sc_int j = s->traj_columns[c];
+            row[c] = j < SC_NX ? x[j] : obs[j - SC_NX];
+        }
+    }
+}
+
+/* The end of a run: its status, counts, time and state. */
+SC_FN void sc_finish(const sc_settings *s, const sc_outputs *o, int status, sc_int accepted,
+                     sc_int rejected, sc_int nfev, double t, const double *x,
+                     const double *z) {
+    o->status[0] = status;
+    o->counts[0] = accepted;
+    o->counts[1] = rejected;
+    o->counts[2] = nfev;
+    o->counts[3] = SPRINGC_N_Z > 0 ? (sc_int)z[SC_NZS - 1] : 0;
+    o->failure_time[0] = t;
+    for (int i = 0; i < SC_NX; i++) o->final[i] = x[i];
+    double span = s->grid[s->m - 1] - s->grid[0];
+    for (sc_int c = 0; c < s->n_columns; c++) {
+        double *out = o->summary + 5 * c;
+        if (status != SC_SUCCESS) {
+            for (int q = 0; q < 5; q++) out[q] = NAN;
+        } else {
+            out[3] = s->m > 1 ? out[3] / span : out[0];
+        }
+    }
+}
+
+/* The output times in (t, t_new]: the states there (and the observed variables). */
+SC_FN int sc_outputs_in_step(const sc_settings *s, const sc_outputs *o, sc_int *filled,
+                             double t, double t_new, double h, const double *y,
+                             const double *y_new, const double *F, double *xo, double *obs,
+                             const double *p, double *z) {
+    while (*filled < s->m && s->grid[*filled] <= t_new) {
+        double tk = s->grid[*filled];
+        if (tk == t_new) {
+            for (int i = 0; i < SC_NX; i++) xo[i] = y_new[i];
+        } else {
+            sc_interpolate(F, y, (tk - t) / h, xo);
+        }
+        if (s->need_observed) {
+            springc_observed(tk, xo, p, z, obs);
+            if (sc_flagged(z)) return SC_MODEL_FAILED;
+        }
+        sc_emit(s, o, *filled, xo, obs);
+        *filled += 1;
+    }
+    return SC_SUCCESS;
+}
+
+/* The initial step (Hairer's algorithm, as scipy's select_initial_step); 0 on failure
+   with *status set. */
+SC_FN double sc_first_step(const sc_settings *s, double t, const double *y, double *K,
+                           double *work, double *scale, const double *p, double *z,
+                           double interval, int *status, sc_int *nfev, double *h0_out) {
+    for (int i = 0; i < SC_NX; i++) scale[i] = s->atol[i] + fabs(y[i]) * s->rtol;
+    double d0 = sc_rms_scaled(y, scale), d1 = sc_rms_scaled(K, scale);
+    double h0 = d0 < 1e-5 || d1 < 1e-5 ? 1e-6 : 0.01 * d0 / d1;
+    h0 = sc_min(h0, interval);
+    *h0_out = h0;
+    for (int i = 0; i < SC_NX; i++) work[i] = y[i] + h0 * K[i];
+    double *d = K + SC_NXS;  /* stage 1's row, free until the first step */
+    springc_rhs(t + h0, work, p, z, d);
+    *nfev += 1;
+    *status = sc_verdict(d, z);
+    if (*status != SC_SUCCESS) return 0.0;
+    double total = 0.0;
+    for (int i = 0; i < SC_NX; i++) {
+        double v = (d[i] - K[i]) / scale[i];
+        total += v * v;
+    }
+    double d2 = sqrt(total) / pow((double)SC_NX, 0.5) / h0;
+    double h1 = d1 <= 1e-15 && d2 <= 1e-15 ? sc_max(1e-6, h0 * 1e-3)
+                                           : pow(0.01 / sc_max(d1, d2), 0.125);
+    double h = sc_min(sc_min(sc_min(100 * h0, h1), interval), s->max_step);
+    if (!(h > 0.0)) *status = SC_STEP_TOO_SMALL;
+    return h;
+}
+
+/* Where the runs come from: the chunk's inputs, shared by every lane. */
+typedef struct {
+    sc_settings s;
+    sc_outputs all;
+    int prepared;
+    const double *V;
+    sc_int n_v;
+    const sc_int *v_index;
+    const double *base;
+    const int *given;
+    const double *P, *X0, *Z;
+    sc_int runs;
+    sc_int stride;    /* CUDA: the threads of the launch; this thread's runs step by it */
+    sc_int next;      /* CUDA: this thread's next run */
+    sc_int *counter;  /* C: the next run not taken, shared by the threads */
+} sc_job;
+
+/* A run in progress: a lane. A thread keeps SC_LANES of them and takes them through
+   each step together (their model evaluations interleave: independent work for the
+   processor while one waits on a division or a square root). */
+typedef struct {
+    sc_int run;  /* -1: idle */
+    int retry;   /* the last attempt was rejected */
+    int ready;   /* between the start of an attempt and its end */
+    double t, h_abs, h, t_new, min_step;
+    sc_int accepted, rejected, nfev, filled;
+    sc_outputs o;
+    double *w;   /* its work array (layout SC_AT_*) */
+} sc_lane;
+
+SC_FN sc_int sc_take(sc_job *job) {
+#ifdef SC_CUDA
+    sc_int r = job->next;
+    job->next += job->stride;
+#else
+    sc_int r;
+#ifdef _OPENMP
+#pragma omp atomic capture
+#endif
+    r = (*job->counter)++;
+#endif
+    return r < job->runs ? r : -1;
+}
+
+SC_FN void sc_end(sc_lane *L, const sc_job *job, int status, double t, const double *x) {
+    sc_finish(&job->s, &L->o, status, L->accepted, L->rejected, L->nfev, t, x,
+              L->w + SC_AT_Z);
+    L->run = -1;
+    L->ready = 0;
+}
+
+/* Run r's parameters and start (see springc_ensemble); 0 if they are not finite. */
+SC_FN int sc_inputs(const sc_job *job, sc_int r, double *y, double *p, double *z) {
+    int code = 0;
+    if (job->prepared) {
+        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = job->P[r * SPRINGC_N_PARAMS + i];
+        for (int i = 0; i < SC_NX; i++) y[i] = job->X0[r * SC_NX + i];
+        for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = job->Z[r * SPRINGC_N_Z + i];
+    } else {
+        for (int i = 0; i < SPRINGC_N_PARAMS; i++) p[i] = job->base[i];
+        for (sc_int j = 0; j < job->n_v; j++) p[job->v_index[j]] = job->V[r * job->n_v + j];
+        springc_parameters(p, job->given);
+        for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = 0.0;
+        code = springc_start(p, y, z);
+    }
+    for (int i = 0; i < SPRINGC_N_PARAMS; i++) code |= !isfinite(p[i]);
+    for (int i = 0; i < SC_NX; i++) code |= !isfinite(y[i]);
+    return code == 0;
+}
+
+/* Lane L takes run r: its inputs, outputs at the start, the initial step. 1 if the run
+   needs steps, 0 if it has ended already. */
+SC_FN int sc_start(sc_lane *L, const sc_job *job, sc_int r) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *K = w, *work = w + 24 * SC_NXS, *scale = w + 26 * SC_NXS;
+    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z, *obs = w + SC_AT_OBS;
+    L->run = r;
+    L->retry = 0;
+    L->accepted = L->rejected = L->nfev = 0;
+    L->filled = 1;
+    L->t = s->grid[0];
+    L->o.summary = job->all.summary + r * 5 * s->n_columns;
+    L->o.traj = job->all.traj + r * s->n_traj_points * s->n_traj;
+    L->o.final = job->all.final + r * SC_NX;
+    L->o.status = job->all.status + r;
+    L->o.counts = job->all.counts + 4 * r;
+    L->o.failure_time = job->all.failure_time + r;
+    if (!sc_inputs(job, r, y, p, z)) { sc_end(L, job, SC_BAD_START, L->t, y); return 0; }
+
+    /* Step 1: the start and its outputs. */
+    if (s->need_observed) {
+        springc_observed(L->t, y, p, z, obs);
+        if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return 0; }
+    }
+    sc_emit(s, &L->o, 0, y, obs);
+    if (s->m == 1 || SC_NX == 0) {
+        for (sc_int k = 1; k < s->m; k++) sc_emit(s, &L->o, k, y, obs);
+        sc_end(L, job, SC_SUCCESS, L->t, y);
+        return 0;
+    }
+    springc_rhs(L->t, y, p, z, K);
+    L->nfev = 1;
+    int status = sc_verdict(K, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
+
+    /* Step 2: the initial step. */
+    double h0 = 0.0, t_end = s->grid[s->m - 1];
+    L->h_abs = sc_first_step(s, L->t, y, K, work, scale, p, z, fabs(t_end - L->t), &status,
+                             &L->nfev, &h0);
+    if (status != SC_SUCCESS) {
+        int small = status == SC_STEP_TOO_SMALL;
+        sc_end(L, job, status, small ? L->t : L->t + h0, small ? y : work);
+        return 0;
+    }
+    return 1;
+}
+
+/* The start of an attempt (Step 3 of dop853_run): the step limit, the step size. 1 if
+   the lane goes on to the stages, 0 if its run has ended. */
+SC_FN int sc_attempt(sc_lane *L, const sc_job *job) {
+    const sc_settings *s = &job->s;
+    double *y = L->w + SC_AT_Y, t_end = s->grid[s->m - 1];
+    if (!L->retry) {
+        if (s->max_steps > 0 && L->accepted + L->rejected >= s->max_steps) {
+            sc_end(L, job, SC_MAX_STEPS, L->t, y);
+            return 0;
+        }
+        L->min_step = 10 * fabs(nextafter(L->t, SC_HUGE) - L->t);
+        if (L->h_abs > s->max_step) L->h_abs = s->max_step;
+        else if (L->h_abs < L->min_step) L->h_abs = L->min_step;
+    }
+    if (L->h_abs < L->min_step) { sc_end(L, job, SC_STEP_TOO_SMALL, L->t, y); return 0; }
+    L->t_new = L->t + L->h_abs;
+    if (L->t_new - t_end > 0) L->t_new = t_end;
+    L->h = L->t_new - L->t;
+    L->h_abs = fabs(L->h);
+    L->ready = 1;
+    return 1;
+}
+
+/* Stage st of the attempt; 0 if the evaluation failed (the run has ended). */
+SC_FN int sc_stage_of(sc_lane *L, const sc_job *job, int st) {
+    double *w = L->w, *K = w, *sums = w + 25 * SC_NXS, *work = w + 24 * SC_NXS;
+    double *z = w + SC_AT_Z, t = L->t + DOP_C[st] * L->h;
+    sc_stage(w + SC_AT_Y, K, st, L->h, sums, work);
+    springc_rhs(t, work, w + SC_AT_P, z, K + st * SC_NXS);
+    L->nfev += 1;
+    int status = sc_verdict(K + st * SC_NXS, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, t, work); return 0; }
+    return 1;
+}
+
+/* The end of an attempt: the new state, its error, accepted or rejected; an accepted
+   step fills the output times it passes (Steps 5 and 7). 0 if the run has ended. */
+SC_FN int sc_conclude(sc_lane *L, const sc_job *job) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *K = w, *F = w + 16 * SC_NXS, *y_new = w + 23 * SC_NXS;
+    double *sums = w + 25 * SC_NXS, *scale = w + 26 * SC_NXS, *err5 = w + 27 * SC_NXS;
+    double *err3 = w + 28 * SC_NXS, *xo = w + 29 * SC_NXS, *y = w + SC_AT_Y;
+    double *p = w + SC_AT_P, *z = w + SC_AT_Z, h = L->h, t = L->t;
+    L->ready = 0;
+    sc_b_sum(K, sums);
+    for (int i = 0; i < SC_NX; i++) y_new[i] = y[i] + h * sums[i];
+    springc_rhs(t + h, y_new, p, z, K + SC_STAGES * SC_NXS);
+    L->nfev += 1;
+    int status = sc_verdict(K + SC_STAGES * SC_NXS, z);
+    if (status != SC_SUCCESS) { sc_end(L, job, status, t + h, y_new); return 0; }
+    double error = sc_error_norm(y, y_new, K, h, s->rtol, s->atol, scale, err5, err3);
+    if (!(error < 1)) {
+        L->h_abs *= sc_max(0.2, 0.9 * pow(error, -0.125));
+        L->retry = 1;
+        L->rejected += 1;
+        return 1;
+    }
+    double factor = error == 0 ? 10.0 : sc_min(10.0, 0.9 * pow(error, -0.125));
+    if (L->retry) factor = sc_min(1.0, factor);
+    L->h_abs *= factor;
+    L->retry = 0;
+    L->accepted += 1;
+    if (L->filled < s->m && s->grid[L->filled] <= L->t_new) {
+        for (int st = SC_STAGES + 1; st < SC_EXTENDED; st++)
+            if (!sc_stage_of(L, job, st)) return 0;
+        sc_interpolant(y, y_new, K, h, F, sums);
+        status = sc_outputs_in_step(s, &L->o, &L->filled, t, L->t_new, h, y, y_new, F, xo,
+                                    w + SC_AT_OBS, p, z);
+        if (status != SC_SUCCESS) {
+            sc_end(L, job, status, s->grid[L->filled], xo);
+            return 0;
+        }
+    }
+    L->t = L->t_new;
+    for (int i = 0; i < SC_NX; i++) {
+        y[i] = y_new[i];
+        K[i] = K[SC_STAGES * SC_NXS + i];
+    }
+    if (!(L->t < s->grid[s->m - 1])) { sc_end(L, job, SC_SUCCESS, L->t, y); return 0; }
+    return 1;
+}
+
+/* A thread's share of the runs, SC_LANES at a time: an idle lane takes the next run
+   (and the next, while runs end at their start); the ready lanes go through each
+   stage together. */
+SC_FN void sc_work(sc_job *job, double *block) {
+    sc_lane lanes[SC_LANES];
+    int exhausted = 0;
+    for (int l = 0; l < SC_LANES; l++) {
+        lanes[l].w = block + l * SC_WORK;
+        lanes[l].run = -1;
+        lanes[l].ready = 0;
+    }
+    for (;;) {
+        int any = 0;
+        for (int l = 0; l < SC_LANES; l++) {
+            sc_lane *L = &lanes[l];
+            while (!exhausted || L->run >= 0) {
+                if (L->run < 0) {
+                    sc_int r = sc_take(job);
+                    if (r < 0) { exhausted = 1; break; }
+                    if (!sc_start(L, job, r)) continue;
+                }
+                if (sc_attempt(L, job)) break;
+            }
+            any |= L->ready;
+        }
+        if (!any) return;
+        for (int st = 1; st < SC_STAGES; st++)
+            for (int l = 0; l < SC_LANES; l++)
+                if (lanes[l].ready) lanes[l].ready = sc_stage_of(&lanes[l], job, st);
+        for (int l = 0; l < SC_LANES; l++)
+            if (lanes[l].ready) sc_conclude(&lanes[l], job);
+    }
+}
+
+#define SC_ENTRY_ARGS                                                                     \
+    sc_int runs, int prepared, const double *V, sc_int n_v, const sc_int *v_index,           \
+    const double *base, const int *given, const double *P, const double *X0,              \
+    const double *Z, const double *grid, sc_int m, double rtol, const double *atol,         \
+    double max_step, sc_int max_steps, const sc_int *columns, sc_int n_columns,            \
+    const sc_int *traj_columns, sc_int n_traj, sc_int every, sc_int n_traj_points,          \
+    int need_observed, double *summary, double *traj, double *final, sc_int *status,        \
+    sc_int *counts, double *failure_time
+
+#define SC_ENTRY_NAMES                                                                    \
+    runs, prepared, V, n_v, v_index, base, given, P, X0, Z, grid, m, rtol, atol, max_step,   \
+    max_steps, columns, n_columns, traj_columns, n_traj, every, n_traj_points,              \
+    need_observed, summary, traj, final, status, counts, failure_time
+
+#define SC_SETUP(job)                                                                     \
+    sc_job job = {{grid, m, rtol, atol, max_step, max_steps, columns, n_columns,             \
+                   traj_columns, n_traj, every, n_traj_points, need_observed},              \
+                  {summary, traj, final, status, counts, failure_time},                    \
+                  prepared, V, n_v, v_index, base, given, P, X0, Z, runs, 1, 0, 0}
+
+#ifdef SC_CUDA
+/* One thread per run (runs beyond the launch's threads: every stride-th). */
+extern "C" __global__ void springc_ensemble(SC_ENTRY_ARGS) {
+    SC_SETUP(job);
+    job.next = (sc_int)blockIdx.x * blockDim.x + threadIdx.x;
+    job.stride = (sc_int)gridDim.x * blockDim.x;
+    double block[SC_LANES * SC_WORK];
+    sc_work(&job, block);
+}
+#ifdef SC_EMULATE_CUDA
+#include SC_EMULATE_CUDA
+#endif
+#else
+#include <stdlib.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+int springc_ensemble_threads(void) {
+#ifdef _OPENMP
+    return omp_get_max_threads();
+#else
+    return 1;
+#endif
+}
+
+/* Every run: `threads` threads (0: OpenMP's default) take runs one at a time, each
+   keeping SC_LANES in progress. Run r's parameters: with `prepared`, row r of P, X0
+   and Z; else `base` with the n_v varied ones (at v_index) from row r of V, completed
+   by springc_parameters (`given` marks the parameters set by the user: the ones bound
+   to them follow) and springc_start. A run whose parameters or start values are not
+   finite ends with SC_BAD_START. Returns 0, or -1 if runs were left (no thread could
+   allocate its work arrays). */
+int springc_ensemble(SC_ENTRY_ARGS, int threads) {
+    SC_SETUP(job);
+    sc_int counter = 0;
+    job.counter = &counter;
+#ifdef _OPENMP
+    if (threads <= 0) threads = omp_get_max_threads();
+#pragma omp parallel num_threads(threads)
+#endif
+    {
+        sc_job mine = job;
+        double *block = (double *)malloc((size_t)SC_LANES * SC_WORK * sizeof(double));
+        if (block != NULL) sc_work(&mine, block);
+        free(block);
+    }
+    (void)threads;
+    return counter < runs ? -1 : 0;
+}
+#endif
