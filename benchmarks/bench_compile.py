@@ -161,8 +161,7 @@ def bench_chain_warm(repeats: int, fused: bool) -> None:
 
     import springc
     from handwritten import chain_rhs
-    from springc.integrate import dop853
-    from springc.integrate import dop853_steps
+    from springc.integrate import dop853, dop853_steps
     from springc.integrate.loop import specialize
     from springc.integrate.models import no_observed
 
