@@ -112,6 +112,7 @@ def read_reference(refs: Path, example: str, guard: float) -> Reference:
         header = [h.strip().strip('"') for h in next(reader)]
         table = np.array([[float(v) for v in row] for row in reader if row])
     column = {name: i for i, name in enumerate(header)}
+    column.setdefault("time", column.get("Time", 0))  # some results write "Time"
     t = table[:, column["time"]]
     steps = np.diff(np.unique(t))
     interval = float(np.median(steps)) if len(steps) else 0.0

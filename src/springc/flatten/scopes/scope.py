@@ -379,7 +379,7 @@ class FlattenContext(ClassViews, FlatResults, Protocol):
     statement_conditions: list[tuple[x.Expr, Span]]
     attribute_cache: AttributeCache
     # the class that wrote the equation being flattened: an inherited equation finds
-    # the functions of its base class's scope (section 5.6.1)
+    # the functions of its base class's scope
     written_in: ClassEntry | None
 
     def report(self, err: FlattenError) -> None: ...
