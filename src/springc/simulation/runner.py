@@ -367,7 +367,8 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
     names = model.outputs
     n = len(model.states)
     columns = [*model.states, *model.observed]
-    wanted = [o for o in model.observed if o in set(names)]
+    selected = set(names)
+    wanted = [o for o in model.observed if o in selected]
     in_order = tuple(columns) == tuple(names)
     out = np.empty((len(grid), len(names)))
     obs = out[:, n:] if in_order else np.empty((len(grid), len(model.observed)))
