@@ -161,3 +161,36 @@ def test_error_output_table_and_unchanged_csv(tmp_path: Path) -> None:
         "Error: --error-output needs an error estimate, which --error-control off turns "
         "off\n")
     assert not (tmp_path / "none.csv").exists()
+
+
+def test_the_estimate_compares_a_few_columns_at_a_time(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """The differences of two runs are taken COLUMNS_PER_PASS columns at a time (a large
+    scene never holds a copy of both runs): the same largest errors, their rows and the
+    scales as the whole arrays at once, the companion's columns in the run's order."""
+    from dataclasses import dataclass
+
+    from springc.simulation import error_estimate
+
+    @dataclass
+    class Run:
+        time: np.ndarray
+        names: tuple[str, ...]
+        values: np.ndarray
+        events: tuple[()] = ()
+
+    rng = np.random.default_rng(7)
+    grid = np.linspace(0.0, 1.0, 6)
+    ours = rng.normal(size=(6, 5))
+    theirs = rng.normal(size=(6, 5))
+    names = ("a", "b", "c", "d", "e")
+    order = [3, 0, 4, 1, 2]  # the companion's columns: d a e b c
+    run = Run(grid, names, ours)
+    companion = Run(grid, tuple(names[j] for j in order), theirs[:, order])
+    monkeypatch.setattr(error_estimate, "COLUMNS_PER_PASS", 2)
+    estimate = error_estimate.compare(run, companion, grid, "test", 2.0, 0.0)
+    error = np.abs((ours - theirs) * 2.0)
+    assert estimate.names == names
+    assert (estimate.absolute == error.max(axis=0)).all()
+    assert (estimate.times == grid[error.argmax(axis=0)]).all()
+    assert (estimate.scales == np.abs(ours).max(axis=0)).all()

@@ -142,3 +142,30 @@ def test_the_clamp_runs_where_a_stale_warm_start_stopped_it(engine: str) -> None
     i = result["i"]
     # the charging current peaks at 0.247 A at the start (the same run to 0.46 s)
     assert abs(np.max(np.abs(i)) - 0.247) < 1e-3
+
+
+def test_rows_go_into_the_given_columns_a_few_at_a_time(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A large result holds one copy: the rows are written into the view given (the
+    result's observed columns), through calls of at most ROWS_PER_CALL rows, each row
+    warm started from the one before across the calls, as in one call."""
+    from springc.simulation import observed_rows
+
+    module, p = AtanModule(), np.zeros(0)
+    times = np.arange(7.0)
+    states = np.array([[0.0], [1.0], [2.0], [3.0], [4.0], [5.0], [6.0]])
+    calls: list[int] = []
+    grid = module.observed_grid
+
+    def counted(ts: np.ndarray, xs: np.ndarray, q: np.ndarray, z: np.ndarray) -> np.ndarray:
+        calls.append(len(ts))
+        return grid(ts, xs, q, z)
+
+    monkeypatch.setattr(module, "observed_grid", counted)
+    monkeypatch.setattr(observed_rows, "ROWS_PER_CALL", 3)
+    result = np.full((7, 3), -1.0)
+    z = np.zeros(2)
+    written = observed_on_rows(module, times, states, p, z, result[:, 2:])
+    assert written.base is result and calls == [3, 3, 1]
+    assert np.allclose(result[:, 2], np.arange(7.0), atol=1e-12)
+    assert (result[:, :2] == -1.0).all() and z[-1] == 0.0

@@ -121,15 +121,21 @@ def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
 
 def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
              states: np.ndarray) -> np.ndarray:
+    """The output columns (``model.outputs``) at the grid's rows: one array, the
+    observed rows written into it directly where the outputs are the states then the
+    observed variables in order (every output: a large scene holds one copy)."""
     names = model.outputs
-    sources = {s: i for i, s in enumerate(model.states)}  # columns of [states | observed]
+    n = len(model.states)
+    columns = [*model.states, *model.observed]
     selected = set(names)
     wanted = [o for o in model.observed if o in selected]
-    obs = np.empty((len(grid), 0))
+    in_order = tuple(columns) == tuple(names)
+    out = np.empty((len(grid), len(names)))
+    obs = out[:, n:] if in_order else np.empty((len(grid), len(model.observed)))
     if wanted:
         z = np.asarray(model.module.guesses(problem.p), dtype=float)
         try:
-            obs = observed_on_rows(model.module, grid, states, problem.p, z)
+            observed_on_rows(model.module, grid, states, problem.p, z, obs)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise _first_failure(model, problem, grid, states, err) from err
         if z[-1] != 0.0:
@@ -138,11 +144,14 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
             raise problem.newton_failure(float(grid[row]), states[row])
         if not np.isfinite(obs).all():
             _locate_observed(model, problem, grid, states, obs)
-        sources.update({o: len(model.states) + i for i, o in enumerate(model.observed)})
-    both = np.hstack((states, obs))  # copies rows: fast for 10^4 columns, unlike a loop
-    index = np.array([sources[n] for n in names], dtype=np.intp)
-    same = len(index) == both.shape[1] and (index == np.arange(len(index))).all()
-    out = both if same else np.take(both, index, axis=1)
+    if in_order:
+        out[:, :n] = states
+    else:
+        sources = {s: i for i, s in enumerate(columns)}  # columns of [states | observed]
+        index = np.array([sources[name] for name in names], dtype=np.intp)
+        from_states = index < n
+        out[:, from_states] = states[:, index[from_states]]
+        out[:, ~from_states] = obs[:, index[~from_states] - n]
     check_outputs(names, grid, out)
     return out
 

@@ -123,13 +123,14 @@ def compare(run: Run, companion: Run, grid: np.ndarray,
     a, b = paired_events(run, companion)
     for low, high in zip(np.minimum(a, b) - abs(a - b), np.maximum(a, b) + abs(a - b)):
         keep &= ~((grid >= low) & (grid <= high))
-    theirs_values = companion.values[theirs[keep]]
+    columns = None
     if companion.names != run.names:  # the same selection: the same columns, in order
         where = {name: j for j, name in enumerate(companion.names)}
-        theirs_values = theirs_values[:, [where[n] for n in run.names]]
-    error = (run.values[ours[keep]] - theirs_values) * gain
-    scales = np.abs(run.values).max(axis=0) if len(run.values) else np.zeros(len(run.names))
-    estimate = measured(run.names, grid[keep], scales, error, method, began)
+        columns = np.array([where[n] for n in run.names], dtype=np.intp)
+    estimate = measured(run.names, grid[keep], *_differences(
+        run.values, companion.values, ours[keep], theirs[keep], columns, gain,
+        len(run.names)),
+        method, began)
     if not len(a):
         return estimate
     # the event times as one more quantity: their largest shift, on the scale of |t|
@@ -142,16 +143,46 @@ def compare(run: Run, companion: Run, grid: np.ndarray,
                    scales=np.append(estimate.scales, scale))
 
 
+COLUMNS_PER_PASS = 1024
+"""Output columns compared at a time: the differences of a large scene's runs never
+take more than this many columns (the 50x50 cloth's 128,700 columns at once would be
+three arrays as large as its result)."""
+
+
+def _differences(ours: np.ndarray, theirs: np.ndarray, our_rows: np.ndarray,
+                 their_rows: np.ndarray, columns: np.ndarray | None, gain: float,
+                 width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The scale of each column of ``ours`` (its largest magnitude over every row), and
+    the largest magnitude of ``(ours - theirs) * gain`` on the paired rows with the
+    index of its row, :data:`COLUMNS_PER_PASS` columns at a time (``columns``: the
+    columns of ``theirs`` in the order of ``ours``; None: the same; ``width``: the
+    number of columns)."""
+    scales = np.zeros(width)
+    absolute = np.zeros(width)
+    rows = np.zeros(width, dtype=np.intp)
+    for begin in range(0, width, COLUMNS_PER_PASS):
+        end = min(begin + COLUMNS_PER_PASS, width)
+        mine = ours[:, begin:end]
+        other = theirs[:, begin:end] if columns is None else theirs[:, columns[begin:end]]
+        if len(mine):
+            scales[begin:end] = np.abs(mine).max(axis=0)
+        if len(our_rows):
+            error = np.abs((mine[our_rows] - other[their_rows]) * gain)
+            absolute[begin:end] = error.max(axis=0)
+            rows[begin:end] = error.argmax(axis=0)
+    return scales, absolute, rows
+
+
 def measured(names: tuple[str, ...], grid: np.ndarray, scales: np.ndarray,
-             error: np.ndarray, method: str, began: float) -> ErrorEstimate:
-    """The estimate from the ``error`` of each variable on ``grid`` (rows), its largest
-    magnitude over the run (``scales``) giving the relative error."""
+             absolute: np.ndarray, rows: np.ndarray, method: str, began: float
+             ) -> ErrorEstimate:
+    """The estimate from the largest error of each variable on ``grid`` (``absolute``,
+    at the rows ``rows`` of ``grid``), its largest magnitude over the run (``scales``)
+    giving the relative error."""
     if not len(grid):
         zero = np.zeros(len(names))
         return ErrorEstimate(names, zero, zero, zero, method, time.perf_counter() - began,
                              scales)
-    absolute = np.abs(error).max(axis=0)
-    where = grid[np.abs(error).argmax(axis=0)]
     relative = absolute / np.where(scales > 0, scales, 1.0)
-    return ErrorEstimate(names, absolute, relative, where, method,
+    return ErrorEstimate(names, absolute, relative, grid[rows], method,
                          time.perf_counter() - began, scales)

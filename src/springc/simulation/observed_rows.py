@@ -106,18 +106,26 @@ def observed_at_rows(module: Any, problem: Problem, times: np.ndarray, states: n
     return out
 
 
+ROWS_PER_CALL = 64
+"""Output rows computed per call of the grid loop: the observed values of a large scene
+go straight into the result, through a buffer of this many rows (the 50x50 cloth's
+120,000 observed variables: 60 MB), never a second array of every row."""
+
+
 def observed_on_rows(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndarray,
-                     z: np.ndarray) -> np.ndarray:
+                     z: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """:func:`.compiled.observed_on_grid` (one ``z`` carried from row to row), with each
     row whose Newton iteration does not converge solved again by continuation from the
     row before; from the first row that still does not, the rows are NaN and ``z[-1]``
-    holds the failure flag, as ``observed_on_grid`` leaves them."""
+    holds the failure flag, as ``observed_on_grid`` leaves them. The rows are written
+    into ``out`` (a view of the result's observed columns, for example) where given."""
     n = warm_slots(module)
-    out = np.empty((len(ts), len(module.OBSERVED)))
+    if out is None:
+        out = np.empty((len(ts), len(module.OBSERVED)))
     k = 0
     while k < len(ts):
         start = z.copy()
-        out[k:] = observed_on_grid(module, ts[k:], states[k:], p, z)
+        _fill(module, ts, states, p, z, out, k)
         if z[-1] == 0.0:
             break
         failed = k + int(np.flatnonzero(np.isnan(out[k:]).all(axis=1))[0])
@@ -137,3 +145,16 @@ def observed_on_rows(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndar
         z[:] = retry
         k = failed + 1
     return out
+
+
+def _fill(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndarray, z: np.ndarray,
+          out: np.ndarray, k: int) -> None:
+    """Rows ``k:`` of ``out`` from the grid loop, :data:`ROWS_PER_CALL` at a time with
+    ``z`` carried over (the same rows as one call); after a row that fails (``z[-1]``
+    set) the rest are NaN, as one call leaves them."""
+    for begin in range(k, len(ts), ROWS_PER_CALL):
+        end = min(begin + ROWS_PER_CALL, len(ts))
+        out[begin:end] = observed_on_grid(module, ts[begin:end], states[begin:end], p, z)
+        if z[-1] != 0.0:
+            out[end:] = np.nan
+            return
