@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
 import xml.etree.ElementTree as ET
 import zipfile
 from pathlib import Path
@@ -115,11 +116,12 @@ def test_without_a_compiler_the_fmu_holds_sources_that_build(
     path_before = os.environ["PATH"]
     monkeypatch.setenv("PATH", str(tmp_path))  # no compiler on it
     monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setitem(sys.modules, "ziglang", None)  # nor zig cc from PyPI
     path = tmp_path / "SpringMass.fmu"
     result = CliRunner().invoke(main, ["fmu", SEED, "-o", str(path)])
     assert result.exit_code == 0, result.output
-    assert "warning: no C compiler found (looked for $CC, cc, gcc, clang): the FMU holds " \
-           "the C sources only" in result.output
+    assert "warning: no C compiler found (looked for $CC, cc, gcc, clang and the ziglang " \
+           "package): the FMU holds the C sources only" in result.output
     with zipfile.ZipFile(path) as archive:
         assert not [n for n in archive.namelist() if n.startswith("binaries/")]
         archive.extractall(tmp_path / "unzipped")
