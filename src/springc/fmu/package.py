@@ -33,8 +33,8 @@ COMMON_HEADERS = ("springc_fmu.h", "springc_glue.h")
 PLATFORM = {3: "x86_64-linux", 2: "linux64"}
 """The binaries folder of the platform (FMI 3.0: platform tuple; FMI 2.0: linux64)."""
 
-COMPILER_FLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-fvisibility=hidden",
-                  "-ffp-contract=off")
+COMPILER_FLAGS = ("-std=c99", "-O2", "-g0", "-shared", "-fPIC", "-fvisibility=hidden",
+                  "-ffp-contract=off")  # -g0: zig cc's debug information names the folder
 NO_COMPILER_NOTE = ("no C compiler found (looked for $CC, cc, gcc, clang and the ziglang "
                     "package): the FMU holds the C sources only; compile them with a C "
                     "compiler (sources/buildDescription.xml lists them) to run it, or "

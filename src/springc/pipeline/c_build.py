@@ -35,9 +35,10 @@ from .compiler import CompiledModel
 
 C_SOURCE_FILE = "cmodel.c"
 C_LIBRARY_FILE = "libcmodel.so"
-C_FLAGS = ("-O2", "-shared", "-fPIC", "-ffp-contract=off", "-DSPRINGC_FN=")
+C_FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-ffp-contract=off", "-DSPRINGC_FN=")
 """No -ffast-math, and no contraction into fused multiply-adds: the library computes
-what the Python module computes, operation for operation."""
+what the Python module computes, operation for operation. No debug information (zig cc
+writes one by default, naming the private build folder): one text, the same bytes."""
 COMPILERS = ("cc", "gcc", "clang")
 ZIG_MODULE = "ziglang"
 """The PyPI package whose ``python -m ziglang cc`` is the C compiler of last resort (a
