@@ -1,11 +1,13 @@
 """The C model (codegen/c_model.py) computes what the Python module computes: every C
 function of the seed, a 100-mass chain, a linear block, the index-3 pendulum (Newton
 blocks) and the bouncing ball (events) against the generated Python module of the same
-model at several (t, x, p), within 1e-12 relative; located errors for what C cannot
-compute."""
+model at several (t, x, p), within 1e-12 relative (the seed also built by zig cc);
+located errors for what C cannot compute."""
 
 from __future__ import annotations
 
+import shlex
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +16,7 @@ import pytest
 import springc
 from pendulum_text import PENDULUM
 from springc.errors import CodegenError
-from springc.pipeline import CLibrary, CompiledModel, c_library
+from springc.pipeline import CLibrary, CompiledModel, c_library, find_compiler
 from springc.pipeline.c_build import build_library
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -125,6 +127,18 @@ def test_seed_functions_equal_the_python_module(tmp_path: Path) -> None:
     m, lib = compiled(tmp_path, None, SEED, "SpringMass")
     assert (lib.n_states, lib.n_params, lib.n_observed, lib.n_z) == (4, 11, 3, 1)
     assert lib.has_jacobian and lib.n_jac == len(m.module.JAC_ROWS) == 6
+    check_continuous(m, lib, {})
+    check_continuous(m, lib, {"spring.k": 250.0, "mass.m": 0.3})
+
+
+def test_the_seed_built_by_zig_cc_equals_the_python_module(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # a machine with Python and pip only: the compiler is zig cc of the ziglang package
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "zig-cache"))  # built afresh
+    monkeypatch.setenv("CC", shlex.join([sys.executable, "-m", "ziglang", "cc"]))
+    assert find_compiler() == [sys.executable, "-m", "ziglang", "cc"]
+    m, lib = compiled(tmp_path, None, SEED, "SpringMass")
+    assert (m.path.parent / "libcmodel.so").read_bytes()[:4] == b"\x7fELF"
     check_continuous(m, lib, {})
     check_continuous(m, lib, {"spring.k": 250.0, "mass.m": 0.3})
 

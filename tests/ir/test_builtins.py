@@ -28,6 +28,7 @@ from springc.flatten.events.event_calls import BOOLEAN_CALLS, EVENT_CALLS
 from springc.ir import builtins as b
 from springc.ir import expr as x
 from springc.ir import latex
+from springc.pipeline import find_compiler
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -150,14 +151,14 @@ def test_transparent_operators_print_their_argument() -> None:
 
 @pytest.fixture(scope="module")
 def c_library(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    """libm with the registry's C helpers, compiled by the system C compiler."""
+    """libm with the registry's C helpers, compiled by the C compiler springc finds."""
     folder = tmp_path_factory.mktemp("c_helpers")
     source = folder / "helpers.c"
     source.write_text("#include <math.h>\n#define SPRINGC_FN\n"
                       + "\n".join(b.C_HELPERS.values()) + "\n")
     library = folder / "helpers.so"
-    subprocess.run(["cc", "-std=c99", "-shared", "-fPIC", "-o", str(library), str(source),
-                    "-lm"], check=True, capture_output=True, timeout=120)
+    subprocess.run([*find_compiler(), "-std=c99", "-shared", "-fPIC", "-o", str(library),
+                    str(source), "-lm"], check=True, capture_output=True, timeout=120)
     return ctypes.CDLL(str(library), mode=ctypes.RTLD_GLOBAL)
 
 

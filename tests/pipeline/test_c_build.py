@@ -1,9 +1,10 @@
 """The C library of a compiled model (pipeline/c_build.py): built once into the model's
 cache entry, loaded from it without a compiler, a damaged file rebuilt with a note, and
-a clear error on a machine without a C compiler."""
+a clear error on a machine without a C compiler (none on the PATH, no ziglang)."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ import pytest
 
 import springc
 from springc.errors import SpringcError
-from springc.pipeline import CCompilerMissing, c_build, c_library
+from springc.pipeline import CCompilerMissing, c_build, c_library, find_compiler
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -73,8 +74,19 @@ def test_no_compiler_is_a_clear_error(tmp_path: Path, monkeypatch: pytest.Monkey
     model = springc.compile_model([SEED], "SpringMass", backend="python")
     monkeypatch.setenv("PATH", str(tmp_path / "empty"))
     monkeypatch.setenv("CC", "no-such-compiler")
+    monkeypatch.setitem(sys.modules, "ziglang", None)  # find_spec: not installed
     with pytest.raises(CCompilerMissing) as caught:
         c_library(model)
     assert caught.value.message == ("no C compiler found (looked for $CC, cc, gcc and "
-                                    "clang on the PATH)")
+                                    "clang on the PATH, and the ziglang package)")
+    assert caught.value.hint == ("pip install ziglang (a C compiler from PyPI), or install "
+                                 "a system C compiler (for example gcc), to build the C "
+                                 "model; the Python module needs none")
     assert isinstance(caught.value, SpringcError)  # the CLI reports it, exit 1
+
+
+def test_without_a_system_compiler_zig_cc_of_the_ziglang_package_is_found(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    monkeypatch.delenv("CC", raising=False)
+    assert find_compiler() == [sys.executable, "-m", "ziglang", "cc"]

@@ -26,7 +26,7 @@ from ..pipeline import CompileOptions, derive_system
 from ..simplify import initial_state, parameter_values
 from . import description as xml
 from .glue import glue_source
-from .package import NO_COMPILER_NOTE, assemble, compile_sources, find_compiler, write_fmu
+from .package import NO_COMPILER_NOTE, assemble, compile_sources, compiler_or_none, write_fmu
 from .variables import ModelTables, interface
 
 FMI_VERSIONS = (3, 2)
@@ -132,7 +132,7 @@ def model_tables(system: ode.ODE, states: Iterable[str], parameters: Iterable[st
 def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
                fmi_version: int = 3) -> FmuExport:
     """Write the FMU of ``options``' model to ``output``: with a binary where a C
-    compiler is found (:func:`.package.find_compiler`), else sources only."""
+    compiler is found (:func:`springc.pipeline.find_compiler`), else sources only."""
     version = check_version(fmi_version)
     check_target(output, options.files)
     derived = derive_system(options)
@@ -153,7 +153,7 @@ def export_fmu(options: CompileOptions, output: str | os.PathLike[str],
     package = assemble(version, identifier, text, build, source.text,
                        glue_source(token, nominals, initial, experiment.tolerance,
                                    relation_sides(system, tables.crossings)),
-                       find_compiler())
+                       compiler_or_none())
     write_fmu(output, package.entries, options.files)
     shown = ", ".join(tables.states[:4]) + (", ..." if len(tables.states) > 4 else "")
     warnings = (STATIC_CHOICE_WARNING.format(states=shown),) if derived.switchable else ()

@@ -1,5 +1,6 @@
 """The files of an FMU -> the ``.fmu`` archive: the C sources (the wrapper of ``c/``, the
-model and its glue), the binary for linux64 compiled with the system C compiler, and
+model and its glue), the binary for linux64 compiled with the C compiler that
+:func:`springc.pipeline.find_compiler` finds (the one owner of that search), and
 the model description; written through :mod:`springc.fileio` (all or nothing, the
 file-safety rules of every output).
 
@@ -11,8 +12,6 @@ A machine without a C compiler gets a sources-only FMU: the caller reports the n
 from __future__ import annotations
 
 import os
-import shlex
-import shutil
 import subprocess
 import tempfile
 import zipfile
@@ -22,6 +21,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..fileio import atomic_write
+from ..pipeline import CCompilerMissing, find_compiler
 
 WRAPPER = {
     3: ("springc_fmi3.c", "springc_fmi3_modes.c"),
@@ -33,11 +33,12 @@ COMMON_HEADERS = ("springc_fmu.h", "springc_glue.h")
 PLATFORM = {3: "x86_64-linux", 2: "linux64"}
 """The binaries folder of the platform (FMI 3.0: platform tuple; FMI 2.0: linux64)."""
 
-COMPILER_FLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-fvisibility=hidden",
-                  "-ffp-contract=off")
-NO_COMPILER_NOTE = ("no C compiler found (looked for $CC, cc, gcc, clang): the FMU holds "
-                    "the C sources only; compile them with a C compiler "
-                    "(sources/buildDescription.xml lists them) to run it")
+COMPILER_FLAGS = ("-std=c99", "-O2", "-g0", "-shared", "-fPIC", "-fvisibility=hidden",
+                  "-ffp-contract=off")  # -g0: zig cc's debug information names the folder
+NO_COMPILER_NOTE = ("no C compiler found (looked for $CC, cc, gcc, clang and the ziglang "
+                    "package): the FMU holds the C sources only; compile them with a C "
+                    "compiler (sources/buildDescription.xml lists them) to run it, or "
+                    "pip install ziglang and export again")
 ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
 
@@ -57,18 +58,13 @@ def compile_sources(version: int) -> tuple[str, ...]:
     return ("springc_glue.c",) + COMMON + WRAPPER[version]
 
 
-def find_compiler() -> list[str] | None:
-    """The C compiler's command: ``$CC`` (split as a shell would, never run by one), else
-    the first of cc, gcc, clang on the PATH; None where there is none (the same rule
-    as the C model's build, ``springc.pipeline.c_build``)."""
-    given = shlex.split(os.environ.get("CC", "").strip())
-    if given and shutil.which(given[0]) is not None:
-        return given
-    for name in ("cc", "gcc", "clang"):
-        found = shutil.which(name)
-        if found:
-            return [found]
-    return None
+def compiler_or_none() -> list[str] | None:
+    """The C compiler's command (:func:`springc.pipeline.find_compiler`), or None where
+    there is none: the FMU then holds its sources only."""
+    try:
+        return find_compiler()
+    except CCompilerMissing:
+        return None
 
 
 def build_binary(sources: Mapping[str, bytes], version: int, identifier: str,

@@ -30,8 +30,9 @@ BAD_START = -1
 """The status of a run whose parameters or start values are not finite (or whose start
 values' Newton iteration failed): it is not integrated."""
 OPENMP = ("-fopenmp",)
-"""The compiler argument of the parallel loop over the runs (the build is tried again
-without it where the compiler has no OpenMP: one thread). The other flags are the C
+"""The compiler argument of the parallel loop over the runs, used where the compiler
+found builds and loads an OpenMP program (:func:`springc.pipeline.openmp_flags`; without
+it the kernel's serial loop, one thread, the same results). The other flags are the C
 model's (:func:`springc.pipeline.kernel_library`): -O2, no fused multiply-adds, so the
 sums round as numba's do."""
 LANES = 4

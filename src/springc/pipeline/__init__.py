@@ -23,15 +23,15 @@ from .options import CompileOptions
 from .selection import select_names
 
 if TYPE_CHECKING:
-    from .c_build import CCompilerMissing, CLibrary, c_library, c_source
-    from .c_kernels import kernel_library
+    from .c_build import CCompilerMissing, CLibrary, c_library, c_source, find_compiler
+    from .c_kernels import kernel_library, openmp_flags
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
 __all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
-           "compile_files", "derive_system", "flatten_files", "generate_source",
-           "kernel_library", "modification_value",
+           "compile_files", "derive_system", "find_compiler", "flatten_files",
+           "generate_source", "kernel_library", "modification_value", "openmp_flags",
            "select_names", "split_values"]
 
 
@@ -41,14 +41,14 @@ def __getattr__(name: str) -> Any:
         from . import generation
 
         return getattr(generation, name)
-    if name in ("c_library", "c_source", "CLibrary", "CCompilerMissing"):  # a C compiler
+    if name in ("c_library", "c_source", "CLibrary", "CCompilerMissing", "find_compiler"):
         from . import c_build
 
         return getattr(c_build, name)
-    if name == "kernel_library":
+    if name in ("kernel_library", "openmp_flags"):
         from . import c_kernels
 
-        return c_kernels.kernel_library
+        return getattr(c_kernels, name)
     if name == "flatten_files":
         from . import files
 

@@ -153,15 +153,11 @@ def c_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, flo
              plan: Plan) -> Engine:
     """The batched C kernel on every core (the model's C file)."""
     from ..integrate import OPENMP, NativeEnsemble, kernel_text
-    from ..pipeline import c_source, kernel_library
+    from ..pipeline import c_source, kernel_library, openmp_flags
 
     text = kernel_text(c_source(model))
-    try:
-        data = kernel_library(model, text, OPENMP, tag="ensemble")
-    except SpringcError:  # no compiler at all
-        raise
-    except RuntimeError:  # the compiler refused -fopenmp: one thread
-        data = kernel_library(model, text, (), tag="ensemble")
+    # OpenMP where the compiler's probe builds and loads, else the serial loop
+    data = kernel_library(model, text, openmp_flags(OPENMP), tag="ensemble")
     kernel = NativeEnsemble(data, len(model.states))
     make = c_runs(model, names, fixed, plan)
     atol = np.full(max(len(model.states), 1), plan.atol)
