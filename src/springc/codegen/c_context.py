@@ -13,8 +13,8 @@ import re
 from collections.abc import Sequence
 
 from ..ir import ode
-from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub
-from .context import NEWTON_ITERATIONS, NEWTON_TOLERANCE, CodegenBug, CodegenContext
+from ..ir.expr import ZERO, BinOp, Var
+from .context import NEWTON_ITERATIONS, CodegenBug, CodegenContext, newton_update
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 SOLVE = """SPRINGC_FN void springc_solve(int n, int m, double *a, double *b, double *y)
@@ -116,14 +116,7 @@ class CContext(CodegenContext):
             loop.append(Raw(f"double _D{index}[{k}];\n"
                             f"springc_solve({k}, 1, _J{index}, _R{index}, _D{index});"))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
-        done: Expr | None = None
-        for i, t in enumerate(block.tearing):
-            loop.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
-            small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
-                          mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
-            done = small if done is None else BinOp("and", done, small)
-        assert done is not None
-        loop.append(Let(f"_done{index}", done))
+        loop += newton_update(block.tearing, index)
         body.append(Loop(f"for (int _it = 0; _it < {NEWTON_ITERATIONS}; _it++) {{", loop))
         body.append(Raw(f"if (!_ok{index}) {{\n    z[{self.flag_slot}] = {float(index + 1)!r};\n"
                         f"    _code = {index + 1};\n}}"))

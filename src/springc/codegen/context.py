@@ -190,14 +190,7 @@ class CodegenContext:
             loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
             loop.append(Raw(guarded_solve(f"_D{index}", f"_J{index}", f"_R{index}", f"{k}")))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
-        done: Expr | None = None
-        for i, t in enumerate(block.tearing):
-            loop.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
-            small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
-                          mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
-            done = small if done is None else BinOp("and", done, small)
-        assert done is not None
-        loop.append(Let(f"_done{index}", done))
+        loop += newton_update(block.tearing, index)
         body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))
         body.append(Raw(f"if not _ok{index}:\n    z[{self.flag_slot}] = "
                         f"{float(index + 1)}"))
@@ -223,6 +216,22 @@ class CodegenContext:
         for n in names:
             visit(n)
         return out
+
+
+def newton_update(tearing: Sequence[str], index: int) -> list[Stmt]:
+    """The Newton step of block ``index`` on its tearing variables (``_d{index}_{i}``
+    holds the solved correction) and its convergence flag ``_done{index}``: every
+    correction within :data:`NEWTON_TOLERANCE` of ``1 + |t|``. Both printers use it."""
+    stmts: list[Stmt] = []
+    done: Expr | None = None
+    for i, t in enumerate(tearing):
+        stmts.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
+        small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
+                      mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
+        done = small if done is None else BinOp("and", done, small)
+    assert done is not None
+    stmts.append(Let(f"_done{index}", done))
+    return stmts
 
 
 def block_comment(kind: str, names: Sequence[str], spans: Sequence[Span]) -> str:
