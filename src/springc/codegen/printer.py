@@ -174,7 +174,7 @@ class FunctionWriter:
                 self._comment(stmt.comment)
             self.write(stmt.body)
         else:
-            for name in defines_inside(stmt.body):
+            for name in sorted(defines_inside(stmt.body)):  # set order varies by run
                 self._reassigned(name)
             self._emit(stmt.header)
             outer = self._indent
