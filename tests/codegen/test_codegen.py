@@ -19,6 +19,7 @@ from springc.ir.expr import BinOp, Call, Const, If, Var
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
 SCENES = str(ROOT / "models" / "Scenes.mdl")
+EVENT_SCENES = str(ROOT / "models" / "EventScenes.mdl")
 
 
 @pytest.fixture(autouse=True)
@@ -356,3 +357,19 @@ def test_vector_layout_groups_a_chain_into_loops() -> None:
     rhs = source[source.index("def rhs("):source.index("def jacobian_values(")]
     assert rhs.count("for _q in range(") <= 8  # a handful of loops, not 10 x 5 statements
     assert "# 9 x s[2].s_rel := m[2].s - m[1].s" in rhs
+
+
+def test_a_parameter_read_only_by_event_code_can_be_changed() -> None:
+    """The ball's restitution ``e`` is read only by its reinit: not structural, and a
+    run with ``e = 0.5`` bounces as the closed form says (impact speed ``e**k * v1``)."""
+    model = springc.compile_model(EVENT_SCENES, "EventScenes.BouncingBall", cache=False)
+    assert "e" not in model.module.STRUCTURAL
+    result = springc.simulate(model, parameters={"e": 0.5}, stop=1.0, interval=0.001,
+                              rtol=1e-10, atol=1e-12)
+    g, e = 9.81, 0.5
+    t1 = (2.0 / g) ** 0.5
+    v1 = g * t1
+    t2 = t1 + 2 * e * v1 / g
+    expected = e * e * v1 - g * (1.0 - t2)
+    v_end = result.values[-1, list(result.names).index("v")]
+    assert v_end == pytest.approx(expected, rel=1e-6)

@@ -25,6 +25,7 @@ from ..errors import CodegenError, Span
 from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Expr, Var, variables
+from ..ir.hybrid import event_expressions
 from .assertions import assertion_function
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
 from .delays import used_names
@@ -42,8 +43,12 @@ from .vector import VECTOR_THRESHOLD, VectorLayout
 
 def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) -> list[str]:
     """Parameters that generated code cannot change: Integer and Boolean ones (they may
-    size arrays or pick equations) and those the flattener already evaluated away."""
+    size arrays or pick equations) and those the flattener already evaluated away (read
+    by no equation, observed variable, start value or event)."""
     used: set[str] = set()
+    if system.events is not None:
+        for e in event_expressions(system.events):
+            used |= variables(e)
     for step in system.steps:
         for e in ode.step_expressions(step):
             used |= variables(e)

@@ -26,6 +26,7 @@ Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 from ..errors import Span
@@ -72,3 +73,21 @@ class EventSystem:
         return not (self.discrete or self.relations or self.time_relations
                     or self.samples or self.whens or self.floors or self.reads_initial
                     or self.reads_terminal)
+
+
+def event_expressions(events: EventSystem) -> Iterator[Expr]:
+    """Every expression the event code evaluates: relations, time-event instants,
+    samples, floors, discrete starts and the when-clauses' conditions, assigned values
+    and reinit values (what a parameter must be read by to be changeable at run time)."""
+    yield from events.relations
+    yield from (r.at for r in events.time_relations)
+    for start, interval in events.samples:
+        yield start
+        yield interval
+    yield from events.floors
+    yield from (d.start for d in events.discrete if d.start is not None)
+    for w in events.whens:
+        for b in w.branches:
+            yield from b.conditions
+            yield from (a.value for a in b.assignments)
+            yield from (r.value for r in b.reinits)
