@@ -35,7 +35,7 @@ from types import ModuleType
 from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
-from ..parse import library_folders, source_files
+from ..parse import key_sources
 from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, user_cache_dir
 
 CACHE_ENTRIES = 200
@@ -121,11 +121,7 @@ def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) 
     h = hashlib.sha256()
     h.update(repr((CODEGEN_VERSION, settings)).encode())
     h.update(springc_digest())
-    sources = [Path(f) for f in files]
-    folders = [Path(f).parent for f in files if Path(f).name in ("package.mo", "package.mdl")]
-    for folder in folders + library_folders(libraries):
-        sources += source_files(folder)
-    for path in sources:
+    for path in key_sources(files, libraries):
         h.update(str(path.resolve()).encode() + b"\0")
         try:
             h.update(hashlib.sha256(path.read_bytes()).digest())

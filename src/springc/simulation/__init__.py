@@ -2,7 +2,9 @@
 
 The package is ``simulation``, not ``simulate``: ``springc.simulate`` is the API function.
 
-The solver names (:mod:`.solver_names`) load with the package; everything else loads
+The solver names (:mod:`.solver_names`) and the standard-library pieces of the
+command line's warm path (:mod:`.csv_rows`, :mod:`.error_rules`, :mod:`.summary`) load
+with the package; everything else loads
 on first use (PEP 562), so that the CLI can offer the solver names without importing
 numpy and scipy (a third of a second on every ``springc check``).
 """
@@ -11,6 +13,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .csv_rows import write_rows  # light: the stdlib pieces of the warm path
+from .error_rules import allowed_errors, companion_tolerances, largest_differences, worst_column
 from .settings import (  # light: the run options, no numpy
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
@@ -40,6 +44,7 @@ from .solver_names import (
     Solver,
     registered,
 )
+from .summary import brief_line
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
@@ -94,14 +99,18 @@ __all__ = [
     "SimulationOptions",
     "SimulationResult",
     "Solver",
+    "allowed_errors",
+    "brief_line",
     "check_run_values",
     "check_trajectory_size",
     "choose_engine",
+    "companion_tolerances",
     "default_backend",
     "error_control_mode",
     "estimate_deprecation",
     "file_format",
     "initial_state",
+    "largest_differences",
     "observed_on_grid",
     "output_grid",
     "plan",
@@ -111,7 +120,9 @@ __all__ = [
     "run_settings",
     "save_outputs",
     "simulate_model",
+    "worst_column",
     "write_csv",
+    "write_rows",
 ]
 
 _LIMITS = frozenset({"OverBudget"})
