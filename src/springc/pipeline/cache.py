@@ -96,10 +96,11 @@ def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]
 
 @functools.cache
 def springc_digest() -> bytes:
-    """SHA-256 of the text of every module below ``PACKAGE_ROOT`` and of the grammar:
-    any change to springc's code moves every key."""
+    """SHA-256 of the text of every module and C source below ``PACKAGE_ROOT`` and of
+    the grammar: any change to springc's code moves every key (the C loop library of
+    an entry, ``cloop.so``, is built from springc's C sources)."""
     h = hashlib.sha256()
-    for path in sorted(PACKAGE_ROOT.glob("**/*.py")):
+    for path in sorted([*PACKAGE_ROOT.glob("**/*.py"), *PACKAGE_ROOT.glob("**/*.c")]):
         h.update(str(path.relative_to(PACKAGE_ROOT)).encode() + b"\0")
         h.update(hashlib.sha256(path.read_bytes()).digest())
     h.update(hashlib.sha256(grammar_path().read_bytes()).digest())
