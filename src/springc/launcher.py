@@ -25,6 +25,7 @@ from __future__ import annotations
 import array
 import hashlib
 import io
+import math
 import os
 import signal
 import sys
@@ -133,11 +134,11 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
     data = run_record.verified(record)
     if data is None:
         raise Fallback
-    from .native.runner import LibraryMismatch, LoopLibrary
+    from .native import LoopLibrary
 
     try:
         library = LoopLibrary(data)
-    except (LibraryMismatch, OSError):
+    except (RuntimeError, OSError):  # not a loop library of this interface
         raise Fallback from None
     run = record["run"]
     if list(library.names("states")) != run["states"] or \
@@ -145,19 +146,19 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
         raise Fallback
     began = time.perf_counter()
     answer = run["answer"]
-    rows, steps = _outputs(library, run, answer["solver"], answer["rtol"], answer["atol"])
+    columns, steps = _outputs(library, run, answer["solver"], answer["rtol"], answer["atol"])
     estimated = tolerance = None
     if run["mode"] != "off":
         tight = companion_tolerances(answer["rtol"], answer["atol"])
         theirs, _ = _outputs(library, run, EXPLICIT, *tight)
-        scales, absolute, _rows = largest_differences(rows, theirs)
+        scales, absolute, _rows = largest_differences(columns, theirs)
         allowed = allowed_errors(scales, run["asked"]["rtol"], run["asked"]["atol"])
         if not all(a <= t for a, t in zip(absolute, allowed)):
             raise Fallback  # the command line tightens or warns
         worst = worst_column(absolute, allowed)
         estimated, tolerance = absolute[worst], allowed[worst]
     text = io.StringIO()
-    write_rows(text, run["names"], ([t, *row] for t, row in zip(run["grid"], rows)))
+    write_rows(text, run["names"], zip(run["grid"], *columns))
     csv = text.getvalue()
     if hashlib.sha256(csv.encode("utf-8")).hexdigest() != output["sha256"]:
         raise Fallback
@@ -169,9 +170,9 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
 
 
 def _outputs(library: Any, run: Mapping[str, Any], solver: str, rtol: float, atol: float
-             ) -> tuple[list[list[float]], int]:
-    """The output rows (columns in the record's order) of one run of ``solver`` at
-    ``rtol``, ``atol`` from the recorded start, and its accepted steps."""
+             ) -> tuple[list[Sequence[float]], int]:
+    """The output columns (in the record's order, each over the grid) of one run of
+    ``solver`` at ``rtol``, ``atol`` from the recorded start, and its accepted steps."""
     grid, p = run["grid"], array.array("d", run["p"])
     done = library.run(solver, grid, run["x0"], p, array.array("d", run["z"]), rtol=rtol,
                        atol=atol)
@@ -181,15 +182,12 @@ def _outputs(library: Any, run: Mapping[str, Any], solver: str, rtol: float, ato
     if failed >= 0:
         raise Fallback
     n, m = library.n_states, library.n_observed
-    sources = [(done.states, n, index) if kind == "state" else (observed, m, index)
+    columns = [done.states[index::n] if kind == "state" else observed[index::m]
                for kind, index in run["columns"]]
-    rows = [[values[i * width + index] for values, width, index in sources]
-            for i in range(len(grid))]
-    for row in rows:
-        for value in row:
-            if value != value or value in (float("inf"), float("-inf")):
-                raise Fallback  # the command line's check of the outputs words it
-    return rows, done.accepted_steps
+    for column in columns:
+        if not all(map(math.isfinite, column)):
+            raise Fallback  # the command line's check of the outputs words it
+    return columns, done.accepted_steps
 
 
 def _write(csv: str, target: str | None, protected: Sequence[str]) -> None:

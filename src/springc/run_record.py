@@ -35,7 +35,6 @@ import hashlib
 import json
 import os
 import sys
-import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeGuard
@@ -73,14 +72,14 @@ def code_stamp() -> str:
     grammar), the check Python's own bytecode cache makes of a module (a change of any
     module, ``CODEGEN_VERSION`` and the version included, moves it)."""
     found = []
-    for folder, subfolders, names in os.walk(PACKAGE_ROOT):
+    root = str(PACKAGE_ROOT)
+    for folder, subfolders, names in os.walk(root):
         subfolders[:] = [d for d in subfolders if d != "__pycache__"]
         for name in names:
             if name.endswith(SOURCE_SUFFIXES):
-                path = os.path.join(folder, name)
+                path = folder + os.sep + name
                 info = os.stat(path)
-                found.append((os.path.relpath(path, PACKAGE_ROOT), info.st_size,
-                              info.st_mtime_ns))
+                found.append((path[len(root):], info.st_size, info.st_mtime_ns))
     info = os.stat(grammar_path())
     found.sort()
     found.append(("grammar", info.st_size, info.st_mtime_ns))
@@ -125,6 +124,8 @@ def write(key: str, content: Mapping[str, Any]) -> Path | None:
         if records is None:
             return None
         target = records / f"{key}.json"
+        import tempfile  # writing only: the warm path reads
+
         text = json.dumps({"format": FORMAT, "key": key, **content})
         fd, temporary = tempfile.mkstemp(dir=records, prefix=".new-", suffix=".part")
         try:

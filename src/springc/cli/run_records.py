@@ -15,7 +15,6 @@ from __future__ import annotations
 import hashlib
 import io
 from collections.abc import Sequence
-from dataclasses import replace
 from typing import Any
 
 import click
@@ -50,7 +49,7 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
                    libraries: Sequence[str], output: str | None, quiet: bool
                    ) -> dict[str, Any] | None:
     """The record of the run (``settings``: as the run was asked), or None."""
-    from ..native.runner import LIBRARY_FILE, cached_library
+    from ..native import LIBRARY_FILE, cached_library
     from ..pipeline import ModuleKind
     from ..simulation import plan, write_csv
 
@@ -95,5 +94,6 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
 
 
 def ran_on_c_loop(result: Any) -> bool:
-    """Whether the run's answer came from the model's C loop library."""
-    return bool(replace(result.stats).engine == "compiled") and False
+    """Whether the run's answer came from the compiled engine (the model's C loop
+    library where its cache entry holds one)."""
+    return bool(result.stats.engine == "compiled")

@@ -30,22 +30,17 @@ def companion_tolerances(rtol: float, atol: float) -> tuple[float, float]:
 
 def largest_differences(ours: Sequence[Sequence[float]], theirs: Sequence[Sequence[float]],
                         gain: float = 1.0) -> tuple[list[float], list[float], list[int]]:
-    """Per column of the rows ``ours`` (one run's output rows, every row paired with the
-    row of ``theirs`` at the same index): its largest magnitude over the rows (the
-    scale), the largest ``|(ours - theirs) * gain|`` and the first row where it occurs."""
-    width = len(ours[0]) if len(ours) else 0
-    scales, absolute, rows = [0.0] * width, [0.0] * width, [0] * width
-    for j in range(width):
-        scale = best = -1.0
-        where = 0
-        for i, (mine, other) in enumerate(zip(ours, theirs)):
-            size = abs(mine[j])
-            if size > scale:
-                scale = size
-            error = abs((mine[j] - other[j]) * gain)
-            if error > best:
-                best, where = error, i
-        scales[j], absolute[j], rows[j] = max(scale, 0.0), max(best, 0.0), where
+    """Per column of one run's outputs ``ours`` (a sequence of columns, each over the
+    output rows) against the same columns ``theirs`` of its companion (row for row):
+    the column's largest magnitude (its scale), the largest
+    ``|(ours - theirs) * gain|`` and the first row where it occurs."""
+    scales, absolute, rows = [], [], []
+    for mine, other in zip(ours, theirs):
+        scales.append(max(map(abs, mine), default=0.0))
+        errors = [abs((a - b) * gain) for a, b in zip(mine, other)]
+        best = max(errors, default=0.0)
+        absolute.append(best)
+        rows.append(errors.index(best) if errors else 0)
     return scales, absolute, rows
 
 
