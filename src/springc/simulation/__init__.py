@@ -43,7 +43,14 @@ from .solver_names import (
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
-    from .compiled import choose_engine, default_backend, observed_on_grid
+    from .compiled import (
+        c_loop_available,
+        c_loop_runs,
+        choose_engine,
+        default_backend,
+        numba_available,
+        observed_on_grid,
+    )
     from .limits import OverBudget
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -94,6 +101,8 @@ __all__ = [
     "SimulationOptions",
     "SimulationResult",
     "Solver",
+    "c_loop_available",
+    "c_loop_runs",
     "check_run_values",
     "check_trajectory_size",
     "choose_engine",
@@ -102,6 +111,7 @@ __all__ = [
     "estimate_deprecation",
     "file_format",
     "initial_state",
+    "numba_available",
     "observed_on_grid",
     "output_grid",
     "plan",
@@ -123,7 +133,8 @@ _RUNNER = frozenset({"LSODA_LIMIT", "RunPlan", "initial_state", "output_grid", "
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
-    if name in ("choose_engine", "default_backend", "observed_on_grid"):
+    if name in ("c_loop_available", "c_loop_runs", "choose_engine", "default_backend",
+                "numba_available", "observed_on_grid"):
         from . import compiled
 
         return getattr(compiled, name)
