@@ -50,6 +50,7 @@ def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
     first = springc.compile_model(SEED)  # fills the cache as the CLI's run would
     assert not first.cached
+    springc.simulate(first, stop=0.1)  # (and the C loop library, where a compiler is)
     out = tmp_path / "seed.csv"
     paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
     env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}

@@ -20,20 +20,24 @@ from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
     CompileOptions,
+    ModuleKind,
     check_parameter_names,
     compile_files,
     modification_value,
 )
 from .simulation import (
+    AUTO,
     DEFAULT_ENGINE,
     DEFAULT_ERROR_CONTROL,
     DEFAULT_SOLVER,
     RunSettings,
     SimulationResult,
+    c_loop_runs,
     check_run_values,
     choose_engine,
     default_backend,
     estimate_deprecation,
+    numba_available,
     run_settings,
     simulate_model,
 )
@@ -153,11 +157,15 @@ loop runs such a model in seconds; large scenes in the vector layout stay far be
 
 def default_choice(backend: str | None, engine: str = "auto", solver: str = "auto"
                    ) -> str | None:
-    """``backend`` as given; else ``None`` where springc would choose numba (for
-    :func:`compile_model`, which also checks the module's size), else ``"python"``."""
+    """``backend`` as given; else ``None`` where the run's backend is the one
+    :func:`compile_model` chooses itself (which also checks a numba module's size, and
+    generates a model with events for numba where it chose python for the C loop),
+    else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for radau where
+    the C loop runs the others)."""
     if backend:
         return backend
-    return None if default_backend(engine, str(solver).lower()) == "numba" else "python"
+    chosen = default_backend(engine, str(solver).lower())
+    return None if chosen == default_backend() else chosen
 
 
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
@@ -166,6 +174,11 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     if chosen and options.backend == "numba" and \
             compiled.source.count("\n") > NUMBA_LINES:
         return _compile_as(replace(options, backend="python"), parameters)
+    if chosen and options.backend == "python" and compiled.kind != ModuleKind.CONTINUOUS \
+            and c_loop_runs(AUTO, None) and numba_available():
+        # springc chose python for the C loop, which runs continuous models only: the
+        # compiled engine runs this one's events, delays or switching states on numba
+        return _compile_as(replace(options, backend="numba"), parameters)
     return compiled
 
 

@@ -302,8 +302,11 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         if folder is not None:  # never leave an entry that cannot be imported
             shutil.rmtree(path.parent, ignore_errors=True)
         raise too_deep_for_python(err) from None
+    # a python module's model keeps its derived system: the C loop's first run prints
+    # the C model from it (c_build.c_source) instead of deriving it again
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated,
+                         derived if options.backend == "python" else None,
                          run_system=run, model_key=model_key)
 
 

@@ -48,7 +48,14 @@ from .summary import brief_line
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
-    from .compiled import choose_engine, default_backend, observed_on_grid
+    from .compiled import (
+        c_loop_available,
+        c_loop_runs,
+        choose_engine,
+        default_backend,
+        numba_available,
+        observed_on_grid,
+    )
     from .limits import OverBudget
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -101,6 +108,8 @@ __all__ = [
     "Solver",
     "allowed_errors",
     "brief_line",
+    "c_loop_available",
+    "c_loop_runs",
     "check_run_values",
     "check_trajectory_size",
     "choose_engine",
@@ -111,6 +120,7 @@ __all__ = [
     "file_format",
     "initial_state",
     "largest_differences",
+    "numba_available",
     "observed_on_grid",
     "output_grid",
     "plan",
@@ -134,7 +144,8 @@ _RUNNER = frozenset({"LSODA_LIMIT", "RunPlan", "initial_state", "output_grid", "
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
-    if name in ("choose_engine", "default_backend", "observed_on_grid"):
+    if name in ("c_loop_available", "c_loop_runs", "choose_engine", "default_backend",
+                "numba_available", "observed_on_grid"):
         from . import compiled
 
         return getattr(compiled, name)

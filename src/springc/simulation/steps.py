@@ -150,12 +150,11 @@ class Problem:
             notes=state_notes(self.names, x, dx), hint=remedy(self.solver)))
 
     def locate(self, function: Any, t: float, x: np.ndarray, what: str) -> Stop | None:
-        """The error of ``function``'s Python original (``py_func`` of a numba function)
-        at ``(t, x)`` on Python floats, where it raises (a division by zero, a square
-        root of a negative number...), naming the line; ``None`` where it does not."""
-        original = getattr(function, "py_func", None)
-        if original is None:
-            return None
+        """The error of ``function``'s Python original (``py_func`` of a numba function,
+        a python module's function itself: the C loop's model) at ``(t, x)`` on Python
+        floats, where it raises (a division by zero, a square root of a negative
+        number...), naming the line; ``None`` where it does not."""
+        original = getattr(function, "py_func", function)
         try:
             with np.errstate(all="ignore"):
                 original(t, x.tolist(), self.p.tolist(), np.array(self.z))
