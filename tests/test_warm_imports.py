@@ -116,11 +116,8 @@ standard library, ctypes and springc's standard-library modules."""
 
 def test_a_replayed_simulate_imports_neither_numpy_nor_click(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from springc.pipeline import loop_library
-
     cache = tmp_path / "cache"
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
-    loop_library(springc.compile_model(SEED))  # the model and its C loop in the cache
     out = tmp_path / "seed.csv"
     paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
     env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}

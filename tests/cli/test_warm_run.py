@@ -18,10 +18,8 @@ from pathlib import Path
 
 import pytest
 
-import springc
 from springc import run_record
 from springc.native import LIBRARY_FILE
-from springc.pipeline import loop_library
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 SEED = (Path(__file__).resolve().parents[2] / "models" / "SpringMass.mdl").read_text()
@@ -61,12 +59,9 @@ def springc_run(folder: Path, *args: str, **env: str) -> Run:
                               check=False))
 
 
-def with_loop_library(folder: Path, *args: str) -> Run:
-    """A run of the command line that leaves a record: the model's cache entry holds
-    its C loop library (built here where the run did not build it)."""
-    springc_run(folder, *args)
-    libraries = [args[i + 1] for i, a in enumerate(args) if a == "-L"]
-    loop_library(springc.compile_model("Seed.mdl", libraries=libraries))
+def command_line(folder: Path, *args: str) -> Run:
+    """A first run: the command line, which keeps the run's record (its model compiled,
+    its C loop library built into the cache)."""
     first = springc_run(folder, *args)
     assert first.code == 0 and not first.warm, first.stderr
     return first
@@ -85,7 +80,7 @@ def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 def test_a_warm_run_writes_the_same_csv_and_summary_without_numpy_or_click(
         folder: Path) -> None:
-    cold = with_loop_library(folder, *ARGS, "-o", "seed.csv")
+    cold = command_line(folder, *ARGS, "-o", "seed.csv")
     written = (folder / "seed.csv").read_bytes()
     (folder / "seed.csv").unlink()
     warm = springc_run(folder, *ARGS, "-o", "seed.csv")
@@ -103,7 +98,7 @@ def test_a_warm_run_writes_the_same_csv_and_summary_without_numpy_or_click(
 
 
 def test_a_warm_run_writes_the_csv_on_stdout_and_respects_quiet(folder: Path) -> None:
-    cold = with_loop_library(folder, *ARGS, "-q")
+    cold = command_line(folder, *ARGS, "-q")
     warm = springc_run(folder, *ARGS, "-q")
     assert warm.warm
     assert (warm.code, warm.stdout, warm.stderr) == (0, cold.stdout, "")
@@ -111,7 +106,7 @@ def test_a_warm_run_writes_the_csv_on_stdout_and_respects_quiet(folder: Path) ->
 
 
 def test_a_changed_model_file_goes_back_to_the_command_line(folder: Path) -> None:
-    with_loop_library(folder, *ARGS, "-o", "seed.csv")
+    command_line(folder, *ARGS, "-o", "seed.csv")
     (folder / "Seed.mdl").write_text(SEED.replace("k = 1e4, l = 1", "k = 2e4, l = 1"))
     changed = springc_run(folder, *ARGS, "-o", "seed.csv")
     assert not changed.warm and changed.code == 0
@@ -122,7 +117,7 @@ def test_a_changed_model_file_goes_back_to_the_command_line(folder: Path) -> Non
 
 def test_a_changed_library_file_or_environment_goes_back_to_the_command_line(
         folder: Path) -> None:
-    cold = with_loop_library(folder, *ARGS, "-L", "lib", "-q")
+    cold = command_line(folder, *ARGS, "-L", "lib", "-q")
     assert springc_run(folder, *ARGS, "-L", "lib", "-q").warm
     (folder / "lib" / "Extra.mo").write_text("model Extra\n  Real y;\nequation\n"
                                              "  y = 2;\nend Extra;\n")
@@ -133,7 +128,7 @@ def test_a_changed_library_file_or_environment_goes_back_to_the_command_line(
 
 
 def test_a_tampered_loop_library_is_not_loaded_and_is_built_again(folder: Path) -> None:
-    cold = with_loop_library(folder, *ARGS, "-q")
+    cold = command_line(folder, *ARGS, "-q")
     records = list((folder / "cache" / run_record.RECORDS_FOLDER).glob("*.json"))
     assert len(records) == 1
     library = Path(run_record.read(records[0].stem)["library"]["path"])  # type: ignore[index]
@@ -141,10 +136,12 @@ def test_a_tampered_loop_library_is_not_loaded_and_is_built_again(folder: Path) 
     library.write_bytes(library.read_bytes() + b"\0")
     tampered = springc_run(folder, *ARGS, "-q")
     assert not tampered.warm and (tampered.code, tampered.stdout) == (0, cold.stdout)
+    rebuilt = springc_run(folder, *ARGS, "-q")  # the command line built it again
+    assert rebuilt.warm and (rebuilt.code, rebuilt.stdout) == (0, cold.stdout)
 
 
 def test_a_malformed_record_is_no_record(folder: Path) -> None:
-    cold = with_loop_library(folder, *ARGS, "-q")
+    cold = command_line(folder, *ARGS, "-q")
     (record,) = (folder / "cache" / run_record.RECORDS_FOLDER).glob("*.json")
     record.write_text('{"format": 1, "key": "' + record.stem + '", "run": 3}')
     broken = springc_run(folder, *ARGS, "-q")
@@ -154,7 +151,7 @@ def test_a_malformed_record_is_no_record(folder: Path) -> None:
 @pytest.mark.parametrize("kind", ["folder", "fifo"])
 def test_an_output_that_is_no_regular_file_is_refused_as_the_command_line_refuses(
         folder: Path, kind: str) -> None:
-    with_loop_library(folder, *ARGS, "-o", "out.csv", "-q")
+    command_line(folder, *ARGS, "-o", "out.csv", "-q")
     (folder / "out.csv").unlink()
     if kind == "folder":
         (folder / "out.csv").mkdir()

@@ -55,7 +55,7 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
 
     stats, module = result.stats, compiled.module
     if (compiled.warnings or stats.warning or result.events or settings.event_rows
-            or stats.solver not in LOOP_SOLVERS or not ran_on_c_loop(result)
+            or stats.solver not in LOOP_SOLVERS or not ran_on_c_loop(compiled, result)
             or getattr(module, "KIND", None) != ModuleKind.CONTINUOUS
             or getattr(module, "ASSERTIONS", ()) or stats.rtol is None
             or len(result.time) * (1 + len(result.names)) > MAX_VALUES):
@@ -93,7 +93,8 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
     }
 
 
-def ran_on_c_loop(result: Any) -> bool:
-    """Whether the run's answer came from the compiled engine (the model's C loop
-    library where its cache entry holds one)."""
-    return bool(result.stats.engine == "compiled")
+def ran_on_c_loop(compiled: Any, result: Any) -> bool:
+    """Whether the run's answer came from the model's C loop library: the compiled
+    engine on a python module (numba's loop runs numba functions only)."""
+    return bool(result.stats.engine == "compiled"
+                and getattr(compiled.module, "BACKEND", "") == "python")
