@@ -210,7 +210,10 @@ class LoopLibrary:
         return int(row), out if self.n_observed else zeros(0)
 
     def _z(self, z: Any) -> Any:
-        view = memoryview(z)
+        try:
+            view = memoryview(z)
+        except TypeError:
+            view = memoryview(b"")
         if view.readonly or view.format != "d" or not view.c_contiguous \
                 or view.nbytes // 8 != self.n_z:
             raise TypeError(f"z must be a writable contiguous buffer of {self.n_z} float64")

@@ -154,10 +154,13 @@ class Problem:
         a python module's function itself: the C loop's model) at ``(t, x)`` on Python
         floats, where it raises (a division by zero, a square root of a negative
         number...), naming the line; ``None`` where it does not."""
-        original = getattr(function, "py_func", function)
+        original = getattr(function, "py_func", None)
+        # (a python module's function takes arrays and computes on Python floats itself)
+        args = (x.tolist(), self.p.tolist()) if original is not None \
+            else (np.array(x, dtype=float), np.array(self.p, dtype=float))
         try:
             with np.errstate(all="ignore"):
-                original(t, x.tolist(), self.p.tolist(), np.array(self.z))
+                (original or function)(t, *args, np.array(self.z))
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             return self.fail(err, t, x, what)
         except TypeError:  # vectorised code needs arrays: no location then
