@@ -126,6 +126,8 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
     summary line, or :class:`Fallback` (nothing is written here)."""
     output = record["output"]
     target = output["csv"]
+    if output["kind"] != "csv":
+        raise Fallback
     if target is not None:
         try:
             check_target(target, output["protected"])
@@ -149,8 +151,10 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
     columns, steps = _outputs(library, run, answer["solver"], answer["rtol"], answer["atol"])
     estimated = tolerance = None
     if run["mode"] != "off":
-        tight = companion_tolerances(answer["rtol"], answer["atol"])
-        theirs, _ = _outputs(library, run, EXPLICIT, *tight)
+        companion = (EXPLICIT, *companion_tolerances(answer["rtol"], answer["atol"]))
+        if list(companion) != [run["companion"][k] for k in ("solver", "rtol", "atol")]:
+            raise Fallback  # recorded by other rules
+        theirs, _ = _outputs(library, run, *companion)
         scales, absolute, _rows = largest_differences(columns, theirs)
         allowed = allowed_errors(scales, run["asked"]["rtol"], run["asked"]["atol"])
         if not all(a <= t for a, t in zip(absolute, allowed)):

@@ -18,9 +18,9 @@ record format. Its **content** (a JSON object, :data:`FORMAT`):
   and ``z``, the answer run's solver and tolerances, its companion's (or none), the
   tolerances the error rule judges by, the output columns (a state or an observed
   variable each, in the CSV's order) and their names;
-- ``output``: the CSV file (or none: the CSV on stdout), the files it may never
-  replace, the verbosity, and what the run printed, to check the replay against:
-  the summary line without its time, and the SHA-256 of the CSV text.
+- ``output``: its kind (``csv``), the CSV file (or none: the CSV on stdout), the files
+  it may never replace, the verbosity, and what the run printed, to check the replay
+  against: the summary line without its time, and the SHA-256 of the CSV text.
 
 Nothing in a record is trusted: :func:`verified` re-reads and re-hashes every input and
 the library, and a record that is missing, unreadable, malformed, of another format or

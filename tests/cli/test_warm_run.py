@@ -97,6 +97,39 @@ def test_a_warm_run_writes_the_same_csv_and_summary_without_numpy_or_click(
     assert len(rows) == 200
 
 
+ESTIMATED = r", est\. error \S+ <= \S+ at rtol "
+AUTO = r"dop853 \(auto\), [\d,]+ steps"
+
+
+@pytest.mark.parametrize(("options", "summary"), [
+    (("--solver", "rk45"), rf"dop853, [\d,]+ steps{ESTIMATED}1e-9"),  # tightened: its companion
+    (("--error-control", "off"), AUTO),
+])
+def test_the_replay_keeps_the_solver_and_error_control_asked(
+        folder: Path, options: tuple[str, ...], summary: str) -> None:
+    cold = command_line(folder, *ARGS, *options)
+    warm = springc_run(folder, *ARGS, *options)
+    assert warm.warm, warm.stderr
+    assert (warm.code, warm.stdout, warm.stderr) == (0, cold.stdout, cold.stderr)
+    assert re.fullmatch(f"SpringMass: {summary}, T s", warm.stderr), warm.stderr
+
+
+def test_a_run_that_warns_keeps_no_record(folder: Path) -> None:
+    options = ("--error-control", "warn", "--rtol", "1e-8")
+    cold = command_line(folder, *ARGS, *options)
+    assert "\nwarning: SpringMass: the estimated error " in cold.stderr
+    again = springc_run(folder, *ARGS, *options)
+    assert not again.warm and (again.code, again.stdout, again.stderr) == \
+        (0, cold.stdout, cold.stderr)
+
+
+def test_a_verbose_run_keeps_no_record(folder: Path) -> None:
+    command_line(folder, *ARGS, "-v")
+    again = springc_run(folder, *ARGS, "-v")
+    assert not again.warm and again.code == 0
+    assert not list((folder / "cache" / run_record.RECORDS_FOLDER).glob("*.json"))
+
+
 def test_a_warm_run_writes_the_csv_on_stdout_and_respects_quiet(folder: Path) -> None:
     cold = command_line(folder, *ARGS, "-q")
     warm = springc_run(folder, *ARGS, "-q")

@@ -51,7 +51,7 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
     """The record of the run (``settings``: as the run was asked), or None."""
     from ..native import LIBRARY_FILE, cached_library
     from ..pipeline import ModuleKind
-    from ..simulation import plan, write_csv
+    from ..simulation import EXPLICIT, companion_tolerances, plan, write_csv
 
     stats, module = result.stats, compiled.module
     if (compiled.warnings or stats.warning or result.events or settings.event_rows
@@ -83,11 +83,14 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
                 "x0": asked.x0.tolist(),
                 "z": [float(v) for v in module.guesses(asked.p)],
                 "answer": {"solver": stats.solver, "rtol": stats.rtol, "atol": stats.atol},
+                "companion": None if settings.error_control == "off" else dict(zip(
+                    ("solver", "rtol", "atol"),
+                    (EXPLICIT, *companion_tolerances(stats.rtol, stats.atol)))),
                 "asked": {"rtol": asked.rtol, "atol": asked.atol},
                 "mode": settings.error_control, "auto": bool(stats.reason),
                 "states": states, "observed": observed,
                 "columns": [where[n] for n in result.names], "names": list(result.names)},
-        "output": {"csv": output, "protected": list(files), "quiet": quiet,
+        "output": {"kind": "csv", "csv": output, "protected": list(files), "quiet": quiet,
                    "brief": stats.brief(result.model).rsplit(", ", 1)[0],
                    "sha256": hashlib.sha256(text.getvalue().encode("utf-8")).hexdigest()},
     }
