@@ -177,9 +177,9 @@ def _outputs(library: Any, run: Mapping[str, Any], solver: str, rtol: float, ato
              ) -> tuple[list[Sequence[float]], int]:
     """The output columns (in the record's order, each over the grid) of one run of
     ``solver`` at ``rtol``, ``atol`` from the recorded start, and its accepted steps."""
-    grid, p = run["grid"], array.array("d", run["p"])
-    done = library.run(solver, grid, run["x0"], p, array.array("d", run["z"]), rtol=rtol,
-                       atol=atol)
+    grid, p = array.array("d", run["grid"]), array.array("d", run["p"])
+    done = library.run(solver, grid, array.array("d", run["x0"]), p,
+                       array.array("d", run["z"]), rtol=rtol, atol=atol)
     if not done.ok or done.filled != len(grid):
         raise Fallback
     failed, observed = library.observed(grid, done.states, p, array.array("d", run["z"]))
