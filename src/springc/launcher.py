@@ -9,7 +9,7 @@ its error-control companion on the model's C loop library (:mod:`springc.native.
 ctypes), estimates the error with :mod:`springc.simulation.error_rules`, writes the CSV
 with :func:`springc.simulation.csv_rows.write_rows` through :mod:`springc.fileio` (the
 same output rules) and prints the summary line of :func:`springc.simulation.summary.brief_line`.
-No numpy, numba, scipy, click or compile path is imported: about 0.05 s where the full
+No numpy, numba, scipy, click or compile path is imported: under 0.1 s of CPU where the full
 command line takes over a second.
 
 Anything else falls back to :func:`springc.cli.main` with no change in behaviour or
