@@ -174,12 +174,22 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     if chosen and options.backend == "numba" and \
             compiled.source.count("\n") > NUMBA_LINES:
         return _compile_as(replace(options, backend="python"), parameters)
-    if chosen and options.backend == "python" and compiled.kind != ModuleKind.CONTINUOUS \
-            and c_loop_runs(AUTO, None) and numba_available():
-        # springc chose python for the C loop, which runs continuous models only: the
-        # compiled engine runs this one's events, delays or switching states on numba
-        return _compile_as(replace(options, backend="numba"), parameters)
+    if chosen and options.backend == "python" and _numba_instead(compiled):
+        numba = replace(options, backend="numba")
+        if not parameters and compiled.derived is not None:  # not derived again
+            return compile_files(numba, compiled.derived)
+        return _compile_as(numba, parameters)
     return compiled
+
+
+def _numba_instead(compiled: CompiledModel) -> bool:
+    """Whether springc, having chosen python for the C loop, generates ``compiled``'s
+    model for numba instead: the C loop runs continuous models of at most
+    ``C_LOOP_STATES`` states; the compiled engine runs others (events, delays,
+    switching states, large scenes) on numba."""
+    return c_loop_runs(AUTO, None) and numba_available() and (
+        compiled.kind != ModuleKind.CONTINUOUS
+        or not c_loop_runs(AUTO, None, len(compiled.states)))
 
 
 def _compile_as(options: CompileOptions,

@@ -39,7 +39,9 @@ def _cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
 
 
-def test_the_runner_runs_the_cached_library_without_numpy() -> None:
+def test_the_runner_runs_the_cached_library_without_numpy(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_LOOP", "c")  # the reference run below on the C loop too
     model = springc.compile_model(SEED, backend="python")
     loop_library(model)  # built into the entry
     entry = model.path.parent

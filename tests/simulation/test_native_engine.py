@@ -64,16 +64,26 @@ def test_the_seed_on_the_c_loop_equals_the_numba_loops_run(
         assert c_run.stats.engine_reason == C_REASON
 
 
-def test_a_c_loop_run_imports_no_numba(tmp_path: Path) -> None:
+def test_the_default_run_takes_the_c_loop_and_imports_no_numba(tmp_path: Path) -> None:
     code = ("import sys, springc\n"
             f"r = springc.simulate({SEED!r}, stop=1.0)\n"
             "print(r.stats.engine, 'numba' in sys.modules)\n")
-    env = {"SPRINGC_CACHE_DIR": str(tmp_path / "fresh"), "SPRINGC_LOOP": "c",
-           "PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "SPRINGC_QUIET": "1"}
+    # the default (no SPRINGC_LOOP) where a compiler is found: the venv's ziglang at least
+    env = {"SPRINGC_CACHE_DIR": str(tmp_path / "fresh"), "PYTHONPATH": str(ROOT / "src"),
+           "PATH": "/usr/bin:/bin", "SPRINGC_QUIET": "1"}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                           text=True, timeout=600, check=False)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["compiled", "False"]
+
+
+def test_a_large_model_is_generated_for_numba(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    scenes = str(ROOT / "models" / "Scenes.mdl")
+    small = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 128})
+    large = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 129})
+    assert (len(small.states), small.module.BACKEND) == (256, "python")
+    assert (len(large.states), large.module.BACKEND) == (258, "numba")
 
 
 def test_a_domain_error_is_located_as_on_the_numba_loop(

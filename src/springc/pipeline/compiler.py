@@ -239,8 +239,9 @@ def split_values(model: CompiledModel, values: Mapping[str, float]
 # ------------------------------------------------------------------ compile
 
 
-def compile_files(options: CompileOptions) -> CompiledModel:
-    """The compiled model for ``options``: from the cache, or generated now.
+def compile_files(options: CompileOptions, derived: Derived | None = None) -> CompiledModel:
+    """The compiled model for ``options``: from the cache, or generated now (from
+    ``derived``, the system of the same files, model and modifications, where given).
 
     The module computes the observed variables ``options.outputs`` selects (every one
     without ``--vars``); its key is the model's key with that selection, so ``--vars``
@@ -255,15 +256,15 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
     model_key = model_key_of(options)
-    derived = None
     observed: object = ALL_OBSERVED
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
             from . import generation  # the compile path, loaded on a miss only
 
-            say(compiling_note(options, folder))
-            derived = generation.derive_system(options)
+            if derived is None:
+                say(compiling_note(options, folder))
+                derived = generation.derive_system(options)
             names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)

@@ -59,7 +59,7 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             # the C loop runs a python module's model (choose_engine allowed it); a large
             # model's generated functions may be plain Python otherwise: scipy's loop then
             native = engine == COMPILED and not jitted(model.module) \
-                and c_loop_runs(solver, model.module.BACKEND)
+                and c_loop_runs(solver, model.module.BACKEND, len(x0))
             compiled = engine == COMPILED and (native or jitted(model.module))
             finish = (advance_native if native else advance_compiled) if compiled else None
             loop_time = 0.0
