@@ -120,7 +120,8 @@ def test_a_replayed_simulate_imports_neither_numpy_nor_click(
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
     out = tmp_path / "seed.csv"
     paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
-    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths),
+           "SPRINGC_LOOP": "c"}  # the C loop (the suite's default is numba's)
     runs = [subprocess.run([sys.executable, "-c", LAUNCHED, SEED, str(out)], env=env,
                            capture_output=True, text=True, timeout=600, check=False)
             for _ in range(2)]  # the command line (it keeps the record), the replay

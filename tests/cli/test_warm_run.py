@@ -70,6 +70,7 @@ def command_line(folder: Path, *args: str) -> Run:
 @pytest.fixture
 def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("SPRINGC_LOOP", "c")  # the C loop (the suite's default is numba's)
     monkeypatch.chdir(tmp_path)  # the runs' folder: their relative paths resolve alike
     (tmp_path / "Seed.mdl").write_text(SEED)
     (tmp_path / "lib").mkdir()
