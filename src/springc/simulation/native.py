@@ -61,7 +61,10 @@ def library(problem: Problem) -> LoopLibrary:
     """The loop library of ``problem``'s model (built once per cache entry)."""
     from ..pipeline import loop_library
 
-    return loop_library(problem.model)
+    if problem.loop_library is None:
+        problem.loop_library = loop_library(problem.model)
+    lib: LoopLibrary = problem.loop_library
+    return lib
 
 
 def _kernel(loop: StepLoop, method: str) -> Kernel:
