@@ -176,8 +176,8 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
         return _compile_as(replace(options, backend="python"), parameters)
     if chosen and options.backend == "python" and _numba_instead(compiled):
         numba = replace(options, backend="numba")
-        if not parameters and compiled.derived is not None:  # not derived again
-            return compile_files(numba, compiled.derived)
+        if not parameters and compiled.compiled_from is not None:  # not derived again
+            return compile_files(numba, compiled.compiled_from)
         return _compile_as(numba, parameters)
     return compiled
 

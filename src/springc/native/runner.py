@@ -90,7 +90,7 @@ def doubles(values: Any, size: int | None = None) -> Any:
 
 def zeros(count: int) -> array.array[float]:
     """``count`` zeros as an ``array('d')``."""
-    return array.array("d", bytes(8 * count))
+    return array.array("d", [0.0]) * count  # (repetition: no bytes object of the size)
 
 
 @dataclass(frozen=True)

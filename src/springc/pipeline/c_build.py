@@ -204,7 +204,7 @@ def c_source(model: CompiledModel) -> str:
         return data.decode("ascii")
     from ..codegen import generate_c  # the C printer: on a miss only
 
-    derived = model.derive()
+    derived = model.compiled_from or model.derive()
     text = generate_c(derived.system, derived.flat_model, model.observed).text
     with contextlib.suppress(OSError):  # a read-only cache: the text is used, not kept
         add_to_entry(entry, C_SOURCE_FILE, text.encode("ascii"))

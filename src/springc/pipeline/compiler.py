@@ -80,6 +80,9 @@ class CompiledModel:
     derived: Derived | None = field(default=None, repr=False)  # set by ``equations``
     run_system: RunSystem | None = field(default=None, repr=False)
     model_key: str = ""  # the cache key of the model when it was compiled
+    # the system a python module was generated from in this process (not pickled): its
+    # C model (c_build.c_source) is printed from it rather than derived again
+    compiled_from: Derived | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict[str, object]:
         return {"text": self.source, "name": getattr(self.module, "__name__", ""),
@@ -307,8 +310,8 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
     # the C model from it (c_build.c_source) instead of deriving it again
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated,
-                         derived if options.backend == "python" else None,
-                         run_system=run, model_key=model_key)
+                         run_system=run, model_key=model_key,
+                         compiled_from=derived if options.backend == "python" else None)
 
 
 def model_key_of(options: CompileOptions) -> str:

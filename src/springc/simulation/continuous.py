@@ -29,7 +29,7 @@ from .compiled import (
 )
 from .failures import Stop, state_notes
 from .limits import OverLimit, check_outputs, over_limit
-from .native import advance_native, native_observed
+from .native import advance_native, loop_ready, native_observed
 from .observed_rows import observed_on_rows
 from .planning import RunPlan
 from .race import auto
@@ -59,7 +59,7 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             # the C loop runs a python module's model (choose_engine allowed it); a large
             # model's generated functions may be plain Python otherwise: scipy's loop then
             native = engine == COMPILED and not jitted(model.module) \
-                and c_loop_runs(solver, model.module.BACKEND, len(x0))
+                and c_loop_runs(solver, model.module.BACKEND, len(x0)) and loop_ready(problem)
             compiled = engine == COMPILED and (native or jitted(model.module))
             finish = (advance_native if native else advance_compiled) if compiled else None
             loop_time = 0.0

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import SimulationError
 from .compiled import C_SOLVERS, Kernel, advance_with
 from .steps import StepLoop, Stepper, Stretch
 
@@ -44,11 +45,26 @@ def advance_native(loop: StepLoop, stepper: Stepper, max_steps: int | None = Non
     return advance_with(loop, stepper, max_steps, _kernel(loop, stepper.method))
 
 
+def loop_ready(problem: Problem) -> bool:
+    """Whether ``problem``'s model has its loop library (built now where needed);
+    False where its C model cannot be printed: a model unpickled in another process,
+    or loaded from the cache, whose files changed since (it then runs on scipy's loop,
+    as a python module did before the C loop)."""
+    try:
+        library(problem)
+    except SimulationError:
+        return False
+    return True
+
+
 def library(problem: Problem) -> LoopLibrary:
     """The loop library of ``problem``'s model (built once per cache entry)."""
     from ..pipeline import loop_library
 
-    return loop_library(problem.model)
+    if problem.loop_library is None:
+        problem.loop_library = loop_library(problem.model)
+    lib: LoopLibrary = problem.loop_library
+    return lib
 
 
 def _kernel(loop: StepLoop, method: str) -> Kernel:

@@ -96,6 +96,7 @@ class Problem:
         self.limits = limits = limits or Limits()
         self.deadline = time.perf_counter() + limits.time_limit
         self.asserts = AssertionCheck(mod, p, self.names)
+        self.loop_library: Any = None  # the C loop's, loaded once per run (.native)
 
     def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
         where = code_location(err, self.path)
