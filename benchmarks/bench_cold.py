@@ -10,7 +10,13 @@ Each measurement runs in a fresh interpreter with its own empty ``NUMBA_CACHE_DI
 - ``seed first simulate``: ``python -m springc simulate models/SpringMass.mdl -o CSV``
   (default solver and engine), CPU seconds of the whole process (the model compiled, its
   functions and the loops it uses compiled by numba);
-- ``seed warm simulate``: the same command again, caches filled.
+- ``seed warm simulate``: the same command again, caches filled;
+- each seed figure twice: on the C loop (``SPRINGC_LOOP=c``: the model's C functions and
+  the DOP853 loop compiled by the C compiler into one library, no numba) and on numba's
+  (``SPRINGC_LOOP=numba``), with their ratio;
+- ``zig``: the seed's C loop library compiled by ``python -m ziglang cc`` with zig's
+  cache empty (its first use on a machine fills it) and again, against the system
+  compiler (``cc``), CPU seconds of the compiler processes.
 
 CPU seconds (``getrusage``), not wall: the development machine is shared, and CPU time
 is what compiling costs. ``--baseline OTHER/src`` measures another springc tree
@@ -50,10 +56,10 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def run(command: list[str], src: Path, cache: Path) -> tuple[str, float]:
+def run(command: list[str], src: Path, cache: Path, **extra: str) -> tuple[str, float]:
     """``command`` in a fresh interpreter on the springc of ``src``: stdout, CPU s."""
     env = {**os.environ, "PYTHONPATH": str(src), "NUMBA_CACHE_DIR": str(cache / "numba"),
-           "SPRINGC_CACHE_DIR": str(cache / "springc"), "SPRINGC_QUIET": "1"}
+           "SPRINGC_CACHE_DIR": str(cache / "springc"), "SPRINGC_QUIET": "1", **extra}
     before = children_cpu()
     done = subprocess.run(command, env=env, cwd=ROOT, capture_output=True, text=True,
                           check=False)
@@ -70,21 +76,51 @@ def loop(method: str, src: Path) -> tuple[float, float]:
     return figures["compile"], figures["process"]
 
 
-def seed(src: Path) -> tuple[float, float]:
-    """CPU s of the seed's first simulate (caches empty) and of the next one."""
+def seed(src: Path, loop: str = "") -> tuple[float, float]:
+    """CPU s of the seed's first simulate (caches empty) and of the next one
+    (``loop``: ``SPRINGC_LOOP``, empty: the default)."""
     with tempfile.TemporaryDirectory() as folder:
         csv = Path(folder) / "seed.csv"
         command = [sys.executable, "-m", "springc", "simulate", "models/SpringMass.mdl",
                    "-o", str(csv)]
-        _, first = run(command, src, Path(folder))
-        _, warm = run(command, src, Path(folder))
+        _, first = run(command, src, Path(folder), SPRINGC_LOOP=loop)
+        _, warm = run(command, src, Path(folder), SPRINGC_LOOP=loop)
     return first, warm
+
+
+ZIG_BUILD = """
+import sys
+import springc
+from springc.pipeline import c_build, c_kernels
+c_build.COMPILERS = ()  # as on a machine whose only compiler is the ziglang package
+if sys.argv[1] == "cc":
+    c_build.ZIG_MODULE = "no-such-module"
+    c_build.COMPILERS = ("cc",)
+model = springc.compile_model("models/SpringMass.mdl", backend="python")
+c_kernels.loop_library(model)
+"""
+
+
+def zig(src: Path) -> list[tuple[str, float]]:
+    """CPU s of building the seed's loop library (its C text printed too) with zig cc,
+    zig's cache empty, then again (a new springc cache), and with cc."""
+    figures = []
+    with tempfile.TemporaryDirectory() as folder:
+        zig_cache = {"ZIG_GLOBAL_CACHE_DIR": str(Path(folder) / "zig"),
+                     "ZIG_LOCAL_CACHE_DIR": str(Path(folder) / "zig-local")}
+        for label, compiler, cache in (("zig cc, zig cache empty", "zig", "a"),
+                                       ("zig cc, zig cache filled", "zig", "b"),
+                                       ("cc (system)", "cc", "c")):
+            _, cpu = run([sys.executable, "-c", ZIG_BUILD, compiler], src,
+                         Path(folder) / cache, **zig_cache)
+            figures.append((label, cpu))
+    return figures
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", type=Path, help="another springc src tree")
-    parser.add_argument("--only", default=",".join((*METHODS, "seed")))
+    parser.add_argument("--only", default=",".join((*METHODS, "seed", "zig")))
     args = parser.parse_args()
     trees = [("this tree", ROOT / "src")]
     if args.baseline:
@@ -96,11 +132,21 @@ def main() -> None:
         print(f"{method + ' loop, CPU s':<28}"
               + "".join(f"{c:>9.2f} (proc {p:5.2f})" for c, p in cells), flush=True)
     if "seed" in wanted:
-        cells = [seed(src) for _, src in trees]
-        print(f"{'seed first simulate, CPU s':<28}"
-              + "".join(f"{first:>22.2f}" for first, _ in cells))
-        print(f"{'seed warm simulate, CPU s':<28}"
-              + "".join(f"{warm:>22.2f}" for _, warm in cells), flush=True)
+        for loop in ("c", "numba"):
+            cells = [seed(src, loop) for _, src in trees]
+            print(f"{'seed first simulate, ' + loop:<28}"
+                  + "".join(f"{first:>22.2f}" for first, _ in cells))
+            print(f"{'seed warm simulate, ' + loop:<28}"
+                  + "".join(f"{warm:>22.2f}" for _, warm in cells), flush=True)
+            if loop == "c":
+                c_cells = cells
+        print(f"{'seed first, C / numba':<28}" + "".join(
+            f"{c[0] / n[0]:>22.2f}" for c, n in zip(c_cells, cells)))
+        print(f"{'seed warm, C / numba':<28}" + "".join(
+            f"{c[1] / n[1]:>22.2f}" for c, n in zip(c_cells, cells)), flush=True)
+    if "zig" in wanted:
+        for label, cpu in zig(trees[-1][1]):
+            print(f"{'seed C loop build, ' + label:<44}{cpu:>8.2f} CPU s", flush=True)
 
 
 if __name__ == "__main__":

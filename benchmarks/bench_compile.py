@@ -18,7 +18,9 @@ seconds (on a loaded machine the CPU time is the better guide to an idle machine
     every output, and the states only) and its loop against the compiled DOP853 loop
     (plain loops) on the hand-written right-hand side of ``handwritten.py`` (with
     ``--fused``: that loop specialised by numba on it, a compile of minutes), same
-    tolerances and grid: target within 1.5x.
+    tolerances and grid: target within 1.5x; the same rows on the C loop
+    (``SPRINGC_LOOP=c``, python modules: the model's C functions and DOP853 in one
+    library).
 (d) the 10,000-mass chain (2,000 with --quick): compile_model and first calls.
 """
 
@@ -217,6 +219,35 @@ def bench_chain_warm(repeats: int, fused: bool) -> None:
                  "<= 1.5x"))
     rows.append(("(c) chain N=1000 warm: its compiled loop", f"{loop * 1e3:.0f} ms", base,
                  f"{loop / hand_time:.2f}x", f"{result.stats.steps} steps"))
+    c_rows(repeats, n, base, hand_time)
+
+
+def c_rows(repeats: int, n: int, base: str, hand_time: float) -> None:
+    """(c) on the C loop (SPRINGC_LOOP=c, python modules): the same rows."""
+    import springc
+
+    os.environ["SPRINGC_LOOP"] = "c"
+    try:
+        every = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
+                                      parameters={"N": n})
+        states = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
+                                       parameters={"N": n}, outputs=list(every.states))
+        all_outputs = best_of(repeats, lambda: springc.simulate(every, solver="dop853"))
+        loops = []
+
+        def states_only() -> None:
+            run = springc.simulate(states, solver="dop853")
+            assert "(C," in run.stats.engine_reason
+            loops.append(run.stats.loop_time)
+        states_time = best_of(repeats, states_only)
+    finally:
+        del os.environ["SPRINGC_LOOP"]
+    rows.append(("(c) C loop: simulate, 10,002 outputs", f"{all_outputs * 1e3:.0f} ms",
+                 base, f"{all_outputs / hand_time:.2f}x", ""))
+    rows.append(("(c) C loop: simulate, the 2,000 states", f"{states_time * 1e3:.0f} ms",
+                 base, f"{states_time / hand_time:.2f}x", "<= 1.5x"))
+    rows.append(("(c) C loop: the loop itself", f"{min(loops) * 1e3:.0f} ms", base,
+                 f"{min(loops) / hand_time:.2f}x", ""))
 
 
 def bench_large(env: dict[str, str], n: int) -> None:

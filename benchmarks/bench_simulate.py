@@ -176,12 +176,26 @@ def bench_engines(repeats: int) -> None:
     rows.append(("(d) seed in process, warm, compiled engine", f"{compiled * 1e3:.1f} ms",
                  f"scipy engine, python module {scipy_python * 1e3:.0f} ms",
                  f"{scipy_python / compiled:.0f}x faster", "(the scipy engine's default)"))
+    os.environ["SPRINGC_LOOP"] = "c"  # the C loop on a python module, same run
+    try:
+        c_auto, c_run = best_run(repeats, model=python_model, engine="compiled")
+        c_direct, _ = best_run(repeats, model=python_model, solver="dop853",
+                               engine="compiled")
+    finally:
+        del os.environ["SPRINGC_LOOP"]
+    assert "(C," in c_run.stats.engine_reason  # type: ignore[attr-defined]
+    rows.append(("(d) seed in process, warm, C loop (auto)", f"{c_auto * 1e3:.1f} ms",
+                 f"numba loop {compiled * 1e3:.1f} ms", f"{c_auto / compiled:.2f}x",
+                 f"{c_run.stats.steps} steps"))  # type: ignore[attr-defined]
     # --solver dop853: no auto probe and no stiffness estimate
     direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="compiled")
     scipy_direct, _ = best_run(repeats, model=numba_model, solver="dop853", engine="scipy")
     rows.append(("(d) seed in process, warm, --solver dop853 compiled",
                  f"{direct * 1e3:.1f} ms", f"scipy engine {scipy_direct * 1e3:.0f} ms",
                  f"{scipy_direct / direct:.0f}x faster", "same steps"))
+    rows.append(("(d) seed in process, warm, --solver dop853, C loop",
+                 f"{c_direct * 1e3:.1f} ms", f"numba loop {direct * 1e3:.1f} ms",
+                 f"{c_direct / direct:.2f}x", "same steps"))
     with tempfile.TemporaryDirectory() as tmp:
         env = dict(os.environ, SPRINGC_CACHE_DIR=str(Path(tmp) / "springc"),
                    NUMBA_CACHE_DIR=str(Path(tmp) / "numba"), PYTHONPATH=str(ROOT / "src"))

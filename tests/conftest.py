@@ -10,6 +10,11 @@ import pytest
 # suite (subprocesses inherit it), so that outputs compared exactly do not depend on
 # which test compiled a model or a kernel first; tests/test_status_lines.py turns them on.
 os.environ["SPRINGC_QUIET"] = "1"
+# The suite's compiled engine is numba's loop whether or not a C compiler is found, so
+# that its figures and engine reasons do not depend on the machine; the tests of the C
+# loop (tests/simulation/test_native_engine.py, tests/native/, tests/integrate/
+# test_native_loop.py) set SPRINGC_LOOP themselves.
+os.environ.setdefault("SPRINGC_LOOP", "numba")
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

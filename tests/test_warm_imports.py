@@ -50,6 +50,7 @@ def test_a_warm_simulate_imports_no_compile_path(tmp_path: Path,
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
     first = springc.compile_model(SEED)  # fills the cache as the CLI's run would
     assert not first.cached
+    springc.simulate(first, stop=0.1)  # (and the C loop library, where a compiler is)
     out = tmp_path / "seed.csv"
     paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
     env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths)}
@@ -98,3 +99,38 @@ def test_a_cached_model_with_a_captured_system_loads_without_the_compile_path(
     assert {name: _loaded(name, modules) for name in FORBIDDEN} == \
         {name: [] for name in FORBIDDEN}
     assert set(_loaded("springc.parse", modules)) == PARSE_ALLOWED
+
+
+LAUNCHED = """
+import atexit, sys
+atexit.register(lambda: print("\\n".join(sorted(sys.modules))))
+from springc.launcher import main
+main(["simulate", sys.argv[1], "-o", sys.argv[2], "-q"])
+"""
+
+REPLAY_FORBIDDEN = (*FORBIDDEN, "numpy", "numba", "scipy", "click", "springc.cli",
+                    "springc.pipeline", "springc.codegen", "springc.api")
+"""What a replayed run (:mod:`springc.launcher`) never imports: nothing beyond the
+standard library, ctypes and springc's standard-library modules."""
+
+
+def test_a_replayed_simulate_imports_neither_numpy_nor_click(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(cache))
+    out = tmp_path / "seed.csv"
+    paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(cache), "PYTHONPATH": os.pathsep.join(paths),
+           "SPRINGC_LOOP": "c"}  # the C loop (the suite's default is numba's)
+    runs = [subprocess.run([sys.executable, "-c", LAUNCHED, SEED, str(out)], env=env,
+                           capture_output=True, text=True, timeout=600, check=False)
+            for _ in range(2)]  # the command line (it keeps the record), the replay
+    assert [r.returncode for r in runs] == [0, 0], runs[0].stderr + runs[1].stderr
+    first, replayed = (set(r.stdout.split()) for r in runs)
+    assert {"numpy", "click"} <= first
+    assert "springc.native.runner" in replayed  # the run was replayed on the C loop
+    assert {name: _loaded(name, replayed) for name in REPLAY_FORBIDDEN} == \
+        {name: [] for name in REPLAY_FORBIDDEN}
+    with out.open(newline="") as f:
+        rows = list(csv.reader(f))
+    assert [float(v) for v in rows[1][:5]] == [0.0, 1.0, -1.0, 0.0, 0.0]  # the start values

@@ -1,5 +1,6 @@
-"""``python -m springc``: the command-line interface."""
+"""``python -m springc``: the command-line interface (a warm run replayed without the
+command line's imports where it can: :mod:`springc.launcher`)."""
 
-from .cli import main
+from .launcher import main
 
 main()

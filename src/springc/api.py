@@ -20,20 +20,24 @@ from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
     CompileOptions,
+    ModuleKind,
     check_parameter_names,
     compile_files,
     modification_value,
 )
 from .simulation import (
+    AUTO,
     DEFAULT_ENGINE,
     DEFAULT_ERROR_CONTROL,
     DEFAULT_SOLVER,
     RunSettings,
     SimulationResult,
+    c_loop_runs,
     check_run_values,
     choose_engine,
     default_backend,
     estimate_deprecation,
+    numba_available,
     run_settings,
     simulate_model,
 )
@@ -153,11 +157,15 @@ loop runs such a model in seconds; large scenes in the vector layout stay far be
 
 def default_choice(backend: str | None, engine: str = "auto", solver: str = "auto"
                    ) -> str | None:
-    """``backend`` as given; else ``None`` where springc would choose numba (for
-    :func:`compile_model`, which also checks the module's size), else ``"python"``."""
+    """``backend`` as given; else ``None`` where the run's backend is the one
+    :func:`compile_model` chooses itself (which also checks a numba module's size, and
+    generates a model with events for numba where it chose python for the C loop),
+    else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for radau where
+    the C loop runs the others)."""
     if backend:
         return backend
-    return None if default_backend(engine, str(solver).lower()) == "numba" else "python"
+    chosen = default_backend(engine, str(solver).lower())
+    return None if chosen == default_backend() else chosen
 
 
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
@@ -166,7 +174,22 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     if chosen and options.backend == "numba" and \
             compiled.source.count("\n") > NUMBA_LINES:
         return _compile_as(replace(options, backend="python"), parameters)
+    if chosen and options.backend == "python" and _numba_instead(compiled):
+        numba = replace(options, backend="numba")
+        if not parameters and compiled.compiled_from is not None:  # not derived again
+            return compile_files(numba, compiled.compiled_from)
+        return _compile_as(numba, parameters)
     return compiled
+
+
+def _numba_instead(compiled: CompiledModel) -> bool:
+    """Whether springc, having chosen python for the C loop, generates ``compiled``'s
+    model for numba instead: the C loop runs continuous models of at most
+    ``C_LOOP_STATES`` states; the compiled engine runs others (events, delays,
+    switching states, large scenes) on numba."""
+    return c_loop_runs(AUTO, None) and numba_available() and (
+        compiled.kind != ModuleKind.CONTINUOUS
+        or not c_loop_runs(AUTO, None, len(compiled.states)))
 
 
 def _compile_as(options: CompileOptions,

@@ -24,6 +24,7 @@ from .options import (
     verbosity,
     verbosity_options,
 )
+from .run_records import remember_run
 
 
 @main.command()
@@ -83,8 +84,9 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         progress = None if quiet or not sys.stderr.isatty() else sys.stderr
         with warnings.catch_warnings():  # said below as the command's own warning
             warnings.simplefilter("ignore", AccuracyWarning)
-            result = run(compiled, settings=replace(settings, progress=progress, parameters={
-                k: v for k, v in settings.parameters.items() if k not in compiled.structural}))
+            run_as = replace(settings, parameters={
+                k: v for k, v in settings.parameters.items() if k not in compiled.structural})
+            result = run(compiled, settings=replace(run_as, progress=progress))
         if error_output and result.error_estimate is None:
             raise click.UsageError(f"--error-output {error_output}: this run made no error "
                                    "estimate (--error-control off, or a model without states)")
@@ -103,3 +105,6 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             click.echo(f"note: generated module {compiled.path}", err=True)
         if result.stats.warning:  # even with --quiet: the answer missed its tolerance
             click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)
+        if not (plot or error_output or no_cache or error_estimate or level > 0) and \
+                (output is None or output.lower().endswith(".csv")):
+            remember_run(compiled, run_as, result, files, libraries, output, quiet)

@@ -51,6 +51,7 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
 """
 
 from .batch import Ensemble, ensemble
+from .compile_lock import locked
 from .engine import (
     Crossings,
     Run,
@@ -67,11 +68,36 @@ from .gpu_ensemble import GpuEnsemble, NoCudaDevice
 from .hybrid import HybridRun, run_hybrid
 from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
 from .native_ensemble import OPENMP, NativeEnsemble, Outputs, Runs, kernel_text
+from .native_loop import loop_text
 from .status import Status
 
-__all__ = ["FIXED_STEP_METHODS", "OPENMP", "Crossings", "Ensemble", "GpuEnsemble",
-           "HybridRun", "NativeEnsemble", "NoCudaDevice", "Outputs", "Run", "Runs", "Status",
-           "bdf", "compile_seconds", "dop853", "ensemble", "fixed_step", "kernel_cached",
-           "kernel_text", "load", "newton_flops", "newton_solve_flops", "observed_grid",
-           "radau", "rk45",
-           "run_hybrid"]
+__all__ = [
+    "FIXED_STEP_METHODS",
+    "OPENMP",
+    "Crossings",
+    "Ensemble",
+    "GpuEnsemble",
+    "HybridRun",
+    "NativeEnsemble",
+    "NoCudaDevice",
+    "Outputs",
+    "Run",
+    "Runs",
+    "Status",
+    "bdf",
+    "compile_seconds",
+    "dop853",
+    "ensemble",
+    "fixed_step",
+    "kernel_cached",
+    "kernel_text",
+    "load",
+    "locked",
+    "loop_text",
+    "newton_flops",
+    "newton_solve_flops",
+    "observed_grid",
+    "radau",
+    "rk45",
+    "run_hybrid",
+]

@@ -11,7 +11,8 @@
    sc_e5_sum, sc_e3_sum, sc_d_row), the status codes of
    springc.integrate.Status (SC_SUCCESS ...) and the model's C functions
    (springc_parameters, springc_start, springc_rhs, springc_observed: the cmodel
-   interface).
+   interface), then dop853_core.c (DOP853's step arithmetic, shared with the
+   single-run loop).
 
    The arithmetic is springc.integrate.dop853_kernel's with plain-loop sums (the same
    controller, error norm, initial step and dense output, every sum in the same order),
@@ -19,21 +20,11 @@
    of the outputs; nothing is reduced across runs, so the results are the same bytes
    whatever the number of threads. */
 
-#ifdef SC_CUDA
-#define SC_FN static __device__
-#else
-#define SC_FN static
-#endif
-
 #ifndef SC_LANES
 #define SC_LANES 1
 #endif
 #define SC_NPS (SPRINGC_N_PARAMS > 0 ? SPRINGC_N_PARAMS : 1)
-#define SC_NZS (SPRINGC_N_Z > 0 ? SPRINGC_N_Z : 1)
 #define SC_NOS (SPRINGC_N_OBSERVED > 0 ? SPRINGC_N_OBSERVED : 1)
-#define SC_STAGES 12
-#define SC_EXTENDED 16
-#define SC_ROWS 7
 /* per-run work: K (16 rows), F (7 rows), y_new, work, sums, scale, err5, err3, the
    state at an output time, y (30 rows in all); then p, z and the observed variables */
 #define SC_AT_Y (30 * SC_NXS)
@@ -70,81 +61,6 @@ typedef struct {
     sc_int *counts;    /* accepted, rejected, evaluations, the model's flag */
     double *failure_time;
 } sc_outputs;
-
-SC_FN double sc_min(double a, double b) { return b < a ? b : a; }  /* Python's min */
-SC_FN double sc_max(double a, double b) { return b > a ? b : a; }  /* Python's max */
-
-SC_FN int sc_flagged(const double *z) {
-    return SPRINGC_N_Z > 0 && z[SC_NZS - 1] != 0.0;
-}
-
-/* SC_SUCCESS, or why the evaluation that wrote d (and set z) is unusable. */
-SC_FN int sc_verdict(const double *d, const double *z) {
-    if (sc_flagged(z)) return SC_MODEL_FAILED;
-    for (int i = 0; i < SC_NX; i++)
-        if (!isfinite(d[i])) return SC_NON_FINITE_DERIVATIVE;
-    return SC_SUCCESS;
-}
-
-/* the state of stage s: y + (sum_j A[s, j] K[j]) * h */
-SC_FN void sc_stage(const double *y, const double *K, int s, double h, double *sums,
-                    double *out) {
-    sc_a_row(s, K, sums);
-    for (int i = 0; i < SC_NX; i++) out[i] = y[i] + sums[i] * h;
-}
-
-SC_FN double sc_rms_scaled(const double *x, const double *scale) {
-    double total = 0.0;
-    for (int i = 0; i < SC_NX; i++) {
-        double v = x[i] / scale[i];
-        total += v * v;
-    }
-    return sqrt(total) / pow((double)SC_NX, 0.5);
-}
-
-SC_FN double sc_error_norm(const double *y, const double *y_new, const double *K, double h,
-                           double rtol, const double *atol, double *scale, double *err5,
-                           double *err3) {
-    for (int i = 0; i < SC_NX; i++)
-        scale[i] = atol[i] + sc_max(fabs(y[i]), fabs(y_new[i])) * rtol;
-    sc_e5_sum(K, err5);
-    sc_e3_sum(K, err3);
-    double e5 = 0.0, e3 = 0.0;
-    for (int i = 0; i < SC_NX; i++) {
-        err5[i] /= scale[i];
-        err3[i] /= scale[i];
-    }
-    for (int i = 0; i < SC_NX; i++) e5 += err5[i] * err5[i];
-    for (int i = 0; i < SC_NX; i++) e3 += err3[i] * err3[i];
-    if (e5 == 0.0 && e3 == 0.0) return 0.0;
-    return fabs(h) * e5 / sqrt((e5 + 0.01 * e3) * SC_NX);
-}
-
-/* the 7 coefficient rows of the dense output over the step (needs K[13..15]) */
-SC_FN void sc_interpolant(const double *y, const double *y_new, const double *K, double h,
-                          double *F, double *sums) {
-    for (int r = 0; r < SC_ROWS - 3; r++) {
-        sc_d_row(r, K, sums);
-        for (int i = 0; i < SC_NX; i++) F[(3 + r) * SC_NXS + i] = h * sums[i];
-    }
-    for (int i = 0; i < SC_NX; i++) {
-        double delta = y_new[i] - y[i];
-        F[i] = delta;
-        F[SC_NXS + i] = h * K[i] - delta;
-        F[2 * SC_NXS + i] = 2 * delta - h * (K[SC_STAGES * SC_NXS + i] + K[i]);
-    }
-}
-
-SC_FN void sc_interpolate(const double *F, const double *y, double theta, double *out) {
-    for (int i = 0; i < SC_NX; i++) {
-        double value = 0.0;
-        for (int r = SC_ROWS - 1; r >= 0; r--) {
-            value += F[r * SC_NXS + i];
-            value *= (SC_ROWS - 1 - r) % 2 == 0 ? theta : 1 - theta;
-        }
-        out[i] = value + y[i];
-    }
-}
 
 /* Output time k reached with states x (observed obs): the statistics and trajectories. */
 SC_FN void sc_emit(const sc_settings *s, const sc_outputs *o, sc_int k, const double *x,

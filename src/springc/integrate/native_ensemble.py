@@ -26,6 +26,8 @@ from . import dop853_tableau as tableau
 from .status import Status
 
 KERNEL = Path(__file__).with_name("ensemble_dop853.c")
+CORE = Path(__file__).with_name("dop853_core.c")
+"""DOP853's step arithmetic, shared with the single-run loop (:mod:`.native_loop`)."""
 BAD_START = -1
 """The status of a run whose parameters or start values are not finite (or whose start
 values' Newton iteration failed): it is not integrated."""
@@ -44,13 +46,13 @@ class CompileFailed(RuntimeError):
     """The CUDA compiler refused the kernel text (its messages are the error's text)."""
 
 
-def _array(name: str, values: np.ndarray, qualifier: str) -> str:
+def c_array(name: str, values: np.ndarray, qualifier: str) -> str:
     flat = np.asarray(values, dtype=float).ravel()
     return (f"{qualifier} double {name}[{flat.size}] = {{"
             + ", ".join(repr(float(v)) for v in flat) + "};\n")
 
 
-def _sum(name: str, weights: np.ndarray, function: str) -> str:
+def c_weighted_sum(name: str, weights: np.ndarray, function: str) -> str:
     """``out[i] = sum_j weights[j] K[j, i]`` as C, summed from 0.0 in the order of j as
     numba's plain loop does, without the zero weights (the stages are finite, so each
     of those adds +0.0 or -0.0 to a sum that started at +0.0: the same value)."""
@@ -61,7 +63,7 @@ def _sum(name: str, weights: np.ndarray, function: str) -> str:
             f"{terms}        out[i] = acc;\n    }}\n}}\n")
 
 
-def _switch(name: str, rows: list[str], function: str) -> str:
+def c_switch(name: str, rows: list[str], function: str) -> str:
     cases = "".join(f"    case {k}: {row}(K, out); break;\n" for k, row in enumerate(rows)
                     if row)
     return (f"{function} void {name}(int row, const double *K, double *out) {{\n"
@@ -78,16 +80,17 @@ def prelude(cuda: bool) -> str:
              "#define SC_NXS (SPRINGC_N_STATES > 0 ? SPRINGC_N_STATES : 1)\n"]
     parts += [f"#define SC_{s.name} {int(s)}\n" for s in Status]
     parts.append(f"#define SC_BAD_START {BAD_START}\n")
-    parts.append(_array("DOP_C", tableau.C, qualifier))
+    parts.append(c_array("DOP_C", tableau.C, qualifier))
     rows = [""] + [f"sc_a_{s}" for s in range(1, tableau.STAGES_EXTENDED)]
-    parts += [_sum(rows[s], tableau.A[s, :s], function)
+    parts += [c_weighted_sum(rows[s], tableau.A[s, :s], function)
               for s in range(1, tableau.STAGES_EXTENDED)]
-    parts.append(_switch("sc_a_row", rows, function))
-    parts += [_sum("sc_b_sum", tableau.B, function), _sum("sc_e5_sum", tableau.E5, function),
-              _sum("sc_e3_sum", tableau.E3, function)]
+    parts.append(c_switch("sc_a_row", rows, function))
+    parts += [c_weighted_sum("sc_b_sum", tableau.B, function),
+              c_weighted_sum("sc_e5_sum", tableau.E5, function),
+              c_weighted_sum("sc_e3_sum", tableau.E3, function)]
     d_rows = [f"sc_d_{r}" for r in range(len(tableau.D))]
-    parts += [_sum(d_rows[r], tableau.D[r], function) for r in range(len(tableau.D))]
-    parts.append(_switch("sc_d_row", d_rows, function))
+    parts += [c_weighted_sum(d_rows[r], tableau.D[r], function) for r in range(len(tableau.D))]
+    parts.append(c_switch("sc_d_row", d_rows, function))
     return "".join(parts)
 
 
@@ -116,7 +119,7 @@ def kernel_text(model_c: str, cuda: bool = False) -> str:
         model = model_c
         head = ("#include <math.h>\n#define SPRINGC_NO_TABLES 1\n#undef SPRINGC_FN\n"
                 f"#define SPRINGC_FN static inline\n#define SC_LANES {LANES}\n")
-    return (head + model + "\n" + prelude(cuda)
+    return (head + model + "\n" + prelude(cuda) + CORE.read_text(encoding="utf-8")
             + KERNEL.read_text(encoding="utf-8"))
 
 

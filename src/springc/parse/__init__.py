@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from .library import library_folders, library_roots, source_files
+from .library import key_sources, library_folders, library_roots, source_files
 
 if TYPE_CHECKING:
     from .loader import ClassEntry, ClassTree, imported_element, lookup_class, member_class
@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from .user_sources import load
 
 __all__ = ["ClassEntry", "ClassTree", "clear_parse_cache", "imported_element",
-           "library_folders", "library_roots",
+           "key_sources", "library_folders", "library_roots",
            "load", "lookup_class", "member_class", "parse_expression", "parse_file", "parse_text",
            "source_files"]
 

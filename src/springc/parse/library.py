@@ -143,6 +143,19 @@ def source_files(folder: Path) -> list[Path]:
     return sorted(found)
 
 
+def key_sources(files: Iterable[str], libraries: Iterable[str]) -> list[Path]:
+    """Every file a load of ``files`` with the library folders ``libraries`` may read,
+    in a fixed order: the files, then the :func:`source_files` of the folders of named
+    ``package.mo`` files and of the library path (:func:`library_folders`). What a
+    cache key must cover: the generated modules' and the run records'."""
+    named = [Path(f) for f in files]
+    folders = [p.parent for p in named if p.name in ("package.mo", "package.mdl")]
+    sources = list(named)
+    for folder in folders + library_folders(libraries):
+        sources += source_files(folder)
+    return sources
+
+
 def _entries(folder: Path) -> list[Path]:
     """The entries of ``folder``, sorted; none if it cannot be read."""
     try:

@@ -24,15 +24,15 @@ from .selection import select_names
 
 if TYPE_CHECKING:
     from .c_build import CCompilerMissing, CLibrary, c_library, c_source, find_compiler
-    from .c_kernels import kernel_library, openmp_flags
+    from .c_kernels import kernel_library, loop_library, openmp_flags
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
 __all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
            "compile_files", "derive_system", "find_compiler", "flatten_files",
-           "generate_source", "kernel_library", "modification_value", "openmp_flags",
-           "select_names", "split_values"]
+           "generate_source", "kernel_library", "loop_library", "modification_value",
+           "openmp_flags", "select_names", "split_values"]
 
 
 def __getattr__(name: str) -> Any:
@@ -45,7 +45,7 @@ def __getattr__(name: str) -> Any:
         from . import c_build
 
         return getattr(c_build, name)
-    if name in ("kernel_library", "openmp_flags"):
+    if name in ("kernel_library", "loop_library", "openmp_flags"):
         from . import c_kernels
 
         return getattr(c_kernels, name)

@@ -22,7 +22,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..codegen import CodegenBug
-from .c_build import build_library, find_compiler
+from ..integrate import locked, loop_text
+from ..native import LIBRARY_FILE, LoopLibrary
+from ..status_line import say
+from .c_build import ZIG_MODULE, build_library, c_source, find_compiler
 from .cache import add_to_entry, read_addition
 from .compiler import CompiledModel
 
@@ -85,3 +88,52 @@ def _openmp_works(compiler: tuple[str, ...], flags: tuple[str, ...]) -> bool:
             return False
         probe.restype, probe.argtypes = ctypes.c_int, [ctypes.c_int]
         return bool(probe(100) == 4950)
+
+
+LOOP_NOTE = "compiling the C loop of {model} for this machine (once), about {seconds} s"
+"""The status line before a model's loop library is built (it is not in the cache)."""
+
+
+def loop_library(model: CompiledModel) -> LoopLibrary:
+    """The loop library of ``model`` (the compiled engine's DOP853 and RK45 in C around
+    the model's C functions, :func:`springc.integrate.native_loop.loop_text`), loaded:
+    from its cache entry (``cloop.so``, verified against ``cloop.sha256``), else built
+    once (under a file lock in the entry, so that workers that need it at once build it
+    once) and added there. The entry's key covers springc's C sources
+    (:func:`.cache.springc_digest`), so the library's name needs no hash of its own."""
+    entry = model.path.parent
+    data = read_addition(entry, LIBRARY_FILE)
+    if data is None:
+        with locked(entry, "cloop"):
+            data = read_addition(entry, LIBRARY_FILE)  # built while this one waited
+            if data is None:
+                data = _build_loop(model)
+                with contextlib.suppress(OSError):  # a read-only cache: built again
+                    add_to_entry(entry, LIBRARY_FILE, data)
+    return _loaded(hashlib.sha256(data).hexdigest(), data)
+
+
+def _build_loop(model: CompiledModel) -> bytes:
+    text = loop_text(c_source(model))
+    seconds = max(1, round(len(text) / LOOP_CHARS_PER_SECOND))
+    if seconds > 1 or ZIG_MODULE in find_compiler():
+        say(LOOP_NOTE.format(model=model.name, seconds=seconds))
+    with tempfile.TemporaryDirectory(prefix="springc-cc-") as folder:
+        return build_library(text, Path(folder), LOOP_FLAGS)
+
+
+LOOP_CHARS_PER_SECOND = 60_000
+"""About the characters of C the compiler takes per CPU second at -O2 (the seed's
+loop library, about 40,000 characters, takes 0.5 s with gcc): the status line's
+estimate, said where the build may take over a second."""
+LOOP_FLAGS = ("-fvisibility=hidden",)
+"""Only the loop library's ``springc_loop_*`` entries are exported (the model's
+functions are static, inlined into the loop)."""
+
+
+@functools.lru_cache(maxsize=64)
+def _loaded(digest: str, data: bytes) -> LoopLibrary:
+    """The library of ``data`` loaded once per process (keyed by its digest, the
+    bytes already verified)."""
+    del digest
+    return LoopLibrary(data)

@@ -35,7 +35,7 @@ from types import ModuleType
 from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
-from ..parse import library_folders, source_files
+from ..parse import key_sources
 from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, user_cache_dir
 
 CACHE_ENTRIES = 200
@@ -96,10 +96,11 @@ def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]
 
 @functools.cache
 def springc_digest() -> bytes:
-    """SHA-256 of the text of every module below ``PACKAGE_ROOT`` and of the grammar:
-    any change to springc's code moves every key."""
+    """SHA-256 of the text of every module and C source below ``PACKAGE_ROOT`` and of
+    the grammar: any change to springc's code moves every key (the C loop library of
+    an entry, ``cloop.so``, is built from springc's C sources)."""
     h = hashlib.sha256()
-    for path in sorted(PACKAGE_ROOT.glob("**/*.py")):
+    for path in sorted([*PACKAGE_ROOT.glob("**/*.py"), *PACKAGE_ROOT.glob("**/*.c")]):
         h.update(str(path.relative_to(PACKAGE_ROOT)).encode() + b"\0")
         h.update(hashlib.sha256(path.read_bytes()).digest())
     h.update(hashlib.sha256(grammar_path().read_bytes()).digest())
@@ -121,11 +122,7 @@ def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) 
     h = hashlib.sha256()
     h.update(repr((CODEGEN_VERSION, settings)).encode())
     h.update(springc_digest())
-    sources = [Path(f) for f in files]
-    folders = [Path(f).parent for f in files if Path(f).name in ("package.mo", "package.mdl")]
-    for folder in folders + library_folders(libraries):
-        sources += source_files(folder)
-    for path in sources:
+    for path in key_sources(files, libraries):
         h.update(str(path.resolve()).encode() + b"\0")
         try:
             h.update(hashlib.sha256(path.read_bytes()).digest())

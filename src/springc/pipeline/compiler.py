@@ -80,6 +80,9 @@ class CompiledModel:
     derived: Derived | None = field(default=None, repr=False)  # set by ``equations``
     run_system: RunSystem | None = field(default=None, repr=False)
     model_key: str = ""  # the cache key of the model when it was compiled
+    # the system a python module was generated from in this process (not pickled): its
+    # C model (c_build.c_source) is printed from it rather than derived again
+    compiled_from: Derived | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict[str, object]:
         return {"text": self.source, "name": getattr(self.module, "__name__", ""),
@@ -239,8 +242,9 @@ def split_values(model: CompiledModel, values: Mapping[str, float]
 # ------------------------------------------------------------------ compile
 
 
-def compile_files(options: CompileOptions) -> CompiledModel:
-    """The compiled model for ``options``: from the cache, or generated now.
+def compile_files(options: CompileOptions, derived: Derived | None = None) -> CompiledModel:
+    """The compiled model for ``options``: from the cache, or generated now (from
+    ``derived``, the system of the same files, model and modifications, where given).
 
     The module computes the observed variables ``options.outputs`` selects (every one
     without ``--vars``); its key is the model's key with that selection, so ``--vars``
@@ -255,15 +259,15 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
     model_key = model_key_of(options)
-    derived = None
     observed: object = ALL_OBSERVED
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
             from . import generation  # the compile path, loaded on a miss only
 
-            say(compiling_note(options, folder))
-            derived = generation.derive_system(options)
+            if derived is None:
+                say(compiling_note(options, folder))
+                derived = generation.derive_system(options)
             names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
@@ -302,9 +306,12 @@ def compile_files(options: CompileOptions) -> CompiledModel:
         if folder is not None:  # never leave an entry that cannot be imported
             shutil.rmtree(path.parent, ignore_errors=True)
         raise too_deep_for_python(err) from None
+    # a python module's model keeps its derived system: the C loop's first run prints
+    # the C model from it (c_build.c_source) instead of deriving it again
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated,
-                         run_system=run, model_key=model_key)
+                         run_system=run, model_key=model_key,
+                         compiled_from=derived if options.backend == "python" else None)
 
 
 def model_key_of(options: CompileOptions) -> str:

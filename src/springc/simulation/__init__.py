@@ -2,7 +2,9 @@
 
 The package is ``simulation``, not ``simulate``: ``springc.simulate`` is the API function.
 
-The solver names (:mod:`.solver_names`) load with the package; everything else loads
+The solver names (:mod:`.solver_names`) and the standard-library pieces of the
+command line's warm path (:mod:`.csv_rows`, :mod:`.error_rules`, :mod:`.summary`) load
+with the package; everything else loads
 on first use (PEP 562), so that the CLI can offer the solver names without importing
 numpy and scipy (a third of a second on every ``springc check``).
 """
@@ -11,6 +13,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .csv_rows import write_rows  # light: the stdlib pieces of the warm path
+from .error_rules import allowed_errors, companion_tolerances, largest_differences, worst_column
 from .settings import (  # light: the run options, no numpy
     DEFAULT_MAX_STEPS,
     DEFAULT_TIME_LIMIT,
@@ -40,10 +44,18 @@ from .solver_names import (
     Solver,
     registered,
 )
+from .summary import brief_line
 from .values import check_run_values  # light: only math and errors
 
 if TYPE_CHECKING:
-    from .compiled import choose_engine, default_backend, observed_on_grid
+    from .compiled import (
+        c_loop_available,
+        c_loop_runs,
+        choose_engine,
+        default_backend,
+        numba_available,
+        observed_on_grid,
+    )
     from .limits import OverBudget
     from .output_size import LARGE_TRAJECTORY, check_trajectory_size
     from .results import (
@@ -94,14 +106,21 @@ __all__ = [
     "SimulationOptions",
     "SimulationResult",
     "Solver",
+    "allowed_errors",
+    "brief_line",
+    "c_loop_available",
+    "c_loop_runs",
     "check_run_values",
     "check_trajectory_size",
     "choose_engine",
+    "companion_tolerances",
     "default_backend",
     "error_control_mode",
     "estimate_deprecation",
     "file_format",
     "initial_state",
+    "largest_differences",
+    "numba_available",
     "observed_on_grid",
     "output_grid",
     "plan",
@@ -111,7 +130,9 @@ __all__ = [
     "run_settings",
     "save_outputs",
     "simulate_model",
+    "worst_column",
     "write_csv",
+    "write_rows",
 ]
 
 _LIMITS = frozenset({"OverBudget"})
@@ -123,7 +144,8 @@ _RUNNER = frozenset({"LSODA_LIMIT", "RunPlan", "initial_state", "output_grid", "
 
 def __getattr__(name: str) -> Any:
     # Lazy (see the docstring): numpy and scipy load with the first simulation name.
-    if name in ("choose_engine", "default_backend", "observed_on_grid"):
+    if name in ("c_loop_available", "c_loop_runs", "choose_engine", "default_backend",
+                "numba_available", "observed_on_grid"):
         from . import compiled
 
         return getattr(compiled, name)

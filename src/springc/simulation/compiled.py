@@ -1,5 +1,9 @@
-"""The compiled engine: springc's runs on :mod:`springc.integrate` (numba, no Python per step).
+"""The compiled engine: springc's runs with no Python per step, on the C loop library
+(:mod:`.native`, DOP853 and RK45 of continuous models where a C compiler is found) or
+on :mod:`springc.integrate`'s numba loops.
 
+- :func:`c_loop_available`: whether the C loop runs (a C compiler found, or
+  ``SPRINGC_LOOP`` forcing ``c`` or ``numba``); the one rule of the choice;
 - :func:`choose_engine`: ``--engine auto|compiled|scipy`` and the solver -> the engine
   of a run (``compiled`` needs numba, a solver with a compiled loop and the numba
   backend's functions; errors name the option).
@@ -19,6 +23,7 @@ state, the model's Newton failure flag, and the step and time limits.
 from __future__ import annotations
 
 import importlib.util
+import os
 import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
@@ -46,6 +51,18 @@ so that a run whose step size is hopeless stops early and the wall-clock limit i
 checked between stretches. The step limit counts accepted steps, as scipy's loop does."""
 FIXED_CHUNK = 200_000
 """Steps of a fixed-step stretch between two checks of the wall clock."""
+C_LOOP_VARIABLE = "SPRINGC_LOOP"
+"""The environment variable that forces the compiled engine's loop: ``c`` (the C loop
+library, a C compiler needed) or ``numba``; unset or empty: C where
+:func:`springc.pipeline.find_compiler` finds a compiler, else numba."""
+C_SOLVERS = ("dop853", "rk45")
+"""The methods the C loop runs (continuous models; ``auto``'s explicit method too)."""
+C_LOOP, NUMBA_LOOP = "c", "numba"
+C_LOOP_STATES = 256
+"""The most states of a model the C loop runs: the C model is printed one statement per
+scalar (no loops over index tables, as the python and numba modules' vector layout
+has), and the C compiler's time grows faster than its text (the 1,000-mass chain's
+5 MB took gcc over 3 minutes at -O2); larger models are generated for numba."""
 SCIPY_COLLAPSE = "Required step size is less than spacing between numbers."
 """scipy's message for the same failure (the step loop words both alike)."""
 
@@ -55,13 +72,48 @@ def numba_available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
+def c_loop_available() -> bool:
+    """Whether the compiled engine runs the C loop (:mod:`.native`) for ``auto``,
+    ``dop853`` and ``rk45`` on continuous models: ``SPRINGC_LOOP`` says ``c`` or
+    ``numba``; unset, where a C compiler is found (compiler presence, never timing).
+    Imports neither numba nor the compiler's output."""
+    choice = os.environ.get(C_LOOP_VARIABLE, "").strip().lower()
+    if choice not in ("", C_LOOP, NUMBA_LOOP):
+        raise UsageError(f"{C_LOOP_VARIABLE} must be {C_LOOP} or {NUMBA_LOOP} (or unset), "
+                         f"not {choice!r}", option=C_LOOP_VARIABLE)
+    if choice:
+        return choice == C_LOOP
+    from ..pipeline import CCompilerMissing, find_compiler
+
+    try:
+        find_compiler()
+    except CCompilerMissing:
+        return False
+    return True
+
+
+def c_loop_runs(solver: str, backend: str | None, states: int = 0) -> bool:
+    """Whether a run of ``solver`` on a module of ``backend`` (None: not chosen yet)
+    with ``states`` states (0: not known yet) takes the C loop: a solver it runs (or
+    ``auto``), a python module (the C loop needs no numba functions), at most
+    :data:`C_LOOP_STATES` states and :func:`c_loop_available`."""
+    return (solver == AUTO or solver in C_SOLVERS) and backend in (None, "python") \
+        and states <= C_LOOP_STATES and c_loop_available()
+
+
 def default_backend(engine: str = AUTO, solver: str = AUTO) -> str:
     """The generated module's backend when the user names none (``--backend`` left out):
-    ``numba`` where the run can take the compiled loop (numba importable, ``engine`` not
-    ``scipy``, ``solver`` with a compiled loop or ``auto``), else ``python``: a run on
-    scipy's loop calls the model's functions from Python, where numba's compilation of
-    a new model (seconds) costs more than it saves on most runs."""
+    ``python`` where the run takes the C loop (:func:`c_loop_runs`: its numba-free
+    module serves the Python side; ``engine`` not ``scipy``); else ``numba`` where the
+    run can take the compiled loop (numba importable, ``engine`` not ``scipy``,
+    ``solver`` with a compiled loop or ``auto``), else ``python``: a run on scipy's loop
+    calls the model's functions from Python, where numba's compilation of a new model
+    (seconds) costs more than it saves on most runs. (A model with events, delays or
+    switching states compiled for the C loop is generated again for numba: see
+    :func:`springc.api.compile_model`.)"""
     name = engine.lower() if isinstance(engine, str) else engine
+    if name != SCIPY and c_loop_runs(solver, None):
+        return "python"
     has_loop = solver == AUTO or solver in COMPILED_SOLVERS
     return "numba" if name != SCIPY and has_loop and numba_available() else "python"
 
@@ -87,12 +139,15 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
         return SCIPY
     if name == AUTO:
         numba_module = backend in (None, "numba")
-        return COMPILED if has_loop and numba_module and numba_available() else SCIPY
+        numba_loop = has_loop and numba_module and numba_available()
+        return COMPILED if numba_loop or c_loop_runs(solver, backend) else SCIPY
     if not has_loop:
         raise UsageError(f"{option} compiled: the {solver} solver has no compiled loop",
                          option=option,
                          hint=f"use {option} scipy (or auto), or a solver with a compiled "
                               f"loop: {', '.join((AUTO, *COMPILED_SOLVERS))}")
+    if c_loop_runs(solver, backend):
+        return COMPILED
     if not numba_available():
         raise UsageError(f"{option} compiled needs numba, which is not installed",
                          option=option, hint=f"install numba, or use {option} scipy")
@@ -106,7 +161,10 @@ def choose_engine(engine: str, solver: str, backend: str | None = None,
 
 def jitted(module: Any) -> bool:
     """Whether the generated module's functions are numba's (the compiled loops call
-    ``rhs`` and ``jacobian_values`` through function pointers)."""
+    ``rhs`` and ``jacobian_values`` through function pointers); a python module's are
+    not (numba is not imported for it)."""
+    if getattr(module, "BACKEND", "") != "numba":
+        return False
     from numba.core.dispatcher import Dispatcher
 
     return all(isinstance(getattr(module, name, None), Dispatcher)
@@ -132,6 +190,12 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
                   states: int = 1) -> str:
     """Why a run of ``solver`` ran on the engine it did, in plain words (``engine``: the
     ``--engine`` option, ``module``: the generated module, ``states``: how many)."""
+    if compiled and not jitted(module):
+        if solver not in C_SOLVERS:  # auto's race handed the run to radau
+            return (f"{solver} ran in scipy's loop: the C loop runs dop853 and rk45 only "
+                    "(auto's explicit steps ran in it)")
+        return (f"{solver} ran in the compiled loop (C, no Python per step: a C compiler "
+                f"was found; {C_LOOP_VARIABLE}=numba runs numba's)")
     if compiled:
         return f"{solver} ran in the compiled loop (numba, no Python per step)"
     where = "springc's Python loop" if solver in FIXED_STEP else "scipy's loop"
@@ -170,11 +234,23 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     methods take the same steps; Radau and BDF restart their Jacobian and step-size
     history). The stretch's ``sizes`` hold its mean accepted step size. A failure moves
     ``stepper`` to its last accepted state before raising the scipy path's error."""
+    kernel = _kernel(loop, stepper.method)
+    load_kernel(stepper.method)  # (numba's cache, once per process: not the stretch's time)
+    return advance_with(loop, stepper, max_steps, kernel)
+
+
+Kernel = Callable[[np.ndarray, np.ndarray, float, int], "Run"]
+"""``run(times, y, first_step, max_steps)``: a compiled loop of a method on a run's model
+and tolerances (``first_step`` 0: the loop selects it), a :class:`springc.integrate.Run`."""
+
+
+def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel: Kernel
+                 ) -> Stretch:
+    """:func:`advance_compiled` on the loop ``kernel`` (numba's or the C loop's: the same
+    contract, see :mod:`.native`)."""
     from springc.integrate import Status
 
     problem, grid = loop.problem, loop.grid
-    kernel = _kernel(loop, stepper.method)
-    load_kernel(stepper.method)  # (numba's cache, once per process: not the stretch's time)
     t, y = stepper.t, stepper.y
     rest = grid[loop.k:]
     times = np.concatenate(([t], rest[rest > t]))
@@ -254,10 +330,8 @@ def load_kernel(method: str, cached: Callable[[str], bool] | None = None) -> Non
     load(method)
 
 
-def _kernel(loop: StepLoop, method: str) -> Callable[[np.ndarray, np.ndarray, float, int],
-                                                     Run]:
-    """``run(times, y, first_step, max_steps)``: ``method``'s compiled loop on ``loop``'s
-    model and tolerances (``first_step`` 0: the loop selects it)."""
+def _kernel(loop: StepLoop, method: str) -> Kernel:
+    """``method``'s numba loop on ``loop``'s model and tolerances (:data:`Kernel`)."""
     problem = loop.problem
 
     def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:

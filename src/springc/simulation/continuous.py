@@ -21,6 +21,7 @@ from .compiled import (
     COMPILED,
     SCIPY,
     advance_compiled,
+    c_loop_runs,
     engine_reason,
     explained,
     jitted,
@@ -28,6 +29,7 @@ from .compiled import (
 )
 from .failures import Stop, state_notes
 from .limits import OverLimit, check_outputs, over_limit
+from .native import advance_native, loop_ready, native_observed
 from .observed_rows import observed_on_rows
 from .planning import RunPlan
 from .race import auto
@@ -54,9 +56,12 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             if problem.asserts:
                 problem.asserts.start(start, x0, problem.z)
             reason = ""
-            # a large model's generated functions may be plain Python: scipy's loop then
-            compiled = engine == COMPILED and jitted(model.module)
-            finish = advance_compiled if compiled else None
+            # the C loop runs a python module's model (choose_engine allowed it); a large
+            # model's generated functions may be plain Python otherwise: scipy's loop then
+            native = engine == COMPILED and not jitted(model.module) \
+                and c_loop_runs(solver, model.module.BACKEND, len(x0)) and loop_ready(problem)
+            compiled = engine == COMPILED and (native or jitted(model.module))
+            finish = (advance_native if native else advance_compiled) if compiled else None
             loop_time = 0.0
             if solver in FIXED_STEP and compiled:
                 states, steps, loop_time = run_fixed_compiled(problem, grid, x0, step)
@@ -78,7 +83,7 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             if problem.asserts and (compiled or not len(x0)):
                 problem.asserts.grid(grid, states, problem.z, _locate(
                     problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
-            outputs = _outputs(model, problem, grid, states)
+            outputs = _outputs(model, problem, grid, states, native)
     except Stop as stop_:
         raise stop_.error from None
     except OverLimit as over:
@@ -91,7 +96,8 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
                             COMPILED if compiled else SCIPY, loop_time,
                             engine_reason=engine_reason(options.engine.lower(), solver,
                                                         model.module, compiled, len(x0))
-                            if explained(options.engine, reason, compiled) else "")
+                            if explained(options.engine, reason, compiled) or native
+                            else "")
     units = model.units
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
@@ -120,10 +126,11 @@ def _locate(problem: Problem, grid: np.ndarray, states: np.ndarray, solver: str,
 
 
 def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
-             states: np.ndarray) -> np.ndarray:
+             states: np.ndarray, native: bool = False) -> np.ndarray:
     """The output columns (``model.outputs``) at the grid's rows: one array, the
     observed rows written into it directly where the outputs are the states then the
-    observed variables in order (every output: a large scene holds one copy)."""
+    observed variables in order (every output: a large scene holds one copy); on the
+    C loop (``native``) by the C model first."""
     names = model.outputs
     n = len(model.states)
     columns = [*model.states, *model.observed]
@@ -134,6 +141,9 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
     obs = out[:, n:] if in_order else np.empty((len(grid), len(model.observed)))
     if wanted:
         z = np.asarray(model.module.guesses(problem.p), dtype=float)
+        if native and native_observed(problem, grid, states, z.copy(), obs):
+            wanted = []
+    if wanted:
         try:
             observed_on_rows(model.module, grid, states, problem.p, z, obs)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:

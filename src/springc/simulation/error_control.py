@@ -8,7 +8,7 @@ run and ``rtol``, ``atol`` are the tolerances asked for (:data:`FACTOR` is 10): 
 variable is judged on its own scale, as the solver's own error test judges each state.
 
 **The modes.** ``tighten`` (the default): a run whose estimate breaks the rule is run
-again :data:`~.error_estimate.COMPANION_FACTOR` times tighter (rtol and atol alike) -
+again :data:`~.error_rules.COMPANION_FACTOR` times tighter (rtol and atol alike) -
 its companion already is that run, so it becomes the answer and a new companion
 estimates its error - until the rule holds, the run's rtol would pass
 :data:`TIGHTEST_RUN_RTOL`, or a companion fails or meets the step or time limit
@@ -32,8 +32,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import SpringcError
-from .error_estimate import ErrorEstimate, companion_tolerances, compare
+from .error_estimate import ErrorEstimate, compare
+from .error_rules import FACTOR, allowed_errors, companion_tolerances, short
 from .settings import (
     RunSettings,
 )
@@ -51,17 +54,10 @@ if TYPE_CHECKING:
 
 MODES = ERROR_CONTROLS
 DEFAULT_MODE = DEFAULT_ERROR_CONTROL
-FACTOR = 10.0
-"""A variable's estimated error may be this many times its tolerance ``rtol*scale + atol``."""
 TIGHTEST_RUN_RTOL = 1e-12
 """``tighten`` runs at no tighter rtol (its companion is then at the solvers' limit)."""
 MAX_ROUNDS = 4
 """At most this many estimates (from rtol 1e-3: runs at 1e-6, 1e-9, 1e-12)."""
-
-
-def short(x: float) -> str:
-    """``1e-06`` -> ``1e-6``, ``2.9e-04`` -> ``2.9e-4``: numbers in the summary."""
-    return f"{x:.2g}".replace("e-0", "e-").replace("e+0", "e+")
 
 
 @dataclass(frozen=True)
@@ -93,8 +89,8 @@ def controlled(options: RunSettings, asked: Asked, run: Run) -> SimulationResult
         if result.stats.solver in FIXED_STEP:
             return _finish(result, rtol, atol, estimate, _words(estimate, "", "fixed"), "",
                            began)
-        estimate = replace(estimate, tolerance=FACTOR * (asked.rtol * estimate.scales
-                                                         + asked.atol))
+        estimate = replace(estimate, tolerance=np.array(allowed_errors(
+            estimate.scales.tolist(), asked.rtol, asked.atol)))
         if (estimate.met or asked.mode == "warn" or tight[0] < TIGHTEST_RUN_RTOL * 0.999
                 or _round == MAX_ROUNDS - 1):
             break

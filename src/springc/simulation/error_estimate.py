@@ -1,8 +1,9 @@
 """The global error a run reached on its output grid: two results -> :class:`ErrorEstimate`.
 
 A run is compared with a *companion* run of the same model and start (:mod:`.error_control`
-runs it): an adaptive run with one at a tolerance :data:`COMPANION_FACTOR` times tighter
-(``dop853``, or the run's own implicit method), whose error is then about a thousandth
+runs it): an adaptive run with one at a tolerance
+:data:`.error_rules.COMPANION_FACTOR` times tighter (``dop853``, or the run's own
+implicit method), whose error is then about a thousandth
 of the run's, so ``|x_run - x_companion|`` is the run's error; a fixed-step run of order
 ``q`` with the same method at half the step (Richardson:
 ``error ~ (x_h - x_h/2) 2^q / (2^q - 1)``).
@@ -27,9 +28,6 @@ from typing import Any, Protocol
 
 import numpy as np
 
-COMPANION_FACTOR = 1000.0
-TIGHTEST_RTOL = 1e-13
-"""The companion's rtol is never below this (DOP853's limit is about 100 eps)."""
 EVENT_TIMES = "(event times)"
 """The estimate's name for the times of a hybrid run's state events."""
 
@@ -91,12 +89,6 @@ class ErrorEstimate:
                                                 self.times, allowed))]
 
 
-def companion_tolerances(rtol: float, atol: float) -> tuple[float, float]:
-    """The companion run's rtol and atol: :data:`COMPANION_FACTOR` times tighter."""
-    tight_rtol = max(float(f"{rtol / COMPANION_FACTOR:.12g}"), TIGHTEST_RTOL)
-    return tight_rtol, float(f"{atol * tight_rtol / rtol:.12g}")
-
-
 def grid_rows(times: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """The row of each output time in a result's ``times`` (the last row at that time:
     ``event_rows`` puts an event's limits before it), -1 where the run did not reach it."""
@@ -154,7 +146,8 @@ def _differences(ours: np.ndarray, theirs: np.ndarray, our_rows: np.ndarray,
                  width: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The scale of each column of ``ours`` (its largest magnitude over every row), and
     the largest magnitude of ``(ours - theirs) * gain`` on the paired rows with the
-    index of its row, :data:`COLUMNS_PER_PASS` columns at a time (``columns``: the
+    index of its row (:func:`.error_rules.largest_differences` on numpy arrays),
+    :data:`COLUMNS_PER_PASS` columns at a time (``columns``: the
     columns of ``theirs`` in the order of ``ours``; None: the same; ``width``: the
     number of columns)."""
     scales = np.zeros(width)

@@ -25,7 +25,9 @@ import numpy as np
 
 from ..errors import OutputError, SpringcError, UnknownNameError, UsageError, printable
 from ..fileio import OutputSet, PathLike, atomic_write
+from .csv_rows import write_rows
 from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
+from .summary import brief_line
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
@@ -79,20 +81,11 @@ class SimulationStats:
         """The short summary line (about 100 characters): model, solver, steps, events,
         the estimated error against its tolerance and the rtol it was reached at, wall
         time (``SpringMass: dop853 (auto), 2,268 steps, est. error 4e-06 <= 0.0003 at
-        rtol 1e-09, 3.41 s``); :meth:`summary` has the full detail (``-v``)."""
-        parts = [f"{printable(model)}: {self.solver}{' (auto)' if self.reason else ''}",
-                 f"{self.steps:,} steps"]
-        events = self.state_events + self.time_events
-        if events:
-            parts.append(f"{events:,} event{'s' if events != 1 else ''}")
-        if self.estimated_error is not None:
-            text = f"est. error {_short(self.estimated_error)}"
-            if self.error_tolerance is not None:
-                within = self.estimated_error <= self.error_tolerance
-                text += f" {'<=' if within else '>'} {_short(self.error_tolerance)}"
-            parts.append(text + (f" at rtol {_short(self.rtol)}" if self.rtol else ""))
-        parts.append(f"{self.wall_time:.2f} s")
-        return ", ".join(parts)
+        rtol 1e-09, 3.41 s``; :func:`.summary.brief_line`); :meth:`summary` has the full
+        detail (``-v``)."""
+        return brief_line(model, self.solver, bool(self.reason), self.steps,
+                          self.state_events + self.time_events, self.estimated_error,
+                          self.error_tolerance, self.rtol, self.wall_time)
 
     def summary(self, model: str) -> str:
         """One line with the full detail (``-v``): solver and engine (``auto -> dop853
@@ -112,11 +105,6 @@ class SimulationStats:
                    if self.state_events or self.time_events else "")
                 + (f"; {self.error}" if self.error else "")
                 + (f"; note: {self.note}" if self.note else ""))
-
-
-def _short(value: float) -> str:
-    """One significant digit, the exponent without a leading zero (``4e-6``)."""
-    return f"{value:.1g}".replace("e-0", "e-").replace("e+0", "e+")
 
 
 @dataclass
@@ -223,9 +211,7 @@ class SimulationResult:
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
     """Header ``time,<names>`` then one row per output time, full precision."""
-    csv.writer(f, lineterminator="\n").writerow(["time", *result.names])
-    table = np.column_stack([result.time, result.values]).tolist()
-    f.writelines(",".join(map(repr, row)) + "\n" for row in table)
+    write_rows(f, result.names, np.column_stack([result.time, result.values]).tolist())
 
 
 def _char_matrix(texts: list[str]) -> np.ndarray:

@@ -96,6 +96,7 @@ class Problem:
         self.limits = limits = limits or Limits()
         self.deadline = time.perf_counter() + limits.time_limit
         self.asserts = AssertionCheck(mod, p, self.names)
+        self.loop_library: Any = None  # the C loop's, loaded once per run (.native)
 
     def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
         where = code_location(err, self.path)
@@ -150,15 +151,17 @@ class Problem:
             notes=state_notes(self.names, x, dx), hint=remedy(self.solver)))
 
     def locate(self, function: Any, t: float, x: np.ndarray, what: str) -> Stop | None:
-        """The error of ``function``'s Python original (``py_func`` of a numba function)
-        at ``(t, x)`` on Python floats, where it raises (a division by zero, a square
-        root of a negative number...), naming the line; ``None`` where it does not."""
+        """The error of ``function``'s Python original (``py_func`` of a numba function,
+        a python module's function itself: the C loop's model) at ``(t, x)`` on Python
+        floats, where it raises (a division by zero, a square root of a negative
+        number...), naming the line; ``None`` where it does not."""
         original = getattr(function, "py_func", None)
-        if original is None:
-            return None
+        # (a python module's function takes arrays and computes on Python floats itself)
+        args = (x.tolist(), self.p.tolist()) if original is not None \
+            else (np.array(x, dtype=float), np.array(self.p, dtype=float))
         try:
             with np.errstate(all="ignore"):
-                original(t, x.tolist(), self.p.tolist(), np.array(self.z))
+                (original or function)(t, *args, np.array(self.z))
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             return self.fail(err, t, x, what)
         except TypeError:  # vectorised code needs arrays: no location then

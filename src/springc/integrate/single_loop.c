@@ -1,0 +1,414 @@
+/* springc's single-run loop in C: the compiled engine's adaptive loop for DOP853 and
+   RK45 on a model's C functions, one shared library per model with the model.
+
+   springc.integrate.native_loop puts the translation unit together: the model's C text
+   (its functions static inline), the DOP853 tableau's sums (sc_a_row ...), RK45's
+   (rk_a_row, rk_b_sum, rk_e_sum, rk_p_col, RK_C), the status codes (SC_SUCCESS ...),
+   dop853_core.c (DOP853's step arithmetic, shared with the ensemble kernel), then this.
+
+   The contract is springc.integrate.loop's adaptive_loop specialised on
+   dop853_steps / rk45_steps with plain-loop sums (scipy_arithmetic off), without zero
+   crossings and time events: the same start, initial step (scipy's
+   select_initial_step), step-size clamp, controller, step limit (accepted and
+   rejected steps), dense output on the grid and result record, every operation in the
+   same order, so that on one machine the states equal the numba loop's within
+   rounding of the math library's functions, with the same steps. A run that stops at
+   the step limit goes on from (failure_time, failure_state, next_step) as one
+   uninterrupted run would. Nothing here allocates but the run's work arrays. */
+
+#include <stdlib.h>
+
+#ifndef SPRINGC_LOOP_EXPORT
+#define SPRINGC_LOOP_EXPORT __attribute__((visibility("default")))
+#endif
+#define SL_ABI 1
+#define SL_DOP853 0
+#define SL_RK45 1
+#define SL_RK_STAGES 6
+#define SL_HUGE 1.7976931348623157e308
+#define SL_ACCEPTED 0
+#define SL_REJECTED 1
+#define SL_RHS_CALLS 2
+
+typedef long long sl_int;
+
+/* The run's work arrays (rows of SC_NXS doubles). */
+typedef struct {
+    double *K;      /* the stages: 16 rows (DOP853), 7 (RK45) */
+    double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
+    double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
+    int method;
+} sl_work;
+
+SC_FN void sl_copy(double *dst, const double *src) {
+    for (int i = 0; i < SC_NX; i++) dst[i] = src[i];
+}
+
+/* numba's rms of plain sums: sqrt(x . x) / n ** 0.5 */
+SC_FN double sl_rms(const double *x) {
+    double total = 0.0;
+    for (int i = 0; i < SC_NX; i++) total += x[i] * x[i];
+    return sqrt(total) / pow((double)SC_NX, 0.5);
+}
+
+/* scipy's select_initial_step from (t, y) with the derivative f there (loop.initial_step);
+   the status; h_abs, or the time of a failed evaluation (its state left in end). */
+SC_FN int sl_initial_step(double t, const double *y, const double *f, double limit,
+                          const double *p, double *z, double rtol, const double *atol,
+                          double max_step, double exponent, sl_work *w, double *end,
+                          sl_int *counts, double *h_abs, double *t_fail) {
+    double *scale = w->scale, *d = w->sums, interval = limit - t;
+    for (int i = 0; i < SC_NX; i++) {
+        scale[i] = atol[i] + fabs(y[i]) * rtol;
+        end[i] = y[i] / scale[i];
+    }
+    double d0 = sl_rms(end);
+    for (int i = 0; i < SC_NX; i++) end[i] = f[i] / scale[i];
+    double d1 = sl_rms(end);
+    double h0 = d0 < 1e-5 || d1 < 1e-5 ? 1e-6 : 0.01 * d0 / d1;
+    h0 = sc_min(h0, interval);
+    for (int i = 0; i < SC_NX; i++) end[i] = y[i] + h0 * f[i];
+    springc_rhs(t + h0, end, p, z, d);
+    counts[SL_RHS_CALLS] += 1;
+    int status = sc_verdict(d, z);
+    *t_fail = t;
+    if (status != SC_SUCCESS) {
+        *h_abs = 0.0;
+        *t_fail = t + h0;
+        return status;
+    }
+    for (int i = 0; i < SC_NX; i++) scale[i] = (d[i] - f[i]) / scale[i];
+    double d2 = sl_rms(scale) / h0;
+    double h1 = d1 <= 1e-15 && d2 <= 1e-15 ? sc_max(1e-6, h0 * 1e-3)
+                                           : pow(0.01 / sc_max(d1, d2), exponent);
+    *h_abs = sc_min(sc_min(sc_min(100 * h0, h1), interval), max_step);
+    if (!(*h_abs > 0.0)) {
+        sl_copy(end, y);
+        return SC_STEP_TOO_SMALL;
+    }
+    return SC_SUCCESS;
+}
+
+/* The stages of one attempt from (t, y) with step h, the new state in y_new and the
+   FSAL evaluation in K's last row; a failed evaluation's time in t_fail, state in end. */
+SC_FN int sl_stages(const sl_work *w, double t, double h, const double *p, double *z,
+                    sl_int *counts, double *end, double *t_fail) {
+    const double *y = w->y;
+    double *K = w->K, *sums = w->sums, *stage = w->stage, *y_new = w->y_new;
+    int dop = w->method == SL_DOP853, stages = dop ? SC_STAGES : SL_RK_STAGES;
+    for (int s = 1; s < stages; s++) {
+        double c = dop ? DOP_C[s] : RK_C[s];
+        if (dop) {
+            sc_stage(y, K, s, h, sums, stage);
+        } else {
+            rk_a_row(s, K, sums);
+            for (int i = 0; i < SC_NX; i++) stage[i] = y[i] + sums[i] * h;
+        }
+        springc_rhs(t + c * h, stage, p, z, K + s * SC_NXS);
+        counts[SL_RHS_CALLS] += 1;
+        int status = sc_verdict(K + s * SC_NXS, z);
+        if (status != SC_SUCCESS) {
+            sl_copy(end, stage);
+            *t_fail = t + c * h;
+            return status;
+        }
+    }
+    if (dop) sc_b_sum(K, sums);
+    else rk_b_sum(K, sums);
+    for (int i = 0; i < SC_NX; i++) y_new[i] = y[i] + h * sums[i];
+    springc_rhs(t + h, y_new, p, z, K + stages * SC_NXS);
+    counts[SL_RHS_CALLS] += 1;
+    int status = sc_verdict(K + stages * SC_NXS, z);
+    if (status != SC_SUCCESS) {
+        sl_copy(end, y_new);
+        *t_fail = t + h;
+    }
+    return status;
+}
+
+/* RK45's error norm of the attempt (rk45_steps.step). */
+SC_FN double sl_rk45_error(const sl_work *w, double h, double rtol, const double *atol) {
+    double *err = w->err5, *scale = w->scale;
+    rk_e_sum(w->K, err);
+    for (int i = 0; i < SC_NX; i++) {
+        scale[i] = atol[i] + sc_max(fabs(w->y[i]), fabs(w->y_new[i])) * rtol;
+        err[i] = err[i] * h / scale[i];
+    }
+    double total = 0.0;
+    for (int i = 0; i < SC_NX; i++) total += err[i] * err[i];
+    return pow(total / SC_NX, 0.5);
+}
+
+/* One accepted step from (t, y) (the step hook of dop853_steps / rk45_steps: rejected
+   attempts inside); *h_abs in: the clamped size, out: the next one. */
+SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, double limit,
+                  const double *p, double *z, double rtol, const double *atol,
+                  sl_int *counts, double *end, double *t_new, double *h, double *t_fail) {
+    int dop = w->method == SL_DOP853, stages = dop ? SC_STAGES : SL_RK_STAGES;
+    double exponent = dop ? -1.0 / 8.0 : -1.0 / (4 + 1);
+    sl_copy(w->K, w->K + stages * SC_NXS);
+    int rejected = 0;
+    for (;;) {
+        if (*h_abs < min_step) {
+            sl_copy(end, w->y);
+            *t_new = t;
+            *h = 0.0;
+            *t_fail = t;
+            return SC_STEP_TOO_SMALL;
+        }
+        *t_new = t + *h_abs;
+        if (*t_new - limit > 0) *t_new = limit;
+        *h = *t_new - t;
+        *h_abs = fabs(*h);
+        int status = sl_stages(w, t, *h, p, z, counts, end, t_fail);
+        if (status != SC_SUCCESS) {
+            *t_new = t;
+            return status;
+        }
+        double error = dop ? sc_error_norm(w->y, w->y_new, w->K, *h, rtol, atol, w->scale,
+                                           w->err5, w->err3)
+                           : sl_rk45_error(w, *h, rtol, atol);
+        if (error < 1) {
+            double factor = error == 0 ? 10.0 : sc_min(10.0, 0.9 * pow(error, exponent));
+            if (rejected) factor = sc_min(1.0, factor);
+            *h_abs = *h_abs * factor;
+            *t_fail = t;
+            return SC_SUCCESS;
+        }
+        *h_abs *= sc_max(0.2, 0.9 * pow(error, exponent));
+        rejected = 1;
+        counts[SL_REJECTED] += 1;
+    }
+}
+
+/* What the dense output of the step needs (prepare_dense): DOP853's three extra stages
+   and its rows F; RK45's Q = K^T P. */
+SC_FN int sl_prepare_dense(const sl_work *w, double t, double h, const double *p, double *z,
+                           sl_int *counts, double *end, double *t_fail) {
+    double *K = w->K;
+    if (w->method == SL_DOP853) {
+        for (int s = SC_STAGES + 1; s < SC_EXTENDED; s++) {
+            sc_stage(w->y, K, s, h, w->sums, w->stage);
+            springc_rhs(t + DOP_C[s] * h, w->stage, p, z, K + s * SC_NXS);
+            counts[SL_RHS_CALLS] += 1;
+            int status = sc_verdict(K + s * SC_NXS, z);
+            if (status != SC_SUCCESS) {
+                sl_copy(end, w->stage);
+                *t_fail = t + DOP_C[s] * h;
+                return status;
+            }
+        }
+        sc_interpolant(w->y, w->y_new, K, h, w->F, w->sums);
+        return SC_SUCCESS;
+    }
+    for (int r = 0; r < 4; r++) {
+        rk_p_col(r, K, w->sums);
+        for (int i = 0; i < SC_NX; i++) w->F[i * 4 + r] = w->sums[i];
+    }
+    return SC_SUCCESS;
+}
+
+/* The dense output of the step from (t, y) with size h at time at, into out. */
+SC_FN void sl_dense(const sl_work *w, double t, double h, double at, double *out) {
+    double x = (at - t) / h;
+    if (w->method == SL_DOP853) {
+        sc_interpolate(w->F, w->y, x, out);
+        return;
+    }
+    double powers[4], power = 1.0;
+    for (int r = 0; r < 4; r++) {
+        power *= x;
+        powers[r] = power;
+    }
+    for (int i = 0; i < SC_NX; i++) {
+        double value = 0.0;
+        for (int r = 0; r < 4; r++) value += w->F[i * 4 + r] * powers[r];
+        out[i] = h * value + w->y[i];
+    }
+}
+
+/* The result record after the loop (adaptive_loop's Step 8). */
+typedef struct {
+    sl_int *counts;   /* accepted, rejected, rhs evaluations, (Jacobians: 0), filled */
+    double *reals;    /* failure time, next step size */
+    double *end;      /* the failure state */
+} sl_record;
+
+/* The output times in (t, t_new]: the states there; the new number filled. */
+SC_FN sl_int sl_fill(const sl_work *w, sl_int filled, sl_int m, const double *grid,
+                     double t, double t_new, double h, double *states) {
+    while (filled < m && grid[filled] <= t_new) {
+        double *row = states + filled * SC_NX;
+        if (grid[filled] == t_new) sl_copy(row, w->y_new);
+        else sl_dense(w, t, h, grid[filled], row);
+        filled += 1;
+    }
+    return filled;
+}
+
+/* The steps from (t, y) until the end of the grid (adaptive_loop's Step 3 on). */
+SC_FN int sl_steps(sl_work *w, sl_int m, const double *grid, const double *p, double *z,
+                   double rtol, const double *atol, double max_step, sl_int max_steps,
+                   double *states, sl_int *filled, double *t_io, double *h_abs,
+                   sl_record *rec) {
+    sl_int *counts = rec->counts;
+    double t = *t_io, limit = grid[m - 1], t_fail = t;
+    int status = SC_SUCCESS;
+    while (t < limit) {
+        if (max_steps > 0 && counts[SL_ACCEPTED] + counts[SL_REJECTED] >= max_steps) {
+            status = SC_MAX_STEPS;
+            sl_copy(rec->end, w->y);
+            t_fail = t;
+            break;
+        }
+        double min_step = 10 * fabs(nextafter(t, SL_HUGE) - t);
+        if (*h_abs > max_step) *h_abs = max_step;
+        else if (*h_abs < min_step) *h_abs = min_step;
+        double t_new, h;
+        status = sl_step(w, t, h_abs, min_step, limit, p, z, rtol, atol, counts, rec->end,
+                         &t_new, &h, &t_fail);
+        if (status != SC_SUCCESS) break;
+        counts[SL_ACCEPTED] += 1;
+        if (*filled < m && grid[*filled] <= t_new) {
+            status = sl_prepare_dense(w, t, h, p, z, counts, rec->end, &t_fail);
+            if (status != SC_SUCCESS) break;
+            *filled = sl_fill(w, *filled, m, grid, t, t_new, h, states);
+        }
+        t = t_new;
+        sl_copy(w->y, w->y_new);
+    }
+    rec->reals[0] = t_fail;
+    *t_io = t;
+    return status;
+}
+
+/* The whole run (adaptive_loop): see springc.native.runner for the arguments. */
+SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
+                 const double *p, double *z, double rtol, const double *atol,
+                 double max_step, double first_step, sl_int max_steps, double *states,
+                 sl_record *rec) {
+    sl_int *counts = rec->counts, filled = 1;
+    double t = grid[0], h_abs = 0.0, t_fail = t;
+    int status = SC_SUCCESS;
+    sl_copy(w->y, x0);
+    sl_copy(rec->end, x0);
+    sl_copy(states, x0);
+    if (sc_flagged(z)) {
+        status = SC_MODEL_FAILED;
+        filled = 0;
+    }
+    int running = status == SC_SUCCESS && m > 1 && SC_NX > 0;
+    if (status == SC_SUCCESS && !running) {
+        for (sl_int k = 1; k < m; k++) sl_copy(states + k * SC_NX, w->y);
+        filled = m;
+    }
+    if (running) {
+        double *f = w->K + (w->method == SL_DOP853 ? SC_STAGES : SL_RK_STAGES) * SC_NXS;
+        springc_rhs(t, w->y, p, z, f);
+        counts[SL_RHS_CALLS] += 1;
+        status = sc_verdict(f, z);
+        if (status == SC_SUCCESS) {
+            if (first_step > 0.0) {
+                h_abs = first_step;
+            } else {
+                double exponent = 1.0 / ((w->method == SL_DOP853 ? 7 : 4) + 1);
+                status = sl_initial_step(t, w->y, f, grid[m - 1], p, z, rtol, atol,
+                                         max_step, exponent, w, rec->end, counts, &h_abs,
+                                         &t_fail);
+            }
+        }
+        if (status == SC_SUCCESS) {
+            status = sl_steps(w, m, grid, p, z, rtol, atol, max_step, max_steps, states,
+                              &filled, &t, &h_abs, rec);
+            t_fail = rec->reals[0];
+        }
+    }
+    if (status == SC_SUCCESS) {
+        t_fail = t;
+        sl_copy(rec->end, w->y);
+    }
+    rec->reals[0] = t_fail;
+    rec->reals[1] = h_abs;
+    counts[4] = filled;
+    return status;
+}
+
+SPRINGC_LOOP_EXPORT int springc_loop_abi(void) { return SL_ABI; }
+
+/* The model's sizes: states, parameters, z, observed, initial conditions, hybrid. */
+SPRINGC_LOOP_EXPORT void springc_loop_sizes(sl_int *n) {
+    n[0] = SPRINGC_N_STATES;
+    n[1] = SPRINGC_N_PARAMS;
+    n[2] = SPRINGC_N_Z;
+    n[3] = SPRINGC_N_OBSERVED;
+    n[4] = SPRINGC_INITIAL_CONDITIONS;
+    n[5] = SPRINGC_HYBRID;
+}
+
+/* Entry i of a name table (0: states, 1: parameters, 2: observed; 3: the model's name),
+   NULL past its end. */
+SPRINGC_LOOP_EXPORT const char *springc_loop_name(int table, sl_int i) {
+    switch (table) {
+    case 0: return i >= 0 && i < SPRINGC_N_STATES ? springc_state_names[i] : 0;
+    case 1: return i >= 0 && i < SPRINGC_N_PARAMS ? springc_parameter_names[i] : 0;
+    case 2: return i >= 0 && i < SPRINGC_N_OBSERVED ? springc_observed_names[i] : 0;
+    case 3: return i == 0 ? springc_model_name : 0;
+    default: return 0;
+    }
+}
+
+SPRINGC_LOOP_EXPORT void springc_loop_parameters(double *p, const int *given) {
+    springc_parameters(p, given);
+}
+
+SPRINGC_LOOP_EXPORT int springc_loop_start(const double *p, double *x, double *z) {
+    return springc_start(p, x, z);
+}
+
+/* One run of method (0: DOP853, 1: RK45) on the output grid (m times, increasing):
+   states (m x n) rows 0..filled-1 written; counts: accepted, rejected, rhs evaluations,
+   0, filled; reals: failure (or stop) time, next step size; end: the state there; z
+   updated in place. first_step 0: scipy's initial step; max_steps 0: no limit.
+   Returns a springc.integrate.Status code, or -1 if the work arrays could not be
+   allocated. */
+SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *grid,
+                                         const double *x0, const double *p, double *z,
+                                         double rtol, const double *atol, double max_step,
+                                         double first_step, sl_int max_steps,
+                                         double *states, sl_int *counts, double *reals,
+                                         double *end) {
+    sl_work w;
+    double *block = (double *)malloc((size_t)32 * SC_NXS * sizeof(double));
+    if (block == NULL) return -1;
+    w.method = method == SL_RK45 ? SL_RK45 : SL_DOP853;
+    w.K = block;
+    w.F = block + 16 * SC_NXS;
+    w.stage = block + 23 * SC_NXS;
+    w.sums = block + 24 * SC_NXS;
+    w.scale = block + 25 * SC_NXS;
+    w.err5 = block + 26 * SC_NXS;
+    w.err3 = block + 27 * SC_NXS;
+    w.y = block + 28 * SC_NXS;
+    w.y_new = block + 29 * SC_NXS;
+    for (int k = 0; k < 5; k++) counts[k] = 0;
+    sl_record rec = {counts, reals, end};
+    int status = sl_run(&w, m, grid, x0, p, z, rtol, atol, max_step, first_step, max_steps,
+                        states, &rec);
+    free(block);
+    return status;
+}
+
+/* The observed variables at the m rows (ts[k], states[k]) into out (m x n_observed), z
+   warm-starting each row from the one before; -1, or the first row whose evaluation
+   set the model's failure flag (rows before it written). */
+SPRINGC_LOOP_EXPORT sl_int springc_loop_observed(sl_int m, const double *ts,
+                                                 const double *states, const double *p,
+                                                 double *z, double *out) {
+    double row[SPRINGC_N_OBSERVED > 0 ? SPRINGC_N_OBSERVED : 1];
+    for (sl_int k = 0; k < m; k++) {
+        springc_observed(ts[k], states + k * SC_NX, p, z, row);
+        if (sc_flagged(z)) return k;
+        for (int j = 0; j < SPRINGC_N_OBSERVED; j++) out[k * SPRINGC_N_OBSERVED + j] = row[j];
+    }
+    return -1;
+}

@@ -1,0 +1,108 @@
+"""The compiled engine on the C loop library: a continuous model's DOP853 and RK45 runs
+with no Python per step and no numba (:func:`advance_native`), and its observed
+variables on the grid (:func:`native_observed`).
+
+The library (:func:`springc.pipeline.loop_library`: the model's C functions with
+``integrate/single_loop.c``, built once into the model's cache entry) keeps the numba
+loop's contract: stretches of steps resumable from (time, state, next step), scipy's
+start, initial step and controller, the dense output on the grid, the status codes
+and counters, so :func:`.compiled.advance_with` runs it as it runs numba's loop, with
+the same step and time limits and the same errors (a non-finite derivative located
+where the model's Python code raises). ``auto``'s race may hand a run to ``radau``,
+whose loop is not in C: that stretch runs on scipy's loop with the model's Python
+functions (the summary says so).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import SimulationError
+from .compiled import C_SOLVERS, Kernel, advance_with
+from .steps import StepLoop, Stepper, Stretch
+
+if TYPE_CHECKING:
+    from springc.integrate import Run
+    from springc.native import LoopLibrary, LoopRun
+
+    from .steps import Problem
+
+
+def advance_native(loop: StepLoop, stepper: Stepper, max_steps: int | None = None
+                   ) -> Stretch:
+    """:func:`.compiled.advance_compiled` on the C loop library (``finish`` of the
+    step loop); a method without a C loop (radau, bdf) steps on scipy's loop from
+    where ``stepper`` is (with its next step size), as a restart."""
+    if stepper.method not in C_SOLVERS:
+        first = stepper.h_abs or None
+        integrator = loop.scipy_start(stepper.method, stepper.t, stepper.y, first)
+        stretch = loop.advance(integrator, max_steps)
+        stepper.t, stepper.y = float(integrator.t), np.array(integrator.y)
+        stepper.h_abs = float(getattr(integrator, "h_abs", 0.0) or 0.0)
+        return stretch
+    return advance_with(loop, stepper, max_steps, _kernel(loop, stepper.method))
+
+
+def loop_ready(problem: Problem) -> bool:
+    """Whether ``problem``'s model has its loop library (built now where needed);
+    False where its C model cannot be printed: a model unpickled in another process,
+    or loaded from the cache, whose files changed since (it then runs on scipy's loop,
+    as a python module did before the C loop)."""
+    try:
+        library(problem)
+    except SimulationError:
+        return False
+    return True
+
+
+def library(problem: Problem) -> LoopLibrary:
+    """The loop library of ``problem``'s model (built once per cache entry)."""
+    from ..pipeline import loop_library
+
+    if problem.loop_library is None:
+        problem.loop_library = loop_library(problem.model)
+    lib: LoopLibrary = problem.loop_library
+    return lib
+
+
+def _kernel(loop: StepLoop, method: str) -> Kernel:
+    problem = loop.problem
+    lib = library(problem)
+
+    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+        done = lib.run(method, times, np.ascontiguousarray(y, dtype=float), problem.p,
+                       problem.z, rtol=loop.rtol, atol=loop.atol, first_step=first or 0.0,
+                       max_steps=steps)
+        return as_run(done, times)
+    return run
+
+
+def as_run(done: LoopRun, times: np.ndarray) -> Run:
+    """The C loop's outcome as :class:`springc.integrate.Run` (numpy views, no copy)."""
+    from springc.integrate import Run, Status
+
+    n = len(done.failure_state)
+    states = np.frombuffer(done.states, dtype=float)[:len(times) * n].reshape(len(times), n)
+    return Run(Status(done.status), times, states, np.empty((len(times), 0)), done.filled,
+               done.accepted_steps, done.rejected_steps, done.rhs_evaluations,
+               done.failure_time, np.frombuffer(done.failure_state, dtype=float).copy(),
+               np.empty(0, dtype=np.int64), done.next_step)
+
+
+def native_observed(problem: Problem, grid: np.ndarray, states: np.ndarray,
+                    z: np.ndarray, out: np.ndarray) -> bool:
+    """The observed variables at the rows ``(grid[k], states[k])`` into ``out`` by the
+    C model's ``springc_observed`` (``z`` carried from row to row); False (``out``
+    partly written) where a row sets the model's failure flag or a value is not
+    finite: the Python path (:func:`.observed_rows.observed_on_rows`) then computes
+    them and words the failure."""
+    lib = library(problem)
+    row, values = lib.observed(np.ascontiguousarray(grid, dtype=float),
+                               np.ascontiguousarray(states, dtype=float), problem.p, z)
+    if row >= 0:
+        return False
+    computed = np.frombuffer(values, dtype=float)[:out.size].reshape(out.shape)
+    out[...] = computed
+    return bool(np.isfinite(computed).all())

@@ -1,0 +1,146 @@
+"""The compiled engine on the C loop (a C compiler found, or ``SPRINGC_LOOP=c``) against
+the numba loop (``SPRINGC_LOOP=numba``): the same runs, the same errors, no numba
+imported; without a compiler the engine is numba's as before."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from springc.errors import SimulationError, UsageError
+from springc.simulation import c_loop_available, default_backend
+
+ROOT = Path(__file__).resolve().parents[2]
+SEED = str(ROOT / "models" / "SpringMass.mdl")
+ROOT_MODEL = """model Root
+  Real x(start = 1, fixed = true);
+equation
+  der(x) = -sqrt(x);
+end Root;
+"""
+BALL = """model Ball
+  Real h(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+equation
+  der(h) = v;
+  der(v) = -9.81;
+  when h < 0 then
+    reinit(v, -0.8 * pre(v));
+  end when;
+end Ball;
+"""
+C_REASON = ("dop853 ran in the compiled loop (C, no Python per step: a C compiler was "
+            "found; SPRINGC_LOOP=numba runs numba's)")
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def _run(monkeypatch: pytest.MonkeyPatch, loop: str, model: str, **options: object
+         ) -> springc.SimulationResult:  # type: ignore[name-defined]
+    monkeypatch.setenv("SPRINGC_LOOP", loop)
+    return springc.simulate(model, **options)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("solver", ["auto", "dop853", "rk45"])
+def test_the_seed_on_the_c_loop_equals_the_numba_loops_run(
+        monkeypatch: pytest.MonkeyPatch, solver: str) -> None:
+    c_run = _run(monkeypatch, "c", SEED, solver=solver, stop=5.0)
+    numba_run = _run(monkeypatch, "numba", SEED, solver=solver, stop=5.0)
+    assert c_run.stats.engine == numba_run.stats.engine == "compiled"
+    assert c_run.stats.steps == numba_run.stats.steps
+    assert c_run.stats.solver == numba_run.stats.solver
+    assert c_run.names == numba_run.names
+    scale = np.maximum(np.abs(numba_run.values).max(axis=0), 1.0)
+    assert (np.abs(c_run.values - numba_run.values) <= 1e-12 * scale).all()
+    if solver == "dop853":
+        assert c_run.stats.engine_reason == C_REASON
+
+
+def test_the_default_run_takes_the_c_loop_and_imports_no_numba(tmp_path: Path) -> None:
+    code = ("import sys, springc\n"
+            f"r = springc.simulate({SEED!r}, stop=1.0)\n"
+            "print(r.stats.engine, 'numba' in sys.modules)\n")
+    # the default (no SPRINGC_LOOP) where a compiler is found: the venv's ziglang at least
+    env = {"SPRINGC_CACHE_DIR": str(tmp_path / "fresh"), "PYTHONPATH": str(ROOT / "src"),
+           "PATH": "/usr/bin:/bin", "SPRINGC_QUIET": "1"}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                          text=True, timeout=600, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["compiled", "False"]
+
+
+def test_a_large_model_is_generated_for_numba(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    scenes = str(ROOT / "models" / "Scenes.mdl")
+    small = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 128})
+    large = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 129})
+    assert (len(small.states), small.module.BACKEND) == (256, "python")
+    assert (len(large.states), large.module.BACKEND) == (258, "numba")
+
+
+def test_a_domain_error_is_located_as_on_the_numba_loop(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    messages = []
+    for loop in ("c", "numba"):
+        monkeypatch.setenv("SPRINGC_LOOP", loop)  # (the backend follows it)
+        model = springc.load_model_from_string(ROOT_MODEL)
+        with pytest.raises(SimulationError) as caught:
+            springc.simulate(model, stop=3.0)
+        assert ("python" if loop == "c" else "numba") == model.module.BACKEND
+        messages.append(caught.value.message)
+    prefix = "math domain error while computing der(x) (<string>:4) at time "
+    assert all(m.startswith(prefix) for m in messages)
+    times = [float(m[len(prefix):]) for m in messages]
+    assert abs(times[0] - times[1]) <= 1e-12 * times[1]
+    assert 1.99 < times[0] < 2.01  # the root of (1 - t/2)^2
+
+
+def test_the_step_limit_stops_the_c_loop_where_it_stops_numbas(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    messages = []
+    for loop in ("c", "numba"):
+        with pytest.raises(SimulationError) as caught:
+            _run(monkeypatch, loop, SEED, solver="rk45", max_steps=30)
+        messages.append(caught.value.message)
+    head, tail = "the simulation stopped at time ", " far over the step limit (--max-steps 30)"
+    assert all(m.startswith(head) and m.endswith(tail) and " rk45 needs ~" in m
+               for m in messages)
+    times = [float(m[len(head):].split(":")[0]) for m in messages]
+    assert abs(times[0] - times[1]) <= 1e-8 * times[1]  # (printed to 9 digits)
+    assert 0.01 < times[0] < 0.2  # 30 steps of about 2 ms (the spring's period: 63 ms)
+
+
+def test_a_model_with_events_stays_on_numba(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    model = springc.load_model_from_string(BALL)
+    assert (model.kind, model.module.BACKEND) == ("hybrid", "numba")
+    result = springc.simulate(model, stop=1.0)
+    assert result.stats.engine == "compiled"
+    assert result.stats.state_events >= 1
+
+
+def test_without_a_compiler_the_engine_is_numbas(tmp_path: Path,
+                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("SPRINGC_LOOP", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.setitem(sys.modules, "ziglang", None)  # find_spec: not installed
+    assert not c_loop_available()
+    assert default_backend() == "numba"
+    result = springc.simulate(SEED, solver="dop853", stop=1.0)
+    assert result.stats.engine == "compiled" and result.stats.engine_reason == ""
+
+
+def test_a_bad_loop_choice_names_the_variable(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_LOOP", "fortran")
+    with pytest.raises(UsageError) as caught:
+        c_loop_available()
+    assert caught.value.message == "SPRINGC_LOOP must be c or numba (or unset), not 'fortran'"
