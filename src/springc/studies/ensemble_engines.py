@@ -221,12 +221,9 @@ def event_constructs(model: CompiledModel, shown: int = 3) -> str:
     return "; ".join(parts) or "when-clauses"
 
 
-def open_engine(model: CompiledModel, engine: str | None, device: str,
-                names: Sequence[str], fixed: Mapping[str, float], plan: Plan
-                ) -> tuple[str, Engine]:
-    """The engine's name and its chunk function. ``engine`` None: ``c`` on the CPU,
-    or ``numba`` where no C compiler is found (a choice fixed by measurement, see the
-    module text, never by the clock)."""
+def resolve_engine(engine: str | None, device: str) -> str:
+    """The engine's name without opening it (checked): ``gpu`` on the GPU, else as
+    asked, else ``c`` where a C compiler is found, else ``numba``."""
     if device not in DEVICES:
         raise UsageError(f"--device {device}: not one of {', '.join(DEVICES)}",
                          option="--device")
@@ -237,8 +234,28 @@ def open_engine(model: CompiledModel, engine: str | None, device: str,
         if engine == "numba":
             raise UsageError("--engine numba runs on the CPU; the GPU runs the C kernel",
                              option="--engine", hint="leave out --engine with --device gpu")
+        return "gpu"
+    if engine is not None:
+        return engine
+    from ..pipeline import CCompilerMissing, find_compiler
+
+    try:
+        find_compiler()
+    except CCompilerMissing:
+        return "numba"
+    return "c"
+
+
+def open_engine(model: CompiledModel, engine: str | None, device: str,
+                names: Sequence[str], fixed: Mapping[str, float], plan: Plan
+                ) -> tuple[str, Engine]:
+    """The engine's name and its chunk function. ``engine`` None: ``c`` on the CPU,
+    or ``numba`` where no C compiler is found (a choice fixed by measurement, see the
+    module text, never by the clock)."""
+    name = resolve_engine(engine, device)
+    if name == "gpu":
         return "gpu", gpu_engine(model, names, fixed, plan)
-    if engine == "numba":
+    if name == "numba":
         return "numba", numba_engine(model, names, fixed, plan)
     from ..pipeline import CCompilerMissing
 
