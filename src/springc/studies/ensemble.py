@@ -159,18 +159,19 @@ def run_table(options: EnsembleOptions) -> tuple[tuple[str, ...], np.ndarray]:
 
 
 def check_model(model: CompiledModel, device: str = "cpu") -> None:
-    """The ensemble engines run continuous models; on the GPU the error names the
-    model's event constructs (:func:`.ensemble_engines.event_constructs`)."""
+    """The ensemble engines run continuous and hybrid models (events in the C kernel);
+    delays and states that switch are refused by name, as are events without states."""
     module = model.module
-    engine = "the GPU engine" if device == "gpu" else "the ensemble engine"
-    for flag, what in (("EVENTS", "events (when, if on a state, sample...)"),
-                       ("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch")):
-        if not getattr(module, flag, False):
-            continue
-        if flag == "EVENTS" and device == "gpu":
-            what = f"events ({event_constructs(model)})"
-        raise SimulationError(f"{model.name} has {what}, which {engine} does not run "
-                              "yet", hint="use springc sweep (one run at a time)")
+    for flag, what in (("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch "
+                                                  "(dynamic state selection)")):
+        if getattr(module, flag, False):
+            raise SimulationError(f"{model.name} has {what}, which the ensemble engine "
+                                  "does not run yet",
+                                  hint="use springc sweep (one run at a time)")
+    if getattr(module, "EVENTS", False) and not model.states:
+        raise SimulationError(f"{model.name} has events ({event_constructs(model)}) but no "
+                              "states, which the ensemble engine does not run yet",
+                              hint="use springc sweep (one run at a time)")
 
 
 def check_bounds(model: CompiledModel, names: Sequence[str], values: np.ndarray,
@@ -221,12 +222,15 @@ def settings_of(model: CompiledModel, options: EnsembleOptions
     return output_grid(start, stop, interval), rtol, atol, max_steps
 
 
+UNSETTLED, CHATTERING = 8, 9  # springc.integrate.native_ensemble's hybrid statuses
 WORDS = {FAILED_PREPARATION: "the parameters or start values are not finite",
          1: "Required step size is less than spacing between numbers.",
          2: "the derivatives are not finite",
          3: "a variable is not finite",
          4: "the run reached the step limit (--max-steps {limit})",
-         5: "a nonlinear system did not converge"}
+         5: "a nonlinear system did not converge",
+         UNSETTLED: "the event iteration did not settle",
+         CHATTERING: "chattering (more than 100 events within 1e-6 of the simulated span)"}
 """The words of a failure's kind (:class:`springc.integrate.Status`), when the run is
 not run again to locate it."""
 
