@@ -250,3 +250,69 @@ def test_delays_switching_states_and_the_numba_engine_are_refused_by_name(
     assert refused.value.message == ("Ball has events (the relation h <= 0), which the "
                                      "numba ensemble engine does not run")
     assert not path.exists()
+
+
+DRAIN = """model Drain
+  parameter Real k = 1;
+  Real x(start = 1, fixed = true);
+equation
+  der(x) = -k * x;
+  when x < 0.5 then
+    terminate("half drained");
+  end when;
+end Drain;
+"""
+LAST = """model Last
+  parameter Real k = 1;
+  Real x(start = 1, fixed = true);
+  discrete Real atEnd(start = 0) "x at the terminal event";
+equation
+  der(x) = -k * x;
+  when time >= 0.35 then
+    reinit(x, 2 * pre(x));
+  end when;
+  when terminal() then
+    atEnd = x;
+  end when;
+end Last;
+"""
+
+
+def _against_simulate(model: CompiledModel, table: dict[str, list], spec: str,
+                      values: np.ndarray, **settings: float) -> None:
+    name = spec.split("=")[0]
+    for run, value in enumerate(values):
+        single = springc.simulate(model, solver="dop853", rtol=RTOL, atol=ATOL,
+                                  error_control="off", parameters={name: float(value)},
+                                  **settings)
+        t = single.time
+        for j, variable in enumerate(single.names):
+            series = single.values[:, j]
+            got = [table[f"{variable}.{s}"][run] for s in ("final", "min", "max", "mean")]
+            expected = [series[-1], series.min(), series.max(),
+                        np.trapezoid(series, t) / (t[-1] - t[0])]
+            np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-12,
+                                       err_msg=variable)
+
+
+def test_terminate_ends_each_run_at_its_own_time(cache: None, tmp_path: Path) -> None:
+    drain = springc.load_model_from_string(DRAIN)
+    table = _table(drain, tmp_path / "d.parquet", "k=0.5:3:6", stop=2.0, interval=0.1)
+    # ok: terminate() is the model's own end (x = 0.5 at t = ln 2 / k, before 2 s for
+    # k > 0.35); the statistics run to that time, as the single run's result does
+    assert table["status"] == ["ok"] * 6
+    np.testing.assert_allclose(table["x.final"], 0.5, rtol=1e-9)
+    _against_simulate(drain, table, "k=0.5:3:6", np.linspace(0.5, 3.0, 6), stop=2.0,
+                      interval=0.1)
+
+
+def test_a_time_event_and_the_terminal_event(cache: None, tmp_path: Path) -> None:
+    last = springc.load_model_from_string(LAST)
+    table = _table(last, tmp_path / "l.parquet", "k=0.5:2:4", stop=1.0, interval=0.05)
+    for run, k in enumerate(np.linspace(0.5, 2.0, 4)):
+        x = 2 * math.exp(-k)  # doubled at 0.35 s
+        assert abs(table["x.final"][run] - x) <= 1e-8
+        assert table["atEnd.final"][run] == table["x.final"][run]
+        assert table["atEnd.min"][run] == 0.0  # 0 up to the last row
+    _against_simulate(last, table, "k=0.5:2:4", np.linspace(0.5, 2.0, 4), stop=1.0,
+                      interval=0.05)
