@@ -20,8 +20,8 @@ cores: compare the CPU seconds, which move far less with the load). 10^6 runs ar
 projected from the CPU seconds per run only when not measured, and labelled so.
 
 ``--ball N``: a hybrid model instead, ``EventScenes.BouncingBall`` (e = 0.8) over N
-values of ``g`` from 9 to 10.5 (1 to 7 bounces... up to 20 by 3.5 s: the bounces
-accumulate after 3.9 s at g = 10.5), 0..3.5 s, rtol 1e-8, atol 1e-10, final values of
+values of ``g`` from 9 to 10.5 (8 to 10 bounces by 3.5 s; the bounces accumulate
+after 3.9 s at g = 10.5), 0..3.5 s, rtol 1e-8, atol 1e-10, final values of
 h, v and bounces: ``run_ensemble`` (C engine, events in the kernel) against ``springc
 sweep`` of the same runs (dop853, the same tolerances, error control off, local
 processes), CPU seconds of this process and its worker processes (``RUSAGE_CHILDREN``),

@@ -76,11 +76,12 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              traj_file: str | None, traj_patterns: tuple[str, ...], every: int,
              engine: str | None, device: str, threads: int | None, scheduler: str | None,
              output: str) -> None:
-    """Run a continuous model over many parameter sets in compiled code, into Parquet.
+    """Run a model over many parameter sets in compiled code, into Parquet.
 
     Every run is integrated with compiled DOP853 in a loop over the runs on every core
     (or one GPU thread per run with --device gpu; no Python per run); each run has its
-    own steps and its own status, and a failed run is recorded with its error. OUTPUT
+    own steps, its own events (hybrid models: the C engine) and its own status, and a
+    failed run is recorded with its error. OUTPUT
     gets one row per run: its parameters, status, error, step counts, and the final
     value, min, max, time-weighted mean and time of the max of each variable (--vars;
     default: all; --stats picks among them). Use --interval to set the grid the
