@@ -18,12 +18,23 @@ of issue 29's diffrax anchor), rtol 1e-6, atol 1e-9, from 0 to the stop time (de
 The load average is printed before and after (other jobs on a shared machine take
 cores: compare the CPU seconds, which move far less with the load). 10^6 runs are
 projected from the CPU seconds per run only when not measured, and labelled so.
+
+``--ball N``: a hybrid model instead, ``EventScenes.BouncingBall`` (e = 0.8) over N
+values of ``g`` from 9 to 10.5 (8 to 10 bounces by 3.5 s; the bounces accumulate
+after 3.9 s at g = 10.5), 0..3.5 s, rtol 1e-8, atol 1e-10, final values of
+h, v and bounces: ``run_ensemble`` (C engine, events in the kernel) against ``springc
+sweep`` of the same runs (dop853, the same tolerances, error control off, local
+processes), CPU seconds of this process and its worker processes (``RUSAGE_CHILDREN``),
+and the largest difference of their final states. ``--sweep-runs M`` runs the sweep
+on the first M of the N values only (its CPU seconds per run are then scaled to N,
+and labelled so).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import tempfile
 import time
 from pathlib import Path
@@ -32,6 +43,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 SEED = ROOT / "models" / "SpringMass.mdl"
+EVENTS = ROOT / "models" / "EventScenes.mdl"
 RTOL, ATOL = 1e-6, 1e-9
 
 
@@ -41,8 +53,15 @@ def main() -> None:
                         help="numbers of runs (default 10^4)")
     parser.add_argument("--engines", default="c,numba", help="engines (c,numba)")
     parser.add_argument("--stop", type=float, default=10.0, help="stop time [s]")
+    parser.add_argument("--ball", type=int, default=0, metavar="N",
+                        help="N bouncing-ball runs: the C engine against sweep")
+    parser.add_argument("--sweep-runs", type=int, default=None, metavar="M",
+                        help="with --ball: sweep the first M runs only")
     args = parser.parse_args()
     os.environ.setdefault("SPRINGC_CACHE_DIR", tempfile.mkdtemp(prefix="springc-bench-"))
+    if args.ball:
+        ball(args.ball, args.sweep_runs or args.ball)
+        return
     import springc
     from springc.integrate import dop853
     from springc.studies import EnsembleOptions, parse_parameter, run_ensemble
@@ -99,6 +118,61 @@ def main() -> None:
     if n < 1_000_000:
         print(f"projected (not measured) 10^6 runs end to end on {cores} idle cores: "
               f"{1e6 * cpu / n / cores:.0f} s (CPU seconds per run x 10^6 / cores)")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+def cpu_seconds() -> float:
+    """User + system CPU seconds of this process and of its waited-for children."""
+    me = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + children.ru_utime + children.ru_stime
+
+
+def ball(n: int, m: int) -> None:
+    """N bouncing-ball runs: the C engine (events in the kernel) against sweep."""
+    import pyarrow.parquet as pq
+
+    import springc
+    from springc.studies import EnsembleOptions, parse_parameter, run_ensemble
+
+    print(f"load average before: {os.getloadavg()[0]:.2f}; cpus: {os.cpu_count()}")
+    model = springc.compile_model([str(EVENTS)], "EventScenes.BouncingBall")
+    values = np.linspace(9.0, 10.5, n)
+    settings = {"stop": 3.5, "interval": 3.5, "rtol": 1e-8, "atol": 1e-10}
+    with tempfile.TemporaryDirectory() as folder:
+        path = str(Path(folder) / "e.parquet")
+        run_ensemble(model, EnsembleOptions((parse_parameter("g=9,10"),), **settings),
+                     path)  # the kernel built before the clock starts
+        options = EnsembleOptions((parse_parameter(f"g=9:10.5:{n}"),),
+                                  variables=("h", "v", "bounces"), **settings)
+        wall, cpu = time.perf_counter(), cpu_seconds()
+        summary = run_ensemble(model, options, path)
+        wall, cpu = time.perf_counter() - wall, cpu_seconds() - cpu
+        table = pq.read_table(path).to_pydict()
+    assert summary.failed == 0, summary
+    print(f"| C engine (run_ensemble) | {n:,} | {wall:.2f} | {cpu:.2f} | "
+          f"{cpu / n * 1e3:.3f} |")
+    measured = []
+    for count in sorted({max(1, m // 5), m}):
+        wall, cpu = time.perf_counter(), cpu_seconds()
+        study = springc.sweep(model, params={"g": values[:count].tolist()}, solver="dop853",
+                              error_control="off", as_="dataframe", **settings)
+        wall, cpu = time.perf_counter() - wall, cpu_seconds() - cpu
+        assert (study.groupby("run")["status"].first() == "ok").all()
+        measured.append((count, cpu))
+        print(f"| sweep (local processes) | {count:,} | {wall:.2f} | {cpu:.2f} | "
+              f"{cpu / count * 1e3:.3f} |")
+    if m < n and len(measured) == 2:  # the workers' start is a fixed cost: the slope
+        (a, ca), (b, cb) = measured
+        marginal = (cb - ca) / (b - a)
+        print(f"sweep projected (not measured) to {n:,} runs: {cb + marginal * (n - b):.1f} "
+              f"CPU s ({marginal * 1e3:.2f} CPU ms per further run)")
+    last = study.groupby("run").last()
+    worst = 0.0
+    for name in ("h", "v", "bounces"):
+        got = np.array(table[f"{name}.final"][:m])
+        worst = max(worst, float(np.max(np.abs(got - last[name].to_numpy()))))
+    print(f"largest difference of the final h, v, bounces (C engine vs sweep): {worst:.1e}")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -134,16 +134,16 @@ def test_a_table_of_runs_from_csv(model: CompiledModel, tmp_path: Path) -> None:
                               "finite number")
 
 
-def test_a_model_with_events_is_refused_by_name(tmp_path: Path) -> None:
-    ball = springc.load_model_from_string(
-        "model Ball\n  Real h(start = 1);\n  Real v;\nequation\n  der(h) = v;\n"
-        "  der(v) = -9.81;\n  when h < 0 then\n    reinit(v, -0.8 * pre(v));\n"
-        "  end when;\nend Ball;\n")
+def test_a_model_with_events_but_no_states_is_refused_by_name(tmp_path: Path) -> None:
+    clock = springc.load_model_from_string(
+        "model Clock\n  parameter Real step = 1;\n  discrete Real n(start = 0);\n"
+        "  Real s = step;\nequation\n  when sample(0, 0.1) then\n"
+        "    n = pre(n) + step;\n  end when;\nend Clock;\n")
     with pytest.raises(SimulationError) as refused:
-        run_ensemble(ball, EnsembleOptions((parse_parameter("h=1,2"),)),
+        run_ensemble(clock, EnsembleOptions((parse_parameter("step=1,2"),)),
                      str(tmp_path / "e.parquet"))
-    assert refused.value.message == ("Ball has events (when, if on a state, sample...), "
-                                     "which the ensemble engine does not run yet")
+    assert refused.value.message == ("Clock has events (sample(...)) but no "
+                                     "states, which the ensemble engine does not run yet")
     assert not (tmp_path / "e.parquet").exists()
 
 

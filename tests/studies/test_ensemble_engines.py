@@ -18,7 +18,7 @@ from click.testing import CliRunner
 
 import springc
 from springc.cli import main
-from springc.errors import SimulationError, UsageError
+from springc.errors import UsageError
 from springc.pipeline import CompiledModel
 from springc.studies import (
     EnsembleOptions,
@@ -133,13 +133,19 @@ def test_the_gpu_without_cupy_is_a_clear_error(model: CompiledModel, tmp_path: P
     assert not (tmp_path / "e.parquet").exists()
 
 
-def test_a_hybrid_model_on_the_gpu_is_refused_naming_its_relation(tmp_path: Path) -> None:
-    ball = springc.load_model_from_string(BALL)
-    with pytest.raises(SimulationError) as refused:
-        run_ensemble(ball, EnsembleOptions((parse_parameter("h=1,2"),), device="gpu"),
+def test_a_hybrid_model_on_a_machine_without_a_gpu_is_the_same_clear_error(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # hybrid models run on the GPU as on the CPU (the same kernel text, compiled as CUDA:
+    # tests/studies/test_ensemble_hybrid.py runs that text as C++)
+    monkeypatch.setitem(sys.modules, "cupy", None)
+    ball = springc.load_model_from_string(BALL.replace("Real h(start = 1)",
+                                                       "parameter Real h0 = 1;\n  "
+                                                       "Real h(start = h0)"))
+    with pytest.raises(UsageError) as refused:
+        run_ensemble(ball, EnsembleOptions((parse_parameter("h0=1,2"),), device="gpu"),
                      str(tmp_path / "e.parquet"))
-    assert refused.value.message == ("Ball has events (the relation h < 0), which the GPU "
-                                     "engine does not run yet")
+    assert refused.value.message.startswith("--device gpu: no CUDA device found (CuPy")
+    assert not (tmp_path / "e.parquet").exists()
 
 
 def test_a_model_with_an_initial_problem_starts_from_its_solution(tmp_path: Path) -> None:

@@ -58,7 +58,11 @@ from .options import (
               show_default=True, help="gpu: the C kernel on an NVIDIA GPU through CuPy, "
               "one thread per run.")
 @click.option("--threads", type=click.IntRange(min=1), default=None,
-              help="CPU threads (default: every core; the results do not depend on it).")
+              help="CPU threads (default: every core; with --scheduler, per task: 1; the "
+              "results do not depend on it).")
+@click.option("--scheduler", metavar="ADDRESS", help="Run each chunk as a task on the Dask "
+              "scheduler at ADDRESS (tcp://host:8786), as sweep does; the same results. "
+              "--chunk default: about four tasks per worker thread.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False), required=True,
               help="The ensemble table (.parquet): one row per run.")
 @verbosity_options("No summary line and no status line (\"springc: compiling ...\").")
@@ -70,12 +74,14 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
              method: str, seed: int, rtol: float | None, atol: float | None,
              max_steps: int | None, chunk: int | None, stats: str | None,
              traj_file: str | None, traj_patterns: tuple[str, ...], every: int,
-             engine: str | None, device: str, threads: int | None, output: str) -> None:
-    """Run a continuous model over many parameter sets in compiled code, into Parquet.
+             engine: str | None, device: str, threads: int | None, scheduler: str | None,
+             output: str) -> None:
+    """Run a model over many parameter sets in compiled code, into Parquet.
 
     Every run is integrated with compiled DOP853 in a loop over the runs on every core
     (or one GPU thread per run with --device gpu; no Python per run); each run has its
-    own steps and its own status, and a failed run is recorded with its error. OUTPUT
+    own steps, its own events (hybrid models: the C engine) and its own status, and a
+    failed run is recorded with its error. OUTPUT
     gets one row per run: its parameters, status, error, step counts, and the final
     value, min, max, time-weighted mean and time of the max of each variable (--vars;
     default: all; --stats picks among them). Use --interval to set the grid the
@@ -115,7 +121,7 @@ def ensemble(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                                   statistics=statistics,
                                   trajectories=trajectory_names(compiled, traj_patterns),
                                   every=every, engine=engine, device=device,
-                                  threads=threads)
+                                  threads=threads, scheduler=scheduler)
         summary = run_ensemble(compiled, options, output, files, traj_file)
     if not quiet:
         click.echo(f"{compiled.name}: {summary.summary_line()}", err=True)

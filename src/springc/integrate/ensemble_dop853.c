@@ -15,10 +15,24 @@
    single-run loop).
 
    The arithmetic is springc.integrate.dop853_kernel's with plain-loop sums (the same
-   controller, error norm, initial step and dense output, every sum in the same order),
-   without zero crossings. Each run reads its own inputs and writes only its own rows
-   of the outputs; nothing is reduced across runs, so the results are the same bytes
-   whatever the number of threads. */
+   controller, error norm, initial step and dense output, every sum in the same order).
+   Each run reads its own inputs and writes only its own rows of the outputs; nothing
+   is reduced across runs, so the results are the same bytes whatever the number of
+   threads.
+
+   A hybrid model (SPRINGC_HYBRID 1) runs springc.simulation.hybrid_compiled's event
+   loop inside the kernel, each run with its own events: the event at the start
+   (springc_event_update with z[SPRINGC_Z_INITIAL] set, twice with
+   SPRINGC_AFTER_INITIAL); steps up to the next time event (springc_next_time_event,
+   a step ends on it exactly); after each accepted step the zero-crossing functions
+   against the held relations (SC_POSITIVE: relation k is > or >=), the earliest
+   crossing located by bisection on the dense output to springc.integrate.crossings'
+   time tolerance, the output times before it filled, then the event update and a
+   restart with a fresh initial step; the rows at an event's time get the values after
+   it; at the stop time its time event and, with SPRINGC_USES_TERMINAL, the terminal
+   event before the last row. More than SC_BURST events within SC_ZENO of the span is
+   chattering (SC_CHATTERING), an event iteration that does not settle SC_UNSETTLED,
+   and terminate() ends the run there (ok, its statistics up to that time). */
 
 #ifndef SC_LANES
 #define SC_LANES 1
@@ -31,7 +45,19 @@
 #define SC_AT_P (31 * SC_NXS)
 #define SC_AT_Z (SC_AT_P + SC_NPS)
 #define SC_AT_OBS (SC_AT_Z + SC_NZS)
+#ifndef SPRINGC_HYBRID
+#define SPRINGC_HYBRID 0
+#endif
+#if SPRINGC_HYBRID
+#define SC_NGS (SPRINGC_N_CROSSINGS > 0 ? SPRINGC_N_CROSSINGS : 1)
+#define SC_BURST 100      /* springc.simulation.events.EVENT_BURST */
+#define SC_ZENO 1e-6      /* springc.simulation.events.ZENO_FRACTION */
+#define SC_AT_G (SC_AT_OBS + SC_NOS)          /* g at the step's start, end, a trial */
+#define SC_AT_RING (SC_AT_G + 3 * SC_NGS)     /* the times of the last SC_BURST events */
+#define SC_WORK (SC_AT_RING + SC_BURST)
+#else
 #define SC_WORK (SC_AT_OBS + SC_NOS)
+#endif
 #define SC_HUGE 1.7976931348623157e308
 
 typedef long long sc_int;
@@ -89,10 +115,11 @@ SC_FN void sc_emit(const sc_settings *s, const sc_outputs *o, sc_int k, const do
     }
 }
 
-/* The end of a run: its status, counts, time and state. */
+/* The end of a run: its status, counts, time and state; `last` is the time of its
+   last output (the stop time, or where terminate() ended it). */
 SC_FN void sc_finish(const sc_settings *s, const sc_outputs *o, int status, sc_int accepted,
                      sc_int rejected, sc_int nfev, double t, const double *x,
-                     const double *z) {
+                     const double *z, double last) {
     o->status[0] = status;
     o->counts[0] = accepted;
     o->counts[1] = rejected;
@@ -100,23 +127,26 @@ SC_FN void sc_finish(const sc_settings *s, const sc_outputs *o, int status, sc_i
     o->counts[3] = SPRINGC_N_Z > 0 ? (sc_int)z[SC_NZS - 1] : 0;
     o->failure_time[0] = t;
     for (int i = 0; i < SC_NX; i++) o->final[i] = x[i];
-    double span = s->grid[s->m - 1] - s->grid[0];
+    double span = last - s->grid[0];
     for (sc_int c = 0; c < s->n_columns; c++) {
         double *out = o->summary + 5 * c;
         if (status != SC_SUCCESS) {
             for (int q = 0; q < 5; q++) out[q] = NAN;
         } else {
-            out[3] = s->m > 1 ? out[3] / span : out[0];
+            out[3] = s->m > 1 && span > 0 ? out[3] / span : out[0];
         }
     }
 }
 
-/* The output times in (t, t_new]: the states there (and the observed variables). */
+/* The output times in (t, t_new] (below row `last`; before an event at t_event that
+   `stops` the step: in (t, t_event)): the states there (and the observed variables). */
 SC_FN int sc_outputs_in_step(const sc_settings *s, const sc_outputs *o, sc_int *filled,
                              double t, double t_new, double h, const double *y,
                              const double *y_new, const double *F, double *xo, double *obs,
-                             const double *p, double *z) {
-    while (*filled < s->m && s->grid[*filled] <= t_new) {
+                             const double *p, double *z, double t_event, int stops,
+                             sc_int last) {
+    while (*filled < last && (s->grid[*filled] < t_event
+                              || (s->grid[*filled] == t_event && !stops))) {
         double tk = s->grid[*filled];
         if (tk == t_new) {
             for (int i = 0; i < SC_NX; i++) xo[i] = y_new[i];
@@ -187,7 +217,9 @@ typedef struct {
     int retry;   /* the last attempt was rejected */
     int ready;   /* between the start of an attempt and its end */
     double t, h_abs, h, t_new, min_step;
-    sc_int accepted, rejected, nfev, filled;
+    double t_stop;  /* the next time event (SC_HUGE: none before the stop time) */
+    double last;    /* the time of the run's last output */
+    sc_int accepted, rejected, nfev, filled, events;
     sc_outputs o;
     double *w;   /* its work array (layout SC_AT_*) */
 } sc_lane;
@@ -208,7 +240,7 @@ SC_FN sc_int sc_take(sc_job *job) {
 
 SC_FN void sc_end(sc_lane *L, const sc_job *job, int status, double t, const double *x) {
     sc_finish(&job->s, &L->o, status, L->accepted, L->rejected, L->nfev, t, x,
-              L->w + SC_AT_Z);
+              L->w + SC_AT_Z, L->last);
     L->run = -1;
     L->ready = 0;
 }
@@ -232,44 +264,138 @@ SC_FN int sc_inputs(const sc_job *job, sc_int r, double *y, double *p, double *z
     return code == 0;
 }
 
-/* Lane L takes run r: its inputs, outputs at the start, the initial step. 1 if the run
-   needs steps, 0 if it has ended already. */
-SC_FN int sc_start(sc_lane *L, const sc_job *job, sc_int r) {
+#if SPRINGC_HYBRID
+/* The side of relation k's zero-crossing function that its held value assumes: +1 where
+   the relation holds for g > 0 (springc.simulation.hybrid_compiled.held_signs). */
+SC_FN double sc_sign(const double *z, int k) {
+    int held = z[SPRINGC_Z_RELATIONS + k] != 0.0, positive = SC_POSITIVE[k] != 0.0;
+    return held == positive ? 1.0 : -1.0;
+}
+
+/* Whether a function crossed from g0 to g1 against its held sign (.crossings). */
+SC_FN int sc_crossed(const double *g0, const double *g1, const double *z) {
+    int any = 0;
+    for (int k = 0; k < SPRINGC_N_CROSSINGS; k++) {
+        double sign = sc_sign(z, k);
+        if (sign * g0[k] >= 0.0 && sign * g1[k] < 0.0) any = 1;
+    }
+    return any;
+}
+
+/* The bracket width at which a crossing in (t, t_new] is located (.crossings). */
+SC_FN double sc_time_tolerance(double t, double t_new) {
+    double width = 1e-12 * sc_max(sc_max(fabs(t), fabs(t_new)), t_new - t);
+    double ulp = nextafter(fabs(t_new), SC_HUGE) - fabs(t_new);
+    return sc_max(width, 4.0 * ulp);
+}
+
+/* The event at L->t on the lane's state (the event iteration, in place): SC_SUCCESS or
+   why the run ends; `counted` events (state and time events) are checked for
+   chattering; *stop is set where terminate() was called. */
+SC_FN int sc_event(sc_lane *L, const sc_job *job, int counted, int *stop) {
+    double *w = L->w, *z = w + SC_AT_Z, *ring = w + SC_AT_RING;
+    int code = springc_event_update(L->t, w + SC_AT_Y, w + SC_AT_P, z);
+    if (code > 0 || sc_flagged(z)) return SC_MODEL_FAILED;
+    if (code == -1) return SC_UNSETTLED;
+    if (counted) {
+        const sc_settings *s = &job->s;
+        ring[L->events % SC_BURST] = L->t;
+        L->events += 1;
+        double oldest = ring[L->events % SC_BURST];
+        if (L->events >= SC_BURST
+            && L->t - oldest <= SC_ZENO * (s->grid[s->m - 1] - s->grid[0]))
+            return SC_CHATTERING;
+    }
+    if (code == -2) *stop = 1;
+    return SC_SUCCESS;
+}
+
+/* The rows at L->t (below row `last`) with the lane's state: the values after an event. */
+SC_FN int sc_rows_at(sc_lane *L, const sc_job *job, sc_int last) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *y = w + SC_AT_Y, *obs = w + SC_AT_OBS;
+    while (L->filled < last && s->grid[L->filled] <= L->t) {
+        if (s->need_observed) {
+            springc_observed(L->t, y, w + SC_AT_P, w + SC_AT_Z, obs);
+            if (sc_flagged(w + SC_AT_Z)) return SC_MODEL_FAILED;
+        }
+        sc_emit(s, &L->o, L->filled, y, obs);
+        L->filled += 1;
+    }
+    return SC_SUCCESS;
+}
+
+/* A run ended by terminate() at L->t: without a row at that time, one more (its
+   values after the event) enters the statistics, as springc.simulate's result ends. */
+SC_FN void sc_terminated(sc_lane *L, const sc_job *job) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *y = w + SC_AT_Y, *obs = w + SC_AT_OBS;
+    double previous = s->grid[L->filled - 1];  /* row 0 is always written */
+    L->last = previous;
+    if (previous < L->t) {
+        if (s->need_observed) {
+            springc_observed(L->t, y, w + SC_AT_P, w + SC_AT_Z, obs);
+            if (sc_flagged(w + SC_AT_Z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return; }
+        }
+        for (sc_int c = 0; c < s->n_columns; c++) {
+            sc_int j = s->columns[c];
+            double v = j < SC_NX ? y[j] : obs[j - SC_NX];
+            double *out = L->o.summary + 5 * c;
+            if (v < out[1]) out[1] = v;
+            if (v > out[2]) { out[2] = v; out[4] = L->t; }
+            out[3] += 0.5 * (v + out[0]) * (L->t - previous);
+            out[0] = v;
+        }
+        L->last = L->t;
+    }
+    sc_end(L, job, SC_SUCCESS, L->t, y);
+}
+
+/* The end of a run at the stop time (with the time event there where `time_event`),
+   the terminal event, then the last row. */
+SC_FN void sc_final(sc_lane *L, const sc_job *job, int time_event) {
+    const sc_settings *s = &job->s;
+    double *w = L->w, *y = w + SC_AT_Y, *z = w + SC_AT_Z;
+    int stop = 0, status = SC_SUCCESS;
+    if (time_event) {
+        double before = L->t - 2e-12 * sc_max(1.0, fabs(L->t));
+        if (springc_next_time_event(before, y, w + SC_AT_P, z) == L->t)
+            status = sc_event(L, job, 1, &stop);
+    }
+    if (status == SC_SUCCESS && stop) { sc_terminated(L, job); return; }
+    if (status == SC_SUCCESS && SPRINGC_USES_TERMINAL) {
+        z[SPRINGC_Z_TERMINAL] = 1.0;
+        status = sc_event(L, job, 0, &stop);
+    }
+    if (status == SC_SUCCESS) status = sc_rows_at(L, job, s->m);
+    sc_end(L, job, status, L->t, y);
+}
+#endif
+
+/* From (L->t, y) at the start or after an event: the next time event and the
+   zero-crossing functions there (hybrid), the derivative and a fresh initial step. 1
+   if the run needs steps, 0 if it has ended. */
+SC_FN int sc_restart(sc_lane *L, const sc_job *job) {
     const sc_settings *s = &job->s;
     double *w = L->w, *K = w, *work = w + 24 * SC_NXS, *scale = w + 26 * SC_NXS;
-    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z, *obs = w + SC_AT_OBS;
-    L->run = r;
+    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z;
+    double t_end = s->grid[s->m - 1];
     L->retry = 0;
-    L->accepted = L->rejected = L->nfev = 0;
-    L->filled = 1;
-    L->t = s->grid[0];
-    L->o.summary = job->all.summary + r * 5 * s->n_columns;
-    L->o.traj = job->all.traj + r * s->n_traj_points * s->n_traj;
-    L->o.final = job->all.final + r * SC_NX;
-    L->o.status = job->all.status + r;
-    L->o.counts = job->all.counts + 4 * r;
-    L->o.failure_time = job->all.failure_time + r;
-    if (!sc_inputs(job, r, y, p, z)) { sc_end(L, job, SC_BAD_START, L->t, y); return 0; }
-
-    /* Step 1: the start and its outputs. */
-    if (s->need_observed) {
-        springc_observed(L->t, y, p, z, obs);
-        if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return 0; }
-    }
-    sc_emit(s, &L->o, 0, y, obs);
-    if (s->m == 1 || SC_NX == 0) {
-        for (sc_int k = 1; k < s->m; k++) sc_emit(s, &L->o, k, y, obs);
-        sc_end(L, job, SC_SUCCESS, L->t, y);
-        return 0;
-    }
+    L->t_stop = SC_HUGE;
+#if SPRINGC_HYBRID
+    double t_event = springc_next_time_event(L->t, y, p, z);
+    if (L->t < t_event && t_event < t_end) L->t_stop = t_event;
+    springc_zero_crossings(L->t, y, p, z, w + SC_AT_G);
+    if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return 0; }
+#endif
     springc_rhs(L->t, y, p, z, K);
-    L->nfev = 1;
+    L->nfev += 1;
     int status = sc_verdict(K, z);
     if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
 
     /* Step 2: the initial step. */
-    double h0 = 0.0, t_end = s->grid[s->m - 1];
-    L->h_abs = sc_first_step(s, L->t, y, K, work, scale, p, z, fabs(t_end - L->t), &status,
+    double h0 = 0.0, limit = sc_min(t_end, L->t_stop);
+    L->h_abs = sc_first_step(s, L->t, y, K, work, scale, p, z, fabs(limit - L->t), &status,
                              &L->nfev, &h0);
     if (status != SC_SUCCESS) {
         int small = status == SC_STEP_TOO_SMALL;
@@ -279,11 +405,56 @@ SC_FN int sc_start(sc_lane *L, const sc_job *job, sc_int r) {
     return 1;
 }
 
+/* Lane L takes run r: its inputs, outputs at the start, the initial step. 1 if the run
+   needs steps, 0 if it has ended already. */
+SC_FN int sc_start(sc_lane *L, const sc_job *job, sc_int r) {
+    const sc_settings *s = &job->s;
+    double *w = L->w;
+    double *y = w + SC_AT_Y, *p = w + SC_AT_P, *z = w + SC_AT_Z, *obs = w + SC_AT_OBS;
+    L->run = r;
+    L->retry = 0;
+    L->accepted = L->rejected = L->nfev = L->events = 0;
+    L->filled = 1;
+    L->t = s->grid[0];
+    L->last = s->grid[s->m - 1];
+    L->o.summary = job->all.summary + r * 5 * s->n_columns;
+    L->o.traj = job->all.traj + r * s->n_traj_points * s->n_traj;
+    L->o.final = job->all.final + r * SC_NX;
+    L->o.status = job->all.status + r;
+    L->o.counts = job->all.counts + 4 * r;
+    L->o.failure_time = job->all.failure_time + r;
+    if (!sc_inputs(job, r, y, p, z)) { sc_end(L, job, SC_BAD_START, L->t, y); return 0; }
+#if SPRINGC_HYBRID
+    /* Step 0: the event at the start (and the one after it for 'not initial()'). */
+    int stop = 0;
+    z[SPRINGC_Z_INITIAL] = 1.0;
+    int code = sc_event(L, job, 0, &stop);
+    if (code == SC_SUCCESS && SPRINGC_AFTER_INITIAL && !stop) code = sc_event(L, job, 0, &stop);
+    if (code != SC_SUCCESS) { sc_end(L, job, code, L->t, y); return 0; }
+#endif
+
+    /* Step 1: the start and its outputs. */
+    if (s->need_observed) {
+        springc_observed(L->t, y, p, z, obs);
+        if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t, y); return 0; }
+    }
+    sc_emit(s, &L->o, 0, y, obs);
+#if SPRINGC_HYBRID
+    if (stop) { L->last = L->t; sc_end(L, job, SC_SUCCESS, L->t, y); return 0; }
+#endif
+    if (s->m == 1 || SC_NX == 0) {
+        for (sc_int k = 1; k < s->m; k++) sc_emit(s, &L->o, k, y, obs);
+        sc_end(L, job, SC_SUCCESS, L->t, y);
+        return 0;
+    }
+    return sc_restart(L, job);
+}
+
 /* The start of an attempt (Step 3 of dop853_run): the step limit, the step size. 1 if
    the lane goes on to the stages, 0 if its run has ended. */
 SC_FN int sc_attempt(sc_lane *L, const sc_job *job) {
     const sc_settings *s = &job->s;
-    double *y = L->w + SC_AT_Y, t_end = s->grid[s->m - 1];
+    double *y = L->w + SC_AT_Y, limit = sc_min(s->grid[s->m - 1], L->t_stop);
     if (!L->retry) {
         if (s->max_steps > 0 && L->accepted + L->rejected >= s->max_steps) {
             sc_end(L, job, SC_MAX_STEPS, L->t, y);
@@ -295,7 +466,7 @@ SC_FN int sc_attempt(sc_lane *L, const sc_job *job) {
     }
     if (L->h_abs < L->min_step) { sc_end(L, job, SC_STEP_TOO_SMALL, L->t, y); return 0; }
     L->t_new = L->t + L->h_abs;
-    if (L->t_new - t_end > 0) L->t_new = t_end;
+    if (L->t_new - limit > 0) L->t_new = limit;
     L->h = L->t_new - L->t;
     L->h_abs = fabs(L->h);
     L->ready = 1;
@@ -341,23 +512,76 @@ SC_FN int sc_conclude(sc_lane *L, const sc_job *job) {
     L->h_abs *= factor;
     L->retry = 0;
     L->accepted += 1;
-    if (L->filled < s->m && s->grid[L->filled] <= L->t_new) {
+    double t_end = s->grid[s->m - 1], t_event = L->t_new;
+    int event = 0, stops = 0;
+    sc_int last = s->m;
+#if SPRINGC_HYBRID
+    /* Step 4: a crossing in (t, t_new]? The last row waits for the events at the end. */
+    double *g0 = w + SC_AT_G, *g1 = g0 + SC_NGS, *gt = g1 + SC_NGS;
+    if (SPRINGC_N_CROSSINGS > 0) {
+        springc_zero_crossings(L->t_new, y_new, p, z, g1);
+        if (sc_flagged(z)) { sc_end(L, job, SC_MODEL_FAILED, L->t_new, y_new); return 0; }
+        event = sc_crossed(g0, g1, z);
+    }
+    stops = event || (L->t_new == L->t_stop && L->t_stop < t_end);
+    last = s->m - 1;
+#endif
+    if (event || (L->filled < last && s->grid[L->filled] <= L->t_new)) {
         for (int st = SC_STAGES + 1; st < SC_EXTENDED; st++)
             if (!sc_stage_of(L, job, st)) return 0;
         sc_interpolant(y, y_new, K, h, F, sums);
+    }
+#if SPRINGC_HYBRID
+    /* Step 6: the earliest crossing, by bisection on the dense output. */
+    if (event) {
+        double low = t, high = L->t_new, tolerance = sc_time_tolerance(t, L->t_new);
+        double *at = w + 24 * SC_NXS;
+        while (high - low > tolerance) {
+            double middle = low + 0.5 * (high - low);
+            if (middle <= low || middle >= high) break;
+            sc_interpolate(F, y, (middle - t) / h, at);
+            springc_zero_crossings(middle, at, p, z, gt);
+            if (sc_crossed(g0, gt, z)) high = middle;
+            else low = middle;
+        }
+        t_event = high;
+        if (high < L->t_new) sc_interpolate(F, y, (high - t) / h, y_new);
+    }
+#endif
+    if (L->filled < last && s->grid[L->filled] <= L->t_new) {
         status = sc_outputs_in_step(s, &L->o, &L->filled, t, L->t_new, h, y, y_new, F, xo,
-                                    w + SC_AT_OBS, p, z);
+                                    w + SC_AT_OBS, p, z, t_event, stops, last);
         if (status != SC_SUCCESS) {
             sc_end(L, job, status, s->grid[L->filled], xo);
             return 0;
         }
     }
-    L->t = L->t_new;
+    L->t = t_event;
     for (int i = 0; i < SC_NX; i++) {
         y[i] = y_new[i];
         K[i] = K[SC_STAGES * SC_NXS + i];
     }
-    if (!(L->t < s->grid[s->m - 1])) { sc_end(L, job, SC_SUCCESS, L->t, y); return 0; }
+#if SPRINGC_HYBRID
+    for (int k = 0; k < SPRINGC_N_CROSSINGS; k++) g0[k] = g1[k];
+    if (stops) {  /* Step 7: the event, the rows at its time, the restart */
+        int stop = 0;
+        status = sc_event(L, job, 1, &stop);
+        if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
+        if (stop) {
+            status = sc_rows_at(L, job, last);
+            if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
+            sc_terminated(L, job);
+            return 0;
+        }
+        if (!(L->t < t_end)) { sc_final(L, job, 0); return 0; }
+        status = sc_rows_at(L, job, last);
+        if (status != SC_SUCCESS) { sc_end(L, job, status, L->t, y); return 0; }
+        return sc_restart(L, job);
+    }
+    if (!(L->t < t_end)) { sc_final(L, job, 1); return 0; }
+#else
+    if (!(L->t < t_end)) { sc_end(L, job, SC_SUCCESS, L->t, y); return 0; }
+#endif
     return 1;
 }
 

@@ -52,19 +52,23 @@ def cupy_module() -> Any:
     return cupy
 
 
-def work_bytes(n_states: int, n_params: int, n_z: int, n_observed: int) -> int:
-    """The bytes of one thread's work array (``SC_WORK`` of the kernel)."""
-    return 8 * (31 * max(n_states, 1) + max(n_params, 1) + max(n_z, 1) + max(n_observed, 1))
+def work_bytes(n_states: int, n_params: int, n_z: int, n_observed: int,
+               crossings: int | None = None) -> int:
+    """The bytes of one thread's work array (``SC_WORK`` of the kernel; ``crossings``:
+    the zero-crossing functions of a hybrid model, None for a continuous one)."""
+    hybrid = 0 if crossings is None else 3 * max(crossings, 1) + 100
+    return 8 * (31 * max(n_states, 1) + max(n_params, 1) + max(n_z, 1) + max(n_observed, 1)
+                + hybrid)
 
 
 class GpuEnsemble:
     """The kernel of one model, compiled for the current CUDA device."""
 
-    def __init__(self, model_c: str, n_states: int) -> None:
+    def __init__(self, model_c: str, n_states: int, positive: Sequence[bool] = ()) -> None:
         self.cupy = cupy_module()
         self.n = n_states
         try:
-            module = self.cupy.RawModule(code=kernel_text(model_c, cuda=True),
+            module = self.cupy.RawModule(code=kernel_text(model_c, cuda=True, positive=positive),
                                          options=("--std=c++14",))
             self.kernel = module.get_function("springc_ensemble")
         except self.cupy.cuda.compiler.CompileException as err:

@@ -31,6 +31,11 @@ CORE = Path(__file__).with_name("dop853_core.c")
 BAD_START = -1
 """The status of a run whose parameters or start values are not finite (or whose start
 values' Newton iteration failed): it is not integrated."""
+UNSETTLED = 8
+"""The status of a hybrid run whose event iteration did not settle."""
+CHATTERING = 9
+"""The status of a hybrid run with more than 100 events within 1e-6 of its span (as
+``springc.simulation.events.EventLoop.check_zeno``)."""
 OPENMP = ("-fopenmp",)
 """The compiler argument of the parallel loop over the runs, used where the compiler
 found builds and loads an OpenMP program (:func:`springc.pipeline.openmp_flags`; without
@@ -70,17 +75,21 @@ def c_switch(name: str, rows: list[str], function: str) -> str:
             f"    switch (row) {{\n{cases}    default: break;\n    }}\n}}\n")
 
 
-def prelude(cuda: bool) -> str:
+def prelude(cuda: bool, positive: Sequence[bool] = ()) -> str:
     """The definitions before the kernel: the status codes and the DOP853 tableau, its
     weighted sums written out (``sc_a_row``, ``sc_b_sum``, ``sc_e5_sum``, ``sc_e3_sum``,
-    ``sc_d_row``) and ``DOP_C``."""
+    ``sc_d_row``), ``DOP_C``, and ``SC_POSITIVE`` (1.0 where relation k of a hybrid
+    model holds for a positive zero-crossing function: ``>`` and ``>=``)."""
     function = "static __device__" if cuda else "static inline"
     qualifier = "static __device__ const" if cuda else "static const"
     parts = ["#define SC_NX SPRINGC_N_STATES\n",
              "#define SC_NXS (SPRINGC_N_STATES > 0 ? SPRINGC_N_STATES : 1)\n"]
     parts += [f"#define SC_{s.name} {int(s)}\n" for s in Status]
-    parts.append(f"#define SC_BAD_START {BAD_START}\n")
+    parts.append(f"#define SC_BAD_START {BAD_START}\n#define SC_UNSETTLED {UNSETTLED}\n"
+                 f"#define SC_CHATTERING {CHATTERING}\n")
     parts.append(c_array("DOP_C", tableau.C, qualifier))
+    parts.append(c_array("SC_POSITIVE", np.array([1.0 if k else 0.0 for k in positive] or
+                                                  [0.0]), qualifier))
     rows = [""] + [f"sc_a_{s}" for s in range(1, tableau.STAGES_EXTENDED)]
     parts += [c_weighted_sum(rows[s], tableau.A[s, :s], function)
               for s in range(1, tableau.STAGES_EXTENDED)]
@@ -104,8 +113,10 @@ CUDA_MACROS = "".join(f"#ifndef {name}\n#define {name} {value}\n#endif\n" for na
 ``math_constants.h`` writes them)."""
 
 
-def kernel_text(model_c: str, cuda: bool = False) -> str:
-    """The whole translation unit: the model's C text, then the tableau and the kernel.
+def kernel_text(model_c: str, cuda: bool = False, positive: Sequence[bool] = ()) -> str:
+    """The whole translation unit: the model's C text, then the tableau and the kernel
+    (``positive``: per zero-crossing function of a hybrid model, whether its relation is
+    ``>`` or ``>=``: the held signs, see :func:`prelude`).
 
     For CUDA (``cuda``) the model's functions become ``__device__`` functions
     (``SPRINGC_FN``), its host-only name tables are left out (``SPRINGC_NO_TABLES``) and
@@ -119,7 +130,7 @@ def kernel_text(model_c: str, cuda: bool = False) -> str:
         model = model_c
         head = ("#include <math.h>\n#define SPRINGC_NO_TABLES 1\n#undef SPRINGC_FN\n"
                 f"#define SPRINGC_FN static inline\n#define SC_LANES {LANES}\n")
-    return (head + model + "\n" + prelude(cuda) + CORE.read_text(encoding="utf-8")
+    return (head + model + "\n" + prelude(cuda, positive) + CORE.read_text(encoding="utf-8")
             + KERNEL.read_text(encoding="utf-8"))
 
 

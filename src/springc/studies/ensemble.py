@@ -24,10 +24,11 @@ bounded by the chunk size, never by the number of runs.
 Only the statistics chosen (``statistics``, default all five) get columns. The message
 of a failed run is the single-run path's own (``springc.simulate`` with
 ``solver="dop853"`` on the run's values, run again for that run only) for the first
-``explain`` failed runs of each chunk; later ones get the words of the failure's kind
-and its time. The file carries the key ``springc`` in its metadata (JSON: the model,
-the parameters, the variables, the options, the engine, ``"format": "springc ensemble
-1"``). Trajectories: :mod:`.ensemble_outputs`.
+``explain`` failed runs of the ensemble (in run order, so the same whatever the chunk
+size); later ones get the words of the failure's kind and its time. The file carries
+the key ``springc`` in its metadata (JSON: the model, the parameters, the variables, the
+options, the engine, ``"format": "springc ensemble 1"``). Trajectories:
+:mod:`.ensemble_outputs`. Chunks as Dask tasks (``scheduler``): :mod:`.ensemble_tasks`.
 
 Parameter values outside a parameter's declared ``min``/``max`` are refused before any
 run (:func:`check_bounds`), naming the parameter and the run.
@@ -37,7 +38,7 @@ from __future__ import annotations
 
 import contextlib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -52,7 +53,15 @@ from ..simulation import (
     resolve,
     simulate_model,
 )
-from .ensemble_engines import FAILED_PREPARATION, Chunk, Plan, event_constructs, open_engine
+from .engines import connect, dask_workers
+from .ensemble_engines import (
+    FAILED_PREPARATION,
+    Chunk,
+    Plan,
+    event_constructs,
+    open_engine,
+    resolve_engine,
+)
 from .ensemble_outputs import (
     SUFFIXES,
     chunk_table,
@@ -60,6 +69,15 @@ from .ensemble_outputs import (
     statistics_of,
     trajectory_layout,
     trajectory_table,
+)
+from .ensemble_tasks import (
+    Chunks,
+    ChunkTask,
+    dask_chunk_size,
+    dask_chunks,
+    fixed_items,
+    local_chunks,
+    task_threads,
 )
 from .job import StudyOptions
 from .params import ParameterSpec
@@ -71,7 +89,6 @@ CHUNKS = {"c": 100_000, "numba": 10_000, "gpu": 1_000_000}
 row group: memory grows with it)."""
 TRAJECTORY_VALUES = 2_000_000
 """With trajectories, a chunk holds at most this many values (runs x times x variables)."""
-NON_FINITE_OUTPUT = 3  # Status.NON_FINITE_STATE: a chosen variable NaN or inf on the grid
 
 
 @dataclass(frozen=True)
@@ -86,7 +103,9 @@ class EnsembleOptions:
     go to the trajectory file. ``engine``: ``c`` or ``numba`` (``None``: ``c`` where a
     C compiler is found); ``device``: ``cpu`` or ``gpu``; ``chunk``: runs per kernel
     call (``None``: the engine's default); ``threads``: the CPU threads (``None``: every
-    core; the results are the same bytes whatever the number)."""
+    core; the results are the same bytes whatever the number); ``scheduler``: the
+    address of a Dask scheduler, each chunk one task there (``chunk`` default: about
+    four tasks per worker thread; ``threads`` default 1 per task), the same bytes."""
 
     parameters: tuple[ParameterSpec, ...] = ()
     samples: int | None = None
@@ -109,6 +128,7 @@ class EnsembleOptions:
     engine: str | None = None
     device: str = "cpu"
     threads: int | None = None
+    scheduler: str | None = None
 
 
 @dataclass(frozen=True)
@@ -139,18 +159,19 @@ def run_table(options: EnsembleOptions) -> tuple[tuple[str, ...], np.ndarray]:
 
 
 def check_model(model: CompiledModel, device: str = "cpu") -> None:
-    """The ensemble engines run continuous models; on the GPU the error names the
-    model's event constructs (:func:`.ensemble_engines.event_constructs`)."""
+    """The ensemble engines run continuous and hybrid models (events in the C kernel);
+    delays and states that switch are refused by name, as are events without states."""
     module = model.module
-    engine = "the GPU engine" if device == "gpu" else "the ensemble engine"
-    for flag, what in (("EVENTS", "events (when, if on a state, sample...)"),
-                       ("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch")):
-        if not getattr(module, flag, False):
-            continue
-        if flag == "EVENTS" and device == "gpu":
-            what = f"events ({event_constructs(model)})"
-        raise SimulationError(f"{model.name} has {what}, which {engine} does not run "
-                              "yet", hint="use springc sweep (one run at a time)")
+    for flag, what in (("DELAYS", "delay(...)"), ("SWITCHABLE", "states that switch "
+                                                  "(dynamic state selection)")):
+        if getattr(module, flag, False):
+            raise SimulationError(f"{model.name} has {what}, which the ensemble engine "
+                                  "does not run yet",
+                                  hint="use springc sweep (one run at a time)")
+    if getattr(module, "EVENTS", False) and not model.states:
+        raise SimulationError(f"{model.name} has events ({event_constructs(model)}) but no "
+                              "states, which the ensemble engine does not run yet",
+                              hint="use springc sweep (one run at a time)")
 
 
 def check_bounds(model: CompiledModel, names: Sequence[str], values: np.ndarray,
@@ -201,12 +222,15 @@ def settings_of(model: CompiledModel, options: EnsembleOptions
     return output_grid(start, stop, interval), rtol, atol, max_steps
 
 
+UNSETTLED, CHATTERING = 8, 9  # springc.integrate.native_ensemble's hybrid statuses
 WORDS = {FAILED_PREPARATION: "the parameters or start values are not finite",
          1: "Required step size is less than spacing between numbers.",
          2: "the derivatives are not finite",
          3: "a variable is not finite",
          4: "the run reached the step limit (--max-steps {limit})",
-         5: "a nonlinear system did not converge"}
+         5: "a nonlinear system did not converge",
+         UNSETTLED: "the event iteration did not settle",
+         CHATTERING: "chattering (more than 100 events within 1e-6 of the simulated span)"}
 """The words of a failure's kind (:class:`springc.integrate.Status`), when the run is
 not run again to locate it."""
 
@@ -232,10 +256,11 @@ def explain(model: CompiledModel, options: EnsembleOptions, settings: Mapping[st
 
 
 def messages(model: CompiledModel, options: EnsembleOptions, names: Sequence[str],
-             values: np.ndarray, result: Chunk, max_steps: int) -> list[str | None]:
-    """The error message of every run of a chunk (``None`` for a run that succeeded)."""
+             values: np.ndarray, result: Chunk, max_steps: int, explained: int = 0
+             ) -> tuple[list[str | None], int]:
+    """The error message of every run of a chunk (``None`` for a run that succeeded),
+    and the runs explained by the single-run path so far (``explained`` before it)."""
     out: list[str | None] = [None] * len(values)
-    explained = 0
     for r in np.flatnonzero(result.status != 0).tolist():
         if r in result.prepared:
             out[r] = result.prepared[r]
@@ -248,17 +273,8 @@ def messages(model: CompiledModel, options: EnsembleOptions, names: Sequence[str
             text = explain(model, options, settings, max_steps)
         out[r] = text or failure_words(int(result.status[r]), float(result.failure_time[r]),
                                        max_steps)
-    return out
+    return out, explained
 
-
-def checked(result: Chunk) -> Chunk:
-    """``result`` with the runs whose chosen values are not finite failed, and the runs
-    Python could not prepare marked so."""
-    status = result.status.copy()
-    finite = np.isfinite(result.summary).all(axis=(1, 2))
-    status[(status == 0) & ~finite] = NON_FINITE_OUTPUT
-    status[list(result.prepared)] = FAILED_PREPARATION
-    return replace(result, status=status)
 
 def chunk_size(options: EnsembleOptions, engine: str, values_per_run: int) -> int:
     """Runs per chunk: as asked, else the engine's default, capped so that a chunk's
@@ -277,9 +293,10 @@ def chunk_size(options: EnsembleOptions, engine: str, values_per_run: int) -> in
 def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
                  protected: Sequence[str] = (), trajectories: str | None = None
                  ) -> EnsembleSummary:
-    """Run every run of ``options`` on ``model`` in chunks and write the ensemble table
-    to ``output`` (and the trajectories of ``options.trajectories`` to
-    ``trajectories``), all or nothing (temporary files, renamed when complete)."""
+    """Run every run of ``options`` on ``model`` in chunks (in this process, or as Dask
+    tasks with ``options.scheduler``) and write the ensemble table to ``output`` (and
+    the trajectories of ``options.trajectories`` to ``trajectories``), all or nothing
+    (temporary files, renamed when complete)."""
     check_model(model, options.device)
     names, values = run_table(options)
     check_names(model, names)
@@ -297,8 +314,20 @@ def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
     kept = np.arange(0, grid.size, options.every)
     kept = kept if kept[-1] == grid.size - 1 else np.append(kept, grid.size - 1)
     plan = Plan(grid, rtol, atol, max_steps, tuple(columns), tuple(traj_columns),
-                options.every, options.threads or 0)
-    engine, run = open_engine(model, options.engine, options.device, names, fixed, plan)
+                options.every, task_threads(options.threads, options.scheduler))
+    engine = resolve_engine(options.engine, options.device)
+    chunk = chunk_size(options, engine, len(kept) * len(traj_names))
+    if options.scheduler is None:
+        engine, run = open_engine(model, options.engine, options.device, names, fixed, plan)
+        chunks = local_chunks(run, values, chunk)
+        client = None
+    else:  # connect first: a scheduler that cannot be reached leaves nothing behind
+        client = connect(options.scheduler)
+        threads = dask_workers(client)
+        if options.chunk is None:
+            chunk = dask_chunk_size(len(values), threads, chunk)
+        task = ChunkTask(model, engine, tuple(names), fixed_items(fixed), plan)
+        chunks = dask_chunks(client, task, values, chunk, threads)
     metadata = {"format": "springc ensemble 1", "model": model.name,
                 "parameters": list(names), "variables": variables,
                 "method": "table" if options.table else
@@ -310,38 +339,41 @@ def run_ensemble(model: CompiledModel, options: EnsembleOptions, output: str,
                 "engine": engine}
     schema = schema_of(model, names, variables, statistics, metadata)
     layout = trajectory_layout(model, names, traj_names, grid[kept], metadata)
-    chunk = chunk_size(options, engine, len(kept) * len(traj_names))
-    return _write(model, options, (names, values), run, (schema, layout, statistics),
-                  (output, trajectories), protected, chunk, (engine, rtol, max_steps))
+    try:
+        failed = _write(model, options, names, chunks, (schema, layout, statistics),
+                        (output, trajectories), protected, (rtol, max_steps))
+    finally:
+        if client is not None:
+            client.close()
+    files = (output,) if trajectories is None else (output, trajectories)
+    return EnsembleSummary(output, len(values), failed, engine, files)
 
 
-def _write(model: CompiledModel, options: EnsembleOptions,
-           runs: tuple[Sequence[str], np.ndarray], run: Any, layouts: tuple[Any, Any, Any],
-           paths: tuple[str, str | None], protected: Sequence[str], chunk: int,
-           settings: tuple[str, float, int]) -> EnsembleSummary:
-    """The chunks, each into the table (and the trajectory file) as a row group."""
+def _write(model: CompiledModel, options: EnsembleOptions, names: Sequence[str],
+           chunks: Chunks, layouts: tuple[Any, Any, Any], paths: tuple[str, str | None],
+           protected: Sequence[str], settings: tuple[float, int]) -> int:
+    """The chunks, in run order, each into the table (and the trajectory file) as a
+    row group; the number of failed runs. The first ``options.explain`` failed runs of
+    the ensemble get the single-run path's message."""
     import pyarrow.parquet as pq
 
-    names, values = runs
     schema, layout, statistics = layouts
     output, trajectories = paths
-    engine, rtol, max_steps = settings
-    failed = 0
+    rtol, max_steps = settings
+    failed = explained = 0
     with OutputSet(protected) as outputs, contextlib.ExitStack() as stack:
         writer = stack.enter_context(pq.ParquetWriter(
             stack.enter_context(outputs.open(output, "wb")), schema))
         traj_writer = None if trajectories is None else stack.enter_context(
             pq.ParquetWriter(stack.enter_context(outputs.open(trajectories, "wb")),
                              layout.schema()))
-        for first in range(0, len(values), chunk):
-            part = values[first:first + chunk]
-            result = checked(run(part))
-            errors = messages(model, options, names, part, result, max_steps)
+        for first, part, result in chunks:
+            errors, explained = messages(model, options, names, part, result, max_steps,
+                                         explained)
             failed += int((result.status != 0).sum())
             writer.write_table(chunk_table(schema, first, part, result, statistics, errors,
                                            SOLVER))
             if traj_writer is not None:
                 traj_writer.write_table(trajectory_table(layout, first, part, result,
                                                          errors, SOLVER, rtol))
-    files = (output,) if trajectories is None else (output, trajectories)
-    return EnsembleSummary(output, len(values), failed, engine, files)
+    return failed

@@ -9,6 +9,11 @@
 - the GPU (``device="gpu"``): the same C kernel text compiled for CUDA by CuPy's NVRTC,
   one thread per run (:mod:`springc.integrate.gpu_ensemble`).
 
+Hybrid models (events: when-clauses, relations on states, ``sample``, time events) run
+on the C kernel, on the CPU and the GPU: each run with its own events, the event
+functions of the C model called in the kernel (see ``ensemble_dop853.c``); the numba
+engine refuses them by name.
+
 All three take the same steps (DOP853 with springc's plain-loop sums, see
 ``benchmarks/README.md`` for their throughput). A model with an initial problem gets
 its start values from Python (:func:`springc.simulation.initial_state`) on every engine.
@@ -96,6 +101,11 @@ def numba_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str,
     """The numba ensemble kernel (the model's numba functions)."""
     from ..integrate import ensemble
 
+    if getattr(model.module, "EVENTS", False):
+        raise SimulationError(f"{model.name} has events ({event_constructs(model)}), which "
+                              "the numba ensemble engine does not run",
+                              hint="use the C engine (--engine c, the default where a C "
+                              "compiler is found)")
     if getattr(model.module, "BACKEND", "") != "numba":
         raise SimulationError(f"the numba ensemble engine needs the numba backend, not "
                               f"{model.module.BACKEND}", hint="compile with --backend numba")
@@ -149,13 +159,19 @@ def _chunk(out: Any, prepared: dict[int, str]) -> Chunk:
                  prepared)
 
 
+def relation_signs(model: CompiledModel) -> tuple[bool, ...]:
+    """Per zero-crossing function of a hybrid model: whether its relation holds where
+    the function is positive (``>``, ``>=``); the kernel's held signs."""
+    return tuple(op in (">", ">=") for op in getattr(model.module, "RELATION_OPS", ()))
+
+
 def c_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, float],
              plan: Plan) -> Engine:
     """The batched C kernel on every core (the model's C file)."""
     from ..integrate import OPENMP, NativeEnsemble, kernel_text
     from ..pipeline import c_source, kernel_library, openmp_flags
 
-    text = kernel_text(c_source(model))
+    text = kernel_text(c_source(model), positive=relation_signs(model))
     # OpenMP where the compiler's probe builds and loads, else the serial loop
     data = kernel_library(model, text, openmp_flags(OPENMP), tag="ensemble")
     kernel = NativeEnsemble(data, len(model.states))
@@ -180,7 +196,7 @@ def gpu_engine(model: CompiledModel, names: Sequence[str], fixed: Mapping[str, f
     from ..pipeline import c_source
 
     try:
-        kernel = GpuEnsemble(c_source(model), len(model.states))
+        kernel = GpuEnsemble(c_source(model), len(model.states), relation_signs(model))
     except NoCudaDevice as err:
         raise UsageError(f"--device gpu: {err}", option="--device",
                          hint="run on the CPU (--device cpu, the default)") from None
@@ -221,12 +237,9 @@ def event_constructs(model: CompiledModel, shown: int = 3) -> str:
     return "; ".join(parts) or "when-clauses"
 
 
-def open_engine(model: CompiledModel, engine: str | None, device: str,
-                names: Sequence[str], fixed: Mapping[str, float], plan: Plan
-                ) -> tuple[str, Engine]:
-    """The engine's name and its chunk function. ``engine`` None: ``c`` on the CPU,
-    or ``numba`` where no C compiler is found (a choice fixed by measurement, see the
-    module text, never by the clock)."""
+def resolve_engine(engine: str | None, device: str) -> str:
+    """The engine's name without opening it (checked): ``gpu`` on the GPU, else as
+    asked, else ``c`` where a C compiler is found, else ``numba``."""
     if device not in DEVICES:
         raise UsageError(f"--device {device}: not one of {', '.join(DEVICES)}",
                          option="--device")
@@ -237,8 +250,28 @@ def open_engine(model: CompiledModel, engine: str | None, device: str,
         if engine == "numba":
             raise UsageError("--engine numba runs on the CPU; the GPU runs the C kernel",
                              option="--engine", hint="leave out --engine with --device gpu")
+        return "gpu"
+    if engine is not None:
+        return engine
+    from ..pipeline import CCompilerMissing, find_compiler
+
+    try:
+        find_compiler()
+    except CCompilerMissing:
+        return "numba"
+    return "c"
+
+
+def open_engine(model: CompiledModel, engine: str | None, device: str,
+                names: Sequence[str], fixed: Mapping[str, float], plan: Plan
+                ) -> tuple[str, Engine]:
+    """The engine's name and its chunk function. ``engine`` None: ``c`` on the CPU,
+    or ``numba`` where no C compiler is found (a choice fixed by measurement, see the
+    module text, never by the clock)."""
+    name = resolve_engine(engine, device)
+    if name == "gpu":
         return "gpu", gpu_engine(model, names, fixed, plan)
-    if engine == "numba":
+    if name == "numba":
         return "numba", numba_engine(model, names, fixed, plan)
     from ..pipeline import CCompilerMissing
 
