@@ -74,7 +74,8 @@ def zero_crossings(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
 
 
 def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
-    out: list[Stmt] = [*m.loads()[:len(m.params)], Let("_zq", x.Const(float("inf")))]
+    out: list[Stmt] = [*m.loads()[:len(m.params)], *_state_loads(m, layout),
+                       Let("_zq", x.Const(float("inf")))]
     later = x.add(x.TIME, _eps(x.TIME))
     for tr in layout.events.time_relations:
         at = tr.at
@@ -97,6 +98,18 @@ def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         nxt = x.If(x.BinOp("<", later, start), start, x.add(start, x.mul(k, interval)))
         out.append(Let("_zq", x.Call("min", (x.Var("_zq"), nxt))))
     return [*out, Raw("_zo = np.empty(1)"), Store("_zo[0]", x.Var("_zq"))]
+
+
+def _state_loads(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    """The loads of the states a time event reads: a ``fixed = false`` parameter
+    the initial equations determine is a constant state (``simplify.free_parameters``),
+    and ``sample(t0 + 1/f, 1/f)`` may start at one (``Blocks.Math.Mean``)."""
+    read: set[str] = set()
+    for tr in layout.events.time_relations:
+        read |= x.variables(tr.at)
+    for start, interval in layout.events.samples:
+        read |= x.variables(start) | x.variables(interval)
+    return [Load(n, f"x[{i}]", n) for i, n in enumerate(m.states) if n in read]
 
 
 def _at_time_zero(e: x.Expr) -> x.Expr:
