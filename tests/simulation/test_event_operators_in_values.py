@@ -69,3 +69,23 @@ def test_nan_in_a_linear_system_is_a_located_failure(tmp_path: Path, backend: st
     message = caught.value.message
     assert message.startswith(f"math domain error while computing c ({model}:9) at time 1")
     assert 1.0 <= float(message.rsplit("at time ", 1)[1]) < 1.1
+
+
+def test_a_latch_through_pre_is_no_algebraic_loop(tmp_path: Path) -> None:
+    """``y = a or (not c and pre(y))``: ``pre(y)`` is the value held from before the
+    event, not an unknown of the equation, so there is no loop to solve (a loop solved
+    as linear once replaced pre(y) by 0: the MSL's LogicalNetwork1 lost its latch)."""
+    model = write(tmp_path, """model Latch
+  Boolean a = time >= 0.5 and time < 1;
+  Boolean c = time >= 1.5;
+  Boolean held;
+  Boolean y;
+equation
+  held = pre(y);
+  y = a or (not c and held);
+end Latch;
+""")
+    result = springc.simulate(model, backend="python", engine="scipy", stop=2.0,
+                              interval=0.25, error_control="off")
+    # set at 0.5 by a, held after a falls at 1, cleared by c at 1.5
+    assert np.asarray(result["y"]).tolist() == [0, 0, 1, 1, 1, 1, 0, 0, 0]
