@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from springc.errors import SpringcError, errors_of
 from springc.ir import expr as x
 from springc.pipeline.files import flatten_files
 
@@ -32,3 +33,24 @@ end M;
     assert (equations["r[1]"], equations["r[2]"]) == (
         "if 4 - i == 1 then m[1,1] else m[2,1]",
         "if 4 - i == 1 then m[1,2] else m[2,2]")
+
+
+def test_assigning_with_a_run_time_subscript_is_a_located_error(tmp_path: Path) -> None:
+    # the MSL's RealFFT: buf[iTick] := u in a when statement
+    path = tmp_path / "m.mo"
+    path.write_text("""model M
+  Real buf[3](each start = 0, each fixed = true);
+  Integer k(start = 0, fixed = true);
+algorithm
+  when sample(0, 0.1) then
+    k := pre(k) + 1;
+    buf[k] := time;
+  end when;
+end M;
+""")
+    with pytest.raises(SpringcError) as info:
+        flatten_files([path], None)
+    (err,) = errors_of(info.value)
+    assert err.span is not None and (err.span.line, err.span.column) == (7, 5)
+    assert err.message == ("assigning to 'buf' with a subscript known only during the "
+                           "simulation is not supported yet")
