@@ -47,6 +47,9 @@ class ReferenceResolver:
                      hint: str = "use parameters and constants with values here") -> Any:
             ...
 
+        def value(self, e: s.Expr, scope: Scope) -> a.Value:
+            ...
+
     def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
         if isinstance(v, (ClassEntry, ClassScope)) or (
