@@ -89,3 +89,25 @@ end Latch;
                               interval=0.25, error_control="off")
     # set at 0.5 by a, held after a falls at 1, cleared by c at 1.5
     assert np.asarray(result["y"]).tolist() == [0, 0, 1, 1, 1, 1, 0, 0, 0]
+
+
+def test_an_rs_flip_flop_latches_within_the_event(tmp_path: Path) -> None:
+    """Two Nor gates and a ``pre`` (the MSL's Logical.RSFlipFlop): the event iteration
+    goes on until ``pre(p) = p`` for the equation-defined ``p`` too (section 8.6), so a
+    set pulse (a sample, true only at its instant) latches; the initial event too."""
+    model = write(tmp_path, """model RS
+  Boolean S = sample(0, 0.5);
+  Boolean R = sample(0.25, 0.5);
+  Boolean p;
+  Boolean q;
+initial equation
+  pre(p) = true;
+equation
+  p = not (S or q);
+  q = not (pre(p) or R);
+end RS;
+""")
+    result = springc.simulate(model, backend="python", engine="scipy", stop=1.0,
+                              interval=0.125, error_control="off")
+    # set at 0, 0.5 and 1 (S), reset at 0.25 and 0.75 (R)
+    assert np.asarray(result["q"]).tolist() == [1, 1, 0, 0, 1, 1, 0, 0, 1]
