@@ -126,3 +126,87 @@ def test_a_while_loop_on_start_values_is_decided_while_flattening(tmp_path: Path
                 "  s := 0;\n  while n < 6 loop\n    n := n + 1;\n    s := s + n;\n"
                 "  end while;\nend M;\n")
     assert sorted(equations(m)) == ["n = 6", "s = 15"]
+
+
+RUN_TIME_JUMPS = """model M
+  function firstTrue
+    input Boolean b[:];
+    output Integer index;
+  algorithm
+    index := 0;
+    for i in 1:size(b, 1) loop
+      if b[i] then
+        index := i;
+        return;
+      end if;
+    end for;
+  end firstTrue;
+  function sumUntil
+    input Real u[:];
+    input Real limit;
+    output Real s;
+  algorithm
+    s := 0;
+    for i in 1:size(u, 1) loop
+      if s + u[i] > limit then
+        break;
+      end if;
+      s := s + u[i];
+    end for;
+    s := 2 * s;
+  end sumUntil;
+  Integer k = firstTrue({time > 0.5, time > 0.25, true});
+  Real y = sumUntil({1, time, 2}, 2.5);
+end M;
+"""
+
+
+def _first_true(b: list[bool]) -> int:
+    return next((i + 1 for i, v in enumerate(b) if v), 0)
+
+
+def _sum_until(u: list[float], limit: float) -> float:
+    s = 0.0
+    for v in u:
+        if s + v > limit:
+            break
+        s += v
+    return 2 * s
+
+
+@pytest.mark.parametrize("t", [0.0, 0.3, 0.6, 1.2, 1.6, 3.0])
+def test_return_and_break_under_run_time_conditions_in_functions(tmp_path: Path,
+                                                                 t: float) -> None:
+    # the jumps become flags (flatten/calls/jumps.py): the flat equations, evaluated at
+    # time t, give what running the functions gives
+    m = flat_of(tmp_path, RUN_TIME_JUMPS)
+    rhs = {x.to_text(e.lhs): e.rhs for e in m.equations}
+    assert x.evaluate(rhs["k"], {}, time=t) == _first_true([t > 0.5, t > 0.25, True])
+    assert x.evaluate(rhs["y"], {}, time=t) == pytest.approx(_sum_until([1, t, 2], 2.5),
+                                                             abs=1e-12)
+
+
+def test_a_variable_assigned_in_one_branch_of_an_if_on_a_parameter(tmp_path: Path) -> None:
+    # the parameter decides the branch, so alpha has a value (the MSL's
+    # Blocks.Continuous.Internal.Filter.Utilities.BesselBaseCoefficients)
+    m = flat_of(tmp_path, """model M
+  function coefficient
+    input Integer order;
+    output Real alpha;
+  algorithm
+    if order == 1 then
+      alpha := 1.5;
+    elseif order == 2 then
+      alpha := 2.5;
+    else
+      assert(false, "order out of range");
+    end if;
+  end coefficient;
+  parameter Integer n = 2;
+  parameter Real a = coefficient(n);
+  Real y = a * time;
+end M;
+""")
+    assert equations(m) == ["y = a * time"]
+    (a,) = [v for v in m.variables if v.name == "a"]
+    assert a.binding is not None and x.evaluate(a.binding, {"n": 2}) == 2.5

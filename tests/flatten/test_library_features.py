@@ -261,3 +261,39 @@ end BF;
     binding = _bindings(model)["c[1,2]"]
     assert x.evaluate(binding, {"n": 2}) == 2
 
+
+
+def test_a_connector_of_an_enumeration_type(tmp_path: Path) -> None:
+    # connector DigitalSignal = Logic (an enumeration): the MSL's Digital connectors,
+    # connected in Electrical.Analog.Examples.AD_DA_conversion (section 9.1)
+    path = tmp_path / "m.mo"
+    path.write_text("""model EnumConn
+  type Logic = enumeration(U, X, Z0, Z1);
+  connector Sig = Logic;
+  connector SigOut = output Sig;
+  connector SigIn = input Sig;
+  block Src
+    SigOut y;
+  equation
+    y = if time < 0.5 then Logic.Z0 else Logic.Z1;
+  end Src;
+  block Snk
+    SigIn u;
+    Boolean high = u == Logic.Z1;
+  end Snk;
+  Src src;
+  Snk snk;
+equation
+  connect(src.y, snk.u);
+end EnumConn;
+""")
+    assert format_flat(flatten_files([path], "EnumConn")) == """model EnumConn
+  discrete output Integer 'src.y';
+  discrete input Integer 'snk.u';
+  discrete Boolean 'snk.high';
+equation
+  'snk.high' = 'snk.u' == 4;
+  'src.y' = if time < 0.5 then 3 else 4;
+  'src.y' = 'snk.u';
+end EnumConn;
+"""

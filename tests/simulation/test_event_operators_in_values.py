@@ -69,3 +69,45 @@ def test_nan_in_a_linear_system_is_a_located_failure(tmp_path: Path, backend: st
     message = caught.value.message
     assert message.startswith(f"math domain error while computing c ({model}:9) at time 1")
     assert 1.0 <= float(message.rsplit("at time ", 1)[1]) < 1.1
+
+
+def test_a_latch_through_pre_is_no_algebraic_loop(tmp_path: Path) -> None:
+    """``y = a or (not c and pre(y))``: ``pre(y)`` is the value held from before the
+    event, not an unknown of the equation, so there is no loop to solve (a loop solved
+    as linear once replaced pre(y) by 0: the MSL's LogicalNetwork1 lost its latch)."""
+    model = write(tmp_path, """model Latch
+  Boolean a = time >= 0.5 and time < 1;
+  Boolean c = time >= 1.5;
+  Boolean held;
+  Boolean y;
+equation
+  held = pre(y);
+  y = a or (not c and held);
+end Latch;
+""")
+    result = springc.simulate(model, backend="python", engine="scipy", stop=2.0,
+                              interval=0.25, error_control="off")
+    # set at 0.5 by a, held after a falls at 1, cleared by c at 1.5
+    assert np.asarray(result["y"]).tolist() == [0, 0, 1, 1, 1, 1, 0, 0, 0]
+
+
+def test_an_rs_flip_flop_latches_within_the_event(tmp_path: Path) -> None:
+    """Two Nor gates and a ``pre`` (the MSL's Logical.RSFlipFlop): the event iteration
+    goes on until ``pre(p) = p`` for the equation-defined ``p`` too (section 8.6), so a
+    set pulse (a sample, true only at its instant) latches; the initial event too."""
+    model = write(tmp_path, """model RS
+  Boolean S = sample(0, 0.5);
+  Boolean R = sample(0.25, 0.5);
+  Boolean p;
+  Boolean q;
+initial equation
+  pre(p) = true;
+equation
+  p = not (S or q);
+  q = not (pre(p) or R);
+end RS;
+""")
+    result = springc.simulate(model, backend="python", engine="scipy", stop=1.0,
+                              interval=0.125, error_control="off")
+    # set at 0, 0.5 and 1 (S), reset at 0.25 and 0.75 (R)
+    assert np.asarray(result["q"]).tolist() == [1, 1, 0, 0, 1, 1, 0, 0, 1]

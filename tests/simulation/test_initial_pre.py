@@ -48,3 +48,32 @@ def test_pre_and_time_in_initial_equations(tmp_path: Path) -> None:
     # count = integer(0 + 2.5) at the start, one more when T passes 0.9 (t = 0.4)
     count = np.asarray(result["count"])
     assert (count[0], count[1], count[-1]) == (2.0, 2.0, 3.0)
+
+
+SAMPLED = '''\
+model Sampled
+  parameter Real f = 2;
+  parameter Real t0(fixed = false);
+  Integer n(start = 0, fixed = true);
+initial equation
+  t0 = time;
+equation
+  when sample(t0 + 1/f, 1/f) then
+    n = pre(n) + 1;
+  end when;
+end Sampled;
+'''
+
+
+def test_sample_starting_at_a_parameter_the_initialization_fixes(tmp_path: Path) -> None:
+    """``t0(fixed = false)`` with ``t0 = time`` is a constant state; the samples after
+    ``t0`` are time events read from it (the MSL's Blocks.Math.Mean)."""
+    path = tmp_path / "Sampled.mo"
+    path.write_text(SAMPLED)
+    result = springc.simulate(str(path), backend="python", engine="scipy", start=0.1,
+                              stop=2.0, interval=0.1, error_control="off")
+    t = np.asarray(result.time)
+    # t0 = 0.1: ticks at 0.6, 1.1, 1.6 (each grid row on a tick holds the new count)
+    expected = np.floor((t - 0.1) / 0.5 + 1e-9)
+    assert np.array_equal(np.asarray(result["n"]), expected)
+    assert np.allclose(result["t0"], 0.1, rtol=0, atol=1e-12)

@@ -74,7 +74,8 @@ def zero_crossings(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
 
 
 def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
-    out: list[Stmt] = [*m.loads()[:len(m.params)], Let("_zq", x.Const(float("inf")))]
+    out: list[Stmt] = [*m.loads()[:len(m.params)], *_state_loads(m, layout),
+                       Let("_zq", x.Const(float("inf")))]
     later = x.add(x.TIME, _eps(x.TIME))
     for tr in layout.events.time_relations:
         at = tr.at
@@ -97,6 +98,18 @@ def next_time_event(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         nxt = x.If(x.BinOp("<", later, start), start, x.add(start, x.mul(k, interval)))
         out.append(Let("_zq", x.Call("min", (x.Var("_zq"), nxt))))
     return [*out, Raw("_zo = np.empty(1)"), Store("_zo[0]", x.Var("_zq"))]
+
+
+def _state_loads(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    """The loads of the states a time event reads: a ``fixed = false`` parameter
+    the initial equations determine is a constant state (``simplify.free_parameters``),
+    and ``sample(t0 + 1/f, 1/f)`` may start at one (``Blocks.Math.Mean``)."""
+    read: set[str] = set()
+    for tr in layout.events.time_relations:
+        read |= x.variables(tr.at)
+    for start, interval in layout.events.samples:
+        read |= x.variables(start) | x.variables(interval)
+    return [Load(n, f"x[{i}]", n) for i, n in enumerate(m.states) if n in read]
 
 
 def _at_time_zero(e: x.Expr) -> x.Expr:
@@ -213,7 +226,14 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
         else:
             changed.append(active_for(ev, name, active))
+    settled = _equation_pres(layout)
+    if settled:  # pre(v) := v once the rest has settled (v is computed from held values)
+        out.append(Let("_zmoved", _flag(_any(changed))))
+        settled = [(slot_name, x.If(_truth("_zmoved"), x.Var(slot_name), now))
+                   for slot_name, now in settled]
+    changed += [x.BinOp("<>", now, x.Var(slot_name)) for slot_name, now in settled]
     out.append(Store(f"z[{slot['_zchanged']}]", _flag(_any(changed))))
+    out += [Store(f"z[{slot[slot_name]}]", now) for slot_name, now in settled]
     out.append(Store(f"z[{slot['_zstop']}]", stop))
     for k, name in enumerate(layout.relations):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zn{k}")))
@@ -233,6 +253,19 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         value = x.Var(f"_zx{index[state]}") if state in index else x.Var(state)
         out.append(Store(f"xn[{k}]", value, state))
     return out
+
+
+def _equation_pres(layout: EventLayout) -> list[tuple[str, x.Expr]]:
+    """``(pre slot, value now)`` of the discrete variables that equations (not
+    when-clauses) give and whose ``pre`` is read: the event iteration goes on until
+    ``pre(v) = v`` for them too (section 8.6), so that ``pre(u)`` sees at the same
+    instant what a when-clause's update or a sampled trigger changed (the MSL's
+    Logical.Pre in an RSFlipFlop latches its input); the initial event iterates so too,
+    from the ``pre(v)`` the initial problem gave. ``v`` is computed from the relations
+    held before the pass, so ``pre(v)`` moves only in a pass where nothing else did."""
+    held = set(layout.discrete)
+    return [(slot_name, x.Var(name)) for name, slot_name in layout.pre.items()
+            if name not in held]
 
 
 def active_for(ev: EventSystem, name: str, active: dict[tuple[int, int], x.Expr]) -> x.Expr:

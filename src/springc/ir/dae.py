@@ -67,6 +67,15 @@ class Residual:
     source: flat.Equation | None = None
     # The names in ``expr`` (derivative variables included), computed once.
     variables: frozenset[str] = frozenset()
+    # Those of ``variables`` that ``expr`` reads only through ``pre``: the value held
+    # from before the event, no unknown of this equation (the structure leaves them
+    # out; a subset is safe: an extra name only adds an edge).
+    pre_only: frozenset[str] = frozenset()
+
+    @property
+    def incident(self) -> frozenset[str]:
+        """The names the equation's structure counts: ``variables`` less ``pre_only``."""
+        return self.variables - self.pre_only if self.pre_only else self.variables
 
     def describe(self) -> str:
         """The equation as the user wrote it (flattened): ``lhs = rhs``."""

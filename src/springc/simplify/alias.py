@@ -181,7 +181,9 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
         if not used:
             return r
         names = set(r.variables).difference(used).union(*(value_vars[n] for n in used))
-        return replace(r, expr=x.substitute(r.expr, full), variables=frozenset(names))
+        held = r.pre_only.difference(used).difference(*(value_vars[n] for n in used))
+        return replace(r, expr=x.substitute(r.expr, full), variables=frozenset(names),
+                       pre_only=held)
 
     equations = tuple(rewrite(r) for r in kept)
     initial = tuple(rewrite(r) for r in system.initial_equations)

@@ -103,7 +103,7 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
     exprs = [r.expr for r in system.equations]
     sources = list(system.equations)
     orders = [0] * len(exprs)
-    incidence = [tuple(sorted(index[n] for n in r.variables if n in index))
+    incidence = [tuple(sorted(index[n] for n in r.incident if n in index))
                  for r in system.equations]
 
     def varying(name: str) -> bool:

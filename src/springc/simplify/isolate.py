@@ -76,6 +76,21 @@ def free_variables(e: x.Expr) -> set[str]:
     return out
 
 
+def pre_only(e: x.Expr) -> frozenset[str]:
+    """The variables ``e`` reads only inside ``pre(...)``."""
+    inside: set[str] = set()
+    outside: set[str] = set()
+    stack: list[tuple[x.Expr, bool]] = [(e, False)]
+    while stack:
+        node, held = stack.pop()
+        if isinstance(node, x.Var):
+            (inside if held else outside).add(node.name)
+            continue
+        held = held or (isinstance(node, x.Call) and node.name == "pre")
+        stack.extend((child, held) for child in x.children(node))
+    return frozenset(inside - outside)
+
+
 def partial(e: x.Expr, name: str) -> x.Expr:
     """``d e / d name``, folded, and counted (:func:`count_diff`)."""
     count_diff()

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from ..ir import dae, flat
 from ..ir import expr as x
 from .events import continuous_part
-from .isolate import count_diff, free_variables
+from .isolate import count_diff, free_variables, pre_only
 
 
 def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
@@ -49,7 +49,15 @@ def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual
     lhs = lower_derivatives(eq.lhs, varying) if _has_der(eq.lhs) else eq.lhs
     rhs = lower_derivatives(eq.rhs, varying) if _has_der(eq.rhs) else eq.rhs
     residual = x.sub(lhs, rhs)
-    return dae.Residual(residual, eq.span, eq.origin, eq, frozenset(free_variables(residual)))
+    names = free_variables(residual)
+    return dae.Residual(residual, eq.span, eq.origin, eq, frozenset(names),
+                        pre_only(residual) if "pre" in _calls(eq) else frozenset())
+
+
+def _calls(eq: flat.Equation) -> set[str]:
+    """The names of the calls in ``eq`` (cheap: most equations hold none)."""
+    return {n.name for side in (eq.lhs, eq.rhs) for n in x.walk(side)
+            if isinstance(n, x.Call)}
 
 
 def _has_der(e: x.Expr) -> bool:

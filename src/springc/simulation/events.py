@@ -218,8 +218,10 @@ class EventLoop:
         x = self.event(float(self.grid[row]), self.states[row], "terminal", "terminal()")
         self.states[row], self.zs[row] = x, self.z
 
-    def next_time(self, t: float) -> float:
-        return float(self.mod.next_time_event(t, np.zeros(0), self.p, self.z))
+    def next_time(self, t: float, x: np.ndarray) -> float:
+        """The first time event after ``t`` at the states ``x`` (a sample may start
+        at a constant state: a ``fixed = false`` parameter)."""
+        return float(self.mod.next_time_event(t, x, self.p, self.z))
 
     # ---------------------------------------------------------------- output
 
@@ -257,7 +259,7 @@ class EventLoop:
         x = self.initial(t, np.asarray(x0, dtype=float))
         self.fill(t, None, t, x, True)
         while t < stop and self.stopped is None:
-            bound = min(self.next_time(t), stop)
+            bound = min(self.next_time(t, x), stop)
             if bound <= t:
                 bound = stop
             if not len(x):
@@ -321,7 +323,7 @@ class EventLoop:
 
     def time_event(self, t: float, x: np.ndarray, stop: float) -> np.ndarray:
         """At the end of an integration: the time event there, if any; the grid row."""
-        if t < stop or self.next_time(t - 2 * LOCATE_TOLERANCE * max(1.0, abs(t))) == t:
+        if t < stop or self.next_time(t - 2 * LOCATE_TOLERANCE * max(1.0, abs(t)), x) == t:
             x = self.event(t, x, "time", f"time = {format_time(t)}")
         self.fill(t, None, t, x, True)
         return x

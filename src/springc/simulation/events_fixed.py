@@ -47,7 +47,7 @@ def run_fixed_events(loop: EventLoop, method: str, x0: np.ndarray, step: float) 
             end = b if i == n - 1 else a + (i + 1) * h
             t = a + i * h
             while t < end and loop.stopped is None:  # terminate() ends the run there
-                te = loop.next_time(t)
+                te = loop.next_time(t, x)
                 # a time event within rounding of the step's end is the step's end
                 target = te if te <= end + LOCATE_TOLERANCE * max(1.0, abs(end)) else end
                 y = advance(problem.rhs, t, x, target - t, pairs, cache)

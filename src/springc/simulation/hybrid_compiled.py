@@ -82,7 +82,7 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
     first_step: float | None = None
     seconds = 0.0
     while t < stop and loop.stopped is None:
-        t_event = loop.next_time(t)
+        t_event = loop.next_time(t, x)
         t_stop = t_event if t < t_event < stop else math.inf
         last = min(loop.k + rows_per_run, len(grid))
         if last < len(grid) and grid[last - 1] == t_stop:

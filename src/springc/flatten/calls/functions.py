@@ -44,6 +44,7 @@ from .control import (
     run_while,
     stray,
 )
+from .jumps import flags, is_flag, lowered, merged_flag
 
 MAX_DEPTH = 50
 
@@ -95,8 +96,11 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
         for stmt in entry.defn.algorithm:
             if isinstance(stmt, s.ForStatement):
                 check_loop_nest(ev, stmt, scope)
+        algorithm = lowered(entry.defn.algorithm)
+        if algorithm is not entry.defn.algorithm:
+            scope.names.update((flag, x.Const(False)) for flag in flags(algorithm))
         try:
-            _run(ev, entry.defn.algorithm, scope)
+            _run(ev, algorithm, scope)
         except Jumped as jumped:
             if jumped.jump.kind != "return":
                 raise stray(jumped) from None
@@ -343,11 +347,13 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         return
     resized = [name for name, value in then_names.items() if name in before
                and a.shape(value) != a.shape(scope.names.get(name))]
-    if resized and ev.flattener.is_parameter_expression(cond):
-        # sizes are fixed before the simulation: so is this branch (10.1)
-        scope.names = dict(before)
-        taken = bool(ev.fold(cond))
-        _run(ev, body, scope, guard) if taken else _if(ev, rest, scope, guard)
+    one_sided = [name for name, value in then_names.items() if name in before
+                 and (value is None) != (scope.names.get(name) is None)]
+    if (resized or one_sided) and _known(ev, cond) is not None:
+        # sizes are fixed before the simulation (10.1), and a variable a branch leaves
+        # unassigned has no value there: the parameters decide the branch taken
+        if _known(ev, cond):
+            scope.names = then_names
         return
     if resized:
         raise FlattenError(f"'{resized[0]}' gets different sizes in the branches of this "
@@ -360,6 +366,9 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         if then_value is None or other is None:
             raise FlattenError(f"'{name}' is assigned in only one branch of this if-statement",
                                stmt.span, hint="assign it before the if-statement too")
+        if is_flag(name):  # a return or break flag (jumps.py): folded Boolean logic
+            scope.names[name] = merged_flag(cond, then_value, other)
+            continue
         scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
 
 

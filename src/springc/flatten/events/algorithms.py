@@ -187,6 +187,11 @@ class _Run:
                 f"cannot assign a value of size {a.describe_shape(a.shape(value))} to "
                 f"'{target.dotted}' of size {a.describe_shape(a.shape(names))}", stmt.span)
         for name, item in zip(a.scalars(names), a.scalars(value)):
+            if isinstance(name, x.If):  # a subscript known only during the simulation
+                raise FlattenError(f"assigning to '{target.dotted}' with a subscript known "
+                                   "only during the simulation is not supported yet",
+                                   target.span, hint="subscripts of an assigned variable "
+                                   "must be parameter expressions or for-loop indices")
             if not isinstance(name, x.Var) or name.name in self.fl.parameter_values.bindings:
                 raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
                                    "parameter or constant", target.span,

@@ -117,8 +117,9 @@ class ClassLookup(FlattenContext):
             short = entry.defn.short or self._extended_type(entry)
             if entry.defn.enumeration is not None:
                 # Enumeration values are their ordinals (1, 2, ...): an Integer.
+                # `connector DigitalSignal = Logic` (an enumeration): a signal connector
                 return ResolvedType("Integer", None, tuple(dims), tuple(mods), prefixes,
-                                    enumeration=enumeration_of(entry))
+                                    connector, enumeration=enumeration_of(entry))
             if short is None:
                 return ResolvedType(None, entry, tuple(dims), tuple(mods), prefixes)
             if short.modification is not None:

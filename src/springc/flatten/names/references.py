@@ -47,6 +47,9 @@ class ReferenceResolver:
                      hint: str = "use parameters and constants with values here") -> Any:
             ...
 
+        def value(self, e: s.Expr, scope: Scope) -> a.Value:
+            ...
+
     def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
         if isinstance(v, (ClassEntry, ClassScope)) or (
@@ -129,21 +132,21 @@ class ReferenceResolver:
         kinds = current.kinds if isinstance(current, Primitive) else ()
         index = tuple(self._index(sub, dims[k], scope, part, kinds[k] if kinds else None)
                       for k, sub in enumerate(part.subscripts))
-        if sum(isinstance(i, np.ndarray) for i in index) > 1:
-            # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
-            # element pairs: take them one dimension at a time
-            result = value
-            for axis in reversed(range(len(index))):
-                if not isinstance(index[axis], slice):
-                    result = np.take(result, index[axis], axis=axis)
-        else:
-            result = value[index]
-        if isinstance(result, np.ndarray) and result.ndim == 0:
-            return result.item()
-        return result
+        return _selected(value, index)
 
     def _index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart,
                kind: DimensionKind = None) -> Any:
+        try:
+            return self._known_index(sub, size, scope, part, kind)
+        except FlattenError:
+            found = self.value(sub, scope) if kind is None else None
+            if isinstance(found, x.Expr) and not isinstance(found, x.Const):
+                return _RunTimeIndex(found, size)  # an Integer variable (section 10.5)
+            raise
+
+
+    def _known_index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart,
+                     kind: DimensionKind = None) -> Any:
         if isinstance(sub, s.Colon):
             return slice(None)
         uses_end = self.uses_end.get(Ident(sub))
@@ -207,3 +210,44 @@ def _loop_context(scope: Scope) -> str:
                   and not isinstance(v.value, bool)] + values
         scope = scope.parent
     return f" (with {', '.join(values)})" if values else ""
+
+
+class _RunTimeIndex:
+    """A subscript known only during the simulation: ``expr[i]`` with ``i`` a
+    discrete Integer selects by an if-expression on ``i`` (:func:`_selected`)."""
+
+    def __init__(self, index: x.Expr, size: int) -> None:
+        self.index, self.size = index, size
+
+
+def _selected(value: Any, index: tuple[Any, ...]) -> Any:
+    """``value[index]``; a :class:`_RunTimeIndex` becomes ``if i == 1 then value[1]
+    elseif ... else value[n]`` element by element (an index out of range takes the
+    last element: checking it is not supported yet)."""
+    for k, i in enumerate(index):
+        if isinstance(i, _RunTimeIndex):
+            choices = [_selected(value, (*index[:k], j, *index[k + 1:]))
+                       for j in range(i.size)]
+            if not choices:
+                raise IndexError("a run-time subscript of an empty dimension")
+            found = choices[-1]
+            for j in reversed(range(i.size - 1)):
+                at = x.BinOp("==", i.index, x.Const(j + 1))
+                found = a.elementwise(lambda c, o, at=at: x.If(at, c, o), choices[j], found)
+            return found
+    return _constant_selected(value, index)
+
+
+def _constant_selected(value: Any, index: tuple[Any, ...]) -> Any:
+    if sum(isinstance(i, np.ndarray) for i in index) > 1:
+        # several vector subscripts select a block (x[1:2, 2:3]), not numpy's
+        # element pairs: take them one dimension at a time
+        result = value
+        for axis in reversed(range(len(index))):
+            if not isinstance(index[axis], slice):
+                result = np.take(result, index[axis], axis=axis)
+    else:
+        result = value[index]
+    if isinstance(result, np.ndarray) and result.ndim == 0:
+        return result.item()
+    return result
