@@ -27,7 +27,10 @@ from .encoding import encode_strings
 from .event_layout import EventLayout
 from .statements import Let, Load, Raw, Stmt, Store
 
-EVENT_ITERATIONS = 50
+EVENT_ITERATIONS = 100
+SIMULTANEOUS_PASSES = 20
+"""Passes of the event iteration that switch every moved relation at once; the
+later ones switch one relation at a time (see :func:`_relations_now`)."""
 _ONE, _ZERO = x.Const(1.0), x.Const(0.0)
 
 
@@ -139,22 +142,30 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     return out
 
 
-def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+def _relations_now(layout: EventLayout, out: list[Stmt]
+                   ) -> tuple[dict[x.Expr, x.Expr], list[x.Expr]]:
+    """The relations, time relations and floor values at the end of a pass (appended
+    to ``out``): their new values by expression and whether each moved. When the
+    event iteration has gone on for :data:`SIMULTANEOUS_PASSES` passes
+    (``z[Z_STATUS]`` is 2.0), a pass switches only the first state relation that
+    moves: a mixed system whose simultaneous update cycles (the friction of two
+    coupled clutches going from one sliding direction to the other and back)
+    then walks to its consistent configuration one switch at a time."""
     ev = layout.events
-    out = _base(m)
-    slot = layout.slot
-    changed: list[x.Expr] = []
-    # pre of the discrete variables: their values before this pass
-    for name in layout.discrete:
-        if name in layout.pre:
-            out.append(Let(layout.pre[name], x.Var(name)))
-    # the relations now
     new: dict[x.Expr, x.Expr] = {}
+    changed: list[x.Expr] = []
+    one_at_a_time = x.BinOp("==", x.Var("_zstatus"), x.Const(2.0))
+    out.append(Let("_zm", _ZERO))
     for k, rel in enumerate(ev.relations):
         g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+        held = x.Var(layout.relations[k])
         out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
-        new[rel] = _truth(f"_zn{k}")
-        changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), x.Var(layout.relations[k])))
+        moved = x.BinOp("<>", x.Var(f"_zn{k}"), held)
+        out.append(Let(f"_zh{k}", x.If(x.BinOp("and", one_at_a_time, _truth("_zm")), held,
+                                       x.Var(f"_zn{k}"))))
+        out.append(Let("_zm", _flag(x.BinOp("or", _truth("_zm"), moved))))
+        new[rel] = _truth(f"_zh{k}")
+        changed.append(moved)
     for k, tr in enumerate(ev.time_relations):
         now = x.BinOp(">=", x.TIME, x.sub(tr.at, _eps(x.TIME)))
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
@@ -167,6 +178,22 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             u = x.add(u, x.mul(rate, _eps(x.TIME)))
         out.append(Let(f"_zk{k}", x.Call("floor", (u,)), x.to_text(call)))
         changed.append(x.BinOp("<>", x.Var(f"_zk{k}"), x.Var(layout.floors[k])))
+    return new, changed
+
+
+def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    ev = layout.events
+    out = _base(m)
+    slot = layout.slot
+    changed: list[x.Expr] = []
+    # pre of the discrete variables: their values before this pass
+    for name in layout.discrete:
+        if name in layout.pre:
+            out.append(Let(layout.pre[name], x.Var(name)))
+    new, moves = _relations_now(layout, out)
+    changed += moves
+    # the relations settle first (pre held), then pre(v) := v of the iterated variables
+    relations_moved = _any(list(changed))
     # clause by clause (sorted: a clause reading what another assigns comes after
     # it): the conditions with the new relations and the values assigned so far (a
     # branch fires when one of its conditions becomes true; at initialization only
@@ -213,10 +240,12 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
         else:
             changed.append(active_for(ev, name, active))
+    for name in ev.iterated:  # equation-defined discrete variables: pre(v) := v (8.6)
+        changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
     out.append(Store(f"z[{slot['_zchanged']}]", _flag(_any(changed))))
     out.append(Store(f"z[{slot['_zstop']}]", stop))
     for k, name in enumerate(layout.relations):
-        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zn{k}")))
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zh{k}")))
     for k, name in enumerate(layout.times):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
     for k, name in enumerate(layout.condition_names):
@@ -227,6 +256,11 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
             out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
+    out.append(Let("_zmoved", _flag(relations_moved)))
+    for name in ev.iterated:
+        pre = x.Var(layout.pre[name])
+        out.append(Store(f"z[{slot[layout.pre[name]]}]",
+                         x.If(_truth("_zmoved"), pre, x.Var(name)), f"pre({name})"))
     out.append(Raw(f"xn = np.empty({len(m.states)})"))
     index = {name: n for n, name in enumerate(reinits)}
     for k, state in enumerate(m.states):
@@ -302,6 +336,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         f"Z_CHANGED = {s['_zchanged']}",
         f"Z_STATUS = {s['_zstatus']}",
         f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
+        f"SIMULTANEOUS_PASSES = {SIMULTANEOUS_PASSES}",
         f"USES_TERMINAL = {layout.uses_terminal}",
         f"AFTER_INITIAL = {after_initial(layout)}",
     ]
@@ -324,6 +359,8 @@ EVENT_UPDATE = '''def event_update(t, x, p, z):
     event_begin(t, x, p, z)
     z[Z_STATUS] = 1.0
     for _k in range(EVENT_ITERATIONS):
+        if _k == SIMULTANEOUS_PASSES:
+            z[Z_STATUS] = 2.0
         x = event_pass(t, x, p, z)
         if z[Z_CHANGED] == 0.0:
             z[Z_STATUS] = 0.0

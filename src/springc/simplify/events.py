@@ -139,10 +139,12 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     discrete = tuple(Discrete(n, by_name[n].type,
                               starts.get(n, by_name[n].attributes.start), by_name[n].span)
                      for n in held)
+    iterated = tuple(n for n in pre if n not in held_set and n in by_name and (
+        by_name[n].type != "Real" or by_name[n].variability == "discrete"))
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
                        tuple(pre), _sorted_whens(model.whens), tuple(floors),
                        tuple(_time_rate(c.args[0], params) for c in floors),
-                       "initial" in phases, "terminal" in phases)
+                       "initial" in phases, "terminal" in phases, iterated)
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
