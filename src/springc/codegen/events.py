@@ -147,25 +147,36 @@ def _relations_now(layout: EventLayout, out: list[Stmt]
     """The relations, time relations and floor values at the end of a pass (appended
     to ``out``): their new values by expression and whether each moved. When the
     event iteration has gone on for :data:`SIMULTANEOUS_PASSES` passes
-    (``z[Z_STATUS]`` is 2.0), a pass switches only the first state relation that
-    moves: a mixed system whose simultaneous update cycles (the friction of two
-    coupled clutches going from one sliding direction to the other and back)
-    then walks to its consistent configuration one switch at a time."""
+    (``z[Z_STATUS]`` is 2.0), a pass switches only one state relation: the first
+    that turns false, else the first that turns true. A mixed system whose
+    simultaneous update cycles (a light body stopping under friction: the path
+    parameter of one sliding direction points to the other and back) then walks to
+    its consistent configuration one switch at a time, giving up a start condition
+    before taking another (so that sticking is found before a reversal)."""
     ev = layout.events
     new: dict[x.Expr, x.Expr] = {}
     changed: list[x.Expr] = []
     one_at_a_time = x.BinOp("==", x.Var("_zstatus"), x.Const(2.0))
-    out.append(Let("_zm", _ZERO))
+    out.append(Let("_zdown", _ZERO))  # whether a relation turns false
     for k, rel in enumerate(ev.relations):
         g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
         held = x.Var(layout.relations[k])
         out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
-        moved = x.BinOp("<>", x.Var(f"_zn{k}"), held)
-        out.append(Let(f"_zh{k}", x.If(x.BinOp("and", one_at_a_time, _truth("_zm")), held,
-                                       x.Var(f"_zn{k}"))))
-        out.append(Let("_zm", _flag(x.BinOp("or", _truth("_zm"), moved))))
+        changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), held))
+        falls = x.BinOp("and", _truth(layout.relations[k]), x.Not(_truth(f"_zn{k}")))
+        out.append(Let("_zdown", _flag(x.BinOp("or", _truth("_zdown"), falls))))
+    out.append(Let("_zm", _ZERO))  # whether a relation has switched in this pass
+    for k, rel in enumerate(ev.relations):
+        held = x.Var(layout.relations[k])
+        # one at a time: the first relation that turns false, else the first that
+        # turns true (a start condition is given up before another is taken)
+        flips = x.BinOp("and", changed[k], x.BinOp(
+            "or", x.Not(_truth("_zdown")), _truth(layout.relations[k])))
+        out.append(Let(f"_zh{k}", x.If(
+            one_at_a_time, x.If(x.BinOp("and", flips, x.Not(_truth("_zm"))),
+                                x.Var(f"_zn{k}"), held), x.Var(f"_zn{k}"))))
+        out.append(Let("_zm", _flag(x.BinOp("or", _truth("_zm"), flips))))
         new[rel] = _truth(f"_zh{k}")
-        changed.append(moved)
     for k, tr in enumerate(ev.time_relations):
         now = x.BinOp(">=", x.TIME, x.sub(tr.at, _eps(x.TIME)))
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
