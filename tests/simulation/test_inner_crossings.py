@@ -2,15 +2,18 @@
 (simulation/events.py, ``first_switch``): the relations are checked at inner points
 of each step's dense output too, not only at its end. The MSL's CoupledClutches
 needs it: a clutch's transmitted torque dips under its breakaway limit while every
-state moves slowly (the solver takes long steps)."""
+state moves slowly (the solver takes long steps). And the message of an event iteration
+that cycles names what moves."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import springc
+from springc.errors import SimulationError
 
 MODEL = '''\
 model Window
@@ -41,3 +44,28 @@ def test_a_window_inside_one_step_is_found(tmp_path: Path) -> None:
     assert abs(float(np.asarray(result["tOn"])[-1]) - on) < 1e-9
     assert abs(float(np.asarray(result["tOff"])[-1]) - off) < 1e-9
     assert float(np.asarray(result["entries"])[-1]) == 1.0
+
+
+FLIP = '''\
+model Flip
+  Real x(start = 0, fixed = true);
+  Real y;
+equation
+  der(x) = 1;
+  y = if y > 0 then -1 else 1;
+end Flip;
+'''
+
+
+def test_a_cycle_of_period_two_is_named(tmp_path: Path) -> None:
+    """An event iteration that alternates between two states names the relation that
+    moves (the check compares each of two passes, not the second with the first's
+    start, which is the same state again)."""
+    path = tmp_path / "Flip.mo"
+    path.write_text(FLIP)
+    with pytest.raises(SimulationError) as caught:
+        springc.simulate(str(path), backend="python", engine="scipy", stop=1.0,
+                         error_control="off")
+    assert str(caught.value).splitlines()[0] == (
+        "error: the event iteration at time 0 did not settle in 100 passes: y > 0 keep "
+        "changing")

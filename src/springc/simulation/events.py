@@ -189,13 +189,15 @@ class EventLoop:
         changing (the discrete variables and relations that differ between passes)."""
         z = self.z.copy()
         y = np.array(x)
-        before = z.copy()
-        for _ in range(2):
+        moved = np.zeros(len(z), dtype=bool)
+        for _ in range(2):  # a cycle of period two shows in either pass
+            before = z.copy()
             y = np.asarray(self.mod.event_pass(t, y, self.p, z))
+            moved |= z != before
         names = [self.mod.DISCRETE[i] for i, slot in enumerate(self.mod.Z_DISCRETE)
-                 if z[slot] != before[slot]]
+                 if moved[slot]]
         names += [self.mod.ZERO_CROSSINGS[k] for k in range(len(self.ops))
-                  if z[self.first + k] != before[self.first + k]]
+                  if moved[self.first + k]]
         shown = ", ".join(names[:6]) or "the states (reinit)"
         return SimulationError(
             f"the event iteration at time {format_time(t)} did not settle in "
