@@ -271,7 +271,8 @@ def test_a_bouncing_ball_with_drag_gets_an_honest_estimate(folder: str, rtol: fl
     result = springc.simulate(model, stop=3, rtol=rtol)
     estimate = result.error_estimate
     assert estimate is not None and estimate.met  # within its rule: not tightened
-    assert result.stats.rtol == rtol and result.stats.state_events == 13
+    # the 8 impacts: abs(v) in the drag is noEvent(...) (3.7.1), no event at the apexes
+    assert result.stats.rtol == rtol and result.stats.state_events == 8
     true = np.abs(result["v"] - reference["v"]).max()
     assert 1 / 3 <= estimate.absolute[estimate.names.index("v")] / true <= 3
 

@@ -315,7 +315,8 @@ def test_time_events_within_rounding_of_an_output_time(models: dict[str, Compile
 @pytest.mark.parametrize("solver", ["dop853", "rk4"])
 def test_sign_and_abs_switch_at_the_same_events(models: dict[str, CompiledModel], solver: str
                                                 ) -> None:
-    """sign and abs outside noEvent switch at events (their relations in zero_crossings)."""
+    """sign outside noEvent switches at events (its relations in zero_crossings); abs
+    is noEvent(if v >= 0 then v else -v) (3.7.1): its value is |v| at every row."""
     scipy, compiled = both(models["bang"], solver, stop=3.0, interval=0.01, rtol=1e-10)
     tau, r = 1 / math.sqrt(5), math.sqrt(20)  # x = 0 at tau + 2 k tau
     u = np.mod(compiled.time, 4 * tau)

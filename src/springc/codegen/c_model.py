@@ -188,6 +188,7 @@ SPRINGC_FN int springc_event_update(double t, double *x, const double *p, double
     int more = 0;
     z[SPRINGC_Z_STATUS] = 1.0;
     for (int k = 0; k < SPRINGC_EVENT_ITERATIONS; k++) {
+        if (k == SPRINGC_SIMULTANEOUS_PASSES) z[SPRINGC_Z_STATUS] = 2.0;
         more = springc_event_pass(t, x, p, z, xn);
         code = more != 0 ? more : code;
         for (int i = 0; i < SPRINGC_N_STATES; i++) x[i] = xn[i];

@@ -145,6 +145,8 @@ class CWriter(FunctionWriter):
         prec = _c_precedence(op)
         if op in ("==", "<>") or prec == 4:  # equality binds looser than <, <=, >, >= in C
             left, right = self.expr(e.left, 5), self.expr(e.right, 5)
+        elif op == "or":  # && inside || in parentheses (-Wparentheses)
+            left, right = self.expr(e.left, 3), self.expr(e.right, 3)
         else:
             left, right = self.expr(e.left, prec), self.expr(e.right, prec + 1)
         return f"{left} {_C_PREC_OP.get(op, op)} {right}", prec

@@ -16,7 +16,7 @@ from ..simplify import conditions as initial_conditions
 from .c_context import CContext
 from .c_printer import c_comment, c_double, c_string
 from .context import CodegenContext
-from .events import EVENT_ITERATIONS, after_initial
+from .events import EVENT_ITERATIONS, SIMULTANEOUS_PASSES, after_initial
 
 # NVRTC (CUDA C++ compiled at run time) has the math functions built in, no <math.h>,
 # and no host tables; CUDA spells infinity and NaN with its bit-pattern intrinsics.
@@ -88,6 +88,7 @@ def _macros(m: CContext, outputs: Sequence[str]) -> list[str]:
             ("SPRINGC_Z_TERMINATE", s["_zstop"]), ("SPRINGC_Z_CHANGED", s["_zchanged"]),
             ("SPRINGC_Z_STATUS", s["_zstatus"]),
             ("SPRINGC_EVENT_ITERATIONS", EVENT_ITERATIONS),
+            ("SPRINGC_SIMULTANEOUS_PASSES", SIMULTANEOUS_PASSES),
             ("SPRINGC_USES_TERMINAL", int(layout.uses_terminal)),
             ("SPRINGC_AFTER_INITIAL", int(after_initial(layout))),
             ("SPRINGC_N_TERMINATE_MESSAGES", len(layout.messages)),

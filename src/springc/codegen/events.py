@@ -27,7 +27,10 @@ from .encoding import encode_strings
 from .event_layout import EventLayout
 from .statements import Let, Load, Raw, Stmt, Store
 
-EVENT_ITERATIONS = 50
+EVENT_ITERATIONS = 100
+SIMULTANEOUS_PASSES = 20
+"""Passes of the event iteration that switch every moved relation at once; the
+later ones switch one relation at a time (see :func:`_relations_now`)."""
 _ONE, _ZERO = x.Const(1.0), x.Const(0.0)
 
 
@@ -152,22 +155,41 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     return out
 
 
-def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+def _relations_now(layout: EventLayout, out: list[Stmt]
+                   ) -> tuple[dict[x.Expr, x.Expr], list[x.Expr]]:
+    """The relations, time relations and floor values at the end of a pass (appended
+    to ``out``): their new values by expression and whether each moved. When the
+    event iteration has gone on for :data:`SIMULTANEOUS_PASSES` passes
+    (``z[Z_STATUS]`` is 2.0), a pass switches only one state relation: the first
+    that turns false, else the first that turns true. A mixed system whose
+    simultaneous update cycles (a light body stopping under friction: the path
+    parameter of one sliding direction points to the other and back) then walks to
+    its consistent configuration one switch at a time, giving up a start condition
+    before taking another (so that sticking is found before a reversal)."""
     ev = layout.events
-    out = _base(m)
-    slot = layout.slot
-    changed: list[x.Expr] = []
-    # pre of the discrete variables: their values before this pass
-    for name in layout.discrete:
-        if name in layout.pre:
-            out.append(Let(layout.pre[name], x.Var(name)))
-    # the relations now
     new: dict[x.Expr, x.Expr] = {}
+    changed: list[x.Expr] = []
+    one_at_a_time = x.BinOp("==", x.Var("_zstatus"), x.Const(2.0))
+    out.append(Let("_zdown", _ZERO))  # whether a relation turns false
     for k, rel in enumerate(ev.relations):
         g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+        held = x.Var(layout.relations[k])
         out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
-        new[rel] = _truth(f"_zn{k}")
-        changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), x.Var(layout.relations[k])))
+        changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), held))
+        falls = x.BinOp("and", _truth(layout.relations[k]), x.Not(_truth(f"_zn{k}")))
+        out.append(Let("_zdown", _flag(x.BinOp("or", _truth("_zdown"), falls))))
+    out.append(Let("_zm", _ZERO))  # whether a relation has switched in this pass
+    for k, rel in enumerate(ev.relations):
+        held = x.Var(layout.relations[k])
+        # one at a time: the first relation that turns false, else the first that
+        # turns true (a start condition is given up before another is taken)
+        flips = x.BinOp("and", changed[k], x.BinOp(
+            "or", x.Not(_truth("_zdown")), _truth(layout.relations[k])))
+        out.append(Let(f"_zh{k}", x.If(
+            one_at_a_time, x.If(x.BinOp("and", flips, x.Not(_truth("_zm"))),
+                                x.Var(f"_zn{k}"), held), x.Var(f"_zn{k}"))))
+        out.append(Let("_zm", _flag(x.BinOp("or", _truth("_zm"), flips))))
+        new[rel] = _truth(f"_zh{k}")
     for k, tr in enumerate(ev.time_relations):
         now = x.BinOp(">=", x.TIME, x.sub(tr.at, _eps(x.TIME)))
         out.append(Let(f"_zu{k}", _flag(now if tr.after else x.Not(now))))
@@ -180,6 +202,22 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             u = x.add(u, x.mul(rate, _eps(x.TIME)))
         out.append(Let(f"_zk{k}", x.Call("floor", (u,)), x.to_text(call)))
         changed.append(x.BinOp("<>", x.Var(f"_zk{k}"), x.Var(layout.floors[k])))
+    return new, changed
+
+
+def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
+    ev = layout.events
+    out = _base(m)
+    slot = layout.slot
+    changed: list[x.Expr] = []
+    # pre of the discrete variables: their values before this pass
+    for name in layout.discrete:
+        if name in layout.pre:
+            out.append(Let(layout.pre[name], x.Var(name)))
+    new, moves = _relations_now(layout, out)
+    changed += moves
+    # the relations settle first (pre held), then pre(v) := v of the iterated variables
+    relations_moved = _any(list(changed))
     # clause by clause (sorted: a clause reading what another assigns comes after
     # it): the conditions with the new relations and the values assigned so far (a
     # branch fires when one of its conditions becomes true; at initialization only
@@ -226,17 +264,12 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
         else:
             changed.append(active_for(ev, name, active))
-    settled = _equation_pres(layout)
-    if settled:  # pre(v) := v once the rest has settled (v is computed from held values)
-        out.append(Let("_zmoved", _flag(_any(changed))))
-        settled = [(slot_name, x.If(_truth("_zmoved"), x.Var(slot_name), now))
-                   for slot_name, now in settled]
-    changed += [x.BinOp("<>", now, x.Var(slot_name)) for slot_name, now in settled]
+    for name in ev.iterated:  # equation-defined discrete variables: pre(v) := v (8.6)
+        changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
     out.append(Store(f"z[{slot['_zchanged']}]", _flag(_any(changed))))
-    out += [Store(f"z[{slot[slot_name]}]", now) for slot_name, now in settled]
     out.append(Store(f"z[{slot['_zstop']}]", stop))
     for k, name in enumerate(layout.relations):
-        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zn{k}")))
+        out.append(Store(f"z[{slot[name]}]", x.Var(f"_zh{k}")))
     for k, name in enumerate(layout.times):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
     for k, name in enumerate(layout.condition_names):
@@ -247,25 +280,17 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
             out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
+    out.append(Let("_zmoved", _flag(relations_moved)))
+    for name in ev.iterated:
+        pre = x.Var(layout.pre[name])
+        out.append(Store(f"z[{slot[layout.pre[name]]}]",
+                         x.If(_truth("_zmoved"), pre, x.Var(name)), f"pre({name})"))
     out.append(Raw(f"xn = np.empty({len(m.states)})"))
     index = {name: n for n, name in enumerate(reinits)}
     for k, state in enumerate(m.states):
         value = x.Var(f"_zx{index[state]}") if state in index else x.Var(state)
         out.append(Store(f"xn[{k}]", value, state))
     return out
-
-
-def _equation_pres(layout: EventLayout) -> list[tuple[str, x.Expr]]:
-    """``(pre slot, value now)`` of the discrete variables that equations (not
-    when-clauses) give and whose ``pre`` is read: the event iteration goes on until
-    ``pre(v) = v`` for them too (section 8.6), so that ``pre(u)`` sees at the same
-    instant what a when-clause's update or a sampled trigger changed (the MSL's
-    Logical.Pre in an RSFlipFlop latches its input); the initial event iterates so too,
-    from the ``pre(v)`` the initial problem gave. ``v`` is computed from the relations
-    held before the pass, so ``pre(v)`` moves only in a pass where nothing else did."""
-    held = set(layout.discrete)
-    return [(slot_name, x.Var(name)) for name, slot_name in layout.pre.items()
-            if name not in held]
 
 
 def active_for(ev: EventSystem, name: str, active: dict[tuple[int, int], x.Expr]) -> x.Expr:
@@ -335,6 +360,7 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
         f"Z_CHANGED = {s['_zchanged']}",
         f"Z_STATUS = {s['_zstatus']}",
         f"EVENT_ITERATIONS = {EVENT_ITERATIONS}",
+        f"SIMULTANEOUS_PASSES = {SIMULTANEOUS_PASSES}",
         f"USES_TERMINAL = {layout.uses_terminal}",
         f"AFTER_INITIAL = {after_initial(layout)}",
     ]
@@ -357,6 +383,8 @@ EVENT_UPDATE = '''def event_update(t, x, p, z):
     event_begin(t, x, p, z)
     z[Z_STATUS] = 1.0
     for _k in range(EVENT_ITERATIONS):
+        if _k == SIMULTANEOUS_PASSES:
+            z[Z_STATUS] = 2.0
         x = event_pass(t, x, p, z)
         if z[Z_CHANGED] == 0.0:
             z[Z_STATUS] = 0.0

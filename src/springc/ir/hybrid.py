@@ -11,6 +11,11 @@ Produced by :mod:`springc.simplify.events` next to the ODE (``ODE.events``):
   (``time >= t0``): time events at ``at``, hit exactly without root finding;
 - ``samples``: the ``sample(start, interval)`` calls (time events too);
 - ``pre``: the variables read by ``pre``, ``edge`` or ``change``;
+- ``iterated``: those of them that equations (not when-clauses) determine and that
+  are discrete-time (Boolean, Integer, enumeration, ``discrete Real``): the event
+  iteration sets ``pre(v) := v`` after each pass until none changes (8.6), which
+  the mixed systems of friction and switches (``pre(mode)``, ``pre(startForward)``)
+  need to settle;
 - ``floors``: the ``floor(u)`` calls on continuous arguments outside ``noEvent``
   (``ceil``, ``integer``, ``div``, ``mod`` and ``rem`` are rewritten into them):
   each keeps its value from the last event; an event occurs when ``u`` leaves
@@ -67,6 +72,7 @@ class EventSystem:
     # initial() / terminal() read by equations or assertions (an if-equation on them)
     reads_initial: bool = False
     reads_terminal: bool = False
+    iterated: tuple[str, ...] = ()
 
     @property
     def empty(self) -> bool:

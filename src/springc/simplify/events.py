@@ -139,15 +139,17 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     discrete = tuple(Discrete(n, by_name[n].type,
                               starts.get(n, by_name[n].attributes.start), by_name[n].span)
                      for n in held)
+    iterated = tuple(n for n in pre if n not in held_set and n in by_name and (
+        by_name[n].type != "Real" or by_name[n].variability == "discrete"))
     return EventSystem(discrete, tuple(relations), tuple(timed.values()), tuple(samples),
                        tuple(pre), _sorted_whens(model.whens), tuple(floors),
                        tuple(_time_rate(c.args[0], params) for c in floors),
-                       "initial" in phases, "terminal" in phases)
+                       "initial" in phases, "terminal" in phases, iterated)
 
 
 def with_events(model: flat.FlatModel, system: ode.ODE) -> ode.ODE:
     """``system`` with its events (``ODE.events``; unchanged for a continuous model).
-    ``abs``, ``sign``, ``min`` and ``max`` outside ``noEvent`` become if-expressions
+    ``sign``, ``min`` and ``max`` outside ``noEvent`` become if-expressions
     on relations first, and ``ceil``, ``integer``, ``div``, ``mod`` and ``rem`` of
     continuous arguments expressions of ``floor`` (held between events), so that
     their switches are events too."""
@@ -175,20 +177,21 @@ def _rewrite_when(clause: w.When, f: Callable[[x.Expr], x.Expr]) -> w.When:
 
 
 def switched_builtins(e: x.Expr, known: frozenset[str] | None = None) -> x.Expr:
-    """``e`` with ``abs(a)`` as ``if a >= 0 then a else -a``, ``sign(a)`` as ``if a > 0
-    then 1 else if a < 0 then -1 else 0``, ``min(a, b)`` as ``if a < b then a else b``
-    and ``max(a, b)`` as ``if a > b then a else b``, outside ``noEvent``/``smooth``
-    (unchanged subtrees are shared). With ``known`` (the parameters and discrete
-    variables), the integer-valued built-ins of arguments that read anything else
-    become expressions of ``floor`` (see :func:`_through_floor`)."""
+    """``e`` with ``sign(a)`` as ``if a > 0 then 1 else if a < 0 then -1 else 0``,
+    ``min(a, b)`` as ``if a < b then a else b`` and ``max(a, b)`` as ``if a > b then a
+    else b``, outside ``noEvent``/``smooth`` (unchanged subtrees are shared). ``abs``
+    stays a call: it expands into ``noEvent(if v >= 0 then v else -v)`` (3.7.1), and
+    as a held branch it would be negative wherever the integrator tries a step past
+    the relation's zero (the MSL's Stribeck friction ``exp(-fexp*abs(v))`` overflowed,
+    an arc's ``abs(i) <= abs(v)*Goff`` never settled). With ``known`` (the parameters
+    and discrete variables), the integer-valued built-ins of arguments that read
+    anything else become expressions of ``floor`` (see :func:`_through_floor`)."""
     if isinstance(e, (x.Const, x.Var, x.Time)):
         return e
     if isinstance(e, x.Call):
         if e.name in _QUIET:
             return e
         args = tuple(switched_builtins(a, known) for a in e.args)
-        if e.name == "abs":
-            return x.If(x.BinOp(">=", args[0], x.ZERO), args[0], x.neg(args[0]))
         if e.name == "sign":
             return x.If(x.BinOp(">", args[0], x.ZERO), x.ONE,
                         x.If(x.BinOp("<", args[0], x.ZERO), x.Const(-1), x.ZERO))

@@ -35,6 +35,8 @@ from .steps import Problem, solver_failure
 
 LOCATE_TOLERANCE = 1e-12
 """Event times are located to this times max(1, |t|) (a bracket that narrow)."""
+STEP_PROBES = 3
+"""Inner points of each accepted step where the relations are checked too."""
 EVENT_BURST = 100
 ZENO_FRACTION = 1e-6
 """More than EVENT_BURST events within ZENO_FRACTION x (stop - start) is chattering."""
@@ -98,6 +100,23 @@ class EventLoop:
         g = self.mod.zero_crossings(t, x, self.p, self.z)
         held = self.z[self.first:self.first + len(self.ops)]
         return [k for k, op in enumerate(self.ops) if op(float(g[k]), 0.0) != (held[k] != 0.0)]
+
+    def first_switch(self, dense: Callable[[float], np.ndarray], ta: float, tb: float,
+                     y: np.ndarray) -> tuple[float, list[int]]:
+        """The relations switched at the first of :data:`STEP_PROBES` inner points
+        of the step ``(ta, tb]`` (on its dense output) where some have, else at its
+        end (``y`` at ``tb``): a relation that switches and switches back within
+        one long step (a clutch's torque dipping under its breakaway limit while
+        its states hardly move) is an event too, and it may come before another
+        that has switched at the end. Returns that time and the relations."""
+        if not self.ops:
+            return tb, []
+        for j in range(1, STEP_PROBES + 1):
+            tm = ta + (tb - ta) * j / (STEP_PROBES + 1)
+            switched = self.switched(tm, np.asarray(dense(tm), dtype=float))
+            if switched:
+                return tm, switched
+        return tb, self.switched(tb, y)
 
     def locate(self, state: Callable[[float], np.ndarray], ta: float, tb: float,
                k: int) -> float:
@@ -170,13 +189,15 @@ class EventLoop:
         changing (the discrete variables and relations that differ between passes)."""
         z = self.z.copy()
         y = np.array(x)
-        before = z.copy()
-        for _ in range(2):
+        moved = np.zeros(len(z), dtype=bool)
+        for _ in range(2):  # a cycle of period two shows in either pass
+            before = z.copy()
             y = np.asarray(self.mod.event_pass(t, y, self.p, z))
+            moved |= z != before
         names = [self.mod.DISCRETE[i] for i, slot in enumerate(self.mod.Z_DISCRETE)
-                 if z[slot] != before[slot]]
+                 if moved[slot]]
         names += [self.mod.ZERO_CROSSINGS[k] for k in range(len(self.ops))
-                  if z[self.first + k] != before[self.first + k]]
+                  if moved[self.first + k]]
         shown = ", ".join(names[:6]) or "the states (reinit)"
         return SimulationError(
             f"the event iteration at time {format_time(t)} did not settle in "
@@ -281,9 +302,9 @@ class EventLoop:
                 self.note_step(t_new)
                 dense = integrator.dense_output()
                 y = np.asarray(integrator.y, dtype=float)
-                switched = self.switched(t_new, y)
+                t_end, switched = self.first_switch(dense, t_old, t_new, y)
                 if switched:
-                    times = {k: self.locate(dense, t_old, t_new, k)
+                    times = {k: self.locate(dense, t_old, t_end, k)
                              for k in switched}
                     k = min(times, key=times.__getitem__)
                     te = times[k]
