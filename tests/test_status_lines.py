@@ -69,7 +69,7 @@ def test_a_kernel_without_numba_cache_says_it_compiles(
     monkeypatch.setattr(springc.integrate, "load", loaded.append)  # no numba compile here
     load_kernel("radau", cached=lambda method: False)
     assert capsys.readouterr().err == ("springc: compiling the radau loop for this machine "
-                                       "(once), about 25 s\n")
+                                       "(once), about 20 s\n")
     load_kernel("radau", cached=lambda method: True)
     with silenced():
         load_kernel("bdf", cached=lambda method: False)

@@ -5,8 +5,9 @@ step-size predictor and the dense output.
 The implicit method for stiff scenes, as scipy's ``Radau`` runs it (Hairer and Wanner's
 ``radau5``: same controller, Newton iteration, Jacobian reuse and error estimate; the
 tests compare steps and errors with scipy's on the same problems): the 3n x 3n Newton
-system is transformed by ``T`` into one real and one complex n x n system, factorised
-by :mod:`.banded_lu` in the ordering of :func:`.banded_lu.band_layout` (``order``:
+system is transformed by ``T`` into one real and one complex n x n system (the complex
+one solved as a real 2n x 2n system: :func:`factor_newton_matrices`), factorised by
+:mod:`.banded_lu` in the ordering of :func:`.banded_lu.band_layout` (``order``:
 position -> state), with the generated sparse Jacobian (``jacobian_values`` in CSC
 order) assembled into the band.
 
@@ -17,10 +18,9 @@ numba keys its disk cache on this file's modification time only: touch it after 
 import math
 
 import numpy as np
-from numba import njit
 
 from . import radau_tableau as tableau
-from .arrays import copy
+from .arrays import copy, inlined, internal
 from .banded_lu import band_factor, band_solve
 from .dop853_steps import verdict
 from .signatures import ModelFunction
@@ -38,40 +38,74 @@ MU_REAL, MU_COMPLEX = tableau.MU_REAL, tableau.MU_COMPLEX
 NEWTON_MAXITER = tableau.NEWTON_MAXITER
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
 def rms(x: np.ndarray) -> float:
-    """Root mean square (scipy's ``norm(x) / sqrt(x.size)``), over all entries."""
-    flat = x.reshape(x.size)
+    """Root mean square (scipy's ``norm(x) / sqrt(x.size)``) of a vector."""
     total = 0.0
-    for value in flat:
-        total += value * value
+    for j in range(x.size):
+        total += x[j] * x[j]
     result: float = math.sqrt(total) / float(x.size) ** 0.5
     return result
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
+def pair_bands(kl: int, ku: int) -> tuple[int, int]:
+    """The bandwidths of the complex system as a real one of twice the size (see
+    :func:`factor_newton_matrices`)."""
+    return 2 * kl if kl > 0 else 1, 2 * ku if ku > 0 else 1
+
+
+@internal
 def factor_newton_matrices(h: float, jacobian: np.ndarray, positions: np.ndarray,
                            diagonal: np.ndarray, kl: int, ku: int, real: np.ndarray,
-                           complex_: np.ndarray, pivots_real: np.ndarray,
-                           pivots_complex: np.ndarray) -> bool:
+                           pair: np.ndarray, pivots: np.ndarray) -> bool:
     """``MU_REAL / h I - J`` and ``MU_COMPLEX / h I - J`` assembled in their bands and
-    factorised; False if either is singular."""
+    factorised (pivots in ``pivots[0]``, ``pivots[1]``); False if either is singular.
+
+    The complex matrix ``(a + i g) I - J`` is factorised as the real matrix of twice the
+    size that acts on each state's real and imaginary parts side by side (rows and
+    columns ``2i``, ``2i + 1``: the block ``[[a - J_ii, -g], [g, a - J_ii]]`` on the
+    diagonal, ``-J_ij`` twice off it), so that one real band LU serves both systems:
+    numba compiles no complex arithmetic (each complex specialisation of the band LU,
+    its solve and the complex vectors cost seconds of compile time)."""
     width = real.shape[1]  # (positions: flat indices into the band)
     for i in range(real.shape[0]):
         for j in range(width):
             real[i, j] = 0.0
-            complex_[i, j] = 0.0
+    for i in range(pair.shape[0]):
+        for j in range(pair.shape[1]):
+            pair[i, j] = 0.0
+    kl2, ku2 = pair_bands(kl, ku)
+    a, g = MU_COMPLEX.real / h, MU_COMPLEX.imag / h
     for k in range(diagonal.size):
-        real[diagonal[k] // width, diagonal[k] % width] = MU_REAL / h
-        complex_[diagonal[k] // width, diagonal[k] % width] = MU_COMPLEX / h
+        i = diagonal[k] // width
+        real[i, diagonal[k] % width] = MU_REAL / h
+        pair[2 * i, kl2], pair[2 * i, kl2 + 1] = a, -g
+        pair[2 * i + 1, kl2 - 1], pair[2 * i + 1, kl2] = g, a
     for k in range(positions.size):
-        real[positions[k] // width, positions[k] % width] -= jacobian[k]
-        complex_[positions[k] // width, positions[k] % width] -= jacobian[k]
-    return (band_factor(real, kl, ku, pivots_real)
-            and band_factor(complex_, kl, ku, pivots_complex))
+        i, column = positions[k] // width, positions[k] % width
+        real[i, column] -= jacobian[k]
+        column2 = 2 * (column - kl) + kl2
+        pair[2 * i, column2] -= jacobian[k]
+        pair[2 * i + 1, column2] -= jacobian[k]
+    return (band_factor(real, kl, ku, pivots[0])
+            and band_factor(pair, kl2, ku2, pivots[1]))
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
+def solve_pair(pair: np.ndarray, kl: int, ku: int, pivots: np.ndarray, order: np.ndarray,
+               re: np.ndarray, im: np.ndarray, work: np.ndarray) -> None:
+    """Solve the complex system factorised by :func:`factor_newton_matrices` in place
+    (its real and imaginary parts ``re``, ``im`` in state order)."""
+    kl2, ku2 = pair_bands(kl, ku)
+    for q in range(order.size):
+        work[2 * q], work[2 * q + 1] = re[order[q]], im[order[q]]
+    band_solve(pair, kl2, ku2, pivots, work)
+    for q in range(order.size):
+        re[order[q]], im[order[q]] = work[2 * q], work[2 * q + 1]
+
+
+@internal
 def solve_in_order(factors: np.ndarray, kl: int, ku: int, pivots: np.ndarray,
                    order: np.ndarray, b: np.ndarray, work: np.ndarray) -> None:
     """Solve with band factors of the reordered matrix, ``b`` in state order, in place."""
@@ -82,7 +116,7 @@ def solve_in_order(factors: np.ndarray, kl: int, ku: int, pivots: np.ndarray,
         b[order[i]] = work[i]
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
 def predict_factor(h_abs: float, h_abs_old: float, error_norm: float,
                    error_norm_old: float) -> float:
     """Gustafsson's predictive step-size factor (``h_abs_old < 0``: no history)."""
@@ -96,32 +130,27 @@ def predict_factor(h_abs: float, h_abs_old: float, error_norm: float,
     return factor
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray,
-           scale: np.ndarray, tol: float, real: np.ndarray, complex_: np.ndarray,
-           pivots_real: np.ndarray, pivots_complex: np.ndarray, kl: int, ku: int,
-           order: np.ndarray, p: np.ndarray, z: np.ndarray, Z: np.ndarray
+           scale: np.ndarray, tol: float, real: np.ndarray, pair: np.ndarray,
+           pivots: np.ndarray, kl: int, ku: int, order: np.ndarray, p: np.ndarray,
+           z: np.ndarray, Z: np.ndarray, rows: np.ndarray, work_pair: np.ndarray
            ) -> tuple[bool, int, float, int, int]:
     """The simplified Newton iteration of the collocation system from ``Z0``; the stage
-    increments in ``Z``. Returns (converged, iterations, rate (-1: none), evaluations,
-    status: MODEL_FAILED if the model flagged a failure)."""
+    increments in ``Z``; ``rows``: the method's vectors (from :data:`W_ROWS` on: work
+    space), ``work_pair``: the complex system's. Returns (converged, iterations, rate
+    (-1: none), evaluations, status: MODEL_FAILED if the model flagged a failure)."""
     n = y.size
     m_real = MU_REAL / h
-    m_complex = MU_COMPLEX / h
-    W = np.zeros((3, n))
+    m_re, m_im = MU_COMPLEX.real / h, MU_COMPLEX.imag / h
+    W, F, dW = rows[W_ROWS:W_ROWS + 3], rows[F_ROWS:F_ROWS + 3], rows[DW_ROWS:DW_ROWS + 3]
+    stage, f_real, work_real = rows[NEWTON_STAGE], rows[F_REAL], rows[WORK_REAL]
+    f_re, f_im = rows[F_RE], rows[F_IM]
     for r in range(3):
-        for c in range(3):
-            for j in range(n):
-                W[r, j] += TI[r, c] * Z0[c, j]
+        for j in range(n):
+            W[r, j] = TI[r, 0] * Z0[0, j] + TI[r, 1] * Z0[1, j] + TI[r, 2] * Z0[2, j]
     for r in range(3):
         copy(Z[r], Z0[r])
-    F = np.empty((3, n))
-    stage = np.empty(n)
-    dW = np.empty((3, n))
-    f_real = np.empty(n)
-    f_complex = np.empty(n, dtype=np.complex128)
-    work_real = np.empty(n)
-    work_complex = np.empty(n, dtype=np.complex128)
     dW_norm_old, rate = -1.0, -1.0
     evaluations, iterations = 0, 0
     for k in range(NEWTON_MAXITER):
@@ -143,15 +172,21 @@ def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray
         for j in range(n):
             f_real[j] = (F[0, j] * TI_REAL[0] + F[1, j] * TI_REAL[1] + F[2, j] * TI_REAL[2]
                          - m_real * W[0, j])
-            f_complex[j] = (F[0, j] * TI_COMPLEX[0] + F[1, j] * TI_COMPLEX[1]
-                            + F[2, j] * TI_COMPLEX[2] - m_complex * (W[1, j] + 1j * W[2, j]))
-        solve_in_order(real, kl, ku, pivots_real, order, f_real, work_real)
-        solve_in_order(complex_, kl, ku, pivots_complex, order, f_complex, work_complex)
+            f_re[j] = (F[0, j] * TI[1, 0] + F[1, j] * TI[1, 1] + F[2, j] * TI[1, 2]
+                       - (m_re * W[1, j] - m_im * W[2, j]))
+            f_im[j] = (F[0, j] * TI[2, 0] + F[1, j] * TI[2, 1] + F[2, j] * TI[2, 2]
+                       - (m_re * W[2, j] + m_im * W[1, j]))
+        solve_in_order(real, kl, ku, pivots[0], order, f_real, work_real)
+        solve_pair(pair, kl, ku, pivots[1], order, f_re, f_im, work_pair)
+        total = 0.0
         for j in range(n):
             dW[0, j] = f_real[j] / scale[j]
-            dW[1, j] = f_complex[j].real / scale[j]
-            dW[2, j] = f_complex[j].imag / scale[j]
-        dW_norm = rms(dW)
+            dW[1, j] = f_re[j] / scale[j]
+            dW[2, j] = f_im[j] / scale[j]
+        for r in range(3):
+            for j in range(n):
+                total += dW[r, j] * dW[r, j]
+        dW_norm = math.sqrt(total) / float(3 * n) ** 0.5
         if dW_norm_old >= 0:
             rate = dW_norm / dW_norm_old
         if rate >= 0 and (rate >= 1 or rate ** (NEWTON_MAXITER - k) / (1 - rate) * dW_norm
@@ -159,8 +194,8 @@ def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray
             break
         for j in range(n):
             W[0, j] += f_real[j]
-            W[1, j] += f_complex[j].real
-            W[2, j] += f_complex[j].imag
+            W[1, j] += f_re[j]
+            W[2, j] += f_im[j]
         for r in range(3):
             for j in range(n):
                 Z[r, j] = T[r, 0] * W[0, j] + T[r, 1] * W[1, j] + T[r, 2] * W[2, j]
@@ -170,7 +205,7 @@ def newton(rhs: ModelFunction, t: float, y: np.ndarray, h: float, Z0: np.ndarray
     return False, iterations, rate, evaluations, SUCCESS
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
 def dense_coefficients(Z: np.ndarray, Q: np.ndarray) -> None:
     """The collocation polynomial of the step: ``Q = Z^T P`` (n x 3)."""
     for j in range(Z.shape[1]):
@@ -178,7 +213,7 @@ def dense_coefficients(Z: np.ndarray, Q: np.ndarray) -> None:
             Q[j, c] = Z[0, j] * P[0, c] + Z[1, j] * P[1, c] + Z[2, j] * P[2, c]
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@inlined
 def dense_state(Q: np.ndarray, y_old: np.ndarray, x: float, out: np.ndarray) -> None:
     """The dense output at the step fraction ``x`` (from ``y_old``)."""
     x2 = x * x
@@ -191,11 +226,16 @@ def dense_state(Q: np.ndarray, y_old: np.ndarray, x: float, out: np.ndarray) -> 
 
 Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
 Work = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-             np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+             np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 #: the rows of the vectors ``work[3]`` (few arrays in the tuple: each one a hook takes
 #: costs compile time): the state at the last step's start, the error weights, the error
 #: estimate, its collocation part, a work vector, the derivative at the step's start
 Y_OLD, SCALE, ERROR, ERROR_Z, STAGE, F = 0, 1, 2, 3, 4, 5
+#: and the Newton iteration's work space (allocated once, not at every iteration): the
+#: transformed increments ``W``, the stage derivatives, the corrections (3 rows each),
+#: a stage, the real system's right-hand side and its solve's work vector
+W_ROWS, F_ROWS, DW_ROWS, NEWTON_STAGE, F_REAL, WORK_REAL, F_RE, F_IM, VECTOR_ROWS = \
+    6, 9, 12, 15, 16, 17, 18, 19, 20
 #: the method's scalars between steps (``work[8]``): the Newton tolerance, the last
 #: step size and error norm (-1: none), the start and length of the last step
 NEWTON_TOL, H_ABS_OLD, ERROR_NORM_OLD, T_OLD, H_DENSE = 0, 1, 2, 3, 4
@@ -204,19 +244,19 @@ NEWTON_TOL, H_ABS_OLD, ERROR_NORM_OLD, T_OLD, H_DENSE = 0, 1, 2, 3, 4
 CURRENT_JAC, FACTORED, HAVE_DENSE = 0, 1, 2
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def setup(n: int, layout: Layout) -> Work:
     """The stage arrays, the band matrices of the Newton systems and their pivots, the
     Jacobian's non-zeros, the derivative at the step's start and the scalars."""
     _, kl, ku, positions, _ = layout
-    width = 2 * kl + ku + 1
-    return (np.zeros((3, n)), np.zeros((3, n)), np.zeros((n, 3)), np.empty((6, n)),
-            np.empty(positions.size), np.zeros((n, width)),
-            np.zeros((n, width), dtype=np.complex128), np.empty((2, n), dtype=np.int64),
-            np.zeros(5), np.zeros(3, dtype=np.int64))
+    kl2, ku2 = pair_bands(kl, ku)
+    return (np.zeros((3, n)), np.zeros((3, n)), np.zeros((n, 3)), np.empty((VECTOR_ROWS, n)),
+            np.empty(positions.size), np.zeros((n, 2 * kl + ku + 1)),
+            np.zeros((2 * n, 2 * kl2 + ku2 + 1)), np.empty((2, 2 * n), dtype=np.int64),
+            np.zeros(5), np.zeros(3, dtype=np.int64), np.empty(2 * n))
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np.ndarray,
           h_abs: float, p: np.ndarray, z: np.ndarray, rtol: float, work: Work,
           counts: np.ndarray, end: np.ndarray) -> tuple[int, float]:
@@ -236,7 +276,7 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
     return SUCCESS, t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def converge(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h: float,
              p: np.ndarray, z: np.ndarray, layout: Layout, work: Work, counts: np.ndarray
              ) -> tuple[bool, int, float, int]:
@@ -245,17 +285,16 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h:
     iterations, rate, status)."""
     order, kl, ku, positions, diagonal = layout
     Z0, Z, scale, J = work[0], work[1], work[3][SCALE], work[4]
-    real, complex_, pivots_real, pivots_complex = work[5], work[6], work[7][0], work[7][1]
-    reals, flags = work[8], work[9]
+    real, pair, pivots, reals, flags = work[5], work[6], work[7], work[8], work[9]
     converged, n_iter, rate = False, 0, -1.0
     while not converged:
         if not flags[FACTORED]:
             flags[FACTORED] = factor_newton_matrices(h, J, positions, diagonal, kl, ku, real,
-                                                     complex_, pivots_real, pivots_complex)
+                                                     pair, pivots)
         if flags[FACTORED]:
             converged, n_iter, rate, used, status = newton(
-                rhs, t, y, h, Z0, scale, reals[NEWTON_TOL], real, complex_, pivots_real,
-                pivots_complex, kl, ku, order, p, z, Z)
+                rhs, t, y, h, Z0, scale, reals[NEWTON_TOL], real, pair, pivots, kl, ku, order,
+                p, z, Z, work[3], work[10])
             counts[RHS_CALLS] += used
             if status != SUCCESS:
                 return False, n_iter, rate, status
@@ -271,7 +310,7 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h:
     return converged, n_iter, rate, SUCCESS
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_proposed: float,
          h_abs: float, min_step: float, limit: float, p: np.ndarray, z: np.ndarray,
          rtol: float, atol: np.ndarray, layout: Layout, work: Work, counts: np.ndarray,
@@ -357,7 +396,7 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
                       y_new, end)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def after_step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray,
                t_new: float, h: float, h_abs: float, h_proposed: float, step_h_old: float,
                step_error_old: float, n_iter: int, rate: float, error_norm: float,
@@ -400,7 +439,7 @@ def after_step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray,
     return SUCCESS, t_new, h, h_abs * factor, t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: np.ndarray,
                   p: np.ndarray, z: np.ndarray, work: Work, counts: np.ndarray,
                   end: np.ndarray, blas: bool | None) -> tuple[int, float]:
@@ -408,7 +447,7 @@ def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: 
     return SUCCESS, t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def dense(work: Work, t: float, h: float, y: np.ndarray, at: float, out: np.ndarray,
           blas: bool | None) -> None:
     """The collocation polynomial of the step at time ``at``."""
