@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .arrays import copy
+from .arrays import copy, internal
 from .banded_lu import band_factor
 from .dop853_steps import verdict
 from .radau_steps import solve_in_order
@@ -39,7 +39,7 @@ ALPHA = (1 - KAPPA) * GAMMA
 ERROR_CONST = KAPPA * GAMMA + 1 / np.arange(1, MAX_ORDER + 2)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def step_ratio_matrix(order: int, factor: float) -> np.ndarray:
     """The matrix that rescales the differences of ``order`` to a step ``factor`` times
     longer (scipy's ``compute_R``)."""
@@ -58,13 +58,23 @@ def step_ratio_matrix(order: int, factor: float) -> np.ndarray:
 @njit(cache=True, error_model="numpy", nogil=True)
 def change_differences(D: np.ndarray, order: int, factor: float) -> None:
     """``D[:order + 1]`` rescaled to a step ``factor`` times longer (scipy's ``change_D``)."""
-    RU = step_ratio_matrix(order, factor) @ step_ratio_matrix(order, 1.0)
-    rescaled = RU.T @ D[:order + 1]
+    R = step_ratio_matrix(order, factor)
+    U = step_ratio_matrix(order, 1.0)
+    RU = np.zeros((order + 1, order + 1))
+    for i in range(order + 1):
+        for k in range(order + 1):
+            for j in range(order + 1):
+                RU[i, j] += R[i, k] * U[k, j]
+    rescaled = np.zeros((order + 1, D.shape[1]))
+    for k in range(order + 1):
+        for i in range(order + 1):
+            for j in range(D.shape[1]):
+                rescaled[i, j] += RU[k, i] * D[k, j]
     for i in range(order + 1):
         copy(D[i], rescaled[i])
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def scaled_rms(x: np.ndarray, weight: float, scale: np.ndarray) -> float:
     """``rms(weight * x / scale)``."""
     total = 0.0
@@ -75,19 +85,19 @@ def scaled_rms(x: np.ndarray, weight: float, scale: np.ndarray) -> float:
     return result
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def newton_bdf(rhs: ModelFunction, t_new: float, y_predict: np.ndarray, c: float,
                psi: np.ndarray, factors: np.ndarray, kl: int, ku: int, pivots: np.ndarray,
                order: np.ndarray, scale: np.ndarray, tol: float, p: np.ndarray,
-               z: np.ndarray, y: np.ndarray, d: np.ndarray) -> tuple[bool, int, int, int]:
+               z: np.ndarray, y: np.ndarray, d: np.ndarray, dy: np.ndarray, work: np.ndarray
+               ) -> tuple[bool, int, int, int]:
     """The Newton iteration of the BDF step from ``y_predict``: the new state in ``y``,
-    its correction in ``d``. Returns (converged, iterations, evaluations, status)."""
+    its correction in ``d`` (``dy``, ``work``: work space). Returns (converged,
+    iterations, evaluations, status)."""
     n = y.size
     copy(y, y_predict)
     for j in range(n):
         d[j] = 0.0
-    dy = np.empty(n)
-    work = np.empty(n)
     dy_norm_old, rate = -1.0, -1.0
     iterations, evaluations = 0, 0
     for k in range(NEWTON_MAXITER):
@@ -118,7 +128,7 @@ def newton_bdf(rhs: ModelFunction, t_new: float, y_predict: np.ndarray, c: float
     return False, iterations, evaluations, SUCCESS
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def bdf_dense_state(D: np.ndarray, order: int, t: float, h: float, at: float,
                     out: np.ndarray) -> None:
     """The interpolating polynomial of the last step (ending at ``t``, current step
@@ -137,8 +147,8 @@ Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
 Work = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
              np.ndarray]
 #: the rows of the vectors ``work[1]``: the predictor, its ``psi``, the correction, the
-#: error weights
-PREDICT, PSI, CORRECTION, SCALE = 0, 1, 2, 3
+#: error weights, and the Newton iteration's work space (its step, its solve's vector)
+PREDICT, PSI, CORRECTION, SCALE, DY, SOLVE = 0, 1, 2, 3, 4, 5
 #: the method's scalars (``work[5]``): the Newton tolerance, the end and the step size of
 #: the differences (the last step's, after its order and step-size change)
 NEWTON_TOL, T_NEW, H_NOW = 0, 1, 2
@@ -147,7 +157,7 @@ NEWTON_TOL, T_NEW, H_NOW = 0, 1, 2
 ORDER, N_EQUAL, FACTORED, CURRENT_JAC = 0, 1, 2, 3
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def factor_iteration_matrix(c: float, J: np.ndarray, positions: np.ndarray,
                             diagonal: np.ndarray, kl: int, ku: int, factors: np.ndarray,
                             pivots: np.ndarray) -> bool:
@@ -163,17 +173,17 @@ def factor_iteration_matrix(c: float, J: np.ndarray, positions: np.ndarray,
     return band_factor(factors, kl, ku, pivots)
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def setup(n: int, layout: Layout) -> Work:
     """The differences ``D``, the predictor and its ``psi``, the correction, the
     iteration matrix's band and pivots, the Jacobian's non-zeros and the scalars."""
     _, kl, ku, positions, _ = layout
-    return (np.zeros((MAX_ORDER + 3, n)), np.empty((4, n)), np.empty(positions.size),
+    return (np.zeros((MAX_ORDER + 3, n)), np.empty((6, n)), np.empty(positions.size),
             np.zeros((n, 2 * kl + ku + 1)), np.empty(n, dtype=np.int64), np.zeros(3),
             np.zeros(4, dtype=np.int64))
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np.ndarray,
           h_abs: float, p: np.ndarray, z: np.ndarray, rtol: float, work: Work,
           counts: np.ndarray, end: np.ndarray) -> tuple[int, float]:
@@ -194,7 +204,7 @@ def begin(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, f: np
     return SUCCESS, t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: np.ndarray,
              z: np.ndarray, layout: Layout, work: Work, counts: np.ndarray,
              y_new: np.ndarray, end: np.ndarray) -> tuple[bool, int, int]:
@@ -214,7 +224,7 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: 
         if ints[FACTORED]:
             converged, n_iter, used, status = newton_bdf(
                 rhs, t_new, y_predict, c, psi, factors, kl, ku, pivots, order_of, scale,
-                reals[NEWTON_TOL], p, z, y_new, d)
+                reals[NEWTON_TOL], p, z, y_new, d, vectors[DY], vectors[SOLVE])
             counts[RHS_CALLS] += used
             if status != SUCCESS:
                 copy(end, y_new)
@@ -231,7 +241,7 @@ def converge(rhs: ModelFunction, jac: ModelFunction, t_new: float, c: float, p: 
         ints[FACTORED], ints[CURRENT_JAC] = 0, 1
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_proposed: float,
          h_abs: float, min_step: float, limit: float, p: np.ndarray, z: np.ndarray,
          rtol: float, atol: np.ndarray, layout: Layout, work: Work, counts: np.ndarray,
@@ -293,7 +303,7 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
         return SUCCESS, t_new, h, new_differences(work, t_new, h_abs, safety, error_norm), t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def new_differences(work: Work, t_new: float, h_abs: float, safety: float,
                     error_norm: float) -> float:
     """The differences after an accepted step, and maybe another order and step size
@@ -328,7 +338,7 @@ def new_differences(work: Work, t_new: float, h_abs: float, safety: float,
     return h_abs
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: np.ndarray,
                   p: np.ndarray, z: np.ndarray, work: Work, counts: np.ndarray,
                   end: np.ndarray, blas: bool | None) -> tuple[int, float]:
@@ -336,7 +346,7 @@ def prepare_dense(rhs: ModelFunction, t: float, h: float, y: np.ndarray, y_new: 
     return SUCCESS, t
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def dense(work: Work, t: float, h: float, y: np.ndarray, at: float, out: np.ndarray,
           blas: bool | None) -> None:
     """The interpolating polynomial of the last step at time ``at``."""

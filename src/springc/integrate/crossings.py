@@ -11,14 +11,15 @@ fires only once it has come back to its held side and left it again.
 """
 
 import numpy as np
-from numba import njit
+
+from .arrays import internal
 
 #: the located crossing time is the right end of a bracket at most this wide, relative
 #: to max(|t|, step)
 EVENT_TIME_TOLERANCE = 1e-12
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def crossings(g_start: np.ndarray, g_end: np.ndarray, signs: np.ndarray,
               directions: np.ndarray, fired: np.ndarray) -> bool:
     """Whether some indicator crossed from ``g_start`` to ``g_end``; ``fired[i]`` is set
@@ -34,7 +35,7 @@ def crossings(g_start: np.ndarray, g_end: np.ndarray, signs: np.ndarray,
     return any_fired
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def time_tolerance(t: float, t_new: float) -> float:
     """The bracket width at which a crossing between ``t`` and ``t_new`` counts as located."""
     width = EVENT_TIME_TOLERANCE * max(abs(t), abs(t_new), t_new - t)

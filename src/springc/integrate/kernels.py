@@ -36,7 +36,7 @@ METHODS = {
     "dop853": Method("dop853", "dop853_steps", False, 10),
     "rk45": Method("rk45", "rk45_steps", False, 8),
     "radau": Method("radau", "radau_steps", True, 25),
-    "bdf": Method("bdf", "bdf_steps", True, 20),
+    "bdf": Method("bdf", "bdf_steps", True, 14),
     FIXED_STEP: Method(FIXED_STEP, None, False, 7),
 }
 """The compiled methods by name (the fixed-step methods share :data:`FIXED_STEP`)."""

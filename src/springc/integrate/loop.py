@@ -45,7 +45,7 @@ import numpy as np
 from numba import njit
 
 from . import dop853_steps as method
-from .arrays import copy
+from .arrays import copy, internal
 from .crossings import crossings, time_tolerance
 from .dop853_steps import flagged, rms, verdict
 from .signatures import ImplicitTuple, ModelFunction
@@ -67,7 +67,7 @@ Layout = tuple[np.ndarray, int, int, np.ndarray, np.ndarray]
 diagonal``: :func:`.banded_lu.band_layout`); the explicit methods ignore it."""
 
 
-@njit(cache=True, error_model="numpy", nogil=True)
+@internal
 def initial_step(rhs: ModelFunction, t: float, y: np.ndarray, f: np.ndarray, limit: float,
                  p: np.ndarray, z: np.ndarray, rtol: float, atol: np.ndarray,
                  max_step: float, exponent: float, blas: bool | None, scale: np.ndarray,
