@@ -29,6 +29,7 @@ from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
+    from .continuous import DeferredOutputs
     from .error_estimate import ErrorEstimate
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
@@ -142,6 +143,9 @@ class SimulationResult:
     #: the same run on another grid (``runner.Rerun``: a plot's finer grid); None: none
     rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False,
                                                             compare=False)
+    #: error control's companion run (``RunSettings.deferred_outputs``): its outputs
+    #: not yet computed (``continuous.DeferredOutputs``), ``values`` then has no columns
+    deferred: DeferredOutputs | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -224,8 +228,15 @@ class SimulationResult:
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
     """Header ``time,<names>`` then one row per output time, full precision."""
     csv.writer(f, lineterminator="\n").writerow(["time", *result.names])
-    table = np.column_stack([result.time, result.values]).tolist()
-    f.writelines(",".join(map(repr, row)) + "\n" for row in table)
+    for begin in range(0, len(result.time), CSV_ROWS):  # no copy of every row at once
+        end = begin + CSV_ROWS
+        f.writelines(f"{t!r},{','.join(map(repr, row))}\n" if row else f"{t!r}\n"
+                     for t, row in zip(np.asarray(result.time[begin:end], float).tolist(),
+                                       np.asarray(result.values[begin:end], float).tolist()))
+
+
+CSV_ROWS = 64
+"""Rows of a result turned into text at a time by :func:`write_csv`."""
 
 
 def _char_matrix(texts: list[str]) -> np.ndarray:
