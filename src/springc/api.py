@@ -22,6 +22,7 @@ from .pipeline import (
     CompileOptions,
     check_parameter_names,
     compile_files,
+    derived_kept,
     modification_value,
 )
 from .simulation import (
@@ -162,11 +163,12 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
 
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
-    compiled = _compile_as(options, parameters)
-    if chosen and options.backend == "numba" and \
-            compiled.source.count("\n") > NUMBA_LINES:
-        return _compile_as(replace(options, backend="python"), parameters)
-    return compiled
+    with derived_kept():  # a module too long for numba: python's from the same system
+        compiled = _compile_as(options, parameters)
+        if chosen and options.backend == "numba" and \
+                compiled.source.count("\n") > NUMBA_LINES:
+            return _compile_as(replace(options, backend="python"), parameters)
+        return compiled
 
 
 def _compile_as(options: CompileOptions,

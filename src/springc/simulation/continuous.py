@@ -31,7 +31,7 @@ from .compiled import (
     run_fixed_compiled,
 )
 from .failures import Stop, state_notes
-from .limits import OverLimit, check_outputs, over_limit
+from .limits import CHECKED_ROWS, OverLimit, check_outputs, over_limit
 from .observed_rows import observed_on_rows
 from .planning import RunPlan
 from .race import auto
@@ -106,8 +106,8 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
                             dict(zip(model.parameter_names, p.tolist())), deferred=deferred)
 
 
-BLOCK_ROWS = 16
-"""Output rows per block of :meth:`DeferredOutputs.blocks` (the 50x50 cloth: 16 MB)."""
+BLOCK_ROWS = 8
+"""Output rows per block of :meth:`DeferredOutputs.blocks` (the 50x50 cloth: 8 MB)."""
 
 
 def _in_order(model: CompiledModel) -> bool:
@@ -199,7 +199,8 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
             row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
             problem.z[-1] = z[-1]
             raise problem.newton_failure(float(grid[row]), states[row])
-        if not np.isfinite(obs).all():
+        if not all(np.isfinite(obs[k:k + CHECKED_ROWS]).all()
+                   for k in range(0, len(obs), CHECKED_ROWS)):
             _locate_observed(model, problem, grid, states, obs)
     if in_order:
         out[:, :n] = states

@@ -16,10 +16,10 @@ import csv
 import difflib
 import io
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -29,7 +29,6 @@ from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
 
 if TYPE_CHECKING:
-    from .continuous import DeferredOutputs
     from .error_estimate import ErrorEstimate
 
 RESULT_FORMATS = {".csv": "csv", ".mat": "mat"}
@@ -120,6 +119,16 @@ def _short(value: float) -> str:
     return f"{value:.1g}".replace("e-0", "e-").replace("e+0", "e+")
 
 
+class Deferred(Protocol):
+    """Outputs computed when read (``continuous.DeferredOutputs``)."""
+
+    def values(self) -> np.ndarray:
+        """Every output row."""
+
+    def blocks(self) -> Iterator[np.ndarray]:
+        """The output rows in order, a few at a time."""
+
+
 @dataclass
 class SimulationResult:
     """Outputs on the output grid: ``values[i, j]`` is ``names[j]`` at ``time[i]``."""
@@ -145,7 +154,7 @@ class SimulationResult:
                                                             compare=False)
     #: error control's companion run (``RunSettings.deferred_outputs``): its outputs
     #: not yet computed (``continuous.DeferredOutputs``), ``values`` then has no columns
-    deferred: DeferredOutputs | None = field(default=None, repr=False, compare=False)
+    deferred: Deferred | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
