@@ -23,6 +23,7 @@ from .pipeline import (
     ModuleKind,
     check_parameter_names,
     compile_files,
+    derived_kept,
     modification_value,
 )
 from .simulation import (
@@ -170,16 +171,17 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
 
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
-    compiled = _compile_as(options, parameters)
-    if chosen and options.backend == "numba" and \
-            compiled.source.count("\n") > NUMBA_LINES:
-        return _compile_as(replace(options, backend="python"), parameters)
-    if chosen and options.backend == "python" and _numba_instead(compiled):
-        numba = replace(options, backend="numba")
-        if not parameters and compiled.compiled_from is not None:  # not derived again
-            return compile_files(numba, compiled.compiled_from)
-        return _compile_as(numba, parameters)
-    return compiled
+    with derived_kept():  # a model derived once is not derived again for another backend
+        compiled = _compile_as(options, parameters)
+        if chosen and options.backend == "numba" and \
+                compiled.source.count("\n") > NUMBA_LINES:
+            return _compile_as(replace(options, backend="python"), parameters)
+        if chosen and options.backend == "python" and _numba_instead(compiled):
+            numba = replace(options, backend="numba")
+            if not parameters and compiled.compiled_from is not None:  # not derived again
+                return compile_files(numba, compiled.compiled_from)
+            return _compile_as(numba, parameters)
+        return compiled
 
 
 def _numba_instead(compiled: CompiledModel) -> bool:

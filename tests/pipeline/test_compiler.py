@@ -158,3 +158,28 @@ def test_nesting_beyond_pythons_compiler_is_a_model_error(tmp_path: Path,
         "(SyntaxError: too many nested parentheses")
     assert "help: split deeply nested calls or parentheses" in run.output
     assert list(cache.glob("*/model.py")) == []  # no entry that cannot be imported
+
+
+def test_a_module_too_long_for_numba_reuses_the_derived_system(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A module longer than NUMBA_LINES is generated again for the python backend from
+    the system derived for numba (flattened and simplified once, not twice): the same
+    module as python's own compile; a later compile derives afresh (nothing kept)."""
+    from springc import api
+    from springc.pipeline import generation
+
+    calls: list[str | None] = []
+    derive = generation.derive_system
+
+    def counted(options):
+        calls.append(options.backend)
+        return derive(options)
+
+    monkeypatch.setattr(generation, "derive_system", counted)
+    monkeypatch.setattr(api, "NUMBA_LINES", 1)
+    seed = str(ROOT / "models" / "SpringMass.mdl")
+    chosen = springc.compile_model(seed, cache=False)
+    assert calls == ["numba"] and chosen.options.backend == "python"
+    python = springc.compile_model(seed, backend="python", cache=False)
+    assert calls == ["numba", "python"]
+    assert chosen.source == python.source

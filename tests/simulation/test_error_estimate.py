@@ -194,3 +194,81 @@ def test_the_estimate_compares_a_few_columns_at_a_time(
     assert (estimate.absolute == error.max(axis=0)).all()
     assert (estimate.times == grid[error.argmax(axis=0)]).all()
     assert (estimate.scales == np.abs(ours).max(axis=0)).all()
+
+
+def test_a_deferred_companion_is_compared_block_by_block(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A companion whose outputs are read block by block (``deferred``: error control's
+    companion of a large scene) gives the estimate of its whole array, bit for bit:
+    ties keep the first row, a NaN wins as ``max`` and ``argmax`` take it."""
+    from dataclasses import dataclass
+
+    from springc.simulation import error_estimate
+
+    @dataclass
+    class Blocks:
+        values: np.ndarray
+        rows: int
+
+        def blocks(self):
+            for begin in range(0, len(self.values), self.rows):
+                yield self.values[begin:begin + self.rows]
+
+    @dataclass
+    class Run:
+        time: np.ndarray
+        names: tuple[str, ...]
+        values: np.ndarray
+        events: tuple[()] = ()
+        deferred: Blocks | None = None
+
+    grid = np.linspace(0.0, 1.0, 9)
+    ours = np.zeros((9, 4))
+    theirs = np.zeros((9, 4))
+    theirs[[2, 6], 0] = 1.0  # a tie: row 2 is the largest error's
+    theirs[[1, 7], 1] = [1.0, 3.0]  # in a later block
+    theirs[[3, 5], 2] = [2.0, np.nan]  # NaN after a larger value: NaN, at row 5
+    ours[:, 3] = np.arange(9.0)
+    names = ("a", "b", "c", "d")
+    whole = error_estimate.compare(Run(grid, names, ours), Run(grid, names, theirs),
+                                   grid, "test", 2.0, 0.0)
+    for rows in (1, 2, 4, 9):
+        streamed = error_estimate.compare(
+            Run(grid, names, ours),
+            Run(grid, names, theirs[:, :0], deferred=Blocks(theirs, rows)), grid, "test",
+            2.0, 0.0)
+        for field in ("absolute", "relative", "times", "scales"):
+            np.testing.assert_array_equal(getattr(streamed, field), getattr(whole, field))
+    assert whole.absolute[:2].tolist() == [2.0, 6.0] and np.isnan(whole.absolute[2])
+    assert whole.times.tolist() == [grid[2], grid[7], grid[5], grid[8]]
+
+
+def test_error_controls_companion_defers_its_outputs(monkeypatch: pytest.MonkeyPatch
+                                                    ) -> None:
+    """A continuous run asked for deferred outputs (error control's companion) returns
+    its states and computes the same outputs block by block, or all at once when it
+    becomes the answer; the estimate from its blocks is the one from its whole array."""
+    from dataclasses import replace
+
+    from springc.simulation import continuous, error_estimate
+    from springc.simulation.runner import simulate_once
+    from springc.simulation.settings import RunSettings
+
+    monkeypatch.setattr(continuous, "BLOCK_ROWS", 7)
+    chain = model("chain")
+    answer = simulate_once(chain, RunSettings(solver="dop853", rtol=1e-5, atol=1e-8,
+                                              error_control="off"))
+    settings = RunSettings(solver="dop853", rtol=1e-8, atol=1e-11, error_control="off")
+    whole = simulate_once(chain, settings)
+    deferred = simulate_once(chain, replace(settings, deferred_outputs=True))
+    assert whole.deferred is None and deferred.deferred is not None
+    assert deferred.values.shape == (len(whole.time), 0) and len(chain.observed) > 0
+    np.testing.assert_array_equal(deferred.deferred.values(), whole.values)
+    blocks = list(deferred.deferred.blocks())
+    assert [len(b) for b in blocks[:2]] == [7, 7]
+    np.testing.assert_array_equal(np.vstack(blocks), whole.values)
+    first = error_estimate.compare(answer, whole, whole.time, "how", 1.0, 0.0)
+    second = error_estimate.compare(answer, deferred, deferred.time, "how", 1.0, 0.0)
+    assert first.absolute.max() > 0
+    for field in ("absolute", "relative", "times", "scales"):
+        np.testing.assert_array_equal(getattr(second, field), getattr(first, field))

@@ -161,3 +161,26 @@ def test_only_whole_arrays_of_one_unit_are_grouped() -> None:
     assert data["a"].dims == ("time", "a_index1", "a_index2")
     assert np.array_equal(data["a"].values, result["a"])
     assert "u[2]" in data and data["u[2]"].attrs == {"units": "s"} and data["w"].attrs == {}
+
+
+def test_the_csv_is_written_a_few_rows_at_a_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``write_csv`` turns CSV_ROWS rows into text at a time (no copy of a large result):
+    the text of the whole table at once, ``repr`` of each float, integers as floats."""
+    import io
+
+    from springc.simulation import results
+
+    monkeypatch.setattr(results, "CSV_ROWS", 2)
+    values = np.array([[0.1, -2.5e-300], [1 / 3, 7.0], [np.nan, np.inf], [4.0, -0.0],
+                       [1e22, 5e-324]])
+    run = SimulationResult("M", np.array([0, 1, 2, 3, 4]), ("a", "b,c"), values,
+                           ("", ""), SimulationStats("rk4", 1, 0, 0, 0.0, 0.0, 0.0, False))
+    text = io.StringIO()
+    results.write_csv(run, text)
+    assert text.getvalue() == (
+        'time,a,"b,c"\n0.0,0.1,-2.5e-300\n1.0,0.3333333333333333,7.0\n2.0,nan,inf\n'
+        "3.0,4.0,-0.0\n4.0,1e+22,5e-324\n")
+    empty = io.StringIO()
+    results.write_csv(SimulationResult("M", np.array([0.0, 0.5]), (), np.zeros((2, 0)), (),
+                                       run.stats), empty)
+    assert empty.getvalue() == "time\n0.0\n0.5\n"

@@ -123,8 +123,24 @@ def walk(e: Expr) -> Iterator[Expr]:
 
 
 def variables(e: Expr) -> set[str]:
-    """Names of all variables referenced in ``e`` (inside ``der`` too)."""
-    return {n.name for n in walk(e) if isinstance(n, Var)}
+    """Names of all variables referenced in ``e`` (inside ``der`` too). One loop over
+    the nodes, without :func:`walk`'s generator: code generation asks this of every
+    binding and assignment of a large model (a third of the time it took)."""
+    out: set[str] = set()
+    stack = [e]
+    while stack:
+        node = stack.pop()
+        if type(node) is Var:
+            out.add(node.name)
+        elif type(node) is BinOp:
+            stack += (node.left, node.right)
+        elif type(node) is Call:
+            stack += node.args
+        elif type(node) is If:
+            stack += (node.cond, node.then, node.otherwise)
+        elif type(node) is Neg or type(node) is Not or type(node) is Der:
+            stack.append(node.arg)
+    return out
 
 
 def derivatives(e: Expr) -> set[str]:

@@ -15,6 +15,7 @@ from .compiler import (
     ModuleKind,
     check_parameter_names,
     compile_files,
+    derived_kept,
     modification_value,
     split_values,
 )
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
-           "compile_files", "derive_system", "find_compiler", "flatten_files",
+           "compile_files", "derive_system", "derived_kept", "find_compiler", "flatten_files",
            "generate_source", "kernel_library", "loop_library", "modification_value",
            "openmp_flags", "select_names", "split_values"]
 

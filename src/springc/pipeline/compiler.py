@@ -11,11 +11,13 @@ loads only on a miss. What a run needs beyond the module is captured at compile 
 
 from __future__ import annotations
 
+import contextlib
 import shutil
 import tempfile
 import time
-from collections.abc import Mapping
-from dataclasses import dataclass, field
+from collections.abc import Iterator, Mapping
+from contextvars import ContextVar
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -267,7 +269,7 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
 
             if derived is None:
                 say(compiling_note(options, folder))
-                derived = generation.derive_system(options)
+                derived = _derive(options)
             names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
@@ -282,7 +284,7 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
 
     if derived is None:
         say(compiling_note(options, folder))
-        derived = generation.derive_system(options)
+        derived = _derive(options)
         write_names(folder, model_key, generation.candidate_names(derived))
     generated = generation.generate_from(derived, options)
     run = run_system_of(derived.system, derived.flat_model, derived.switchable)
@@ -312,6 +314,37 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
                          outputs_of(module, options), temporary, generated,
                          run_system=run, model_key=model_key,
                          compiled_from=derived if options.backend == "python" else None)
+
+
+_KEPT: ContextVar[dict[str, Derived] | None] = ContextVar("springc_derived", default=None)
+"""Within :func:`derived_kept`: the models derived so far, by their key without backend."""
+
+
+@contextlib.contextmanager
+def derived_kept() -> Iterator[None]:
+    """Within it, a model derived (flattened and simplified) once is not derived again
+    for another backend: a model whose numba module is too long for numba is generated
+    for the python backend from the same system (the 10,000-mass chain: 14 s of CPU).
+    What it kept is let go on exit."""
+    token = _KEPT.set({} if _KEPT.get() is None else _KEPT.get())
+    try:
+        yield
+    finally:
+        _KEPT.reset(token)
+
+
+def _derive(options: CompileOptions) -> Derived:
+    """The flat model and simplified system of ``options`` (kept within
+    :func:`derived_kept`, whose backend and outputs they do not depend on)."""
+    from . import generation  # the compile path, loaded on a miss only
+
+    kept = _KEPT.get()
+    if kept is None:
+        return generation.derive_system(options)
+    key = model_key_of(replace(options, backend="", outputs=None))
+    if key not in kept:
+        kept[key] = generation.derive_system(options)
+    return kept[key]
 
 
 def model_key_of(options: CompileOptions) -> str:

@@ -4,13 +4,16 @@ without events, delays or switching states (``KIND`` ``continuous``).
 The step loop (:mod:`.steps`) on scipy's integrators or the compiled loops
 (:mod:`.compiled`), ``auto``'s race (:mod:`.race`), the fixed-step solvers
 (:mod:`.solvers`), the model's assertions after every step, then the outputs on the
-grid (:func:`.observed_rows.observed_on_rows`).
+grid (:func:`.observed_rows.observed_on_rows`), or, for error control's companion
+(``RunSettings.deferred_outputs``), the states with :class:`DeferredOutputs`: the
+output rows computed when read, a few rows at a time.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,10 +28,11 @@ from .compiled import (
     engine_reason,
     explained,
     jitted,
+    observed_on_grid,
     run_fixed_compiled,
 )
 from .failures import Stop, state_notes
-from .limits import OverLimit, check_outputs, over_limit
+from .limits import CHECKED_ROWS, OverLimit, check_outputs, over_limit
 from .native import advance_native, loop_ready, native_observed
 from .observed_rows import observed_on_rows
 from .planning import RunPlan
@@ -83,7 +87,12 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             if problem.asserts and (compiled or not len(x0)):
                 problem.asserts.grid(grid, states, problem.z, _locate(
                     problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
-            outputs = _outputs(model, problem, grid, states, native)
+            # a C loop run's outputs come from the C model at once (at most
+            # C_LOOP_STATES states: small); others may be deferred for error control
+            deferred = DeferredOutputs(model, problem, grid, states) \
+                if options.deferred_outputs and not native and _in_order(model) else None
+            outputs = _outputs(model, problem, grid, states, native) if deferred is None \
+                else np.empty((len(grid), 0))
     except Stop as stop_:
         raise stop_.error from None
     except OverLimit as over:
@@ -102,7 +111,57 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
     names = model.outputs
     return SimulationResult(model.name, grid, names, outputs,
                             tuple(units.get(n, "") for n in names), stats,
-                            dict(zip(model.parameter_names, p.tolist())))
+                            dict(zip(model.parameter_names, p.tolist())), deferred=deferred)
+
+
+BLOCK_ROWS = 8
+"""Output rows per block of :meth:`DeferredOutputs.blocks` (the 50x50 cloth: 8 MB)."""
+
+
+def _in_order(model: CompiledModel) -> bool:
+    """Whether the outputs are every state then every observed variable, in order."""
+    return tuple(model.outputs) == (*model.states, *model.observed)
+
+
+@dataclass(frozen=True)
+class DeferredOutputs:
+    """A continuous run's outputs (every state, then every observed variable) not yet
+    computed: its states on the grid. Error control compares its companion run with
+    the answer block by block (:func:`.error_estimate.compare`), so a large scene never
+    holds a second array of every output; :meth:`values` computes them all when the
+    companion becomes the answer."""
+
+    model: CompiledModel
+    problem: Problem
+    grid: np.ndarray
+    states: np.ndarray
+
+    def values(self) -> np.ndarray:
+        """Every output row (as a run that is not deferred computes them, its errors)."""
+        return _outputs(self.model, self.problem, self.grid, self.states)
+
+    def blocks(self) -> Iterator[np.ndarray]:
+        """The output rows in order, :data:`BLOCK_ROWS` at a time: the same rows as
+        :meth:`values` (the grid loop carries ``z`` from block to block as from row to
+        row). From a block with a row that fails or is not finite on, the rest come
+        from :meth:`values`, in one block (its continuation, or its error)."""
+        module, p, n = self.model.module, self.problem.p, len(self.model.states)
+        width = n + len(self.model.observed)
+        z = np.asarray(module.guesses(p), dtype=float) if width > n else np.zeros(1)
+        for begin in range(0, len(self.grid), BLOCK_ROWS):
+            end = min(begin + BLOCK_ROWS, len(self.grid))
+            block = np.empty((end - begin, width))
+            block[:, :n] = self.states[begin:end]
+            try:
+                if width > n:
+                    block[:, n:] = observed_on_grid(module, self.grid[begin:end],
+                                                    self.states[begin:end], p, z)
+            except (ArithmeticError, ValueError, np.linalg.LinAlgError):
+                z[-1] = 1.0
+            if (width > n and z[-1] != 0.0) or not np.isfinite(block).all():
+                yield self.values()[begin:]
+                return
+            yield block
 
 
 
@@ -152,7 +211,8 @@ def _outputs(model: CompiledModel, problem: Problem, grid: np.ndarray,
             row = int(np.flatnonzero(np.isnan(obs).all(axis=1))[0])
             problem.z[-1] = z[-1]
             raise problem.newton_failure(float(grid[row]), states[row])
-        if not np.isfinite(obs).all():
+        if not all(np.isfinite(obs[k:k + CHECKED_ROWS]).all()
+                   for k in range(0, len(obs), CHECKED_ROWS)):
             _locate_observed(model, problem, grid, states, obs)
     if in_order:
         out[:, :n] = states

@@ -15,5 +15,15 @@ from typing import IO
 
 def write_rows(f: IO[str], names: Sequence[str], rows: Iterable[Sequence[float]]) -> None:
     """Write the header and ``rows`` (each: the time, then one value per name)."""
+    write_header(f, names)
+    write_lines(f, rows)
+
+
+def write_header(f: IO[str], names: Sequence[str]) -> None:
+    """The header line: ``time``, then the names."""
     csv.writer(f, lineterminator="\n").writerow(["time", *names])
+
+
+def write_lines(f: IO[str], rows: Iterable[Sequence[float]]) -> None:
+    """One line per row (the time, then one value per name), each number its ``repr``."""
     f.writelines(",".join(map(repr, row)) + "\n" for row in rows)

@@ -50,7 +50,7 @@ from .solver_names import (
 )
 
 if TYPE_CHECKING:
-    from .results import SimulationResult
+    from .results import SimulationResult, SimulationStats
 
 MODES = ERROR_CONTROLS
 DEFAULT_MODE = DEFAULT_ERROR_CONTROL
@@ -94,7 +94,10 @@ def controlled(options: RunSettings, asked: Asked, run: Run) -> SimulationResult
         if (estimate.met or asked.mode == "warn" or tight[0] < TIGHTEST_RUN_RTOL * 0.999
                 or _round == MAX_ROUNDS - 1):
             break
-        result, (rtol, atol) = _tightened(result, companion), tight
+        # the first run let go before the companion's outputs are computed: a large
+        # scene holds one array of every output at a time
+        result, first = companion, result.stats
+        result, (rtol, atol) = _tightened(first, result), tight
     return _verdict(result, estimate, asked, rtol, atol, began)
 
 
@@ -108,7 +111,7 @@ def _estimate(options: RunSettings, result: SimulationResult, rtol: float,
     if left <= 0:
         raise SpringcError(f"the time limit of {options.seconds_limit:g} s is reached")
     base = replace(options, progress=None, event_rows=False, time_limit=left,
-                   error_control="off")
+                   error_control="off", deferred_outputs=True)
     started = time.perf_counter()
     if solver in FIXED_STEP:
         step = float(options.step or 0.0) / 2
@@ -132,13 +135,16 @@ def _quiet(run: Run, options: RunSettings) -> SimulationResult:
         return run(options)
 
 
-def _tightened(first: SimulationResult, companion: SimulationResult) -> SimulationResult:
-    """The companion as the answer, with the first run's words on why its solver and
-    engine (``auto``'s choice) where it ran the same solver."""
-    if companion.stats.solver != first.stats.solver:
+def _tightened(first: SimulationStats, companion: SimulationResult) -> SimulationResult:
+    """The companion as the answer, its outputs computed (where they were deferred),
+    with the first run's words on why its solver and engine (``auto``'s choice) where
+    it ran the same solver."""
+    if companion.deferred is not None:
+        companion = replace(companion, values=companion.deferred.values(), deferred=None)
+    if companion.stats.solver != first.solver:
         return companion
-    return replace(companion, stats=replace(companion.stats, reason=first.stats.reason,
-                                            engine_reason=first.stats.engine_reason))
+    return replace(companion, stats=replace(companion.stats, reason=first.reason,
+                                            engine_reason=first.engine_reason))
 
 
 def _verdict(result: SimulationResult, estimate: ErrorEstimate, asked: Asked, rtol: float,

@@ -23,6 +23,7 @@ the run (the relative error).
 from __future__ import annotations
 
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
@@ -119,10 +120,11 @@ def compare(run: Run, companion: Run, grid: np.ndarray,
     if companion.names != run.names:  # the same selection: the same columns, in order
         where = {name: j for j, name in enumerate(companion.names)}
         columns = np.array([where[n] for n in run.names], dtype=np.intp)
-    estimate = measured(run.names, grid[keep], *_differences(
-        run.values, companion.values, ours[keep], theirs[keep], columns, gain,
-        len(run.names)),
-        method, began)
+    deferred = getattr(companion, "deferred", None)  # its rows computed as they are read
+    differences = _differences(run.values, companion.values, ours[keep], theirs[keep],
+                               columns, gain, len(run.names)) if deferred is None else \
+        _streamed(run.values, deferred.blocks(), ours[keep], theirs[keep], columns, gain)
+    estimate = measured(run.names, grid[keep], *differences, method, began)
     if not len(a):
         return estimate
     # the event times as one more quantity: their largest shift, on the scale of |t|
@@ -164,6 +166,47 @@ def _differences(ours: np.ndarray, theirs: np.ndarray, our_rows: np.ndarray,
             absolute[begin:end] = error.max(axis=0)
             rows[begin:end] = error.argmax(axis=0)
     return scales, absolute, rows
+
+
+def _streamed(ours: np.ndarray, blocks: Iterable[np.ndarray], our_rows: np.ndarray,
+              their_rows: np.ndarray, columns: np.ndarray | None, gain: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_differences` with the companion's rows read block by block, in order
+    (``blocks``: a deferred run's, never all of them at once; ``their_rows`` in
+    increasing order): the same differences, and per column the largest with the first
+    row where it occurs (NaN, as ``max`` and ``argmax`` take it, first)."""
+    absolute = rows = None
+    end = 0
+    for block in blocks:  # every block is read: a failing row raises its error
+        begin, end = end, end + len(block)
+        lo, hi = (int(k) for k in np.searchsorted(their_rows, [begin, end]))
+        if hi == lo:
+            continue
+        theirs = block[their_rows[lo:hi] - begin]
+        error = ours[our_rows[lo:hi]]
+        error -= theirs if columns is None else theirs[:, columns]
+        error *= gain
+        np.abs(error, out=error)
+        top, where = error.max(axis=0), error.argmax(axis=0) + lo
+        if absolute is None or rows is None:
+            absolute, rows = top, where
+            continue
+        better = (top > absolute) | (np.isnan(top) & ~np.isnan(absolute))
+        absolute, rows = np.where(better, top, absolute), np.where(better, where, rows)
+    if absolute is None or rows is None:
+        absolute, rows = np.zeros(ours.shape[1]), np.zeros(ours.shape[1], dtype=np.intp)
+    return _scales(ours), absolute, rows
+
+
+def _scales(ours: np.ndarray) -> np.ndarray:
+    """The largest magnitude of each column over every row, :data:`COLUMNS_PER_PASS`
+    columns at a time."""
+    scales = np.zeros(ours.shape[1])
+    if len(ours):
+        for begin in range(0, ours.shape[1], COLUMNS_PER_PASS):
+            scales[begin:begin + COLUMNS_PER_PASS] = np.abs(
+                ours[:, begin:begin + COLUMNS_PER_PASS]).max(axis=0)
+    return scales
 
 
 def measured(names: tuple[str, ...], grid: np.ndarray, scales: np.ndarray,

@@ -124,10 +124,22 @@ def check_parameters(names: Sequence[str], values: np.ndarray) -> None:
 
 
 def check_outputs(names: Sequence[str], grid: np.ndarray, values: np.ndarray) -> None:
-    """Raise at the first output time where a value is NaN or infinite."""
-    finite = np.isfinite(values)
-    if finite.all():
-        return
+    """Raise at the first output time where a value is NaN or infinite (the rows
+    checked :data:`CHECKED_ROWS` at a time: no mask as large as a large scene's result)."""
+    for begin in range(0, len(values), CHECKED_ROWS):
+        finite = np.isfinite(values[begin:begin + CHECKED_ROWS])
+        if not finite.all():
+            _not_finite(names, grid[begin:], values[begin:], finite)
+
+
+CHECKED_ROWS = 16
+"""Rows of a result checked for NaN and infinities at a time."""
+
+
+def _not_finite(names: Sequence[str], grid: np.ndarray, values: np.ndarray,
+                finite: np.ndarray) -> None:
+    """Raise at the first row of ``finite`` (the mask of the first rows of ``values``)
+    with a value that is not finite."""
     row = int(np.flatnonzero(~finite.all(axis=1))[0])
     columns = np.flatnonzero(~finite[row])
     shown = ", ".join(f"{names[j]} = {_word(values[row, j])}" for j in columns[:4])

@@ -106,10 +106,10 @@ def observed_at_rows(module: Any, problem: Problem, times: np.ndarray, states: n
     return out
 
 
-ROWS_PER_CALL = 64
+ROWS_PER_CALL = 16
 """Output rows computed per call of the grid loop: the observed values of a large scene
 go straight into the result, through a buffer of this many rows (the 50x50 cloth's
-120,000 observed variables: 60 MB), never a second array of every row."""
+120,000 observed variables: 15 MB), never a second array of every row."""
 
 
 def observed_on_rows(module: Any, ts: np.ndarray, states: np.ndarray, p: np.ndarray,

@@ -47,8 +47,9 @@ LARGE_PANELS = 4
 COMPONENTS = 3
 """A last subscript of at most this many values is a vector's component (x, y, z)."""
 LINES, HEATMAP = "lines", "heatmap"
-CHUNK = 4096
-"""Candidate copies compared at a time (bounds the memory of the comparison)."""
+CHUNK = 512
+"""Candidate copies compared at a time (bounds the memory of the comparison: 2 MB per
+array for the 50x50 cloth's 501 rows)."""
 MAX_ALIASES = 2
 """Copies named in a legend entry before ``(+N more)``."""
 SAMPLES_PER_PERIOD = 16

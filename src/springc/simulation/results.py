@@ -16,16 +16,16 @@ import csv
 import difflib
 import io
 import os
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from ..errors import OutputError, SpringcError, UnknownNameError, UsageError, printable
 from ..fileio import OutputSet, PathLike, atomic_write
-from .csv_rows import write_rows
+from .csv_rows import write_header, write_lines
 from .plot_layout import HEATMAP, PlotLayout, choose_layout, plot_points
 from .summary import brief_line
 from .tables import array_values, array_variables, html_table, to_pandas, to_xarray
@@ -107,6 +107,16 @@ class SimulationStats:
                 + (f"; note: {self.note}" if self.note else ""))
 
 
+class Deferred(Protocol):
+    """Outputs computed when read (``continuous.DeferredOutputs``)."""
+
+    def values(self) -> np.ndarray:
+        """Every output row."""
+
+    def blocks(self) -> Iterator[np.ndarray]:
+        """The output rows in order, a few at a time."""
+
+
 @dataclass
 class SimulationResult:
     """Outputs on the output grid: ``values[i, j]`` is ``names[j]`` at ``time[i]``."""
@@ -130,6 +140,9 @@ class SimulationResult:
     #: the same run on another grid (``runner.Rerun``: a plot's finer grid); None: none
     rerun: Callable[[int], SimulationResult] | None = field(default=None, repr=False,
                                                             compare=False)
+    #: error control's companion run (``RunSettings.deferred_outputs``): its outputs
+    #: not yet computed (``continuous.DeferredOutputs``), ``values`` then has no columns
+    deferred: Deferred | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, name: str) -> np.ndarray:
         """The column of a flat name (``mass.pos[1]``: one value per time), or an array
@@ -211,7 +224,15 @@ class SimulationResult:
 
 def write_csv(result: SimulationResult, f: IO[str]) -> None:
     """Header ``time,<names>`` then one row per output time, full precision."""
-    write_rows(f, result.names, np.column_stack([result.time, result.values]).tolist())
+    write_header(f, result.names)
+    for begin in range(0, len(result.time), CSV_ROWS):  # no copy of every row at once
+        end = begin + CSV_ROWS
+        write_lines(f, np.column_stack([result.time[begin:end],
+                                        result.values[begin:end]]).tolist())
+
+
+CSV_ROWS = 64
+"""Rows of a result turned into text at a time by :func:`write_csv`."""
 
 
 def _char_matrix(texts: list[str]) -> np.ndarray:

@@ -57,6 +57,9 @@ class RunSettings:
     error_control: str = DEFAULT_ERROR_CONTROL  # tighten, warn or off (.error_control)
     event_rows: bool = False  # add rows with the left and right limits at each event
     progress: TextIO | None = None  # a progress bar on this stream (after a second)
+    # error control's companion: a continuous run returns its states and computes its
+    # outputs when read (``SimulationResult.deferred``; not an option of the user's)
+    deferred_outputs: bool = False
 
     @property
     def step_limit(self) -> int:
