@@ -49,6 +49,9 @@ class ReferenceResolver:
 
     def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
+        if isinstance(v, ClassScope) and v.kind == "record":
+            record: a.Value = self.record_value(v, e, scope)
+            return record
         if isinstance(v, (ClassEntry, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"'{e.dotted}' is a component or class, not a value", e.span,
@@ -56,6 +59,14 @@ class ReferenceResolver:
                                f"'{e.dotted}.<name>'")
         value: a.Value = v
         return value
+
+    def record_value(self, record: ClassScope, e: s.Ref, scope: Scope) -> Any:
+        """The record component ``e`` as a value: its fields read one by one."""
+        fields = {}
+        for name in record.view.components:
+            ref = s.Ref((*e.parts, s.RefPart(name, (), e.span)), e.span, e.is_global)
+            fields[name] = self._Ref(ref, scope)
+        return a.RecordValue(record.entry.full_name, fields)
 
     def reference(self, e: s.Ref, scope: Scope) -> Any:
         """Follow a component reference; the result may be a scope or array of scopes."""
@@ -82,6 +93,12 @@ class ReferenceResolver:
                                    part.span, hint="its literals are: "
                                    + ", ".join(current.literals))
             return literal_value(current, current.literals.index(part.name) + 1)
+        if isinstance(current, a.RecordValue):
+            if part.name not in current.fields:
+                raise FlattenError(f"record '{current.name}' has no field '{part.name}'",
+                                   part.span, hint="its fields are: "
+                                   + ", ".join(current.fields))
+            return self._subscript(current.fields[part.name], part, scope)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)

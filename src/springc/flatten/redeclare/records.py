@@ -72,6 +72,9 @@ def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
             return {f.name: (s.Ref((*expr.parts, s.RefPart(f.name, (), expr.span)),
                                    expr.span), where)
                     for f in constructor_fields(view)}
+    if isinstance(expr, s.Call | s.IfExpr | s.FieldOf):  # a function returning a record
+        return {f.name: (s.FieldOf(expr, f.name, expr.span), where)
+                for f in constructor_fields(view)}
     raise FlattenError(f"the value of record '{name}' must be a record", expr.span,
                        hint=HINT)
 
