@@ -30,7 +30,13 @@ from .calls import (
     string_binary,
 )
 from .checks import check_enum_relation
-from .connect import CARDINALITY, GRAPH_FUNCTIONS, cardinality_call
+from .connect import (
+    CARDINALITY,
+    GRAPH_FUNCTIONS,
+    ConnectionGraph,
+    cardinality_call,
+    graph_value,
+)
 from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
 from .names import ReferenceResolver
 from .scopes import (
@@ -67,6 +73,7 @@ class Evaluator(ReferenceResolver):
         # Whether a subscript contains `end`, by syntax node (its identity: equal
         # subscripts written in two places are two entries).
         self.uses_end: dict[Ident[s.Expr], bool] = {}
+        self.graph = ConnectionGraph()  # the flattener's, once it has connections
         self.record_values: dict[tuple[Ident[s.Expr], Ident[Scope]], a.Value] = {}
         self.cardinality_used = False  # placeholders to replace (flatten/connect/cardinality.py)
 
@@ -337,7 +344,9 @@ class Evaluator(ReferenceResolver):
 
     def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
-        if name in UNSUPPORTED_CALLS or name in GRAPH_FUNCTIONS:
+        if name in GRAPH_FUNCTIONS:
+            return graph_value(self, self.graph, e, scope)
+        if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")

@@ -50,7 +50,7 @@ class ReferenceResolver:
     def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
         if isinstance(v, ClassScope) and v.kind == "record":
-            record: a.Value = self.record_value(v, e, scope)
+            record: a.Value = self.record_value(v)
             return record
         if isinstance(v, (ClassEntry, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
@@ -60,12 +60,15 @@ class ReferenceResolver:
         value: a.Value = v
         return value
 
-    def record_value(self, record: ClassScope, e: s.Ref, scope: Scope) -> Any:
-        """The record component ``e`` as a value: its fields read one by one."""
+    def record_value(self, record: ClassScope) -> Any:
+        """A record component as a value: its fields read one by one."""
         fields = {}
         for name in record.view.components:
-            ref = s.Ref((*e.parts, s.RefPart(name, (), e.span)), e.span, e.is_global)
-            fields[name] = self._Ref(ref, scope)
+            member = record.member(name)
+            if isinstance(member, ClassScope) and member.kind == "record":
+                fields[name] = self.record_value(member)
+            else:
+                fields[name] = self.member_value(member)
         return a.RecordValue(record.entry.full_name, fields)
 
     def reference(self, e: s.Ref, scope: Scope) -> Any:

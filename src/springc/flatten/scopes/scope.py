@@ -313,6 +313,8 @@ class ExpressionEvaluator(Protocol):
     """What the flattening helpers call on the expression evaluator (``evaluate.py``)."""
 
     flattener: FlattenContext
+
+    def record_value(self, record: ClassScope) -> Any: ...
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
     call_depth: int  # nesting of user-defined function calls being inlined
     events: EventUses  # pre/edge/change uses and when-clause nesting (event_calls.py)
