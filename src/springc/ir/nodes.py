@@ -114,10 +114,19 @@ def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
 
 
 def walk(e: Expr) -> Iterator[Expr]:
-    """All nodes of ``e``, parents before children."""
+    """All nodes of ``e``, parents before children; a node object shared by several
+    parents (inlined functions build such graphs, whose trees can be thousands of
+    times larger) once."""
     stack = [e]
+    seen: set[int] = set()
     while stack:
         node = stack.pop()
+        if type(node) is Const or type(node) is Var:
+            yield node
+            continue
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
         yield node
         stack.extend(children(node))
 
