@@ -21,6 +21,8 @@ def short_defaults(ev: ExpressionEvaluator, entry: ClassEntry, ref: s.Ref, scope
                    ) -> tuple[ClassEntry, dict[str, tuple[a.Value, Span]]]:
     """The full function behind ``entry`` and the defaults its short definitions give."""
     defaults: dict[str, tuple[a.Value, Span]] = {}
+    if entry.defn.short is None:
+        return entry, defaults
     where: Scope = _written_in(ev, entry, ref, scope)
     seen = 0
     while entry.defn.short is not None and seen < 100:

@@ -73,10 +73,18 @@ def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
                                    expr.span), where)
                     for f in constructor_fields(view)}
     if isinstance(expr, s.Call | s.IfExpr | s.FieldOf):  # a function returning a record
-        return {f.name: (s.FieldOf(expr, f.name, expr.span), where)
-                for f in constructor_fields(view)}
+        return {f.name: (field_of(expr, f.name), where) for f in constructor_fields(view)}
     raise FlattenError(f"the value of record '{name}' must be a record", expr.span,
                        hint=HINT)
+
+
+def field_of(expr: s.Expr, name: str) -> s.Expr:
+    """The field ``name`` of the record value ``expr``; of each branch of an
+    if-expression (``if c then f(x) else g(x)``), so that the branches are records."""
+    if isinstance(expr, s.IfExpr):
+        return s.IfExpr(tuple((c, field_of(v, name)) for c, v in expr.branches),
+                        field_of(expr.otherwise, name), expr.span)
+    return s.FieldOf(expr, name, expr.span)
 
 
 def _constructor(fl: ClassViews, call: s.Call, where: Any) -> ClassEntry | None:

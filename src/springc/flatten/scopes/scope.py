@@ -433,6 +433,8 @@ def build_view(entry: ClassEntry, flattener: ClassViews, seen: tuple[ClassEntry,
             base = inherited_class(flattener.resolve_class, entry, element.span)
         else:
             base = flattener.resolve_class(element.base, entry.parent or entry, entry)
+        if base.defn.short is not None and entry.defn.kind == "type":
+            continue  # type T extends Real[4]: no components (its functions are members)
         if base.defn.short is not None:
             raise FlattenError("extending a short class definition is not supported yet",
                                element.span)
