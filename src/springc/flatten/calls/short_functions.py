@@ -29,7 +29,8 @@ def short_defaults(ev: ExpressionEvaluator, entry: ClassEntry, ref: s.Ref, scope
         short = entry.defn.short
         for arg in short.modification.arguments if short.modification else ():
             mod = arg.modification
-            if len(arg.path) != 1 or mod is None or mod.value is None or mod.arguments:
+            if len(arg.path) != 1 or mod is None or mod.value is None or mod.arguments \
+                    or arg.redeclare is not None:
                 raise FlattenError(f"only values of inputs may modify a function "
                                    f"(`{'.'.join(arg.path)}`)", arg.span)
             if arg.path[0] not in defaults:  # the outer definition wins
