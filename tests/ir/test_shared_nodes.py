@@ -33,3 +33,8 @@ def test_substitute_keeps_sharing() -> None:
         assert isinstance(inner, x.BinOp)
         inner = inner.left
     assert x.to_text(inner) == "2 * b"
+
+
+def test_evaluate_visits_a_shared_node_once() -> None:
+    e = _doubling(60)
+    assert x.evaluate(e, {"a": 3.0, "b": 0.5}) == 1.5 * 2.0**60
