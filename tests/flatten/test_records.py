@@ -185,3 +185,14 @@ equation
 ])
 def test_record_function_errors(tmp_path: Path, body: str, message: str) -> None:
     assert error_of(tmp_path, FUNCTIONS + body).split(": ", 1)[1] == message
+
+
+def test_final_record_bound_to_a_function(tmp_path: Path) -> None:
+    """``final R = f(x)`` in a modification (MultiBody's World.surface)."""
+    m = flat_of(tmp_path, FUNCTIONS + """  model Holder
+    input O R = null();
+  end Holder;
+  Holder h(final R = planar(0, 2));
+""")
+    assert equations(m) == ["h.R.T[1,1] = 1.0", "h.R.T[1,2] = 0.0", "h.R.T[2,1] = -0.0",
+                            "h.R.T[2,2] = 1.0", "h.R.w = 2"]

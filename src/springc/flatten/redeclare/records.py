@@ -50,10 +50,12 @@ def record_mod(fl: FlattenContext, mod: Mod, view: ClassView, name: str) -> Mod:
     children = {key: Mod(ModValue(expr, where), span=expr.span)
                 for key, (expr, where) in fields.items()}
     # the value replaces the fields' modifications written with the declaration
-    explicit = Mod(None, mod.children, mod.each, mod.final, mod.span)
+    # (`final R = f(x)` makes the whole final, not the fields against its own value)
+    explicit = Mod(None, mod.children, mod.each, False, mod.span)
     merged = merge(Mod(None, children, span=mod.span), explicit, name)
     assert merged is not None
-    return merged
+    return Mod(None, merged.children, merged.each, mod.final, merged.span,
+               merged.redeclare)
 
 
 def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
