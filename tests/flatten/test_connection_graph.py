@@ -1,7 +1,8 @@
 """Overdetermined connectors (Modelica 3.6, sections 9.3.1 and 9.4): an element of a
 type defining ``equalityConstraint`` counts as its residues in the connector balance;
-the graph operators are equations of an equation section (``not supported yet`` there,
-errors elsewhere). Exact outcomes."""
+the graph operators are equations of an equation section (errors elsewhere); the
+virtual connection graph: roots by priority, ``rooted`` and ``isRoot``, a loop broken
+with ``equalityConstraint``. Exact outcomes and flat equations."""
 
 from __future__ import annotations
 
@@ -10,6 +11,9 @@ from pathlib import Path
 import pytest
 
 from rule_outcome import outcome
+from springc.errors import ErrorGroup, SpringcError, errors_of
+from springc.ir import expr as x
+from springc.pipeline.files import flatten_files
 
 BASE = """model M
   type Angle
@@ -51,11 +55,9 @@ CASES = {
         _model(2), "18:5: connector 'c' (M.C) has 2 flow and 3 potential variables\nhelp: a "
         "connector has as many flow variables as variables that are neither parameter, "
         "constant, input, output nor flow (Modelica 3.6, section 9.3.1)"),
-    "root_as_an_equation": (
+    "root_of_an_unconnected_element": (
         _model(1, "  Connections.root(c.theta);\n"),
-        "22:3: `Connections.root` (overdetermined connection graphs, section 9.4) is not "
-        "supported yet\nhelp: springc supports a subset of Modelica; see \"Not supported "
-        "yet\" in docs/language.md"),
+        "M: 5 unknowns, 5 equations, 0 parameters: balanced"),
     "branch_in_an_algorithm": (
         _model(1, "algorithm\n  Connections.branch(c.theta, c.theta);\n"),
         f"23:3: `Connections.branch` is not allowed in an algorithm section\n{PLACES}"),
@@ -70,3 +72,49 @@ CASES = {
 def test_overdetermined_connectors(tmp_path: Path, name: str) -> None:
     text, expected = CASES[name]
     assert outcome(tmp_path, text) == expected
+
+
+GRAPH = (Path(__file__).parent / "models" / "connection_graph.mo")
+
+
+def _equations(name: str) -> set[str]:
+    model = flatten_files([GRAPH], f"G.{name}")
+    return {f"{x.to_text(e.lhs)} = {x.to_text(e.rhs)}" for e in model.equations}
+
+
+def test_chain_from_a_definite_root() -> None:
+    """The ground's root wins over the body's potential root: the body is no root,
+    the joint's frame a is rooted (b computed from a), the connections are kept."""
+    eqs = _equations("Chain")
+    assert {"b.root = 0", "g.f.R.c = j.a.R.c", "j.b.R.s = b.f.R.s",
+            "j.b.R.c = j.a.R.c * cos(j.phi) - j.a.R.s * sin(j.phi)"} <= eqs
+    assert not any(e.startswith("0 = ") for e in eqs)
+
+
+def test_potential_root_of_the_lowest_priority_number() -> None:
+    """Without a definite root, priority 0 (b2) beats 1 (b1); the joint then computes
+    frame a from frame b (not rooted)."""
+    eqs = _equations("Priority")
+    assert {"b1.root = 0", "b2.root = 1", "b2.f.R.c = cos(time)",
+            "j.a.R.c = j.b.R.c * cos(-j.phi) - j.b.R.s * sin(-j.phi)"} <= eqs
+
+
+def test_a_loop_is_broken_with_the_equality_constraint() -> None:
+    """Two joints from the ground to one body close a loop: the connection reached
+    last (j2.b to b.f) is broken, its 2 equalities replaced by the 1 residue."""
+    eqs = _equations("Loop")
+    assert "0 = j2.b.R.s * b.f.R.c - j2.b.R.c * b.f.R.s" in eqs
+    assert {"j1.b.R.c = b.f.R.c", "j1.b.R.s = b.f.R.s"} <= eqs
+    assert not {e for e in eqs if e.startswith("j2.b.R.") and "b.f.R" in e
+                and "cos" not in e}
+
+
+@pytest.mark.parametrize(("name", "message"), [
+    ("NoRoot", "the connection graph of 'j.a.R' has no root"),
+    ("RootInBinding", "`Connections.isRoot` is supported only in the conditions of "
+     "if-equations"),
+])
+def test_graph_errors(name: str, message: str) -> None:
+    with pytest.raises((SpringcError, ErrorGroup)) as info:
+        flatten_files([GRAPH], f"G.{name}")
+    assert [e.message for e in errors_of(info.value)] == [message]

@@ -4,6 +4,7 @@ components (4.4.2.2): exact flat equations and located errors."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,104 @@ equation
 ])
 def test_record_value_errors(tmp_path: Path, body: str, message: str) -> None:
     assert error_of(tmp_path, body) == message
+
+
+FUNCTIONS = """  record O
+    Real T[2, 2];
+    Real w;
+  end O;
+  record P
+    O o;
+    Real s;
+  end P;
+  function null
+    output O r;
+  algorithm
+    r := O(T = [1, 0; 0, 1], w = 0);
+  end null;
+  function planar
+    input Real a;
+    input Real wa;
+    output O r;
+  algorithm
+    r.T := [cos(a), sin(a); -sin(a), cos(a)];
+    r.w := wa;
+  end planar;
+  function compose
+    input O r1;
+    input O r2;
+    output O r;
+  algorithm
+    r := O(T = r2.T * r1.T, w = r1.w + r2.w);
+  end compose;
+  function scaled
+    input P p;
+    output P q;
+  algorithm
+    q := P(o = compose(p.o, p.o), s = 2 * p.s);
+  end scaled;
+  function resolve
+    input O r;
+    input Real v[2];
+    output Real y[2];
+  algorithm
+    y := r.T * v;
+  end resolve;
+  function g = gain(k = kk);
+  function gain
+    input Real u;
+    input Real k = 1;
+    output Real y;
+  algorithm
+    y := k * u;
+  end gain;
+  parameter Real kk = 3;
+"""
+
+
+def test_records_returned_by_functions(tmp_path: Path) -> None:
+    """A record returned by a function binds a parameter record, an array field and a
+    nested record; record components are function inputs; a record output is filled
+    field by field; a function defined by a modification of another gives its input
+    defaults."""
+    m = flat_of(tmp_path, FUNCTIONS + """  parameter O r0 = null();
+  parameter P p = scaled(P(o = planar(0.5, 2), s = 4));
+  O r;
+  Real y[2];
+  Real z;
+equation
+  r = compose(r0, planar(time, 1));
+  y = resolve(r, {1, 2});
+  z = g(time);
+""")
+    got = {v.name: v.binding for v in m.variables if v.binding is not None}
+    assert x.to_text(got["r0.T[1,1]"]) == "1" and x.to_text(got["r0.T[1,2]"]) == "0"
+    c, s_ = math.cos(1.0), math.sin(1.0)  # planar(0.5) twice is planar(1)
+    assert float(x.to_text(got["p.o.T[1,1]"])) == pytest.approx(c, abs=1e-12)
+    assert float(x.to_text(got["p.o.T[1,2]"])) == pytest.approx(s_, abs=1e-12)
+    assert float(x.to_text(got["p.o.w"])) == 4 and float(x.to_text(got["p.s"])) == 8
+    eqs = equations(m)
+    assert "r.w = r0.w + 1" in eqs
+    assert "z = kk * time" in eqs
+    assert len(eqs) == 4 + 1 + 2 + 1
+
+
+@pytest.mark.parametrize(("body", "message"), [
+    ("  Real y[2] = resolve(O(w = 1), {1, 2});\n",
+     "field 'T' of record 'M.O' needs a value in this constructor call"),
+    ("  Real y = null();\n", "'y' is not a record, but its value is a record 'M.O'"),
+    ("  Real y[2] = resolve(1, {1, 2});\n", "'T' cannot be selected from a value"),
+])
+def test_record_function_errors(tmp_path: Path, body: str, message: str) -> None:
+    assert error_of(tmp_path, FUNCTIONS + body).split(": ", 1)[1] == message
+
+
+def test_final_record_bound_to_a_function(tmp_path: Path) -> None:
+    """``final R = f(x)`` in a modification (MultiBody's World.surface)."""
+    m = flat_of(tmp_path, FUNCTIONS + """  model Holder
+    input O R = null();
+  end Holder;
+  Holder h(final R = planar(0, 2));
+""")
+    assert equations(m) == ["h.R.T[1,1] = 1.0", "h.R.T[1,2] = 0.0", "h.R.T[2,1] = -0.0",
+                            "h.R.T[2,2] = 1.0", "h.R.w = 2"]

@@ -40,13 +40,12 @@ REJECTED = {
     "    s = \"a\";\n  end when;\n  b = s == \"a\";\nend M;\n":
         "8:7: error: reading the discrete String 's' (assigned in a when-clause) is not "
         "supported yet",
-    "model M\n  Real x = 1;\nequation\n  Connections.root(x);\nend M;\n":
-        "4:3: error: `Connections.root` (overdetermined connection graphs, section 9.4) is "
-        "not supported yet",
+    "model M\n  Real x = 1;\n  Real y = if Connections.isRoot(x) then 1 else 0;\nend M;\n":
+        "3:15: error: `Connections.isRoot` is supported only in the conditions of "
+        "if-equations",
     "model M\n  function f\n    input Real x;\n    output Real y;\n  algorithm\n    y := x;\n"
-    "  end f;\n  function f2 = f(x = 3);\n  Real y = f2(1);\nend M;\n":
-        "9:12: error: a function defined by a modification of another (`function f2 = "
-        "f(...)`) is not supported yet",
+    "  end f;\n  function f2 = f(x(start = 3));\n  Real y = f2(1);\nend M;\n":
+        "8:19: error: only values of inputs may modify a function (`x`)",
     "model M\n  String s;\nequation\n  s = String(time);\nend M;\n":
         "4:14: error: 'String' of a value that changes during the simulation is not "
         "supported yet: it depends on time",

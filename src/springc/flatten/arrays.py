@@ -10,12 +10,27 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any, TypeGuard
 
 import numpy as np
 
 from ..ir import expr as x
 
+
+@dataclass(frozen=True)
+class RecordValue:
+    """A record as a value (section 12.6): what a function returns or takes, a record
+    constructor call, a record component named in an expression. ``name``: the
+    record class's full name; ``fields``: each component's value (nested records
+    as ``RecordValue``)."""
+
+    name: str
+    fields: dict[str, Any]
+
+
+#: A value; a record value (``RecordValue``) travels where a function returns or takes
+#: one, typed as this alias only by the few places that make or read it.
 Value = x.Expr | str | np.ndarray
 
 

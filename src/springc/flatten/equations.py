@@ -18,7 +18,7 @@ from . import arrays as a
 from .array_ops import check_loop_nest, with_range
 from .calls import assertion, call_for_effect, multiple_outputs, string_equation
 from .checks import check_boolean_condition
-from .connect import GRAPH_EQUATIONS, ConnectionSets, graph_equation
+from .connect import GRAPH_EQUATIONS, ConnectionSets, misplaced, operator_nodes, uses_graph
 from .equation_templates import Template, make_template, reusable
 from .events import (
     EVENT_EQUATIONS,
@@ -41,6 +41,8 @@ class EquationFlattening(FlattenContext):
     reusable_views: dict[Ident[ClassView], bool]  # whether a view's equations are a template
     algorithm_sections: list[Section]
     written_in: ClassEntry | None
+    # if-equations on Connections.isRoot/rooted, flattened once the graph is solved
+    deferred_ifs: list[tuple[s.IfEquation, Scope, ClassScope, bool, ClassEntry | None]]
 
     def equations_of(self, scope: ClassScope, initial: bool = False) -> None:
         """The equations of one instance; from the class's template when it has one."""
@@ -55,6 +57,7 @@ class EquationFlattening(FlattenContext):
             target += template.instantiate(scope.prefix)
             return
         start, errors, reads = len(target), len(self.errors), self.parameter_values.reads
+        deferred = len(self.deferred_ifs)
         for item in items:
             self.written_in = item.defined_in
             try:
@@ -64,7 +67,7 @@ class EquationFlattening(FlattenContext):
             finally:
                 self.written_in = None
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
-                and scope.package is None:
+                and scope.package is None and len(self.deferred_ifs) == deferred:
             independent = self.parameter_values.reads == reads \
                 and reusable(self, view, self.reusable_views)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
@@ -85,6 +88,11 @@ class EquationFlattening(FlattenContext):
         elif isinstance(eq, s.WhenEquation):
             flatten_when(self, eq, where, owner, initial)
         elif isinstance(eq, s.IfEquation):
+            if not self.connections.graph.solved \
+                    and uses_graph(tuple(c for c, _ in eq.branches)):
+                # on Connections.isRoot/rooted: once every connection is known
+                self.deferred_ifs.append((eq, where, owner, initial, self.written_in))
+                return
             for cond, body in eq.branches:  # in order, up to the first true (8.3.4)
                 if self._variable_condition(cond, where):
                     variable_if_equation(self, eq, where, owner, initial)
@@ -101,7 +109,10 @@ class EquationFlattening(FlattenContext):
             raise FlattenError(f"{name}(...) is only allowed inside a when-clause", eq.span,
                                hint=f"write 'when condition then {name}(...); end when;'")
         elif eq.call.func.dotted in GRAPH_EQUATIONS:
-            raise graph_equation(eq.call)
+            if initial:
+                raise misplaced(eq.call, "an initial equation section")
+            nodes, priority = operator_nodes(self.evaluator, eq.call, where)
+            self.connections.graph.operator(eq.call, nodes, priority)
         elif eq.call.func.dotted == "assert":
             kind = "initial" if initial else "equation"
             self.assertions.append(

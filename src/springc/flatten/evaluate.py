@@ -21,9 +21,22 @@ from ..ir import syntax as s
 from ..parse import ClassEntry
 from . import arrays as a
 from .array_ops import type_range, typed_range, typed_range_bounds, with_range
-from .calls import Builtins, call_function, function_of, guard_assertions, string_binary
+from .calls import (
+    Builtins,
+    call_function,
+    function_of,
+    guard_assertions,
+    short_defaults,
+    string_binary,
+)
 from .checks import check_enum_relation
-from .connect import CARDINALITY, GRAPH_FUNCTIONS, cardinality_call
+from .connect import (
+    CARDINALITY,
+    GRAPH_FUNCTIONS,
+    ConnectionGraph,
+    cardinality_call,
+    graph_value,
+)
 from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
 from .names import ReferenceResolver
 from .scopes import (
@@ -60,6 +73,8 @@ class Evaluator(ReferenceResolver):
         # Whether a subscript contains `end`, by syntax node (its identity: equal
         # subscripts written in two places are two entries).
         self.uses_end: dict[Ident[s.Expr], bool] = {}
+        self.graph = ConnectionGraph()  # the flattener's, once it has connections
+        self.record_values: dict[tuple[Ident[s.Expr], Ident[Scope]], a.Value] = {}
         self.cardinality_used = False  # placeholders to replace (flatten/connect/cardinality.py)
 
     # ------------------------------------------------------------ entry points
@@ -70,7 +85,7 @@ class Evaluator(ReferenceResolver):
 
     def scalar(self, e: s.Expr, scope: Scope) -> x.Expr:
         v = self.value(e, scope)
-        if a.is_array(v) or isinstance(v, str):
+        if a.is_array(v) or isinstance(v, str | a.RecordValue):
             raise FlattenError(f"expected a scalar, found {self.describe(v)}", e.span)
         return v  # type: ignore[return-value]
 
@@ -113,6 +128,8 @@ class Evaluator(ReferenceResolver):
     def describe(self, v: Any) -> str:
         if isinstance(v, str):
             return "a string"
+        if isinstance(v, a.RecordValue):
+            return f"a record '{v.name}'"
         if isinstance(v, (ClassScope, ClassEntry)) or (a.is_array(v) and v.size and
                                                      isinstance(v.flat[0], ClassScope)):
             return "a component"
@@ -327,7 +344,9 @@ class Evaluator(ReferenceResolver):
 
     def _Call(self, e: s.Call, scope: Scope) -> a.Value:
         name = e.func.dotted
-        if name in UNSUPPORTED_CALLS or name in GRAPH_FUNCTIONS:
+        if name in GRAPH_FUNCTIONS:
+            return graph_value(self, self.graph, e, scope)
+        if name in UNSUPPORTED_CALLS:
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")
@@ -341,10 +360,25 @@ class Evaluator(ReferenceResolver):
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
             return handler(e, scope)
-        entry = function_of(self, e.func, scope)
+        entry, named = short_defaults(self, function_of(self, e.func, scope), e.func, scope)
         args = [self.value(arg, scope) for arg in e.args]
-        named = {n.name: (self.value(n.value, scope), n.span) for n in e.named}
+        named.update({n.name: (self.value(n.value, scope), n.span) for n in e.named})
         return call_function(self, entry, args, named, e)
+
+    def _FieldOf(self, e: s.FieldOf, scope: Scope) -> a.Value:
+        key = (Ident(e.record), Ident(scope))  # one evaluation for all the fields
+        record = self.record_values.get(key)
+        if record is None:
+            record = self.record_values[key] = self.value(e.record, scope)
+        if not isinstance(record, a.RecordValue):
+            raise FlattenError(f"a record is expected here, found {self.describe(record)}",
+                               e.record.span)
+        value = record.fields.get(e.name)
+        if value is None:
+            raise FlattenError(f"field '{e.name}' of this record value is never assigned",
+                               e.record.span)
+        field: a.Value = value
+        return field
 
     def _Comprehension(self, e: s.Comprehension, scope: Scope) -> a.Value:
         return self._stack(list(self.iterate(e.body, e.indices, scope)), e.span)

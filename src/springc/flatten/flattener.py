@@ -28,6 +28,7 @@ from .experiment import experiment_of
 from .instance_templates import InstanceTemplates
 from .instantiate import Instantiation
 from .names import ClassLookup, select_model
+from .overdetermined import solve_graph
 from .redeclare import check_redeclarations
 from .scopes import (
     DEFAULT_MAX_SIZE,
@@ -59,8 +60,11 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.package_scopes: dict[ClassEntry, ClassScope] = {}
         self.rule_errors: dict[ClassEntry, FlattenError] = {}
         self.parameter_values = ParameterValues()
-        self.evaluator: ExpressionEvaluator = Evaluator(self)
+        evaluator = Evaluator(self)
+        self.evaluator: ExpressionEvaluator = evaluator
         self.connections = ConnectionSets()
+        evaluator.graph = self.connections.graph
+        self.deferred_ifs = []
         self.equations: list[flat.Equation] = []
         self.initial_equations: list[flat.Equation] = []
         self.whens: list[When] = []
@@ -186,6 +190,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
             check_connector_size(scope)
         for scope in scopes:
             flattener.equations_of(scope)
+        solve_graph(flattener)
         for scope in scopes:
             flattener.equations_of(scope, initial=True)
         if cast(Evaluator, flattener.evaluator).cardinality_used:

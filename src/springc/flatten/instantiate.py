@@ -388,6 +388,10 @@ class Instantiation(FlattenContext):
         value = self.mod_value(mod.value)
         if isinstance(value, str):
             raise FlattenError(f"'{name}' cannot be given a string", mod.value.span)
+        if isinstance(value, a.RecordValue):
+            raise FlattenError(f"'{name}' is not a record, but its value is a record "
+                               f"'{value.name}'", mod.value.span,
+                               [Note("declared here", decl.span)])
         if a.shape(value) != dims:
             raise FlattenError(
                 f"'{name}' has size {a.describe_shape(dims)} but is given a value of size "

@@ -184,27 +184,44 @@ def evaluate(e: Expr, env: Mapping[str, object], time: float = 0.0,
     is ``env["pre(v)"]`` if given, else ``v`` (away from an event a variable equals its
     left limit), ``edge`` and ``change`` follow from ``pre``, and ``sample(start,
     interval)`` holds at ``start + k interval``."""
+    return _evaluate(e, env, time, initial, {})
+
+
+def _evaluate(e: Expr, env: Mapping[str, object], time: float, initial: bool | None,
+              memo: dict[int, tuple[Expr, Any]]) -> Any:
+    """:func:`evaluate`, each node shared by several parents once (``memo``)."""
     if isinstance(e, Const):
         return e.value
     if isinstance(e, Var):
         return env[e.name]
+    found = memo.get(id(e))
+    if found is not None and found[0] is e:
+        return found[1]
+    value = _evaluate_node(e, env, time, initial, memo)
+    memo[id(e)] = (e, value)
+    return value
+
+
+def _evaluate_node(e: Expr, env: Mapping[str, object], time: float, initial: bool | None,
+                   memo: dict[int, tuple[Expr, Any]]) -> Any:
     if isinstance(e, BinOp):
-        return _BINARY[e.op](evaluate(e.left, env, time, initial),
-                             evaluate(e.right, env, time, initial))
+        return _BINARY[e.op](_evaluate(e.left, env, time, initial, memo),
+                             _evaluate(e.right, env, time, initial, memo))
     if isinstance(e, Neg):
-        return -evaluate(e.arg, env, time, initial)
+        return -_evaluate(e.arg, env, time, initial, memo)
     if isinstance(e, Not):
-        return not evaluate(e.arg, env, time, initial)
+        return not _evaluate(e.arg, env, time, initial, memo)
     if isinstance(e, Call):
         function = MATH.get(e.name)
         if function is None:
             return _event_call(e, env, time, initial)
-        return function(*(evaluate(a, env, time, initial) for a in e.args))
+        return function(*(_evaluate(a, env, time, initial, memo) for a in e.args))
     if isinstance(e, If):
-        branch = e.then if evaluate(e.cond, env, time, initial) else e.otherwise
-        return evaluate(branch, env, time, initial)
+        branch = e.then if _evaluate(e.cond, env, time, initial, memo) else e.otherwise
+        return _evaluate(branch, env, time, initial, memo)
     if isinstance(e, Time):
         return time
+    assert isinstance(e, Der)
     raise KeyError(f"der({to_text(e.arg)})")
 
 

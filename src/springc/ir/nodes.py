@@ -114,10 +114,19 @@ def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
 
 
 def walk(e: Expr) -> Iterator[Expr]:
-    """All nodes of ``e``, parents before children."""
+    """All nodes of ``e``, parents before children; a node object shared by several
+    parents (inlined functions build such graphs, whose trees can be thousands of
+    times larger) once."""
     stack = [e]
+    seen: set[int] = set()
     while stack:
         node = stack.pop()
+        if type(node) is Const or type(node) is Var:
+            yield node
+            continue
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
         yield node
         stack.extend(children(node))
 
@@ -149,19 +158,35 @@ def derivatives(e: Expr) -> set[str]:
 
 
 def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
-    """Replace variables by expressions; unchanged subtrees are shared, not copied."""
+    """Replace variables by expressions; unchanged subtrees are shared, not copied, and
+    a subtree shared by several parents is rewritten once (the result shares it too)."""
+    return _substitute(e, mapping, {})
+
+
+def _substitute(e: Expr, mapping: Mapping[str, Expr], memo: dict[int, tuple[Expr, Expr]]
+                ) -> Expr:
     if isinstance(e, Var):
         return mapping.get(e.name, e)
     if isinstance(e, (Const, Time)):
         return e
+    found = memo.get(id(e))
+    if found is not None and found[0] is e:
+        return found[1]
+    out = _substitute_node(e, mapping, memo)
+    memo[id(e)] = (e, out)
+    return out
+
+
+def _substitute_node(e: Expr, mapping: Mapping[str, Expr],
+                     memo: dict[int, tuple[Expr, Expr]]) -> Expr:
     if isinstance(e, BinOp):
-        left, right = substitute(e.left, mapping), substitute(e.right, mapping)
+        left, right = _substitute(e.left, mapping, memo), _substitute(e.right, mapping, memo)
         return e if left is e.left and right is e.right else BinOp(e.op, left, right)
     if isinstance(e, (Neg, Not, Der)):
-        arg = substitute(e.arg, mapping)
+        arg = _substitute(e.arg, mapping, memo)
         return e if arg is e.arg else type(e)(arg)
     if isinstance(e, Call):
-        args = tuple(substitute(a, mapping) for a in e.args)
+        args = tuple(_substitute(a, mapping, memo) for a in e.args)
         if all(a is b for a, b in zip(args, e.args)):
             return e
         if e.name in ("pre", "edge", "change") and len(args) == 1 \
@@ -169,7 +194,7 @@ def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
             return args[0] if e.name == "pre" else Const(False)
         return Call(e.name, args)
     if isinstance(e, If):
-        c, t, o = (substitute(x, mapping) for x in (e.cond, e.then, e.otherwise))
+        c, t, o = (_substitute(x, mapping, memo) for x in (e.cond, e.then, e.otherwise))
         return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
     raise TypeError(f"not an expression: {e!r}")
 

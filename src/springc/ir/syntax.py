@@ -169,9 +169,19 @@ class Tuple:
     span: Span
 
 
+@dataclass(frozen=True, slots=True)
+class FieldOf:
+    """The field ``name`` of a record-valued expression (``f(x)`` returning a record):
+    never parsed, made by flattening when a record is bound to such an expression."""
+
+    record: Expr
+    name: str
+    span: Span
+
+
 Expr = (
     Number | Bool | String | Ref | Colon | End | Unary | Binary | IfExpr | Call
-    | Comprehension | ArrayLit | MatrixLit | Range | Tuple
+    | Comprehension | ArrayLit | MatrixLit | Range | Tuple | FieldOf
 )
 
 # -------------------------------------------------------------- modifications

@@ -38,6 +38,7 @@ class UnitChecker:
 
     def __init__(self, model: FlatModel) -> None:
         self.units: dict[str, Unit | None] = {}
+        self.shared: dict[int, tuple[x.Expr, Unit | None]] = {}
         for v in model.variables:
             self.units[v.name] = _declared(v.attributes.unit) if v.type == "Real" else None
 
@@ -57,7 +58,12 @@ class UnitChecker:
             self.unit(e.arg)
             return None
         if isinstance(e, x.BinOp):
-            return self.binop(e)
+            found = self.shared.get(id(e))  # a node shared by several parents: once
+            if found is not None and found[0] is e:
+                return found[1]
+            unit = self.binop(e)
+            self.shared[id(e)] = (e, unit)
+            return unit
         if isinstance(e, x.If):
             self.unit(e.cond)
             return agree(self.unit(e.then), self.unit(e.otherwise), "if-branches",

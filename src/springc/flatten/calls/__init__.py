@@ -8,6 +8,7 @@ from .assertions import assertion, check_conditions, guard_assertions, unique
 from .builtins import CONSTANTS, Builtins
 from .control import Jumped, branch_jumps, check_jumps, folded, run_loop_body, run_while, stray
 from .functions import call_for_effect, call_function, function_of, multiple_outputs
+from .short_functions import short_defaults
 from .strings import (
     is_string,
     read,
@@ -35,6 +36,7 @@ __all__ = [
     "read",
     "run_loop_body",
     "run_while",
+    "short_defaults",
     "stray",
     "string_binary",
     "string_component",

@@ -45,6 +45,8 @@ from .control import (
     stray,
 )
 from .jumps import flags, is_flag, lowered, merged_flag
+from .record_values import construct, empty_record, record_class, store_field
+from .short_functions import short_defaults
 
 MAX_DEPTH = 50
 
@@ -54,6 +56,9 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
                   count: int = 1) -> a.Value:
     """The value of the call's first output (``count`` > 1: a list of the first
     ``count`` outputs, for ``(a, b) := f(x)``)."""
+    if entry.defn.kind == "record":
+        record: a.Value = construct(ev, entry, args, named, call)
+        return record
     depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",
@@ -170,9 +175,9 @@ def _redeclared_function(ev: ExpressionEvaluator, owner: ClassScope,
 def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int
                  ) -> list[a.Value]:
     """The first ``count`` outputs of a call of a user-defined function."""
-    entry = function_of(ev, call.func, scope)
+    entry, named = short_defaults(ev, function_of(ev, call.func, scope), call.func, scope)
     args = [ev.value(arg, scope) for arg in call.args]
-    named = {n.name: (ev.value(n.value, scope), n.span) for n in call.named}
+    named.update({n.name: (ev.value(n.value, scope), n.span) for n in call.named})
     values = call_function(ev, entry, args, named, call, count)
     return values if count > 1 else [values]  # type: ignore[return-value]
 
@@ -230,6 +235,10 @@ def _declare(ev: ExpressionEvaluator, scope: FunctionScope, comp: s.Component,
     if comp.causality == "input":
         raise FlattenError(f"input '{comp.name}' is missing in this call", call.span,
                            [Note("declared here", comp.span)])
+    record = record_class(ev, comp, scope.entry)
+    if record is not None:
+        scope.names[comp.name] = empty_record(ev, record)
+        return
     dims = [d for d in comp.dims + comp.type_dims]
     if dims and all(isinstance(d, s.Colon) for d in dims):
         # a flexible array: empty until assigned (section 12.4.5)
@@ -397,6 +406,11 @@ def _assign(ev: ExpressionEvaluator, stmt: s.Assign, scope: FunctionScope) -> No
 def _store(ev: ExpressionEvaluator, target: s.Ref, value: a.Value, stmt: s.Assign,
            scope: FunctionScope) -> None:
     part = target.parts[0]
+    current = scope.names.get(part.name)
+    if len(target.parts) > 1 and isinstance(current, a.RecordValue) \
+            and not any(p.subscripts for p in target.parts):
+        scope.names[part.name] = store_field(current, target.parts[1:], value, target)
+        return
     if len(target.parts) > 1 or part.name not in scope.names:
         raise FlattenError(f"'{target.dotted}' is not a variable of this function",
                            target.span)

@@ -10,9 +10,14 @@ from .connect_rules import check_connector_size, check_no_connect
 from .connection_graph import (
     GRAPH_EQUATIONS,
     GRAPH_FUNCTIONS,
+    ConnectionGraph,
+    Edge,
     check_branches,
-    graph_equation,
+    graph_node,
+    graph_value,
     misplaced,
+    operator_nodes,
+    uses_graph,
 )
 from .connections import ConnectionSets
 
@@ -20,12 +25,17 @@ __all__ = [
     "CARDINALITY",
     "GRAPH_EQUATIONS",
     "GRAPH_FUNCTIONS",
+    "ConnectionGraph",
     "ConnectionSets",
+    "Edge",
     "apply_cardinalities",
     "cardinality_call",
     "check_branches",
     "check_connector_size",
     "check_no_connect",
-    "graph_equation",
+    "graph_node",
+    "graph_value",
     "misplaced",
+    "operator_nodes",
+    "uses_graph",
 ]

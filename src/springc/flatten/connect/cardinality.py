@@ -41,21 +41,32 @@ def cardinality_call(ev: ExpressionEvaluator, e: s.Call, scope: Scope) -> x.Expr
                        "(Modelica 3.6, section 3.7.4.4)")
 
 
-def _replace(e: x.Expr, counts: Counter[str]) -> x.Expr:
-    """``e`` with its placeholders replaced (unchanged subtrees shared)."""
+def _replace(e: x.Expr, counts: Counter[str], memo: dict[int, tuple[x.Expr, x.Expr]]
+             ) -> x.Expr:
+    """``e`` with its placeholders replaced (unchanged subtrees shared; a subtree
+    shared by several parents, as inlined functions make them, visited once)."""
+    found = memo.get(id(e))
+    if found is not None and found[0] is e:
+        return found[1]
     if isinstance(e, x.Call) and e.name == NAME and isinstance(e.args[0], x.Var):
-        return x.Const(counts[e.args[0].name])
-    return x.map_children(e, lambda c: _replace(c, counts))
+        out: x.Expr = x.Const(counts[e.args[0].name])
+    elif isinstance(e, x.Const | x.Var):
+        return e
+    else:
+        out = x.map_children(e, lambda c: _replace(c, counts, memo))
+    memo[id(e)] = (e, out)
+    return out
 
 
 def apply_cardinalities(fl: FlatResults, counts: Counter[str]) -> None:
     """Replace every ``cardinality`` placeholder by the connector's count."""
+    memo: dict[int, tuple[x.Expr, x.Expr]] = {}
     for items in (fl.equations, fl.initial_equations):
         for i, eq in enumerate(items):
-            lhs, rhs = _replace(eq.lhs, counts), _replace(eq.rhs, counts)
+            lhs, rhs = _replace(eq.lhs, counts, memo), _replace(eq.rhs, counts, memo)
             if lhs is not eq.lhs or rhs is not eq.rhs:
                 items[i] = flat.Equation(lhs, rhs, eq.span, eq.origin)
     for i, (item, span) in enumerate(fl.assertions):
-        condition = _replace(item.condition, counts)
+        condition = _replace(item.condition, counts, memo)
         if condition is not item.condition:
             fl.assertions[i] = (dataclasses.replace(item, condition=condition), span)

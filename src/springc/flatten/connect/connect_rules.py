@@ -122,17 +122,17 @@ def check_connector_size(scope: ClassScope) -> None:
                                      and scope.outer.kind == "connector"):
         return
     flows = potentials = 0
-    overdetermined = _overdetermined(scope)
+    special = overdetermined(scope)
     for name, prim in primitives(scope):
         size = int(np.prod(prim.dims)) if prim.dims else 1
         if prim.variability in ("parameter", "constant") or prim.causality \
-                or name.split(".")[0].split("[")[0] in overdetermined:
+                or name.split(".")[0].split("[")[0] in special:
             continue
         if prim.flow:
             flows += size
         else:
             potentials += size
-    potentials += sum(overdetermined.values())
+    potentials += sum(special.values())
     if flows and flows != potentials:
         raise rule_error(f"connector '{scope.prefix}' ({scope.entry.full_name}) has "
                          f"{flows} flow and {potentials} potential variables",
@@ -143,7 +143,7 @@ def check_connector_size(scope: ClassScope) -> None:
                                scope.entry.defn.span),))
 
 
-def _overdetermined(scope: ClassScope) -> dict[str, int]:
+def overdetermined(scope: ClassScope) -> dict[str, int]:
     """The elements of a connector of an overdetermined type (one that defines an
     ``equalityConstraint`` function), each counting as many potential variables as
     that function has residues (sections 9.3.1, 9.4)."""

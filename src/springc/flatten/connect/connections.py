@@ -28,7 +28,8 @@ from ..scopes import (
     Primitive,
     Scope,
 )
-from .connect_rules import check_pair, check_reference_form, check_sources
+from .connect_rules import check_pair, check_reference_form, check_sources, overdetermined
+from .connection_graph import ConnectionGraph, Edge
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -130,6 +131,8 @@ class ConnectionSets:
         self.counts: Counter[str] = Counter()  # connect equations per connector (cardinality)
         # protected outside connectors: a signal's source only when public (9.3)
         self.protected: set[str] = set()
+        self.graph = ConnectionGraph()  # overdetermined elements (section 9.4)
+        self._special: dict[str, dict[str, int]] = {}  # by connector class
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -216,8 +219,22 @@ class ConnectionSets:
                 "prefixes)")
         self.causal.update(check_pair(ca, cb, eq))
         link = Link(eq.span, owner.prefix, f"connect({ca.prefix}, {cb.prefix})")
+        special = self._special.get(ca.entry.full_name)
+        if special is None:
+            special = self._special[ca.entry.full_name] = overdetermined(ca)
+        edges: dict[str, Edge] = {}
         for p, q in zip(leaves_a, leaves_b):
             ka, kb = (p.name, out_a), (q.name, out_b)
+            element = p.relative.split(".")[0].split("[")[0]
+            if element in special:  # joined when the graph keeps the edge
+                if element not in edges:
+                    edges[element] = Edge(f"{ca.prefix}.{element}", f"{cb.prefix}.{element}",
+                                          (ca, cb), element, [], link)
+                    self.graph.edges.append(edges[element])
+                edges[element].pairs.append((ka, kb))
+                self._add(ka, p.flow, link)
+                self._add(kb, q.flow, link)
+                continue
             self._add(ka, p.flow, link)
             self._add(kb, q.flow, link)
             ra, rb = self._find(ka), self._find(kb)
@@ -240,6 +257,14 @@ class ConnectionSets:
         ra, rb = self._find(ka), self._find(kb)
         if ra != rb:
             self.parent[rb] = ra
+
+    def join_kept(self) -> None:
+        """Join the overdetermined elements of the connections the graph keeps."""
+        for edge in self.graph.kept:
+            for ka, kb in edge.pairs:
+                ra, rb = self._find(ka), self._find(kb)
+                if ra != rb:
+                    self.parent[rb] = ra
 
     def equations(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
         """Equations of all sets (in order of first connection), then zero flows."""

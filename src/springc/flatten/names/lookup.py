@@ -211,19 +211,15 @@ class ClassLookup(FlattenContext):
         if entry.defn.outer:  # `outer function f = A;`: the inner one (section 5.4)
             entry = inner_class(scope, entry, ref.span)
         short = entry.defn.short
-        if short is not None and entry.defn.kind == "function":  # function f = g;
-            if short.modification is not None:
-                raise FlattenError("a function defined by a modification of another "
-                                   f"(`function {entry.name} = "
-                                   f"{short.base.dotted}(...)`) is not supported yet",
-                                   ref.span, [Note("defined here", entry.defn.span)],
-                                   "springc supports a subset of Modelica; see \"Not "
-                                   "supported yet\" in docs/language.md")
+        if short is not None and entry.defn.kind == "function" \
+                and short.modification is None:  # function f = g; (f = g(k = 1): calls)
             entry = self.follow_short(entry)[0]
         constructor = member_class(entry, "constructor") \
             if entry.defn.kind == "class" and is_external_object(entry) else None
         if constructor is not None:  # `E(...)` of an external object (section 12.9.7)
             entry = constructor
+        if entry.defn.kind == "record":  # a record constructor (section 12.6)
+            return self.follow_short(entry)[0] if short is not None else entry
         if entry.defn.kind != "function":
             raise FlattenError(f"'{ref.dotted}' is a {entry.defn.kind}, not a function",
                                ref.span, [Note("defined here", entry.defn.span)])

@@ -52,6 +52,9 @@ class ReferenceResolver:
 
     def _Ref(self, e: s.Ref, scope: Scope) -> a.Value:
         v = self.reference(e, scope)
+        if isinstance(v, ClassScope) and v.kind == "record":
+            record: a.Value = self.record_value(v)
+            return record
         if isinstance(v, (ClassEntry, ClassScope)) or (
                 a.is_array(v) and v.size and isinstance(v.flat[0], ClassScope)):
             raise FlattenError(f"'{e.dotted}' is a component or class, not a value", e.span,
@@ -59,6 +62,17 @@ class ReferenceResolver:
                                f"'{e.dotted}.<name>'")
         value: a.Value = v
         return value
+
+    def record_value(self, record: ClassScope) -> Any:
+        """A record component as a value: its fields read one by one."""
+        fields = {}
+        for name in record.view.components:
+            member = record.member(name)
+            if isinstance(member, ClassScope) and member.kind == "record":
+                fields[name] = self.record_value(member)
+            else:
+                fields[name] = self.member_value(member)
+        return a.RecordValue(record.entry.full_name, fields)
 
     def reference(self, e: s.Ref, scope: Scope) -> Any:
         """Follow a component reference; the result may be a scope or array of scopes."""
@@ -85,6 +99,12 @@ class ReferenceResolver:
                                    part.span, hint="its literals are: "
                                    + ", ".join(current.literals))
             return literal_value(current, current.literals.index(part.name) + 1)
+        if isinstance(current, a.RecordValue):
+            if part.name not in current.fields:
+                raise FlattenError(f"record '{current.name}' has no field '{part.name}'",
+                                   part.span, hint="its fields are: "
+                                   + ", ".join(current.fields))
+            return self._subscript(current.fields[part.name], part, scope)
         if isinstance(current, ClassEntry):
             found = self.flattener.class_member(current, part.name, part.span)
             return self._subscript(found, part, scope)

@@ -22,12 +22,26 @@ from .instance_classes import (
     redeclared_package,
     type_name_package,
 )
-from .records import record_equation, record_mod
+from .records import constructor_fields, record_equation, record_mod
 from .redeclare_rules import check_redeclarations, check_replaceables
 
 __all__ = [
-    "check_redeclarations", "check_replaceables", "class_in_instance", "class_modification",
-    "condition_holds", "disabled", "inner_class", "inner_member", "instance_scope",
-    "named_through", "record_equation", "record_mod", "redeclared", "redeclared_class",
-    "redeclared_class_mod", "redeclared_package", "type_name_package",
+    "check_redeclarations",
+    "check_replaceables",
+    "class_in_instance",
+    "class_modification",
+    "condition_holds",
+    "constructor_fields",
+    "disabled",
+    "inner_class",
+    "inner_member",
+    "instance_scope",
+    "named_through",
+    "record_equation",
+    "record_mod",
+    "redeclared",
+    "redeclared_class",
+    "redeclared_class_mod",
+    "redeclared_package",
+    "type_name_package",
 ]

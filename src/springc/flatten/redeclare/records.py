@@ -50,10 +50,12 @@ def record_mod(fl: FlattenContext, mod: Mod, view: ClassView, name: str) -> Mod:
     children = {key: Mod(ModValue(expr, where), span=expr.span)
                 for key, (expr, where) in fields.items()}
     # the value replaces the fields' modifications written with the declaration
-    explicit = Mod(None, mod.children, mod.each, mod.final, mod.span)
+    # (`final R = f(x)` makes the whole final, not the fields against its own value)
+    explicit = Mod(None, mod.children, mod.each, False, mod.span)
     merged = merge(Mod(None, children, span=mod.span), explicit, name)
     assert merged is not None
-    return merged
+    return Mod(None, merged.children, merged.each, mod.final, merged.span,
+               merged.redeclare)
 
 
 def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
@@ -72,8 +74,19 @@ def field_values(fl: FlattenContext, expr: s.Expr, where: Any, view: ClassView,
             return {f.name: (s.Ref((*expr.parts, s.RefPart(f.name, (), expr.span)),
                                    expr.span), where)
                     for f in constructor_fields(view)}
+    if isinstance(expr, s.Call | s.IfExpr | s.FieldOf):  # a function returning a record
+        return {f.name: (field_of(expr, f.name), where) for f in constructor_fields(view)}
     raise FlattenError(f"the value of record '{name}' must be a record", expr.span,
                        hint=HINT)
+
+
+def field_of(expr: s.Expr, name: str) -> s.Expr:
+    """The field ``name`` of the record value ``expr``; of each branch of an
+    if-expression (``if c then f(x) else g(x)``), so that the branches are records."""
+    if isinstance(expr, s.IfExpr):
+        return s.IfExpr(tuple((c, field_of(v, name)) for c, v in expr.branches),
+                        field_of(expr.otherwise, name), expr.span)
+    return s.FieldOf(expr, name, expr.span)
 
 
 def _constructor(fl: ClassViews, call: s.Call, where: Any) -> ClassEntry | None:

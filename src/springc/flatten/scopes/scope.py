@@ -313,6 +313,8 @@ class ExpressionEvaluator(Protocol):
     """What the flattening helpers call on the expression evaluator (``evaluate.py``)."""
 
     flattener: FlattenContext
+
+    def record_value(self, record: ClassScope) -> Any: ...
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
     call_depth: int  # nesting of user-defined function calls being inlined
     events: EventUses  # pre/edge/change uses and when-clause nesting (event_calls.py)
@@ -396,6 +398,8 @@ class FlattenContext(ClassViews, FlatResults, Protocol):
 
     def package_scope(self, entry: ClassEntry) -> ClassScope: ...
 
+    def follow_short(self, entry: ClassEntry) -> tuple[ClassEntry, list[Any]]: ...
+
     def instantiate(self, scope: ClassScope, comp: ViewComponent) -> Member: ...
 
     def declared_type(self, comp: ViewComponent) -> Declared: ...
@@ -429,6 +433,8 @@ def build_view(entry: ClassEntry, flattener: ClassViews, seen: tuple[ClassEntry,
             base = inherited_class(flattener.resolve_class, entry, element.span)
         else:
             base = flattener.resolve_class(element.base, entry.parent or entry, entry)
+        if base.defn.short is not None and entry.defn.kind == "type":
+            continue  # type T extends Real[4]: no components (its functions are members)
         if base.defn.short is not None:
             raise FlattenError("extending a short class definition is not supported yet",
                                element.span)

@@ -72,6 +72,8 @@ def refs(e: object) -> Iterator[s.Ref]:
             yield from refs(named.value)
     elif isinstance(e, s.Unary):
         yield from refs(e.operand)
+    elif isinstance(e, s.FieldOf):
+        yield from refs(e.record)
     elif isinstance(e, s.Binary):
         yield from refs(e.left)
         yield from refs(e.right)

@@ -59,11 +59,12 @@ def attributes_of(flattener: FlattenContext, scope: ClassScope, prim: Primitive
         yield flat.Variable(
             name, prim.type, prim.variability, prim.causality, prim.flow,
             bindings.get(name) if is_param else None,
-            _attributes(flattener, mod, name), prim.decl.description, scope.prefix,
+            _attributes(flattener, mod, name, idx), prim.decl.description, scope.prefix,
             prim.decl.span)
 
 
-def _attributes(flattener: FlattenContext, mod: Mod | None, name: str) -> flat.Attributes:
+def _attributes(flattener: FlattenContext, mod: Mod | None, name: str,
+                index: tuple[int, ...] = ()) -> flat.Attributes:
     """The attributes given by ``mod``, remembered per combination of attribute
     modification objects: a type's modifiers (``unit = "m"``) are objects shared by all
     its variables, also where a merge with a binding built a new ``mod`` around them."""
@@ -72,11 +73,19 @@ def _attributes(flattener: FlattenContext, mod: Mod | None, name: str) -> flat.A
     key = tuple((k, Ident(child)) for k, child in mod.children.items())
     cached = flattener.attribute_cache.get(key)
     if cached is None:
-        cached = flattener.attribute_cache[key] = _evaluate(flattener, mod, name)
+        try:
+            cached = flattener.attribute_cache[key] = _evaluate(flattener, mod, name)
+        except _PerElement:  # an array type's attribute: {1, 1, 1} for Integer[3]
+            return _evaluate(flattener, mod, name, index)
     return cached
 
 
-def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes:
+class _PerElement(Exception):
+    """An attribute is an array (of an array type); each element takes its own."""
+
+
+def _evaluate(flattener: FlattenContext, mod: Mod, name: str,
+              index: tuple[int, ...] | None = None) -> flat.Attributes:
     values: dict[str, Any] = {}
     for key, child in mod.children.items():
         if child.value is None:
@@ -85,6 +94,10 @@ def _evaluate(flattener: FlattenContext, mod: Mod, name: str) -> flat.Attributes
             values["state_select"] = _state_select(flattener, child)
             continue
         value = flattener.mod_value(child.value)
+        if a.is_array(value) and index is None and value.ndim:
+            raise _PerElement
+        if a.is_array(value) and index and value.ndim <= len(index):
+            value = value[tuple(i - 1 for i in index[len(index) - value.ndim:])]
         if a.is_array(value):
             raise FlattenError(f"the attribute '{key}' of '{name}' must be a scalar, found an "
                                f"array of size {a.describe_shape(value.shape)}",
