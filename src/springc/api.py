@@ -15,7 +15,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any, TextIO
 
-from .errors import OutputError, UsageError
+from .errors import CodegenError, OutputError, UsageError
 from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
@@ -188,10 +188,20 @@ def _numba_instead(compiled: CompiledModel) -> bool:
     """Whether springc, having chosen python for the C loop, generates ``compiled``'s
     model for numba instead: the C loop runs continuous models of at most
     ``C_LOOP_STATES`` states; the compiled engine runs others (events, delays,
-    switching states, large scenes) on numba."""
-    return c_loop_runs(AUTO, None) and numba_available() and (
-        compiled.kind != ModuleKind.CONTINUOUS
-        or not c_loop_runs(AUTO, None, len(compiled.states)))
+    switching states, large scenes) on numba, and so does a model the C printer cannot
+    print (a function with no C spelling): numba's loop, not scipy's, runs it."""
+    if not (c_loop_runs(AUTO, None) and numba_available()):
+        return False
+    if compiled.kind != ModuleKind.CONTINUOUS \
+            or not c_loop_runs(AUTO, None, len(compiled.states)):
+        return True
+    from .pipeline import c_source  # the C printer: on this choice only
+
+    try:
+        c_source(compiled)  # kept in the cache entry for the loop library
+    except CodegenError:
+        return True
+    return False
 
 
 def _compile_as(options: CompileOptions,

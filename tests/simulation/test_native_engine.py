@@ -144,3 +144,27 @@ def test_a_bad_loop_choice_names_the_variable(monkeypatch: pytest.MonkeyPatch) -
     with pytest.raises(UsageError) as caught:
         c_loop_available()
     assert caught.value.message == "SPRINGC_LOOP must be c or numba (or unset), not 'fortran'"
+
+
+def test_a_model_the_c_printer_cannot_print_is_compiled_for_numba(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Where the C model cannot be printed (a CodegenError from the C printer), springc's
+    own backend choice regenerates the model for numba, whose compiled loop runs it: the
+    run neither fails nor falls to scipy's loop."""
+    import springc.pipeline
+
+    from springc.errors import CodegenError
+
+    def refuse(model: object) -> str:
+        raise CodegenError("cannot generate C code for the function 'f'")
+
+    monkeypatch.setattr(springc.pipeline, "c_source", refuse)
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    path = tmp_path / "Root.mo"
+    path.write_text(ROOT_MODEL, encoding="utf-8")
+    model = springc.compile_model(str(path))
+    assert model.module.BACKEND == "numba"
+    result = springc.simulate(model, solver="dop853", stop=1.0, rtol=1e-10, atol=1e-12)
+    assert result.stats.engine == "compiled"
+    x = result.values[-1, list(result.names).index("x")]
+    assert x == pytest.approx((1.0 - 0.5) ** 2, rel=1e-8)  # x = (1 - t/2)^2

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import SimulationError
+from ..errors import CodegenError, SimulationError
 from .compiled import C_SOLVERS, Kernel, advance_with
 from .steps import StepLoop, Stepper, Stretch
 
@@ -49,10 +49,12 @@ def loop_ready(problem: Problem) -> bool:
     """Whether ``problem``'s model has its loop library (built now where needed);
     False where its C model cannot be printed: a model unpickled in another process,
     or loaded from the cache, whose files changed since (it then runs on scipy's loop,
-    as a python module did before the C loop)."""
+    as a python module did before the C loop), or a function the C printer cannot
+    spell (a model compiled with ``--backend python``; springc's own choice of backend
+    regenerates such a model for numba)."""
     try:
         library(problem)
-    except SimulationError:
+    except (SimulationError, CodegenError):
         return False
     return True
 
