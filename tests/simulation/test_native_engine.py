@@ -152,7 +152,6 @@ def test_a_model_the_c_printer_cannot_print_is_compiled_for_numba(
     own backend choice regenerates the model for numba, whose compiled loop runs it: the
     run neither fails nor falls to scipy's loop."""
     import springc.pipeline
-
     from springc.errors import CodegenError
 
     def refuse(model: object) -> str:
