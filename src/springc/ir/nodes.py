@@ -134,14 +134,22 @@ def walk(e: Expr) -> Iterator[Expr]:
 def variables(e: Expr) -> set[str]:
     """Names of all variables referenced in ``e`` (inside ``der`` too). One loop over
     the nodes, without :func:`walk`'s generator: code generation asks this of every
-    binding and assignment of a large model (a third of the time it took)."""
+    binding and assignment of a large model (a third of the time it took). A node shared
+    by several parents is visited once, as :func:`walk` does."""
     out: set[str] = set()
+    seen: set[int] = set()
     stack = [e]
     while stack:
         node = stack.pop()
         if type(node) is Var:
             out.add(node.name)
-        elif type(node) is BinOp:
+            continue
+        if type(node) is Const or type(node) is Time:
+            continue
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if type(node) is BinOp:
             stack += (node.left, node.right)
         elif type(node) is Call:
             stack += node.args
