@@ -158,12 +158,11 @@ class ReferenceResolver:
                kind: DimensionKind = None) -> Any:
         try:
             return self._known_index(sub, size, scope, part, kind)
-        except FlattenError:
+        except _UnknownIndex as unknown:
             found = self.value(sub, scope) if kind is None else None
             if isinstance(found, x.Expr) and not isinstance(found, x.Const):
                 return _RunTimeIndex(found, size)  # an Integer variable (section 10.5)
-            raise
-
+            raise unknown.error from None
 
     def _known_index(self, sub: s.Expr, size: int, scope: Scope, part: s.RefPart,
                      kind: DimensionKind = None) -> Any:
@@ -176,7 +175,10 @@ class ReferenceResolver:
             scope = LocalScope({}, scope, size)
         v = self._loop_index(sub, scope)
         if v is None:
-            v = self.constant(sub, scope, "a subscript")
+            try:
+                v = self.constant(sub, scope, "a subscript")
+            except FlattenError as err:  # not a parameter expression: maybe run time
+                raise _UnknownIndex(err) from None
         values = list(v.flat) if isinstance(v, np.ndarray) else [v]
         if kind is not None or any(value_kind(i) is not None for i in values):
             values = [typed_index(i, kind, sub.span, part.name) for i in values]
@@ -230,6 +232,17 @@ def _loop_context(scope: Scope) -> str:
                   and not isinstance(v.value, bool)] + values
         scope = scope.parent
     return f" (with {', '.join(values)})" if values else ""
+
+
+class _UnknownIndex(Exception):
+    """A subscript with no value while flattening (``error`` says why): a run-time
+    subscript where it is an Integer variable, else ``error``. A subscript whose value
+    is known and out of range is its own error, never a run-time subscript (an
+    unselected if-branch's index is left to the branch's pruning)."""
+
+    def __init__(self, error: FlattenError) -> None:
+        super().__init__(error.message)
+        self.error = error
 
 
 class _RunTimeIndex:
