@@ -5,6 +5,7 @@ solvers, the API attribute, the deprecated ``error_estimate`` and the CSV side f
 from __future__ import annotations
 
 import csv
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
@@ -68,6 +69,28 @@ def test_richardson_estimate_of_the_fixed_step_solvers(solver: str, step: float)
     true = true_relative_error(result, reference("seed"))
     assert 1 / 3 <= estimate.error / true.max() <= 3
 
+
+@dataclass
+class _Blocks:
+    """A deferred result's outputs, read ``rows`` rows at a time."""
+
+    values: np.ndarray
+    rows: int
+
+    def blocks(self):
+        for begin in range(0, len(self.values), self.rows):
+            yield self.values[begin:begin + self.rows]
+
+
+@dataclass
+class _Run:
+    """What :func:`error_estimate.compare` reads of a run."""
+
+    time: np.ndarray
+    names: tuple[str, ...]
+    values: np.ndarray
+    events: tuple[()] = ()
+    deferred: _Blocks | None = None
 
 def test_api_attribute_summary_and_off() -> None:
     on = springc.simulate(model("seed"), solver="dop853", error_control="warn")
@@ -168,16 +191,7 @@ def test_the_estimate_compares_a_few_columns_at_a_time(
     """The differences of two runs are taken COLUMNS_PER_PASS columns at a time (a large
     scene never holds a copy of both runs): the same largest errors, their rows and the
     scales as the whole arrays at once, the companion's columns in the run's order."""
-    from dataclasses import dataclass
-
     from springc.simulation import error_estimate
-
-    @dataclass
-    class Run:
-        time: np.ndarray
-        names: tuple[str, ...]
-        values: np.ndarray
-        events: tuple[()] = ()
 
     rng = np.random.default_rng(7)
     grid = np.linspace(0.0, 1.0, 6)
@@ -185,8 +199,8 @@ def test_the_estimate_compares_a_few_columns_at_a_time(
     theirs = rng.normal(size=(6, 5))
     names = ("a", "b", "c", "d", "e")
     order = [3, 0, 4, 1, 2]  # the companion's columns: d a e b c
-    run = Run(grid, names, ours)
-    companion = Run(grid, tuple(names[j] for j in order), theirs[:, order])
+    run = _Run(grid, names, ours)
+    companion = _Run(grid, tuple(names[j] for j in order), theirs[:, order])
     monkeypatch.setattr(error_estimate, "COLUMNS_PER_PASS", 2)
     estimate = error_estimate.compare(run, companion, grid, "test", 2.0, 0.0)
     error = np.abs((ours - theirs) * 2.0)
@@ -201,26 +215,7 @@ def test_a_deferred_companion_is_compared_block_by_block(
     """A companion whose outputs are read block by block (``deferred``: error control's
     companion of a large scene) gives the estimate of its whole array, bit for bit:
     ties keep the first row, a NaN wins as ``max`` and ``argmax`` take it."""
-    from dataclasses import dataclass
-
     from springc.simulation import error_estimate
-
-    @dataclass
-    class Blocks:
-        values: np.ndarray
-        rows: int
-
-        def blocks(self):
-            for begin in range(0, len(self.values), self.rows):
-                yield self.values[begin:begin + self.rows]
-
-    @dataclass
-    class Run:
-        time: np.ndarray
-        names: tuple[str, ...]
-        values: np.ndarray
-        events: tuple[()] = ()
-        deferred: Blocks | None = None
 
     grid = np.linspace(0.0, 1.0, 9)
     ours = np.zeros((9, 4))
@@ -230,12 +225,12 @@ def test_a_deferred_companion_is_compared_block_by_block(
     theirs[[3, 5], 2] = [2.0, np.nan]  # NaN after a larger value: NaN, at row 5
     ours[:, 3] = np.arange(9.0)
     names = ("a", "b", "c", "d")
-    whole = error_estimate.compare(Run(grid, names, ours), Run(grid, names, theirs),
+    whole = error_estimate.compare(_Run(grid, names, ours), _Run(grid, names, theirs),
                                    grid, "test", 2.0, 0.0)
     for rows in (1, 2, 4, 9):
         streamed = error_estimate.compare(
-            Run(grid, names, ours),
-            Run(grid, names, theirs[:, :0], deferred=Blocks(theirs, rows)), grid, "test",
+            _Run(grid, names, ours),
+            _Run(grid, names, theirs[:, :0], deferred=_Blocks(theirs, rows)), grid, "test",
             2.0, 0.0)
         for field in ("absolute", "relative", "times", "scales"):
             np.testing.assert_array_equal(getattr(streamed, field), getattr(whole, field))

@@ -155,24 +155,26 @@ def _has_jump(body: tuple[s.Statement, ...]) -> bool:
 
 def _returns(body: tuple[s.Statement, ...]) -> bool:
     """Whether ``body`` holds a ``return``, at any depth."""
-    for st in body:
-        if isinstance(st, s.Jump) and st.kind == "return":
-            return True
-        if isinstance(st, s.IfStatement) and (
-                any(_returns(b) for _c, b in st.branches) or _returns(st.otherwise)):
-            return True
-        if isinstance(st, (s.ForStatement, s.WhileStatement)) and _returns(st.body):
-            return True
-    return False
+    return _holds(body, "return", into_loops=True)
 
 
 def _breaks(body: tuple[s.Statement, ...]) -> bool:
     """Whether ``body`` holds a ``break`` of its own loop (not of a loop inside)."""
+    return _holds(body, "break", into_loops=False)
+
+
+def _holds(body: tuple[s.Statement, ...], kind: str, into_loops: bool) -> bool:
+    """Whether ``body`` holds a jump of ``kind``, inside if-statements and, where
+    ``into_loops``, inside the loops it holds."""
     for st in body:
-        if isinstance(st, s.Jump) and st.kind == "break":
+        if isinstance(st, s.Jump) and st.kind == kind:
             return True
         if isinstance(st, s.IfStatement) and (
-                any(_breaks(b) for _c, b in st.branches) or _breaks(st.otherwise)):
+                any(_holds(b, kind, into_loops) for _c, b in st.branches)
+                or _holds(st.otherwise, kind, into_loops)):
+            return True
+        if into_loops and isinstance(st, (s.ForStatement, s.WhileStatement)) \
+                and _holds(st.body, kind, into_loops):
             return True
     return False
 
