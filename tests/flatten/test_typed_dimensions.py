@@ -216,3 +216,20 @@ def test_enumeration_and_boolean_dimensions_simulate() -> None:
     assert np.max(np.abs(r["y[2]"] - t)) < 1e-12
     assert np.max(np.abs(r["z[2,3]"] - (6 + np.exp(-t)))) < 1e-8
     assert np.max(np.abs(r["z[1,1]"] - 1)) < 1e-12
+
+
+def test_an_enumeration_value_survives_pickling() -> None:
+    """A cache entry holding ``E.b`` (a flat constant, a RunSystem) loads back as ``E.b``:
+    int's own pickling called ``EnumLiteral(2)`` and failed ("missing 'ordinal'")."""
+    import copy
+    import pickle
+
+    from springc.flatten.scopes import Enumeration, EnumLiteral, literal_value
+
+    colour = Enumeration("M.Colour", ("red", "green", "blue"))
+    const = literal_value(colour, 2)
+    for again in (pickle.loads(pickle.dumps(const, protocol=pickle.HIGHEST_PROTOCOL)),
+                  pickle.loads(pickle.dumps(const, protocol=2)), copy.deepcopy(const)):
+        value = again.value
+        assert type(value) is EnumLiteral
+        assert (int(value), value.enumeration, value.literal) == (2, colour, "green")

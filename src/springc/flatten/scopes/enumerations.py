@@ -42,6 +42,10 @@ class EnumLiteral(int):
         value.enumeration = enumeration
         return value
 
+    def __reduce__(self) -> tuple[type[EnumLiteral], tuple[Enumeration, int]]:
+        # int's pickling would call ``EnumLiteral(ordinal)`` and lose the type
+        return EnumLiteral, (self.enumeration, int(self))
+
     @property
     def literal(self) -> str:
         return self.enumeration.literals[int(self) - 1]
