@@ -182,3 +182,26 @@ def atomic_write(path: PathLike, mode: str, protected: Iterable[PathLike] = ()
     """Write ``path`` through a temporary file next to it; rename only on success."""
     with OutputSet(protected) as outputs, outputs.open(path, mode) as f:
         yield f
+
+
+def replace_private(target: PathLike, data: bytes) -> None:
+    """Write ``data`` as ``target``, a file of one of springc's private cache folders:
+    through a temporary file beside it (``.NAME.XXXXXXXX.part``, created exclusively,
+    never through a link, mode 0600) renamed over ``target`` once complete, so that a
+    reader sees the old file or the new one; on any error, ``KeyboardInterrupt`` or
+    ``SystemExit`` the temporary file is removed and the error raised (``OSError``
+    where writing failed). The one temp-and-rename writer of the cache's entries and
+    run records (outputs the user names go through :class:`OutputSet`, which checks
+    the target)."""
+    path = Path(target)
+    temporary = path.parent / f".{path.name}.{secrets.token_hex(4)}.part"
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    fd = os.open(temporary, flags, 0o600)
+    try:
+        with os.fdopen(fd, "wb") as out:
+            out.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise

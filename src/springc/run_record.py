@@ -39,6 +39,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeGuard
 
+from .fileio import replace_private
 from .parse import key_sources  # the face and its library walk: no parser, no lark
 from .resources import PACKAGE_ROOT, CacheUnusable, grammar_path, private_folder, user_cache_dir
 
@@ -124,18 +125,8 @@ def write(key: str, content: Mapping[str, Any]) -> Path | None:
         if records is None:
             return None
         target = records / f"{key}.json"
-        import tempfile  # writing only: the warm path reads
-
         text = json.dumps({"format": FORMAT, "key": key, **content})
-        fd, temporary = tempfile.mkstemp(dir=records, prefix=".new-", suffix=".part")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
-            os.replace(temporary, target)
-        except BaseException:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
-            raise
+        replace_private(target, text.encode("utf-8"))
         prune(records)
         return target
     except OSError:

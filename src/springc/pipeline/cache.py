@@ -35,6 +35,7 @@ from types import ModuleType
 from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
+from ..fileio import replace_private
 from ..parse import key_sources
 from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, user_cache_dir
 
@@ -199,15 +200,7 @@ def add_to_entry(entry: Path, name: str, data: bytes) -> Path:
     for target, content in ((entry / _hash_file(name),
                              (hashlib.sha256(data).hexdigest() + "\n").encode("ascii")),
                             (entry / name, data)):
-        fd, temporary = tempfile.mkstemp(dir=entry, prefix=".new-")  # created 0600
-        try:
-            with os.fdopen(fd, "wb") as out:
-                out.write(content)
-            os.replace(temporary, target)
-        except OSError:
-            with contextlib.suppress(OSError):
-                os.unlink(temporary)
-            raise
+        replace_private(target, content)
     return entry / name
 
 
