@@ -5,6 +5,8 @@ sweep's worker, a notebook) parses each library file once. The cache is bounded:
 keeps the most recently used files up to :data:`MAX_SOURCE_BYTES` of source text
 (a tree takes some tens of times its text in memory), one entry per path (a changed
 file replaces its old tree), and forgets the least recently used ones beyond that.
+Below it, :mod:`.parsed_store` keeps the trees on disk for the next process: a file
+found there is not parsed (nor is lark imported for it).
 """
 
 from __future__ import annotations
@@ -12,8 +14,9 @@ from __future__ import annotations
 from collections import OrderedDict
 from pathlib import Path
 
+from ..errors import LoadError
 from ..ir import syntax as s
-from .parser import parse_file
+from .parsed_store import ParsedStore
 
 MAX_SOURCE_BYTES = 32 << 20
 """Source text whose trees the shared cache keeps (32 MiB: the files of the Modelica
@@ -25,8 +28,10 @@ class ParseCache:
     those it was parsed at; least recently used first out beyond ``max_bytes`` of
     source text (a single larger file is parsed and not kept)."""
 
-    def __init__(self, max_bytes: int = MAX_SOURCE_BYTES) -> None:
+    def __init__(self, max_bytes: int = MAX_SOURCE_BYTES,
+                 store: ParsedStore | None = None) -> None:
         self.max_bytes = max_bytes
+        self.store = store
         self.size = 0  # source bytes of the files kept
         self._trees: OrderedDict[str, tuple[tuple[int, int], s.StoredDefinition]] = \
             OrderedDict()
@@ -39,19 +44,40 @@ class ParseCache:
         try:
             stat = path.stat()
         except OSError:
-            return parse_file(path, defer=True)
+            return self._read(path)  # the error names the file
         name, version = str(path), (stat.st_mtime_ns, stat.st_size)
         found = self._trees.get(name)
         if found is not None and found[0] == version:
             self._trees.move_to_end(name)
             return found[1]
-        stored = parse_file(path, defer=True)
+        stored = self._read(path)
         self._forget(name)
         if stat.st_size <= self.max_bytes:
             self._trees[name] = (version, stored)
             self.size += stat.st_size
             while self.size > self.max_bytes:
                 self._forget(next(iter(self._trees)))
+        return stored
+
+    def _read(self, path: Path) -> s.StoredDefinition:
+        """The tree of ``path``: from the store where it holds the file's bytes, else
+        parsed (and stored)."""
+        try:
+            data = path.read_bytes()
+            text = data.decode("utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise LoadError(f"cannot read '{path}': {exc}") from None
+        if self.store is not None:
+            found = self.store.load(path, data)
+            if found is not None:
+                return found
+        from .parser import parse_text  # lark: only for a file the store lacks
+
+        # the newlines of a file read as text (Path.read_text), as spans count them
+        stored = parse_text(text.replace("\r\n", "\n").replace("\r", "\n"), str(path),
+                            defer=True)
+        if self.store is not None:
+            self.store.save(path, data, stored)
         return stored
 
     def clear(self) -> None:
@@ -65,8 +91,9 @@ class ParseCache:
             self.size -= found[0][1]
 
 
-SHARED = ParseCache()
-"""The cache of this process, used by :func:`parse_cached`."""
+SHARED = ParseCache(store=ParsedStore())
+"""The cache of this process, used by :func:`parse_cached`, over the trees of the user's
+cache folder."""
 
 
 def parse_cached(path: Path) -> s.StoredDefinition:
