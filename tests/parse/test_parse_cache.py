@@ -4,9 +4,15 @@ recently used first out beyond its size in source bytes, one entry per path."""
 from __future__ import annotations
 
 import os
+import stat
 from pathlib import Path
 
+import pytest
+
+from springc.errors import LoadError
+from springc.parse import parser
 from springc.parse.parse_cache import ParseCache
+from springc.parse.parsed_store import ParsedStore
 
 
 def _file(folder: Path, name: str, size: int) -> Path:
@@ -57,3 +63,73 @@ def test_a_file_larger_than_the_cache_is_parsed_and_not_kept(tmp_path: Path) -> 
     a = _file(tmp_path, "A", 100)
     assert cache.parse(a).classes[0].name == "A"
     assert (len(cache), cache.size) == (0, 0)
+
+
+# ------------------------------------------------------------ the trees kept on disk
+
+
+def _fresh(store_folder: Path) -> ParseCache:
+    """A cache of a new process: nothing in memory, the store on disk."""
+    return ParseCache(store=ParsedStore(store_folder))
+
+
+def _no_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("parsed again")
+
+    monkeypatch.setattr(parser, "parse_text", refuse)
+
+
+def test_a_file_parsed_by_one_process_is_read_back_by_the_next(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    a = tmp_path / "A.mo"
+    a.write_text("model A\n  expandable connector Bus\n  end Bus;\n  Real x(start = 1);\n"
+                 "equation\n  der(x) = -x;\nend A;\n")
+    first = _fresh(tmp_path / "store").parse(a)
+    entries = os.listdir(tmp_path / "store")
+    assert len(entries) == 1 and entries[0].endswith(".pickle")
+    assert stat.S_IMODE((tmp_path / "store" / entries[0]).stat().st_mode) == 0o600
+    _no_parsing(monkeypatch)
+    again = _fresh(tmp_path / "store").parse(a)
+    assert again is not first
+    assert again.classes[0].elements[1:] == first.classes[0].elements[1:]
+    assert again.classes[0].equations == first.classes[0].equations
+    # the construct outside the subset is reported as before, where it was written
+    bus = again.classes[0].elements[0]
+    assert [str(e) for e in bus.unsupported] == [str(e) for e in
+                                                  first.classes[0].elements[0].unsupported]
+    assert str(bus.unsupported[0]).startswith(
+        f"{a}:2:3: error: `expandable` connectors are not supported yet")
+
+
+def test_a_changed_file_or_a_damaged_entry_is_parsed_again(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    a = _file(tmp_path, "A", 100)
+    _fresh(tmp_path / "store").parse(a)
+    a.write_text("model A\n  Real y;\nend A;\n")  # same size class, other bytes
+    changed = _fresh(tmp_path / "store").parse(a)
+    assert [c.name for c in changed.classes[0].elements] == ["y"]
+    assert len(os.listdir(tmp_path / "store")) == 2
+    for entry in (tmp_path / "store").iterdir():
+        entry.write_bytes(b"not a pickle")
+    assert [c.name for c in _fresh(tmp_path / "store").parse(a).classes[0].elements] \
+        == ["y"]
+    _no_parsing(monkeypatch)  # the damaged entry was replaced
+    assert [c.name for c in _fresh(tmp_path / "store").parse(a).classes[0].elements] \
+        == ["y"]
+
+
+def test_windows_newlines_and_unreadable_bytes_read_as_from_text(tmp_path: Path) -> None:
+    a = tmp_path / "A.mo"
+    a.write_bytes(b"model A\r\n  Real x;\r\n  Real z;\r\nend A;\r\n")
+    tree = _fresh(tmp_path / "store").parse(a)
+    assert [(c.name, c.span.line, c.span.column) for c in tree.classes[0].elements] == [
+        ("x", 2, 8), ("z", 3, 8)]
+    assert tree == parser.parse_file(a, defer=True)  # Path.read_text's newlines
+    b = tmp_path / "B.mo"
+    b.write_bytes(b"model B\n  Real \xff;\nend B;\n")
+    with pytest.raises(LoadError) as caught:
+        _fresh(tmp_path / "store").parse(b)
+    assert caught.value.message == (
+        f"cannot read '{b}': 'utf-8' codec can't decode byte 0xff in position 15: "
+        "invalid start byte")
