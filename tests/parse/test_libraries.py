@@ -373,3 +373,41 @@ def test_a_top_level_class_hiding_another_gets_a_note(tmp_path: Path) -> None:
     assert flat.notes == (
         f"note: the top-level class 'Modelica' is taken from {lib / 'mine.mdl'}; it hides "
         f"{models_dir() / 'Modelica' / 'package.mo'} (the bundled models)",)
+
+
+MSL_LIKE = {
+    # the layout of the Modelica Standard Library as distributed: a package folder
+    "Modelica/package.mo": "within;\npackage Modelica\n  extends Modelica.Icons.Package;\n"
+                           "end Modelica;\n",
+    "Modelica/package.order": "Icons\nBlocks\nMechanics\n",
+    "Modelica/Icons.mo": "within Modelica;\npackage Icons\n  partial package Package\n"
+                         "  end Package;\nend Icons;\n",
+    "Modelica/Blocks/package.mo": "within Modelica;\npackage Blocks\n"
+                                  "  this is not Modelica;\nend Blocks;\n",
+    "Modelica/Mechanics/package.mo": "within Modelica;\npackage Mechanics\n"
+                                     "  constant Real k = 7;\nend Mechanics;\n",
+}
+
+
+@pytest.mark.parametrize("how", ["-L", "MODELICAPATH"])
+def test_the_real_library_on_the_path_takes_precedence_over_the_bundled_one(
+        tmp_path: Path, how: str) -> None:
+    """The MSL (a ``Modelica`` folder) on ``-L`` or ``MODELICAPATH`` is used instead of
+    the bundled ``Modelica``, with a note naming both; read lazily: the file of a
+    package the model does not use (here one that does not even parse) is not read."""
+    from click.testing import CliRunner
+
+    from springc.cli import main
+    from springc.resources import models_dir
+
+    lib = write(tmp_path / "lib", MSL_LIKE)
+    user = write(tmp_path, {"m.mo": "model M\n  Real a = Modelica.Mechanics.k;\nend M;\n"})
+    options = ["-L", str(lib)] if how == "-L" else []
+    result = CliRunner().invoke(
+        main, ["check", *options, str(user / "m.mo")], prog_name="springc",
+        env={"SPRINGC_PATH": "", "MODELICAPATH": str(lib) if how != "-L" else ""})
+    assert (result.exit_code, result.output) == (0, (
+        f"note: the top-level class 'Modelica' is taken from "
+        f"{lib / 'Modelica' / 'package.mo'}; it hides "
+        f"{models_dir() / 'Modelica' / 'package.mo'} (the bundled models)\n"
+        "M: 1 unknown, 1 equation, 0 parameters: balanced\n"))
