@@ -205,3 +205,24 @@ def test_augmenting_path_flips_the_path_and_reports_what_it_visited() -> None:
     blocked = augmenting_path(0, neighbours.__getitem__, lambda r: mate.get(r, UNMATCHED),
                               usable=lambda r: r != 1)
     assert blocked.pairs == () and blocked.left == (0, 1) and blocked.right == (0,)
+
+
+def test_perfectly_matchable_agrees_with_the_maximum_matching() -> None:
+    """The Python search of the balance check against scipy's Hopcroft-Karp on 300
+    random square incidences (dense enough that about half have a perfect matching),
+    and two closed cases: a chain (matchable) and two equations in one variable."""
+    from springc.structure import perfectly_matchable
+
+    rng = np.random.default_rng(7)
+    answers = []
+    for _ in range(300):
+        n = int(rng.integers(1, 30))
+        rows = [sorted(set(rng.integers(0, n, size=int(rng.integers(1, 5))).tolist()))
+                for _ in range(n)]
+        expected = maximum_matching(rows, n).is_perfect
+        assert perfectly_matchable(rows, n) is expected
+        answers.append(expected)
+    assert 60 < sum(answers) < 240
+    assert perfectly_matchable([[0, 1], [1, 2], [2]], 3) is True
+    assert perfectly_matchable([[0], [0], [1, 2]], 3) is False
+    assert perfectly_matchable([[0, 1]], 2) is False  # not square

@@ -11,7 +11,6 @@ from ..ir import syntax as s
 from .library import is_package_file, library_roots
 from .loader import ClassTree
 from .parse_cache import parse_cached
-from .parser import parse_text
 
 
 def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
@@ -45,6 +44,8 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
         except SpringcError as error:
             errors.append(error)
     for text_name, text in texts:
+        from .parser import parse_text  # lark: the files may all come from the store
+
         try:  # its spans carry the text, for the excerpts of their errors
             parsed.append((parse_text(text, SourceName(text_name, text), defer=True), None))
         except ErrorGroup as group:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from ..errors import BalanceError, Note
 from ..ir import dae, flat
 from ..ir import expr as x
-from ..structure import dulmage_mendelsohn, maximum_matching
+from ..structure import dulmage_mendelsohn, maximum_matching, perfectly_matchable
 from .events import continuous_part
 
 MAX_NOTES = 20
@@ -86,14 +86,13 @@ def check_balance(model: flat.FlatModel, rows: Sequence[Sequence[int]] | None = 
     model = continuous_part(model)
     unknowns = model.unknowns
     rows = [list(r) for r in rows] if rows is not None else incidence(model)
-    matching = maximum_matching(rows, len(unknowns))
     n_eq, n_var = len(model.equations), len(unknowns)
-    if n_eq == n_var and matching.is_perfect:
+    if n_eq == n_var and perfectly_matchable(rows, n_var):
         held = len(full.unknowns) - n_var
         discrete = sum(1 for v in full.unknowns if v.variability == "discrete")
         return Balance(model.name, n_var + held, n_eq + held, *count_parameters(model),
                        discrete=max(discrete, held), when_equations=held)
-    parts = dulmage_mendelsohn(rows, n_var, matching)
+    parts = dulmage_mendelsohn(rows, n_var, maximum_matching(rows, n_var))
     notes: list[Note] = []
     for eqs, var_ids in _blocks(rows, parts.under_equations, parts.under_variables):
         names = _names(unknowns, var_ids)

@@ -13,7 +13,14 @@ from .dummy import (
 )
 from .graph import Incidence, biadjacency, to_incidence, transpose
 from .index import IndexReduction, StructurallySingular, pantelides
-from .matching import DMParts, Matching, dulmage_mendelsohn, maximum_matching, validate_matching
+from .matching import (
+    DMParts,
+    Matching,
+    dulmage_mendelsohn,
+    maximum_matching,
+    perfectly_matchable,
+    validate_matching,
+)
 from .sorting import blt
 from .tearing import Tearing, tear
 
@@ -33,6 +40,7 @@ __all__ = [
     "kept_by_preference",
     "maximum_matching",
     "pantelides",
+    "perfectly_matchable",
     "state_priority",
     "tear",
     "to_incidence",

@@ -12,9 +12,12 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_matrix
+
+if TYPE_CHECKING:
+    from scipy.sparse import csr_matrix
 
 Incidence = Sequence[Sequence[int]]
 """For each equation, the indices of the variables it contains."""
@@ -37,6 +40,8 @@ def biadjacency(incidence: Incidence, n_var: int) -> csr_matrix:
         bad = int(indices[(indices < 0) | (indices >= n_var)][0])
         raise ValueError(f"variable index {bad} outside 0..{n_var - 1}")
     data = np.ones(nnz, dtype=np.int8)
+    from scipy.sparse import csr_matrix  # scipy when a graph is built: a check never needs it
+
     matrix = csr_matrix((data, indices, indptr), shape=(n_eq, n_var))
     matrix.sum_duplicates()
     matrix.data[:] = 1

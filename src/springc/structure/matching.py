@@ -13,10 +13,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import breadth_first_order, maximum_bipartite_matching
+
+if TYPE_CHECKING:
+    from scipy.sparse import csr_matrix
 
 from .graph import Incidence, biadjacency
 
@@ -81,11 +83,36 @@ def maximum_matching(incidence: Incidence, n_var: int) -> Matching:
     graph = biadjacency(incidence, n_var)
     if graph.shape[0] == 0 or n_var == 0:
         return Matching((UNMATCHED,) * graph.shape[0], (UNMATCHED,) * n_var)
+    from scipy.sparse.csgraph import maximum_bipartite_matching
+
     eq_to_var = maximum_bipartite_matching(graph, perm_type="column")
     var_to_eq = np.full(n_var, UNMATCHED, dtype=np.int64)
     matched = np.flatnonzero(eq_to_var >= 0)
     var_to_eq[eq_to_var[matched]] = matched
     return Matching(tuple(eq_to_var.tolist()), tuple(var_to_eq.tolist()))
+
+
+SMALL = 5000
+"""Equations up to which :func:`perfectly_matchable` searches in Python."""
+
+
+def perfectly_matchable(incidence: Incidence, n_var: int) -> bool:
+    """Whether each equation can be matched to a variable of its own, every variable
+    matched: by augmenting paths in Python for up to :data:`SMALL` equations (the
+    balance check of a model that size never imports scipy), else by
+    :func:`maximum_matching`."""
+    if len(incidence) != n_var:
+        return False
+    if n_var > SMALL:
+        return maximum_matching(incidence, n_var).is_perfect
+    mate = [UNMATCHED] * n_var
+    for eq in range(len(incidence)):
+        found = augmenting_path(eq, incidence.__getitem__, mate.__getitem__)
+        if not found.pairs:
+            return False
+        for left, right in found.pairs:
+            mate[right] = left
+    return True
 
 
 @dataclass(frozen=True, slots=True)
@@ -219,6 +246,9 @@ def _alternating_reach(graph: csr_matrix, col_to_row: np.ndarray, starts: np.nda
     keep = targets >= 0
     src = np.concatenate([rows[keep], np.full(starts.size, n_rows)])
     dst = np.concatenate([targets[keep], starts])
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import breadth_first_order
+
     walk = csr_matrix((np.ones(src.size), (src, dst)), shape=(n_rows + 1, n_rows + 1))
     reached = breadth_first_order(walk, n_rows, directed=True, return_predecessors=False)
     return np.sort(reached[reached != n_rows])

@@ -14,10 +14,12 @@ topological sort of the condensation, O(n_blocks log n_blocks + nnz).
 from __future__ import annotations
 
 import heapq
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
+
+if TYPE_CHECKING:
+    from scipy.sparse import csr_matrix
 
 from .graph import Incidence, biadjacency
 from .matching import Matching, validate_matching
@@ -61,6 +63,9 @@ def blt(incidence: Incidence, matching: Matching) -> tuple[Block, ...]:
 def _strong_components(graph: csr_matrix, var_to_eq: np.ndarray) -> np.ndarray:
     """Label each equation with its strongly connected component in the dependency graph."""
     n_eq = graph.shape[0]
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
     dependency = csr_matrix(
         (np.ones(graph.nnz), var_to_eq[graph.indices], graph.indptr), shape=(n_eq, n_eq)
     )
