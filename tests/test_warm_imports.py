@@ -134,3 +134,38 @@ def test_a_replayed_simulate_imports_neither_numpy_nor_click(
     with out.open(newline="") as f:
         rows = list(csv.reader(f))
     assert [float(v) for v in rows[1][:5]] == [0.0, 1.0, -1.0, 0.0, 0.0]  # the start values
+
+
+WARM_CHECK = """
+import sys
+from springc.cli import main
+main(["check", "-L", sys.argv[1], sys.argv[2], "-q"], standalone_mode=False)
+print("\\n".join(sorted(sys.modules)))
+"""
+
+
+def test_a_warm_check_parses_nothing_and_imports_no_scipy(tmp_path: Path) -> None:
+    """A check whose files a first check parsed reads their trees from the cache
+    (``parse.parsed_store``): neither lark nor the parser load, and the balance check of
+    a small model needs no scipy (issue 25: a warm check of an MSL example)."""
+    lib = tmp_path / "lib" / "Lib"
+    lib.mkdir(parents=True)
+    (lib / "package.mo").write_text(
+        "within;\npackage Lib\n  model Decay\n    parameter Real k = 2;\n"
+        "    Real x(start = 1);\n  equation\n    der(x) = -k * x;\n  end Decay;\nend Lib;\n")
+    user = tmp_path / "m.mo"
+    user.write_text("model M\n  Lib.Decay d;\n  Real y = d.x;\nend M;\n")
+    paths = [str(ROOT / "src"), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+    env = {**os.environ, "SPRINGC_CACHE_DIR": str(tmp_path / "cache"),
+           "PYTHONPATH": os.pathsep.join(paths)}
+    runs = [subprocess.run([sys.executable, "-c", WARM_CHECK, str(tmp_path / "lib"),
+                            str(user)], env=env, capture_output=True, text=True,
+                           timeout=600, check=False) for _ in range(2)]
+    assert [r.returncode for r in runs] == [0, 0], runs[1].stderr
+    assert runs[1].stdout.split("\n")[0] == \
+        "M: 2 unknowns, 2 equations, 1 parameter: balanced"
+    cold, warm = (set(r.stdout.split("\n")[1:]) for r in runs)
+    assert "springc.parse.parser" in cold
+    assert [m for m in sorted(warm) if m == "lark" or m.startswith("lark.")
+            or m == "springc.parse.parser" or m.startswith("scipy")] == []
+    assert len(os.listdir(tmp_path / "cache" / "parsed")) == 2
