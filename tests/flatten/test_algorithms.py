@@ -305,3 +305,41 @@ end M;
 """)
     assert asserts(m) == [("if x > 1 then x - 1 > 0 else true", "u must be positive",
                            "error")]
+
+
+def test_a_fixed_false_parameter_assigned_or_tested_in_an_initial_algorithm(
+        tmp_path: Path) -> None:
+    """``Electrical.Analog.Sources.DCPowerSupply``: an initial algorithm computes
+    ``fixed = false`` parameters (section 8.6) and an if-equation tests one. Both are
+    located errors naming the missing feature (not "cannot be assigned: it is a
+    parameter", not a hint about events)."""
+    path = tmp_path / "m.mo"
+    path.write_text("""model M
+  parameter Real v0 = 2;
+  parameter Real lim(fixed = false);
+  parameter Boolean big(fixed = false);
+  Real y;
+initial algorithm
+  lim := 2 * v0;
+  big := lim > 3;
+equation
+  if big then
+    y = lim;
+  else
+    y = v0;
+  end if;
+end M;
+""")
+    with pytest.raises((SpringcError, ErrorGroup)) as info:
+        flatten_files([path], None)
+    assert [str(e) for e in errors_of(info.value)] == [
+        f"{path}:10:6: error: the condition of an if-equation must be a parameter "
+        "expression, but it depends on the parameter 'big', which has no value\n"
+        "   10 |   if big then\n      |      ^^^\n"
+        "help: an if-equation's branches are chosen while flattening: a condition on a "
+        "parameter the initialization computes (`fixed = false`) is not supported yet; "
+        "give the parameter a binding, or write one equation with an if-expression",
+        f"{path}:7:3: error: assigning the parameter 'lim' in an initial algorithm is not "
+        "supported yet\n    7 |   lim := 2 * v0;\n      |   ^^^\n"
+        "help: compute a `fixed = false` parameter by an initial equation instead "
+        "(Modelica 3.6, section 8.6)"]

@@ -31,6 +31,11 @@ from .events import (
 from .redeclare import record_equation
 from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
+NO_VALUE_HINT = ("an if-equation's branches are chosen while flattening: a condition on a "
+                 "parameter the initialization computes (`fixed = false`) is not supported "
+                 "yet; give the parameter a binding, or write one equation with an "
+                 "if-expression")
+
 
 class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
@@ -137,6 +142,10 @@ class EquationFlattening(FlattenContext):
                 "switching equations on a variable needs events, which are not supported "
                 "yet; for a continuous switch write one equation with an if-expression "
                 "inside noEvent(...)")
+        except FlattenError as err:
+            if not err.message.endswith("which has no value"):
+                raise
+            raise FlattenError(err.message, err.span, hint=NO_VALUE_HINT) from None
         finally:
             self.evaluator.no_event -= 1
         check_boolean_condition(value, cond.span, "the condition of an if-equation")

@@ -192,6 +192,12 @@ class _Run:
                                    "only during the simulation is not supported yet",
                                    target.span, hint="subscripts of an assigned variable "
                                    "must be parameter expressions or for-loop indices")
+            if self.initial and isinstance(name, x.Var) and \
+                    self.fl.parameter_values.bindings.get(name.name, 0) is None:
+                raise FlattenError(f"assigning the parameter '{target.dotted}' in an "
+                                   "initial algorithm is not supported yet", target.span,
+                                   hint="compute a `fixed = false` parameter by an initial "
+                                   "equation instead (Modelica 3.6, section 8.6)")
             if not isinstance(name, x.Var) or name.name in self.fl.parameter_values.bindings:
                 raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
                                    "parameter or constant", target.span,
