@@ -66,17 +66,25 @@ MAX_INTEGER_EXPONENT = 4096
 
 def check_powers(e: x.Expr, values: Mapping[str, Any]) -> None:
     """Raise OverflowError for an integer power in ``e`` whose exact value would be huge;
-    inner powers are checked before the operands that contain them are evaluated."""
-    if not isinstance(e, x.BinOp) or e.op != "^":
-        for child in x.children(e):
-            check_powers(child, values)
-        return
-    check_powers(e.left, values)
-    check_powers(e.right, values)
-    base, exponent = x.evaluate(e.left, values), x.evaluate(e.right, values)
-    if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
-            and abs(exponent) > MAX_INTEGER_EXPONENT:
-        raise OverflowError(f"{base} ^ {exponent} is too large")
+    inner powers are checked before the operands that contain them are evaluated. A
+    node shared by several parents is visited once (the values a function's loop
+    builds share their sub-expressions: walking them as trees took 160 s for
+    ``Blocks.Examples.Filter``)."""
+    seen: set[int] = set()
+
+    def visit(node: x.Expr) -> None:
+        if id(node) in seen:
+            return
+        seen.add(id(node))
+        for child in x.children(node):
+            visit(child)
+        if isinstance(node, x.BinOp) and node.op == "^":
+            base, exponent = x.evaluate(node.left, values), x.evaluate(node.right, values)
+            if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
+                    and abs(exponent) > MAX_INTEGER_EXPONENT:
+                raise OverflowError(f"{base} ^ {exponent} is too large")
+
+    visit(e)
 
 
 def binding_errors(variables: Iterable[flat.Variable], values: ParameterValues
