@@ -196,3 +196,40 @@ def test_final_record_bound_to_a_function(tmp_path: Path) -> None:
 """)
     assert equations(m) == ["h.R.T[1,1] = 1.0", "h.R.T[1,2] = 0.0", "h.R.T[2,1] = -0.0",
                             "h.R.T[2,2] = 1.0", "h.R.w = 2"]
+
+
+def test_a_redeclared_function_keeps_the_values_its_redeclaration_gives(
+        tmp_path: Path) -> None:
+    """``world(redeclare function gravityAcceleration = g(phi = lat))`` and a call
+    ``world.gravityAcceleration(r)`` (MultiBody's UserDefinedGravityField): ``phi`` takes
+    the value the redeclaration gives, evaluated where it is written (was "input 'phi' is
+    missing in this call")."""
+    path = tmp_path / "m.mo"
+    path.write_text("""package P
+  function constant_g
+    input Real r;
+    output Real g;
+  algorithm
+    g := 2;
+  end constant_g;
+  function latitude_g
+    input Real r;
+    input Real phi;
+    output Real g;
+  algorithm
+    g := r * phi;
+  end latitude_g;
+  model World
+    replaceable function gravityAcceleration = constant_g;
+  end World;
+  model M
+    parameter Real lat = 3;
+    World world(redeclare function gravityAcceleration = latitude_g(phi = lat));
+    World plain;
+    Real z = world.gravityAcceleration(5);
+    Real w = plain.gravityAcceleration(5);
+  end M;
+end P;
+""")
+    m = flatten_files([path], "P.M")
+    assert equations(m) == ["z = 5 * lat", "w = 2"]
