@@ -32,9 +32,6 @@ if TYPE_CHECKING:
 
 IMPLICIT = ("radau", "bdf")
 """The implicit methods of the C loop (they take the band ordering)."""
-DENSE_LIMIT = 64
-"""The most states whose Newton matrices the implicit methods factorise dense (the
-default ``dense_limit`` of :func:`springc.integrate.radau`; ``SI_DENSE_LIMIT`` in C)."""
 
 
 def advance_native(loop: StepLoop, stepper: Stepper, max_steps: int | None = None
@@ -69,17 +66,12 @@ def library(problem: Problem) -> LoopLibrary:
 
 
 def band_order(module: Any) -> list[int] | None:
-    """The ordering of the states in the implicit methods' band LU: the numba loops'
-    (:func:`springc.integrate.ordering.band_layout` of the generated module's Jacobian
-    sparsity: reverse Cuthill-McKee above 64 states), None at or below (state order)."""
-    from springc.integrate.ordering import band_layout
+    """The ordering of the states in the implicit methods' band LU, the numba loops'
+    (:func:`springc.integrate.band_order` of the generated module's Jacobian sparsity:
+    reverse Cuthill-McKee above 64 states, None at or below: state order)."""
+    from springc.integrate import band_order as order_of
 
-    indptr = np.asarray(module.JAC_INDPTR, dtype=np.int64)
-    if indptr.size - 1 <= DENSE_LIMIT:
-        return None
-    order = band_layout(indptr.size - 1, indptr, np.asarray(module.JAC_INDICES,
-                                                           dtype=np.int64), DENSE_LIMIT)[0]
-    return [int(i) for i in order]
+    return order_of(module.JAC_INDPTR, module.JAC_INDICES)
 
 
 def _kernel(loop: StepLoop, method: str) -> Kernel:
