@@ -65,8 +65,8 @@ O1_PRAGMA = ('#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC optimize
 """GCC compiles the implicit methods (the rest of the text) at -O1: at -O2 they took
 the seed's library build from 0.6-0.7 s to 1.7-2.3 s of CPU (1.1-1.6 s with this, gcc
 12 at load 16), while a warm run's time (the 256-state chain: radau 36 ms, bdf 14 ms)
-moved within this machine's noise. The results do not depend on it (no fast-math, no contraction: IEEE
-arithmetic at every level). Clang (and zig cc) ignore it."""
+moved within this machine's noise. The results do not depend on it (no fast-math, no
+contraction: IEEE arithmetic at every level). Clang (and zig cc) ignore it."""
 
 
 def implicit_prelude() -> str:
