@@ -1,10 +1,11 @@
-"""Radau IIA and BDF in the compiled engine's C loop (``implicit_steps.c``) against the
-numba loop on the same generated model: the same steps, rejections, right-hand-side
-and Jacobian evaluations, and states within 1e-10 relative (on this machine they are
-equal: the C hooks do the numba hooks' operations in the same order, but the C math
-library may round pow/hypot otherwise than numba's); against the analytic solution of
-a linear stiff model, with the analytic Jacobian and with the forward differences of a
-C model printed without one; and the status of a failing Newton iteration."""
+"""Radau IIA and BDF in the compiled engine's C loop (``radau_steps.c``,
+``bdf_steps.c``) against the numba loop on the same generated model: the same steps,
+rejections, right-hand-side and Jacobian evaluations, and states within 1e-10
+relative (on this machine they are equal: the C hooks do the numba hooks' operations
+in the same order, but the C math library may round pow/hypot otherwise than
+numba's); against the analytic solution of a linear stiff model, with the analytic
+Jacobian and with the forward differences of a C model printed without one; and the
+status of a failing Newton iteration."""
 
 from __future__ import annotations
 

@@ -1,16 +1,17 @@
 """The compiled engine's single-run loop in C: a model's C text -> the translation unit
 of its loop library (DOP853 and RK45, ``single_loop.c``; Radau IIA and BDF,
-``implicit_steps.c``).
+``implicit_core.c``, ``radau_steps.c``, ``bdf_steps.c``).
 
 One text per model: the model's C functions (``static inline``, so that the C
 compiler inlines them into the loop, and its name tables), the DOP853 tableau's
 weighted sums written out (:func:`.native_ensemble.prelude`), RK45's
 (:func:`rk45_prelude`), DOP853's step arithmetic shared with the ensemble kernel
 (``dop853_core.c``), the loop (``single_loop.c``), the implicit methods' constants
-(:func:`implicit_prelude`) and hooks (``implicit_steps.c``): the contract of
-:mod:`.loop` (its ``adaptive_loop`` specialised on :mod:`.dop853_steps` or
-:mod:`.rk45_steps` with plain-loop sums, on :mod:`.radau_steps` or :mod:`.bdf_steps`
-with the C model's analytic Jacobian), every operation in the same order. The
+(:func:`implicit_prelude`) and hooks (``implicit_core.c``, ``radau_steps.c``,
+``bdf_steps.c``): the contract of :mod:`.loop` (its ``adaptive_loop`` specialised
+on :mod:`.dop853_steps` or :mod:`.rk45_steps` with plain-loop sums, on
+:mod:`.radau_steps` or :mod:`.bdf_steps` with the C model's analytic Jacobian), every
+operation in the same order. The
 library is built by :func:`springc.pipeline.loop_library` and run by
 :mod:`springc.native.runner` (stdlib and ctypes only). Imports nothing from springc.
 """
@@ -25,7 +26,8 @@ from . import bdf_tableau, radau_tableau, rk45_tableau
 from .native_ensemble import CORE, c_array, c_switch, c_weighted_sum, prelude
 
 LOOP = Path(__file__).with_name("single_loop.c")
-IMPLICIT = Path(__file__).with_name("implicit_steps.c")
+IMPLICIT = tuple(Path(__file__).with_name(name) for name in (
+    "implicit_core.c", "radau_steps.c", "bdf_steps.c"))
 ABI = 2
 """The interface version of the library's exports (``springc_loop_abi()``): a change of
 an export's arguments moves it, and the runner refuses a library of another."""
@@ -56,8 +58,12 @@ def _table(name: str, values: np.ndarray) -> str:
     """A constant array of doubles (of any shape) as C, every value exact."""
     values = np.asarray(values, dtype=float)
     dims = "".join(f"[{d}]" for d in values.shape)
-    return (f"static const double {name}{dims} = {{"
-            + ", ".join(repr(float(v)) for v in values.ravel()) + "};\n")
+
+    def braced(part: np.ndarray) -> str:
+        if part.ndim == 0:
+            return repr(float(part))
+        return "{" + ", ".join(braced(row) for row in part) + "}"
+    return f"static const double {name}{dims} = {braced(values)};\n"
 
 
 O1_PRAGMA = ('#if defined(__GNUC__) && !defined(__clang__)\n#pragma GCC optimize ("O1")\n'
@@ -101,4 +107,5 @@ def loop_text(model_c: str) -> str:
     head = ("#include <math.h>\n#undef SPRINGC_FN\n#define SPRINGC_FN static inline\n")
     return (head + model_c + "\n" + prelude(False) + rk45_prelude()
             + CORE.read_text(encoding="utf-8") + LOOP.read_text(encoding="utf-8")
-            + implicit_prelude() + IMPLICIT.read_text(encoding="utf-8"))
+            + implicit_prelude()
+            + "".join(path.read_text(encoding="utf-8") for path in IMPLICIT))

@@ -6,7 +6,7 @@
    (its functions static inline), the DOP853 tableau's sums (sc_a_row ...), RK45's
    (rk_a_row, rk_b_sum, rk_e_sum, rk_p_col, RK_C), the status codes (SC_SUCCESS ...),
    dop853_core.c (DOP853's step arithmetic, shared with the ensemble kernel), then this,
-   then the implicit methods' constants and their hooks (implicit_steps.c: si_create,
+   then the implicit methods' constants and their hooks (implicit_core.c: si_create,
    si_begin, si_step, si_dense, declared here).
 
    The contract is springc.integrate.loop's adaptive_loop specialised on
@@ -19,7 +19,7 @@
    the step limit goes on from (failure_time, failure_state, next_step) as one
    uninterrupted run would. Nothing here allocates but the run's work arrays. Radau
    and BDF are the loop specialised on radau_steps / bdf_steps the same way (see
-   implicit_steps.c). */
+   implicit_core.c, radau_steps.c, bdf_steps.c). */
 
 #include <stdlib.h>
 
@@ -47,10 +47,10 @@ typedef struct {
     double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
     double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
     int method;
-    struct si_work *implicit;  /* Radau's or BDF's work (implicit_steps.c), else NULL */
+    struct si_work *implicit;  /* Radau's or BDF's work (implicit_core.c), else NULL */
 } sl_work;
 
-/* The implicit methods' hooks (implicit_steps.c). */
+/* The implicit methods' hooks (implicit_core.c). */
 SC_FN int si_begin(struct si_work *s, double t, const double *y, const double *f,
                    double h_abs, const double *p, double *z, double rtol, sl_int *counts,
                    double *end);
