@@ -14,13 +14,18 @@ Each measurement runs in a fresh interpreter with its own empty ``NUMBA_CACHE_DI
 - each seed figure twice: on the C loop (``SPRINGC_LOOP=c``: the model's C functions and
   the DOP853 loop compiled by the C compiler into one library, no numba) and on numba's
   (``SPRINGC_LOOP=numba``), with their ratio;
+- ``stiff``: the first ``simulate --solver radau`` (and ``bdf``) of a small stiff model
+  (STIFF below, 2 states), caches empty, on the C loop (the model's C functions, the
+  loop and the implicit methods compiled into one library) and on numba's (its radau or
+  bdf loop compiled by numba), with their ratio, and the next (warm) run: issue #24's
+  "first use of each implicit solver under 10 s of CPU";
 - ``zig``: the seed's C loop library compiled by ``python -m ziglang cc`` with zig's
   cache empty (its first use on a machine fills it) and again, against the system
   compiler (``cc``), CPU seconds of the compiler processes.
 
 CPU seconds (``getrusage``), not wall: the development machine is shared, and CPU time
 is what compiling costs. ``--baseline OTHER/src`` measures another springc tree
-alongside, in the same run (before/after); ``--only dop853,radau`` a subset.
+alongside, in the same run (before/after); ``--only dop853,radau,stiff`` a subset.
 
 Run: ``PYTHONPATH=src python benchmarks/bench_cold.py [--baseline OTHER/src]``.
 """
@@ -76,16 +81,49 @@ def loop(method: str, src: Path) -> tuple[float, float]:
     return figures["compile"], figures["process"]
 
 
-def seed(src: Path, loop: str = "") -> tuple[float, float]:
+def seed(src: Path, loop: str = "", model: str = "models/SpringMass.mdl",
+         options: tuple[str, ...] = ()) -> tuple[float, float]:
     """CPU s of the seed's first simulate (caches empty) and of the next one
-    (``loop``: ``SPRINGC_LOOP``, empty: the default)."""
+    (``loop``: ``SPRINGC_LOOP``, empty: the default; ``model``, ``options``: another
+    model file and simulate options)."""
     with tempfile.TemporaryDirectory() as folder:
         csv = Path(folder) / "seed.csv"
-        command = [sys.executable, "-m", "springc", "simulate", "models/SpringMass.mdl",
+        command = [sys.executable, "-m", "springc", "simulate", model, *options,
                    "-o", str(csv)]
         _, first = run(command, src, Path(folder), SPRINGC_LOOP=loop)
         _, warm = run(command, src, Path(folder), SPRINGC_LOOP=loop)
     return first, warm
+
+
+STIFF = """model Stiff
+  parameter Real k = 10000;
+  Real a(start = 1, fixed = true);
+  Real b(start = 0, fixed = true);
+equation
+  der(a) = -k * (a - cos(time));
+  der(b) = a - b;
+end Stiff;
+"""
+
+
+def stiff(trees: list[tuple[str, Path]]) -> None:
+    """The rows of ``stiff``: radau's and bdf's first and warm simulate of STIFF, on
+    the C loop and on numba's, and their ratios."""
+    with tempfile.TemporaryDirectory() as folder:
+        model = Path(folder) / "Stiff.mo"
+        model.write_text(STIFF, encoding="utf-8")
+        for solver in ("radau", "bdf"):
+            options = ("--solver", solver, "--stop", "20")
+            cells = {loop: [seed(src, loop, str(model), options) for _, src in trees]
+                     for loop in ("c", "numba")}
+            for loop in ("c", "numba"):
+                for k, label in enumerate(("first", "warm")):
+                    print(f"{f'{solver} {label} simulate, {loop}':<28}"
+                          + "".join(f"{cell[k]:>22.2f}" for cell in cells[loop]))
+            for k, label in enumerate(("first", "warm")):
+                print(f"{f'{solver} {label}, C / numba':<28}" + "".join(
+                    f"{c[k] / n[k]:>22.2f}" for c, n in zip(cells["c"], cells["numba"])),
+                    flush=True)
 
 
 ZIG_BUILD = """
@@ -120,7 +158,7 @@ def zig(src: Path) -> list[tuple[str, float]]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", type=Path, help="another springc src tree")
-    parser.add_argument("--only", default=",".join((*METHODS, "seed", "zig")))
+    parser.add_argument("--only", default=",".join((*METHODS, "seed", "stiff", "zig")))
     args = parser.parse_args()
     trees = [("this tree", ROOT / "src")]
     if args.baseline:
@@ -144,6 +182,8 @@ def main() -> None:
             f"{c[0] / n[0]:>22.2f}" for c, n in zip(c_cells, cells)))
         print(f"{'seed warm, C / numba':<28}" + "".join(
             f"{c[1] / n[1]:>22.2f}" for c, n in zip(c_cells, cells)), flush=True)
+    if "stiff" in wanted:
+        stiff(trees)
     if "zig" in wanted:
         for label, cpu in zig(trees[-1][1]):
             print(f"{'seed C loop build, ' + label:<44}{cpu:>8.2f} CPU s", flush=True)

@@ -161,8 +161,8 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
     """``backend`` as given; else ``None`` where the run's backend is the one
     :func:`compile_model` chooses itself (which also checks a numba module's size, and
     generates a model with events for numba where it chose python for the C loop),
-    else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for radau where
-    the C loop runs the others)."""
+    else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for a solver the
+    C loop does not run, the fixed-step ones, where it runs the others)."""
     if backend:
         return backend
     chosen = default_backend(engine, str(solver).lower())

@@ -167,3 +167,52 @@ def test_a_model_the_c_printer_cannot_print_is_compiled_for_numba(
     assert result.stats.engine == "compiled"
     x = result.values[-1, list(result.names).index("x")]
     assert x == pytest.approx((1.0 - 0.5) ** 2, rel=1e-8)  # x = (1 - t/2)^2
+
+
+STIFF = """model Stiff
+  parameter Real k = 10000;
+  Real a(start = 1, fixed = true);
+  Real b(start = 0, fixed = true);
+equation
+  der(a) = -k * (a - cos(time));
+  der(b) = a - b;
+end Stiff;
+"""
+
+
+@pytest.mark.parametrize("solver", ["auto", "radau", "bdf"])
+def test_a_stiff_model_runs_its_implicit_method_in_the_c_loop(
+        monkeypatch: pytest.MonkeyPatch, solver: str) -> None:
+    runs = []
+    for loop in ("c", "numba"):
+        monkeypatch.setenv("SPRINGC_LOOP", loop)
+        model = springc.load_model_from_string(STIFF)
+        assert ("python" if loop == "c" else "numba") == model.module.BACKEND
+        runs.append(springc.simulate(model, solver=solver, stop=20.0))
+    c_run, numba_run = runs
+    method = "radau" if solver == "auto" else solver
+    assert c_run.stats.solver == numba_run.stats.solver == method  # auto: stiff -> radau
+    assert c_run.stats.engine == numba_run.stats.engine == "compiled"
+    assert f"{method} ran in the compiled loop (C, no Python per step" in \
+        c_run.stats.engine_reason
+    assert (c_run.stats.steps, c_run.stats.rhs_evaluations,
+            c_run.stats.jacobian_evaluations) == (
+        numba_run.stats.steps, numba_run.stats.rhs_evaluations,
+        numba_run.stats.jacobian_evaluations)
+    scale = np.maximum(np.abs(numba_run.values).max(axis=0), 1.0)
+    assert (np.abs(c_run.values - numba_run.values) <= 1e-10 * scale).all()
+
+
+@pytest.mark.parametrize("solver", ["radau", "bdf"])
+def test_an_implicit_run_fails_on_the_c_loop_as_on_numbas(
+        monkeypatch: pytest.MonkeyPatch, solver: str) -> None:
+    messages = []
+    for loop in ("c", "numba"):
+        monkeypatch.setenv("SPRINGC_LOOP", loop)
+        model = springc.load_model_from_string(ROOT_MODEL)
+        with pytest.raises(SimulationError) as caught:
+            springc.simulate(model, solver=solver, stop=3.0)
+        messages.append(caught.value.message)
+    assert messages[0] == messages[1]
+    assert messages[0].startswith("math domain error while computing der(x) (<string>:4) "
+                                  "at time 2")

@@ -55,6 +55,7 @@ from .compile_lock import locked
 from .engine import (
     Crossings,
     Run,
+    band_order,
     bdf,
     dop853,
     fixed_step,
@@ -84,6 +85,7 @@ __all__ = [
     "Run",
     "Runs",
     "Status",
+    "band_order",
     "bdf",
     "compile_seconds",
     "dop853",

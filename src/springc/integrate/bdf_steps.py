@@ -10,7 +10,7 @@ matrix per step size). ``D[j]`` holds the j-th backward difference of the soluti
 scaled to the current step.
 
 numba keys its disk cache on this file's modification time only: touch this file after
-editing ``banded_lu``, ``radau_steps`` or ``status``.
+editing ``bdf_tableau``, ``banded_lu``, ``radau_steps`` or ``status``.
 """
 
 import math
@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import bdf_tableau as tableau
 from .arrays import copy, internal
 from .banded_lu import band_factor
 from .dop853_steps import verdict
@@ -31,12 +32,9 @@ MODEL_FAILED = int(Status.MODEL_FAILED)
 MIN_FACTOR, MAX_FACTOR = 0.2, 10.0
 EPS = float(np.finfo(float).eps)
 ERROR_ORDER = 1  # of the error estimator (at the first step): the initial exponent 1 / 2
-MAX_ORDER = 5
-NEWTON_MAXITER = 4
-KAPPA = np.array([0.0, -0.1850, -1 / 9, -0.0823, -0.0415, 0.0])
-GAMMA = np.concatenate((np.zeros(1), np.cumsum(1 / np.arange(1, MAX_ORDER + 1))))
-ALPHA = (1 - KAPPA) * GAMMA
-ERROR_CONST = KAPPA * GAMMA + 1 / np.arange(1, MAX_ORDER + 2)
+MAX_ORDER, NEWTON_MAXITER = tableau.MAX_ORDER, tableau.NEWTON_MAXITER
+KAPPA, GAMMA, ALPHA = tableau.KAPPA, tableau.GAMMA, tableau.ALPHA
+ERROR_CONST = tableau.ERROR_CONST
 
 
 @internal

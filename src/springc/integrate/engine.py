@@ -208,6 +208,21 @@ def newton_solve_flops(indptr: Any, indices: Any, dense_limit: int = 64) -> floa
     return 10.0 * n * (2 * kl + ku + 1)
 
 
+def band_order(indptr: Any, indices: Any, dense_limit: int = 64) -> list[int] | None:
+    """The ordering of the states (position -> state) in :func:`radau`'s and
+    :func:`bdf`'s banded LU for a Jacobian of CSC sparsity ``(indptr, indices)``: None
+    up to ``dense_limit`` states (a dense LU in state order), else the reverse
+    Cuthill-McKee order of :func:`.ordering.band_layout`. The C loop takes it
+    (``springc.native.LoopLibrary.run``'s ``order``) to factorise as these loops do."""
+    indptr_ = np.ascontiguousarray(indptr, dtype=np.int64)
+    indices_ = np.ascontiguousarray(indices, dtype=np.int64)
+    n = indptr_.size - 1
+    if n <= dense_limit:
+        return None
+    order = _band_layout(n, indptr_.tobytes(), indices_.tobytes(), dense_limit)[0]
+    return [int(i) for i in order]
+
+
 @functools.lru_cache(maxsize=16)
 def _band_layout(n: int, indptr: bytes, indices: bytes, dense_limit: int
                  ) -> tuple[np.ndarray, int, int, np.ndarray, np.ndarray]:

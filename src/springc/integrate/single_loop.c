@@ -1,10 +1,13 @@
-/* springc's single-run loop in C: the compiled engine's adaptive loop for DOP853 and
-   RK45 on a model's C functions, one shared library per model with the model.
+/* springc's single-run loop in C: the compiled engine's adaptive loop for DOP853,
+   RK45, Radau IIA and BDF on a model's C functions, one shared library per model with
+   the model.
 
    springc.integrate.native_loop puts the translation unit together: the model's C text
    (its functions static inline), the DOP853 tableau's sums (sc_a_row ...), RK45's
    (rk_a_row, rk_b_sum, rk_e_sum, rk_p_col, RK_C), the status codes (SC_SUCCESS ...),
-   dop853_core.c (DOP853's step arithmetic, shared with the ensemble kernel), then this.
+   dop853_core.c (DOP853's step arithmetic, shared with the ensemble kernel), then this,
+   then the implicit methods' constants and their hooks (implicit_core.c: si_create,
+   si_begin, si_step, si_dense, declared here).
 
    The contract is springc.integrate.loop's adaptive_loop specialised on
    dop853_steps / rk45_steps with plain-loop sums (scipy_arithmetic off), without zero
@@ -14,23 +17,29 @@
    same order, so that on one machine the states equal the numba loop's within
    rounding of the math library's functions, with the same steps. A run that stops at
    the step limit goes on from (failure_time, failure_state, next_step) as one
-   uninterrupted run would. Nothing here allocates but the run's work arrays. */
+   uninterrupted run would. Nothing here allocates but the run's work arrays. Radau
+   and BDF are the loop specialised on radau_steps / bdf_steps the same way (see
+   implicit_core.c, radau_steps.c, bdf_steps.c). */
 
 #include <stdlib.h>
 
 #ifndef SPRINGC_LOOP_EXPORT
 #define SPRINGC_LOOP_EXPORT __attribute__((visibility("default")))
 #endif
-#define SL_ABI 1
+#define SL_ABI 2
 #define SL_DOP853 0
 #define SL_RK45 1
+#define SL_RADAU 2
+#define SL_BDF 3
 #define SL_RK_STAGES 6
 #define SL_HUGE 1.7976931348623157e308
 #define SL_ACCEPTED 0
 #define SL_REJECTED 1
 #define SL_RHS_CALLS 2
+#define SL_JACOBIAN_CALLS 3
 
 typedef long long sl_int;
+struct si_work;
 
 /* The run's work arrays (rows of SC_NXS doubles). */
 typedef struct {
@@ -38,7 +47,21 @@ typedef struct {
     double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
     double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
     int method;
+    struct si_work *implicit;  /* Radau's or BDF's work (implicit_core.c), else NULL */
 } sl_work;
+
+/* The implicit methods' hooks (implicit_core.c). */
+SC_FN int si_begin(struct si_work *s, double t, const double *y, const double *f,
+                   double h_abs, const double *p, double *z, double rtol, sl_int *counts,
+                   double *end);
+SC_FN int si_step(struct si_work *s, double t, const double *y, double h_proposed,
+                  double *h_abs, double min_step, double limit, const double *p, double *z,
+                  double rtol, const double *atol, sl_int *counts, double *y_new,
+                  double *end, double *t_new, double *h, double *t_fail);
+SC_FN void si_dense(const struct si_work *s, double t, double h, const double *y, double at,
+                    double *out);
+SC_FN struct si_work *si_create(int method, const sl_int *order);
+SC_FN void si_free(struct si_work *s);
 
 SC_FN void sl_copy(double *dst, const double *src) {
     for (int i = 0; i < SC_NX; i++) dst[i] = src[i];
@@ -186,6 +209,7 @@ SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, do
 SC_FN int sl_prepare_dense(const sl_work *w, double t, double h, const double *p, double *z,
                            sl_int *counts, double *end, double *t_fail) {
     double *K = w->K;
+    if (w->implicit) return SC_SUCCESS;  /* the step's polynomial is its dense output */
     if (w->method == SL_DOP853) {
         for (int s = SC_STAGES + 1; s < SC_EXTENDED; s++) {
             sc_stage(w->y, K, s, h, w->sums, w->stage);
@@ -210,6 +234,10 @@ SC_FN int sl_prepare_dense(const sl_work *w, double t, double h, const double *p
 
 /* The dense output of the step from (t, y) with size h at time at, into out. */
 SC_FN void sl_dense(const sl_work *w, double t, double h, double at, double *out) {
+    if (w->implicit) {
+        si_dense(w->implicit, t, h, w->y, at, out);
+        return;
+    }
     double x = (at - t) / h;
     if (w->method == SL_DOP853) {
         sc_interpolate(w->F, w->y, x, out);
@@ -261,12 +289,16 @@ SC_FN int sl_steps(sl_work *w, sl_int m, const double *grid, const double *p, do
             t_fail = t;
             break;
         }
-        double min_step = 10 * fabs(nextafter(t, SL_HUGE) - t);
+        double min_step = 10 * fabs(nextafter(t, SL_HUGE) - t), h_proposed = *h_abs;
         if (*h_abs > max_step) *h_abs = max_step;
         else if (*h_abs < min_step) *h_abs = min_step;
         double t_new, h;
-        status = sl_step(w, t, h_abs, min_step, limit, p, z, rtol, atol, counts, rec->end,
-                         &t_new, &h, &t_fail);
+        if (w->implicit)
+            status = si_step(w->implicit, t, w->y, h_proposed, h_abs, min_step, limit, p, z,
+                             rtol, atol, counts, w->y_new, rec->end, &t_new, &h, &t_fail);
+        else
+            status = sl_step(w, t, h_abs, min_step, limit, p, z, rtol, atol, counts,
+                             rec->end, &t_new, &h, &t_fail);
         if (status != SC_SUCCESS) break;
         counts[SL_ACCEPTED] += 1;
         if (*filled < m && grid[*filled] <= t_new) {
@@ -303,7 +335,10 @@ SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
         filled = m;
     }
     if (running) {
-        double *f = w->K + (w->method == SL_DOP853 ? SC_STAGES : SL_RK_STAGES) * SC_NXS;
+        int order = w->method == SL_DOP853 ? 7 : w->method == SL_RK45 ? 4
+                    : w->method == SL_RADAU ? 3 : 1;  /* of the error estimator */
+        double *f = w->implicit ? w->K
+                    : w->K + (w->method == SL_DOP853 ? SC_STAGES : SL_RK_STAGES) * SC_NXS;
         springc_rhs(t, w->y, p, z, f);
         counts[SL_RHS_CALLS] += 1;
         status = sc_verdict(f, z);
@@ -311,12 +346,13 @@ SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
             if (first_step > 0.0) {
                 h_abs = first_step;
             } else {
-                double exponent = 1.0 / ((w->method == SL_DOP853 ? 7 : 4) + 1);
                 status = sl_initial_step(t, w->y, f, grid[m - 1], p, z, rtol, atol,
-                                         max_step, exponent, w, rec->end, counts, &h_abs,
-                                         &t_fail);
+                                         max_step, 1.0 / (order + 1), w, rec->end, counts,
+                                         &h_abs, &t_fail);
             }
         }
+        if (status == SC_SUCCESS && w->implicit)
+            status = si_begin(w->implicit, t, w->y, f, h_abs, p, z, rtol, counts, rec->end);
         if (status == SC_SUCCESS) {
             status = sl_steps(w, m, grid, p, z, rtol, atol, max_step, max_steps, states,
                               &filled, &t, &h_abs, rec);
@@ -365,10 +401,12 @@ SPRINGC_LOOP_EXPORT int springc_loop_start(const double *p, double *x, double *z
     return springc_start(p, x, z);
 }
 
-/* One run of method (0: DOP853, 1: RK45) on the output grid (m times, increasing):
-   states (m x n) rows 0..filled-1 written; counts: accepted, rejected, rhs evaluations,
-   0, filled; reals: failure (or stop) time, next step size; end: the state there; z
-   updated in place. first_step 0: scipy's initial step; max_steps 0: no limit.
+/* One run of method (0: DOP853, 1: RK45, 2: Radau IIA, 3: BDF) on the output grid (m
+   times, increasing): states (m x n) rows 0..filled-1 written; counts: accepted,
+   rejected, rhs evaluations, Jacobian evaluations, filled; reals: failure (or stop)
+   time, next step size; end: the state there; z updated in place. first_step 0:
+   scipy's initial step; max_steps 0: no limit. order: the implicit methods' ordering of
+   the states in their band LU above 64 states (position -> state; NULL: state order).
    Returns a springc.integrate.Status code, or -1 if the work arrays could not be
    allocated. */
 SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *grid,
@@ -376,11 +414,19 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
                                          double rtol, const double *atol, double max_step,
                                          double first_step, sl_int max_steps,
                                          double *states, sl_int *counts, double *reals,
-                                         double *end) {
+                                         double *end, const sl_int *order) {
     sl_work w;
     double *block = (double *)malloc((size_t)32 * SC_NXS * sizeof(double));
     if (block == NULL) return -1;
-    w.method = method == SL_RK45 ? SL_RK45 : SL_DOP853;
+    w.method = method >= SL_RK45 && method <= SL_BDF ? method : SL_DOP853;
+    w.implicit = NULL;
+    if (w.method == SL_RADAU || w.method == SL_BDF) {
+        w.implicit = si_create(w.method, order);
+        if (w.implicit == NULL) {
+            free(block);
+            return -1;
+        }
+    }
     w.K = block;
     w.F = block + 16 * SC_NXS;
     w.stage = block + 23 * SC_NXS;
@@ -394,6 +440,7 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
     sl_record rec = {counts, reals, end};
     int status = sl_run(&w, m, grid, x0, p, z, rtol, atol, max_step, first_step, max_steps,
                         states, &rec);
+    if (w.implicit) si_free(w.implicit);
     free(block);
     return status;
 }

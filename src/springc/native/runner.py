@@ -32,10 +32,10 @@ from typing import Any
 
 LIBRARY_FILE = "cloop.so"
 RECORD_FILE = "cloop.sha256"
-ABI = 1
+ABI = 2
 """The library's interface version (``springc_loop_abi()``; the same number as
 ``springc.integrate.native_loop.ABI``)."""
-METHODS = {"dop853": 0, "rk45": 1}
+METHODS = {"dop853": 0, "rk45": 1, "radau": 2, "bdf": 3}
 SUCCESS, MAX_STEPS = 0, 4
 
 _int64 = ctypes.c_longlong
@@ -109,6 +109,7 @@ class LoopRun:
     failure_time: float
     failure_state: array.array[float]
     next_step: float
+    jacobian_evaluations: int = 0
 
     @property
     def ok(self) -> bool:
@@ -141,7 +142,7 @@ class LoopLibrary:
         self.lib.springc_loop_run.argtypes = [
             ctypes.c_int, _int64, _double_p, _double_p, _double_p, _double_p,
             ctypes.c_double, _double_p, ctypes.c_double, ctypes.c_double, _int64,
-            _double_p, _int64_p, _double_p, _double_p]
+            _double_p, _int64_p, _double_p, _double_p, _int64_p]
         self.lib.springc_loop_observed.restype = _int64
         self.lib.springc_loop_observed.argtypes = [_int64, _double_p, _double_p, _double_p,
                                                    _double_p, _double_p]
@@ -174,11 +175,15 @@ class LoopLibrary:
 
     def run(self, method: str, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
             atol: float | Sequence[float], max_step: float = math.inf,
-            first_step: float = 0.0, max_steps: int = 0) -> LoopRun:
+            first_step: float = 0.0, max_steps: int = 0,
+            order: Sequence[int] | None = None) -> LoopRun:
         """Integrate from ``(grid[0], x0)`` over the increasing ``grid`` with ``method``
-        (dop853 or rk45); ``z`` is updated in place. ``first_step`` 0 selects the first
-        step as scipy does; ``max_steps`` counts accepted and rejected steps (0: no
-        limit)."""
+        (dop853, rk45, radau or bdf); ``z`` is updated in place. ``first_step`` 0 selects
+        the first step as scipy does; ``max_steps`` counts accepted and rejected steps
+        (0: no limit). ``order``: radau's and bdf's ordering of the states in their
+        banded LU above 64 states (position -> state, e.g. the reverse Cuthill-McKee
+        order of ``springc.integrate.ordering.band_layout``, which the numba loops use;
+        None: state order)."""
         n = self.n_states
         grid_ = doubles(grid)
         m = len(grid_) if len(grid) else 0
@@ -187,15 +192,20 @@ class LoopLibrary:
         z_ = self._z(z)
         states, end = zeros(max(m * n, 1)), zeros(max(n, 1))
         counts, reals = (_int64 * 5)(), (ctypes.c_double * 2)()
+        ordering = None
+        if order is not None:
+            if sorted(int(i) for i in order) != list(range(n)):
+                raise ValueError(f"order must be a permutation of the {n} states")
+            ordering = (_int64 * max(n, 1))(*(int(i) for i in order))
         status = self.lib.springc_loop_run(
             METHODS[method], m, grid_, doubles(x0, n), doubles(p, self.n_params), z_,
             float(rtol), doubles(atol, n), float(max_step), float(first_step),
-            int(max_steps), doubles(states), counts, reals, doubles(end))
+            int(max_steps), doubles(states), counts, reals, doubles(end), ordering)
         if status < 0:
             raise MemoryError("the loop could not allocate its work arrays")
         return LoopRun(int(status), states if n else zeros(0), int(counts[4]),
                        int(counts[0]), int(counts[1]), int(counts[2]), float(reals[0]),
-                       end[:n], float(reals[1]))
+                       end[:n], float(reals[1]), int(counts[3]))
 
     def observed(self, ts: Any, states: Any, p: Any, z: Any
                  ) -> tuple[int, array.array[float]]:

@@ -1,6 +1,6 @@
 """The compiled engine: springc's runs with no Python per step, on the C loop library
-(:mod:`.native`, DOP853 and RK45 of continuous models where a C compiler is found) or
-on :mod:`springc.integrate`'s numba loops.
+(:mod:`.native`, DOP853, RK45, Radau IIA and BDF of continuous models where a C
+compiler is found) or on :mod:`springc.integrate`'s numba loops.
 
 - :func:`c_loop_available`: whether the C loop runs (a C compiler found, or
   ``SPRINGC_LOOP`` forcing ``c`` or ``numba``); the one rule of the choice;
@@ -55,8 +55,9 @@ C_LOOP_VARIABLE = "SPRINGC_LOOP"
 """The environment variable that forces the compiled engine's loop: ``c`` (the C loop
 library, a C compiler needed) or ``numba``; unset or empty: C where
 :func:`springc.pipeline.find_compiler` finds a compiler, else numba."""
-C_SOLVERS = ("dop853", "rk45")
-"""The methods the C loop runs (continuous models; ``auto``'s explicit method too)."""
+C_SOLVERS = ("dop853", "rk45", "radau", "bdf")
+"""The methods the C loop runs (continuous models; ``auto``'s explicit method and the
+radau its race may hand over to too)."""
 C_LOOP, NUMBA_LOOP = "c", "numba"
 C_LOOP_STATES = 256
 """The most states of a model the C loop runs: the C model is printed one statement per
@@ -74,7 +75,7 @@ def numba_available() -> bool:
 
 def c_loop_available() -> bool:
     """Whether the compiled engine runs the C loop (:mod:`.native`) for ``auto``,
-    ``dop853`` and ``rk45`` on continuous models: ``SPRINGC_LOOP`` says ``c`` or
+    ``dop853``, ``rk45``, ``radau`` and ``bdf`` on continuous models: ``SPRINGC_LOOP`` says ``c`` or
     ``numba``; unset, where a C compiler is found (compiler presence, never timing).
     Imports neither numba nor the compiler's output."""
     choice = os.environ.get(C_LOOP_VARIABLE, "").strip().lower()
@@ -191,9 +192,6 @@ def engine_reason(engine: str, solver: str, module: Any, compiled: bool,
     """Why a run of ``solver`` ran on the engine it did, in plain words (``engine``: the
     ``--engine`` option, ``module``: the generated module, ``states``: how many)."""
     if compiled and not jitted(module):
-        if solver not in C_SOLVERS:  # auto's race handed the run to radau
-            return (f"{solver} ran in scipy's loop: the C loop runs dop853 and rk45 only "
-                    "(auto's explicit steps ran in it)")
         return (f"{solver} ran in the compiled loop (C, no Python per step: a C compiler "
                 f"was found; {C_LOOP_VARIABLE}=numba runs numba's)")
     if compiled:

@@ -1,6 +1,6 @@
-"""The compiled engine on the C loop library: a continuous model's DOP853 and RK45 runs
-with no Python per step and no numba (:func:`advance_native`), and its observed
-variables on the grid (:func:`native_observed`).
+"""The compiled engine on the C loop library: a continuous model's DOP853, RK45, Radau
+IIA and BDF runs with no Python per step and no numba (:func:`advance_native`), and its
+observed variables on the grid (:func:`native_observed`).
 
 The library (:func:`springc.pipeline.loop_library`: the model's C functions with
 ``integrate/single_loop.c``, built once into the model's cache entry) keeps the numba
@@ -8,19 +8,20 @@ loop's contract: stretches of steps resumable from (time, state, next step), sci
 start, initial step and controller, the dense output on the grid, the status codes
 and counters, so :func:`.compiled.advance_with` runs it as it runs numba's loop, with
 the same step and time limits and the same errors (a non-finite derivative located
-where the model's Python code raises). ``auto``'s race may hand a run to ``radau``,
-whose loop is not in C: that stretch runs on scipy's loop with the model's Python
-functions (the summary says so).
+where the model's Python code raises). Radau and BDF use the C model's analytic
+Jacobian (its forward differences where the C model has none) in the band LU of the
+numba loops, in the same ordering of the states (:func:`band_order`), so that they take
+the numba loops' steps.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import CodegenError, SimulationError
-from .compiled import C_SOLVERS, Kernel, advance_with
+from .compiled import Kernel, advance_with
 from .steps import StepLoop, Stepper, Stretch
 
 if TYPE_CHECKING:
@@ -29,19 +30,14 @@ if TYPE_CHECKING:
 
     from .steps import Problem
 
+IMPLICIT = ("radau", "bdf")
+"""The implicit methods of the C loop (they take the band ordering)."""
+
 
 def advance_native(loop: StepLoop, stepper: Stepper, max_steps: int | None = None
                    ) -> Stretch:
     """:func:`.compiled.advance_compiled` on the C loop library (``finish`` of the
-    step loop); a method without a C loop (radau, bdf) steps on scipy's loop from
-    where ``stepper`` is (with its next step size), as a restart."""
-    if stepper.method not in C_SOLVERS:
-        first = stepper.h_abs or None
-        integrator = loop.scipy_start(stepper.method, stepper.t, stepper.y, first)
-        stretch = loop.advance(integrator, max_steps)
-        stepper.t, stepper.y = float(integrator.t), np.array(integrator.y)
-        stepper.h_abs = float(getattr(integrator, "h_abs", 0.0) or 0.0)
-        return stretch
+    step loop)."""
     return advance_with(loop, stepper, max_steps, _kernel(loop, stepper.method))
 
 
@@ -69,16 +65,27 @@ def library(problem: Problem) -> LoopLibrary:
     return lib
 
 
+def band_order(module: Any) -> list[int] | None:
+    """The ordering of the states in the implicit methods' band LU, the numba loops'
+    (:func:`springc.integrate.band_order` of the generated module's Jacobian sparsity:
+    reverse Cuthill-McKee above 64 states, None at or below: state order)."""
+    from springc.integrate import band_order as order_of
+
+    return order_of(module.JAC_INDPTR, module.JAC_INDICES)
+
+
 def _kernel(loop: StepLoop, method: str) -> Kernel:
     problem = loop.problem
     lib = library(problem)
+    order = band_order(problem.mod) if method in IMPLICIT else None
 
     def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
         done = lib.run(method, times, np.ascontiguousarray(y, dtype=float), problem.p,
                        problem.z, rtol=loop.rtol, atol=loop.atol, first_step=first or 0.0,
-                       max_steps=steps)
+                       max_steps=steps, order=order)
         return as_run(done, times)
     return run
+
 
 
 def as_run(done: LoopRun, times: np.ndarray) -> Run:
@@ -90,7 +97,7 @@ def as_run(done: LoopRun, times: np.ndarray) -> Run:
     return Run(Status(done.status), times, states, np.empty((len(times), 0)), done.filled,
                done.accepted_steps, done.rejected_steps, done.rhs_evaluations,
                done.failure_time, np.frombuffer(done.failure_state, dtype=float).copy(),
-               np.empty(0, dtype=np.int64), done.next_step)
+               np.empty(0, dtype=np.int64), done.next_step, done.jacobian_evaluations)
 
 
 def native_observed(problem: Problem, grid: np.ndarray, states: np.ndarray,
