@@ -21,6 +21,7 @@ from ..ir.expr import If, Var
 from .c_context import SOLVE, CContext, c_jacobian, c_statements
 from .c_printer import C_RESERVED, HELPERS, c_function_body
 from .c_tables import c_tables
+from .c_vector import grouped, grouped_parameters, model_functions, parameter_functions
 from .context import CodegenContext, source_comment
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
@@ -83,13 +84,13 @@ def _generate_c(system: ode.ODE, flat_model: flat.FlatModel | None,
         raise CodegenError(f"the name '{reserved}' is reserved for springc's generated code")
     namer = Namer(m.model_names, C_RESERVED, "springc")
     helpers: set[str] = set()
-    functions = _functions(m, chosen, namer, helpers)
+    data, functions = _functions(m, chosen, namer, helpers)
     structural = structural_parameters(system, flat_model)
     lines = c_tables(m, chosen, structural)
     if m.uses_solve:
         lines += ["", SOLVE]
     lines += [text for name in sorted(helpers) for text in ("", HELPERS[name])]
-    lines += functions
+    lines += data + functions
     crossings = tuple(m.events.texts) if m.events is not None else ()
     return CModelSource(system.name, "\n".join(lines) + "\n", tuple(m.states),
                         tuple(m.params), tuple(chosen), crossings, m.events is not None,
@@ -102,23 +103,36 @@ def _function(head: str, body: list[str], ret: str = "_code") -> list[str]:
 
 
 def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str]
-               ) -> list[str]:
+               ) -> tuple[list[str], list[str]]:
+    """The file-scope data (index tables of the vector layout) and the functions."""
     steps, described = m.step_stmts()
-    loads = m.loads()
-    computed = set(m.ode.step_names())
-    rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
-    rhs += [Store(f"dx[{i}]", Var(d), d) for i, d in enumerate(m.derivatives)]
-    obs = loads + steps + m.alias_stmts(outputs)
-    obs += [Store(f"out[{i}]", Var(name), name) for i, name in enumerate(outputs)]
-    lines = _parameters(m, namer, helpers)
-    lines += _function("int springc_start(const double *p, double *x, double *z)",
-                       c_function_body(namer, helpers, _start(m)))
-    lines += _function(f"int springc_rhs({_SIGNATURE}, double *dx)",
-                       c_function_body(namer, helpers, rhs))
-    lines += _function(f"int springc_observed({_SIGNATURE}, double *out)",
-                       c_function_body(namer, helpers, obs))
+    data: list[str] = []
+    if grouped_parameters(m):
+        tables, parameters, start = parameter_functions(m, helpers)
+        data += ["", *tables]
+        lines = _parameters_function(parameters)
+    else:
+        lines = _parameters(m, namer, helpers)
+        start = c_function_body(namer, helpers, _start(m))
+    lines += _function("int springc_start(const double *p, double *x, double *z)", start)
+    if grouped(m):
+        tables, bodies = model_functions(m, outputs, helpers)
+        data += ["", *tables]
+        rhs, obs = bodies[0][1], bodies[1][1]
+    else:
+        loads = m.loads()
+        computed = set(m.ode.step_names())
+        rhs_stmts = loads + steps + m.alias_stmts([d for d in m.derivatives
+                                                   if d not in computed])
+        rhs_stmts += [Store(f"dx[{i}]", Var(d), d) for i, d in enumerate(m.derivatives)]
+        obs_stmts = loads + steps + m.alias_stmts(outputs)
+        obs_stmts += [Store(f"out[{i}]", Var(name), name) for i, name in enumerate(outputs)]
+        rhs = c_function_body(namer, helpers, rhs_stmts)
+        obs = c_function_body(namer, helpers, obs_stmts)
+    lines += _function(f"int springc_rhs({_SIGNATURE}, double *dx)", rhs)
+    lines += _function(f"int springc_observed({_SIGNATURE}, double *out)", obs)
     lines += _jacobian(m, steps, described, namer, helpers)
-    return lines + _event_functions(m, namer, helpers)
+    return data, lines + _event_functions(m, namer, helpers)
 
 
 def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, int, str]],
@@ -158,7 +172,10 @@ def _parameters(m: CContext, namer: Namer, helpers: set[str]) -> list[str]:
         stmts.append(Let(q.name, If(Var(f"_pg{i}"), Var(f"_pp{i}"), parameter_value(q)),
                          source_comment(q.name, q.span)))
         stmts.append(Store(f"p[{i}]", Var(q.name)))
-    body = c_function_body(namer, helpers, stmts)
+    return _parameters_function(c_function_body(namer, helpers, stmts))
+
+
+def _parameters_function(body: list[str]) -> list[str]:
     return ["", "SPRINGC_FN void springc_parameters(double *p, const int *given)", "{",
             *body, "}", "",
             "SPRINGC_FN void springc_default_parameters(double *p)", "{",
