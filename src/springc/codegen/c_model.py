@@ -53,12 +53,15 @@ class CModelSource:
 
 
 def generate_c(system: ode.ODE, flat_model: flat.FlatModel | None = None,
-               outputs: Sequence[str] | None = None) -> CModelSource:
+               outputs: Sequence[str] | None = None, vector: bool | None = None
+               ) -> CModelSource:
     """The C file of ``system`` computing the observed variables ``outputs`` (None:
     every one). An expression that C cannot compute is a :class:`CodegenError` located
-    at the model element it comes from."""
+    at the model element it comes from. ``vector``: loops over index tables
+    (:mod:`.c_vector`) by the size rule of the Python modules (None), wherever the
+    system allows them (True), or none (False: one statement per scalar)."""
     try:
-        return _generate_c(at_initialization(system), flat_model, outputs)
+        return _generate_c(at_initialization(system), flat_model, outputs, vector)
     except CodegenError as err:
         located = locate(err, system)
         if located is None:
@@ -67,7 +70,7 @@ def generate_c(system: ode.ODE, flat_model: flat.FlatModel | None = None,
 
 
 def _generate_c(system: ode.ODE, flat_model: flat.FlatModel | None,
-                outputs: Sequence[str] | None) -> CModelSource:
+                outputs: Sequence[str] | None, vector: bool | None) -> CModelSource:
     if system.events is not None:  # the continuous functions read held values
         system = held_system(system, CodegenContext(system, flat_model).events)  # type: ignore[arg-type]
     m = CContext(system, flat_model)
@@ -84,7 +87,8 @@ def _generate_c(system: ode.ODE, flat_model: flat.FlatModel | None,
         raise CodegenError(f"the name '{reserved}' is reserved for springc's generated code")
     namer = Namer(m.model_names, C_RESERVED, "springc")
     helpers: set[str] = set()
-    data, functions = _functions(m, chosen, namer, helpers)
+    data, functions = _functions(m, chosen, namer, helpers, vector)
+    m.code_chars = sum(len(line) + 1 for line in functions)
     structural = structural_parameters(system, flat_model)
     lines = c_tables(m, chosen, structural)
     if m.uses_solve:
@@ -102,12 +106,12 @@ def _function(head: str, body: list[str], ret: str = "_code") -> list[str]:
             f"    return {ret};", "}"]
 
 
-def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str]
-               ) -> tuple[list[str], list[str]]:
+def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str],
+               vector: bool | None) -> tuple[list[str], list[str]]:
     """The file-scope data (index tables of the vector layout) and the functions."""
     steps, described = m.step_stmts()
     data: list[str] = []
-    if grouped_parameters(m):
+    if grouped_parameters(m, vector):
         tables, parameters, start = parameter_functions(m, helpers)
         data += ["", *tables]
         lines = _parameters_function(parameters)
@@ -115,7 +119,7 @@ def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[s
         lines = _parameters(m, namer, helpers)
         start = c_function_body(namer, helpers, _start(m))
     lines += _function("int springc_start(const double *p, double *x, double *z)", start)
-    if grouped(m):
+    if grouped(m, vector):
         tables, bodies = model_functions(m, outputs, helpers)
         data += ["", *tables]
         rhs, obs = bodies[0][1], bodies[1][1]

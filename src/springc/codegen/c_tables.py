@@ -85,7 +85,7 @@ def _macros(m: CContext, outputs: Sequence[str]) -> list[str]:
         ("SPRINGC_HYBRID", int(layout is not None)),
         ("SPRINGC_INITIAL_CONDITIONS", len(initial_conditions(m.ode))),
         ("SPRINGC_HAS_JACOBIAN", int(m.has_jacobian)), ("SPRINGC_N_JAC", m.jacobian_size),
-        ("SPRINGC_WORK_DOUBLES", m.work_doubles),
+        ("SPRINGC_WORK_DOUBLES", m.work_doubles), ("SPRINGC_CODE_CHARS", m.code_chars),
     ]
     if layout is not None:
         s = layout.slot

@@ -20,19 +20,30 @@ from collections.abc import Sequence
 from .c_context import CContext
 from .c_printer import c_double
 from .module_text import parameter_value, start_of, topological
-from .vector import VectorLayout, parameters_suit, vector_statements, vector_suits
+from .vector import (
+    VECTOR_THRESHOLD,
+    VectorLayout,
+    parameters_suit,
+    vector_statements,
+    vector_suits,
+)
 
 Printed = tuple[str, list[str]]
 """A function's head (``int springc_rhs(...)``) and its body lines."""
 
 
-def grouped(m: CContext) -> bool:
-    """Whether ``rhs`` and ``observed`` of ``m`` are printed as loops."""
-    return m.events is None and not len(m.delays) and vector_suits(m.ode)
+def grouped(m: CContext, vector: bool | None = None) -> bool:
+    """Whether ``rhs`` and ``observed`` of ``m`` are printed as loops (``vector``:
+    None by size, :func:`.vector.vector_suits`; True: wherever the system allows)."""
+    if m.events is not None or len(m.delays) or vector is False:
+        return False
+    return vector_suits(m.ode, 0 if vector else VECTOR_THRESHOLD)
 
 
-def grouped_parameters(m: CContext) -> bool:
+def grouped_parameters(m: CContext, vector: bool | None = None) -> bool:
     """Whether ``springc_parameters`` and ``springc_start`` are printed as loops."""
+    if vector is not None:
+        return vector and m.guess_slots == {} and m.events is None and not len(m.delays)
     return not len(m.delays) and parameters_suit(m)
 
 
