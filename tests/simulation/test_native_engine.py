@@ -87,7 +87,8 @@ def test_a_large_chain_runs_on_the_c_loop_as_on_numbas(
         monkeypatch.setenv("SPRINGC_LOOP", loop)
         model = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 300})
         runs[loop] = springc.simulate(model, solver="dop853", stop=2.0, error_control="off")
-        assert model.module.BACKEND == ("python" if loop == "c" else "numba")
+        backend = model.module.BACKEND
+        assert backend == ("python" if loop == "c" else "numba")
     c_run, numba_run = runs["c"], runs["numba"]
     assert c_run.stats.engine_reason == C_REASON
     assert c_run.stats.steps == numba_run.stats.steps
