@@ -18,7 +18,8 @@ seconds (on a loaded machine the CPU time is the better guide to an idle machine
     every output, and the states only) and its loop against the compiled DOP853 loop
     (plain loops) on the hand-written right-hand side of ``handwritten.py`` (with
     ``--fused``: that loop specialised by numba on it, a compile of minutes), same
-    tolerances and grid: target within 1.5x; the same rows on the C loop
+    tolerances and grid, error control off (the hand-written run has none): target
+    within 1.5x; the same rows on the C loop
     (``SPRINGC_LOOP=c``, python modules: the model's C functions and DOP853 in one
     library).
 (d) the 10,000-mass chain (2,000 with --quick): compile_model and first calls.

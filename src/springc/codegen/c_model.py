@@ -21,7 +21,13 @@ from ..ir.expr import If, Var
 from .c_context import SOLVE, CContext, c_jacobian, c_statements
 from .c_printer import C_RESERVED, HELPERS, c_function_body
 from .c_tables import c_tables
-from .c_vector import grouped, grouped_parameters, model_functions, parameter_functions
+from .c_vector import (
+    grouped,
+    grouped_parameters,
+    jacobian_floor,
+    model_functions,
+    parameter_functions,
+)
 from .context import CodegenContext, source_comment
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
@@ -135,21 +141,23 @@ def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[s
         obs = c_function_body(namer, helpers, obs_stmts)
     lines += _function(f"int springc_rhs({_SIGNATURE}, double *dx)", rhs)
     lines += _function(f"int springc_observed({_SIGNATURE}, double *out)", obs)
-    lines += _jacobian(m, steps, described, namer, helpers)
+    large = grouped(m, vector) and jacobian_floor(m) > JACOBIAN_LIMIT
+    lines += _jacobian(m, [] if large else steps, described, namer, helpers, large)
     return data, lines + _event_functions(m, namer, helpers)
 
 
 def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, int, str]],
-              namer: Namer, helpers: set[str]) -> list[str]:
+              namer: Namer, helpers: set[str], large: bool) -> list[str]:
     """``springc_jacobian`` (the non-zeros of d(rhs)/dx in CSC order, the analytic
     Jacobian of :mod:`.jacobian`, blocks through ``springc_solve``) and
     ``springc_jacobian_pattern``, where it has at most :data:`JACOBIAN_LIMIT`
     non-zeros (else ``SPRINGC_HAS_JACOBIAN`` is 0 and ``springc_jacobian`` returns
-    -3)."""
-    body, pattern = jacobian_statements(
+    -3; ``large``: known to have more, :func:`.c_vector.jacobian_floor`, so not
+    differentiated at all)."""
+    body, pattern = ([], []) if large else jacobian_statements(
         m.states, m.derivatives, described,
         {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
-    cheap = len(pattern) <= JACOBIAN_LIMIT
+    cheap = not large and len(pattern) <= JACOBIAN_LIMIT
     m.jacobian_size = len(pattern) if cheap else 0
     m.has_jacobian = cheap
     lines = ["", "SPRINGC_FN void springc_jacobian_pattern(int *rows, int *cols)", "{"]

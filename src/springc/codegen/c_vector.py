@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from ..ir.expr import variables
 from .c_context import CContext
 from .c_printer import c_double
 from .module_text import parameter_value, start_of, topological
@@ -45,6 +46,17 @@ def grouped_parameters(m: CContext, vector: bool | None = None) -> bool:
     if vector is not None:
         return vector and m.guess_slots == {} and m.events is None and not len(m.delays)
     return not len(m.delays) and parameters_suit(m)
+
+
+def jacobian_floor(m: CContext) -> int:
+    """The derivatives whose assignment reads a state, directly or through other
+    assignments: each is a non-zero of the Jacobian (barring an exact cancellation),
+    so a floor of their count, found without differentiating anything."""
+    states = set(m.states)
+    reads: dict[str, bool] = {}
+    for name, e, _ in vector_statements(m, ()):
+        reads[name] = any(v in states or reads.get(v, False) for v in variables(e))
+    return sum(reads.get(d, False) for d in m.derivatives)
 
 
 def _data(kind: str, name: str, values: Sequence[int] | Sequence[float]) -> list[str]:
