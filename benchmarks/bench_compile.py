@@ -18,7 +18,8 @@ seconds (on a loaded machine the CPU time is the better guide to an idle machine
     every output, and the states only) and its loop against the compiled DOP853 loop
     (plain loops) on the hand-written right-hand side of ``handwritten.py`` (with
     ``--fused``: that loop specialised by numba on it, a compile of minutes), same
-    tolerances and grid: target within 1.5x; the same rows on the C loop
+    tolerances and grid, error control off (the hand-written run has none): target
+    within 1.5x; the same rows on the C loop
     (``SPRINGC_LOOP=c``, python modules: the model's C functions and DOP853 in one
     library).
 (d) the 10,000-mass chain (2,000 with --quick): compile_model and first calls.
@@ -172,15 +173,16 @@ def bench_chain_warm(repeats: int, fused: bool) -> None:
                                   parameters={"N": n})
     states = springc.compile_model(SCENES, "Scenes.Chain", backend="numba",
                                    parameters={"N": n}, outputs=list(every.states))
-    result = springc.simulate(every, solver="dop853", engine="compiled")
+    result = springc.simulate(every, solver="dop853", engine="compiled", error_control="off")
     rtol, atol, grid = 1e-6, 1e-9, result.time  # springc's defaults: atol = rtol / 1000
     all_outputs = best_of(repeats, lambda: springc.simulate(every, solver="dop853",
-                                                            engine="compiled"))
+                                                            engine="compiled",
+                                                            error_control="off"))
     loops = []
 
     def states_only() -> None:
-        loops.append(springc.simulate(states, solver="dop853", engine="compiled")
-                     .stats.loop_time)
+        loops.append(springc.simulate(states, solver="dop853", engine="compiled",
+                                      error_control="off").stats.loop_time)
     states_time = best_of(repeats, states_only)
     loop = min(loops)
 
@@ -232,11 +234,12 @@ def c_rows(repeats: int, n: int, base: str, hand_time: float) -> None:
                                       parameters={"N": n})
         states = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
                                        parameters={"N": n}, outputs=list(every.states))
-        all_outputs = best_of(repeats, lambda: springc.simulate(every, solver="dop853"))
+        all_outputs = best_of(repeats, lambda: springc.simulate(every, solver="dop853",
+                                                            error_control="off"))
         loops = []
 
         def states_only() -> None:
-            run = springc.simulate(states, solver="dop853")
+            run = springc.simulate(states, solver="dop853", error_control="off")
             assert "(C," in run.stats.engine_reason
             loops.append(run.stats.loop_time)
         states_time = best_of(repeats, states_only)

@@ -186,20 +186,21 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
 
 def _numba_instead(compiled: CompiledModel) -> bool:
     """Whether springc, having chosen python for the C loop, generates ``compiled``'s
-    model for numba instead: the C loop runs continuous models of at most
-    ``C_LOOP_STATES`` states; the compiled engine runs others (events, delays,
-    switching states, large scenes) on numba, and so does a model the C printer cannot
-    print (a function with no C spelling): numba's loop, not scipy's, runs it."""
+    model for numba instead: the C loop runs continuous models whose loop library
+    builds (:func:`springc.pipeline.loop_library`, built here once per cache entry);
+    the compiled engine runs others on numba: events, delays, switching states, a
+    model beyond the loop's size rule, one the C printer cannot print (a function with
+    no C spelling), and one whose C the compiler refused (with a one-line note)."""
     if not (c_loop_runs(AUTO, None) and numba_available()):
         return False
-    if compiled.kind != ModuleKind.CONTINUOUS \
-            or not c_loop_runs(AUTO, None, len(compiled.states)):
+    if compiled.kind != ModuleKind.CONTINUOUS:
         return True
-    from .pipeline import c_source  # the C printer: on this choice only
+    from .pipeline import loop_library, note_refused  # the C printer: on this choice only
 
     try:
-        c_source(compiled)  # kept in the cache entry for the loop library
-    except CodegenError:
+        loop_library(compiled)  # kept in the cache entry for the runs
+    except CodegenError as error:
+        note_refused(error, "numba's loop")
         return True
     return False
 

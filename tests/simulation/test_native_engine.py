@@ -77,13 +77,66 @@ def test_the_default_run_takes_the_c_loop_and_imports_no_numba(tmp_path: Path) -
     assert done.stdout.split() == ["compiled", "False"]
 
 
-def test_a_large_model_is_generated_for_numba(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("SPRINGC_LOOP", "c")
+def test_a_large_chain_runs_on_the_c_loop_as_on_numbas(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """600 states (over the old 256-state cap): the C model's loops over index tables
+    run on the C loop, states within 1e-12 of numba's loop, the same steps."""
     scenes = str(ROOT / "models" / "Scenes.mdl")
-    small = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 128})
-    large = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 129})
-    assert (len(small.states), small.module.BACKEND) == (256, "python")
-    assert (len(large.states), large.module.BACKEND) == (258, "numba")
+    runs = {}
+    for loop in ("c", "numba"):
+        monkeypatch.setenv("SPRINGC_LOOP", loop)
+        model = springc.compile_model(scenes, "Scenes.Chain", parameters={"N": 300})
+        runs[loop] = springc.simulate(model, solver="dop853", stop=2.0, error_control="off")
+        backend = model.module.BACKEND
+        assert backend == ("python" if loop == "c" else "numba")
+    c_run, numba_run = runs["c"], runs["numba"]
+    assert c_run.stats.engine_reason == C_REASON
+    assert c_run.stats.steps == numba_run.stats.steps
+    scale = np.maximum(np.abs(numba_run.values).max(axis=0), 1.0)
+    assert (np.abs(c_run.values - numba_run.values) <= 1e-12 * scale).all()
+
+
+def test_a_model_beyond_the_loops_size_rule_is_generated_for_numba(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from springc.pipeline import c_kernels
+
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    monkeypatch.setattr(c_kernels, "C_LOOP_CODE_CHARS", 1000)
+    model = springc.compile_model(SEED)
+    assert model.module.BACKEND == "numba"
+    code = int(c_kernels.c_source(model).split("#define SPRINGC_CODE_CHARS ")[1].split()[0])
+    assert c_kernels.loop_refusal(c_kernels.c_source(model)) == (
+        f"its C functions take {code:,} characters (the C loop takes at most 1,000)")
+    monkeypatch.setattr(c_kernels, "C_LOOP_CODE_CHARS", 10**9)
+    monkeypatch.setattr(c_kernels, "C_LOOP_STACK_BYTES", 16)
+    assert c_kernels.loop_refusal(c_kernels.c_source(model)) == (
+        "its C functions need 24 bytes of stack (the C loop takes at most 16)")  # 3 outputs
+    monkeypatch.setattr(c_kernels, "C_LOOP_STACK_BYTES", 10**9)
+    without = c_kernels.c_source(model).replace("#define SPRINGC_HAS_JACOBIAN 1\n",
+                                                "#define SPRINGC_HAS_JACOBIAN 0\n")
+    assert c_kernels.loop_refusal(without) is None  # 4 states: a dense Jacobian is cheap
+    monkeypatch.setattr(c_kernels, "C_LOOP_DENSE_STATES", 3)
+    assert c_kernels.loop_refusal(without) == (
+        "it has 4 states and no Jacobian in C (the C loop's implicit methods would "
+        "factorise a dense one; it takes at most 3 states without one)")
+
+
+def test_a_c_build_the_compiler_refuses_falls_back_to_numba_with_a_note(
+        monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    compiler = tmp_path / "brokencc"
+    compiler.write_text("#!/bin/sh\necho 'build.c:1:1: warning: odd' >&2\n"
+                        "echo 'build.c:9:5: error: broken compiler' >&2\nexit 1\n")
+    compiler.chmod(0o755)
+    monkeypatch.setenv("CC", str(compiler))
+    monkeypatch.delenv("SPRINGC_LOOP", raising=False)
+    model = springc.compile_model(SEED)
+    assert model.module.BACKEND == "numba"
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        "note: the C compiler refused the C loop of SpringMass (build.c:9:5: error: "
+        "broken compiler); running on numba's loop")
+    result = springc.simulate(model, solver="dop853", stop=1.0)
+    assert result.stats.engine == "compiled" and result.stats.engine_reason == ""
 
 
 def test_a_domain_error_is_located_as_on_the_numba_loop(
@@ -151,13 +204,13 @@ def test_a_model_the_c_printer_cannot_print_is_compiled_for_numba(
     """Where the C model cannot be printed (a CodegenError from the C printer), springc's
     own backend choice regenerates the model for numba, whose compiled loop runs it: the
     run neither fails nor falls to scipy's loop."""
-    import springc.pipeline
+    import springc.pipeline.c_kernels
     from springc.errors import CodegenError
 
     def refuse(model: object) -> str:
         raise CodegenError("cannot generate C code for the function 'f'")
 
-    monkeypatch.setattr(springc.pipeline, "c_source", refuse)
+    monkeypatch.setattr(springc.pipeline.c_kernels, "c_source", refuse)
     monkeypatch.setenv("SPRINGC_LOOP", "c")
     path = tmp_path / "Root.mo"
     path.write_text(ROOT_MODEL, encoding="utf-8")

@@ -80,6 +80,8 @@ class CContext(CodegenContext):
     uses_solve = False
     jacobian_size = 0  # non-zeros of springc_jacobian
     has_jacobian = False  # whether the C file computes the Jacobian (see c_model)
+    work_doubles = 0  # the largest local work arrays of a function (see c_vector)
+    code_chars = 0  # characters of the file's functions (the C compiler's work)
 
     def _linear(self, block: ode.LinearBlock, index: int, comment: str) -> Stmt:
         n = len(block.names)

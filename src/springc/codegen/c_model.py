@@ -21,6 +21,13 @@ from ..ir.expr import If, Var
 from .c_context import SOLVE, CContext, c_jacobian, c_statements
 from .c_printer import C_RESERVED, HELPERS, c_function_body
 from .c_tables import c_tables
+from .c_vector import (
+    grouped,
+    grouped_parameters,
+    jacobian_floor,
+    model_functions,
+    parameter_functions,
+)
 from .context import CodegenContext, source_comment
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
@@ -52,12 +59,15 @@ class CModelSource:
 
 
 def generate_c(system: ode.ODE, flat_model: flat.FlatModel | None = None,
-               outputs: Sequence[str] | None = None) -> CModelSource:
+               outputs: Sequence[str] | None = None, vector: bool | None = None
+               ) -> CModelSource:
     """The C file of ``system`` computing the observed variables ``outputs`` (None:
     every one). An expression that C cannot compute is a :class:`CodegenError` located
-    at the model element it comes from."""
+    at the model element it comes from. ``vector``: loops over index tables
+    (:mod:`.c_vector`) by the size rule of the Python modules (None), wherever the
+    system allows them (True), or none (False: one statement per scalar)."""
     try:
-        return _generate_c(at_initialization(system), flat_model, outputs)
+        return _generate_c(at_initialization(system), flat_model, outputs, vector)
     except CodegenError as err:
         located = locate(err, system)
         if located is None:
@@ -66,7 +76,7 @@ def generate_c(system: ode.ODE, flat_model: flat.FlatModel | None = None,
 
 
 def _generate_c(system: ode.ODE, flat_model: flat.FlatModel | None,
-                outputs: Sequence[str] | None) -> CModelSource:
+                outputs: Sequence[str] | None, vector: bool | None) -> CModelSource:
     if system.events is not None:  # the continuous functions read held values
         system = held_system(system, CodegenContext(system, flat_model).events)  # type: ignore[arg-type]
     m = CContext(system, flat_model)
@@ -83,13 +93,14 @@ def _generate_c(system: ode.ODE, flat_model: flat.FlatModel | None,
         raise CodegenError(f"the name '{reserved}' is reserved for springc's generated code")
     namer = Namer(m.model_names, C_RESERVED, "springc")
     helpers: set[str] = set()
-    functions = _functions(m, chosen, namer, helpers)
+    data, functions = _functions(m, chosen, namer, helpers, vector)
+    m.code_chars = sum(len(line) + 1 for line in functions)
     structural = structural_parameters(system, flat_model)
     lines = c_tables(m, chosen, structural)
     if m.uses_solve:
         lines += ["", SOLVE]
     lines += [text for name in sorted(helpers) for text in ("", HELPERS[name])]
-    lines += functions
+    lines += data + functions
     crossings = tuple(m.events.texts) if m.events is not None else ()
     return CModelSource(system.name, "\n".join(lines) + "\n", tuple(m.states),
                         tuple(m.params), tuple(chosen), crossings, m.events is not None,
@@ -101,37 +112,52 @@ def _function(head: str, body: list[str], ret: str = "_code") -> list[str]:
             f"    return {ret};", "}"]
 
 
-def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str]
-               ) -> list[str]:
+def _functions(m: CContext, outputs: Sequence[str], namer: Namer, helpers: set[str],
+               vector: bool | None) -> tuple[list[str], list[str]]:
+    """The file-scope data (index tables of the vector layout) and the functions."""
     steps, described = m.step_stmts()
-    loads = m.loads()
-    computed = set(m.ode.step_names())
-    rhs = loads + steps + m.alias_stmts([d for d in m.derivatives if d not in computed])
-    rhs += [Store(f"dx[{i}]", Var(d), d) for i, d in enumerate(m.derivatives)]
-    obs = loads + steps + m.alias_stmts(outputs)
-    obs += [Store(f"out[{i}]", Var(name), name) for i, name in enumerate(outputs)]
-    lines = _parameters(m, namer, helpers)
-    lines += _function("int springc_start(const double *p, double *x, double *z)",
-                       c_function_body(namer, helpers, _start(m)))
-    lines += _function(f"int springc_rhs({_SIGNATURE}, double *dx)",
-                       c_function_body(namer, helpers, rhs))
-    lines += _function(f"int springc_observed({_SIGNATURE}, double *out)",
-                       c_function_body(namer, helpers, obs))
-    lines += _jacobian(m, steps, described, namer, helpers)
-    return lines + _event_functions(m, namer, helpers)
+    data: list[str] = []
+    if grouped_parameters(m, vector):
+        tables, parameters, start = parameter_functions(m, helpers)
+        data += ["", *tables]
+        lines = _parameters_function(parameters)
+    else:
+        lines = _parameters(m, namer, helpers)
+        start = c_function_body(namer, helpers, _start(m))
+    lines += _function("int springc_start(const double *p, double *x, double *z)", start)
+    if grouped(m, vector):
+        tables, bodies = model_functions(m, outputs, helpers)
+        data += ["", *tables]
+        rhs, obs = bodies[0][1], bodies[1][1]
+    else:
+        loads = m.loads()
+        computed = set(m.ode.step_names())
+        rhs_stmts = loads + steps + m.alias_stmts([d for d in m.derivatives
+                                                   if d not in computed])
+        rhs_stmts += [Store(f"dx[{i}]", Var(d), d) for i, d in enumerate(m.derivatives)]
+        obs_stmts = loads + steps + m.alias_stmts(outputs)
+        obs_stmts += [Store(f"out[{i}]", Var(name), name) for i, name in enumerate(outputs)]
+        rhs = c_function_body(namer, helpers, rhs_stmts)
+        obs = c_function_body(namer, helpers, obs_stmts)
+    lines += _function(f"int springc_rhs({_SIGNATURE}, double *dx)", rhs)
+    lines += _function(f"int springc_observed({_SIGNATURE}, double *out)", obs)
+    large = grouped(m, vector) and jacobian_floor(m) > JACOBIAN_LIMIT
+    lines += _jacobian(m, [] if large else steps, described, namer, helpers, large)
+    return data, lines + _event_functions(m, namer, helpers)
 
 
 def _jacobian(m: CContext, steps: list[Stmt], described: list[tuple[ode.Step, int, str]],
-              namer: Namer, helpers: set[str]) -> list[str]:
+              namer: Namer, helpers: set[str], large: bool) -> list[str]:
     """``springc_jacobian`` (the non-zeros of d(rhs)/dx in CSC order, the analytic
     Jacobian of :mod:`.jacobian`, blocks through ``springc_solve``) and
     ``springc_jacobian_pattern``, where it has at most :data:`JACOBIAN_LIMIT`
     non-zeros (else ``SPRINGC_HAS_JACOBIAN`` is 0 and ``springc_jacobian`` returns
-    -3)."""
-    body, pattern = jacobian_statements(
+    -3; ``large``: known to have more, :func:`.c_vector.jacobian_floor`, so not
+    differentiated at all)."""
+    body, pattern = ([], []) if large else jacobian_statements(
         m.states, m.derivatives, described,
         {a.name: a.expr for a in m.ode.observed if a.name in m.derivative_set})
-    cheap = len(pattern) <= JACOBIAN_LIMIT
+    cheap = not large and len(pattern) <= JACOBIAN_LIMIT
     m.jacobian_size = len(pattern) if cheap else 0
     m.has_jacobian = cheap
     lines = ["", "SPRINGC_FN void springc_jacobian_pattern(int *rows, int *cols)", "{"]
@@ -158,7 +184,10 @@ def _parameters(m: CContext, namer: Namer, helpers: set[str]) -> list[str]:
         stmts.append(Let(q.name, If(Var(f"_pg{i}"), Var(f"_pp{i}"), parameter_value(q)),
                          source_comment(q.name, q.span)))
         stmts.append(Store(f"p[{i}]", Var(q.name)))
-    body = c_function_body(namer, helpers, stmts)
+    return _parameters_function(c_function_body(namer, helpers, stmts))
+
+
+def _parameters_function(body: list[str]) -> list[str]:
     return ["", "SPRINGC_FN void springc_parameters(double *p, const int *given)", "{",
             *body, "}", "",
             "SPRINGC_FN void springc_default_parameters(double *p)", "{",

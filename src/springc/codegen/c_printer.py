@@ -12,6 +12,7 @@ Model text reaches C only through :func:`c_string` (string literals), :func:`c_c
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Sequence
 
 from ..ir.builtins import BUILTINS, C_HELPERS
@@ -50,6 +51,8 @@ _RESERVED_WORDS = (
 )
 C_RESERVED = frozenset(_RESERVED_WORDS.split()) | frozenset(HELPERS)
 
+_PLAIN = re.compile(r"[\x20\x21\x23-\x3e\x40-\x5b\x5d-\x7e]*")
+"""Printable ASCII but ``"``, ``?`` and ``\\``: a C string literal as it is."""
 _C_PREC_OP = {"<>": "!=", "==": "==", "and": "&&", "or": "||"}
 
 
@@ -57,6 +60,8 @@ def c_string(text: str) -> str:
     """``text`` as a C string literal: its UTF-8 bytes, printable ASCII as itself except
     ``"``, ``\\`` and ``?`` (no trigraph can form), every other byte a 3-digit octal
     escape (which cannot run into a following digit)."""
+    if _PLAIN.fullmatch(text):  # most names: nothing to escape
+        return '"' + text + '"'
     out = []
     for byte in text.encode("utf-8"):
         char = chr(byte)

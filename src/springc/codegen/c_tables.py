@@ -30,6 +30,13 @@ _HEADER = """#if defined(__CUDACC_RTC__) && !defined(SPRINGC_NO_TABLES)
 #ifndef SPRINGC_FN
 #define SPRINGC_FN static
 #endif
+#ifndef SPRINGC_DATA
+#ifdef __CUDACC__
+#define SPRINGC_DATA static __device__ const
+#else
+#define SPRINGC_DATA static const
+#endif
+#endif
 #ifndef SPRINGC_INF
 #ifdef __CUDACC__
 #define SPRINGC_INF __longlong_as_double(0x7ff0000000000000LL)
@@ -78,6 +85,7 @@ def _macros(m: CContext, outputs: Sequence[str]) -> list[str]:
         ("SPRINGC_HYBRID", int(layout is not None)),
         ("SPRINGC_INITIAL_CONDITIONS", len(initial_conditions(m.ode))),
         ("SPRINGC_HAS_JACOBIAN", int(m.has_jacobian)), ("SPRINGC_N_JAC", m.jacobian_size),
+        ("SPRINGC_WORK_DOUBLES", m.work_doubles), ("SPRINGC_CODE_CHARS", m.code_chars),
     ]
     if layout is not None:
         s = layout.slot

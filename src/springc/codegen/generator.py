@@ -21,10 +21,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from ..errors import CodegenError, Span
+from ..errors import CodegenError
 from ..ir import flat, ode
 from ..ir.dae import derivative_name
-from ..ir.expr import Expr, Var, variables
+from ..ir.expr import Var, variables
 from ..ir.hybrid import event_expressions
 from .assertions import assertion_function
 from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
@@ -35,8 +35,8 @@ from .jacobian import jacobian_statements
 from .locate import at_initialization, locate
 from .module_text import module_text, parameter_value, topological
 from .printer import function_lines
-from .statements import Let, Namer, Raw, Store, reserved_name
-from .vector import VECTOR_THRESHOLD, VectorLayout
+from .statements import Namer, Raw, Store, reserved_name
+from .vector import VectorLayout, vector_statements, vector_suits
 
 # ------------------------------------------------------------------ parameters
 
@@ -117,11 +117,11 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
     if m.events is not None or len(m.delays):
         vector = False  # the event functions are written with scalar statements
     elif vector is None:
-        vector = _vector_suits(system)
-    elif vector and not _vector_suits(system, 0):
+        vector = vector_suits(system)
+    elif vector and not vector_suits(system, 0):
         raise CodegenError("the vector layout needs a system of explicit assignments only")
     if vector:
-        layout = VectorLayout(m, _vector_statements(m, outputs), numba)
+        layout = VectorLayout(m, vector_statements(m, outputs), numba)
         jac_lines, pattern = layout.jacobian_body(helpers)
         bodies = [
             ("rhs", "Time derivatives of the states at time t.",
@@ -154,21 +154,6 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
 
 
 _JAC_DOC = "Non-zeros of d(rhs)/dx in CSC order (JAC_INDICES, JAC_INDPTR)."
-
-
-def _vector_suits(system: ode.ODE, threshold: int = VECTOR_THRESHOLD) -> bool:
-    return (len(system.steps) >= threshold
-            and all(isinstance(s, ode.Assign) for s in system.steps))
-
-
-def _vector_statements(m: CodegenContext, outputs: Sequence[str]) -> list[tuple[str, Expr, Span]]:
-    statements = [(s.name, s.expr, s.span) for s in m.ode.steps if isinstance(s, ode.Assign)]
-    computed = {s[0] for s in statements}
-    wanted = [d for d in m.derivatives if d not in computed] + list(outputs)
-    for let in m.alias_stmts(wanted):
-        assert isinstance(let, Let)
-        statements.append((let.name, let.expr, m.aliases[let.name].span))
-    return statements
 
 
 def _scalar_bodies(m: CodegenContext, outputs: Sequence[str], namer: Namer, helpers: set[str],

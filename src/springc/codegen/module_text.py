@@ -23,7 +23,7 @@ from .events import constants as event_constants
 from .module_api import CODEGEN_VERSION, ModuleKind
 from .printer import HELPERS, function_lines
 from .statements import Let, Namer, Raw, Stmt, Store, escaped
-from .vector import VECTOR_THRESHOLD, VectorLayout
+from .vector import VectorLayout, parameters_suit
 
 FROZEN_BYTES = 10**6
 """numba's limit for freezing a global array into compiled code (``make_constant_array``)."""
@@ -296,8 +296,7 @@ def _parameters_vector(m: CodegenContext, helpers: set[str]) -> list[str]:
 
 def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> list[str]:
     """``parameters(values)``, ``start(p)`` and ``guesses(p)``: plain Python."""
-    if m.guess_slots == {} and len(m.params) + len(m.states) >= VECTOR_THRESHOLD \
-            and m.events is None:
+    if parameters_suit(m):
         return _parameters_vector(m, helpers)
     index = {name: i for i, name in enumerate(m.params)}
     stmts: list[Stmt] = []

@@ -11,7 +11,9 @@ of equal shape whose operands are ready at the same dependency level form a grou
 members are ordered by their subscripts (``s[2]`` before ``s[10]``), so the
 indices of chains and grids advance by constant strides. A run of members with
 constant strides becomes one loop (numba) or one slice expression (numpy); other
-members read their indices from the table ``_I``.
+members read their indices from the table ``_I``. The C model (:mod:`.c_model`) prints
+the same loops in C (``c=True``: ``for`` loops, fixed-size work arrays, the tables as
+``static const`` arrays), so one grouping serves the numba module and the C file.
 
 The Jacobian is forward-mode over the same groups: each loop also stores the partial
 derivatives of its shape in ``D``, and a precomputed tape of multiply-adds
@@ -28,11 +30,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import Span
+from ..ir import ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, diff, to_text
+from .c_printer import c_comment, c_function_body
 from .context import CodegenBug, CodegenContext
 from .locate import untranslatable
 from .printer import NumpyWriter, function_lines
-from .statements import Store, escaped
+from .statements import Let, Store, escaped
 
 VECTOR_THRESHOLD = 300
 """Systems with at least this many explicit assignments use the vector layout."""
@@ -40,6 +44,34 @@ MIN_RUN = 8
 """Shorter runs of constant strides go to the index table instead of a loop."""
 
 _ARRAY = {"x": "x", "p": "p", "w": "w", "d": "dx", "c": "_F"}
+
+
+def vector_suits(system: ode.ODE, threshold: int = VECTOR_THRESHOLD) -> bool:
+    """Whether ``system``'s functions take the vector layout: at least ``threshold``
+    steps, all explicit assignments (the one policy of the Python modules and the C
+    file; a model with events or delays keeps scalar statements: its callers check)."""
+    return (len(system.steps) >= threshold
+            and all(isinstance(s, ode.Assign) for s in system.steps))
+
+
+def vector_statements(m: CodegenContext, outputs: Sequence[str]
+                      ) -> list[tuple[str, Expr, Span]]:
+    """The assignments of ``rhs`` and ``observed`` (``outputs``) for the layout: the
+    system's steps, then the aliases the derivatives and outputs read."""
+    statements = [(s.name, s.expr, s.span) for s in m.ode.steps if isinstance(s, ode.Assign)]
+    computed = {s[0] for s in statements}
+    wanted = [d for d in m.derivatives if d not in computed] + list(outputs)
+    for let in m.alias_stmts(wanted):
+        assert isinstance(let, Let)
+        statements.append((let.name, let.expr, m.aliases[let.name].span))
+    return statements
+
+
+def parameters_suit(m: CodegenContext) -> bool:
+    """Whether ``parameters`` and ``start`` take the vector layout (constants lifted
+    into a table): many parameters and states, no Newton guesses, no events."""
+    return (m.guess_slots == {} and len(m.params) + len(m.states) >= VECTOR_THRESHOLD
+            and m.events is None)
 
 
 @dataclass
@@ -74,29 +106,43 @@ def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
     return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
 
 
-def _shape(e: Expr, slots: list[str]) -> Expr:
+def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None) -> Expr:
+    """``e`` with a slot for each variable (and, with ``lift``, each number: ``lift``
+    names the table entry that holds it)."""
     if isinstance(e, Var):
         slots.append(e.name)
+        return Var(f"${len(slots) - 1}")
+    if isinstance(e, Const) and lift is not None and isinstance(e.value, (int, float)) \
+            and not isinstance(e.value, bool):
+        slots.append(lift(float(e.value)))
         return Var(f"${len(slots) - 1}")
     if isinstance(e, (Const, Time)):
         return e
     if isinstance(e, (Neg, Not)):
-        return type(e)(_shape(e.arg, slots))
+        return type(e)(_shape(e.arg, slots, lift))
     if isinstance(e, BinOp):
-        return BinOp(e.op, _shape(e.left, slots), _shape(e.right, slots))
+        return BinOp(e.op, _shape(e.left, slots, lift), _shape(e.right, slots, lift))
     if isinstance(e, Call):
-        return Call(e.name, tuple(_shape(a, slots) for a in e.args))
+        return Call(e.name, tuple(_shape(a, slots, lift) for a in e.args))
     if isinstance(e, If):
-        return If(_shape(e.cond, slots), _shape(e.then, slots), _shape(e.otherwise, slots))
+        return If(_shape(e.cond, slots, lift), _shape(e.then, slots, lift),
+                  _shape(e.otherwise, slots, lift))
     raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
+
+
+def _fixed(text: str) -> Callable[[str], str]:
+    return lambda q: text
 
 
 class VectorLayout:
     """The grouped form of a system of explicit assignments, for one backend."""
 
     def __init__(self, m: CodegenContext, statements: Sequence[tuple[str, Expr, Span]],
-                 numba: bool, table_name: str = "_I", lift_constants: bool = False) -> None:
-        self.m, self.numba, self.table_name = m, numba, table_name
+                 numba: bool, table_name: str = "_I", lift_constants: bool = False,
+                 c: bool = False, float_name: str = "_F") -> None:
+        # numba and C print loops with indices; numpy prints slices and gathers
+        self.m, self.numba, self.c, self.table_name = m, numba or c, c, table_name
+        self.arrays = {**_ARRAY, "c": float_name}
         self.table: list[int] = []
         self.floats: list[float] = []
         self.location: dict[str, tuple[str, int]] = {}
@@ -107,12 +153,14 @@ class VectorLayout:
         groups: dict[tuple[object, ...], int] = {}  # compared once here, not per grouping
         for name, e, span in statements:
             slots: list[str] = []
-            if lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
+            if lift_constants and c:
+                # Every number becomes data (C's doubles either way), so that
+                # bindings such as L * 2, L * 3, ... group whatever their numbers.
+                shape: Expr = _shape(e, slots, self._lifted)
+            elif lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
                 # Constant values become data (_F), so they group whatever their value.
-                slots.append(f"#{len(self.floats)}")
-                self.location[slots[0]] = ("c", len(self.floats))
-                self.floats.append(float(e.value))
-                shape: Expr = Var("$0")
+                slots.append(self._lifted(float(e.value)))
+                shape = Var("$0")
             else:
                 shape = _shape(e, slots)
             for v in slots:
@@ -137,6 +185,12 @@ class VectorLayout:
                     self.w_names.append(a.name)
         for a in self.assignments.values():
             a.operands = [self.location[v] for v in a.slots]
+
+    def _lifted(self, value: float) -> str:
+        name = f"#{len(self.floats)}"
+        self.location[name] = ("c", len(self.floats))
+        self.floats.append(value)
+        return name
 
     def _kind(self, name: str) -> str:
         if name in self.location:
@@ -175,7 +229,7 @@ class VectorLayout:
         with a constant offset) for numba; one slice or one gather for numpy."""
         matrix = np.array([[a.out[1]] + [o[1] for o in a.operands] for a in group],
                           dtype=np.int64).reshape(len(group), -1)
-        arrays = [_ARRAY[group[0].out[0]]] + [_ARRAY[k] for k in group[0].kinds]
+        arrays = [self.arrays[group[0].out[0]]] + [self.arrays[k] for k in group[0].kinds]
         spans: list[tuple[int, int]] = []  # maximal runs of constant strides
         i = 0
         while i < len(group):
@@ -266,41 +320,68 @@ class VectorLayout:
         """``stores`` of (target access, expression over slots) for every member."""
         first = run.members[0]
         count = len(run.members)
-        comment = escaped(first.comment)
-        lines.append(f"    # {count} x {comment}" if count > 1 else f"    # {comment}")
+        if self.c:
+            text = c_comment(f"{count} x {first.comment}" if count > 1 else first.comment)
+            lines.append(f"    /* {text} */")
+        else:
+            comment = escaped(first.comment)
+            lines.append(f"    # {count} x {comment}" if count > 1 else f"    # {comment}")
         looped = self.numba and count > 1
         names = {f"${k}": acc("_q") for k, acc in enumerate(run.access[1:])}
         stmts = [Store(target("_q"), e) for target, e in stores]
         indent = "    "
-        if looped:
-            for var, size in zip(["_r", "_q"][-len(run.dims):], run.dims):
-                lines.append(f"{indent}for {var} in range({size}):")
-                indent += "    "
+        loops = list(zip(["_r", "_q"][-len(run.dims):], run.dims)) if looped else []
+        for var, size in loops:
+            lines.append(f"{indent}for (int {var} = 0; {var} < {size}; {var}++) {{"
+                         if self.c else f"{indent}for {var} in range({size}):")
+            indent += "    "
+        if self.c:
+            lines += c_function_body(lambda n: names.get(n, n), helpers, stmts, indent)
+            lines += [f"{'    ' * k}}}" for k in range(len(loops), 0, -1)]
+            return
         writer = None if self.numba else NumpyWriter
         lines += function_lines(lambda n: names.get(n, n), helpers, stmts, indent, writer)
 
-    def _arrays(self, needed: Sequence[_Assignment]) -> list[str]:
+    def _sizes(self, needed: Sequence[_Assignment], dx: bool) -> list[tuple[str, int]]:
         kinds = {a.out[0] for a in needed} | {k for a in needed for k in a.kinds}
-        lines = []
-        if "w" in kinds:
-            lines.append(f"    w = np.empty({max(1, len(self.w_names))})")
-        if "d" in kinds:
-            lines.append(f"    dx = np.empty({len(self.m.states)})")
-        return lines
+        sizes = [("w", max(1, len(self.w_names)))] if "w" in kinds else []
+        if "d" in kinds and dx:
+            sizes.append(("dx", len(self.m.states)))
+        return sizes
+
+    def _arrays(self, needed: Sequence[_Assignment], dx: bool = True) -> list[str]:
+        """The work arrays ``needed`` writes: ``w``, and ``dx`` unless ``dx`` is False
+        (the caller's own array: C's ``springc_rhs``)."""
+        if self.c:
+            return [f"    double {name}[{size}];" for name, size in self._sizes(needed, dx)]
+        return [f"    {name} = np.empty({size})" for name, size in self._sizes(needed, dx)]
+
+    def work_doubles(self, targets: Sequence[str], dx: bool = True) -> int:
+        """The doubles of :meth:`body`'s work arrays for ``targets`` (C: on the stack)."""
+        return sum(size for _, size in self._sizes(self.needed(targets), dx))
 
     def body(self, targets: Sequence[str], helpers: set[str],
-             after_level: Sequence[str] = ()) -> list[str]:
+             after_level: Sequence[str] = (), dx: bool = True,
+             kept: Callable[[str], str] | None = None) -> list[str]:
         """Statements computing ``targets`` (and what they read) into ``w``/``dx``;
-        ``after_level`` lines run after each dependency level."""
+        ``after_level`` lines run after each dependency level. ``dx`` False: the
+        caller holds ``dx`` (C). ``kept`` (C): the text of a condition on an output's
+        index (``q``) under which the output keeps its value (a given parameter)."""
         needed = self.needed(targets)
-        lines = self._arrays(needed)
+        lines = self._arrays(needed, dx)
         level = None
         for group in self._groups(needed):
             if level is not None and group[0].level != level:
                 lines += after_level
             level = group[0].level
             for run in self._runs(group):
-                self._loop(run, [(run.access[0], run.members[0].shape)], helpers, lines)
+                shape = run.members[0].shape
+                if kept is not None:  # two more slots: the condition, the old value
+                    slot = len(run.access) - 1
+                    condition: str = kept(run.access[0]("_q"))
+                    run.access += [_fixed(condition), run.access[0]]
+                    shape = If(Var(f"${slot}"), Var(f"${slot + 1}"), shape)
+                self._loop(run, [(run.access[0], shape)], helpers, lines)
         return lines + list(after_level)
 
     def jacobian_body(self, helpers: set[str]) -> tuple[list[str], list[tuple[int, int]]]:
@@ -382,19 +463,24 @@ class VectorLayout:
         return lines
 
     def gather(self, names: Sequence[str]) -> list[str]:
-        """``out`` holding ``names`` (computed by :meth:`body`)."""
+        """``out`` holding ``names`` (computed by :meth:`body`; C: the caller's ``out``)."""
         w = [self.location[n] for n in names]
-        lines = [f"    out = np.empty({len(names)})"]
+        t = self.table_name
+        lines = [] if self.c else [f"    out = np.empty({len(names)})"]
         for kind in ("w", "d", "x", "p"):
             pos = [i for i, (k, _) in enumerate(w) if k == kind]
             if not pos:
                 continue
             src = self._index([w[i][1] for i in pos])
             dst = self._index(pos)
-            if self.numba:
+            array = self.arrays[kind]
+            if self.c:
+                lines += [f"    for (int _q = 0; _q < {len(pos)}; _q++) "
+                          f"out[{t}[{dst} + _q]] = {array}[{t}[{src} + _q]];"]
+            elif self.numba:
                 lines += [f"    for _q in range({len(pos)}):",
-                          f"        out[_I[{dst} + _q]] = {_ARRAY[kind]}[_I[{src} + _q]]"]
+                          f"        out[{t}[{dst} + _q]] = {array}[{t}[{src} + _q]]"]
             else:
-                lines.append(f"    out[_I[{dst}:{dst + len(pos)}]] = "
-                             f"{_ARRAY[kind]}[_I[{src}:{src + len(pos)}]]")
+                lines.append(f"    out[{t}[{dst}:{dst + len(pos)}]] = "
+                             f"{array}[{t}[{src}:{src + len(pos)}]]")
         return lines

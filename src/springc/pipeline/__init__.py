@@ -25,15 +25,16 @@ from .selection import select_names
 
 if TYPE_CHECKING:
     from .c_build import CCompilerMissing, CLibrary, c_library, c_source, find_compiler
-    from .c_kernels import kernel_library, loop_library, openmp_flags
+    from .c_kernels import CLoopRefused, kernel_library, loop_library, note_refused, openmp_flags
     from .files import flatten_files
     from .generation import derive_system, generate_source
 
-__all__ = ["CCompilerMissing", "CLibrary", "CompileOptions", "CompiledModel", "ModuleKind",
+__all__ = ["CCompilerMissing", "CLibrary", "CLoopRefused", "CompileOptions", "CompiledModel",
+           "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
            "compile_files", "derive_system", "derived_kept", "find_compiler", "flatten_files",
            "generate_source", "kernel_library", "loop_library", "modification_value",
-           "openmp_flags", "select_names", "split_values"]
+           "note_refused", "openmp_flags", "select_names", "split_values"]
 
 
 def __getattr__(name: str) -> Any:
@@ -46,7 +47,8 @@ def __getattr__(name: str) -> Any:
         from . import c_build
 
         return getattr(c_build, name)
-    if name in ("kernel_library", "loop_library", "openmp_flags"):
+    if name in ("kernel_library", "loop_library", "openmp_flags", "CLoopRefused",
+                "note_refused"):
         from . import c_kernels
 
         return getattr(c_kernels, name)

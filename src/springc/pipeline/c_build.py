@@ -75,6 +75,21 @@ def find_compiler() -> list[str]:
                            "the Python module needs none")
 
 
+class CompilerRefused(CodegenBug):
+    """The C compiler failed on springc's C text (a bug of springc's printer, or a
+    broken compiler); ``stderr``: what the compiler said."""
+
+    def __init__(self, message: str, stderr: str) -> None:
+        super().__init__(message)
+        self.stderr = stderr
+
+    def first_error(self) -> str:
+        """The compiler's first line that names an error (else its first line)."""
+        lines = [line.strip() for line in self.stderr.splitlines() if line.strip()]
+        named = [line for line in lines if "error" in line]
+        return (named or lines or ["no message"])[0][:200]
+
+
 def build_library(source: str, folder: Path, extra: Sequence[str] = ()) -> bytes:
     """The shared library compiled from the C text ``source`` in ``folder`` (a private
     folder of the caller), with further compiler arguments ``extra``; its bytes."""
@@ -85,9 +100,9 @@ def build_library(source: str, folder: Path, extra: Sequence[str] = ()) -> bytes
     argv = [*find_compiler(), *C_FLAGS, *extra, "-o", "build.so", "build.c", "-lm"]
     done = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=folder)
     if done.returncode != 0 or not out.is_file():
-        raise CodegenBug("the C compiler refused springc's C model "
-                         f"({' '.join(argv[:1])} exit {done.returncode}): "
-                         + done.stderr.strip()[-2000:])
+        raise CompilerRefused("the C compiler refused springc's C model "
+                              f"({' '.join(argv[:1])} exit {done.returncode}): "
+                              + done.stderr.strip()[-2000:], done.stderr)
     return out.read_bytes()
 
 

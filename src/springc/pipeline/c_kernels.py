@@ -17,16 +17,18 @@ import contextlib
 import ctypes
 import functools
 import hashlib
+import re
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
 from ..codegen import CodegenBug
+from ..errors import CodegenError
 from ..integrate import locked, loop_text
 from ..native import LIBRARY_FILE, LoopLibrary
 from ..status_line import say
-from .c_build import ZIG_MODULE, build_library, c_source, find_compiler
-from .cache import add_to_entry, read_addition
+from .c_build import ZIG_MODULE, CompilerRefused, build_library, c_source, find_compiler
+from .cache import add_to_entry, note, read_addition
 from .compiler import CompiledModel
 
 
@@ -94,37 +96,114 @@ LOOP_NOTE = "compiling the C loop of {model} for this machine (once), about {sec
 """The status line before a model's loop library is built (it is not in the cache)."""
 
 
+C_LOOP_CODE_CHARS = 1_000_000
+"""The most characters of C functions (``SPRINGC_CODE_CHARS``) of a model the C loop
+takes: the C compiler's time grows faster than the code of one function (scalar
+statements: the 100-mass chain's 0.5 MB took gcc -O2 3 s of CPU, the 1,000-mass
+chain's 5 MB over 3 minutes). Large scenes in the vector layout stay far below (the
+10,000-mass chain: loops over index tables, gcc 3 s); a model beyond runs on numba."""
+C_LOOP_STACK_BYTES = 2 * 1024 * 1024
+"""The most bytes the C loop's model functions keep on the stack of the thread that
+runs them: the work arrays of the vector layout (``SPRINGC_WORK_DOUBLES``) and the
+loop's row of observed values (``SPRINGC_N_OBSERVED``); a quarter of Linux's usual
+8 MiB (the 10,000-mass chain: 1.3 MB); a model beyond runs on numba."""
+
+
+C_LOOP_DENSE_STATES = 256
+"""The most states of a model whose C model has no Jacobian (``SPRINGC_HAS_JACOBIAN``
+0: over ``codegen.c_model.JACOBIAN_LIMIT`` non-zeros) the C loop takes: its radau and
+bdf (explicitly asked for, or run by ``auto``'s race) then difference and factorise a
+dense Jacobian, n**2 memory and n**3 work per factorisation; a larger one runs on
+numba, whose analytic Jacobian is sparse."""
+
+
+class CLoopRefused(CodegenError):
+    """The C loop cannot run a model: it exceeds what the loop takes
+    (:func:`loop_refusal`), or the C compiler refused its text (``failed_build``:
+    a bug of springc's C printer or a broken compiler, worth a note)."""
+
+    def __init__(self, message: str, failed_build: bool = False) -> None:
+        super().__init__(message)
+        self.failed_build = failed_build
+
+
+def note_refused(error: CodegenError, instead: str) -> None:
+    """The one-line note on stderr of a C loop the compiler refused (``error``),
+    saying which loop runs ``instead``; nothing for a model the loop does not take."""
+    if isinstance(error, CLoopRefused) and error.failed_build:
+        note(f"{error.message}; running on {instead}")
+
+
+def loop_refusal(text: str) -> str | None:
+    """Why the C loop does not take the model of the C file ``text`` (its size
+    macros against :data:`C_LOOP_CODE_CHARS`, :data:`C_LOOP_STACK_BYTES` and
+    :data:`C_LOOP_DENSE_STATES`), or
+    None where it does. The loop runs continuous models only: the caller checks."""
+    sizes = _sizes(text)
+    code = sizes["SPRINGC_CODE_CHARS"]
+    if code > C_LOOP_CODE_CHARS:
+        return (f"its C functions take {code:,} characters (the C loop takes at most "
+                f"{C_LOOP_CODE_CHARS:,})")
+    stack = 8 * (sizes["SPRINGC_WORK_DOUBLES"] + sizes["SPRINGC_N_OBSERVED"])
+    if stack > C_LOOP_STACK_BYTES:
+        return (f"its C functions need {stack:,} bytes of stack (the C loop takes at "
+                f"most {C_LOOP_STACK_BYTES:,})")
+    states = sizes["SPRINGC_N_STATES"]
+    if not sizes["SPRINGC_HAS_JACOBIAN"] and states > C_LOOP_DENSE_STATES:
+        return (f"it has {states:,} states and no Jacobian in C (the C loop's implicit "
+                f"methods would factorise a dense one; it takes at most "
+                f"{C_LOOP_DENSE_STATES:,} states without one)")
+    return None
+
+
+def _sizes(text: str) -> dict[str, int]:
+    head = text[:text.find("#ifndef SPRINGC_NO_TABLES")]
+    return {name: int(value) for name, value
+            in re.findall(r"^#define (SPRINGC_\w+) (\d+)$", head, re.MULTILINE)}
+
+
 def loop_library(model: CompiledModel) -> LoopLibrary:
     """The loop library of ``model`` (the compiled engine's DOP853 and RK45 in C around
     the model's C functions, :func:`springc.integrate.native_loop.loop_text`), loaded:
     from its cache entry (``cloop.so``, verified against ``cloop.sha256``), else built
     once (under a file lock in the entry, so that workers that need it at once build it
     once) and added there. The entry's key covers springc's C sources
-    (:func:`.cache.springc_digest`), so the library's name needs no hash of its own."""
+    (:func:`.cache.springc_digest`), so the library's name needs no hash of its own.
+    :class:`CLoopRefused` where the model exceeds what the loop takes or the compiler
+    refuses its text; a :class:`CodegenError` where C cannot spell the model."""
     entry = model.path.parent
     data = read_addition(entry, LIBRARY_FILE)
     if data is None:
+        text = c_source(model)
+        refusal = loop_refusal(text)
+        if refusal is not None:
+            raise CLoopRefused(f"the C loop does not run {model.name}: {refusal}")
         with locked(entry, "cloop"):
             data = read_addition(entry, LIBRARY_FILE)  # built while this one waited
             if data is None:
-                data = _build_loop(model)
+                data = _build_loop(model.name, text, _sizes(text)["SPRINGC_CODE_CHARS"])
                 with contextlib.suppress(OSError):  # a read-only cache: built again
                     add_to_entry(entry, LIBRARY_FILE, data)
     return _loaded(hashlib.sha256(data).hexdigest(), data)
 
 
-def _build_loop(model: CompiledModel) -> bytes:
-    text = loop_text(c_source(model))
-    seconds = max(1, round(len(text) / LOOP_CHARS_PER_SECOND))
+def _build_loop(name: str, model_text: str, code: int) -> bytes:
+    text = loop_text(model_text)
+    seconds = max(1, round((code + len(text) - len(model_text)) / LOOP_CHARS_PER_SECOND))
     if seconds > 1 or ZIG_MODULE in find_compiler():
-        say(LOOP_NOTE.format(model=model.name, seconds=seconds))
+        say(LOOP_NOTE.format(model=name, seconds=seconds))
     with tempfile.TemporaryDirectory(prefix="springc-cc-") as folder:
-        return build_library(text, Path(folder), LOOP_FLAGS)
+        try:
+            return build_library(text, Path(folder), LOOP_FLAGS)
+        except CompilerRefused as bug:
+            raise CLoopRefused(f"the C compiler refused the C loop of {name} "
+                               f"({bug.first_error()})", failed_build=True) from None
 
 
 LOOP_CHARS_PER_SECOND = 70_000
-"""About the characters of C the compiler takes per CPU second (the seed's loop
-library, about 98,000 characters with the implicit methods, GCC compiling those at
+"""About the characters of C code (the model's functions, ``SPRINGC_CODE_CHARS``, and
+the loop's; the name tables cost little) the compiler takes per CPU second (the seed's
+loop library, about 98,000 characters with the implicit methods, GCC compiling those at
 -O1, takes 1.1-1.6 s with gcc): the status line's estimate, said where the build may
 take over a second."""
 LOOP_FLAGS = ("-fvisibility=hidden",)

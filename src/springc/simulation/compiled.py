@@ -59,11 +59,6 @@ C_SOLVERS = ("dop853", "rk45", "radau", "bdf")
 """The methods the C loop runs (continuous models; ``auto``'s explicit method and the
 radau its race may hand over to too)."""
 C_LOOP, NUMBA_LOOP = "c", "numba"
-C_LOOP_STATES = 256
-"""The most states of a model the C loop runs: the C model is printed one statement per
-scalar (no loops over index tables, as the python and numba modules' vector layout
-has), and the C compiler's time grows faster than its text (the 1,000-mass chain's
-5 MB took gcc over 3 minutes at -O2); larger models are generated for numba."""
 SCIPY_COLLAPSE = "Required step size is less than spacing between numbers."
 """scipy's message for the same failure (the step loop words both alike)."""
 
@@ -93,13 +88,15 @@ def c_loop_available() -> bool:
     return True
 
 
-def c_loop_runs(solver: str, backend: str | None, states: int = 0) -> bool:
+def c_loop_runs(solver: str, backend: str | None) -> bool:
     """Whether a run of ``solver`` on a module of ``backend`` (None: not chosen yet)
-    with ``states`` states (0: not known yet) takes the C loop: a solver it runs (or
-    ``auto``), a python module (the C loop needs no numba functions), at most
-    :data:`C_LOOP_STATES` states and :func:`c_loop_available`."""
+    may take the C loop: a solver it runs (or ``auto``), a python module (the C loop
+    needs no numba functions) and :func:`c_loop_available`. The model decides the
+    rest: a continuous one whose loop library builds
+    (:func:`springc.pipeline.loop_library`: printable in C, within
+    :data:`springc.pipeline.c_kernels.C_LOOP_CODE_CHARS` and ``C_LOOP_STACK_BYTES``)."""
     return (solver == AUTO or solver in C_SOLVERS) and backend in (None, "python") \
-        and states <= C_LOOP_STATES and c_loop_available()
+        and c_loop_available()
 
 
 def default_backend(engine: str = AUTO, solver: str = AUTO) -> str:

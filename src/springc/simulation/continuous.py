@@ -63,7 +63,7 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             # the C loop runs a python module's model (choose_engine allowed it); a large
             # model's generated functions may be plain Python otherwise: scipy's loop then
             native = engine == COMPILED and not jitted(model.module) \
-                and c_loop_runs(solver, model.module.BACKEND, len(x0)) and loop_ready(problem)
+                and c_loop_runs(solver, model.module.BACKEND) and loop_ready(problem)
             compiled = engine == COMPILED and (native or jitted(model.module))
             finish = (advance_native if native else advance_compiled) if compiled else None
             loop_time = 0.0
@@ -87,8 +87,8 @@ def simulate_continuous(model: CompiledModel, plan: RunPlan) -> SimulationResult
             if problem.asserts and (compiled or not len(x0)):
                 problem.asserts.grid(grid, states, problem.z, _locate(
                     problem, grid, states, solver, rtol, atol, step) if len(x0) else None)
-            # a C loop run's outputs come from the C model at once (at most
-            # C_LOOP_STATES states: small); others may be deferred for error control
+            # a C loop run's outputs come from the C model at once; others may be
+            # deferred for error control
             deferred = DeferredOutputs(model, problem, grid, states) \
                 if options.deferred_outputs and not native and _in_order(model) else None
             outputs = _outputs(model, problem, grid, states, native) if deferred is None \

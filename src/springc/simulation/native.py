@@ -50,7 +50,12 @@ def loop_ready(problem: Problem) -> bool:
     regenerates such a model for numba)."""
     try:
         library(problem)
-    except (SimulationError, CodegenError):
+    except CodegenError as error:
+        from ..pipeline import note_refused
+
+        note_refused(error, "scipy's loop")
+        return False
+    except SimulationError:
         return False
     return True
 
