@@ -67,12 +67,22 @@ MAX_INTEGER_EXPONENT = 4096
 def check_powers(e: x.Expr, values: Mapping[str, Any]) -> None:
     """Raise OverflowError for an integer power in ``e`` whose exact value would be huge;
     inner powers are checked before the operands that contain them are evaluated."""
+    _check_powers(e, values, set())
+
+
+def _check_powers(e: x.Expr, values: Mapping[str, Any], seen: set[int]) -> None:
+    """:func:`check_powers`, a node shared by several parents once (``seen``: the ids
+    of the nodes of ``e`` visited, alive as long as ``e``). A symbolic loop of a
+    function (Blocks.Continuous.Filter's) builds graphs whose trees are exponential."""
+    if id(e) in seen:
+        return
+    seen.add(id(e))
     if not isinstance(e, x.BinOp) or e.op != "^":
         for child in x.children(e):
-            check_powers(child, values)
+            _check_powers(child, values, seen)
         return
-    check_powers(e.left, values)
-    check_powers(e.right, values)
+    _check_powers(e.left, values, seen)
+    _check_powers(e.right, values, seen)
     base, exponent = x.evaluate(e.left, values), x.evaluate(e.right, values)
     if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
             and abs(exponent) > MAX_INTEGER_EXPONENT:
