@@ -204,10 +204,35 @@ def unique(pending: list[Pending]) -> tuple[flat.Assertion, ...]:
     twice), without those of functions that hold trivially."""
     seen: set[tuple[object, ...]] = set()
     out: list[flat.Assertion] = []
+    memo: dict[int, int] = {}
     for item, _span in pending:
-        key = (item.condition, item.message, item.level, item.span)
+        key = (digest(item.condition, memo), item.message, item.level, item.span)
         if key in seen or (item.origin.kind == "function" and item.condition == x.Const(True)):
             continue
         seen.add(key)
         out.append(item)
     return tuple(out)
+
+
+def digest(e: x.Expr, memo: dict[int, int]) -> int:
+    """A structural hash of ``e``, each node shared by several parents hashed once
+    (``memo``, by id, valid while the nodes live): the dataclasses' own hash walks the
+    whole tree, exponential in the graphs of symbolic loops in functions (the asserts of
+    Blocks.Continuous.Filter's coefficient functions took minutes)."""
+    stack = [e]
+    while stack:
+        node = stack[-1]
+        if id(node) in memo:
+            stack.pop()
+            continue
+        kids = x.children(node)
+        missing = [k for k in kids if id(k) not in memo]
+        if missing:
+            stack += missing
+            continue
+        stack.pop()
+        own = (node.op if isinstance(node, x.BinOp) else node.name
+               if isinstance(node, (x.Call, x.Var)) else (node.value, type(node.value))
+               if isinstance(node, x.Const) else None)
+        memo[id(node)] = hash((type(node).__name__, own, *(memo[id(k)] for k in kids)))
+    return memo[id(e)]
