@@ -62,6 +62,12 @@ BUS = """package P
   equation
     connect(s, bus.missing);
   end Undeclared;
+  model Augmented
+    Bus bus;
+    Part part;
+  equation
+    connect(bus, part.sub);
+  end Augmented;
 end P;
 """
 
@@ -113,3 +119,14 @@ def test_a_name_the_bus_does_not_declare_is_not_supported_yet(tmp_path: Path) ->
     assert error.message == ("adding 'missing' to the expandable connector 'bus' (P.Bus) "
                              "by a connection is not supported yet")
     assert (error.span.line, error.span.column) == (45, 20)
+
+
+def test_buses_declaring_different_variables_are_not_supported_yet(tmp_path: Path) -> None:
+    path = tmp_path / "bus.mo"
+    path.write_text(BUS)
+    with pytest.raises(FlattenError) as info:
+        flatten_files([path], "P.Augmented")
+    assert info.value.message == (
+        "connecting the expandable connectors 'bus' (P.Bus) and 'part.sub' (P.SubBus), "
+        "which declare different variables, is not supported yet")
+    assert (info.value.span.line, info.value.span.column) == (51, 5)

@@ -31,7 +31,7 @@ from ..scopes import (
 )
 from .connect_rules import check_pair, check_reference_form, check_sources, overdetermined
 from .connection_graph import ConnectionGraph, Edge
-from .expandable import absent, undeclared_member
+from .expandable import absent, augmenting, undeclared_member
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -209,6 +209,9 @@ class ConnectionSets:
             self._pair_signals(ca, cb, out_a, out_b, eq, owner)
             return
         leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
+        if ca.connector_signature != cb.connector_signature and ca.expandable \
+                and cb.expandable:
+            raise augmenting(ca, cb, eq.span)
         if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "

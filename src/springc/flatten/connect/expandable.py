@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from ...errors import FlattenError
+from ...errors import FlattenError, Span
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
@@ -32,6 +32,14 @@ def undeclared_member(owner: ClassScope, ref: s.Ref) -> FlattenError:
         f"adding '{last.name}' to the expandable connector '{owner.prefix}' "
         f"({owner.entry.full_name}) by a connection is not supported yet", last.span,
         hint=f"declare '{last.name}' in '{owner.entry.full_name}' (section 9.1.3)")
+
+
+def augmenting(a: ClassScope, b: ClassScope, span: Span) -> FlattenError:
+    """``connect(bus1, bus2)`` of expandable connectors that declare different variables."""
+    return FlattenError(
+        f"connecting the expandable connectors '{a.prefix}' ({a.entry.full_name}) and "
+        f"'{b.prefix}' ({b.entry.full_name}), which declare different variables, is not "
+        "supported yet", span, hint="declare the same variables in both (section 9.1.3)")
 
 
 def absent(candidates: set[str], sets: Iterable[list[str]], model: flat.FlatModel
