@@ -491,7 +491,6 @@ def test_other_lexical_and_syntax_errors() -> None:
 
 UNSUPPORTED = [
     ("connector C stream Real h; end C;", "`stream` connectors are"),
-    ("expandable connector C end C;", "`expandable` connectors are"),
     ("operator record R end R;", "`operator` classes are"),
     ("impure function f end f;", "`impure` functions are"),
     ("model A Real x = (y)[1]; end A;", "subscripts on a parenthesized expression (`(e)[i]`) are"),
@@ -510,13 +509,13 @@ def test_unsupported_constructs_are_rejected(text: str, what: str) -> None:
 def test_all_unsupported_constructs_are_reported_together() -> None:
     text = (
         "model A\n  Real y;\n  stream Real h;\nend A;\n"
-        "expandable connector E\nend E;\n"
+        "impure function f\nend f;\n"
     )
     with pytest.raises(ErrorGroup) as info:
         parse_text(text, "t.mo")
     assert [(e.message, e.span.line, e.span.column) for e in info.value.errors] == [
         ("`stream` connectors are not supported yet", 3, 3),
-        ("`expandable` connectors are not supported yet", 5, 1),
+        ("`impure` functions are not supported yet", 5, 1),
     ]
 
 

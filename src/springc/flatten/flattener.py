@@ -10,6 +10,7 @@ from __future__ import annotations
 import gc
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import replace
 from typing import cast
 
 import numpy as np
@@ -207,13 +208,17 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     if flattener.errors:
         errs = flattener.errors
         raise errs[0] if len(errs) == 1 else ErrorGroup(errs)
-    flattener.equations += flattener.connections.equations(scopes, top)
-    return flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
-                          tuple(flattener.initial_equations),
-                          experiment_of(flattener, entry, top), entry.defn.span,
-                          notes=(*tree.notes, *added_inner_notes(top)),
-                          whens=tuple(flattener.whens),
-                          assertions=unique(flattener.assertions))
+    flat_model = flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
+                                tuple(flattener.initial_equations),
+                                experiment_of(flattener, entry, top), entry.defn.span,
+                                notes=(*tree.notes, *added_inner_notes(top)),
+                                whens=tuple(flattener.whens),
+                                assertions=unique(flattener.assertions))
+    # the variables of expandable connectors that are not present (9.1.3)
+    gone = flattener.connections.absent(scopes, flat_model)
+    connected = flattener.connections.equations(scopes, top, gone)
+    return replace(flat_model, variables=tuple(v for v in variables if v.name not in gone),
+                   equations=(*flat_model.equations, *connected))
 
 
 def added_inner_notes(top: ClassScope) -> Iterator[str]:

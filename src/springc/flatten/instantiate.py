@@ -349,7 +349,8 @@ class Instantiation(FlattenContext):
             value = a.make_array([x.Var(n) for n in name_list], dims) if dims else x.Var(name)
         flow = decl.flow or rtype.prefixes[2] or scope.flow
         prim = Primitive(names, value, decl, variability, causality,
-                         flow, rtype.primitive or "Real", mod, dims, rtype.connector,
+                         flow, rtype.primitive or "Real", mod, dims,
+                         rtype.connector or scope.expandable,  # 9.1.3: all connectors
                          rtype.enumeration, kinds)
         if variability in ("parameter", "constant"):
             for n, b in zip(name_list, _binding_scalars(binding, dims)):

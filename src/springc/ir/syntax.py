@@ -448,6 +448,8 @@ class ClassDef:
     unsupported: tuple[ParseError, ...] = ()
     # `external "C" ...` of a function springc evaluates natively (ir.native_externals)
     external: ExternalCall | None = None
+    # `expandable connector C ... end C;` (section 9.1.3)
+    expandable: bool = False
 
 
 Element = Component | Extends | Import | ClassDef

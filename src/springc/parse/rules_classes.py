@@ -121,9 +121,8 @@ class ClassRules(RuleBase):
             return spec
         words = [str(t) for t in prefixes]
         for tok in prefixes:
-            if tok in ("operator", "expandable", "impure"):
+            if tok in ("operator", "impure"):
                 kind = {"operator": "`operator` classes are",
-                        "expandable": "`expandable` connectors are",
                         "impure": "`impure` functions are"}[tok]
                 self.reject(kind, self.token_span(tok))
         kind = words[-1]
@@ -148,6 +147,7 @@ class ClassRules(RuleBase):
             class_extends=spec.class_extends,
             unsupported=self.take_deferred(span) if self.defer else (),
             external=body["external"][0] if body["external"] else None,
+            expandable="expandable" in words,
         )
 
     def short_class_definition(self, meta: Meta, ch: list[Any]) -> Any:

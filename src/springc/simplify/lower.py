@@ -16,26 +16,43 @@ from .isolate import count_diff, free_variables, pre_only
 
 def lower_derivatives(e: x.Expr, varying: Callable[[str], bool]) -> x.Expr:
     """Replace ``der(expr)`` by derivative variables (``der(x)`` for ``der(x)``);
-    ``varying(name)`` is false for parameters, whose derivative is zero."""
+    ``varying(name)`` is false for parameters, whose derivative is zero. A node shared
+    by several parents is lowered once (the assertions of functions that loop
+    symbolically, Blocks.Continuous.Filter's, are graphs whose trees are exponential)."""
+    return _lower(e, varying, {})
+
+
+def _lower(e: x.Expr, varying: Callable[[str], bool],
+           memo: dict[int, tuple[x.Expr, x.Expr]]) -> x.Expr:
+    if isinstance(e, (x.Const, x.Var, x.Time)):
+        return e
+    found = memo.get(id(e))
+    if found is not None and found[0] is e:
+        return found[1]
+    out = _lower_node(e, varying, memo)
+    memo[id(e)] = (e, out)
+    return out
+
+
+def _lower_node(e: x.Expr, varying: Callable[[str], bool],
+                memo: dict[int, tuple[x.Expr, x.Expr]]) -> x.Expr:
     if isinstance(e, x.Der):
         arg = e.arg
         if isinstance(arg, x.Var):
             return x.Var(dae.derivative_name(arg.name)) if varying(arg.name) else x.ZERO
-        inner = lower_derivatives(arg, varying)
-        return lower_derivatives(x.time_derivative(inner, varying), varying)
-    if isinstance(e, (x.Const, x.Var, x.Time)):
-        return e
+        inner = _lower(arg, varying, memo)
+        return _lower(x.time_derivative(inner, varying), varying, memo)
     if isinstance(e, x.BinOp):
-        left, right = lower_derivatives(e.left, varying), lower_derivatives(e.right, varying)
+        left, right = _lower(e.left, varying, memo), _lower(e.right, varying, memo)
         return e if left is e.left and right is e.right else x.BinOp(e.op, left, right)
     if isinstance(e, (x.Neg, x.Not)):
-        arg = lower_derivatives(e.arg, varying)
+        arg = _lower(e.arg, varying, memo)
         return e if arg is e.arg else type(e)(arg)
     if isinstance(e, x.Call):
-        return x.Call(e.name, tuple(lower_derivatives(a, varying) for a in e.args))
+        return x.Call(e.name, tuple(_lower(a, varying, memo) for a in e.args))
     if isinstance(e, x.If):
-        return x.If(lower_derivatives(e.cond, varying), lower_derivatives(e.then, varying),
-                    lower_derivatives(e.otherwise, varying))
+        return x.If(_lower(e.cond, varying, memo), _lower(e.then, varying, memo),
+                    _lower(e.otherwise, varying, memo))
     raise TypeError(f"not an expression: {e!r}")
 
 

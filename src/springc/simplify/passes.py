@@ -8,7 +8,9 @@ The pipeline is a short list of passes, each in its own module:
 1. ``free_parameters`` (:mod:`springc.simplify.free_parameters`): ``fixed = false``
    parameters bound by their initial equations, or kept constant as states;
    ``pre_starts`` (:mod:`springc.simplify.pre_starts`): ``pre(v) = e`` initial equations
-   as start values; then
+   as start values; ``initial_whens`` (:mod:`springc.simplify.initial_whens`): initial
+   equations ``v = e`` of when-assigned ``v`` reading variables as ``when initial()``
+   branches; then
    ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
@@ -31,6 +33,7 @@ from .events import with_events
 from .free_parameters import free_parameters
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
+from .initial_whens import initial_whens
 from .lower import lower
 from .pre_starts import pre_starts
 from .state_select import check_state_select
@@ -69,7 +72,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
-    model = pre_starts(free_parameters(model))
+    model = initial_whens(pre_starts(free_parameters(model)))
     system = lower(model)
     check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)

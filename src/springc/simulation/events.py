@@ -328,6 +328,8 @@ class EventLoop:
         ``time`` that has switched there is a state event, located on it."""
         j = int(np.searchsorted(self.grid, t, side="right"))
         end = min(bound, float(self.grid[j])) if j < len(self.grid) else bound
+        if bound - end <= LOCATE_TOLERANCE * max(1.0, abs(bound)):
+            end = bound  # the same time (next_time_event would pass the event by from end)
         switched = self.switched(end, x)
         if switched:
             times = {k: self.locate(lambda _: x, t, end, k) for k in switched}

@@ -10,6 +10,7 @@ connectors that are connected nowhere are set to zero.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +31,7 @@ from ..scopes import (
 )
 from .connect_rules import check_pair, check_reference_form, check_sources, overdetermined
 from .connection_graph import ConnectionGraph, Edge
+from .expandable import absent, augmenting, undeclared_member
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -207,6 +209,9 @@ class ConnectionSets:
             self._pair_signals(ca, cb, out_a, out_b, eq, owner)
             return
         leaves_a, leaves_b = connector_leaves(ca), connector_leaves(cb)
+        if ca.connector_signature != cb.connector_signature and ca.expandable \
+                and cb.expandable:
+            raise augmenting(ca, cb, eq.span)
         if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
@@ -266,13 +271,14 @@ class ConnectionSets:
                 if ra != rb:
                     self.parent[rb] = ra
 
-    def equations(self, scopes: list[ClassScope], top: ClassScope) -> list[flat.Equation]:
-        """Equations of all sets (in order of first connection), then zero flows."""
-        sets: dict[Key, list[Key]] = {}
-        for key in self.parent:
-            sets.setdefault(self._find(key), []).append(key)
+    def equations(self, scopes: list[ClassScope], top: ClassScope,
+                  absent: AbstractSet[str] = frozenset()) -> list[flat.Equation]:
+        """Equations of all sets (in order of first connection), then zero flows; none
+        for the sets of ``absent`` variables (of expandable connectors, 9.1.3)."""
         out: list[flat.Equation] = []
-        for members in sets.values():
+        for members in self._sets().values():
+            if members[0][0] in absent:
+                continue
             first = self.link[members[0]]
             if self.flow[members[0]]:
                 out.append(self._flow_sum(members, first))
@@ -285,6 +291,22 @@ class ConnectionSets:
                         for k in members[1:]]
         out += self._unconnected(scopes, top)
         return out
+
+    def absent(self, scopes: list[ClassScope], model: flat.FlatModel) -> set[str]:
+        """The variables of expandable connectors that are not present (9.1.3), given
+        the model without its connection equations."""
+        declared = {leaf.name for scope in scopes if scope.kind == "connector"
+                    and scope.expandable for leaf in connector_leaves(scope)}
+        if not declared:
+            return declared
+        return absent(declared, [[name for name, _ in keys]
+                                 for keys in self._sets().values()], model)
+
+    def _sets(self) -> dict[Key, list[Key]]:
+        sets: dict[Key, list[Key]] = {}
+        for key in self.parent:
+            sets.setdefault(self._find(key), []).append(key)
+        return sets
 
     def _flow_sum(self, members: list[Key], first: Link) -> flat.Equation:
         total: x.Expr = x.ZERO
@@ -330,6 +352,8 @@ def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
         owners = list(found.flat) if isinstance(found, np.ndarray) else [found]
     if not owners or not all(isinstance(o, ClassScope) and o.has_member(last.name)
                              for o in owners):
+        if owners and isinstance(owners[0], ClassScope) and owners[0].expandable:
+            raise undeclared_member(owners[0], ref)
         return None
     members = [o.member(last.name, last.span) for o in owners]
     if not all(isinstance(m, Primitive) and m.connector for m in members):

@@ -160,6 +160,11 @@ class ClassScope:
     def kind(self) -> str:
         return self.view.entry.defn.kind
 
+    @property
+    def expandable(self) -> bool:
+        """An instance of an ``expandable connector`` (section 9.1.3)."""
+        return self.view.entry.defn.expandable
+
     def flat_name(self, name: str) -> str:
         return f"{self.prefix}.{name}" if self.prefix else name
 

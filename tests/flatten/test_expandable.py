@@ -1,0 +1,132 @@
+"""Expandable connectors (Modelica 3.6, section 9.1.3), as Modelica.Blocks.Examples.
+BusUsage uses them: every component of an expandable connector is a connector, a
+declared variable is only potentially present (one no connection reaches and nothing
+reads is no variable), two buses of one class connect element by element, and a
+name the bus does not declare is a located "not supported yet"."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from springc.errors import FlattenError
+from springc.ir.flat import format_flat
+from springc.pipeline.files import flatten_files
+
+BUS = """package P
+  expandable connector Bus
+    Real speed;
+    Real unused;
+    Integer count;
+    SubBus sub;
+  end Bus;
+  expandable connector SubBus
+    Real a;
+    Real b;
+  end SubBus;
+  connector RealOutput = output Real;
+  connector RealInput = input Real;
+  block Gain
+    RealInput u;
+    RealOutput y;
+  equation
+    y = 2*u;
+  end Gain;
+  model Part
+    SubBus sub;
+    RealOutput y;
+  equation
+    y = 3*time;
+    connect(y, sub.a);
+  end Part;
+  model M
+    RealOutput s;
+    Gain gain;
+    Gain gain2;
+    Part part;
+  protected
+    Bus bus;
+  equation
+    s = sin(time);
+    connect(s, bus.speed);
+    connect(bus.speed, gain.u);
+    connect(part.sub, bus.sub);
+    connect(bus.sub.a, gain2.u);
+  end M;
+  model Undeclared
+    RealOutput s = time;
+    Bus bus;
+  equation
+    connect(s, bus.missing);
+  end Undeclared;
+  model Augmented
+    Bus bus;
+    Part part;
+  equation
+    connect(bus, part.sub);
+  end Augmented;
+end P;
+"""
+
+
+def test_a_bus_keeps_only_what_is_connected(tmp_path: Path) -> None:
+    # bus.unused, bus.count and sub.b (connected only bus to bus) are not present
+    path = tmp_path / "bus.mo"
+    path.write_text(BUS)
+    assert format_flat(flatten_files([path], "P.M")) == """model 'P.M'
+  output Real s;
+  input Real 'gain.u';
+  output Real 'gain.y';
+  input Real 'gain2.u';
+  output Real 'gain2.y';
+  Real 'part.sub.a';
+  output Real 'part.y';
+  Real 'bus.speed';
+  Real 'bus.sub.a';
+equation
+  'gain.y' = 2 * 'gain.u';
+  'gain2.y' = 2 * 'gain2.u';
+  'part.y' = 3 * time;
+  s = sin(time);
+  'part.y' = 'part.sub.a';
+  'part.y' = 'bus.sub.a';
+  s = 'bus.speed';
+  s = 'gain.u';
+  'bus.sub.a' = 'gain2.u';
+end 'P.M';
+"""
+
+
+def test_signals_pass_through_a_bus(tmp_path: Path) -> None:
+    path = tmp_path / "bus.mo"
+    path.write_text(BUS)
+    result = springc.simulate([path], model_name="P.M", stop=1.0, interval=0.25,
+                              engine="scipy", backend="python", error_control="off")
+    t = np.asarray(result.time)
+    assert np.allclose(result["gain.y"], 2 * np.sin(t), rtol=0, atol=1e-12)
+    assert np.allclose(result["gain2.y"], 6 * t, rtol=0, atol=1e-12)
+
+
+def test_a_name_the_bus_does_not_declare_is_not_supported_yet(tmp_path: Path) -> None:
+    path = tmp_path / "bus.mo"
+    path.write_text(BUS)
+    with pytest.raises(FlattenError) as info:
+        flatten_files([path], "P.Undeclared")
+    error = info.value
+    assert error.message == ("adding 'missing' to the expandable connector 'bus' (P.Bus) "
+                             "by a connection is not supported yet")
+    assert (error.span.line, error.span.column) == (45, 20)
+
+
+def test_buses_declaring_different_variables_are_not_supported_yet(tmp_path: Path) -> None:
+    path = tmp_path / "bus.mo"
+    path.write_text(BUS)
+    with pytest.raises(FlattenError) as info:
+        flatten_files([path], "P.Augmented")
+    assert info.value.message == (
+        "connecting the expandable connectors 'bus' (P.Bus) and 'part.sub' (P.SubBus), "
+        "which declare different variables, is not supported yet")
+    assert (info.value.span.line, info.value.span.column) == (51, 5)
