@@ -11,9 +11,8 @@ relations ``u < _zf<k>`` and ``u >= _zf<k> + 1`` come last among the relations),
 the ``pre``
 values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), then
 ``initial()`` (``_zinit``), ``terminal()`` (``_zterm``), the terminate code (0, or
-1 + the index of the ``terminate`` message), the changed flag of the last event pass,
-the event-iteration status (1.0: did not converge) and the number of passes of the
-event so far (``_zpass``).
+1 + the index of the ``terminate`` message), the changed flag of the last event pass
+and the event-iteration status (1.0: did not converge).
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ from ..ir.hybrid import EventSystem
 from .statements import Load, Stmt
 
 _QUIET = names(lambda b: b.quiet)
-FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus", "_zpass")
+FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus")
 
 
 class EventLayout:

@@ -31,12 +31,6 @@ EVENT_ITERATIONS = 100
 SIMULTANEOUS_PASSES = 20
 """Passes of the event iteration that switch every moved relation at once; the
 later ones switch one relation at a time (see :func:`_relations_now`)."""
-PRE_WHILE_MOVING = 40
-"""From this pass of an event on, ``pre(v) := v`` of the iterated variables happens
-in every pass, also while relations still move (see :func:`event_pass`)."""
-RELATION_BAND = 1e-10
-"""The band around a relation's boundary, relative to ``1 + |left| + |right|``, that
-its value must cross to switch (see :func:`crossing`)."""
 _ONE, _ZERO = x.Const(1.0), x.Const(0.0)
 
 
@@ -74,30 +68,11 @@ def _base(m: CodegenContext) -> list[Stmt]:
     return m.loads() + steps + m.alias_stmts(sorted(m.aliases))
 
 
-def crossing(layout: EventLayout, k: int) -> x.Expr:
-    """The zero-crossing function of state relation ``k``: ``left - right`` moved by
-    :data:`RELATION_BAND` ``* (1 + |left| + |right|)`` towards the side the relation
-    holds, so that the relation switches only once its sides are apart by more than
-    that band (a hysteresis, as OpenModelica's relations have). A relation whose two
-    sides an equation makes equal in the configuration it selects (a friction
-    element starting to slide while another stuck element in series holds the
-    acceleration at 0: its path parameter sits exactly on the breakaway torque)
-    keeps its value instead of flipping with the rounding of the solution. Both the
-    events and the event iteration decide relations by this function."""
-    rel = layout.events.relations[k]
-    left, right = layout.hold(rel.left), layout.hold(rel.right)
-    band = x.mul(x.Const(RELATION_BAND), x.add(_ONE, x.add(
-        x.Call("abs", (left,)), x.Call("abs", (right,)))))
-    held = _truth(layout.relations[k])
-    # the side where the relation is true: g > 0 for '>' and '>=', g < 0 otherwise
-    towards = held if rel.op in (">", ">=") else x.Not(held)
-    return x.add(x.sub(left, right), x.If(towards, band, x.Neg(band)))
-
-
 def zero_crossings(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     out = [*_base(m), Raw(f"g = np.empty({len(layout.relations)})")]
     for k, rel in enumerate(layout.events.relations):
-        out.append(Store(f"g[{k}]", crossing(layout, k), x.to_text(rel)))
+        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+        out.append(Store(f"g[{k}]", g, x.to_text(rel)))
     return out
 
 
@@ -176,7 +151,6 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             out.append(Store(f"z[{layout.slot[slot_name]}]", now, f"pre({name})"))
     for (start, interval), name in zip(layout.events.samples, layout.samples):
         out.append(Store(f"z[{layout.slot[name]}]", _flag(_sample_hit(x.TIME, start, interval))))
-    out.append(Store(f"z[{layout.slot['_zpass']}]", _ZERO))
     out.append(Raw("_zdone = 1.0"))
     return out
 
@@ -198,7 +172,7 @@ def _relations_now(layout: EventLayout, out: list[Stmt]
     one_at_a_time = x.BinOp("==", x.Var("_zstatus"), x.Const(2.0))
     out.append(Let("_zdown", _ZERO))  # whether a relation turns false
     for k, rel in enumerate(ev.relations):
-        g = crossing(layout, k)
+        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
         held = x.Var(layout.relations[k])
         out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
         changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), held))
@@ -294,7 +268,6 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         changed.append(x.BinOp("<>", x.Var(name), x.Var(layout.pre[name])))
     out.append(Store(f"z[{slot['_zchanged']}]", _flag(_any(changed))))
     out.append(Store(f"z[{slot['_zstop']}]", stop))
-    out.append(Store(f"z[{slot['_zpass']}]", x.add(x.Var("_zpass"), _ONE)))
     for k, name in enumerate(layout.relations):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zh{k}")))
     for k, name in enumerate(layout.times):
@@ -307,12 +280,7 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
             out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
-    # from pass PRE_WHILE_MOVING on, pre(v) := v also while relations move: a
-    # start condition whose relation flips with the configuration it selects
-    # (OneWayClutch: 'sa > tau0_max' when locked, not once sliding) is kept by its
-    # own 'pre(startForward) and sa > tau0' once pre(startForward) is true
-    late = x.BinOp(">=", x.Var("_zpass"), x.Const(float(PRE_WHILE_MOVING)))
-    out.append(Let("_zmoved", _flag(x.BinOp("and", relations_moved, x.Not(late)))))
+    out.append(Let("_zmoved", _flag(relations_moved)))
     for name in ev.iterated:
         pre = x.Var(layout.pre[name])
         out.append(Store(f"z[{slot[layout.pre[name]]}]",

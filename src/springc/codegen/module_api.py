@@ -22,8 +22,7 @@ CODEGEN_VERSION = 9
 every cache key (here, not with the module text, so that the cache reads it without
 loading the generator). 5: a cache entry holds the captured system (``system.pickle``,
 :mod:`springc.pipeline.closed`); 6: a module declares its ``KIND``; 7: a module declares
-``PARAMETER_BOUNDS``; 9: relations switch past a band (``codegen.events.crossing``), the
-event slots count the passes (``_zpass``), torn blocks take ``_newton_solve``."""
+``PARAMETER_BOUNDS``; 9: torn blocks take ``_newton_solve`` (``codegen.newton_step``)."""
 
 
 class ModuleKind:
