@@ -8,7 +8,8 @@ The pipeline is a short list of passes, each in its own module:
 1. ``free_parameters`` (:mod:`springc.simplify.free_parameters`): ``fixed = false``
    parameters bound by their initial equations, or kept constant as states;
    ``pre_starts`` (:mod:`springc.simplify.pre_starts`): ``pre(v) = e`` initial equations
-   as start values; then
+   as start values; ``parameter_branches`` (:mod:`springc.simplify.parameter_branches`):
+   if-expressions of Boolean or Integer parameters with a `der` in a branch chosen; then
    ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
@@ -32,6 +33,7 @@ from .free_parameters import free_parameters
 from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .lower import lower
+from .parameter_branches import parameter_branches
 from .pre_starts import pre_starts
 from .state_select import check_state_select
 
@@ -69,7 +71,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
-    model = pre_starts(free_parameters(model))
+    model = parameter_branches(pre_starts(free_parameters(model)))
     system = lower(model)
     check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)
