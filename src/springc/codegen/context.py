@@ -17,6 +17,7 @@ from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
+from .newton_step import newton_solve
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store, guarded_solve
 
 
@@ -188,7 +189,10 @@ class CodegenContext:
             loop += [Store(f"_J{index}[{i}, {j}]", e) for (i, j), e in entries.items()]
             loop.append(Raw(f"_R{index} = np.empty({k})"))
             loop += [Store(f"_R{index}[{i}]", Var(f"_r{index}_{i}")) for i in range(k)]
-            loop.append(Raw(guarded_solve(f"_D{index}", f"_J{index}", f"_R{index}", f"{k}")))
+            loop.append(Raw(f"_T{index} = np.empty({k})"))
+            loop += [Store(f"_T{index}[{i}]", Var(t)) for i, t in enumerate(block.tearing)]
+            loop.append(Raw(newton_solve(f"_D{index}", f"_J{index}", f"_R{index}",
+                                         f"_T{index}", k)))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
         loop += newton_update(block.tearing, index)
         body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))

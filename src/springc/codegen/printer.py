@@ -17,6 +17,7 @@ from collections.abc import Callable, Iterator, Sequence
 from ..ir.builtins import BUILTINS, PYTHON_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
 from .locate import untranslatable
+from .newton_step import NEWTON_SOLVE
 from .statements import (
     Block,
     Let,
@@ -35,8 +36,9 @@ from .statements import (
 _PREC = {"or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
          "+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
 _PY_OP = {"<>": "!=", "^": "**"}
-HELPERS = PYTHON_HELPERS
-"""The helper functions a generated module defines when it calls them (the registry's)."""
+HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE}
+"""The helper functions a generated module defines when it calls them (the registry's
+and the Newton correction of torn blocks, which a :class:`Raw` line calls)."""
 
 
 def _spelled(spelling: str, args: str) -> str:
@@ -167,6 +169,8 @@ class FunctionWriter:
         elif isinstance(stmt, Store):
             self._assign(stmt.target, self.expr(stmt.expr), stmt.comment)
         elif isinstance(stmt, Raw):
+            if "_newton_solve(" in stmt.text:
+                self.helpers.add("_newton_solve")
             for line in stmt.text.splitlines():
                 self._emit(line)
         elif isinstance(stmt, Block):

@@ -10,7 +10,8 @@ The pipeline is a short list of passes, each in its own module:
    ``pre_starts`` (:mod:`springc.simplify.pre_starts`): ``pre(v) = e`` initial equations
    as start values; ``initial_whens`` (:mod:`springc.simplify.initial_whens`): initial
    equations ``v = e`` of when-assigned ``v`` reading variables as ``when initial()``
-   branches; then
+   branches; ``parameter_branches`` (:mod:`springc.simplify.parameter_branches`):
+   if-expressions of Boolean or Integer parameters with a `der` in a branch chosen; then
    ``lower`` (:mod:`springc.simplify.lower`): residual equations and derivative variables;
 2. ``eliminate_aliases`` (:mod:`springc.simplify.alias`): ``a = ±b`` and ``a = p`` removed;
 3. ``index_reduce`` (:mod:`springc.simplify.index_reduction`): Pantelides and dummy derivatives;
@@ -35,6 +36,7 @@ from .hybrid_checks import check_reinits
 from .index_reduction import DummyBlock, index_reduce
 from .initial_whens import initial_whens
 from .lower import lower
+from .parameter_branches import parameter_branches
 from .pre_starts import pre_starts
 from .state_select import check_state_select
 
@@ -72,7 +74,7 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
 
 
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
-    model = initial_whens(pre_starts(free_parameters(model)))
+    model = parameter_branches(initial_whens(pre_starts(free_parameters(model))))
     system = lower(model)
     check_balance(model, dae_incidence(system))
     aliased = eliminate_aliases(system)
