@@ -177,11 +177,8 @@ def one(args: argparse.Namespace, out: dict[str, object]) -> None:
         (refdir / f"{example.split('.')[-1]}.csv").exists() else None
     import springc
 
-    # MultiBody: the animation off (the shapes feed nothing back; their inlined Frames
-    # functions are what springc's simplifier cannot yet take in reasonable time)
-    parameters = {"world.enableAnimation": 0.0} if ".MultiBody." in example else None
     model = springc.compile_model(files, example, libraries=[str(args.msl)],
-                                  backend=args.backend, parameters=parameters)
+                                  backend=args.backend)
     result = springc.simulate(model, interval=reference.interval if reference else None,
                               engine=args.engine, error_control=args.error_control)
     _stage(out, "compare")

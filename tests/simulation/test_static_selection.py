@@ -2,7 +2,9 @@
 states that cannot turn singular is kept for the whole run, on the compiled engine.
 
 Rule 1: constraints with a constant Jacobian (``s_rel = flange_b.s - flange_a.s``);
-rule 2: the ``StateSelect.prefer`` candidates are exactly the states a block keeps.
+rule 2: the ``StateSelect.prefer`` candidates are exactly the states a block keeps;
+rule 3: the Jacobian on the dummies is block triangular with constant, regular diagonal
+blocks (a MultiBody joint: ``der(x) = L*cos(phi)*der(phi)``).
 Each trajectory is checked against an independent solution: a closed form (matrix
 exponential) or scipy's DOP853 on a hand-written ODE at rtol 1e-12.
 """
@@ -54,6 +56,31 @@ equation
   der(vy) = -F*y - g;
   x^2 + y^2 = L^2;
 end PreferredPendulum;
+"""
+
+# A pendulum in its angle (preferred, fixed start), with its Cartesian position and a
+# second preferred angle phi2 = phi - p0 (as a damper's phi_rel on a revolute joint)
+# that x reads: der(phi2) is a dummy, so rule 2 fails; the dummies' Jacobian is
+# triangular with ones on its diagonal whatever phi (rule 3). Without rule 3 the
+# position block was switchable.
+ANGLE_PENDULUM = """model AnglePendulum
+  parameter Real L = 0.8, g = 9.81, m = 2, p0 = 0.1;
+  Real phi(start = 1.2, fixed = true, stateSelect = StateSelect.prefer);
+  Real w(start = 0, fixed = true, stateSelect = StateSelect.prefer);
+  Real phi2(stateSelect = StateSelect.prefer), w2(stateSelect = StateSelect.prefer);
+  Real x, y, vx, vy, F, a;
+equation
+  x = L*sin(phi2 + p0);
+  y = -L*cos(phi);
+  vx = der(x);
+  vy = der(y);
+  m*der(vx) = -F*x/L;
+  m*der(vy) = -F*y/L - m*g;
+  w = der(phi);
+  a = der(w);
+  phi2 = phi - p0;
+  w2 = der(phi2);
+end AnglePendulum;
 """
 
 TIGHT = {"rtol": 1e-10, "atol": 1e-12, "engine": "compiled"}
@@ -142,3 +169,35 @@ def test_a_constant_block_is_static_and_a_nonlinear_one_is_not() -> None:
     circle = x.add(x.mul(x.Var("der(x)"), x.Var("x")), x.mul(x.Var("der(y)"), x.Var("y")))
     assert not static_block([circle], ("der(y)", "der(x)"), ("der(y)",), [DEFAULT] * 2,
                             {})
+
+
+def test_a_triangular_block_of_a_preferred_angle_is_static(tmp_path: Path) -> None:
+    path = tmp_path / "angle.mo"
+    path.write_text(ANGLE_PENDULUM)
+    model = springc.compile_model(str(path), backend="python")
+    assert not model.module.SWITCHABLE and model.states == ("phi", "w")
+    result = springc.simulate(model, stop=2.0, interval=0.05, rtol=1e-10, atol=1e-12,
+                              engine="scipy")
+    exact = solve_ivp(lambda t, y: [y[1], -9.81 / 0.8 * np.sin(y[0])], (0.0, 2.0),
+                      [1.2, 0.0], method="DOP853", rtol=1e-12, atol=1e-14,
+                      t_eval=result.time).y
+    assert np.max(np.abs(result["phi"] - exact[0])) < 1e-7
+    assert np.max(np.abs(result["w2"] - exact[1])) < 1e-7
+    # the rod's tension: m*(g*cos(phi) + L*w^2)
+    tension = 2 * (9.81 * np.cos(exact[0]) + 0.8 * exact[1] ** 2)
+    assert np.max(np.abs(result["F"] - tension)) < 1e-6
+
+
+def test_rule_3_needs_constant_diagonal_blocks() -> None:
+    # der(t) - cos(p)*der(p) = 0 and der(q) - der(p) = 0, dummies der(t), der(q): the
+    # diagonal is (1, 1) whatever p; with der(t)*p instead, it depends on p.
+    p, dp = x.Var("p"), x.Var("der(p)")
+    first = x.sub(x.Var("der(t)"), x.mul(x.Call("cos", (p,)), dp))
+    second = x.sub(x.Var("der(q)"), dp)
+    names, dummies = ("der(t)", "der(q)", "der(p)"), ("der(t)", "der(q)")
+    assert static_block([first, second], names, dummies, [DEFAULT] * 3, {})
+    scaled = x.sub(x.mul(x.Var("der(t)"), p), x.mul(x.Call("cos", (p,)), dp))
+    assert not static_block([scaled, second], names, dummies, [DEFAULT] * 3, {})
+    # a zero on the diagonal: der(t) - der(t) + ... folds to no dependence
+    singular = x.sub(x.mul(x.Const(0.0), x.Var("der(t)")), dp)
+    assert not static_block([singular, second], names, dummies, [DEFAULT] * 3, {})

@@ -124,3 +124,32 @@ def test_a_run_that_fails_before_its_first_output_time_says_where(
     reached = float(message.removeprefix("the integration failed at t = ").split(":")[0])
     assert 0.0 <= reached < 0.5  # before the first output time after the start
     assert "Warning" not in capsys.readouterr().err
+
+
+# A switching pendulum with a discrete output (an Integer, as a MultiBody shape's colour).
+COLOURED = """model Coloured
+  parameter Real L = 1, g = 9.81;
+  parameter Integer colour[3] = {0, 128, 255};
+  Real x(start = 0.6), y(start = -0.8);
+  Real vx(start = 0), vy, F;
+  Integer c = colour[2];
+equation
+  der(x) = vx;
+  der(y) = vy;
+  der(vx) = -F*x;
+  der(vy) = -F*y - g;
+  x^2 + y^2 = L^2;
+end Coloured;
+"""
+
+
+def test_a_discrete_variable_is_an_output_of_a_switching_run(tmp_path: Path) -> None:
+    import springc
+
+    path = tmp_path / "coloured.mo"
+    path.write_text(COLOURED)
+    result = springc.simulate(str(path), stop=0.2, interval=0.1, rtol=1e-8)
+    assert result.stats.reason == "dynamic state selection, no switch in this run"
+    assert list(result["c"]) == [128.0, 128.0, 128.0]
+    # the rod keeps its length
+    assert np.max(np.abs(result["x"] ** 2 + result["y"] ** 2 - 1.0)) < 1e-6

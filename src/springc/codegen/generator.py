@@ -205,7 +205,7 @@ def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
                 name = sorted(unknown)[0]
                 raise CodegenBug(f"the simplified system reads '{name}' but nothing "
                                  "computes it")
-    computed_set = set(computed)
+    computed_set = set(computed) | set(m.states)  # a state may be der(v) of another
     for d in m.derivatives:
         if d not in computed_set and d not in m.aliases:
             raise CodegenBug(f"nothing computes {d}")

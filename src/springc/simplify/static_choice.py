@@ -12,7 +12,15 @@ turn singular during the run. It cannot, and the choice is kept for the whole ru
    stays regular; or
 2. its ``StateSelect.prefer`` (or ``always``) candidates are exactly the states it
    keeps (:func:`springc.structure.kept_by_preference`), as OpenModelica and Dymola
-   choose them statically (a relative position with ``stateSelect = prefer``).
+   choose them statically (a relative position with ``stateSelect = prefer``);
+3. its Jacobian with respect to the dummies alone (the matrix the generated code
+   solves) is block triangular with constant, regular diagonal blocks: the blocks of
+   the equations' BLT ordering on the dummies (:func:`springc.structure.blt`). A
+   triangular matrix is regular where its diagonal blocks are, whatever the entries
+   below them: a MultiBody joint's ``der(R_rel.T[i,j]) = f(phi)*der(phi)`` has the
+   coefficient 1 on its dummy whatever ``phi`` (DoublePendulum: the damper's
+   preferred ``phi_rel`` and the revolute's preferred ``phi`` are one state, so rule 2
+   does not hold).
 
 A parameter changed at run time (``--set``) that makes a block of rule 1 singular, or
 a preferred choice that turns singular, stops the run with the generated solve's error
@@ -26,8 +34,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..ir import expr as x
-from ..structure import kept_by_preference
-from .isolate import partial
+from ..structure import blt, kept_by_preference, maximum_matching
+from .isolate import free_variables, partial
 from .ode_eval import evaluate_with
 
 SINGULAR_RTOL = 1e-8
@@ -38,13 +46,21 @@ def static_block(equations: Sequence[x.Expr], candidates: Sequence[str],
                  dummies: Sequence[str], priorities: Sequence[float],
                  parameters: Mapping[str, float] | None) -> bool:
     """Is this block's choice of ``dummies`` among ``candidates`` valid for the whole
-    run (rule 1 or 2 of the module docstring)? ``priorities[k]``: that of the state of
+    run (rule 1, 2 or 3 of the module docstring)? ``priorities[k]``: that of the state of
     ``candidates[k]``; ``parameters``: values of every parameter (None: unknown)."""
     chosen = set(dummies)
     if kept_by_preference(priorities, [c in chosen for c in candidates]):
         return True
     if parameters is None:
         return False
+    return _constant_jacobian(equations, candidates, dummies, parameters) or \
+        _triangular(equations, dummies, parameters)
+
+
+def _constant_jacobian(equations: Sequence[x.Expr], candidates: Sequence[str],
+                       dummies: Sequence[str], parameters: Mapping[str, float]) -> bool:
+    """Rule 1: every derivative with respect to a candidate constant, and the
+    dummies' square part regular."""
     column = {name: j for j, name in enumerate(dummies)}
     jac = np.zeros((len(equations), len(dummies)))
     for i, e in enumerate(equations):
@@ -57,6 +73,40 @@ def static_block(equations: Sequence[x.Expr], candidates: Sequence[str],
                     jac[i, column[name]] = evaluate_with(d, parameters.__getitem__)
                 except (ArithmeticError, ValueError, KeyError):
                     return False
+    return _regular(jac)
+
+
+def _triangular(equations: Sequence[x.Expr], dummies: Sequence[str],
+                parameters: Mapping[str, float]) -> bool:
+    """Rule 3: the BLT blocks of ``equations`` on ``dummies`` have constant, regular
+    Jacobians."""
+    column = {name: j for j, name in enumerate(dummies)}
+    incidence = [sorted(column[n] for n in free_variables(e) if n in column)
+                 for e in equations]
+    matching = maximum_matching(incidence, len(dummies))
+    if len(equations) != len(dummies) or not matching.is_perfect:
+        return False
+    for rows in blt(incidence, matching):
+        cols = [matching.eq_to_var[r] for r in rows]
+        jac = np.zeros((len(rows), len(cols)))
+        for i, r in enumerate(rows):
+            for j, c in enumerate(cols):
+                if c not in incidence[r]:
+                    continue
+                d = partial(equations[r], dummies[c])
+                if not _constant(d, parameters):
+                    return False
+                try:
+                    jac[i, j] = evaluate_with(d, parameters.__getitem__)
+                except (ArithmeticError, ValueError, KeyError):
+                    return False
+        if not _regular(jac):
+            return False
+    return True
+
+
+def _regular(jac: np.ndarray) -> bool:
+    """Is the constant matrix ``jac`` finite and well away from singular?"""
     if not np.all(np.isfinite(jac)):
         return False
     values = np.linalg.svd(jac, compute_uv=False)

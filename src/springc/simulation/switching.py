@@ -100,8 +100,8 @@ class Switch:
 
 @dataclass(frozen=True)
 class SwitchingResult:
-    """``values[name][k]``: every continuous variable of the flat model at ``t[k]``;
-    the integrator's accepted steps and its RHS and Jacobian evaluations, over all
+    """``values[name][k]``: every continuous and discrete variable of the flat model at
+    ``t[k]``; the integrator's accepted steps and its RHS and Jacobian evaluations, over all
     segments."""
 
     t: np.ndarray
@@ -180,7 +180,7 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
     if needs_switch(choice, values, threshold, t0):
         choice = _switch(model, choice, values, t0, threshold, switches)
         x0 = state_vector(choice, values)
-    names = [v.name for v in model.variables if v.variability == "continuous"]
+    names = [v.name for v in model.variables if v.is_unknown]
     times: list[float] = []
     rows: list[dict[str, float]] = []
     requested = None if t_eval is None else np.asarray(t_eval, dtype=float)
@@ -277,6 +277,15 @@ def _switch(model: flat.FlatModel, old: StateChoice, values: Mapping[str, float]
     return new
 
 
+def _column(run: SwitchingResult, name: str) -> np.ndarray:
+    """The trajectory of the output ``name`` (a variable the run did not compute is a
+    bug of springc, named, not a ``KeyError``)."""
+    if name in run.values:
+        return run.values[name]
+    raise RuntimeError(f"the run with dynamic state selection computed no value of the "
+                       f"output '{name}' (a bug in springc)")
+
+
 def simulate_switching_model(model: CompiledModel, plan: RunPlan) -> SimulationResult:
     """Run ``model`` as ``plan`` says with dynamic state selection (adaptive solvers
     only; on scipy's loop, the only one that switches states)."""
@@ -317,7 +326,7 @@ def _switching_run(model: CompiledModel, solver: str, grid: np.ndarray, rtol: fl
         known = parameter_values(closed.system.parameters, parameters)
         check_trajectory(flat_model.assertions, np.asarray(grid, dtype=float), run.values,
                          known)
-    values = np.column_stack([run.values[name] for name in model.outputs])
+    values = np.column_stack([_column(run, name) for name in model.outputs])
     check_outputs(model.outputs, np.asarray(grid, dtype=float), values)
     units = tuple(str(u) for u in getattr(model.module, "OBSERVED_UNITS", ()))
     unit_of = dict(zip(model.states, getattr(model.module, "STATE_UNITS", ())))
