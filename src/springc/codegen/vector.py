@@ -74,20 +74,40 @@ def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
     return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
 
 
-def _shape(e: Expr, slots: list[str]) -> Expr:
+_LIFTED_OPS = frozenset("+-*/")
+"""Operators whose constant operands :class:`VectorLayout` may lift into ``_F``: their
+value is the same whether the constant is a literal or a float read from the table
+(Modelica's ``/`` divides reals; ``^``'s integer exponents and call arguments stay)."""
+
+
+def _liftable(e: Expr) -> bool:
+    return isinstance(e, Const) and type(e.value) in (int, float) \
+        and (type(e.value) is float or abs(e.value) < 2 ** 53)  # exactly a float
+
+
+def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None) -> Expr:
+    """``e`` with each variable replaced by a slot ``$k`` (``slots[k]``: its name);
+    with ``lift``, also the constant operands of ``+ - * /`` (``lift(value)``: the name
+    of its slot), so that ``L * 110`` and ``L * 111`` have one shape."""
     if isinstance(e, Var):
         slots.append(e.name)
         return Var(f"${len(slots) - 1}")
     if isinstance(e, (Const, Time)):
         return e
     if isinstance(e, (Neg, Not)):
-        return type(e)(_shape(e.arg, slots))
+        return type(e)(_shape(e.arg, slots, lift))
     if isinstance(e, BinOp):
-        return BinOp(e.op, _shape(e.left, slots), _shape(e.right, slots))
+        if lift is not None and e.op in _LIFTED_OPS:
+            operands = [Var(lift(float(o.value))) if _liftable(o) else o  # type: ignore[union-attr]
+                        for o in (e.left, e.right)]
+            return BinOp(e.op, _shape(operands[0], slots, lift),
+                         _shape(operands[1], slots, lift))
+        return BinOp(e.op, _shape(e.left, slots, lift), _shape(e.right, slots, lift))
     if isinstance(e, Call):
-        return Call(e.name, tuple(_shape(a, slots) for a in e.args))
+        return Call(e.name, tuple(_shape(a, slots, lift) for a in e.args))
     if isinstance(e, If):
-        return If(_shape(e.cond, slots), _shape(e.then, slots), _shape(e.otherwise, slots))
+        return If(_shape(e.cond, slots, lift), _shape(e.then, slots, lift),
+                  _shape(e.otherwise, slots, lift))
     raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
 
 
@@ -109,12 +129,10 @@ class VectorLayout:
             slots: list[str] = []
             if lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
                 # Constant values become data (_F), so they group whatever their value.
-                slots.append(f"#{len(self.floats)}")
-                self.location[slots[0]] = ("c", len(self.floats))
-                self.floats.append(float(e.value))
+                slots.append(self._lift(float(e.value)))
                 shape: Expr = Var("$0")
             else:
-                shape = _shape(e, slots)
+                shape = _shape(e, slots, self._lift if lift_constants else None)
             for v in slots:
                 if v not in self.location and v not in self.assignments:
                     raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
@@ -137,6 +155,13 @@ class VectorLayout:
                     self.w_names.append(a.name)
         for a in self.assignments.values():
             a.operands = [self.location[v] for v in a.slots]
+
+    def _lift(self, value: float) -> str:
+        """The slot name of a constant ``value`` read from ``_F``."""
+        name = f"#{len(self.floats)}"
+        self.location[name] = ("c", len(self.floats))
+        self.floats.append(value)
+        return name
 
     def _kind(self, name: str) -> str:
         if name in self.location:
