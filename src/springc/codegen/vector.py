@@ -49,11 +49,16 @@ class _Assignment:
     slots: list[str]  # the variable read by each slot
     kinds: tuple[str, ...]
     level: int
-    comment: str
+    expr: Expr  # the assignment's expression and location: its comment (read by
+    span: Span  # the first member of each loop only, so written on demand)
     group: int  # assignments of one level, shape and operand kinds share it
     order: tuple[str, tuple[int, ...], tuple[int, ...]]  # loop order (see _order)
     out: tuple[str, int] = ("w", -1)
     operands: list[tuple[str, int]] = field(default_factory=list)
+
+    @property
+    def comment(self) -> str:
+        return f"{self.name} := {to_text(self.expr)}  {self.span.file}:{self.span.line}"
 
 
 @dataclass
@@ -139,9 +144,8 @@ class VectorLayout:
             level = 1 + max((self.assignments[v].level for v in slots
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
-            comment = f"{name} := {to_text(e)}  {span.file}:{span.line}"
             self.assignments[name] = _Assignment(
-                name, shape, slots, kinds, level, comment,
+                name, shape, slots, kinds, level, e, span,
                 groups.setdefault((level, shape, kinds), len(groups)), _order(name))
         # Intermediate values get slots of w group by group, in natural name order.
         self.w_names: list[str] = []
