@@ -20,10 +20,10 @@ from .ir.expr import recursion_room
 from .pipeline import (
     CompiledModel,
     CompileOptions,
+    Derived,
     ModuleKind,
     check_parameter_names,
     compile_files,
-    derived_kept,
     modification_value,
 )
 from .simulation import (
@@ -171,17 +171,16 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
 
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
-    with derived_kept():  # a model derived once is not derived again for another backend
-        compiled = _compile_as(options, parameters)
-        if chosen and options.backend == "numba" and \
-                compiled.source.count("\n") > NUMBA_LINES:
-            return _compile_as(replace(options, backend="python"), parameters)
-        if chosen and options.backend == "python" and _numba_instead(compiled):
-            numba = replace(options, backend="numba")
-            if not parameters and compiled.compiled_from is not None:  # not derived again
-                return compile_files(numba, compiled.compiled_from)
-            return _compile_as(numba, parameters)
-        return compiled
+    compiled, base = _compile_as(options, parameters)
+    other = None
+    if chosen and options.backend == "numba" and compiled.source.count("\n") > NUMBA_LINES:
+        other = "python"
+    elif chosen and options.backend == "python" and _numba_instead(compiled):
+        other = "numba"
+    if other is not None:  # generated from the system derived for the first backend
+        compiled, _ = _compile_as(replace(options, backend=other), parameters,
+                                  compiled.compiled_from, base)
+    return compiled.settled()
 
 
 def _numba_instead(compiled: CompiledModel) -> bool:
@@ -205,23 +204,32 @@ def _numba_instead(compiled: CompiledModel) -> bool:
     return False
 
 
-def _compile_as(options: CompileOptions,
-                parameters: Mapping[str, float] | None) -> CompiledModel:
+def _compile_as(options: CompileOptions, parameters: Mapping[str, float] | None,
+                derived: Derived | None = None, base: CompiledModel | None = None
+                ) -> tuple[CompiledModel, CompiledModel | None]:
+    """The model of ``options`` with ``parameters``, and the unmodified model compiled
+    to learn which of them are structural (None without parameters). ``derived`` is
+    the system of the same model derived for another backend, ``base`` that backend's
+    unmodified model: neither is derived again (a system does not depend on the
+    backend)."""
     if not parameters:
-        return compile_files(options)
-    # Which parameters are structural is known once the unmodified model is compiled
-    # (all outputs: the selection may name variables that only the modified one has).
-    base = compile_files(replace(options, outputs=None))
-    check_parameter_names(base, parameters)
-    _check_integers(base, parameters)
+        return compile_files(options, derived), None
+    if base is None:
+        # Which parameters are structural is known once the unmodified model is
+        # compiled (all outputs: the selection may name variables that only the
+        # modified one has).
+        base = compile_files(replace(options, outputs=None))
+        check_parameter_names(base, parameters)
+        _check_integers(base, parameters)
     structural = {k: v for k, v in parameters.items() if k in base.structural}
     if not structural:
-        return compile_files(options)
-    return _with_structural(base, structural, options)
+        return compile_files(options, derived or base.compiled_from), base
+    return _with_structural(base, structural, options, derived), base
 
 
 def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
-                     options: CompileOptions | None = None) -> CompiledModel:
+                     options: CompileOptions | None = None,
+                     derived: Derived | None = None) -> CompiledModel:
     if not values:
         return compiled
     mods = tuple(sorted((k, modification_value(compiled, k, v)) for k, v in values.items()))
@@ -230,7 +238,7 @@ def _with_structural(compiled: CompiledModel, values: Mapping[str, float],
                              "would compile another model",
                              "compile the files again with compile_model(files, "
                              "parameters=...)")
-    return compile_files(replace(options or compiled.options, modifications=mods))
+    return compile_files(replace(options or compiled.options, modifications=mods), derived)
 
 
 @recursion_room()

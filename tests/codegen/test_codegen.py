@@ -359,6 +359,30 @@ def test_vector_layout_groups_a_chain_into_loops() -> None:
     assert "# 9 x s[2].s_rel := m[2].s - m[1].s" in rhs
 
 
+CHAIN_200 = """
+model Chain200
+  extends Scenes.Chain(N = 200);
+end Chain200;
+"""
+
+
+def test_vector_parameters_lift_constant_operands(tmp_path: Path) -> None:
+    """``m[i].s0 = L*i`` (+ ``ds`` for i = 1): the constants i are read from a table,
+    so the 200 bindings are one numpy statement, not 200 lines, with the same values
+    (``L * i`` exactly, here with L = 0.3 given)."""
+    (tmp_path / "chain.mdl").write_text(CHAIN_200)
+    source = _generated([SCENES, str(tmp_path / "chain.mdl")], "Chain200",
+                        backend="numba").source
+    body = source[source.index("def parameters("):source.index("def start(")]
+    assert body.count("\n") < 40  # one line per binding was 400 lines
+    module = _load(source, tmp_path, "chain200_lifted")
+    p = module.parameters({"L": 0.3})
+    s0 = [p[module.PARAMETERS.index(f"m[{i}].s0")] for i in range(1, 201)]
+    assert s0 == [0.3 * 1 + 0.5] + [0.3 * i for i in range(2, 201)]
+    x = module.start(p)
+    assert [x[module.STATES.index(f"m[{i}].s")] for i in range(1, 201)] == s0
+
+
 def test_a_parameter_read_only_by_event_code_can_be_changed() -> None:
     """The ball's restitution ``e`` is read only by its reinit: not structural, and a
     run with ``e = 0.5`` bounces as the closed form says (impact speed ``e**k * v1``)."""

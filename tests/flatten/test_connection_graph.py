@@ -118,3 +118,32 @@ def test_graph_errors(name: str, message: str) -> None:
     with pytest.raises((SpringcError, ErrorGroup)) as info:
         flatten_files([GRAPH], f"G.{name}")
     assert [e.message for e in errors_of(info.value)] == [message]
+
+
+def test_overdetermined_elements_looked_up_once_per_connector_class(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Four instances of C (c, d, e[1], e[2]): its overdetermined elements are found
+    once, and each instance is still checked: with two residues the first one, c, is
+    reported with the same counts as a single instance."""
+    from springc.flatten.connect import connect_rules
+
+    calls: list[str] = []
+    found = connect_rules.overdetermined
+
+    def counted(scope):
+        calls.append(scope.entry.full_name)
+        return found(scope)
+
+    monkeypatch.setattr(connect_rules, "overdetermined", counted)
+    balanced = _model(1).replace("  C c(theta = 1, v = 2);\n",
+                                 "  C c(theta = 1, v = 2), d(theta = 1, v = 2);\n"
+                                 "  C e[2](each theta = 1, each v = 2);\n")
+    assert outcome(tmp_path, balanced) == \
+        "M: 17 unknowns, 17 equations, 0 parameters: balanced"  # 4 x 4 + x
+    assert calls == ["M.C"]
+    calls.clear()
+    text = _model(2).replace("  C c(theta = 1, v = 2);\n",
+                             "  C c(theta = 1, v = 2), d(theta = 1, v = 2);\n")
+    assert outcome(tmp_path, text).startswith(
+        "18:5: connector 'c' (M.C) has 2 flow and 3 potential variables\n")
+    assert calls == ["M.C"]

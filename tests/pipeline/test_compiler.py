@@ -183,3 +183,34 @@ def test_a_module_too_long_for_numba_reuses_the_derived_system(
     python = springc.compile_model(seed, backend="python", cache=False)
     assert calls == ["numba", "python"]
     assert chosen.source == python.source
+    assert chosen.compiled_from is not None  # a python module's, for its C model
+
+
+def test_a_structural_model_too_long_for_numba_is_derived_once(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """With a structural value (N = 12) the unmodified chain (N = 10) and the modified
+    one are each derived once although both backends' modules are generated: the
+    second backend reuses the first's system and its unmodified model. The numba
+    model the process keeps lets its system go (``settled``)."""
+    from springc import api
+    from springc.pipeline import generation
+
+    calls: list[tuple[tuple[str, str], ...]] = []
+    derive = generation.derive_system
+
+    def counted(options):
+        calls.append(options.modifications)
+        return derive(options)
+
+    monkeypatch.setattr(generation, "derive_system", counted)
+    monkeypatch.setattr(api, "NUMBA_LINES", 1)
+    chosen = springc.compile_model(SCENES, "Scenes.Chain", parameters={"N": 12},
+                                   cache=False)
+    assert calls == [(), (("N", "12"),)] and chosen.options.backend == "python"
+    python = springc.compile_model(SCENES, "Scenes.Chain", parameters={"N": 12},
+                                   backend="python", cache=False)
+    assert chosen.source == python.source and len(python.states) == 24
+    monkeypatch.setattr(api, "NUMBA_LINES", 10**9)
+    numba = springc.compile_model(SCENES, "Scenes.Chain", parameters={"N": 12},
+                                  backend="numba", cache=False)
+    assert numba.compiled_from is None and numba.module.BACKEND == "numba"

@@ -14,8 +14,8 @@ from collections.abc import Iterator
 from dataclasses import replace
 
 from ..errors import CodegenError, Span
+from ..ir import dae, ode
 from ..ir import expr as x
-from ..ir import ode
 
 
 def untranslatable(message: str, node: x.Expr) -> CodegenError:
@@ -92,9 +92,18 @@ def at_initialization(system: ode.ODE) -> ode.ODE:
             return e
         return _replace_initial(e)
 
-    parameters = tuple(replace(p, binding=fixed(p.binding), start=fixed(p.start))
-                       for p in system.parameters)
-    states = tuple(replace(s, start=fixed(s.start)) for s in system.states)
+    def parameter(p: dae.Parameter) -> dae.Parameter:
+        binding, start = fixed(p.binding), fixed(p.start)
+        if binding is p.binding and start is p.start:
+            return p  # (no copy of the 100,000 parameters of a large scene)
+        return replace(p, binding=binding, start=start)
+
+    def state(s: ode.State) -> ode.State:
+        start = fixed(s.start)
+        return s if start is s.start else replace(s, start=start)
+
+    parameters = tuple(map(parameter, system.parameters))
+    states = tuple(map(state, system.states))
     events = system.events
     if events is not None:
         events = replace(events, discrete=tuple(replace(d, start=fixed(d.start))

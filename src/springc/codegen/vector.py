@@ -81,11 +81,16 @@ class _Assignment:
     slots: list[str]  # the variable read by each slot
     kinds: tuple[str, ...]
     level: int
-    comment: str
+    expr: Expr  # the assignment's expression and location: its comment (read by
+    span: Span  # the first member of each loop only, so written on demand)
     group: int  # assignments of one level, shape and operand kinds share it
     order: tuple[str, tuple[int, ...], tuple[int, ...]]  # loop order (see _order)
     out: tuple[str, int] = ("w", -1)
     operands: list[tuple[str, int]] = field(default_factory=list)
+
+    @property
+    def comment(self) -> str:
+        return f"{self.name} := {to_text(self.expr)}  {self.span.file}:{self.span.line}"
 
 
 @dataclass
@@ -106,27 +111,48 @@ def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
     return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
 
 
-def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None) -> Expr:
-    """``e`` with a slot for each variable (and, with ``lift``, each number: ``lift``
-    names the table entry that holds it)."""
+_LIFTED_OPS = frozenset("+-*/")
+"""Operators whose constant operands :class:`VectorLayout` may lift into ``_F``: their
+value is the same whether the constant is a literal or a float read from the table
+(Modelica's ``/`` divides reals; ``^``'s integer exponents and call arguments stay)."""
+
+
+def _liftable(e: Expr) -> bool:
+    return isinstance(e, Const) and type(e.value) in (int, float) \
+        and (type(e.value) is float or abs(e.value) < 2 ** 53)  # exactly a float
+
+
+def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None,
+           every: bool = False) -> Expr:
+    """``e`` with each variable replaced by a slot ``$k`` (``slots[k]``: its name);
+    with ``lift``, also constants (``lift(value)``: the name of its slot): every number
+    where ``every`` (the C model: doubles either way), else the constant operands of
+    ``+ - * /`` that are exactly a float, so that ``L * 110`` and ``L * 111`` have one
+    shape."""
     if isinstance(e, Var):
         slots.append(e.name)
         return Var(f"${len(slots) - 1}")
-    if isinstance(e, Const) and lift is not None and isinstance(e.value, (int, float)) \
-            and not isinstance(e.value, bool):
+    if every and lift is not None and isinstance(e, Const) \
+            and isinstance(e.value, (int, float)) and not isinstance(e.value, bool):
         slots.append(lift(float(e.value)))
         return Var(f"${len(slots) - 1}")
     if isinstance(e, (Const, Time)):
         return e
     if isinstance(e, (Neg, Not)):
-        return type(e)(_shape(e.arg, slots, lift))
+        return type(e)(_shape(e.arg, slots, lift, every))
     if isinstance(e, BinOp):
-        return BinOp(e.op, _shape(e.left, slots, lift), _shape(e.right, slots, lift))
+        if lift is not None and not every and e.op in _LIFTED_OPS:
+            operands = [Var(lift(float(o.value))) if _liftable(o) else o  # type: ignore[union-attr]
+                        for o in (e.left, e.right)]
+            return BinOp(e.op, _shape(operands[0], slots, lift),
+                         _shape(operands[1], slots, lift))
+        return BinOp(e.op, _shape(e.left, slots, lift, every),
+                     _shape(e.right, slots, lift, every))
     if isinstance(e, Call):
-        return Call(e.name, tuple(_shape(a, slots, lift) for a in e.args))
+        return Call(e.name, tuple(_shape(a, slots, lift, every) for a in e.args))
     if isinstance(e, If):
-        return If(_shape(e.cond, slots, lift), _shape(e.then, slots, lift),
-                  _shape(e.otherwise, slots, lift))
+        return If(_shape(e.cond, slots, lift, every), _shape(e.then, slots, lift, every),
+                  _shape(e.otherwise, slots, lift, every))
     raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
 
 
@@ -156,22 +182,21 @@ class VectorLayout:
             if lift_constants and c:
                 # Every number becomes data (C's doubles either way), so that
                 # bindings such as L * 2, L * 3, ... group whatever their numbers.
-                shape: Expr = _shape(e, slots, self._lifted)
+                shape: Expr = _shape(e, slots, self._lift, every=True)
             elif lift_constants and isinstance(e, Const) and not isinstance(e.value, bool):
                 # Constant values become data (_F), so they group whatever their value.
-                slots.append(self._lifted(float(e.value)))
+                slots.append(self._lift(float(e.value)))
                 shape = Var("$0")
             else:
-                shape = _shape(e, slots)
+                shape = _shape(e, slots, self._lift if lift_constants else None)
             for v in slots:
                 if v not in self.location and v not in self.assignments:
                     raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
             level = 1 + max((self.assignments[v].level for v in slots
                              if v in self.assignments), default=0)
             kinds = tuple(self._kind(v) for v in slots)
-            comment = f"{name} := {to_text(e)}  {span.file}:{span.line}"
             self.assignments[name] = _Assignment(
-                name, shape, slots, kinds, level, comment,
+                name, shape, slots, kinds, level, e, span,
                 groups.setdefault((level, shape, kinds), len(groups)), _order(name))
         # Intermediate values get slots of w group by group, in natural name order.
         self.w_names: list[str] = []
@@ -186,7 +211,8 @@ class VectorLayout:
         for a in self.assignments.values():
             a.operands = [self.location[v] for v in a.slots]
 
-    def _lifted(self, value: float) -> str:
+    def _lift(self, value: float) -> str:
+        """The slot name of a constant ``value`` read from ``_F``."""
         name = f"#{len(self.floats)}"
         self.location[name] = ("c", len(self.floats))
         self.floats.append(value)

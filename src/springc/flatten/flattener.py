@@ -36,6 +36,7 @@ from .scopes import (
     ClassScope,
     ClassView,
     ExpressionEvaluator,
+    Ident,
     Limits,
     ParameterValues,
     Primitive,
@@ -187,8 +188,9 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     scopes = [top]
     try:
         scopes = [*flattener.walk(top), *flattener.walk_added(top), top]
+        overdetermined: dict[Ident[ClassView], dict[str, int]] = {}  # by connector class
         for scope in scopes:
-            check_connector_size(scope)
+            check_connector_size(scope, overdetermined)
         for scope in scopes:
             flattener.equations_of(scope)
         solve_graph(flattener)

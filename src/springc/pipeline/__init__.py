@@ -15,12 +15,11 @@ from .compiler import (
     ModuleKind,
     check_parameter_names,
     compile_files,
-    derived_kept,
     modification_value,
     split_values,
 )
 from .notes import announce_functions
-from .options import CompileOptions
+from .options import CompileOptions, Derived
 from .selection import select_names
 
 if TYPE_CHECKING:
@@ -30,9 +29,9 @@ if TYPE_CHECKING:
     from .generation import derive_system, generate_source
 
 __all__ = ["CCompilerMissing", "CLibrary", "CLoopRefused", "CompileOptions", "CompiledModel",
-           "ModuleKind",
+           "Derived", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
-           "compile_files", "derive_system", "derived_kept", "find_compiler", "flatten_files",
+           "compile_files", "derive_system", "find_compiler", "flatten_files",
            "generate_source", "kernel_library", "loop_library", "modification_value",
            "note_refused", "openmp_flags", "select_names", "split_values"]
 

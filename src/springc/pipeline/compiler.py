@@ -11,13 +11,11 @@ loads only on a miss. What a run needs beyond the module is captured at compile 
 
 from __future__ import annotations
 
-import contextlib
 import shutil
 import tempfile
 import time
-from collections.abc import Iterator, Mapping
-from contextvars import ContextVar
-from dataclasses import dataclass, field, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -82,8 +80,10 @@ class CompiledModel:
     derived: Derived | None = field(default=None, repr=False)  # set by ``equations``
     run_system: RunSystem | None = field(default=None, repr=False)
     model_key: str = ""  # the cache key of the model when it was compiled
-    # the system a python module was generated from in this process (not pickled): its
-    # C model (c_build.c_source) is printed from it rather than derived again
+    # the system the module was generated from in this process (not pickled): the one
+    # memory of a derivation. Another backend's module of the same model is generated
+    # from it (api), and a python module's C model (c_build.c_source) is printed from
+    # it rather than derived again; :meth:`settled` lets it go where neither follows.
     compiled_from: Derived | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict[str, object]:
@@ -98,6 +98,14 @@ class CompiledModel:
                       state["cached"], state["compile_time"], state["outputs"],
                       imported.temporary, state["text"], None, state["run_system"],
                       state["model_key"])
+
+    def settled(self) -> CompiledModel:
+        """This model, keeping the system it was generated from only where its C model
+        may be printed from it (the python backend's, for the C loop): a large model's
+        flat model and system are not kept alive through its runs."""
+        if self.options.backend != "python":
+            self.compiled_from = None
+        return self
 
     @property
     def name(self) -> str:
@@ -308,43 +316,16 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
         if folder is not None:  # never leave an entry that cannot be imported
             shutil.rmtree(path.parent, ignore_errors=True)
         raise too_deep_for_python(err) from None
-    # a python module's model keeps its derived system: the C loop's first run prints
-    # the C model from it (c_build.c_source) instead of deriving it again
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated,
-                         run_system=run, model_key=model_key,
-                         compiled_from=derived if options.backend == "python" else None)
-
-
-_KEPT: ContextVar[dict[str, Derived] | None] = ContextVar("springc_derived", default=None)
-"""Within :func:`derived_kept`: the models derived so far, by their key without backend."""
-
-
-@contextlib.contextmanager
-def derived_kept() -> Iterator[None]:
-    """Within it, a model derived (flattened and simplified) once is not derived again
-    for another backend: a model whose numba module is too long for numba is generated
-    for the python backend from the same system (the 10,000-mass chain: 14 s of CPU).
-    What it kept is let go on exit."""
-    token = _KEPT.set({} if _KEPT.get() is None else _KEPT.get())
-    try:
-        yield
-    finally:
-        _KEPT.reset(token)
+                         run_system=run, model_key=model_key, compiled_from=derived)
 
 
 def _derive(options: CompileOptions) -> Derived:
-    """The flat model and simplified system of ``options`` (kept within
-    :func:`derived_kept`, whose backend and outputs they do not depend on)."""
+    """The flat model and simplified system of ``options``."""
     from . import generation  # the compile path, loaded on a miss only
 
-    kept = _KEPT.get()
-    if kept is None:
-        return generation.derive_system(options)
-    key = model_key_of(replace(options, backend="", outputs=None))
-    if key not in kept:
-        kept[key] = generation.derive_system(options)
-    return kept[key]
+    return generation.derive_system(options)
 
 
 def model_key_of(options: CompileOptions) -> str:

@@ -99,6 +99,12 @@ def switching(e: x.Expr) -> Iterator[x.Expr]:
         stack.extend(x.children(node))
 
 
+def _plain(e: x.Expr) -> bool:
+    """Whether ``e`` has neither a call nor a relation (no event, ``pre`` or phase)."""
+    return not any(type(n) is x.Call or (type(n) is x.BinOp and n.op in x.RELATIONS)
+                   for n in x.walk(e))
+
+
 def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     """The events of ``system`` (None for a purely continuous model)."""
     params = {q.name for q in system.parameters}
@@ -107,6 +113,9 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     exprs = [e for step in system.steps for e in ode.step_expressions(step)]
     exprs += [a.expr for a in system.observed]
     exprs += list(when_exprs(model.whens))
+    # Only expressions with a call or a relation can hold anything found below
+    # (one walk of each, instead of three, for the plain sums of a large scene).
+    exprs = [e for e in exprs if not _plain(e)]
     relations: dict[x.BinOp, None] = {}
     timed: dict[x.BinOp, TimeRelation] = {}
     samples: dict[tuple[x.Expr, x.Expr], None] = {}

@@ -18,7 +18,7 @@ from ...ir import expr as x
 from ...ir import syntax as s
 from ...parse import member_class
 from ..checks import rule_error
-from ..scopes import ClassScope, Primitive, equations
+from ..scopes import ClassScope, ClassView, Ident, Primitive, equations
 
 
 def primitives(scope: ClassScope, prefix: str = "") -> Iterator[tuple[str, Primitive]]:
@@ -114,15 +114,24 @@ def check_sources(members: list[tuple[str, bool]], causal: dict[str, str],
                          "outside input", "9.3")
 
 
-def check_connector_size(scope: ClassScope) -> None:
+def check_connector_size(scope: ClassScope,
+                         known: dict[Ident[ClassView], dict[str, int]] | None = None) -> None:
     """A connector has as many flow variables as variables that are neither parameter,
     constant, input, output nor flow (9.3.1); checked on connector instances that are
-    not nested in another connector."""
+    not nested in another connector. ``known``: the :func:`overdetermined` elements of
+    the class views seen so far in this walk (one look-up per connector class, not per
+    instance: the 50,000 flanges of a 10,000-mass chain)."""
     if scope.kind != "connector" or (scope.outer is not None
                                      and scope.outer.kind == "connector"):
         return
     flows = potentials = 0
-    special = overdetermined(scope)
+    if known is None:
+        special = overdetermined(scope)
+    else:
+        key = Ident(scope.view)
+        if key not in known:
+            known[key] = overdetermined(scope)
+        special = known[key]
     for name, prim in primitives(scope):
         size = int(np.prod(prim.dims)) if prim.dims else 1
         if prim.variability in ("parameter", "constant") or prim.causality \
