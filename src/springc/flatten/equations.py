@@ -125,7 +125,16 @@ class EquationFlattening(FlattenContext):
         switch at events: flatten/events/when.py)."""
         value = self.evaluator.value(cond, where)
         return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) and (
-            not self.is_parameter_expression(value) or event_dependent(value))
+            not self.is_parameter_expression(value) or event_dependent(value)
+            or self._unknown_until_initialized(value))
+
+    def _unknown_until_initialized(self, value: x.Expr) -> bool:
+        """Whether ``value`` reads a parameter with no value while flattening (``fixed =
+        false``, section 8.6: the initialization computes it): the if-equation then
+        switches at run time, its branches the same size (8.3.4), as Dymola and
+        OpenModelica do (Electrical.Analog.Sources.DCPowerSupply's ``cp``)."""
+        bindings = self.parameter_values.bindings
+        return any(bindings.get(n, x.ZERO) is None for n in x.variables(value))
 
     def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression
