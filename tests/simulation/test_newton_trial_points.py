@@ -46,3 +46,34 @@ def test_a_failing_trial_point_rejects_the_step(tmp_path: Path, solver: str) -> 
     expected = [z_exact(float(t)) for t in times]
     assert np.allclose(np.asarray(result["z"]), expected, rtol=0, atol=1e-4)
     assert [e.cause for e in result.events if e.kind == "state"] == ["x < 1"]
+
+
+
+INFINITE = '''\
+model HeldOverflow
+  parameter Real big = 1e308;
+  Real x(start = 0, fixed = true);
+  Real z(start = 0, fixed = true);
+equation
+  der(x) = 1;
+  der(z) = if x < 1 then 1.01 - x + noEvent(max(x - 1.01, 0))*big*big else 0.01;
+end HeldOverflow;
+'''
+
+
+def z_linear(t: float) -> float:
+    """z = 1.01 t - t^2/2 up to t <= 1, then 0.01 per second."""
+    return 1.01 * t - t * t / 2 if t <= 1.0 else 0.51 + 0.01 * (t - 1.0)
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk45"])
+def test_a_non_finite_trial_point_rejects_the_step(tmp_path: Path, solver: str) -> None:
+    # (the held branch overflows past x = 1.01: before, "der(z) is infinite at time
+    # 1.1111" at a point only a step tried)
+    path = tmp_path / "HeldOverflow.mo"
+    path.write_text(INFINITE)
+    result = springc.simulate(str(path), backend="python", engine="scipy", stop=6.0,
+                              interval=0.5, solver=solver, rtol=1e-3, atol=1e-3,
+                              error_control="off")
+    expected = [z_linear(float(t)) for t in np.asarray(result.time)]
+    assert np.allclose(np.asarray(result["z"]), expected, rtol=0, atol=1e-6)

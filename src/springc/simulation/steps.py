@@ -143,6 +143,11 @@ class Problem:
             return np.full(len(x), math.nan)
         # a sum is finite if every term is (a finite sum that overflows is checked again)
         if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
+            if self.trial is not None:  # the step is rejected (see try_step)
+                self.z[:] = self.trial
+                if self.rejected is None:
+                    self.rejected = self.explain(t, np.array(x))
+                return np.asarray(dx)
             raise self.explain(t, np.asarray(x))
         if now >= self.progress.next:
             self.progress.update(t)
@@ -150,10 +155,11 @@ class Problem:
 
     def try_step(self, integrator: Any) -> str | None:
         """``integrator.step()`` (scipy's), where a nonlinear system that does not
-        converge at a point the step tries rejects the step, which scipy retries
-        smaller (a semiconductor's thermal loop has no solution far past the point
-        where it starts to conduct), as established tools do; where the step then
-        fails, the run stops with that Newton failure."""
+        converge or derivatives that are not finite at a point the step tries reject
+        the step, which scipy retries smaller (a semiconductor's thermal loop has no
+        solution, a transistor's held exponential branch overflows, far past the point
+        where it switches), as established tools do; where the step then fails, the
+        run stops with that failure."""
         self.trial, self.rejected = np.array(self.z), None
         try:
             message: str | None = integrator.step()
