@@ -77,3 +77,19 @@ def test_a_non_finite_trial_point_rejects_the_step(tmp_path: Path, solver: str) 
                               error_control="off")
     expected = [z_linear(float(t)) for t in np.asarray(result.time)]
     assert np.allclose(np.asarray(result["z"]), expected, rtol=0, atol=1e-6)
+
+
+RAISING = INFINITE.replace("HeldOverflow", "HeldExp").replace(
+    "noEvent(max(x - 1.01, 0))*big*big", "exp(noEvent(max(x - 1.01, 0))*big) - 1")
+
+
+def test_an_overflow_at_a_trial_point_rejects_the_step(tmp_path: Path) -> None:
+    # (the python backend raises OverflowError in exp past x = 1.01: before,
+    # "overflow while computing der(z)" at a point only a step tried)
+    path = tmp_path / "HeldExp.mo"
+    path.write_text(RAISING)
+    result = springc.simulate(str(path), backend="python", engine="scipy", stop=6.0,
+                              interval=0.5, solver="dop853", rtol=1e-3, atol=1e-3,
+                              error_control="off")
+    expected = [z_linear(float(t)) for t in np.asarray(result.time)]
+    assert np.allclose(np.asarray(result["z"]), expected, rtol=0, atol=1e-6)

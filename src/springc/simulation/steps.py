@@ -127,7 +127,12 @@ class Problem:
         try:
             dx = self.mod.rhs(t, x, self.p, self.z)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
-            raise self.fail(err, t, x, "the derivatives") from err
+            failure = self.fail(err, t, x, "the derivatives")
+            if self.trial is None:
+                raise failure from err
+            self.z[:] = self.trial  # the step is rejected (see try_step)
+            self.rejected = self.rejected or failure
+            return np.full(len(x), math.nan)
         now = time.perf_counter()
         self.model_time += now - began
         if now > self.deadline:
