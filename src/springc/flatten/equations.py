@@ -31,11 +31,6 @@ from .events import (
 from .redeclare import record_equation
 from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
 
-NO_VALUE_HINT = ("an if-equation's branches are chosen while flattening: a condition on a "
-                 "parameter the initialization computes (`fixed = false`) is not supported "
-                 "yet; give the parameter a binding, or write one equation with an "
-                 "if-expression")
-
 
 class EquationFlattening(FlattenContext):
     """Equation flattening; mixed into the Flattener, which provides the lists."""
@@ -130,7 +125,16 @@ class EquationFlattening(FlattenContext):
         switch at events: flatten/events/when.py)."""
         value = self.evaluator.value(cond, where)
         return isinstance(value, (x.BinOp, x.Var, x.Not, x.Call, x.If)) and (
-            not self.is_parameter_expression(value) or event_dependent(value))
+            not self.is_parameter_expression(value) or event_dependent(value)
+            or self._unknown_until_initialized(value))
+
+    def _unknown_until_initialized(self, value: x.Expr) -> bool:
+        """Whether ``value`` reads a parameter with no value while flattening (``fixed =
+        false``, section 8.6: the initialization computes it): the if-equation then
+        switches at run time, its branches the same size (8.3.4), as Dymola and
+        OpenModelica do (Electrical.Analog.Sources.DCPowerSupply's ``cp``)."""
+        bindings = self.parameter_values.bindings
+        return any(bindings.get(n, x.ZERO) is None for n in x.variables(value))
 
     def _if_condition(self, cond: s.Expr, where: Scope) -> bool:
         """The value of an if-equation condition, which must be a parameter expression
@@ -142,10 +146,6 @@ class EquationFlattening(FlattenContext):
                 "switching equations on a variable needs events, which are not supported "
                 "yet; for a continuous switch write one equation with an if-expression "
                 "inside noEvent(...)")
-        except FlattenError as err:
-            if not err.message.endswith("which has no value"):
-                raise
-            raise FlattenError(err.message, err.span, hint=NO_VALUE_HINT) from None
         finally:
             self.evaluator.no_event -= 1
         check_boolean_condition(value, cond.span, "the condition of an if-equation")

@@ -15,7 +15,7 @@ from ..ir import expr as x
 from ..ir import ode
 from ..structure import Matching, blt, dulmage_mendelsohn, maximum_matching, tear
 from .index_reduction import Reduced
-from .isolate import fold, free_variables, partial, solvable, solve_for
+from .isolate import fold, free_variables, linear_split, partial, solve_for
 
 
 def causalize(reduced: Reduced) -> list[ode.Step]:
@@ -79,9 +79,14 @@ def _torn(reduced: Reduced, block: list[int], names: list[str],
           rows: Sequence[Sequence[int]], matching: Matching, unknown_ids: list[int],
           spans: tuple[Span, ...]) -> ode.Step:
     exprs = {e: reduced.equations[e] for e in block}
+    varying = frozenset(reduced.names) | {"time"}
 
     def can_solve(eq: int, var: int) -> bool:
-        return solvable(exprs[eq], reduced.names[unknown_ids[var]], knowns_only=False)
+        # as Dymola and OpenModelica do, an inner equation never divides by a
+        # time-varying coefficient (``LossPower = i*v`` for ``i`` divides by zero where
+        # ``v = 0``): such a pair is left to Newton, through a residual
+        split = linear_split(exprs[eq], reduced.names[unknown_ids[var]])
+        return split is not None and not free_variables(split[0]) & varying
 
     tearing = tear(block, rows, matching, can_solve)
     inner = []

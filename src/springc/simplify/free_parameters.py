@@ -29,7 +29,7 @@ def free_parameters(model: flat.FlatModel) -> flat.FlatModel:
     """``model`` with its ``fixed = false`` parameters bound or turned into states
     (module docstring); the model itself when it has none."""
     free = {v.name for v in model.variables if v.variability == "parameter"
-            and v.binding is None and v.attributes.fixed is False and v.type == "Real"}
+            and v.binding is None and v.attributes.fixed is False}
     if not free:
         return model
     known = {v.name for v in model.variables
@@ -50,7 +50,7 @@ def free_parameters(model: flat.FlatModel) -> flat.FlatModel:
     for v in model.variables:
         if v.name in bindings:
             v = replace(v, binding=bindings[v.name])
-        elif v.name in free:
+        elif v.name in free and v.type == "Real":  # (a Boolean or Integer: rule 1 only)
             v = replace(v, variability="continuous")
             equations.append(flat.Equation(
                 x.Der(x.Var(v.name)), x.ZERO, v.span,

@@ -289,7 +289,7 @@ class EventLoop:
             integrator = cls(problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs)
             while True:
                 t_old = integrator.t
-                message = integrator.step()
+                message = problem.try_step(integrator)
                 if integrator.status == "failed":
                     raise Stop(solver_failure(problem, float(integrator.t),
                                               np.asarray(integrator.y), message))

@@ -97,6 +97,8 @@ class Problem:
         self.deadline = time.perf_counter() + limits.time_limit
         self.asserts = AssertionCheck(mod, p, self.names)
         self.loop_library: Any = None  # the C loop's, loaded once per run (.native)
+        self.trial: np.ndarray | None = None  # z before the step being tried (try_step)
+        self.rejected: Stop | None = None
 
     def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
         where = code_location(err, self.path)
@@ -125,20 +127,52 @@ class Problem:
         try:
             dx = self.mod.rhs(t, x, self.p, self.z)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
-            raise self.fail(err, t, x, "the derivatives") from err
+            failure = self.fail(err, t, x, "the derivatives")
+            if self.trial is None:
+                raise failure from err
+            self.z[:] = self.trial  # the step is rejected (see try_step)
+            self.rejected = self.rejected or failure
+            return np.full(len(x), math.nan)
         now = time.perf_counter()
         self.model_time += now - began
         if now > self.deadline:
             raise OverLimit(f"{self.limits.time_limit:g} s of wall clock reached the time "
                             "limit (--time-limit)", t, np.array(x), self.solver)
         if self.z[-1] != 0.0:
-            raise self.newton_failure(t, x)
+            failure = self.newton_failure(t, x)
+            if self.trial is None:
+                raise failure
+            # at a point a step tries: the step is rejected (NaN), the guesses restored
+            self.z[:] = self.trial
+            self.rejected = failure
+            return np.full(len(x), math.nan)
         # a sum is finite if every term is (a finite sum that overflows is checked again)
         if not math.isfinite(dx.sum()) and not np.isfinite(dx).all():
+            if self.trial is not None:  # the step is rejected (see try_step)
+                self.z[:] = self.trial
+                if self.rejected is None:
+                    self.rejected = self.explain(t, np.array(x))
+                return np.asarray(dx)
             raise self.explain(t, np.asarray(x))
         if now >= self.progress.next:
             self.progress.update(t)
         return np.asarray(dx)
+
+    def try_step(self, integrator: Any) -> str | None:
+        """``integrator.step()`` (scipy's), where a nonlinear system that does not
+        converge or derivatives that are not finite at a point the step tries reject
+        the step, which scipy retries smaller (a semiconductor's thermal loop has no
+        solution, a transistor's held exponential branch overflows, far past the point
+        where it switches), as established tools do; where the step then fails, the
+        run stops with that failure."""
+        self.trial, self.rejected = np.array(self.z), None
+        try:
+            message: str | None = integrator.step()
+        finally:
+            self.trial = None
+        if integrator.status == "failed" and self.rejected is not None:
+            raise self.rejected
+        return message
 
     def non_finite(self, t: float, x: np.ndarray, dx: np.ndarray) -> Stop:
         """The error of derivatives ``dx`` that are NaN or infinite at ``(t, x)``."""
@@ -351,7 +385,7 @@ class StepLoop:
         while not self.done and taken != max_steps:
             before = integrator.t
             try:
-                message = integrator.step()
+                message = problem.try_step(integrator)
             except ValueError as err:  # LU of I - h*J with an overflowing Jacobian
                 if "infs or NaNs" not in str(err):
                     raise

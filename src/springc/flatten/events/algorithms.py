@@ -192,13 +192,11 @@ class _Run:
                                    "only during the simulation is not supported yet",
                                    target.span, hint="subscripts of an assigned variable "
                                    "must be parameter expressions or for-loop indices")
-            if self.initial and isinstance(name, x.Var) and \
-                    self.fl.parameter_values.bindings.get(name.name, 0) is None:
-                raise FlattenError(f"assigning the parameter '{target.dotted}' in an "
-                                   "initial algorithm is not supported yet", target.span,
-                                   hint="compute a `fixed = false` parameter by an initial "
-                                   "equation instead (Modelica 3.6, section 8.6)")
-            if not isinstance(name, x.Var) or name.name in self.fl.parameter_values.bindings:
+            bindings = self.fl.parameter_values.bindings
+            if not isinstance(name, x.Var) or (name.name in bindings and not (
+                    self.initial and bindings[name.name] is None)):
+                # (an initial algorithm computes parameters without a value: fixed =
+                # false, section 8.6; simplify/free_parameters.py binds them)
                 raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
                                    "parameter or constant", target.span,
                                    hint="an algorithm section assigns variables only")
