@@ -83,7 +83,8 @@ def _no_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
 def test_a_file_parsed_by_one_process_is_read_back_by_the_next(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     a = tmp_path / "A.mo"
-    a.write_text("model A\n  expandable connector Bus\n  end Bus;\n  Real x(start = 1);\n"
+    a.write_text("model A\n  connector Port\n    Real p;\n    flow Real m;\n"
+                 "    stream Real h;\n  end Port;\n  Real x(start = 1);\n"
                  "equation\n  der(x) = -x;\nend A;\n")
     first = _fresh(tmp_path / "store").parse(a)
     entries = os.listdir(tmp_path / "store")
@@ -95,11 +96,11 @@ def test_a_file_parsed_by_one_process_is_read_back_by_the_next(
     assert again.classes[0].elements[1:] == first.classes[0].elements[1:]
     assert again.classes[0].equations == first.classes[0].equations
     # the construct outside the subset is reported as before, where it was written
-    bus = again.classes[0].elements[0]
-    assert [str(e) for e in bus.unsupported] == [str(e) for e in
-                                                  first.classes[0].elements[0].unsupported]
-    assert str(bus.unsupported[0]).startswith(
-        f"{a}:2:3: error: `expandable` connectors are not supported yet")
+    port = again.classes[0].elements[0]
+    assert [str(e) for e in port.unsupported] == [str(e) for e in
+                                                   first.classes[0].elements[0].unsupported]
+    assert str(port.unsupported[0]).startswith(
+        f"{a}:5:5: error: `stream` connectors are not supported yet")
 
 
 def test_a_changed_file_or_a_damaged_entry_is_parsed_again(
