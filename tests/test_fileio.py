@@ -53,3 +53,19 @@ def test_the_cache_and_the_run_record_write_through_it(tmp_path: Path,
         b"ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad\n")
     assert written[2][1] == b'{"format": %d, "key": "%s", "x": 1}' % (
         run_record.FORMAT, b"k" * 64)
+
+
+def test_keep_newest_removes_only_its_own_oldest_files(tmp_path: Path) -> None:
+    from springc.fileio import keep_newest
+
+    ours = [tmp_path / f"{i:064x}.json" for i in range(4)]
+    for age, path in enumerate(ours):
+        path.write_text("{}")
+        os.utime(path, ns=(10**18 - age * 10**9, 10**18 - age * 10**9))  # ours[0] newest
+    other = tmp_path / "notes.json"  # not a hash: never counted, never removed
+    other.write_text("mine")
+    os.utime(other, ns=(1, 1))
+    keep_newest(tmp_path, ".json", 69, 2)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [ours[0].name, ours[1].name, other.name])
+    keep_newest(tmp_path / "absent", ".json", 69, 2)  # a missing folder: nothing to do

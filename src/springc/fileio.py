@@ -205,3 +205,19 @@ def replace_private(target: PathLike, data: bytes) -> None:
         with contextlib.suppress(OSError):
             os.unlink(temporary)
         raise
+
+
+def keep_newest(folder: Path, suffix: str, name_length: int, keep: int) -> None:
+    """Remove the least recently written files of ``folder`` beyond ``keep``, counting
+    only springc's own: names ending in ``suffix`` and ``name_length`` characters long
+    (a hash and the suffix). An entry that vanishes or cannot be removed is left."""
+    found = []
+    with contextlib.suppress(OSError), os.scandir(folder) as entries:
+        for entry in entries:
+            if entry.name.endswith(suffix) and len(entry.name) == name_length:
+                with contextlib.suppress(OSError):
+                    found.append((entry.stat().st_mtime_ns, entry.path))
+    found.sort(reverse=True)
+    for _, path in found[keep:]:
+        with contextlib.suppress(OSError):
+            os.unlink(path)

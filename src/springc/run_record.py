@@ -39,7 +39,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeGuard
 
-from .fileio import replace_private
+from .fileio import keep_newest, replace_private
 from .parse import key_sources  # the face and its library walk: no parser, no lark
 from .resources import PACKAGE_ROOT, CacheUnusable, grammar_path, private_folder, user_cache_dir
 
@@ -135,15 +135,7 @@ def write(key: str, content: Mapping[str, Any]) -> Path | None:
 
 def prune(records: Path, keep: int = KEEP) -> None:
     """Remove the least recently written records beyond ``keep``."""
-    found = []
-    for entry in os.scandir(records):
-        if entry.name.endswith(".json") and len(entry.name) == 69:
-            with contextlib.suppress(OSError):
-                found.append((entry.stat().st_mtime_ns, entry.path))
-    found.sort(reverse=True)
-    for _, path in found[keep:]:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
+    keep_newest(records, ".json", 69, keep)
 
 
 def read(key: str) -> dict[str, Any] | None:

@@ -16,7 +16,6 @@ parsed as before.
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import hashlib
 import importlib.util
@@ -25,7 +24,7 @@ import pickle
 import sys
 from pathlib import Path
 
-from ..fileio import replace_private
+from ..fileio import keep_newest, replace_private
 from ..ir.expr import recursion_room
 from ..ir.syntax import StoredDefinition
 from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, private_folder, user_cache_dir
@@ -127,13 +126,4 @@ class ParsedStore:
 
 def prune(folder: Path, keep: int = KEEP) -> None:
     """Remove the least recently written entries of ``folder`` beyond ``keep``."""
-    found = []
-    with contextlib.suppress(OSError), os.scandir(folder) as entries:
-        for entry in entries:
-            if entry.name.endswith(".pickle") and len(entry.name) == 71:
-                with contextlib.suppress(OSError):
-                    found.append((entry.stat().st_mtime_ns, entry.path))
-    found.sort(reverse=True)
-    for _, path in found[keep:]:
-        with contextlib.suppress(OSError):
-            os.unlink(path)
+    keep_newest(folder, ".pickle", 71, keep)
