@@ -17,6 +17,7 @@ from springc.simulation import c_loop_available, default_backend
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
+SCENES = str(ROOT / "models" / "Scenes.mdl")
 ROOT_MODEL = """model Root
   Real x(start = 1, fixed = true);
 equation
@@ -119,6 +120,33 @@ def test_a_model_beyond_the_loops_size_rule_is_generated_for_numba(
     assert c_kernels.loop_refusal(without) == (
         "it has 4 states and no Jacobian in C (the C loop's implicit methods would "
         "factorise a dense one; it takes at most 3 states without one)")
+
+
+@pytest.mark.parametrize(("masses", "grouped"), [(20, False), (200, True)])
+def test_a_refusal_the_module_tells_prints_no_c_and_agrees_with_the_c_file(
+        masses: int, grouped: bool, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    # the 10,000-mass chain's case (20,000 states, Jacobian non-zeros in 20,000 rows),
+    # scaled down: 2 * masses states, a limit of 10 non-zeros
+    from springc.codegen import c_model
+    from springc.pipeline import CLoopRefused, c_kernels
+
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(c_kernels, "C_LOOP_DENSE_STATES", 8)
+    model = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
+                                  parameters={"N": masses})
+    assert hasattr(model.module, "_I") == grouped  # the vector layout's index table
+    assert c_kernels.known_refusal(model) is None  # 2,000 non-zeros: a Jacobian in C
+    monkeypatch.setattr(c_kernels, "JACOBIAN_LIMIT", 10)
+    monkeypatch.setattr(c_model, "JACOBIAN_LIMIT", 10)
+    reason = (f"it has {2 * masses:,} states and no Jacobian in C (the C loop's implicit "
+              "methods would factorise a dense one; it takes at most 8 states without one)")
+    assert c_kernels.known_refusal(model) == reason
+    with pytest.raises(CLoopRefused, match="no Jacobian in C"):
+        c_kernels.loop_library(model)
+    assert not (model.path.parent / "cmodel.c").exists()  # refused without printing C
+    text = c_kernels.c_source(model)  # the C file the loop used to print and refuse
+    assert "#define SPRINGC_HAS_JACOBIAN 0\n" in text
+    assert c_kernels.loop_refusal(text) == reason
 
 
 def test_a_c_build_the_compiler_refuses_falls_back_to_numba_with_a_note(

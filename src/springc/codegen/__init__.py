@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 from .module_api import (
     CODEGEN_VERSION,
     HYBRID_NAMES,
+    JACOBIAN_LIMIT,
     MODULE_NAMES,
     GeneratedModule,
     HybridModule,
@@ -25,9 +26,9 @@ if TYPE_CHECKING:
     from .context import BACKENDS, CodegenBug, CodegenOptions, GeneratedModel
     from .generator import generate
 
-__all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "MODULE_NAMES", "CModelSource",
-           "CodegenBug", "CodegenOptions", "GeneratedModel", "GeneratedModule", "HybridModule",
-           "ModuleKind", "generate", "generate_c"]
+__all__ = ["BACKENDS", "CODEGEN_VERSION", "HYBRID_NAMES", "JACOBIAN_LIMIT", "MODULE_NAMES",
+           "CModelSource", "CodegenBug", "CodegenOptions", "GeneratedModel", "GeneratedModule",
+           "HybridModule", "ModuleKind", "generate", "generate_c"]
 
 
 def __getattr__(name: str) -> Any:

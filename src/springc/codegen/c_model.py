@@ -34,14 +34,11 @@ from .events import held_system
 from .generator import structural_parameters
 from .jacobian import jacobian_statements
 from .locate import at_initialization, locate, untranslatable
+from .module_api import JACOBIAN_LIMIT
 from .module_text import parameter_value, start_of, topological
 from .statements import Let, Load, Namer, Raw, Stmt, Store, reserved_name
 
 _SIGNATURE = "double t, const double *x, const double *p, double *z"
-JACOBIAN_LIMIT = 2000
-"""Non-zeros of the largest Jacobian printed in C. The 10 x 10 cloth's 3,300 take 2.5 MB
-of C in one function, and the C compiler minutes at -O2 (about 30 s of CPU without
-it); integrators of the C model (FMI's, the GPU's explicit methods) work without."""
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,14 @@ loading the generator). 5: a cache entry holds the captured system (``system.pic
 ``PARAMETER_BOUNDS``; 9: torn blocks take ``_newton_solve`` (``codegen.newton_step``)."""
 
 
+JACOBIAN_LIMIT = 2000
+"""Non-zeros of the largest Jacobian printed in C (``codegen.c_model``). The 10 x 10
+cloth's 3,300 take 2.5 MB of C in one function, and the C compiler minutes at -O2 (about
+30 s of CPU without it); integrators of the C model (FMI's, the GPU's explicit methods)
+work without. Here, with the module contract, so that the pipeline knows a model the C
+loop refuses from its module alone (``pipeline.c_kernels.known_refusal``)."""
+
+
 class ModuleKind:
     """What a generated module declares as ``KIND``: the driver that runs it
     (``springc.simulation.runner.DRIVERS``)."""

@@ -22,7 +22,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..codegen import CodegenBug
+from ..codegen import JACOBIAN_LIMIT, CodegenBug
 from ..errors import CodegenError
 from ..integrate import locked, loop_text
 from ..native import LIBRARY_FILE, LoopLibrary
@@ -150,10 +150,31 @@ def loop_refusal(text: str) -> str | None:
                 f"most {C_LOOP_STACK_BYTES:,})")
     states = sizes["SPRINGC_N_STATES"]
     if not sizes["SPRINGC_HAS_JACOBIAN"] and states > C_LOOP_DENSE_STATES:
-        return (f"it has {states:,} states and no Jacobian in C (the C loop's implicit "
-                f"methods would factorise a dense one; it takes at most "
-                f"{C_LOOP_DENSE_STATES:,} states without one)")
+        return _dense_refusal(states)
     return None
+
+
+def known_refusal(model: CompiledModel) -> str | None:
+    """Why the C loop does not take ``model``, where its generated module tells without
+    printing its C file (the 10,000-mass chain's is 12 MB, about 8 s of CPU, printed
+    only to be refused): over :data:`C_LOOP_DENSE_STATES` states and Jacobian non-zeros
+    in more than :data:`~springc.codegen.JACOBIAN_LIMIT` rows (``JAC_ROWS``). The C
+    file then has no Jacobian: its scalar one has the module's pattern, its grouped one
+    is not printed where more derivatives than the limit read a state
+    (``codegen.c_vector.jacobian_floor``), and each row holding a non-zero is such a
+    derivative. None where only the C file tells (:func:`loop_refusal`)."""
+    states = len(model.states)
+    if states <= C_LOOP_DENSE_STATES or len(model.module.JAC_ROWS) <= JACOBIAN_LIMIT:
+        return None
+    if len(set(model.module.JAC_ROWS.tolist())) <= JACOBIAN_LIMIT:
+        return None
+    return _dense_refusal(states)
+
+
+def _dense_refusal(states: int) -> str:
+    return (f"it has {states:,} states and no Jacobian in C (the C loop's implicit "
+            f"methods would factorise a dense one; it takes at most "
+            f"{C_LOOP_DENSE_STATES:,} states without one)")
 
 
 def _sizes(text: str) -> dict[str, int]:
@@ -174,8 +195,9 @@ def loop_library(model: CompiledModel) -> LoopLibrary:
     entry = model.path.parent
     data = read_addition(entry, LIBRARY_FILE)
     if data is None:
-        text = c_source(model)
-        refusal = loop_refusal(text)
+        refusal = known_refusal(model)
+        text = "" if refusal is not None else c_source(model)
+        refusal = refusal or loop_refusal(text)
         if refusal is not None:
             raise CLoopRefused(f"the C loop does not run {model.name}: {refusal}")
         with locked(entry, "cloop"):
