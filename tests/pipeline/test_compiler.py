@@ -214,3 +214,38 @@ def test_a_structural_model_too_long_for_numba_is_derived_once(
     numba = springc.compile_model(SCENES, "Scenes.Chain", parameters={"N": 12},
                                   backend="numba", cache=False)
     assert numba.compiled_from is None and numba.module.BACKEND == "numba"
+
+
+def test_a_second_backends_module_shares_the_first_ones_backend_free_parts(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Generated from one derivation (a model over the C loop's size rule: python, then
+    numba), the structural parameters and the vector layout's ``parameters`` and
+    ``start`` are made once; the numba module is the text of a generation of its own."""
+    from dataclasses import replace
+
+    from springc.codegen import generator, module_text
+    from springc.pipeline import CompileOptions, generation
+
+    made: list[str] = []
+    structural, vector = generator.structural_parameters, module_text._parameters_vector
+
+    def counted_structural(*args):
+        made.append("structural")
+        return structural(*args)
+
+    def counted_vector(*args):
+        made.append("parameters")
+        return vector(*args)
+
+    monkeypatch.setattr(generator, "structural_parameters", counted_structural)
+    monkeypatch.setattr(module_text, "_parameters_vector", counted_vector)
+    options = CompileOptions((str(SCENES),), "Scenes.Chain", modifications=(("N", "200"),))
+    derived = generation.derive_system(options)
+    python = generation.generate_from(derived, options)
+    numba = generation.generate_from(derived, replace(options, backend="numba"))
+    assert made == ["structural", "parameters"]
+    alone = generation.generate_from(replace(derived, parts={}),
+                                     replace(options, backend="numba"))
+    assert made == ["structural", "parameters"] * 2
+    assert numba == alone and "\n_jit = njit(" in numba and "BACKEND = 'python'" in python
+    assert python.count("def parameters(values=None):") == 1

@@ -9,8 +9,9 @@ with ``printer``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, TypeVar, cast
 
 from ..errors import Span
 from ..ir import flat, ode
@@ -19,6 +20,8 @@ from .delays import DelayLayout
 from .event_layout import EventLayout
 from .newton_step import newton_solve
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store, guarded_solve
+
+T = TypeVar("T")
 
 
 class CodegenBug(RuntimeError):
@@ -54,13 +57,28 @@ class CodegenOptions:
     ``switchable``: index reduction left a choice of states that may turn singular
     during a run (the module says so; the simulator then switches states);
     ``warnings``: diagnostics of the model that are not errors, as text the module keeps
-    (``WARNINGS``) for whoever loads it from the cache."""
+    (``WARNINGS``) for whoever loads it from the cache;
+    ``shared``: the parts of a module that do not depend on the backend (the structural
+    parameters, the vector layout's ``parameters`` and ``start``), kept for another
+    generation of the same system (the pipeline's ``Derived.parts``: a model over the
+    C loop's size rule is generated for python, then for numba; :func:`shared_part`)."""
 
     backend: str = "python"
     outputs: tuple[str, ...] | None = None
     vector: bool | None = None  # None: by size (vector.VECTOR_THRESHOLD)
     switchable: bool = False
     warnings: tuple[str, ...] = ()
+    shared: dict[str, Any] | None = field(default=None, compare=False, repr=False)
+
+
+def shared_part(options: CodegenOptions, name: str, make: Callable[[], T]) -> T:
+    """The part ``name`` of the module: made by ``make``, once per ``options.shared``
+    (whose generations are of one system: :func:`.generator.generate` checks)."""
+    if options.shared is None:
+        return make()
+    if name not in options.shared:
+        options.shared[name] = make()
+    return cast(T, options.shared[name])
 
 
 @dataclass(frozen=True)

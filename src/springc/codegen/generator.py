@@ -20,6 +20,7 @@ or escaped comments (``printer.escaped``).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 from ..errors import CodegenError
 from ..ir import flat, ode
@@ -27,7 +28,14 @@ from ..ir.dae import derivative_name
 from ..ir.expr import Var, variables
 from ..ir.hybrid import event_expressions
 from .assertions import assertion_function
-from .context import BACKENDS, CodegenBug, CodegenContext, CodegenOptions, GeneratedModel
+from .context import (
+    BACKENDS,
+    CodegenBug,
+    CodegenContext,
+    CodegenOptions,
+    GeneratedModel,
+    shared_part,
+)
 from .delays import used_names
 from .events import FUNCTIONS as EVENT_FUNCTIONS
 from .events import held_system
@@ -78,6 +86,9 @@ def generate(system: ode.ODE, flat_model: flat.FlatModel | None = None,
     """The Python module of ``system`` for ``options.backend`` (default options: the
     python backend, every observed variable). An expression that cannot be translated
     is a :class:`CodegenError` located at the model element it comes from."""
+    if options is not None and options.shared is not None \
+            and options.shared.setdefault("system", system) is not system:
+        options = replace(options, shared=None)  # kept for another system: not used
     try:
         return _generate(at_initialization(system), flat_model, options)
     except CodegenError as err:
@@ -146,7 +157,8 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
         bodies.append(("delay_inputs", "The delayed expressions, then the delay times.",
                        function_lines(namer, helpers, prologue + m.delays.inputs_body(base)),
                        "di"))
-    structural = structural_parameters(system, flat_model)
+    structural = shared_part(options, "structural",
+                             lambda: structural_parameters(system, flat_model))
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
                           table)
     return GeneratedModel(system.name, source, options.backend, tuple(m.states),

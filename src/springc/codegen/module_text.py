@@ -16,7 +16,7 @@ from ..ir import dae
 from ..ir.expr import ZERO, Const, Expr, Var, substitute, variables
 from ..simplify import conditions as initial_conditions
 from .assertions import assertion_table
-from .context import CodegenContext, CodegenOptions, source_comment, source_location
+from .context import CodegenContext, CodegenOptions, shared_part, source_comment, source_location
 from .encoding import encode_floats, encode_ints, encode_strings
 from .events import EVENT_UPDATE, NO_EVENTS
 from .events import constants as event_constants
@@ -163,7 +163,7 @@ def module_text(m: CodegenContext, options: CodegenOptions,
     ]
     lines += event_constants(m, m.events) if m.events is not None else NO_EVENTS
     lines += m.delays.constants()
-    lines += parameters_function(m, namer, helpers)
+    lines += _parameters_part(m, options, namer, helpers)
     for name in sorted(helpers):
         lines += ["", ""] + (["@_jit"] if numba else []) + HELPERS[name].splitlines()
     if table is not None:  # numba freezes the global table as a constant of each function
@@ -292,6 +292,22 @@ def _parameters_vector(m: CodegenContext, helpers: set[str]) -> list[str]:
         '    """Initial Newton guesses of the tearing variables, then the flag."""',
         "    return np.zeros(1)",
     ]
+
+
+def _parameters_part(m: CodegenContext, options: CodegenOptions, namer: Namer,
+                     helpers: set[str]) -> list[str]:
+    """:func:`parameters_function`; in the vector layout (no names of ``namer``: the
+    same text for every backend) one text per ``options.shared``."""
+    if not parameters_suit(m):
+        return parameters_function(m, namer, helpers)
+
+    def make() -> tuple[tuple[str, ...], frozenset[str]]:
+        used: set[str] = set()
+        return tuple(_parameters_vector(m, used)), frozenset(used)
+
+    lines, used = shared_part(options, "parameters", make)
+    helpers |= used
+    return list(lines)
 
 
 def parameters_function(m: CodegenContext, namer: Namer, helpers: set[str]) -> list[str]:

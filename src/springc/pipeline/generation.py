@@ -38,5 +38,6 @@ def generate_from(derived: Derived, options: CompileOptions) -> str:
     selected = set(select_names(candidates, options.outputs))
     observed = tuple(n for n in system.observed_names() if n in selected)
     codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
-                             warnings=encode_warnings(derived.warnings))
+                             warnings=encode_warnings(derived.warnings),
+                             shared=derived.parts)
     return generate(system, flat_model, codegen).source

@@ -9,7 +9,8 @@ a cached model captured) and the compile path a cache miss takes (:mod:`.derive`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 from ..errors import UnitError
 from ..ir import flat, ode
@@ -39,9 +40,12 @@ class CompileOptions:
 class Derived:
     """The simplified system of a model, its flat model, whether index reduction
     left a choice of states that may turn singular during a run (``switchable``), and
-    the unit mismatches of the flat model."""
+    the unit mismatches of the flat model; ``parts``: what its generations share
+    (``codegen.CodegenOptions.shared``: a second backend's module reuses the first's
+    backend-independent parts)."""
 
     system: ode.ODE
     flat_model: flat.FlatModel
     switchable: bool
     warnings: tuple[UnitError, ...] = ()
+    parts: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
