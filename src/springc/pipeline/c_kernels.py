@@ -111,7 +111,7 @@ loop's row of observed values (``SPRINGC_N_OBSERVED``); a quarter of Linux's usu
 
 C_LOOP_DENSE_STATES = 256
 """The most states of a model whose C model has no Jacobian (``SPRINGC_HAS_JACOBIAN``
-0: over ``codegen.c_model.JACOBIAN_LIMIT`` non-zeros) the C loop takes: its radau and
+0: over ``codegen.JACOBIAN_LIMIT`` non-zeros) the C loop takes: its radau and
 bdf (explicitly asked for, or run by ``auto``'s race) then difference and factorise a
 dense Jacobian, n**2 memory and n**3 work per factorisation; a larger one runs on
 numba, whose analytic Jacobian is sparse."""
