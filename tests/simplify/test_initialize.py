@@ -11,7 +11,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from springc.pipeline.files import flatten_files
-from springc.simplify.initialize import InitializationError, conditions, initial_state
+from springc.simplify.initialize import (
+    InitializationError,
+    RedundantInitialWarning,
+    conditions,
+    initial_state,
+)
 from springc.simplify.ode_eval import OdeEvaluator
 from springc.simplify.passes import simplify
 
@@ -110,8 +115,7 @@ def test_overdetermined_names_user_equations(tmp_path: Path) -> None:
     assert all(n.span is not None and n.span.file.endswith("m.mdl") for n in err.notes)
 
 
-def test_singular_initial_problem(tmp_path: Path) -> None:
-    model = compile_text(tmp_path, """
+REDUNDANT = """
 model R
   Real x(start = 1);
   Real y(start = 2);
@@ -120,13 +124,69 @@ equation
   der(y) = -x;
 initial equation
   x = 1;
-  2*x = 2;
+  2*x = RHS;
 end R;
-""")
+"""
+
+
+def test_redundant_consistent_initial_equation_is_dropped(tmp_path: Path) -> None:
+    model = compile_text(tmp_path, REDUNDANT.replace("RHS", "2"))
+    with pytest.warns(RedundantInitialWarning) as caught:
+        x0, info = initial_state(model)
+    assert str(caught[0].message) == ("R: 1 redundant initial condition(s) left out, "
+                                      "consistent with the others: x = 1")
+    assert [c.text for c in info.dropped] == ["x = 1"]
+    assert info.solved == ("x",) and info.defaulted == ("y",)
+    assert x0.tolist() == pytest.approx([1.0, 2.0], abs=1e-12)
+
+
+def test_redundant_inconsistent_initial_equation_is_an_error(tmp_path: Path) -> None:
+    model = compile_text(tmp_path, REDUNDANT.replace("RHS", "3"))
     with pytest.raises(InitializationError) as info:
         initial_state(model)
-    assert "singular" in str(info.value)
-    assert "der(" not in str(info.value) + " ".join(n.message for n in info.value.notes)
+    assert str(info.value).splitlines()[0].endswith(
+        "error: the initialization problem is singular: 2 initial conditions determine "
+        "only 1 state(s), and the redundant ones do not hold")
+    assert [n.message for n in info.value.notes] == [
+        "condition: x = 1 (residual 0.5 at the solution of the others)"]
+
+
+def test_redundant_through_the_dynamics(tmp_path: Path) -> None:
+    """An RC pair whose initial current and capacitor voltage say the same thing
+    (i = (u - v)/R): v = 1 and i = (3 - 1)/2 = 1 are one condition; v = 1 is the
+    state's value, the other state w takes the second equation w = 2*v."""
+    model = compile_text(tmp_path, """
+model RC
+  parameter Real R = 2;
+  Real v(start = 0);
+  Real w(start = 0);
+  Real i;
+equation
+  i = (3 - v)/R;
+  der(v) = i;
+  der(w) = v - w;
+initial equation
+  v = 1;
+  i = 1;
+  w = 2*v;
+end RC;
+""")
+    with pytest.warns(RedundantInitialWarning):
+        x0, info = initial_state(model)
+    assert len(info.dropped) == 1 and info.defaulted == ()
+    assert dict(zip(info.solved, x0.tolist())) == pytest.approx({"v": 1.0, "w": 2.0})
+    assert info.residual <= 1e-9
+
+
+def test_fixed_start_and_equal_initial_equation(tmp_path: Path) -> None:
+    """More conditions than free states: ``x(fixed = true, start = 1)`` and ``x = 1``."""
+    model = compile_text(tmp_path, REDUNDANT.replace("Real x(start = 1);",
+                                                     "Real x(start = 1, fixed = true);")
+                         .replace("  2*x = RHS;\n", "  y = 5;\n"))
+    with pytest.warns(RedundantInitialWarning):
+        x0, info = initial_state(model)
+    assert [c.text for c in info.dropped] == ["x = 1"]
+    assert x0.tolist() == pytest.approx([1.0, 5.0], abs=1e-12)
 
 
 def test_pendulum_start_is_consistent_with_dummy_derivatives() -> None:
