@@ -123,6 +123,10 @@ def initial_state(model: ode.ODE, parameters: Mapping[str, float] | None = None,
     if conds:
         _check_evaluable(model, conds, evaluator, x0, t0)
         chosen, kept = _choose_states(conds, free, x0, lambda z, c: residuals(z, c))
+        regular = _regular_elsewhere(model, conds, free, x0, residuals, tol) \
+            if len(kept) < len(conds) <= len(free) else None
+        if regular is not None:  # singular at the start values only: nothing dropped
+            chosen, kept = regular, list(range(len(conds)))
         dropped = tuple(c for i, c in enumerate(conds) if i not in set(kept))
         if chosen:
             x0[chosen] = _solve(model, tuple(conds[i] for i in kept), chosen, x0,
@@ -157,6 +161,43 @@ def _check_evaluable(model: ode.ODE, conds: tuple[Condition, ...], evaluator: Od
                 "derivatives of variables that appear differentiated in the model") from None
 
 
+def _jacobian(n: int, free: list[int], x0: np.ndarray,
+              residuals: Callable[[np.ndarray, list[int]], np.ndarray]) -> np.ndarray:
+    """The finite-difference Jacobian of the ``n`` residuals on the ``free`` states."""
+    base = residuals(x0[free], free)
+    jac = np.zeros((n, len(free)))
+    for j in range(len(free)):
+        z = x0[free].copy()
+        h = 1e-7 * max(1.0, abs(z[j]))
+        z[j] += h
+        jac[:, j] = (residuals(z, free) - base) / h
+    return jac
+
+
+def _regular_elsewhere(model: ode.ODE, conds: tuple[Condition, ...], free: list[int],
+                       x0: np.ndarray,
+                       residuals: Callable[[np.ndarray, list[int]], np.ndarray], tol: float
+                       ) -> list[int] | None:
+    """Conditions whose Jacobian is singular at the start values only (nonlinear ones
+    at a degenerate start, LightningImpulse's ``eta``, ``T``, ``tau1``...): solved all
+    together for the states of the pivoted columns; those states where the Jacobian
+    has full rank at the solution (then nothing is redundant), else None."""
+    import scipy.linalg
+
+    _, _, perm = scipy.linalg.qr(_scaled(_jacobian(len(conds), free, x0, residuals)),
+                                 pivoting=True, mode="economic")
+    chosen = sorted(free[j] for j in perm[:len(conds)])
+    try:
+        z = _solve(model, conds, chosen, x0, lambda z: residuals(z, chosen), tol)
+    except InitializationError:
+        return None
+    trial = x0.copy()
+    trial[chosen] = z
+    if _rank(_jacobian(len(conds), free, trial, residuals)) < len(conds):
+        return None
+    return chosen
+
+
 def _choose_states(conds: tuple[Condition, ...], free: list[int], x0: np.ndarray,
                    residuals: Callable[[np.ndarray, list[int]], np.ndarray]
                    ) -> tuple[list[int], list[int]]:
@@ -165,13 +206,7 @@ def _choose_states(conds: tuple[Condition, ...], free: list[int], x0: np.ndarray
     its transpose where its rank is below the number of conditions)."""
     import scipy.linalg
 
-    base = residuals(x0[free], free)
-    jac = np.zeros((len(conds), len(free)))
-    for j in range(len(free)):
-        z = x0[free].copy()
-        h = 1e-7 * max(1.0, abs(z[j]))
-        z[j] += h
-        jac[:, j] = (residuals(z, free) - base) / h
+    jac = _scaled(_jacobian(len(conds), free, x0, residuals))
     kept = list(range(len(conds)))
     rank = _rank(jac)
     if rank < len(conds):
@@ -183,10 +218,26 @@ def _choose_states(conds: tuple[Condition, ...], free: list[int], x0: np.ndarray
     return sorted(free[j] for j in perm[:len(kept)]), kept
 
 
+def _scaled(jac: np.ndarray) -> np.ndarray:
+    """``jac`` with each row, then each column, scaled to a largest entry of 1 (zero
+    ones left): conditions and states of any magnitude (a time constant of 1e-5 s
+    beside an amplitude factor of 1) count alike in the rank decisions."""
+    out = np.array(jac, dtype=float)
+    if out.size == 0:
+        return out
+    rows = np.abs(out).max(axis=1, keepdims=True)
+    out /= np.where(rows > 0, rows, 1.0)
+    cols = np.abs(out).max(axis=0, keepdims=True)
+    out /= np.where(cols > 0, cols, 1.0)
+    return out
+
+
 def _rank(jac: np.ndarray) -> int:
-    """The numerical rank of ``jac`` (relative threshold 1e-6 on R's diagonal)."""
+    """The numerical rank of ``jac`` (scaled: relative threshold 1e-6 on R's
+    diagonal)."""
     import scipy.linalg
 
+    jac = _scaled(jac)
     if jac.size == 0:
         return 0
     r = scipy.linalg.qr(jac, pivoting=True, mode="r")[0]
