@@ -4,6 +4,7 @@ check of the index-reduced pendulum with the reference evaluator."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from springc.pipeline.files import flatten_files
-from springc.simplify.initialize import InitializationError, conditions, initial_state
+from springc.simplify.initialize import (
+    InitializationError,
+    RedundantInitialWarning,
+    conditions,
+    initial_state,
+)
 from springc.simplify.ode_eval import OdeEvaluator
 from springc.simplify.passes import simplify
 
@@ -110,8 +116,7 @@ def test_overdetermined_names_user_equations(tmp_path: Path) -> None:
     assert all(n.span is not None and n.span.file.endswith("m.mdl") for n in err.notes)
 
 
-def test_singular_initial_problem(tmp_path: Path) -> None:
-    model = compile_text(tmp_path, """
+REDUNDANT = """
 model R
   Real x(start = 1);
   Real y(start = 2);
@@ -120,13 +125,69 @@ equation
   der(y) = -x;
 initial equation
   x = 1;
-  2*x = 2;
+  2*x = RHS;
 end R;
-""")
+"""
+
+
+def test_redundant_consistent_initial_equation_is_dropped(tmp_path: Path) -> None:
+    model = compile_text(tmp_path, REDUNDANT.replace("RHS", "2"))
+    with pytest.warns(RedundantInitialWarning) as caught:
+        x0, info = initial_state(model)
+    assert str(caught[0].message) == ("R: 1 redundant initial condition(s) left out, "
+                                      "consistent with the others: 2 * x = 2")
+    assert [c.text for c in info.dropped] == ["2 * x = 2"]
+    assert info.solved == ("x",) and info.defaulted == ("y",)
+    assert x0.tolist() == pytest.approx([1.0, 2.0], abs=1e-12)
+
+
+def test_redundant_inconsistent_initial_equation_is_an_error(tmp_path: Path) -> None:
+    model = compile_text(tmp_path, REDUNDANT.replace("RHS", "3"))
     with pytest.raises(InitializationError) as info:
         initial_state(model)
-    assert "singular" in str(info.value)
-    assert "der(" not in str(info.value) + " ".join(n.message for n in info.value.notes)
+    assert str(info.value).splitlines()[0].endswith(
+        "error: the initialization problem is singular: 2 initial conditions determine "
+        "only 1 state(s), and the redundant ones do not hold")
+    assert [n.message for n in info.value.notes] == [
+        "condition: 2 * x = 3 (residual -1 at the solution of the others)"]
+
+
+def test_redundant_through_the_dynamics(tmp_path: Path) -> None:
+    """An RC pair whose initial current and capacitor voltage say the same thing
+    (i = (u - v)/R): v = 1 and i = (3 - 1)/2 = 1 are one condition; v = 1 is the
+    state's value, the other state w takes the second equation w = 2*v."""
+    model = compile_text(tmp_path, """
+model RC
+  parameter Real R = 2;
+  Real v(start = 0);
+  Real w(start = 0);
+  Real i;
+equation
+  i = (3 - v)/R;
+  der(v) = i;
+  der(w) = v - w;
+initial equation
+  v = 1;
+  i = 1;
+  w = 2*v;
+end RC;
+""")
+    with pytest.warns(RedundantInitialWarning):
+        x0, info = initial_state(model)
+    assert len(info.dropped) == 1 and info.defaulted == ()
+    assert dict(zip(info.solved, x0.tolist())) == pytest.approx({"v": 1.0, "w": 2.0})
+    assert info.residual <= 1e-9
+
+
+def test_fixed_start_and_equal_initial_equation(tmp_path: Path) -> None:
+    """More conditions than free states: ``x(fixed = true, start = 1)`` and ``x = 1``."""
+    model = compile_text(tmp_path, REDUNDANT.replace("Real x(start = 1);",
+                                                     "Real x(start = 1, fixed = true);")
+                         .replace("  2*x = RHS;\n", "  y = 5;\n"))
+    with pytest.warns(RedundantInitialWarning):
+        x0, info = initial_state(model)
+    assert [c.text for c in info.dropped] == ["x = 1"]
+    assert x0.tolist() == pytest.approx([1.0, 5.0], abs=1e-12)
 
 
 def test_pendulum_start_is_consistent_with_dummy_derivatives() -> None:
@@ -161,3 +222,31 @@ def test_pendulum_numerics() -> None:
                     [math.pi / 4, 0.0], method="DOP853", rtol=1e-12, atol=1e-12,
                     t_eval=times)
     assert np.max(np.abs(theta - ref.y[0])) < 1e-6
+
+
+def test_singular_at_the_start_values_only(tmp_path: Path) -> None:
+    """``x*y = 2`` and ``x + y = 3`` from ``x = y = 0``: the Jacobian ``[[y, x], [1, 1]]``
+    is singular there but not at the roots, so nothing is redundant (LightningImpulse's
+    time constants); and a time constant of 1e-5 beside a factor of 1 counts alike."""
+    model = compile_text(tmp_path, """
+model S
+  Real x(start = 0);
+  Real y(start = 0);
+  Real t(start = 1e-5);
+equation
+  der(x) = 0;
+  der(y) = 0;
+  der(t) = 0;
+initial equation
+  x*y = 2;
+  x + y = 3;
+  exp(-1e-5/t) = x*exp(-1);
+end S;
+""")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RedundantInitialWarning)
+        x0, info = initial_state(model)
+    assert info.dropped == () and info.residual <= 1e-9
+    x, y, t = x0.tolist()
+    assert sorted([x, y]) == pytest.approx([1.0, 2.0], rel=1e-9)
+    assert t == pytest.approx(1e-5 / (1 - math.log(x)), rel=1e-9)

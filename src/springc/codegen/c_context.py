@@ -13,8 +13,14 @@ import re
 from collections.abc import Sequence
 
 from ..ir import ode
-from ..ir.expr import ZERO, BinOp, Var
-from .context import NEWTON_ITERATIONS, CodegenBug, CodegenContext, newton_update
+from ..ir.expr import ZERO, Var
+from .context import (
+    NEWTON_ITERATIONS,
+    CodegenBug,
+    CodegenContext,
+    newton_update,
+    scalar_newton_step,
+)
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 SOLVE = """SPRINGC_FN void springc_solve(int n, int m, double *a, double *b, double *y)
@@ -107,8 +113,7 @@ class CContext(CodegenContext):
         loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
         entries = {(i, j): e for i, j, e in block.jacobian}
         if k == 1:
-            pivot = entries.get((0, 0), ZERO)
-            loop.append(Let(f"_d{index}_0", BinOp("/", Var(f"_r{index}_0"), pivot)))
+            loop += scalar_newton_step(block.tearing[0], entries.get((0, 0), ZERO), index)
         else:
             self.uses_solve = True
             loop.append(Raw(f"double _J{index}[{k * k}] = {{0.0}};"))

@@ -15,7 +15,7 @@ from typing import Any, TypeVar, cast
 
 from ..errors import Span
 from ..ir import flat, ode
-from ..ir.expr import ZERO, BinOp, Call, Const, Expr, Var, add, mul, sub, variables
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, sub, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
 from .newton_step import newton_solve
@@ -200,8 +200,7 @@ class CodegenContext:
         loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
         entries = {(i, j): e for i, j, e in block.jacobian}
         if k == 1:
-            pivot = entries.get((0, 0), ZERO)
-            loop.append(Let(f"_d{index}_0", BinOp("/", Var(f"_r{index}_0"), pivot)))
+            loop += scalar_newton_step(block.tearing[0], entries.get((0, 0), ZERO), index)
         else:
             loop.append(Raw(f"_J{index} = np.zeros(({k}, {k}))"))
             loop += [Store(f"_J{index}[{i}, {j}]", e) for (i, j), e in entries.items()]
@@ -238,6 +237,24 @@ class CodegenContext:
         for n in names:
             visit(n)
         return out
+
+
+NEWTON_NUDGE = 1e-6
+"""Where a scalar block's derivative is exactly 0 at an iterate that is no solution
+(``P = v*i`` at ``v = i = 0``), the next iterate is this far from it, relative to
+``1 + |t|``: the tangent there has no root, a point beside it has one."""
+
+
+def scalar_newton_step(tearing: str, pivot: Expr, index: int) -> list[Stmt]:
+    """``_d{index}_0``, the Newton correction of a block with one tearing variable:
+    ``r / pivot``; 0 at a zero pivot where ``r`` is 0, else a step of
+    :data:`NEWTON_NUDGE` off the point (no division by zero)."""
+    r, d = Var(f"_r{index}_0"), Var(f"_p{index}_0")
+    nudge = mul(Const(-NEWTON_NUDGE), add(Const(1.0), Call("abs", (Var(tearing),))))
+    zero = BinOp("==", d, ZERO)
+    return [Let(f"_p{index}_0", pivot),
+            Let(f"_d{index}_0", If(zero, If(BinOp("==", r, ZERO), ZERO, nudge),
+                                   BinOp("/", r, d)))]
 
 
 def newton_update(tearing: Sequence[str], index: int) -> list[Stmt]:

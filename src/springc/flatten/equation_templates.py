@@ -78,7 +78,7 @@ def fixed_shape(flattener: FlattenContext, comp: ViewComponent,
     declared = flattener.declared_type(comp)
     rtype = declared.rtype
     if declared.dims is None or "constant" in (comp.decl.variability, rtype.prefixes[0]) \
-            or rtype.primitive == "String":
+            or rtype.primitive == "String" or comp.decl.evaluate:
         return False
     if rtype.entry is None:
         return True

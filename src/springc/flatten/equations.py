@@ -29,7 +29,7 @@ from .events import (
     variable_if_equation,
 )
 from .redeclare import record_equation
-from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Scope
+from .scopes import ClassScope, ClassView, FlattenContext, Ident, LocalScope, Primitive, Scope
 
 
 class EquationFlattening(FlattenContext):
@@ -52,7 +52,10 @@ class EquationFlattening(FlattenContext):
             return
         target = self.initial_equations if initial else self.equations
         key = (Ident(view), initial)
-        template = self.templates.get(key) if scope.package is None else None
+        # an instance with evaluated parameters (Evaluate = true, or final and bound to
+        # those) has its own folded equations: no template for it, none from it
+        shared = scope.package is None and not _evaluated_members(scope)
+        template = self.templates.get(key) if shared else None
         if template is not None:
             target += template.instantiate(scope.prefix)
             return
@@ -67,7 +70,7 @@ class EquationFlattening(FlattenContext):
             finally:
                 self.written_in = None
         if key not in self.templates and scope.prefix and len(self.errors) == errors \
-                and scope.package is None and len(self.deferred_ifs) == deferred:
+                and shared and len(self.deferred_ifs) == deferred:
             independent = self.parameter_values.reads == reads \
                 and reusable(self, view, self.reusable_views)
             self.templates[key] = make_template(scope.prefix, target[start:]) \
@@ -204,3 +207,9 @@ class EquationFlattening(FlattenContext):
         target = self.initial_equations if initial else self.equations
         for left, right in zip(a.scalars(lhs), a.scalars(rhs)):
             target.append(flat.Equation(left, right, eq.span, origin))
+
+
+def _evaluated_members(scope: ClassScope) -> bool:
+    """Whether a parameter of ``scope`` was folded into a constant (18.3)."""
+    return any(isinstance(m, Primitive) and m.variability == "constant"
+               and m.decl.variability == "parameter" for m in scope.members.values())

@@ -179,6 +179,10 @@ class InstanceTemplates:
                                    prim.dims, scope.flat_name(name), prim.decl)
                 if value is None:
                     raise FlattenError(f"'{scope.flat_name(name)}' has no value")
+                given = scope.mod.children[name] if scope.mod else None
+                if given is not None and given.final and \
+                        all(isinstance(v, x.Const) for v in a.scalars(value)):
+                    return  # may be evaluated (18.3): the general path decides
                 outer.update(zip(_scalar_names(prim, scope.prefix, template.scope.prefix),
                                  a.scalars(value)))
         except FlattenError:

@@ -339,6 +339,8 @@ class Instantiation(FlattenContext):
         if mod is not None and mod.value is not None:
             check_discrete_binding(name, rtype.primitive or "Real", variability,
                                    mod.value.expr, mod.value.scope)
+        if variability == "parameter" and self._evaluated(decl, mod, binding, name):
+            variability = "constant"
         if variability == "constant":
             if binding is None:
                 raise FlattenError(f"constant '{name}' needs a value", decl.span)
@@ -359,6 +361,25 @@ class Instantiation(FlattenContext):
             prim_binding = binding
             self._binding_equations(scope, prim, prim_binding)
         return prim
+
+    def _evaluated(self, decl: s.Component, mod: Mod | None, binding: a.Value | None,
+                   name: str) -> bool:
+        """Whether a parameter is folded into the model as a constant (Modelica 18.3):
+        ``annotation(Evaluate = true)``, or ``final`` with a binding that names such
+        parameters or constants only (``final C = CapVal``), as the established tools
+        do; its binding must be a constant expression."""
+        if binding is None or mod is None or mod.value is None:
+            return False
+        if not decl.evaluate:
+            final = decl.final or mod.final
+            if not final or isinstance(mod.value.expr, (s.Number, s.Bool, s.String)) or \
+                    not all(isinstance(v, x.Const) for v in a.scalars(binding)):
+                return False
+        try:
+            self._constant_value(binding, name, mod)
+        except FlattenError:
+            return False
+        return True
 
     def _constant_value(self, binding: a.Value, name: str, mod: Mod | None) -> Any:
         """The numeric value of a constant's binding (a constant expression): a number,

@@ -246,6 +246,9 @@ class Component:
     # The type and modification of `constrainedby T(...)` (Modelica 7.3.2).
     constraint: tuple[Ref, Modification | None] | None = None
     redeclare: bool = False  # an element `redeclare T x;` replacing an inherited one
+    # `annotation(Evaluate = true)` (Modelica 18.3): the parameter's value is folded into
+    # the model as a constant's is
+    evaluate: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -18,6 +18,7 @@ from lark.tree import Meta
 
 from ..errors import Span
 from ..ir.syntax import (
+    Bool,
     ClassDef,
     Component,
     ElementModification,
@@ -44,6 +45,16 @@ class _Decl:
     description: str
     span: Span
     condition: Expr | None
+    evaluate: bool = False
+
+
+def _evaluate_annotation(annotation: Modification | None) -> bool:
+    """Whether an element's annotation says ``Evaluate = true`` (Modelica 18.3)."""
+    if annotation is None:
+        return False
+    return any(arg.path == ("Evaluate",) and arg.modification is not None
+               and isinstance(arg.modification.value, Bool) and arg.modification.value.value
+               for arg in annotation.arguments)
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,6 +122,7 @@ class ElementRules(RuleBase):
                 replaceable="replaceable" in words,
                 constraint=(constraint.type_name, constraint.modification)
                 if constraint else None, redeclare="redeclare" in words,
+                evaluate=d.evaluate,
             )
             for d in item.declarations
         ]
@@ -172,7 +184,8 @@ class ElementRules(RuleBase):
         condition = of(ch, _Condition)
         return _Decl(self.ident(ch[0]), dims.items if dims else (), of(ch, Modification),
                      comment.description, self.span_of(meta),
-                     condition.expr if condition else None)
+                     condition.expr if condition else None,
+                     _evaluate_annotation(comment.annotation))
 
     def condition_attribute(self, meta: Meta, ch: list[Any]) -> _Condition:
         return _Condition(ch[0])

@@ -16,7 +16,7 @@ from ..errors import Note
 from ..ir import dae
 from ..ir import expr as x
 from .index_reduction import unknown_priority
-from .isolate import free_variables
+from .isolate import fold, free_variables
 from .lower import differentiate
 
 
@@ -182,14 +182,23 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
             return r
         names = set(r.variables).difference(used).union(*(value_vars[n] for n in used))
         held = r.pre_only.difference(used).difference(*(value_vars[n] for n in used))
-        return replace(r, expr=x.substitute(r.expr, full), variables=frozenset(names),
-                       pre_only=held)
+        expr = x.substitute(r.expr, full)
+        if any(isinstance(full[n], x.Const) for n in used):
+            # a constant may remove terms: `c*der(v)` with `c = 0` (an evaluated
+            # parameter) no longer reads der(v), and v is no state for it
+            expr = fold(expr)
+            present = free_variables(expr)
+            names &= present
+            held = held.intersection(present)
+        return replace(r, expr=expr, variables=frozenset(names), pre_only=held)
 
     equations = tuple(rewrite(r) for r in kept)
     initial = tuple(rewrite(r) for r in system.initial_equations)
     remaining = tuple(new_unknowns.get(u.name, u) for u in system.unknowns
                       if u.name not in mapping)
     differentiated -= set(mapping)
+    differentiated &= {dae.derivative_base(n) for r in equations + initial
+                       for n in r.variables}
     reduced = replace(system, unknowns=remaining, equations=equations,
                       initial_equations=initial, differentiated=frozenset(differentiated))
     # Step 4: a substitution may have made an alias of a kept equation (``s = f - z``

@@ -18,6 +18,7 @@ within :data:`ZENO_FRACTION` of the simulated span.
 
 from __future__ import annotations
 
+import functools
 import math
 import operator
 from collections import deque
@@ -286,7 +287,8 @@ class EventLoop:
             if not len(x):
                 t, x = self.stateless_step(t, bound, x, stop)
                 continue
-            integrator = cls(problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs)
+            integrator = problem.start(functools.partial(
+                cls, problem.rhs, t, x, bound, rtol=rtol, atol=atol, **kwargs), t, x)
             while True:
                 t_old = integrator.t
                 message = problem.try_step(integrator)

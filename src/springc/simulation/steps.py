@@ -174,6 +174,23 @@ class Problem:
             raise self.rejected
         return message
 
+    def start(self, make: Callable[[], Any], t: float, x: np.ndarray) -> Any:
+        """scipy's integrator ``make()`` from the accepted point ``(t, x)``: the probe
+        its first step size takes (``select_initial_step`` evaluates at ``t + h0``, up
+        to the next event, far from ``t`` where the states barely move) is a point a
+        step tries, as in :meth:`try_step`: where it fails, the probe is NaN, the
+        step size comes from ``t`` alone and the first step is rejected smaller (a
+        transistor's Newton system, warm started 20 s before, has no converging
+        iterate there). The evaluation at ``(t, x)`` itself must succeed."""
+        self.trial, self.rejected = np.array(self.z), None
+        try:
+            integrator = make()
+        finally:
+            self.trial, self.rejected = None, None
+        if not np.isfinite(np.asarray(integrator.f)).all():
+            self.rhs(t, np.asarray(x))  # raises the located failure
+        return integrator
+
     def non_finite(self, t: float, x: np.ndarray, dx: np.ndarray) -> Stop:
         """The error of derivatives ``dx`` that are NaN or infinite at ``(t, x)``."""
         bad = [self.names[i] for i in np.flatnonzero(~np.isfinite(dx))]
