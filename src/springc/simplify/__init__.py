@@ -15,8 +15,11 @@ from .state_choice import (
     state_vector,
     switch,
 )
+from .static_choice import CHECK_DETAIL, CHECK_MESSAGE, pivot_checks
 
 __all__ = [
+    "CHECK_DETAIL",
+    "CHECK_MESSAGE",
     "THRESHOLD",
     "OdeEvaluator",
     "StateChoice",
@@ -27,6 +30,7 @@ __all__ = [
     "initial_state",
     "needs_switch",
     "parameter_values",
+    "pivot_checks",
     "select_states",
     "simplify",
     "state_vector",
