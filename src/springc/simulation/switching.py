@@ -12,6 +12,12 @@ code, but these index-3 scenes are small) and reports each switch in the summary
 - the states are reselected there (:func:`springc.simplify.switch`) and the run
   restarts at the same time from the values there, which satisfy every constraint.
 
+Where every block that may turn singular carries its run-time check
+(:func:`springc.simplify.pivot_checks`: one-equation blocks, a free body's quaternion
+constraint), :func:`simulate_switching_model` first runs the generated code with the
+states chosen at compile time, as the continuous driver does; the result stands when
+no check fails (no switch was needed), else the run starts again here.
+
 The ODE's functions come from a callback (``make_functions``), by default the
 reference evaluator (:class:`EvaluatorFunctions`), so that generated code can be
 used instead.
