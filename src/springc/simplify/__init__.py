@@ -7,7 +7,6 @@ from .initialize import conditions, initial_state
 from .ode_eval import OdeEvaluator, parameter_values
 from .passes import simplify
 from .state_choice import (
-    THRESHOLD,
     StateChoice,
     conditioning,
     needs_switch,
@@ -15,8 +14,11 @@ from .state_choice import (
     state_vector,
     switch,
 )
+from .static_choice import CHECK_DETAIL, CHECK_MESSAGE, THRESHOLD, pivot_checks
 
 __all__ = [
+    "CHECK_DETAIL",
+    "CHECK_MESSAGE",
     "THRESHOLD",
     "OdeEvaluator",
     "StateChoice",
@@ -27,6 +29,7 @@ __all__ = [
     "initial_state",
     "needs_switch",
     "parameter_values",
+    "pivot_checks",
     "select_states",
     "simplify",
     "state_vector",

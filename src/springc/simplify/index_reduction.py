@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import Note, SimplifyError
+from ..errors import Note, SimplifyError, Span
 from ..ir import dae
 from ..ir import expr as x
 from ..structure import (
@@ -49,7 +49,8 @@ class DummyBlock:
     """One block of the dummy-derivative choice, by name: ``equations`` (residuals of
     the augmented system) are solved for ``dummies``, chosen among ``candidates``
     (priority order; ``tiers`` numbers their priority classes). ``static``: the choice
-    holds for the whole run (:mod:`.static_choice`)."""
+    holds for the whole run (:mod:`.static_choice`); ``span``: where the block's first
+    equation was written (None: unknown)."""
 
     level: int
     equations: tuple[x.Expr, ...]
@@ -57,6 +58,7 @@ class DummyBlock:
     candidates: tuple[str, ...]
     tiers: tuple[int, ...]
     static: bool = False
+    span: Span | None = None
 
     @property
     def switchable(self) -> bool:
@@ -155,7 +157,9 @@ def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Redu
         static = at is None and len(candidates) > len(dummies) and static_block(
             equations, candidates, dummies, [priority[base[v]] for v in b.candidates],
             known)
-        blocks.append(DummyBlock(b.level, equations, dummies, candidates, b.tiers, static))
+        span = sources[b.equations[0]].span if b.equations else None
+        blocks.append(DummyBlock(b.level, equations, dummies, candidates, b.tiers, static,
+                                 span))
     return Reduced(tuple(names), tuple(exprs), tuple(sources), tuple(orders),
                    reduction.incidence, states, tuple(blocks))
 

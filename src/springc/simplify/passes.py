@@ -21,10 +21,10 @@ The pipeline is a short list of passes, each in its own module:
 from __future__ import annotations
 
 import gc
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import Note
+from ..errors import Note, Span
 from ..ir import flat, ode
 from .alias import eliminate_aliases
 from .assertions import simplified_assertions
@@ -39,6 +39,7 @@ from .lower import lower
 from .parameter_branches import parameter_branches
 from .pre_starts import pre_starts
 from .state_select import check_state_select
+from .static_choice import pivot_checks
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,15 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
             gc.enable()
 
 
+def _pivot_checks(blocks: Sequence[DummyBlock], span: Span) -> tuple[flat.Assertion, ...]:
+    """The run-time checks of the default choice's blocks that may turn singular
+    (:func:`springc.simplify.static_choice.pivot_checks`; none where one cannot be
+    checked)."""
+    checks = pivot_checks([(b.equations, b.candidates, b.dummies, b.tiers, b.span or span)
+                           for b in blocks if b.switchable])
+    return checks or ()
+
+
 def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplified:
     model = parameter_branches(initial_whens(pre_starts(free_parameters(model))))
     system = lower(model)
@@ -92,6 +102,8 @@ def _simplify(model: flat.FlatModel, at: Mapping[str, float] | None) -> Simplifi
                                 u.span if u else model.span))
     observed = tuple(ode.Assign(a.name, a.value, a.equation.span) for a in aliased.aliases)
     assertions = simplified_assertions(model.assertions, system, aliased.aliases)
+    if at is None:
+        assertions += _pivot_checks(reduced.blocks, model.span)
     result = ode.ODE(model.name, tuple(states), tuple(steps), observed,
                      aliased.dae.parameters, aliased.dae, assertions=assertions)
     result = with_events(model, result)

@@ -40,9 +40,7 @@ from ..ir import flat, ode
 from .index_reduction import DummyBlock, pivoted_choice
 from .isolate import free_variables, partial
 from .passes import simplify
-
-THRESHOLD = 0.2
-"""Switch when the current choice is this much worse conditioned than the best one."""
+from .static_choice import THRESHOLD
 
 
 @dataclass(frozen=True)

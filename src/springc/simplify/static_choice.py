@@ -25,6 +25,17 @@ turn singular during the run. It cannot, and the choice is kept for the whole ru
 A parameter changed at run time (``--set``) that makes a block of rule 1 singular, or
 a preferred choice that turns singular, stops the run with the generated solve's error
 instead of switching states.
+
+Other blocks may turn singular. Where every such block is one equation (a free body's
+quaternion constraint ``2*Q*der(Q) = 0``, a rod's ``x*der(x) + y*der(y) = 0``), the
+default choice is still the one the generated code runs first, *checked at run time*
+(:func:`pivot_checks`): an assertion per block that its pivot stays at least
+:data:`THRESHOLD` times every other candidate's coefficient of its priority class or a
+higher one, the conditioning measure at which dynamic state selection would switch
+(:func:`springc.simplify.state_choice.conditioning`). A run whose check holds to the
+end is that of a static choice (MultiBody's free bodies that turn less than a quarter
+turn: PointGravity, the spring-mass systems); one whose check fails is run again with
+dynamic state selection (:mod:`springc.simulation.switching`).
 """
 
 from __future__ import annotations
@@ -33,13 +44,22 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ..errors import Span
 from ..ir import expr as x
+from ..ir import flat
 from ..structure import blt, kept_by_preference, maximum_matching
 from .isolate import free_variables, partial
 from .ode_eval import evaluate_with
 
 SINGULAR_RTOL = 1e-8
 """A constant block whose smallest singular value is below this (relative) is singular."""
+THRESHOLD = 0.2
+"""Switch when the current choice is this much worse conditioned than the best one
+(dynamic state selection, and the run-time check of :func:`pivot_checks`)."""
+CHECK_DETAIL = "static choice of states checked at run time"
+"""The ``origin.detail`` of the assertions of :func:`pivot_checks`."""
+CHECK_MESSAGE = "the states chosen at compile time turn singular"
+"""The start of their messages (a run that fails one is run again with switching)."""
 
 
 def static_block(equations: Sequence[x.Expr], candidates: Sequence[str],
@@ -122,3 +142,37 @@ def _constant(e: x.Expr, parameters: Mapping[str, float]) -> bool:
         if isinstance(node, x.Var) and node.name not in parameters:
             return False
     return True
+
+
+def pivot_checks(blocks: Sequence[tuple[Sequence[x.Expr], Sequence[str], Sequence[str],
+                                        Sequence[int], Span]]
+                 ) -> tuple[flat.Assertion, ...] | None:
+    """The run-time checks of ``blocks`` (``(equations, candidates, dummies, tiers,
+    span)`` of each block that may turn singular; see the module docstring), or None
+    where a block has more than one equation (no scalar check: dynamic state selection
+    from the start)."""
+    checks = []
+    for equations, candidates, dummies, tiers, span in blocks:
+        if len(equations) != 1 or len(dummies) != 1:
+            return None
+        k = list(candidates).index(dummies[0])
+        pivot = _magnitude(partial(equations[0], dummies[0]))
+        terms = [x.BinOp(">=", pivot, x.mul(x.Const(THRESHOLD),
+                                            _magnitude(partial(equations[0], c))))
+                 for j, c in enumerate(candidates) if j != k and tiers[j] <= tiers[k]]
+        if not terms:
+            continue
+        condition: x.Expr = terms[0]
+        for term in terms[1:]:
+            condition = x.BinOp("and", condition, term)
+        others = ", ".join(c for c in candidates if c != dummies[0])
+        message = (f"{CHECK_MESSAGE}: '{dummies[0]}' (solved from this equation) has a "
+                   f"coefficient under {THRESHOLD:g} times that of one of {others}; "
+                   "dynamic state selection switches here")
+        checks.append(flat.Assertion(x.Call("noEvent", (condition,)), message, "error",
+                                     span, flat.Origin("equation", "", CHECK_DETAIL)))
+    return tuple(checks)
+
+
+def _magnitude(e: x.Expr) -> x.Expr:
+    return x.Call("abs", (e,))

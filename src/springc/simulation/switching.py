@@ -12,6 +12,12 @@ code, but these index-3 scenes are small) and reports each switch in the summary
 - the states are reselected there (:func:`springc.simplify.switch`) and the run
   restarts at the same time from the values there, which satisfy every constraint.
 
+Where every block that may turn singular carries its run-time check
+(:func:`springc.simplify.pivot_checks`: one-equation blocks, a free body's quaternion
+constraint), :func:`simulate_switching_model` first runs the generated code with the
+states chosen at compile time, as the continuous driver does; the result stands when
+no check fails (no switch was needed), else the run starts again here.
+
 The ODE's functions come from a callback (``make_functions``), by default the
 reference evaluator (:class:`EvaluatorFunctions`), so that generated code can be
 used instead.
@@ -30,8 +36,10 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..ir import flat
-from ..pipeline import CompiledModel
+from ..pipeline import CompiledModel, ModuleKind
 from ..simplify import (
+    CHECK_DETAIL,
+    CHECK_MESSAGE,
     THRESHOLD,
     OdeEvaluator,
     StateChoice,
@@ -290,6 +298,9 @@ def simulate_switching_model(model: CompiledModel, plan: RunPlan) -> SimulationR
     """Run ``model`` as ``plan`` says with dynamic state selection (adaptive solvers
     only; on scipy's loop, the only one that switches states)."""
     settings = plan.settings
+    checked = _checked_run(model, plan)
+    if checked is not None:
+        return checked
     if settings.engine == COMPILED:
         raise SimulationError(f"{model.name} may switch its states during the run "
                               "(dynamic state selection), which only the scipy engine "
@@ -306,6 +317,32 @@ def simulate_switching_model(model: CompiledModel, plan: RunPlan) -> SimulationR
         result.stats = replace(result.stats, engine_reason=(
             f"{result.stats.solver} ran in scipy's loop, the only one that switches "
             "states"))
+    return result
+
+
+def _checked_run(model: CompiledModel, plan: RunPlan) -> SimulationResult | None:
+    """The run of the states chosen at compile time on the generated code, where every
+    block that may turn singular has its run-time check
+    (:func:`springc.simplify.pivot_checks`) and no check fails; None otherwise (a
+    check failed: the run must switch states)."""
+    system = model.closed_system().system
+    if not any(a.origin.detail == CHECK_DETAIL for a in system.assertions):
+        return None
+    from .continuous import simulate_continuous  # the continuous driver's module
+    from .planning import initial_state
+
+    x0 = initial_state(model, plan.p, plan.start, plan.starts)
+    try:
+        result = simulate_continuous(model, replace(plan, x0=x0,
+                                                    driver=ModuleKind.CONTINUOUS))
+    except SimulationError as err:
+        if CHECK_MESSAGE in str(err):
+            return None
+        raise
+    result.stats = replace(result.stats, engine_reason=(
+        f"{result.stats.engine_reason + '; ' if result.stats.engine_reason else ''}"
+        "the states chosen at compile time stayed well conditioned (checked at every "
+        "step): no switch of states"))
     return result
 
 
