@@ -1,6 +1,7 @@
 """``--solver auto`` on hybrid models (springc.simulation.hybrid_auto): a stiff RC
-circuit switched by ``sample`` goes to radau for its counted work, the bouncing ball
-and a long sampled oscillator keep dop853 with its very steps."""
+circuit switched by ``sample`` goes to radau for its counted work, and so does a stiff
+mass whose start rings (radau's first probe spends its steps on the ringing), the
+bouncing ball and a long sampled oscillator keep dop853 with its very steps."""
 
 from __future__ import annotations
 
@@ -38,6 +39,23 @@ equation
     n = pre(n) + 1;
   end when;
 end SampledOscillator;
+"""
+
+
+RINGING = """
+model RingingStart
+  Real x(start = 1, fixed = true);
+  Real v(start = 0, fixed = true);
+  Real y(start = 0, fixed = true);
+  discrete Integer n(start = 0);
+equation
+  der(x) = v;
+  der(v) = -1e8 * x - 5e3 * v;
+  der(y) = 1 - y;
+  when sample(1, 1) then
+    n = pre(n) + 1;
+  end when;
+end RingingStart;
 """
 
 
@@ -101,3 +119,28 @@ def test_a_long_non_stiff_run_keeps_dop853_after_its_probe(tmp_path: Path) -> No
     assert np.array_equal(auto.values, dop853.values)
     assert auto["n"][-1] == 1000
     assert np.max(np.abs(auto["x"] - np.cos(auto.time))) < 1e-3  # 160 periods at rtol 1e-6
+
+
+def test_a_stiff_start_that_rings_goes_to_radau_past_its_first_probe(tmp_path: Path) -> None:
+    """radau's first 100 steps cover under 1e-3 s of the ringing (omega 1e4 1/s, damping
+    ratio 0.25): at that rate its projection is dearer than dop853's; the longer probes,
+    projected at the rate of the steps each added, find the run cheap (Translational.
+    PreLoad's start, where dop853 took 8e5 steps)."""
+    model = springc.compile_model(write(tmp_path, RINGING))
+    auto, radau = (springc.simulate(model, solver=solver, engine="scipy", stop=100.0,
+                                    interval=0.1, error_control="off")
+                   for solver in ("auto", "radau"))
+    assert radau.step_times[99] < 1e-3
+    assert auto.stats.solver == "radau"
+    assert auto.stats.reason.startswith(
+        "stiff: fastest time scale 1/1e+04 s is 1e+06x shorter than the 100 s span; "
+        "counted: radau finished the run in its 1600 trial steps, dop853 ~")
+    assert auto.stats.steps == radau.stats.steps < 1600
+    assert np.array_equal(auto.values, radau.values)
+    zeta, w0 = 0.25, 1e4
+    wd = w0 * np.sqrt(1 - zeta**2)
+    t = auto.time
+    x = np.exp(-zeta * w0 * t) * (np.cos(wd * t) + zeta * w0 / wd * np.sin(wd * t))
+    assert np.max(np.abs(auto["x"] - x)) < 1e-6
+    assert np.max(np.abs(auto["y"] - (1 - np.exp(-t)))) < 1e-5
+    assert np.array_equal(auto["n"], np.floor(t + 1e-9))

@@ -51,8 +51,9 @@ from .vector import VectorLayout, vector_statements, vector_suits
 
 def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) -> list[str]:
     """Parameters that generated code cannot change: Integer and Boolean ones (they may
-    size arrays or pick equations) and those the flattener already evaluated away (read
-    by no equation, observed variable, start value or event)."""
+    size arrays or pick equations), those the flattener already evaluated away (read
+    by no equation, observed variable, start value or event) and those it computed a
+    call with (``FlatModel.evaluated``, and the parameters their values come from)."""
     used: set[str] = set()
     if system.events is not None:
         for e in event_expressions(system.events):
@@ -69,13 +70,16 @@ def structural_parameters(system: ode.ODE, flat_model: flat.FlatModel | None) ->
         if u.start is not None:
             used |= variables(u.start)
     by_name = {q.name: q for q in system.parameters}
+    evaluated = set(flat_model.evaluated) if flat_model else set()
     for q in reversed(topological(system.parameters)):
         if q.name in used:
             used |= variables(parameter_value(q))
+        if q.name in evaluated:  # what it is computed from was evaluated with it
+            evaluated |= variables(parameter_value(q))
     types = {v.name: v.type for v in flat_model.variables} if flat_model else {}
     return [q.name for q in system.parameters
             if q.name not in used or types.get(q.name, "Real") != "Real"
-            or q.name not in by_name]
+            or q.name not in by_name or q.name in evaluated]
 
 
 # ------------------------------------------------------------------ module

@@ -73,6 +73,8 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.assertions: list[tuple[flat.Assertion, Span]] = []
         self.algorithm_sections: list[Section] = []
         self.statement_conditions: list[tuple[x.Expr, Span]] = []
+        self.parameter_decisions = 0
+        self.evaluated: set[str] = set()
         self.errors: list[SpringcError] = []
         self.mod_values = {}
         self.declared_types = {}
@@ -215,7 +217,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
                                 experiment_of(flattener, entry, top), entry.defn.span,
                                 notes=(*tree.notes, *added_inner_notes(top)),
                                 whens=tuple(flattener.whens),
-                                assertions=unique(flattener.assertions))
+                                assertions=unique(flattener.assertions),
+                                evaluated=tuple(sorted(flattener.evaluated)))
     # the variables of expandable connectors that are not present (9.1.3)
     gone = flattener.connections.absent(scopes, flat_model)
     connected = flattener.connections.equations(scopes, top, gone)

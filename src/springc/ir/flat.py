@@ -118,6 +118,9 @@ class FlatModel:
     notes: tuple[str, ...] = field(default=())
     whens: tuple[When, ...] = field(default=())  # when-clauses (ir/when.py)
     assertions: tuple[Assertion, ...] = field(default=())
+    # parameters whose values the flattener computed with (a call evaluated for them,
+    # flatten/calls/parameter_calls.py): structural, as with ``Evaluate = true``
+    evaluated: tuple[str, ...] = field(default=())
 
     @property
     def unknowns(self) -> tuple[Variable, ...]:

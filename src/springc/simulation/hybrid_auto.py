@@ -15,12 +15,20 @@ takes exactly the first steps of the full one, so ``auto -> X`` gives ``X``'s re
    and ``dop853`` runs.
 3. Else ``radau`` runs :data:`IMPLICIT_PROBE` steps (a run that ends there is the run)
    and is projected alike; where its projection is :data:`~springc.simulation.race.SURE`
-   times below ``dop853``'s, ``radau`` runs, else ``dop853``. The reason gives both
-   projections (steps to go x RHS evaluations per step = work).
+   times below ``dop853``'s, ``radau`` runs. Else its probe may have spent its steps
+   on the start's transient (a stiff start after the initial events: Translational.
+   PreLoad's radau takes 300 steps for its first 5 ms, then 22 for the next 2 s), so
+   ``radau`` runs again from the start in stretches :data:`GROWTH` times longer, each
+   projected at the rate of the steps it added to the one before (its marginal rate,
+   the step size it settled on), while each stretch lowers the projection below
+   :data:`~springc.simulation.race.STALL` of the last and the probes' work stays within
+   :data:`~springc.simulation.race.BUDGET` of ``dop853``'s projection (the continuous
+   race's rules). ``radau`` runs where a projection wins by ``SURE``, else ``dop853``.
+   The reason gives both projections (steps to go x RHS evaluations per step = work).
 
-The probes cost at most ``CHEAP_STEPS + IMPLICIT_PROBE`` steps more than the run. A
-failure in ``dop853``'s probe is the run's own (as with ``--solver dop853``); one in
-``radau``'s hands the run to ``dop853``.
+The probes cost at most ``CHEAP_STEPS`` steps of ``dop853`` and a fifth of its projected
+work in ``radau``'s probes more than the run. A failure in ``dop853``'s probe is the
+run's own (as with ``--solver dop853``); one in ``radau``'s hands the run to ``dop853``.
 """
 
 from __future__ import annotations
@@ -33,7 +41,7 @@ import numpy as np
 
 from .failures import Stop
 from .limits import OverLimit
-from .race import CHEAP_STEPS, SURE, Projection, counted
+from .race import BUDGET, CHEAP_STEPS, STALL, SURE, Projection, counted
 from .solver_names import EXPLICIT, RACE, RACE_IMPLICIT
 from .solvers import choose as estimate
 from .step_cost import Work, step_costs
@@ -41,6 +49,9 @@ from .step_cost import Work, step_costs
 IMPLICIT_PROBE = 100
 """``radau``'s probe: enough steps past its first growth from a tiny step that its
 average rate is its rate (each event restarts it from a small step again)."""
+
+GROWTH = 4
+"""Each of ``radau``'s further probes takes this many times the steps of the one before."""
 
 OLD_REASON = "a hybrid model: dop853 with event location"
 
@@ -72,30 +83,48 @@ def choose(attempt: Callable[[str, int | None], Attempt], x0: np.ndarray, start:
     choice = estimate(first.problem.jac(over.t, np.asarray(over.y, dtype=float)), stop - start)
     if choice.solver != RACE:
         return attempt(choice.solver, None), choice.reason
-    try:
-        second = attempt(RACE_IMPLICIT, IMPLICIT_PROBE)
-    except Stop as failure:
-        return attempt(EXPLICIT, None), (f"{choice.reason}, but {RACE_IMPLICIT} failed in "
-                                         f"its trial steps ({failure})")
-    if second.capped is None:
-        return second, (f"{choice.reason}; counted: {RACE_IMPLICIT} finished the run in "
-                        f"its {IMPLICIT_PROBE} trial steps, {EXPLICIT} {ahead.text()} to go")
-    behind = _projection(second, True, start, stop)
-    text = counted(behind, ahead)
-    if SURE * behind.work <= ahead.work:
-        return attempt(RACE_IMPLICIT, None), f"{choice.reason}; {text}"
-    return attempt(EXPLICIT, None), (f"{choice.reason}, but the fast modes must be "
-                                     f"resolved anyway; {text}")
+    cap, before, spent = IMPLICIT_PROBE, None, 0.0
+    while True:
+        try:
+            second = attempt(RACE_IMPLICIT, cap)
+        except Stop as failure:
+            return attempt(EXPLICIT, None), (f"{choice.reason}, but {RACE_IMPLICIT} failed "
+                                             f"in its trial steps ({failure})")
+        if second.capped is None:
+            return second, (f"{choice.reason}; counted: {RACE_IMPLICIT} finished the run "
+                            f"in its {cap} trial steps, {EXPLICIT} {ahead.text()} to go")
+        behind = _projection(second, True, start, stop, before)
+        text = counted(behind, ahead)
+        if SURE * behind.work <= ahead.work:
+            return attempt(RACE_IMPLICIT, None), f"{choice.reason}; {text}"
+        spent += _work(second, True)
+        last = _projection(before, True, start, stop) if before is not None else None
+        if (last is not None and not behind.work < STALL * last.work) or \
+                spent + GROWTH * _work(second, True) > BUDGET * ahead.work:
+            return attempt(EXPLICIT, None), (f"{choice.reason}, but the fast modes must be "
+                                             f"resolved anyway; {text}")
+        before, cap = second, cap * GROWTH
 
 
-def _projection(probe: Attempt, implicit: bool, start: float, stop: float) -> Projection:
-    """A capped probe's work to go: the span left at its average rate, each step at its
-    work per step in the cost model (attempts counted as accepted steps: the event
-    loops count no rejections)."""
+def _projection(probe: Attempt, implicit: bool, start: float, stop: float,
+                before: Attempt | None = None) -> Projection:
+    """A capped probe's work to go: the span left at its rate, each step at its work per
+    step in the cost model (attempts counted as accepted steps: the event loops count no
+    rejections). The rate is the probe's average, or with ``before`` (a shorter probe of
+    the same method: the first steps of this one) that of the steps it added."""
     assert probe.capped is not None
-    problem, reached, taken = probe.problem, float(probe.capped.t), probe.loop.steps
-    covered = reached - start
+    reached, taken = float(probe.capped.t), probe.loop.steps
+    covered, work = reached - start, _work(probe, implicit)
+    if before is not None:
+        assert before.capped is not None
+        covered = reached - float(before.capped.t)
+        taken, work = taken - before.loop.steps, work - _work(before, implicit)
     steps = (stop - reached) * taken / covered if covered > 0 else math.inf
-    work = Work(taken, taken, problem.nfev, problem.njev)
+    return Projection(steps, work / max(taken, 1))
+
+
+def _work(probe: Attempt, implicit: bool) -> float:
+    """A probe's work in equivalent right-hand side evaluations (the cost model)."""
+    problem, taken = probe.problem, probe.loop.steps
     costs = step_costs(problem.mod, probe.compiled)
-    return Projection(steps, costs.evaluations(implicit, work) / max(taken, 1))
+    return costs.evaluations(implicit, Work(taken, taken, problem.nfev, problem.njev))

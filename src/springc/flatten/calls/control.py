@@ -48,6 +48,7 @@ def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
         if not isinstance(value, x.Const) and ev.flattener.is_parameter_expression(value):
             # decided by the parameters' values, as an if-equation's condition is
             value = x.Const(ev.fold(value))
+            ev.flattener.parameter_decisions += 1  # (calls.parameter_calls)
         if isinstance(value, x.Const) and not isinstance(value.value, (bool, np.bool_)):
             raise FlattenError("the condition of a while loop must be a Boolean expression",
                                stmt.condition.span)

@@ -45,6 +45,7 @@ from .control import (
     stray,
 )
 from .jumps import flags, is_flag, lowered, merged_flag
+from .parameter_calls import parameter_call
 from .record_values import construct, empty_record, record_class, store_field
 from .short_functions import short_defaults
 
@@ -59,6 +60,15 @@ def call_function(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value
     if entry.defn.kind == "record":
         record: a.Value = construct(ev, entry, args, named, call)
         return record
+    if is_external(entry):
+        return _execute(ev, entry, args, named, call, count)
+    return parameter_call(ev, args, named,
+                          lambda given, by_name: _execute(ev, entry, given, by_name, call, count))
+
+
+def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
+             named: dict[str, tuple[a.Value, Span]], call: s.Call, count: int) -> a.Value:
+    """The call's outputs by executing the function's algorithm symbolically."""
     depth = ev.call_depth
     if depth > MAX_DEPTH:
         raise FlattenError(f"'{entry.full_name}' calls itself too deeply to be inlined",

@@ -384,6 +384,10 @@ class FlattenContext(ClassViews, FlatResults, Protocol):
     errors: list[SpringcError]
     # conditions of if-statements, checked to be Boolean once the types are known
     statement_conditions: list[tuple[x.Expr, Span]]
+    # while loops decided by the parameters' values, and the parameters of the calls
+    # evaluated numerically for them (flatten/calls/parameter_calls.py)
+    parameter_decisions: int
+    evaluated: set[str]
     attribute_cache: AttributeCache
     # the class that wrote the equation being flattened: an inherited equation finds
     # the functions of its base class's scope
