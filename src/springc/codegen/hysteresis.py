@@ -1,0 +1,129 @@
+"""The hysteresis of a hybrid model's state relations: when a relation ``left op right``
+switches, in the zero-crossing functions and in the passes of the event iteration.
+
+A relation that an equation of the configuration it selects puts on its own boundary
+(a friction element starting while another stuck one in series holds the
+acceleration at 0: its path parameter is exactly its breakaway torque; a quenched
+arc switch: ``i = Goff*v`` makes ``abs(i) <= abs(v)*Goff`` an identity) flips with
+the rounding of the solution, and neither the event iteration nor the integration
+after it can settle on it. As OpenModelica's relations (``LessZC`` and its
+siblings: a band of about ``1e-10 (|a| + |b| + nominal)`` around the boundary, kept
+towards the value the relation had at the start of the event), a relation here
+switches only past a band around its boundary, on the side away from a reference
+value:
+
+- in the first pass of an event and in the zero-crossing functions the reference is
+  the held value (the value after the last event) and the band is
+  :data:`NARROW_BAND` ``* (|left| + |right|)``: no band where one side is 0 (a ball's
+  ``h <= 0`` switches at the floor, its bounces keep their Zeno limit), a few
+  hundred rounding units where the two sides are equal and large;
+- in the later passes of an event the reference is the value of the first pass and
+  the band :data:`WIDE_BAND` ``* (1 + |left| + |right|)``: a relation that the
+  first pass decided keeps that value while a configuration it selects puts it on
+  its boundary (the event iteration settles);
+- after the event, a relation whose held value the narrow band would not keep (the
+  wide band kept it) goes on with the wide band in its zero-crossing function
+  (``_zw<k>``) until the next event, so that the integration does not meet the
+  same boundary again at once.
+
+The specification leaves this open: 8.6 asks for an event iteration that stops
+when nothing changes, and a relation on its boundary is either value within the
+rounding of its sides.
+"""
+
+from __future__ import annotations
+
+from ..ir import expr as x
+from .event_layout import EventLayout
+from .statements import Stmt, Store
+
+NARROW_BAND = 1e-14
+"""The band of the zero crossings and first passes, relative to ``|left| + |right|``."""
+WIDE_BAND = 1e-10
+"""The band of the later passes of an event, relative to ``1 + |left| + |right|``."""
+
+BAND_PASS = 40
+"""The passes of an event in which relations switch as their zero crossings do; an
+iteration that has not settled by then (a relation on its own boundary flipping
+with the configuration it selects) goes on with the wide band."""
+
+_ONE, _ZERO = x.Const(1.0), x.Const(0.0)
+
+
+def _truth(name: str) -> x.Expr:
+    return x.BinOp("<>", x.Var(name), _ZERO)
+
+
+def _size(left: x.Expr, right: x.Expr) -> x.Expr:
+    return x.add(x.Call("abs", (left,)), x.Call("abs", (right,)))
+
+
+def _kept(layout: EventLayout, k: int, side: x.Expr, width: x.Expr) -> x.Expr:
+    """``left - right`` of relation ``k`` moved by ``width`` towards the side where
+    the relation is ``side``: the relation's value with that band."""
+    rel = layout.events.relations[k]
+    left, right = layout.hold(rel.left), layout.hold(rel.right)
+    towards = side if rel.op in (">", ">=") else x.Not(side)
+    return x.add(x.sub(left, right), x.If(towards, width, x.Neg(width)))
+
+
+def _narrow(layout: EventLayout, k: int) -> x.Expr:
+    rel = layout.events.relations[k]
+    return x.mul(x.Const(NARROW_BAND), _size(layout.hold(rel.left), layout.hold(rel.right)))
+
+
+def _wide(layout: EventLayout, k: int) -> x.Expr:
+    rel = layout.events.relations[k]
+    return x.mul(x.Const(WIDE_BAND),
+                 x.add(_ONE, _size(layout.hold(rel.left), layout.hold(rel.right))))
+
+
+def crossing(layout: EventLayout, k: int) -> x.Expr:
+    """The zero-crossing function of state relation ``k``: ``left - right`` moved
+    towards its held value's side by the narrow band, or by the wide one where the
+    last event kept the relation inside it (``_zw<k>``)."""
+    width = x.If(_truth(layout.wide[k]), _wide(layout, k), _narrow(layout, k))
+    return _kept(layout, k, _truth(layout.relations[k]), width)
+
+
+def pass_value(layout: EventLayout, k: int) -> x.Expr:
+    """The value of state relation ``k`` in a pass of the event iteration: as the
+    zero crossings decide it (towards the value of the pass before) in the first
+    :data:`BAND_PASS` passes, later with the wide band kept towards its value in
+    the last of those (``_zb<k>``)."""
+    op = layout.events.relations[k].op
+    first = x.BinOp(op, crossing(layout, k), _ZERO)
+    later = x.BinOp(op, _kept(layout, k, _truth(layout.firsts[k]), _wide(layout, k)), _ZERO)
+    return x.If(_early(), first, later)
+
+
+def _early() -> x.Expr:
+    return x.BinOp("<", x.Var("_zpass"), x.Const(float(BAND_PASS)))
+
+
+def first_values(layout: EventLayout, values: list[str]) -> list[Stmt]:
+    """The stores of a pass that keep the relations' ``values`` (locals) while the
+    passes are fewer than :data:`BAND_PASS`, and count the pass."""
+    slot = layout.slot
+    out: list[Stmt] = [Store(f"z[{slot[name]}]", x.If(_early(), x.Var(value), x.Var(name)))
+                       for name, value in zip(layout.firsts, values)]
+    out.append(Store(f"z[{slot['_zpass']}]", x.add(x.Var("_zpass"), _ONE)))
+    return out
+
+
+def after_event(layout: EventLayout) -> list[Stmt]:
+    """The stores at the end of an event: which relations the narrow band would not
+    keep at their held values (then their zero crossings take the wide band)."""
+    out: list[Stmt] = []
+    for k, rel in enumerate(layout.events.relations):
+        narrow = x.BinOp(rel.op, _kept(layout, k, _truth(layout.relations[k]),
+                                       _narrow(layout, k)), _ZERO)
+        out.append(Store(f"z[{layout.slot[layout.wide[k]]}]",
+                         x.If(x.BinOp("<>", x.If(narrow, _ONE, _ZERO),
+                                        x.Var(layout.relations[k])), _ONE, _ZERO)))
+    return out
+
+
+def begin_event(layout: EventLayout) -> list[Stmt]:
+    """The store at the start of an event: no pass yet."""
+    return [Store(f"z[{layout.slot['_zpass']}]", _ZERO)]
