@@ -25,7 +25,14 @@ from ..ir.hybrid import EventSystem
 from .context import CodegenContext
 from .encoding import encode_strings
 from .event_layout import EventLayout
-from .hysteresis import after_event, begin_event, crossing, first_values, pass_value
+from .hysteresis import (
+    after_event,
+    begin_event,
+    crossing,
+    early_pass,
+    first_values,
+    pass_value,
+)
 from .statements import Let, Load, Raw, Stmt, Store
 
 EVENT_ITERATIONS = 100
@@ -281,7 +288,11 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
             out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
-    out.append(Let("_zmoved", _flag(relations_moved)))
+    # from pass BAND_PASS on, pre(v) := v also while relations move (8.6 as written):
+    # a start condition whose relation holds in the configuration before it and not
+    # in the one it selects (OneWayClutch's 'sa > tau0_max') is then kept by its own
+    # 'pre(startForward) and sa > tau0'
+    out.append(Let("_zmoved", _flag(x.BinOp("and", relations_moved, early_pass()))))
     for name in ev.iterated:
         pre = x.Var(layout.pre[name])
         out.append(Store(f"z[{slot[layout.pre[name]]}]",

@@ -64,7 +64,16 @@ def _kept(layout: EventLayout, k: int, side: x.Expr, width: x.Expr) -> x.Expr:
     rel = layout.events.relations[k]
     left, right = layout.hold(rel.left), layout.hold(rel.right)
     towards = side if rel.op in (">", ">=") else x.Not(side)
-    return x.add(x.sub(left, right), x.If(towards, width, x.Neg(width)))
+    diff = x.sub(left, right)
+    return x.add(diff, x.If(towards, width, x.Neg(width)))
+
+
+def _narrowed(layout: EventLayout, k: int, side: x.Expr, width: x.Expr) -> x.Expr:
+    """:func:`_kept`, but exactly ``left - right`` where that is 0: sides made
+    equal on purpose (``reinit(s, smax)`` at a stop) decide as the relation does."""
+    rel = layout.events.relations[k]
+    diff = x.sub(layout.hold(rel.left), layout.hold(rel.right))
+    return x.If(x.BinOp("==", diff, _ZERO), _ZERO, _kept(layout, k, side, width))
 
 
 def _narrow(layout: EventLayout, k: int) -> x.Expr:
@@ -82,8 +91,9 @@ def crossing(layout: EventLayout, k: int) -> x.Expr:
     """The zero-crossing function of state relation ``k``: ``left - right`` moved
     towards its held value's side by the narrow band, or by the wide one where the
     last event kept the relation inside it (``_zw<k>``)."""
-    width = x.If(_truth(layout.wide[k]), _wide(layout, k), _narrow(layout, k))
-    return _kept(layout, k, _truth(layout.relations[k]), width)
+    wide = _kept(layout, k, _truth(layout.relations[k]), _wide(layout, k))
+    narrow = _narrowed(layout, k, _truth(layout.relations[k]), _narrow(layout, k))
+    return x.If(_truth(layout.wide[k]), wide, narrow)
 
 
 def pass_value(layout: EventLayout, k: int) -> x.Expr:
@@ -94,10 +104,11 @@ def pass_value(layout: EventLayout, k: int) -> x.Expr:
     op = layout.events.relations[k].op
     first = x.BinOp(op, crossing(layout, k), _ZERO)
     later = x.BinOp(op, _kept(layout, k, _truth(layout.firsts[k]), _wide(layout, k)), _ZERO)
-    return x.If(_early(), first, later)
+    return x.If(early_pass(), first, later)
 
 
-def _early() -> x.Expr:
+def early_pass() -> x.Expr:
+    """Whether the event iteration is in its first :data:`BAND_PASS` passes."""
     return x.BinOp("<", x.Var("_zpass"), x.Const(float(BAND_PASS)))
 
 
@@ -105,7 +116,7 @@ def first_values(layout: EventLayout, values: list[str]) -> list[Stmt]:
     """The stores of a pass that keep the relations' ``values`` (locals) while the
     passes are fewer than :data:`BAND_PASS`, and count the pass."""
     slot = layout.slot
-    out: list[Stmt] = [Store(f"z[{slot[name]}]", x.If(_early(), x.Var(value), x.Var(name)))
+    out: list[Stmt] = [Store(f"z[{slot[name]}]", x.If(early_pass(), x.Var(value), x.Var(name)))
                        for name, value in zip(layout.firsts, values)]
     out.append(Store(f"z[{slot['_zpass']}]", x.add(x.Var("_zpass"), _ONE)))
     return out
@@ -116,8 +127,8 @@ def after_event(layout: EventLayout) -> list[Stmt]:
     keep at their held values (then their zero crossings take the wide band)."""
     out: list[Stmt] = []
     for k, rel in enumerate(layout.events.relations):
-        narrow = x.BinOp(rel.op, _kept(layout, k, _truth(layout.relations[k]),
-                                       _narrow(layout, k)), _ZERO)
+        narrow = x.BinOp(rel.op, _narrowed(layout, k, _truth(layout.relations[k]),
+                                           _narrow(layout, k)), _ZERO)
         out.append(Store(f"z[{layout.slot[layout.wide[k]]}]",
                          x.If(x.BinOp("<>", x.If(narrow, _ONE, _ZERO),
                                         x.Var(layout.relations[k])), _ONE, _ZERO)))
