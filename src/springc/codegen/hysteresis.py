@@ -10,17 +10,21 @@ after it can settle on it. As OpenModelica's relations (``LessZC`` and its
 siblings: a band of about ``1e-10 (|a| + |b| + nominal)`` around the boundary, kept
 towards the value the relation had at the start of the event), a relation here
 switches only past a band around its boundary, on the side away from a reference
-value:
+value (OpenModelica's reference is the value at the start of the event):
 
-- in the first pass of an event and in the zero-crossing functions the reference is
-  the held value (the value after the last event) and the band is
-  :data:`NARROW_BAND` ``* (|left| + |right|)``: no band where one side is 0 (a ball's
-  ``h <= 0`` switches at the floor, its bounces keep their Zeno limit), a few
-  hundred rounding units where the two sides are equal and large;
-- in the later passes of an event the reference is the value of the first pass and
-  the band :data:`WIDE_BAND` ``* (1 + |left| + |right|)``: a relation that the
-  first pass decided keeps that value while a configuration it selects puts it on
-  its boundary (the event iteration settles);
+- in the zero-crossing functions and the first :data:`BAND_PASS` passes of an
+  event the reference is the held value (after the last event; in a pass, the pass
+  before) and the band is :data:`NARROW_BAND` ``* (|left| + |right|)``: none where
+  one side is 0 (a ball's ``h <= 0`` switches at the floor, its bounces keep their
+  Zeno limit) or where the sides are exactly equal (``reinit(s, smax)`` at a stop
+  decides as the relation does), a few hundred rounding units where the two sides
+  are equal and large. An iteration that settles in these passes is the exact one
+  (Rotational.Friction, CoupledClutches, the LossyGearDemos 1 and 3 run as before);
+- an iteration still moving after them (a relation on its own boundary, flipping
+  with the configuration it selects) goes on with the band :data:`WIDE_BAND`
+  ``* (1 + |left| + |right|)`` kept towards the value of pass :data:`BAND_PASS`
+  (``_zb<k>``), and, as 8.6 writes the iteration, sets ``pre(v) := v`` in every
+  pass also while relations move (``events.event_pass``);
 - after the event, a relation whose held value the narrow band would not keep (the
   wide band kept it) goes on with the wide band in its zero-crossing function
   (``_zw<k>``) until the next event, so that the integration does not meet the
@@ -87,12 +91,13 @@ def _wide(layout: EventLayout, k: int) -> x.Expr:
                  x.add(_ONE, _size(layout.hold(rel.left), layout.hold(rel.right))))
 
 
-def crossing(layout: EventLayout, k: int) -> x.Expr:
+def crossing(layout: EventLayout, k: int, exact_ties: bool = True) -> x.Expr:
     """The zero-crossing function of state relation ``k``: ``left - right`` moved
     towards its held value's side by the narrow band, or by the wide one where the
     last event kept the relation inside it (``_zw<k>``)."""
     wide = _kept(layout, k, _truth(layout.relations[k]), _wide(layout, k))
-    narrow = _narrowed(layout, k, _truth(layout.relations[k]), _narrow(layout, k))
+    narrow = (_narrowed if exact_ties else _kept)(
+        layout, k, _truth(layout.relations[k]), _narrow(layout, k))
     return x.If(_truth(layout.wide[k]), wide, narrow)
 
 
@@ -102,7 +107,7 @@ def pass_value(layout: EventLayout, k: int) -> x.Expr:
     :data:`BAND_PASS` passes, later with the wide band kept towards its value in
     the last of those (``_zb<k>``)."""
     op = layout.events.relations[k].op
-    first = x.BinOp(op, crossing(layout, k), _ZERO)
+    first = x.BinOp(op, crossing(layout, k, exact_ties=False), _ZERO)
     later = x.BinOp(op, _kept(layout, k, _truth(layout.firsts[k]), _wide(layout, k)), _ZERO)
     return x.If(early_pass(), first, later)
 
