@@ -16,8 +16,8 @@ value (OpenModelica's reference is the value at the start of the event):
   event the reference is the held value (after the last event; in a pass, the pass
   before) and the band is :data:`NARROW_BAND` ``* (|left| + |right|)``: none where
   one side is 0 (a ball's ``h <= 0`` switches at the floor, its bounces keep their
-  Zeno limit) or where the sides are exactly equal (``reinit(s, smax)`` at a stop
-  decides as the relation does), a few hundred rounding units where the two sides
+  Zeno limit) or, in the zero crossings and the first pass, where the sides are
+  exactly equal (``reinit(s, smax)`` at a stop decides as the relation does), a few hundred rounding units where the two sides
   are equal and large. An iteration that settles in these passes is the exact one
   (Rotational.Friction, CoupledClutches, the LossyGearDemos 1 and 3 run as before);
 - an iteration still moving after them (a relation on its own boundary, flipping
@@ -107,7 +107,12 @@ def pass_value(layout: EventLayout, k: int) -> x.Expr:
     :data:`BAND_PASS` passes, later with the wide band kept towards its value in
     the last of those (``_zb<k>``)."""
     op = layout.events.relations[k].op
-    first = x.BinOp(op, crossing(layout, k, exact_ties=False), _ZERO)
+    # the first pass decides as the zero crossing that located the event (exact ties);
+    # the later ones keep a tie towards the pass before (a configuration that puts the
+    # relation on its boundary: LossyGearDemo2's starting bearing friction)
+    at_start = x.BinOp("==", x.Var("_zpass"), _ZERO)
+    first = x.BinOp(op, x.If(at_start, crossing(layout, k),
+                             crossing(layout, k, exact_ties=False)), _ZERO)
     later = x.BinOp(op, _kept(layout, k, _truth(layout.firsts[k]), _wide(layout, k)), _ZERO)
     return x.If(early_pass(), first, later)
 
