@@ -17,9 +17,10 @@ value (OpenModelica's reference is the value at the start of the event):
   before) and the band is :data:`NARROW_BAND` ``* (|left| + |right|)``: none where
   one side is 0 (a ball's ``h <= 0`` switches at the floor, its bounces keep their
   Zeno limit) or, in the zero crossings and the first pass, where the sides are
-  exactly equal (``reinit(s, smax)`` at a stop decides as the relation does), a few hundred rounding units where the two sides
-  are equal and large. An iteration that settles in these passes is the exact one
-  (Rotational.Friction, CoupledClutches, the LossyGearDemos 1 and 3 run as before);
+  exactly equal (``reinit(s, smax)`` at a stop decides as the relation does), a
+  few hundred rounding units where the two sides are equal and large. An iteration
+  that settles in these passes is the exact one (Rotational.Friction,
+  CoupledClutches, the LossyGearDemos 1 and 3 run as before);
 - an iteration still moving after them (a relation on its own boundary, flipping
   with the configuration it selects) goes on with the band :data:`WIDE_BAND`
   ``* (1 + |left| + |right|)`` kept towards the value of pass :data:`BAND_PASS`
