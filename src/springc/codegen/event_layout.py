@@ -9,10 +9,13 @@ event at a sample time), the discrete variables (their flat names), the held val
 of every ``floor(u)`` (``_zf<k>``; unless ``u`` is affine in time, its two state
 relations ``u < _zf<k>`` and ``u >= _zf<k> + 1`` come last among the relations),
 the ``pre``
-values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), then
-``initial()`` (``_zinit``), ``terminal()`` (``_zterm``), the terminate code (0, or
-1 + the index of the ``terminate`` message), the changed flag of the last event pass
-and the event-iteration status (1.0: did not converge).
+values (``_zp<k>``), the when-condition values at the last event (``_zc<k>``), per
+state relation its value after the first pass of the event (``_zb<k>``, the side its
+hysteresis keeps in the later passes) and whether its held value sits inside its wide
+band (``_zw<k>``, see :mod:`.hysteresis`), then ``initial()`` (``_zinit``),
+``terminal()`` (``_zterm``), the terminate code (0, or 1 + the index of the
+``terminate`` message), the changed flag of the last event pass, the event-iteration
+status (1.0: did not converge) and the passes of the event so far (``_zpass``).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from ..ir.hybrid import EventSystem
 from .statements import Load, Stmt
 
 _QUIET = names(lambda b: b.quiet)
-FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus")
+FLAGS = ("_zinit", "_zterm", "_zstop", "_zchanged", "_zstatus", "_zpass")
 
 
 class EventLayout:
@@ -56,8 +59,11 @@ class EventLayout:
             for j, branch in enumerate(clause.branches):
                 self.conditions += [(i, j, c) for c in branch.conditions]
         self.condition_names = [f"_zc{k}" for k in range(len(self.conditions))]
+        self.firsts = [f"_zb{k}" for k in range(len(self.relations))]
+        self.wide = [f"_zw{k}" for k in range(len(self.relations))]
         names = (self.relations + self.times + self.samples + self.discrete + self.floors
-                 + list(self.pre.values()) + self.condition_names + list(FLAGS))
+                 + list(self.pre.values()) + self.condition_names + self.firsts
+                 + self.wide + list(FLAGS))
         self.slot = {name: base + i for i, name in enumerate(names)}
         self.size = len(names)
         self.held = self._held()

@@ -25,6 +25,14 @@ from ..ir.hybrid import EventSystem
 from .context import CodegenContext
 from .encoding import encode_strings
 from .event_layout import EventLayout
+from .hysteresis import (
+    after_event,
+    begin_event,
+    crossing,
+    early_pass,
+    first_values,
+    pass_value,
+)
 from .statements import Let, Load, Raw, Stmt, Store
 
 EVENT_ITERATIONS = 100
@@ -71,8 +79,7 @@ def _base(m: CodegenContext) -> list[Stmt]:
 def zero_crossings(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     out = [*_base(m), Raw(f"g = np.empty({len(layout.relations)})")]
     for k, rel in enumerate(layout.events.relations):
-        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
-        out.append(Store(f"g[{k}]", g, x.to_text(rel)))
+        out.append(Store(f"g[{k}]", crossing(layout, k), x.to_text(rel)))
     return out
 
 
@@ -151,6 +158,7 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             out.append(Store(f"z[{layout.slot[slot_name]}]", now, f"pre({name})"))
     for (start, interval), name in zip(layout.events.samples, layout.samples):
         out.append(Store(f"z[{layout.slot[name]}]", _flag(_sample_hit(x.TIME, start, interval))))
+    out += begin_event(layout)
     out.append(Raw("_zdone = 1.0"))
     return out
 
@@ -172,9 +180,8 @@ def _relations_now(layout: EventLayout, out: list[Stmt]
     one_at_a_time = x.BinOp("==", x.Var("_zstatus"), x.Const(2.0))
     out.append(Let("_zdown", _ZERO))  # whether a relation turns false
     for k, rel in enumerate(ev.relations):
-        g = x.sub(layout.hold(rel.left), layout.hold(rel.right))
         held = x.Var(layout.relations[k])
-        out.append(Let(f"_zn{k}", _flag(x.BinOp(rel.op, g, _ZERO)), x.to_text(rel)))
+        out.append(Let(f"_zn{k}", _flag(pass_value(layout, k)), x.to_text(rel)))
         changed.append(x.BinOp("<>", x.Var(f"_zn{k}"), held))
         falls = x.BinOp("and", _truth(layout.relations[k]), x.Not(_truth(f"_zn{k}")))
         out.append(Let("_zdown", _flag(x.BinOp("or", _truth("_zdown"), falls))))
@@ -270,6 +277,7 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
     out.append(Store(f"z[{slot['_zstop']}]", stop))
     for k, name in enumerate(layout.relations):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zh{k}")))
+    out += first_values(layout, [f"_zh{k}" for k in range(len(layout.relations))])
     for k, name in enumerate(layout.times):
         out.append(Store(f"z[{slot[name]}]", x.Var(f"_zu{k}")))
     for k, name in enumerate(layout.condition_names):
@@ -280,7 +288,11 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
         out.append(Store(f"z[{slot[name]}]", x.Var(name), name))
         if name in layout.pre:
             out.append(Store(f"z[{slot[layout.pre[name]]}]", x.Var(layout.pre[name])))
-    out.append(Let("_zmoved", _flag(relations_moved)))
+    # from pass BAND_PASS on, pre(v) := v also while relations move (8.6 as written):
+    # a start condition whose relation holds in the configuration before it and not
+    # in the one it selects (OneWayClutch's 'sa > tau0_max') is then kept by its own
+    # 'pre(startForward) and sa > tau0'
+    out.append(Let("_zmoved", _flag(x.BinOp("and", relations_moved, early_pass()))))
     for name in ev.iterated:
         pre = x.Var(layout.pre[name])
         out.append(Store(f"z[{slot[layout.pre[name]]}]",
@@ -316,6 +328,7 @@ def event_end(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
                          x.to_text(cond)))
     for name in layout.samples:
         out.append(Store(f"z[{slot[name]}]", _ZERO))
+    out += after_event(layout)
     out.append(Store(f"z[{slot['_zinit']}]", _ZERO))
     held = set(layout.discrete)
     for name, slot_name in layout.pre.items():  # between events pre(v) is v

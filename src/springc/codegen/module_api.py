@@ -22,7 +22,9 @@ CODEGEN_VERSION = 10
 every cache key (here, not with the module text, so that the cache reads it without
 loading the generator). 5: a cache entry holds the captured system (``system.pickle``,
 :mod:`springc.pipeline.closed`); 6: a module declares its ``KIND``; 7: a module declares
-``PARAMETER_BOUNDS``; 9: torn blocks take ``_newton_solve`` (``codegen.newton_step``)."""
+``PARAMETER_BOUNDS``; 9: torn blocks take ``_newton_solve`` (``codegen.newton_step``);
+10: relations switch past a band (``codegen.hysteresis``; slots ``_zb``, ``_zw``,
+``_zpass``)."""
 
 
 JACOBIAN_LIMIT = 2000
