@@ -11,6 +11,7 @@ import numpy as np
 
 import springc
 from springc.ir import expr as x
+from springc.ir import flat
 from springc.pipeline.files import flatten_files
 from springc.simplify.free_parameters import free_parameters
 
@@ -67,3 +68,45 @@ def test_simulated_against_the_closed_form(tmp_path: Path) -> None:
     assert np.allclose(result["x"], 1.5 - 0.5 * np.exp(-6 * t), rtol=0, atol=1e-7)
     assert np.allclose(result["y"], 1.5 + 0.5 * np.exp(-3 * t), rtol=0, atol=1e-7)
     assert math.isclose(float(result["d"][-1]), 3.0, abs_tol=1e-9)
+
+
+CHAIN = '''\
+model SC "a mass on a spring at rest at x = 0.5: k from the steady state"
+  parameter Real m = 2;
+  parameter Real g = 9.81;
+  parameter Real k(fixed = false, start = 10);
+  parameter Real k2 = 2 * k;
+  parameter Real k3 = k2 + 1;
+  Real x(start = 0.5, fixed = true);
+  Real v(start = 0, fixed = true);
+initial equation
+  der(v) = 0;
+equation
+  der(x) = v;
+  m * der(v) = -k2 / 2 * x + m * g - 0.1 * v + (k3 - k2 - 1) * x;
+end SC;
+'''
+
+
+def test_parameters_bound_to_a_free_parameter_follow_it(tmp_path: Path) -> None:
+    # rule 3: k2 reads the free k, k3 reads k2 (MultiBody's InitSpringConstant: the
+    # spring's c passed on to its line force)
+    path = tmp_path / "SC.mo"
+    path.write_text(CHAIN)
+    model = free_parameters(flatten_files([path], "SC"))
+    kinds = {v.name: (v.variability, v.binding) for v in model.variables}
+    assert kinds["k2"] == ("continuous", None) and kinds["k3"] == ("continuous", None)
+    assert flat_equation(model, "k3") == x.BinOp("+", x.Var("k2"), x.Const(1))
+    result = springc.simulate(str(path), backend="python", engine="scipy", stop=1.0,
+                              interval=0.5, rtol=1e-10, error_control="off")
+    # at rest at x = 0.5: k x = m g, k = 2 * 9.81 / 0.5
+    assert np.allclose(result["k"], 39.24, rtol=0, atol=1e-9)
+    assert np.allclose(result["k3"], 2 * 39.24 + 1, rtol=0, atol=1e-9)
+    assert np.allclose(result["x"], 0.5, rtol=0, atol=1e-9)
+
+
+def flat_equation(model: flat.FlatModel, name: str) -> x.Expr:
+    """The right-hand side of ``name = e`` among ``model``'s equations."""
+    found = [eq.rhs for eq in model.equations if eq.lhs == x.Var(name)]
+    assert len(found) == 1
+    return found[0]

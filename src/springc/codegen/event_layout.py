@@ -67,6 +67,7 @@ class EventLayout:
         self.slot = {name: base + i for i, name in enumerate(names)}
         self.size = len(names)
         self.held = self._held()
+        self._hold: _Hold | None = None
         self.uses_terminal = events.reads_terminal or any(
             isinstance(n, x.Call) and n.name == "terminal"
             for _, _, c in self.conditions for n in x.walk(c))
@@ -94,17 +95,49 @@ class EventLayout:
         ``floor`` calls their held values, ``sample``/``initial``/``terminal`` their
         flags, ``pre(v)`` its slot,
         ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``."""
-        return _replace(e, self.held if held is None else held, self, False)
+        if held is None:  # one walk for every expression of the system: they share nodes
+            if self._hold is None:
+                self._hold = _Hold(self.held, {_head(k) for k in self.held}, self, {})
+            return _replace(e, self._hold, False)
+        return _replace(e, _Hold(held, {_head(k) for k in held}, self, {}), False)
 
     def sample_name(self, call: x.Call) -> str:
         return self.samples[self.events.samples.index((call.args[0], call.args[1]))]
 
 
-def _replace(e: x.Expr, held: Mapping[x.Expr, x.Expr], layout: EventLayout,
-             quiet: bool) -> x.Expr:
+@dataclasses.dataclass(frozen=True)
+class _Hold:
+    """One :meth:`EventLayout.hold`: the mapping, the heads of its keys (an operator or
+    a function name: only a node with such a head is looked up, so that a large
+    arithmetic node is never hashed) and the nodes done, by identity (the expressions
+    of index reduction share subtrees: a walk of the tree would be exponential)."""
+
+    held: Mapping[x.Expr, x.Expr]
+    heads: set[str]
+    layout: EventLayout
+    memo: dict[tuple[int, bool], tuple[x.Expr, x.Expr]]
+
+
+def _head(e: x.Expr) -> str:
+    return e.op if isinstance(e, x.BinOp) else e.name if isinstance(e, x.Call) else ""
+
+
+def _replace(e: x.Expr, h: _Hold, quiet: bool) -> x.Expr:
     if isinstance(e, (x.Const, x.Var, x.Time)):
         return e
-    if not quiet and isinstance(e, (x.BinOp, x.Call)) and e in held:
+    key = (id(e), quiet)
+    found = h.memo.get(key)
+    if found is not None and found[0] is e:
+        return found[1]
+    out = _replace_node(e, h, quiet)
+    h.memo[key] = (e, out)
+    return out
+
+
+def _replace_node(e: x.Expr, h: _Hold, quiet: bool) -> x.Expr:
+    held, layout = h.held, h.layout
+    if not quiet and isinstance(e, (x.BinOp, x.Call)) and _head(e) in h.heads \
+            and e in held:
         return held[e]
     if isinstance(e, x.Call):
         if e.name == "pre":
@@ -120,13 +153,13 @@ def _replace(e: x.Expr, held: Mapping[x.Expr, x.Expr], layout: EventLayout,
         if e.name == "sample":
             return x.Var(layout.sample_name(e))
         inner = quiet or e.name in _QUIET
-        return x.Call(e.name, tuple(_replace(a, held, layout, inner) for a in e.args))
+        return x.Call(e.name, tuple(_replace(a, h, inner) for a in e.args))
     if isinstance(e, x.BinOp):
-        return x.BinOp(e.op, _replace(e.left, held, layout, quiet),
-                       _replace(e.right, held, layout, quiet))
+        return x.BinOp(e.op, _replace(e.left, h, quiet),
+                       _replace(e.right, h, quiet))
     if isinstance(e, (x.Neg, x.Not, x.Der)):
-        return type(e)(_replace(e.arg, held, layout, quiet))
+        return type(e)(_replace(e.arg, h, quiet))
     if isinstance(e, x.If):
-        return x.If(_replace(e.cond, held, layout, quiet), _replace(e.then, held, layout, quiet),
-                    _replace(e.otherwise, held, layout, quiet))
+        return x.If(_replace(e.cond, h, quiet), _replace(e.then, h, quiet),
+                    _replace(e.otherwise, h, quiet))
     raise TypeError(f"not an expression: {e!r}")

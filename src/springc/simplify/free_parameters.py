@@ -14,7 +14,11 @@ out of the initialization's unknowns:
    equation leaves the initial problem (repeated until none is found: a chain of
    coefficients, each computed from the ones before);
 2. any other becomes a continuous variable that keeps its start value as a guess, with
-   ``der(p) = 0``: a state the initial equations determine, constant during the run.
+   ``der(p) = 0``: a state the initial equations determine, constant during the run;
+3. a parameter whose binding reads such a state (directly or through another parameter
+   of this rule: ``Forces.Spring``'s ``c`` passed on to its inner line force) is no
+   longer known before the initialization either: it becomes a continuous variable with
+   its binding as an equation ``q = e``, constant as the states it reads.
 """
 
 from __future__ import annotations
@@ -46,19 +50,44 @@ def free_parameters(model: flat.FlatModel) -> flat.FlatModel:
                 bindings[target] = value
                 initial.remove(eq)
                 found = True
+    stateful = {v.name for v in model.variables if v.name in free - bindings.keys()
+                and v.type == "Real"}  # (a Boolean or Integer: rule 1 only)
+    dependent = _dependents(model, stateful)
     variables, equations = [], list(model.equations)
     for v in model.variables:
         if v.name in bindings:
             v = replace(v, binding=bindings[v.name])
-        elif v.name in free and v.type == "Real":  # (a Boolean or Integer: rule 1 only)
+        elif v.name in stateful:
             v = replace(v, variability="continuous")
             equations.append(flat.Equation(
                 x.Der(x.Var(v.name)), x.ZERO, v.span,
                 flat.Origin("equation", v.component, f"'{v.name}' is a parameter with "
                             "fixed = false: constant after the initialization")))
+        elif v.name in dependent and v.binding is not None:
+            equations.append(flat.Equation(
+                x.Var(v.name), v.binding, v.span,
+                flat.Origin("equation", v.component, f"'{v.name}' is a parameter whose "
+                            "binding reads a parameter with fixed = false")))
+            v = replace(v, variability="continuous", binding=None)
         variables.append(v)
     return replace(model, variables=tuple(variables), equations=tuple(equations),
                    initial_equations=tuple(initial))
+
+
+def _dependents(model: flat.FlatModel, stateful: set[str]) -> set[str]:
+    """The parameters whose bindings read a name of ``stateful`` or, in turn, one of
+    them (rule 3)."""
+    reads = {v.name: x.variables(v.binding) for v in model.variables
+             if v.variability == "parameter" and v.binding is not None}
+    dependent: set[str] = set()
+    found = bool(stateful)
+    while found:
+        found = False
+        for name, names in reads.items():
+            if name not in dependent and not names.isdisjoint(stateful | dependent):
+                dependent.add(name)
+                found = True
+    return dependent
 
 
 def _definition(eq: flat.Equation, free: set[str]) -> tuple[str | None, x.Expr | None]:

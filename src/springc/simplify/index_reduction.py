@@ -86,7 +86,8 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
     pending = sorted({n for r in system.equations for n in r.variables
-                      if dae.is_derivative(n)}, key=lambda n: (len(n), n))
+                      if dae.is_derivative(n)} | forced_derivatives(system),
+                     key=lambda n: (len(n), n))
     for name in pending:
         base = dae.derivative_base(name)
         if base is None or base not in index:
@@ -97,6 +98,17 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
         names.append(name)
         derivative.append(-1)
     return names, index, derivative
+
+
+def forced_derivatives(system: dae.DAE) -> set[str]:
+    """The derivative variables of the unknowns declared ``StateSelect.always``
+    (Modelica 3.6, section 4.8.7.1: "always: do use it as a state"), whether or not an
+    equation differentiates them. Where none does, ``der(v)`` enters with no equation:
+    ``v`` becomes a candidate state, Pantelides differentiates the equations that
+    determine it, and the dummy-derivative choice keeps ``v`` (it ranks first), as
+    OpenModelica and Dymola make such a variable a state."""
+    return {dae.derivative_name(u.name) for u in system.unknowns
+            if u.state_select == "always"}
 
 
 def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Reduced:
