@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any, cast
 
 import numpy as np
 
@@ -421,10 +422,47 @@ def _store(ev: ExpressionEvaluator, target: s.Ref, value: a.Value, stmt: s.Assig
     if not a.is_array(current):
         raise FlattenError(f"'{part.name}' is not an array", part.span)
     updated = current.copy()
-    index = tuple(slice(None) if isinstance(sub, s.Colon) else
-                  ev.integer(sub, scope, "a subscript") - 1 for sub in part.subscripts)
+    index = tuple(_subscript(ev, sub, scope) for sub in part.subscripts)
     try:
-        updated[index] = value
+        if any(isinstance(i, x.Expr) for i in index):
+            _store_at_run_time(updated, index, value)
+        else:
+            updated[cast(tuple[slice | int, ...], index)] = value
     except (IndexError, ValueError) as err:
         raise FlattenError(f"cannot assign to '{target.dotted}': {err}", stmt.span) from None
     scope.names[part.name] = updated
+
+
+def _subscript(ev: ExpressionEvaluator, sub: s.Expr, scope: FunctionScope
+               ) -> slice | int | x.Expr:
+    """A 0-based subscript, or the expression of one known only during the simulation
+    (an Integer the function computes from its inputs)."""
+    if isinstance(sub, s.Colon):
+        return slice(None)
+    try:
+        return ev.integer(sub, scope, "a subscript") - 1
+    except FlattenError:
+        found = ev.value(sub, scope)
+        if isinstance(found, x.Expr) and not isinstance(found, x.Const):
+            return found
+        raise
+
+
+def _store_at_run_time(updated: np.ndarray, index: tuple[slice | int | x.Expr, ...],
+                       value: a.Value) -> None:
+    """``updated[index] := value`` where some subscripts are known only during the
+    simulation: every element they may name becomes ``if i == k then value else
+    old``, so that an index out of range assigns none."""
+    run_time = [k for k, i in enumerate(index) if isinstance(i, x.Expr)]
+    for chosen in np.ndindex(*(updated.shape[k] for k in run_time)):
+        at: list[Any] = list(index)
+        cond: x.Expr | None = None
+        for k, j in zip(run_time, chosen):
+            test = x.BinOp("==", cast(x.Expr, index[k]), x.Const(j + 1))
+            cond = test if cond is None else x.BinOp("and", cond, test)
+            at[k] = j
+        assert cond is not None
+        place: tuple[Any, ...] = tuple(at)
+        old = updated[place]
+        updated[place] = a.elementwise(lambda new, kept, c=cond: x.If(c, new, kept),
+                                       value, old)
