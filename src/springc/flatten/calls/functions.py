@@ -45,6 +45,7 @@ from .control import (
     run_while,
     stray,
 )
+from .counted import run_counted
 from .jumps import flags, is_flag, lowered, merged_flag
 from .record_values import construct, empty_record, record_class, store_field
 from .short_functions import short_defaults
@@ -291,7 +292,9 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
 def _while(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: FunctionScope,
            guard: x.Expr | None) -> None:
     run_while(ev, stmt, lambda: ev.scalar(stmt.condition, scope),
-              lambda: _run(ev, stmt.body, scope, guard))
+              lambda: _run(ev, stmt.body, scope, guard),
+              lambda: run_counted(ev, stmt, scope, guard,
+                                  lambda running: _run(ev, stmt.body, scope, running)))
 
 
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
@@ -374,8 +377,10 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         if then_value is other or name not in before:
             continue
         if then_value is None or other is None:
-            raise FlattenError(f"'{name}' is assigned in only one branch of this if-statement",
-                               stmt.span, hint="assign it before the if-statement too")
+            # unassigned where the other branch runs: its value there is undefined
+            # (reading it is an error, 12.4.4), and the assigned one serves as well
+            scope.names[name] = other if then_value is None else then_value
+            continue
         if is_flag(name):  # a return or break flag (jumps.py): folded Boolean logic
             scope.names[name] = merged_flag(cond, then_value, other)
             continue

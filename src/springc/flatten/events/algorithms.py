@@ -40,6 +40,7 @@ from ..calls import (
     run_while,
     stray,
     string_equation,
+    without_events,
 )
 from ..connect import GRAPH_EQUATIONS, misplaced
 from ..scopes import ClassScope, FlatResults, FlattenContext, LocalScope, Scope
@@ -313,8 +314,11 @@ class _Run:
             self.parts.append(parts)
             try:
                 self.run(body, where, guard)
-                return {n: (v, self.spans[n]) for n, v in self.env.items()
-                        if before.get(n) is not v}
+                # the body runs at the when's events only: its relations are taken
+                # literally there (no crossing, no held value: a function it calls
+                # may read a variable the body has just assigned, TimeTable's last)
+                return {n: (without_events(v), self.spans[n])
+                        for n, v in self.env.items() if before.get(n) is not v}
             finally:
                 self.context.pop()
                 self.parts.pop()

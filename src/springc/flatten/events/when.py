@@ -18,7 +18,7 @@ from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
 from ...ir import when as w
-from ...ir.builtins import BUILTINS, names
+from ...ir.builtins import BUILTINS, SAME, names
 from .. import arrays as a
 from ..calls import assertion, string_equation
 from ..connect import check_branches, check_no_connect
@@ -105,7 +105,9 @@ def _boolean_shape(e: x.Expr) -> bool:
         return e.op in x.RELATIONS or e.op in ("and", "or")
     if isinstance(e, x.Call):
         builtin = BUILTINS.get(e.name)
-        return builtin is not None and (builtin.boolean or e.name == "noEvent")
+        if builtin is not None and builtin.result == SAME and len(e.args) == 1:
+            return _boolean_shape(e.args[0])  # pre(b), noEvent(b)
+        return builtin is not None and builtin.boolean
     if isinstance(e, x.If):
         return _boolean_shape(e.then) and _boolean_shape(e.otherwise)
     return isinstance(e, (x.Not, x.Var))
