@@ -339,3 +339,42 @@ def test_an_external_function_names_its_libraries_and_sources(tmp_path: Path,
         "its external clause", "it links the libraries 'LibC', 'm'",
         f"{where} holds its C sources (twice.c)" if shipped
         else f"{where} is not in this copy of the library"]
+
+
+def test_pieces_of_the_msl_time_table_and_radio_button(tmp_path: Path) -> None:
+    # TimeTable: 'next0' is assigned in one branch of an if on a run-time condition
+    # only (undefined in the other, which never reads it); RadioButtonSource: a
+    # when-statement on a Boolean vector its algorithm assigns from pre(...)
+    path = tmp_path / "m.mo"
+    path.write_text("""model M
+  function f
+    input Real u;
+    output Real y;
+  protected
+    Real d;
+  algorithm
+    if u > 1 then
+      d := u - 1;
+      y := 2 * d;
+    else
+      y := 0;
+    end if;
+  end f;
+  Real y = f(time);
+  Boolean reset[1] = {time > 0.5};
+  Boolean pre_reset[1];
+  Boolean on(start = true, fixed = true);
+initial equation
+  pre(reset) = {false};
+algorithm
+  pre_reset := pre(reset);
+  when pre_reset then
+    on := false;
+  end when;
+end M;
+""")
+    model = flatten_files([path])
+    equations = {x.to_text(e.lhs): x.to_text(e.rhs) for e in model.equations}
+    assert equations["y"] == "if time > 1 then 2 * (time - 1) else 0"
+    (when,) = model.whens
+    assert [x.to_text(c) for c in when.branches[0].conditions] == ["pre(reset[1])"]

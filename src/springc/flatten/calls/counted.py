@@ -6,8 +6,9 @@ next := next + 1; end while``).
 Such a loop is unrolled symbolically, soundly, where its shape bounds it:
 
 - its body raises a counter ``i`` by a constant step ``c > 0`` in one unconditional
-  statement ``i := i + c`` (no other statement assigns ``i``) and has no ``break``
-  or ``return``;
+  statement ``i := i + c`` (no other statement assigns ``i``); a ``break`` or
+  ``return`` in it has become a flag before (:mod:`.jumps`), read by the condition
+  as one more conjunct;
 - its condition is a conjunction (``p and q and ...``) one of whose conjuncts
   compares a subscript ``A[..., i, ...]`` of an array whose dimension there has
   ``n`` elements known while flattening.
