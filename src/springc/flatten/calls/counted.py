@@ -59,7 +59,8 @@ def run_counted(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: Function
     running: x.Expr = x.Const(True)
     runs: list[x.Expr] = []
     for k in range(bound):
-        scope.names[name] = folded(x.BinOp("+", start, x.Const(int(step) * k)))
+        scope.names[name] = start if k == 0 else \
+            folded(x.BinOp("+", start, x.Const(int(step) * k)))
         cond = _simplified(folded(ev.scalar(stmt.condition, scope)))
         if isinstance(cond, x.Const) and not cond.value:
             break
