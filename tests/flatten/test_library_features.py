@@ -9,7 +9,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from rule_outcome import outcome
+from springc.errors import SpringcError, errors_of
 from springc.ir import expr as x
 from springc.ir.flat import format_flat
 from springc.pipeline.files import flatten_files
@@ -83,7 +86,7 @@ def test_an_unknown_external_function_is_located_where_called(tmp_path: Path) ->
     text = outcome(tmp_path, STRINGS + "model Top\n  P.Foreign f;\nend Top;\n")
     assert text == (f"{call}:14: the external function 'P.foreign' (C function "
                     "'my_c_function') is not supported yet\nhelp: springc calls no foreign "
-                    "code; it evaluates the tables (ModelicaStandardTables) and string "
+                    "code yet; it evaluates the tables (ModelicaStandardTables) and string "
                     "functions (ModelicaStrings) of the Modelica Standard Library itself")
 
 
@@ -297,3 +300,81 @@ equation
   'src.y' = 'snk.u';
 end EnumConn;
 """
+
+
+LIBRARY = '''package Lib
+  function twice
+    input Real u;
+    output Real y;
+  external "C" y = lib_twice(u)
+    annotation(IncludeDirectory="modelica://Lib/Resources/C-Sources",
+               Include="#include \\"twice.h\\"", Library={"LibC", "m"});
+  end twice;
+  model M
+    Real y = twice(time);
+  end M;
+end Lib;
+'''
+
+
+@pytest.mark.parametrize("shipped", [True, False])
+def test_an_external_function_names_its_libraries_and_sources(tmp_path: Path,
+                                                               shipped: bool) -> None:
+    # the MSL's FFT: external "C" with IncludeDirectory and Library annotations (12.9.4)
+    folder = tmp_path / "libs" / "Lib"
+    folder.mkdir(parents=True)
+    (folder / "package.mo").write_text(LIBRARY)
+    sources = folder / "Resources" / "C-Sources"
+    if shipped:
+        sources.mkdir(parents=True)
+        (sources / "twice.c").write_text("double lib_twice(double u) { return 2*u; }\n")
+    with pytest.raises(SpringcError) as info:
+        flatten_files([], "Lib.M", [tmp_path / "libs"])
+    (err,) = errors_of(info.value)
+    assert err.message == ("the external function 'Lib.twice' (C function 'lib_twice') is "
+                           "not supported yet")
+    assert err.span is not None and (err.span.line, err.span.column) == (10, 14)
+    where = f"its include directory modelica://Lib/Resources/C-Sources ({sources})"
+    assert [n.message for n in err.notes] == [
+        "its external clause", "it links the libraries 'LibC', 'm'",
+        f"{where} holds its C sources (twice.c)" if shipped
+        else f"{where} is not in this copy of the library"]
+
+
+def test_pieces_of_the_msl_time_table_and_radio_button(tmp_path: Path) -> None:
+    # TimeTable: 'next0' is assigned in one branch of an if on a run-time condition
+    # only (undefined in the other, which never reads it); RadioButtonSource: a
+    # when-statement on a Boolean vector its algorithm assigns from pre(...)
+    path = tmp_path / "m.mo"
+    path.write_text("""model M
+  function f
+    input Real u;
+    output Real y;
+  protected
+    Real d;
+  algorithm
+    if u > 1 then
+      d := u - 1;
+      y := 2 * d;
+    else
+      y := 0;
+    end if;
+  end f;
+  Real y = f(time);
+  Boolean reset[1] = {time > 0.5};
+  Boolean pre_reset[1];
+  Boolean on(start = true, fixed = true);
+initial equation
+  pre(reset) = {false};
+algorithm
+  pre_reset := pre(reset);
+  when pre_reset then
+    on := false;
+  end when;
+end M;
+""")
+    model = flatten_files([path])
+    equations = {x.to_text(e.lhs): x.to_text(e.rhs) for e in model.equations}
+    assert equations["y"] == "if time > 1 then 2 * (time - 1) else 0"
+    (when,) = model.whens
+    assert [x.to_text(c) for c in when.branches[0].conditions] == ["pre(reset[1])"]

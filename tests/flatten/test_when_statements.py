@@ -51,7 +51,7 @@ equation
   z = 2 * x + n;
   when {x < 0.5, x < 0.25} then
     n = pre(n) + 1;
-    y = if pre(n) + 1 > 1 then -(2 * x + (pre(n) + 1)) else 2 * x + (pre(n) + 1);
+    y = noEvent(if pre(n) + 1 > 1 then -(2 * x + (pre(n) + 1)) else 2 * x + (pre(n) + 1));
   elsewhen time >= 2 then
     y = -1;
     terminate("late");

@@ -462,13 +462,15 @@ Element = Component | Extends | Import | ClassDef
 class ExternalCall:
     """The external clause of a function springc evaluates natively
     (``external "C" y = name(a, b)``, section 12.9): the foreign function's name, the
-    output it assigns, and its arguments as written."""
+    output it assigns, and its arguments as written; ``annotation`` is the clause's own
+    (``Include``, ``IncludeDirectory``, ``Library``, ``LibraryDirectory``: 12.9.4)."""
 
     language: str
     name: str
     output: str | None
     args: tuple[Expr, ...]
     span: Span
+    annotation: Modification | None = None
 
 
 @dataclass(frozen=True, slots=True)

@@ -283,7 +283,11 @@ class ClassRules(RuleBase):
         language = next((str(c)[1:-1] for c in ch if isinstance(c, Token)
                          and c.type == "STRING"), "C")
         call = next((c for c in ch if isinstance(c, ExternalCall)), None)
-        return replace(call, language=language) if call is not None else None
+        notes = next((c.modification for c in ch if isinstance(c, Annotation)), None)
+        if call is None:  # the default call (12.9.1): the function's own name
+            return ExternalCall(language, "", None, (), self.keyword_span(meta, "external"),
+                                notes) if notes is not None else None
+        return replace(call, language=language, annotation=notes)
 
     def external_call(self, meta: Meta, ch: list[Any]) -> Any:
         output = None

@@ -106,7 +106,7 @@ class Builtins:
             (v,) = self._args(call, scope, 1)
         finally:
             self.ev.no_event -= 1
-        return a.elementwise(_keep_no_event, v)
+        return a.elementwise(without_events, v)
 
     def smooth(self, call: s.Call, scope: Scope) -> a.Value:
         self.ev.no_event += 1
@@ -114,7 +114,7 @@ class Builtins:
             _, v = self._args(call, scope, 2)
         finally:
             self.ev.no_event -= 1
-        return a.elementwise(_keep_no_event, v)
+        return a.elementwise(without_events, v)
 
     def homotopy(self, call: s.Call, scope: Scope) -> a.Value:
         actual = next((n.value for n in call.named if n.name == "actual"), None)
@@ -247,9 +247,9 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
 _SWITCHING_CALLS = names(lambda b: b.switching)
 
 
-def _keep_no_event(e: x.Expr) -> x.Expr:
-    """``noEvent`` only matters around relations and the built-ins that would switch
-    at events (3.7.2); elsewhere it is dropped."""
+def without_events(e: x.Expr) -> x.Expr:
+    """``noEvent(e)``: ``noEvent`` only matters around relations and the built-ins that
+    would switch at events (3.7.2); elsewhere it is dropped."""
     has_switch = any(isinstance(n, x.If) or (isinstance(n, x.BinOp) and n.op in x.RELATIONS)
                      or (isinstance(n, x.Call) and n.name in _SWITCHING_CALLS)
                      for n in x.walk(e))

@@ -41,8 +41,11 @@ def folded(e: x.Expr) -> x.Expr:
 
 
 def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
-              condition: Callable[[], x.Expr], body: Callable[[], None]) -> None:
-    """Run ``body`` while ``condition()`` (re-evaluated each time) is true."""
+              condition: Callable[[], x.Expr], body: Callable[[], None],
+              at_run_time: Callable[[], bool] | None = None) -> None:
+    """Run ``body`` while ``condition()`` (re-evaluated each time) is true; where the
+    condition is known only during the simulation, ``at_run_time()`` runs the rest of
+    the loop if it can (a counted search in a function: :mod:`.counted`)."""
     while True:
         value = folded(condition())
         if not isinstance(value, x.Const) and ev.flattener.is_parameter_expression(value):
@@ -53,6 +56,8 @@ def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
             raise FlattenError("the condition of a while loop must be a Boolean expression",
                                stmt.condition.span)
         if not isinstance(value, x.Const):
+            if at_run_time is not None and at_run_time():
+                return
             raise FlattenError("`while` loops whose condition is known only during the "
                                "simulation are not supported yet", stmt.condition.span,
                                hint="loop over a range (for i in 1:n) with break")

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import Any, cast
 
 import numpy as np
 
@@ -44,6 +45,7 @@ from .control import (
     run_while,
     stray,
 )
+from .counted import run_counted
 from .jumps import flags, is_flag, lowered, merged_flag
 from .parameter_calls import parameter_call
 from .record_values import construct, empty_record, record_class, store_field
@@ -300,7 +302,9 @@ def _run(ev: ExpressionEvaluator, body: tuple[s.Statement, ...], scope: Function
 def _while(ev: ExpressionEvaluator, stmt: s.WhileStatement, scope: FunctionScope,
            guard: x.Expr | None) -> None:
     run_while(ev, stmt, lambda: ev.scalar(stmt.condition, scope),
-              lambda: _run(ev, stmt.body, scope, guard))
+              lambda: _run(ev, stmt.body, scope, guard),
+              lambda: run_counted(ev, stmt, scope, guard,
+                                  lambda running: _run(ev, stmt.body, scope, running)))
 
 
 def _call(ev: ExpressionEvaluator, stmt: s.CallStatement, scope: FunctionScope,
@@ -383,8 +387,10 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         if then_value is other or name not in before:
             continue
         if then_value is None or other is None:
-            raise FlattenError(f"'{name}' is assigned in only one branch of this if-statement",
-                               stmt.span, hint="assign it before the if-statement too")
+            # unassigned where the other branch runs: its value there is undefined
+            # (reading it is an error, 12.4.4), and the assigned one serves as well
+            scope.names[name] = other if then_value is None else then_value
+            continue
         if is_flag(name):  # a return or break flag (jumps.py): folded Boolean logic
             scope.names[name] = merged_flag(cond, then_value, other)
             continue
@@ -431,10 +437,47 @@ def _store(ev: ExpressionEvaluator, target: s.Ref, value: a.Value, stmt: s.Assig
     if not a.is_array(current):
         raise FlattenError(f"'{part.name}' is not an array", part.span)
     updated = current.copy()
-    index = tuple(slice(None) if isinstance(sub, s.Colon) else
-                  ev.integer(sub, scope, "a subscript") - 1 for sub in part.subscripts)
+    index = tuple(_subscript(ev, sub, scope) for sub in part.subscripts)
     try:
-        updated[index] = value
+        if any(isinstance(i, x.Expr) for i in index):
+            _store_at_run_time(updated, index, value)
+        else:
+            updated[cast(tuple[slice | int, ...], index)] = value
     except (IndexError, ValueError) as err:
         raise FlattenError(f"cannot assign to '{target.dotted}': {err}", stmt.span) from None
     scope.names[part.name] = updated
+
+
+def _subscript(ev: ExpressionEvaluator, sub: s.Expr, scope: FunctionScope
+               ) -> slice | int | x.Expr:
+    """A 0-based subscript, or the expression of one known only during the simulation
+    (an Integer the function computes from its inputs)."""
+    if isinstance(sub, s.Colon):
+        return slice(None)
+    try:
+        return ev.integer(sub, scope, "a subscript") - 1
+    except FlattenError:
+        found = ev.value(sub, scope)
+        if isinstance(found, x.Expr) and not isinstance(found, x.Const):
+            return found
+        raise
+
+
+def _store_at_run_time(updated: np.ndarray, index: tuple[slice | int | x.Expr, ...],
+                       value: a.Value) -> None:
+    """``updated[index] := value`` where some subscripts are known only during the
+    simulation: every element they may name becomes ``if i == k then value else
+    old``, so that an index out of range assigns none."""
+    run_time = [k for k, i in enumerate(index) if isinstance(i, x.Expr)]
+    for chosen in np.ndindex(*(updated.shape[k] for k in run_time)):
+        at: list[Any] = list(index)
+        cond: x.Expr | None = None
+        for k, j in zip(run_time, chosen):
+            test = x.BinOp("==", cast(x.Expr, index[k]), x.Const(j + 1))
+            cond = test if cond is None else x.BinOp("and", cond, test)
+            at[k] = j
+        assert cond is not None
+        place: tuple[Any, ...] = tuple(at)
+        old = updated[place]
+        updated[place] = a.elementwise(lambda new, kept, c=cond: x.If(c, new, kept),
+                                       value, old)

@@ -40,6 +40,7 @@ from ..calls import (
     run_while,
     stray,
     string_equation,
+    without_events,
 )
 from ..connect import GRAPH_EQUATIONS, misplaced
 from ..scopes import ClassScope, FlatResults, FlattenContext, LocalScope, Scope
@@ -183,30 +184,37 @@ class _Run:
         names = self.ev.value(target, where)
         if string_equation(names, value, stmt.span):
             return
+        if a.shape(names) != a.shape(value):
             raise FlattenError(
                 f"cannot assign a value of size {a.describe_shape(a.shape(value))} to "
                 f"'{target.dotted}' of size {a.describe_shape(a.shape(names))}", stmt.span)
         for name, item in zip(a.scalars(names), a.scalars(value)):
             if isinstance(name, x.If):  # a subscript known only during the simulation
-                raise FlattenError(f"assigning to '{target.dotted}' with a subscript known "
-                                   "only during the simulation is not supported yet",
-                                   target.span, hint="subscripts of an assigned variable "
-                                   "must be parameter expressions or for-loop indices")
-            bindings = self.fl.parameter_values.bindings
-            if not isinstance(name, x.Var) or (name.name in bindings and not (
-                    self.initial and bindings[name.name] is None)):
-                # (an initial algorithm computes parameters without a value: fixed =
-                # false, section 8.6; simplify/free_parameters.py binds them)
-                raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
-                                   "parameter or constant", target.span,
-                                   hint="an algorithm section assigns variables only")
-            if name.name in self.held and not self.parts:
-                raise FlattenError(f"'{name.name}' is assigned both in a when statement "
-                                   "and outside of it in this algorithm section", stmt.span,
-                                   hint="a variable a when statement assigns is discrete: "
-                                   "assign it only in when statements")
-            self.env[name.name] = item
-            self.spans[name.name] = stmt.span
+                for leaf, chosen in run_time_targets(name, target):
+                    # the subscript's value now, as a read of it gives
+                    now = cast(x.Expr, self.read(chosen, target.span))
+                    self.store_scalar(leaf, x.If(now, item, self.env.get(leaf.name, leaf)),
+                                      target, stmt)
+                continue
+            self.store_scalar(name, item, target, stmt)
+
+    def store_scalar(self, name: x.Expr, item: x.Expr, target: s.Ref, stmt: s.Assign
+                     ) -> None:
+        bindings = self.fl.parameter_values.bindings
+        if not isinstance(name, x.Var) or (name.name in bindings and not (
+                self.initial and bindings[name.name] is None)):
+            # (an initial algorithm computes parameters without a value: fixed =
+            # false, section 8.6; simplify/free_parameters.py binds them)
+            raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
+                               "parameter or constant", target.span,
+                               hint="an algorithm section assigns variables only")
+        if name.name in self.held and not self.parts:
+            raise FlattenError(f"'{name.name}' is assigned both in a when statement "
+                               "and outside of it in this algorithm section", stmt.span,
+                               hint="a variable a when statement assigns is discrete: "
+                               "assign it only in when statements")
+        self.env[name.name] = item
+        self.spans[name.name] = stmt.span
 
     def if_(self, branches: tuple[tuple[s.Expr, tuple[s.Statement, ...]], ...],
             otherwise: tuple[s.Statement, ...], where: Scope, guard: x.Expr | None) -> None:
@@ -306,8 +314,11 @@ class _Run:
             self.parts.append(parts)
             try:
                 self.run(body, where, guard)
-                return {n: (v, self.spans[n]) for n, v in self.env.items()
-                        if before.get(n) is not v}
+                # the body runs at the when's events only: its relations are taken
+                # literally there (no crossing, no held value: a function it calls
+                # may read a variable the body has just assigned, TimeTable's last)
+                return {n: (without_events(v), self.spans[n])
+                        for n, v in self.env.items() if before.get(n) is not v}
             finally:
                 self.context.pop()
                 self.parts.pop()
@@ -339,6 +350,46 @@ class _Run:
                                lambda v: self.read(v, stmt.span))
         condition = cast(x.Expr, self.read(item.condition, span))
         self.fl.assertions.append((_with_condition(item, condition), span))
+
+
+def run_time_targets(names: x.Expr, target: s.Ref) -> list[tuple[x.Var, x.Expr]]:
+    """The elements a subscript known only during the simulation may name, each with
+    the condition that selects it: ``names`` is the if-expression that reading
+    ``target`` gives (``if i == 1 then buf[1] elseif ... else buf[n]``); the last
+    element is chosen by ``i == n``, so that an index out of range assigns none."""
+    found: list[tuple[x.Var, x.Expr]] = []
+    pending: list[tuple[x.Expr, x.Expr | None]] = [(names, None)]
+    while pending:  # along a chain without recursion: a subscript may range over 4000
+        e, path = pending.pop()
+        if isinstance(e, x.Var):
+            found.append((e, path if path is not None else x.Const(True)))
+            continue
+        if not (isinstance(e, x.If) and _index_test(e.cond)):
+            raise FlattenError(f"'{target.dotted}' cannot be assigned: it is a "
+                               "parameter or constant", target.span,
+                               hint="an algorithm section assigns variables only")
+        while True:
+            test = cast(x.BinOp, e.cond)
+            pending.append((e.then, _and(path, test)))
+            rest = e.otherwise
+            if isinstance(rest, x.If) and _index_test(rest.cond) \
+                    and cast(x.BinOp, rest.cond).left == test.left:
+                e = rest  # the same subscript's next element
+                continue
+            # the last element (or an inner subscript's chain)
+            last = x.Const(cast(x.Const, test.right).value + 1)
+            pending.append((rest, _and(path, x.BinOp("==", test.left, last))))
+            break
+    found.reverse()  # in the order of the elements
+    return found
+
+
+def _index_test(cond: x.Expr) -> bool:
+    """Whether ``cond`` is ``i == k`` with ``k`` an Integer, as references._selected
+    builds it."""
+    return isinstance(cond, x.BinOp) and cond.op == "==" \
+        and isinstance(cond.right, x.Const) and isinstance(cond.right.value, int) \
+        and not isinstance(cond.right.value, bool)
 
 
 def _and(guard: x.Expr | None, cond: x.Expr) -> x.Expr:

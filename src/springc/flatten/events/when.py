@@ -18,9 +18,9 @@ from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
 from ...ir import when as w
-from ...ir.builtins import BUILTINS, names
+from ...ir.builtins import BUILTINS, SAME, names
 from .. import arrays as a
-from ..calls import assertion, string_equation
+from ..calls import assertion, string_equation, without_events
 from ..connect import check_branches, check_no_connect
 from ..scopes import ClassScope, FlattenContext, LocalScope, Scope, equations
 from .when_rules import check_when_target
@@ -105,7 +105,9 @@ def _boolean_shape(e: x.Expr) -> bool:
         return e.op in x.RELATIONS or e.op in ("and", "or")
     if isinstance(e, x.Call):
         builtin = BUILTINS.get(e.name)
-        return builtin is not None and (builtin.boolean or e.name == "noEvent")
+        if builtin is not None and builtin.result == SAME and len(e.args) == 1:
+            return _boolean_shape(e.args[0])  # pre(b), noEvent(b)
+        return builtin is not None and builtin.boolean
     if isinstance(e, x.If):
         return _boolean_shape(e.then) and _boolean_shape(e.otherwise)
     return isinstance(e, (x.Not, x.Var))
@@ -127,7 +129,10 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
                                    "be a variable", item.lhs.span,
                                    hint="a when-equation is solved for its left-hand side: "
                                    "write 'v = expression'")
-            parts.assignments.append(w.Assignment(left.name, right, item.span))
+            # the value is taken at the when's events only: its relations are
+            # literal there (no crossing, no held value), as in a when statement
+            parts.assignments.append(w.Assignment(left.name, without_events(right),
+                                                  item.span))
     elif isinstance(item, s.CallEquation) and item.call.func.dotted == "reinit":
         call = item.call
         if len(call.args) != 2 or call.named:

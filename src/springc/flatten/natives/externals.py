@@ -9,6 +9,7 @@ of any other external function is a located error naming it; declaring one is no
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from ...errors import FlattenError, Note
@@ -37,8 +38,8 @@ def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, 
         raise FlattenError(
             f"the external function '{entry.full_name}' ({external.language} function "
             f"'{c_name}') is not supported yet", call.span,
-            [Note("its external clause", external.span)],
-            "springc calls no foreign code; it evaluates the tables "
+            [Note("its external clause", external.span), *_sources(entry, external)],
+            "springc calls no foreign code yet; it evaluates the tables "
             "(ModelicaStandardTables) and string functions (ModelicaStrings) of the "
             "Modelica Standard Library itself")
     operation, roles = known
@@ -90,3 +91,45 @@ def _index(ev: ExpressionEvaluator, given: dict[str, Any], role: str, call: s.Ca
         raise FlattenError(f"the {role} of a string function must be known before the "
                            f"simulation, but it depends on {missing.args[0]}",
                            call.span) from None
+
+
+def _sources(entry: ClassEntry, external: s.ExternalCall) -> list[Note]:
+    """Where the external clause's annotation (12.9.4) says the function's C code is:
+    its libraries, and its include directory (``modelica://Top/Resources/Include`` by
+    default) with whether the library at hand ships it."""
+    notes: dict[str, list[str]] = {}
+    for arg in external.annotation.arguments if external.annotation else ():
+        value = arg.modification.value if arg.modification else None
+        items = value.items if isinstance(value, s.ArrayLit) else (value,)
+        notes[".".join(arg.path)] = [i.value for i in items if isinstance(i, s.String)]
+    found: list[Note] = []
+    if notes.get("Library"):
+        found.append(Note("it links the librar" + ("y " if len(notes["Library"]) == 1
+                                                   else "ies ")
+                          + ", ".join(f"'{name}'" for name in notes["Library"])))
+    top = entry
+    while top.parent is not None and top.parent.parent is not None:
+        top = top.parent  # up to the top-level class, below the tree's root
+    include = (notes.get("IncludeDirectory") or
+               [f"modelica://{top.defn.name}/Resources/Include"])[0]
+    folder = _resolved(include, top)
+    if folder is None:
+        return found
+    where = f"its include directory {include} ({folder})"
+    if not folder.is_dir():
+        found.append(Note(f"{where} is not in this copy of the library"))
+    else:
+        sources = sorted(p.name for p in folder.glob("*.c"))
+        listed = ", ".join(sources[:4]) + (", ..." if len(sources) > 4 else "")
+        found.append(Note(f"{where} holds its C sources" + (
+            f" ({listed})" if sources else "")))
+    return found
+
+
+def _resolved(uri: str, top: ClassEntry) -> Path | None:
+    """The folder a ``modelica://Top/path`` URI names, where ``Top`` is the library
+    ``top`` stored as a folder; None where it is another library or not a folder."""
+    prefix = f"modelica://{top.defn.name}/"
+    if not uri.startswith(prefix) or top.folder is None:
+        return None
+    return top.folder.joinpath(*uri[len(prefix):].split("/"))
