@@ -88,14 +88,6 @@ def when_exprs(whens: Iterable[w.When]) -> Iterator[x.Expr]:
             yield from (r.value for r in b.reinits)
 
 
-def when_values(whens: Iterable[w.When]) -> Iterator[x.Expr]:
-    """The values the when-clauses assign and reinit (their bodies, not conditions)."""
-    for clause in whens:
-        for b in clause.branches:
-            yield from (a.value for a in b.assignments)
-            yield from (r.value for r in b.reinits)
-
-
 def switching(e: x.Expr) -> Iterator[x.Expr]:
     """The nodes of ``e`` outside ``noEvent(...)`` and ``smooth(...)``."""
     stack = [e]
@@ -120,11 +112,6 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     held_set = set(held)
     exprs = [e for step in system.steps for e in ode.step_expressions(step)]
     exprs += [a.expr for a in system.observed]
-    # a when-clause's body is evaluated at its events only: the relations of its
-    # values are taken literally there and need no zero crossing (8.5; the MSL's
-    # ContinuousSignalExtrema: 't_min = if y_min < pre(y_min) ...' with
-    # 'y_min = min({pre(y_min), u, pre(u)})' sits on its boundary after each event)
-    bodies = set(when_values(model.whens)) - set(exprs)
     exprs += list(when_exprs(model.whens))
     # Only expressions with a call or a relation can hold anything found below
     # (one walk of each, instead of three, for the plain sums of a large scene).
@@ -135,9 +122,8 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     pre: dict[str, None] = {}
     floors: dict[x.Call, None] = {}
     for e in exprs:
-        in_body = e in bodies
         for node in switching(e):
-            if isinstance(node, x.BinOp) and node.op in STATE_RELATIONS and not in_body:
+            if isinstance(node, x.BinOp) and node.op in STATE_RELATIONS:
                 kind = _time_relation(node, params)
                 if kind is not None:
                     timed.setdefault(node, kind)

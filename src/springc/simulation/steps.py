@@ -185,10 +185,11 @@ class Problem:
         self.trial, self.rejected = np.array(self.z), None
         try:
             integrator = make()
+            failed = self.rejected is not None
         finally:
             self.trial, self.rejected = None, None
-        if not np.isfinite(np.asarray(integrator.f)).all():
-            self.rhs(t, np.asarray(x))  # raises the located failure
+        if failed:  # the probe or (t, x) itself (scipy's BDF and LSODA keep no f)
+            self.rhs(t, np.asarray(x))  # raises the located failure at (t, x)
         return integrator
 
     def non_finite(self, t: float, x: np.ndarray, dx: np.ndarray) -> Stop:

@@ -130,7 +130,8 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
                                    hint="a when-equation is solved for its left-hand side: "
                                    "write 'v = expression'")
             # the value is taken at the when's events only: its relations are
-            # literal there (no crossing, no held value), as in a when statement
+            # literal there (no crossing, no held value; 8.5), as in a when
+            # statement; so are reinit's values below
             parts.assignments.append(w.Assignment(left.name, without_events(right),
                                                   item.span))
     elif isinstance(item, s.CallEquation) and item.call.func.dotted == "reinit":
@@ -146,7 +147,7 @@ def _body_item(ctx: FlattenContext, item: s.Equation, where: Scope, parts: _Body
                 raise FlattenError("the first argument of reinit must be a variable",
                                    call.args[0].span,
                                    hint="write reinit(x, value) with x a state")
-            parts.reinits.append(w.Reinit(t.name, v, item.span))
+            parts.reinits.append(w.Reinit(t.name, without_events(v), item.span))
     elif isinstance(item, s.CallEquation) and item.call.func.dotted == "terminate":
         call = item.call
         message = ev.value(call.args[0], where) if len(call.args) == 1 else None
