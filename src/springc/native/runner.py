@@ -37,6 +37,14 @@ ABI = 2
 ``springc.integrate.native_loop.ABI``)."""
 METHODS = {"dop853": 0, "rk45": 1, "radau": 2, "bdf": 3}
 SUCCESS, MAX_STEPS = 0, 4
+FIRST_STRETCH = 10_000
+"""Steps (accepted and rejected) of a compiled run's first stretch; each next stretch
+goes on from where the one before stopped (its time, state and next step size) and is
+:data:`STRETCH_GROWTH` times longer. The explicit methods take the same steps as one
+uninterrupted run; radau and bdf start their step history again (bdf at order 1), so
+the full path (:func:`springc.simulation.compiled.advance_with`) and the warm replay
+(:mod:`springc.launcher`) stop and resume at the same steps."""
+STRETCH_GROWTH = 10
 
 _int64 = ctypes.c_longlong
 _double_p = ctypes.POINTER(ctypes.c_double)

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import SimulationError, UsageError
+from ..native import FIRST_STRETCH, STRETCH_GROWTH
 from ..status_line import say
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
@@ -43,12 +44,14 @@ if TYPE_CHECKING:
     from springc.integrate import Run
 
 COMPILED, SCIPY = "compiled", "scipy"
-FIRST_CHUNK = 10_000
+FIRST_CHUNK = FIRST_STRETCH
 """Steps (accepted and rejected) of the first compiled stretch: a longer run goes on
 from where the stretch stopped (its time, state and next step size: the explicit
-methods take the same steps as one uninterrupted run) in stretches ten times longer,
-so that a run whose step size is hopeless stops early and the wall-clock limit is
-checked between stretches. The step limit counts accepted steps, as scipy's loop does."""
+methods take the same steps as one uninterrupted run) in stretches
+:data:`~springc.native.STRETCH_GROWTH` times longer (the policy of
+:mod:`springc.native.runner`, which the warm replay follows too), so that a run whose
+step size is hopeless stops early and the wall-clock limit is checked between
+stretches. The step limit counts accepted steps, as scipy's loop does."""
 FIXED_CHUNK = 200_000
 """Steps of a fixed-step stretch between two checks of the wall clock."""
 C_LOOP_VARIABLE = "SPRINGC_LOOP"
@@ -282,7 +285,7 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
                             stepper.method)
         if time.perf_counter() > problem.deadline:
             raise time_limit_reached(problem, run)
-        chunk *= 10
+        chunk *= STRETCH_GROWTH
     seconds = time.perf_counter() - began
     if run.status == Status.STEP_TOO_SMALL and not accepted and not stepper.h_abs > 0 \
             and not run.next_step > 0:  # no first step: scipy's steps word why
