@@ -237,9 +237,12 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     return advance_with(loop, stepper, max_steps, kernel)
 
 
-Kernel = Callable[[np.ndarray, np.ndarray, float, int], "Run"]
-"""``run(times, y, first_step, max_steps)``: a compiled loop of a method on a run's model
-and tolerances (``first_step`` 0: the loop selects it), a :class:`springc.integrate.Run`."""
+Kernel = Callable[[np.ndarray, np.ndarray, float, int, "np.ndarray | None"], "Run"]
+"""``run(times, y, first_step, max_steps, out)``: a compiled loop of a method on a run's
+model and tolerances (``first_step`` 0: the loop selects it), a
+:class:`springc.integrate.Run`; ``out``, where not None, are rows (C-contiguous) the loop
+may write its states into, row 0 the stretch's start (the C loop does: its
+``Run.states`` are then a view of them; numba's allocates its own)."""
 
 
 def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel: Kernel
@@ -259,7 +262,14 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
     chunk, accepted, taken, nfev, njev = FIRST_CHUNK, 0, 0, 0, 0
     while True:
         attempt = int(max(min(chunk, allowed - accepted, budget - taken), 1))
-        run = kernel(times, y, min(first, float(times[-1] - t)), attempt)
+        # the rows from loop.k - 1 on as the loop's own (row 0, the start, is put back):
+        # no buffer of the stretch's rows filled and copied where the loop writes there
+        aligned = len(times) - 1 == len(grid) - loop.k
+        out = loop.states[loop.k - 1:] if aligned else None
+        before = loop.states[loop.k - 1].copy() if aligned else None
+        run = kernel(times, y, min(first, float(times[-1] - t)), attempt, out)
+        if before is not None:
+            loop.states[loop.k - 1] = before
         problem.nfev += run.rhs_evaluations
         problem.njev += run.jacobian_evaluations
         nfev += run.rhs_evaluations
@@ -267,7 +277,8 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
         accepted += run.accepted_steps
         taken += run.accepted_steps + run.rejected_steps
         rows = run.filled - 1  # row 0 is the stretch's start
-        loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
+        if out is None or not np.shares_memory(run.states, out):
+            loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
         loop.k += rows
         if run.status != Status.MAX_STEPS or accepted >= allowed:
             break
@@ -332,7 +343,8 @@ def _kernel(loop: StepLoop, method: str) -> Kernel:
     """``method``'s numba loop on ``loop``'s model and tolerances (:data:`Kernel`)."""
     problem = loop.problem
 
-    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int,
+            out: np.ndarray | None) -> Run:  # (numba's loop allocates its rows)
         return adaptive_run(method, problem.mod, times, y, problem.p, problem.z,
                             rtol=loop.rtol, atol=loop.atol, first_step=first or None,
                             max_steps=steps)
