@@ -178,8 +178,10 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     elif chosen and options.backend == "python" and _numba_instead(compiled):
         other = "numba"
     if other is not None:  # generated from the system derived for the first backend
+        first = compiled
         compiled, _ = _compile_as(replace(options, backend=other), parameters,
                                   compiled.compiled_from, base)
+        first.let_go()
     return compiled.settled()
 
 

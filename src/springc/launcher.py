@@ -39,9 +39,10 @@ from . import run_record
 from .errors import OutputError
 from .fileio import atomic_write, check_target
 from .simulation import (
-    EXPLICIT,
+    IMPLICIT_SOLVERS,
     allowed_errors,
     brief_line,
+    companion_solver,
     companion_tolerances,
     largest_differences,
     worst_column,
@@ -151,7 +152,8 @@ def replay(record: Mapping[str, Any]) -> tuple[str, str]:
     columns, steps = _outputs(library, run, answer["solver"], answer["rtol"], answer["atol"])
     estimated = tolerance = None
     if run["mode"] != "off":
-        companion = (EXPLICIT, *companion_tolerances(answer["rtol"], answer["atol"]))
+        companion = (companion_solver(answer["solver"]),
+                     *companion_tolerances(answer["rtol"], answer["atol"]))
         if list(companion) != [run["companion"][k] for k in ("solver", "rtol", "atol")]:
             raise Fallback  # recorded by other rules
         theirs, _ = _outputs(library, run, *companion)
@@ -178,20 +180,46 @@ def _outputs(library: Any, run: Mapping[str, Any], solver: str, rtol: float, ato
     """The output columns (in the record's order, each over the grid) of one run of
     ``solver`` at ``rtol``, ``atol`` from the recorded start, and its accepted steps."""
     grid, p = array.array("d", run["grid"]), array.array("d", run["p"])
-    done = library.run(solver, grid, array.array("d", run["x0"]), p,
-                       array.array("d", run["z"]), rtol=rtol, atol=atol)
-    if not done.ok or done.filled != len(grid):
-        raise Fallback
-    failed, observed = library.observed(grid, done.states, p, array.array("d", run["z"]))
+    states, accepted = _stretched(library, run, solver, rtol, atol, grid, p)
+    failed, observed = library.observed(grid, states, p, array.array("d", run["z"]))
     if failed >= 0:
         raise Fallback
     n, m = library.n_states, library.n_observed
-    columns = [done.states[index::n] if kind == "state" else observed[index::m]
+    columns = [states[index::n] if kind == "state" else observed[index::m]
                for kind, index in run["columns"]]
     for column in columns:
         if not all(map(math.isfinite, column)):
             raise Fallback  # the command line's check of the outputs words it
-    return columns, done.accepted_steps
+    return columns, accepted
+
+
+def _stretched(library: Any, run: Mapping[str, Any], solver: str, rtol: float,
+               atol: float, grid: array.array[float], p: array.array[float]
+               ) -> tuple[array.array[float], int]:
+    """The states on the grid (row-major) and the accepted steps of the run, in the
+    stretches of the full path (:data:`springc.native.FIRST_STRETCH` steps, then
+    :data:`~springc.native.STRETCH_GROWTH` times more each, within the recorded step
+    limit), each resumed from where the one before stopped; radau and bdf in the
+    recorded ordering of the states."""
+    from .native import FIRST_STRETCH, MAX_STEPS, STRETCH_GROWTH
+
+    order = run["order"] if solver in IMPLICIT_SOLVERS else None
+    limit, n = int(run["max_steps"]), library.n_states
+    times, x, z = grid, array.array("d", run["x0"]), array.array("d", run["z"])
+    states, first, chunk, accepted = array.array("d"), 0.0, FIRST_STRETCH, 0
+    while True:
+        done = library.run(solver, times, x, p, z, rtol=rtol, atol=atol, order=order,
+                           first_step=min(first, times[-1] - times[0]),
+                           max_steps=max(min(chunk, limit - accepted), 1))
+        accepted += done.accepted_steps
+        states.extend(done.states[(n if states else 0):done.filled * n])  # row 0: its start
+        if done.status != MAX_STEPS or accepted >= limit:
+            break
+        times = array.array("d", [done.failure_time]) + times[done.filled:]
+        x, first, chunk = done.failure_state, done.next_step, chunk * STRETCH_GROWTH
+    if not done.ok or len(states) != len(grid) * n:
+        raise Fallback
+    return states, accepted
 
 
 def _write(csv: str, target: str | None, protected: Sequence[str]) -> None:

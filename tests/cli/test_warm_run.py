@@ -115,6 +115,43 @@ def test_the_replay_keeps_the_solver_and_error_control_asked(
     assert re.fullmatch(f"SpringMass: {summary}, T s", warm.stderr), warm.stderr
 
 
+SCENES = str(Path(__file__).resolve().parents[2] / "models" / "Scenes.mdl")
+
+
+@pytest.mark.parametrize(("args", "solver"), [
+    (ARGS, "bdf"),
+    # 66 states: above 64 the band LU factorises in the reverse Cuthill-McKee order
+    (("simulate", SCENES, "--model", "Scenes.Chain", "--set", "N=33", "--stop", "1"),
+     "radau"),
+])
+def test_radau_and_bdf_asked_by_name_replay_on_the_c_loop(
+        folder: Path, args: tuple[str, ...], solver: str) -> None:
+    cold = command_line(folder, *args, "--solver", solver)
+    (record,) = (folder / "cache" / run_record.RECORDS_FOLDER).glob("*.json")
+    run = run_record.read(record.stem)["run"]  # type: ignore[index]
+    assert (run["answer"]["solver"], run["companion"]["solver"]) == (solver, solver)
+    assert (run["order"] is None) == (len(run["states"]) <= 64)
+    if run["order"] is not None:
+        assert sorted(run["order"]) == list(range(66)) and run["order"] != sorted(run["order"])
+    warm = springc_run(folder, *args, "--solver", solver)
+    assert warm.warm, warm.stderr
+    assert (warm.code, warm.stdout, warm.stderr) == (0, cold.stdout, cold.stderr)
+    assert re.fullmatch(rf"[\w.]+: {solver}, [\d,]+ steps{ESTIMATED}1e-\d+, T s",
+                        warm.stderr), warm.stderr
+
+
+def test_auto_handing_over_to_radau_keeps_no_record(folder: Path) -> None:
+    stiff = folder / "Stiff.mo"
+    stiff.write_text("model Stiff\n  Real x(start = 1), y(start = 0);\nequation\n"
+                     "  der(x) = -1000*(x - cos(time));\n  der(y) = x;\n"
+                     "  annotation(experiment(StopTime = 10));\nend Stiff;\n")
+    cold = command_line(folder, "simulate", "Stiff.mo")
+    assert re.match(r"Stiff: radau \(auto\), ", cold.stderr), cold.stderr
+    assert not list((folder / "cache" / run_record.RECORDS_FOLDER).glob("*.json"))
+    again = springc_run(folder, "simulate", "Stiff.mo")
+    assert not again.warm and (again.code, again.stdout) == (0, cold.stdout)
+
+
 def test_a_run_that_warns_keeps_no_record(folder: Path) -> None:
     options = ("--error-control", "warn", "--rtol", "1e-8")
     cold = command_line(folder, *ARGS, *options)

@@ -3,6 +3,7 @@ standard library only (no numpy imported), giving the engine's values."""
 
 from __future__ import annotations
 
+import array
 import json
 import subprocess
 import sys
@@ -91,3 +92,27 @@ def test_only_a_loop_library_loads_and_z_must_be_a_writable_buffer() -> None:
     with pytest.raises(TypeError, match="z must be a writable contiguous buffer of 1 "):
         lib.run("dop853", [0.0, 1.0], [1, -1, 0, 0], lib.parameters(), (0.0,),
                 rtol=1e-6, atol=1e-9)
+
+
+def test_a_run_writes_its_rows_into_the_buffer_given_and_no_other_row() -> None:
+    model = springc.compile_model(SEED, backend="python")
+    lib = loop_library(model)
+    p = lib.parameters()
+    _, x0, z = lib.start(p)
+    grid = np.linspace(0.0, 2.0, 41)
+    alone = lib.run("dop853", grid, x0, p, array.array("d", z), rtol=1e-8, atol=1e-11)
+    out = np.full((43, 4), np.nan)  # two rows more than the grid's
+    into = lib.run("dop853", grid, x0, p, array.array("d", z), rtol=1e-8, atol=1e-11,
+                   out=out)
+    assert into.states is out and (into.filled, alone.filled) == (41, 41)
+    assert (out[:41] == np.array(alone.states).reshape(41, 4)).all()  # the same code
+    assert np.isnan(out[41:]).all()
+    stopped = np.full((41, 4), np.nan)  # a run stopped by the step limit: its rows only
+    short = lib.run("dop853", grid, x0, p, array.array("d", z), rtol=1e-8, atol=1e-11,
+                    max_steps=20, out=stopped)
+    assert short.status == runner.MAX_STEPS and 1 < short.filled < 41
+    assert (stopped[:short.filled] == out[:short.filled]).all()
+    assert np.isnan(stopped[short.filled:]).all()
+    with pytest.raises(TypeError, match="out must be a writable contiguous buffer of 164 "):
+        lib.run("dop853", grid, x0, p, array.array("d", z), rtol=1e-8, atol=1e-11,
+                out=np.zeros((41, 4))[:, :2])

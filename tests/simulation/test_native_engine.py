@@ -13,7 +13,7 @@ import pytest
 
 import springc
 from springc.errors import SimulationError, UsageError
-from springc.simulation import c_loop_available, default_backend
+from springc.simulation import c_loop_available, compiled, default_backend
 
 ROOT = Path(__file__).resolve().parents[2]
 SEED = str(ROOT / "models" / "SpringMass.mdl")
@@ -105,6 +105,10 @@ def test_a_model_beyond_the_loops_size_rule_is_generated_for_numba(
     monkeypatch.setattr(c_kernels, "C_LOOP_CODE_CHARS", 1000)
     model = springc.compile_model(SEED)
     assert model.module.BACKEND == "numba"
+    # the python module it was generated from first is not kept (sys.modules let go)
+    generated = [m for name, m in sys.modules.items() if name.startswith("springc_model_")
+                 and getattr(m, "MODEL", "") == "SpringMass"]
+    assert [getattr(m, "BACKEND", "") for m in generated] == ["numba"]
     code = int(c_kernels.c_source(model).split("#define SPRINGC_CODE_CHARS ")[1].split()[0])
     assert c_kernels.loop_refusal(c_kernels.c_source(model)) == (
         f"its C functions take {code:,} characters (the C loop takes at most 1,000)")
@@ -197,6 +201,20 @@ def test_the_step_limit_stops_the_c_loop_where_it_stops_numbas(
     times = [float(m[len(head):].split(":")[0]) for m in messages]
     assert abs(times[0] - times[1]) <= 1e-8 * times[1]  # (printed to 9 digits)
     assert 0.01 < times[0] < 0.2  # 30 steps of about 2 ms (the spring's period: 63 ms)
+
+
+def test_a_run_in_stretches_fills_every_row_as_one_stretch_does(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # the C loop writes each stretch's rows into the run's own (row 0, the stretch's
+    # start, put back): DOP853 resumed takes the steps of one uninterrupted run
+    model = springc.compile_model(SEED, backend="python")
+    monkeypatch.setenv("SPRINGC_LOOP", "c")
+    whole = springc.simulate(model, solver="dop853", stop=2.0, error_control="off")
+    monkeypatch.setattr(compiled, "FIRST_CHUNK", 7)  # 7, 70, 700... steps
+    stretched = springc.simulate(model, solver="dop853", stop=2.0, error_control="off")
+    assert stretched.stats.engine_reason == whole.stats.engine_reason == C_REASON
+    assert stretched.stats.steps == whole.stats.steps > 77  # three stretches at least
+    assert np.array_equal(stretched.values, whole.values)
 
 
 def test_a_model_with_events_stays_on_numba(monkeypatch: pytest.MonkeyPatch) -> None:

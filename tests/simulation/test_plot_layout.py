@@ -228,3 +228,23 @@ def test_a_plot_is_drawn_from_a_finer_run_and_the_result_keeps_its_grid(tmp_path
     assert abs(v[at[0]] + 9.81 * bounce) < 1e-6
     assert abs(v[at[-1]] - 0.8 * 9.81 * bounce) < 1e-6
     assert figure.layout.note == f"drawn on {len(time)} times (the output grid has 11)"
+
+
+def test_a_heat_map_resampled_before_it_is_coloured_is_the_same_image() -> None:
+    # many more variables than pixel rows: matplotlib picks the nearest value of each
+    # pixel; colouring first (the rgba stage) made an RGBA array of every value
+    from springc.simulation.figure import draw_layout
+
+    n, t = 2_000, np.linspace(0.0, 1.0, 301)
+    names = [f"c[{i}].s" for i in range(1, n + 1)]
+    values = np.sin(np.outer(t, np.arange(1.0, n + 1.0)) * 0.37) * np.arange(1.0, n + 1.0)
+    layout = choose_layout(names, ["m"] * n, values)
+    assert [p.kind for p in layout.panels] == [HEATMAP]
+    figure = draw_layout("M", t, values, layout, names)
+    (image,) = [image for ax in figure.axes for image in ax.images]
+    assert image.get_interpolation_stage() == "data"
+    figure.canvas.draw()
+    resampled = np.array(figure.canvas.buffer_rgba())
+    image.set_interpolation_stage("rgba")
+    figure.canvas.draw()
+    assert np.array_equal(np.array(figure.canvas.buffer_rgba()), resampled)

@@ -285,6 +285,51 @@ def compile_options(func: Callable[..., Any]) -> Callable[..., Any]:
                         "compiled loop).")(func)
 
 
+MMAP_THRESHOLD = 1 << 20
+"""Bytes from which glibc's ``malloc`` maps each allocation apart and unmaps it when
+it is freed (:func:`unmapped_large_buffers`)."""
+
+
+def unmapped_large_buffers() -> None:
+    """With glibc, allocations of :data:`MMAP_THRESHOLD` bytes or more are mapped apart
+    and returned to the system when freed, unless the user set
+    ``MALLOC_MMAP_THRESHOLD_``. By default glibc raises that threshold (up to 32 MB)
+    once such a buffer is freed; a large scene's blocks of rows (the observed rows, the
+    error estimate's, 8 to 16 MB each) then come from the heap, where freed space
+    stays resident between the live arrays: the 50x50 cloth's warm run held about 75
+    MB more at its result. A no-op elsewhere (no glibc ``mallopt``)."""
+    import ctypes
+    import os
+
+    if not sys.platform.startswith("linux") or "MALLOC_MMAP_THRESHOLD_" in os.environ:
+        return
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return
+    mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
+    mallopt(-3, MMAP_THRESHOLD)  # M_MMAP_THRESHOLD
+
+
+def release_compile_memory() -> None:
+    """After a model compiled in this process: its collected objects freed and, with
+    glibc, the free pages of the heap returned to the system (``malloc_trim``). A 50x50
+    cloth compiled cold keeps 740 MB of RSS after ``compile_model``, 567 MB after
+    this, the run then starting from there (flattening's million expression nodes
+    leave most of the rest in Python's partly used arenas)."""
+    import ctypes
+    import gc
+
+    gc.collect()
+    if sys.platform.startswith("linux"):
+        try:
+            trim = ctypes.CDLL(None).malloc_trim
+        except (OSError, AttributeError):
+            return
+        trim.argtypes = [ctypes.c_size_t]
+        trim(0)
+
+
 def single_threaded_blas() -> None:
     """Run BLAS on one thread unless the user chose otherwise: the solvers' vector
     operations are too small to gain from threads, and on a busy machine threaded

@@ -5,9 +5,12 @@ A record is written only for what the warm path replays exactly: a command start
 the ``springc`` entry point (the launcher hands its arguments over as the context's
 ``obj``); a trajectory as CSV (a file or stdout) and nothing else; the default verbosity
 or ``-q``; a model in the cache, without events, delays, switching states, assertions
-or unit warnings; an answer of ``dop853`` or ``rk45`` that ran on the model's C loop
-library, with no warning; every output finite. Anything else keeps no record, and its
-next run takes the command line again.
+or unit warnings; an answer of a method of the model's C loop library (``dop853``,
+``rk45``, ``radau``, ``bdf``: :data:`springc.native.METHODS`) that ran there, with no
+warning (radau and bdf asked for by name: ``auto`` hands over to radau within a run,
+which a replay from the start would not repeat; their band LU's ordering of the states
+recorded); every output finite. Anything else keeps no record, and its next run takes
+the command line again.
 """
 
 from __future__ import annotations
@@ -20,8 +23,9 @@ from typing import Any
 import click
 
 from .. import run_record
+from ..native import METHODS
 
-LOOP_SOLVERS = ("dop853", "rk45")
+LOOP_SOLVERS = tuple(METHODS)
 """The methods of the C loop library (:mod:`springc.native.runner`)."""
 MAX_VALUES = 1_000_000
 """Output values (rows x columns) beyond which no record is kept: the warm path's
@@ -49,13 +53,21 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
                    libraries: Sequence[str], output: str | None, quiet: bool
                    ) -> dict[str, Any] | None:
     """The record of the run (``settings``: as the run was asked), or None."""
+    from ..integrate import band_order
     from ..native import LIBRARY_FILE, cached_library
     from ..pipeline import ModuleKind
-    from ..simulation import EXPLICIT, companion_tolerances, plan, write_csv
+    from ..simulation import (
+        IMPLICIT_SOLVERS,
+        companion_solver,
+        companion_tolerances,
+        plan,
+        write_csv,
+    )
 
     stats, module = result.stats, compiled.module
     if (compiled.warnings or stats.warning or result.events or settings.event_rows
             or stats.solver not in LOOP_SOLVERS or not ran_on_c_loop(compiled, result)
+            or (stats.solver in IMPLICIT_SOLVERS and stats.reason)
             or getattr(module, "KIND", None) != ModuleKind.CONTINUOUS
             or getattr(module, "ASSERTIONS", ()) or stats.rtol is None
             or len(result.time) * (1 + len(result.names)) > MAX_VALUES):
@@ -85,7 +97,11 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
                 "answer": {"solver": stats.solver, "rtol": stats.rtol, "atol": stats.atol},
                 "companion": None if settings.error_control == "off" else dict(zip(
                     ("solver", "rtol", "atol"),
-                    (EXPLICIT, *companion_tolerances(stats.rtol, stats.atol)))),
+                    (companion_solver(stats.solver),
+                     *companion_tolerances(stats.rtol, stats.atol)))),
+                "order": band_order(module.JAC_INDPTR, module.JAC_INDICES)
+                if stats.solver in IMPLICIT_SOLVERS else None,
+                "max_steps": asked.limits.max_steps,
                 "asked": {"rtol": asked.rtol, "atol": asked.atol},
                 "mode": settings.error_control, "auto": bool(stats.reason),
                 "states": states, "observed": observed,

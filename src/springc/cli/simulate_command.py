@@ -17,10 +17,12 @@ from .options import (
     check_output_options,
     compile_options,
     model_options,
+    release_compile_memory,
     report_units,
     run_settings_options,
     single_threaded_blas,
     units_option,
+    unmapped_large_buffers,
     verbosity,
     verbosity_options,
 )
@@ -65,6 +67,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     if error_estimate is not None:
         click.echo(f"warning: {estimate_deprecation(error_estimate)}", err=True)
     single_threaded_blas()
+    unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
     from ..simulation import check_trajectory_size, save_outputs, write_csv
@@ -78,6 +81,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
                                  outputs=patterns or None, parameters=settings.parameters,
                                  cache=not no_cache)
         report_units(compiled.warnings, strict_units)
+        if not compiled.cached:
+            release_compile_memory()
         if not patterns and (output or not plot):  # the default trajectory of every output
             check_trajectory_size(compiled, settings,
                                   f"-o {output}" if output else "the CSV on stdout")

@@ -3,6 +3,17 @@ no numpy, numba or scipy is imported (:mod:`.runner`). The library is built by
 :func:`springc.pipeline.loop_library` from the text of
 :func:`springc.integrate.native_loop.loop_text`; see ``docs/c_model.md``."""
 
-from .runner import LIBRARY_FILE, LoopLibrary, LoopRun, cached_library, read_verified
+from .runner import (
+    FIRST_STRETCH,
+    LIBRARY_FILE,
+    MAX_STEPS,
+    METHODS,
+    STRETCH_GROWTH,
+    LoopLibrary,
+    LoopRun,
+    cached_library,
+    read_verified,
+)
 
-__all__ = ["LIBRARY_FILE", "LoopLibrary", "LoopRun", "cached_library", "read_verified"]
+__all__ = ["FIRST_STRETCH", "LIBRARY_FILE", "MAX_STEPS", "METHODS", "STRETCH_GROWTH",
+           "LoopLibrary", "LoopRun", "cached_library", "read_verified"]

@@ -37,6 +37,14 @@ ABI = 2
 ``springc.integrate.native_loop.ABI``)."""
 METHODS = {"dop853": 0, "rk45": 1, "radau": 2, "bdf": 3}
 SUCCESS, MAX_STEPS = 0, 4
+FIRST_STRETCH = 10_000
+"""Steps (accepted and rejected) of a compiled run's first stretch; each next stretch
+goes on from where the one before stopped (its time, state and next step size) and is
+:data:`STRETCH_GROWTH` times longer. The explicit methods take the same steps as one
+uninterrupted run; radau and bdf start their step history again (bdf at order 1), so
+the full path (:func:`springc.simulation.compiled.advance_with`) and the warm replay
+(:mod:`springc.launcher`) stop and resume at the same steps."""
+STRETCH_GROWTH = 10
 
 _int64 = ctypes.c_longlong
 _double_p = ctypes.POINTER(ctypes.c_double)
@@ -86,6 +94,15 @@ def doubles(values: Any, size: int | None = None) -> Any:
         raise ValueError(f"expected {size} values, got {len(copy)}")
     return (ctypes.c_double * max(len(copy), 1))(*copy) if len(copy) else \
         (ctypes.c_double * 1)()
+
+
+def _rows(out: Any, count: int) -> Any:
+    """``out`` where it is a writable C-contiguous buffer of at least ``count`` float64."""
+    view = memoryview(out)
+    if view.readonly or view.format != "d" or not view.c_contiguous \
+            or view.nbytes // 8 < count:
+        raise TypeError(f"out must be a writable contiguous buffer of {count} float64")
+    return out
 
 
 def zeros(count: int) -> array.array[float]:
@@ -176,21 +193,25 @@ class LoopLibrary:
     def run(self, method: str, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
             atol: float | Sequence[float], max_step: float = math.inf,
             first_step: float = 0.0, max_steps: int = 0,
-            order: Sequence[int] | None = None) -> LoopRun:
+            order: Sequence[int] | None = None, out: Any = None) -> LoopRun:
         """Integrate from ``(grid[0], x0)`` over the increasing ``grid`` with ``method``
         (dop853, rk45, radau or bdf); ``z`` is updated in place. ``first_step`` 0 selects
         the first step as scipy does; ``max_steps`` counts accepted and rejected steps
         (0: no limit). ``order``: radau's and bdf's ordering of the states in their
         banded LU above 64 states (position -> state, e.g. the reverse Cuthill-McKee
         order of ``springc.integrate.ordering.band_layout``, which the numba loops use;
-        None: state order)."""
+        None: state order). ``out``: a writable C-contiguous float64 buffer of at least
+        ``len(grid)`` rows of the states, which the run's rows are written into (no
+        other row is touched) and which :attr:`LoopRun.states` then is; None: a new
+        buffer of zeros."""
         n = self.n_states
         grid_ = doubles(grid)
         m = len(grid_) if len(grid) else 0
         if m < 1:
             raise ValueError("the grid is empty")
         z_ = self._z(z)
-        states, end = zeros(max(m * n, 1)), zeros(max(n, 1))
+        states = zeros(max(m * n, 1)) if out is None or not n else _rows(out, m * n)
+        end = zeros(max(n, 1))
         counts, reals = (_int64 * 5)(), (ctypes.c_double * 2)()
         ordering = None
         if order is not None:

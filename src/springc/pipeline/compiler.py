@@ -12,6 +12,7 @@ loads only on a miss. What a run needs beyond the module is captured at compile 
 from __future__ import annotations
 
 import shutil
+import sys
 import tempfile
 import time
 from collections.abc import Mapping
@@ -106,6 +107,15 @@ class CompiledModel:
         if self.options.backend != "python":
             self.compiled_from = None
         return self
+
+    def let_go(self) -> None:
+        """Forget this model's module in ``sys.modules`` (where the import put it for
+        numba's cache), so that its code and globals are freed with the model: api's
+        module of the backend springc did not keep (the 50x50 cloth's python module,
+        whose C loop is refused by size, holds about 100 MB)."""
+        name = getattr(self.module, "__name__", "")
+        if sys.modules.get(name) is self.module:
+            del sys.modules[name]
 
     @property
     def name(self) -> str:

@@ -42,6 +42,7 @@ from .solver_names import (
     REGISTRY,
     SOLVERS,
     Solver,
+    companion_solver,
     registered,
 )
 from .summary import brief_line
@@ -113,6 +114,7 @@ __all__ = [
     "check_run_values",
     "check_trajectory_size",
     "choose_engine",
+    "companion_solver",
     "companion_tolerances",
     "default_backend",
     "error_control_mode",

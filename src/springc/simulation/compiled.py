@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ..errors import SimulationError, UsageError
+from ..native import FIRST_STRETCH, STRETCH_GROWTH
 from ..status_line import say
 from .failures import Stop
 from .limits import HOPELESS, OverLimit
@@ -43,12 +44,14 @@ if TYPE_CHECKING:
     from springc.integrate import Run
 
 COMPILED, SCIPY = "compiled", "scipy"
-FIRST_CHUNK = 10_000
+FIRST_CHUNK = FIRST_STRETCH
 """Steps (accepted and rejected) of the first compiled stretch: a longer run goes on
 from where the stretch stopped (its time, state and next step size: the explicit
-methods take the same steps as one uninterrupted run) in stretches ten times longer,
-so that a run whose step size is hopeless stops early and the wall-clock limit is
-checked between stretches. The step limit counts accepted steps, as scipy's loop does."""
+methods take the same steps as one uninterrupted run) in stretches
+:data:`~springc.native.STRETCH_GROWTH` times longer (the policy of
+:mod:`springc.native.runner`, which the warm replay follows too), so that a run whose
+step size is hopeless stops early and the wall-clock limit is checked between
+stretches. The step limit counts accepted steps, as scipy's loop does."""
 FIXED_CHUNK = 200_000
 """Steps of a fixed-step stretch between two checks of the wall clock."""
 C_LOOP_VARIABLE = "SPRINGC_LOOP"
@@ -234,9 +237,12 @@ def advance_compiled(loop: StepLoop, stepper: Stepper, max_steps: int | None = N
     return advance_with(loop, stepper, max_steps, kernel)
 
 
-Kernel = Callable[[np.ndarray, np.ndarray, float, int], "Run"]
-"""``run(times, y, first_step, max_steps)``: a compiled loop of a method on a run's model
-and tolerances (``first_step`` 0: the loop selects it), a :class:`springc.integrate.Run`."""
+Kernel = Callable[[np.ndarray, np.ndarray, float, int, "np.ndarray | None"], "Run"]
+"""``run(times, y, first_step, max_steps, out)``: a compiled loop of a method on a run's
+model and tolerances (``first_step`` 0: the loop selects it), a
+:class:`springc.integrate.Run`; ``out``, where not None, are rows (C-contiguous) the loop
+may write its states into, row 0 the stretch's start (the C loop does: its
+``Run.states`` are then a view of them; numba's allocates its own)."""
 
 
 def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel: Kernel
@@ -256,7 +262,14 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
     chunk, accepted, taken, nfev, njev = FIRST_CHUNK, 0, 0, 0, 0
     while True:
         attempt = int(max(min(chunk, allowed - accepted, budget - taken), 1))
-        run = kernel(times, y, min(first, float(times[-1] - t)), attempt)
+        # the rows from loop.k - 1 on as the loop's own (row 0, the start, is put back):
+        # no buffer of the stretch's rows filled and copied where the loop writes there
+        aligned = len(times) - 1 == len(grid) - loop.k
+        out = loop.states[loop.k - 1:] if aligned else None
+        before = loop.states[loop.k - 1].copy() if aligned else None
+        run = kernel(times, y, min(first, float(times[-1] - t)), attempt, out)
+        if before is not None:
+            loop.states[loop.k - 1] = before
         problem.nfev += run.rhs_evaluations
         problem.njev += run.jacobian_evaluations
         nfev += run.rhs_evaluations
@@ -264,7 +277,8 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
         accepted += run.accepted_steps
         taken += run.accepted_steps + run.rejected_steps
         rows = run.filled - 1  # row 0 is the stretch's start
-        loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
+        if out is None or not np.shares_memory(run.states, out):
+            loop.states[loop.k:loop.k + rows] = run.states[1:run.filled]
         loop.k += rows
         if run.status != Status.MAX_STEPS or accepted >= allowed:
             break
@@ -282,7 +296,7 @@ def advance_with(loop: StepLoop, stepper: Stepper, max_steps: int | None, kernel
                             stepper.method)
         if time.perf_counter() > problem.deadline:
             raise time_limit_reached(problem, run)
-        chunk *= 10
+        chunk *= STRETCH_GROWTH
     seconds = time.perf_counter() - began
     if run.status == Status.STEP_TOO_SMALL and not accepted and not stepper.h_abs > 0 \
             and not run.next_step > 0:  # no first step: scipy's steps word why
@@ -329,7 +343,8 @@ def _kernel(loop: StepLoop, method: str) -> Kernel:
     """``method``'s numba loop on ``loop``'s model and tolerances (:data:`Kernel`)."""
     problem = loop.problem
 
-    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int,
+            out: np.ndarray | None) -> Run:  # (numba's loop allocates its rows)
         return adaptive_run(method, problem.mod, times, y, problem.p, problem.z,
                             rtol=loop.rtol, atol=loop.atol, first_step=first or None,
                             max_steps=steps)

@@ -43,9 +43,8 @@ from .settings import (
 from .solver_names import (
     DEFAULT_ERROR_CONTROL,
     ERROR_CONTROLS,
-    EXPLICIT,
     FIXED_STEP,
-    IMPLICIT_SOLVERS,
+    companion_solver,
     registered,
 )
 
@@ -121,7 +120,7 @@ def _estimate(options: RunSettings, result: SimulationResult, rtol: float,
                                   f"Richardson against {solver} at step {step:.3g} s",
                                   gain / (gain - 1), started), (rtol, atol)
     tight = companion_tolerances(rtol, atol)
-    chosen = solver if solver in IMPLICIT_SOLVERS else EXPLICIT
+    chosen = companion_solver(solver)
     companion = _quiet(run, replace(base, solver=chosen, rtol=tight[0], atol=tight[1]))
     return companion, compare(result, companion, companion.time,
                               f"companion {chosen} at rtol {short(tight[0])}", 1.0,

@@ -84,17 +84,19 @@ def _kernel(loop: StepLoop, method: str) -> Kernel:
     lib = library(problem)
     order = band_order(problem.mod) if method in IMPLICIT else None
 
-    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int) -> Run:
+    def run(times: np.ndarray, y: np.ndarray, first: float, steps: int,
+            out: np.ndarray | None) -> Run:
         done = lib.run(method, times, np.ascontiguousarray(y, dtype=float), problem.p,
                        problem.z, rtol=loop.rtol, atol=loop.atol, first_step=first or 0.0,
-                       max_steps=steps, order=order)
+                       max_steps=steps, order=order, out=out)
         return as_run(done, times)
     return run
 
 
 
 def as_run(done: LoopRun, times: np.ndarray) -> Run:
-    """The C loop's outcome as :class:`springc.integrate.Run` (numpy views, no copy)."""
+    """The C loop's outcome as :class:`springc.integrate.Run` (numpy views, no copy: of
+    the ``out`` rows where the run wrote its states there)."""
     from springc.integrate import Run, Status
 
     n = len(done.failure_state)

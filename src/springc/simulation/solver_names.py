@@ -92,6 +92,16 @@ def registered(name: str) -> Solver:
 SOLVERS = {s.name: s.scipy for s in REGISTRY.values() if s.kind == ADAPTIVE}
 """Adaptive solvers: springc name -> ``scipy.integrate`` class name."""
 IMPLICIT_SOLVERS = frozenset(s.name for s in REGISTRY.values() if s.implicit)
+
+
+def companion_solver(solver: str) -> str:
+    """The method of the companion run that estimates the error of a run of the
+    adaptive ``solver``: the same method for an implicit one (a stiff run), else
+    :data:`EXPLICIT` (the full path's :mod:`.error_control` and the warm replay of
+    :mod:`springc.launcher` both ask here)."""
+    return solver if solver in IMPLICIT_SOLVERS else EXPLICIT
+
+
 FIXED_STEP = tuple(s.name for s in REGISTRY.values() if s.fixed)
 """Fixed-step solvers; they need a step (``RunSettings.step``, ``--step H``)."""
 ORDERS = {s.name: s.order for s in REGISTRY.values() if s.fixed}
