@@ -234,6 +234,10 @@ def c_rows(repeats: int, n: int, base: str, hand_time: float) -> None:
                                       parameters={"N": n})
         states = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
                                        parameters={"N": n}, outputs=list(every.states))
+        probe = springc.simulate(states, solver="dop853", error_control="off")
+        if "(C," not in probe.stats.engine_reason:  # pipeline.c_kernels.loop_refusal
+            rows.append(("(c) C loop: not taken", probe.stats.engine_reason, base, "", ""))
+            return
         all_outputs = best_of(repeats, lambda: springc.simulate(every, solver="dop853",
                                                             error_control="off"))
         loops = []
