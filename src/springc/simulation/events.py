@@ -35,12 +35,25 @@ from .solver_names import IMPLICIT_SOLVERS, SOLVERS
 from .steps import Problem, solver_failure
 
 LOCATE_TOLERANCE = 1e-12
-"""Event times are located to this times max(1, |t|) (a bracket that narrow)."""
+"""Times within this times max(1, |t|) are the same event time (a time event and a state
+event, the end of a split step)."""
+LOCATE_RELATIVE = 1e-12
+"""State events are located to a bracket this times max(|t|, step) wide (at least four
+rounding units of ``t``), as the compiled engine's kernels
+(:func:`springc.integrate.crossings.time_tolerance`): relative to the time, not to
+max(1, |t|), so that a model on a nanosecond scale (NandGate's 1 ns edges) gets its
+events to 1e-12 of its own scale, not 1e-12 s late."""
 STEP_PROBES = 3
 """Inner points of each accepted step where the relations are checked too."""
 EVENT_BURST = 100
 ZENO_FRACTION = 1e-6
 """More than EVENT_BURST events within ZENO_FRACTION x (stop - start) is chattering."""
+
+def _bracket_width(ta: float, tb: float) -> float:
+    """The bracket width at which a state event in ``(ta, tb]`` counts as located."""
+    width = LOCATE_RELATIVE * max(abs(ta), abs(tb), tb - ta)
+    return max(width, 4.0 * (math.nextafter(abs(tb), math.inf) - abs(tb)))
+
 
 _OPS: dict[str, Callable[[float, float], bool]] = {
     "<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
@@ -122,7 +135,7 @@ class EventLoop:
     def locate(self, state: Callable[[float], np.ndarray], ta: float, tb: float,
                k: int) -> float:
         """The first time in ``(ta, tb]`` at which relation ``k`` has switched (to
-        :data:`LOCATE_TOLERANCE`), by regula falsi with the Illinois rule on its
+        :data:`LOCATE_RELATIVE`), by regula falsi with the Illinois rule on its
         zero-crossing function, keeping a bracket."""
         op, held = self.ops[k], self.z[self.first + k] != 0.0
 
@@ -131,7 +144,7 @@ class EventLoop:
 
         ga, gb = g(ta), g(tb)
         side = 0
-        tol = LOCATE_TOLERANCE * max(1.0, abs(tb))
+        tol = _bracket_width(ta, tb)
         for _ in range(200):
             if tb - ta <= tol:
                 break
