@@ -206,6 +206,8 @@ def one(args: argparse.Namespace, out: dict[str, object]) -> None:
                              initial=0.0))
         if not error <= worst:
             worst, where = error, signal
+    if not where:  # every signal equal to its reference (Booleans, Integers)
+        where = f"all {len(reference.signals)} signals"
     out.update(stage="match" if worst <= args.tol else "compare", worst=worst, signal=where)
 
 
