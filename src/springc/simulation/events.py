@@ -49,6 +49,7 @@ EVENT_BURST = 100
 ZENO_FRACTION = 1e-6
 """More than EVENT_BURST events within ZENO_FRACTION x (stop - start) is chattering."""
 
+
 def _bracket_width(ta: float, tb: float) -> float:
     """The bracket width at which a state event in ``(ta, tb]`` counts as located."""
     width = LOCATE_RELATIVE * max(abs(ta), abs(tb), tb - ta)

@@ -97,10 +97,11 @@ def choose(attempt: Callable[[str, int | None], Attempt], x0: np.ndarray, start:
         text = counted(behind, ahead)
         if SURE * behind.work <= ahead.work:
             return attempt(RACE_IMPLICIT, None), f"{choice.reason}; {text}"
-        spent += _work(second, True)
+        work = _work(second, True)
+        spent += work
         last = _projection(before, True, start, stop) if before is not None else None
         if (last is not None and not behind.work < STALL * last.work) or \
-                spent + GROWTH * _work(second, True) > BUDGET * ahead.work:
+                spent + GROWTH * work > BUDGET * ahead.work:
             return attempt(EXPLICIT, None), (f"{choice.reason}, but the fast modes must be "
                                              f"resolved anyway; {text}")
         before, cap = second, cap * GROWTH

@@ -44,16 +44,12 @@ def parameter_call(ev: ExpressionEvaluator, args: list[a.Value],
     del fl.assertions[marks[0]:]
     del fl.statement_conditions[marks[1]:]
     for v in values:
-        fl.evaluated.update(n for e in _items(v) for n in x.variables(e))
+        fl.evaluated.update(n for e in a.scalars(v) for n in x.variables(e))
     numeric = run([_constant(ev, v) for v in args],
                   {k: (_constant(ev, v), span) for k, (v, span) in named.items()})
     if isinstance(numeric, list):  # several outputs
         return [_folded(v) for v in numeric]  # type: ignore[return-value]
     return _folded(numeric)
-
-
-def _items(v: a.Value) -> list[x.Expr]:
-    return list(v.flat) if isinstance(v, np.ndarray) else [v]  # type: ignore[list-item]
 
 
 def _foldable(ev: ExpressionEvaluator, v: a.Value) -> bool:
@@ -70,12 +66,7 @@ def _foldable(ev: ExpressionEvaluator, v: a.Value) -> bool:
 
 
 def _constant(ev: ExpressionEvaluator, v: a.Value) -> a.Value:
-    if isinstance(v, np.ndarray):
-        out = np.empty(v.shape, dtype=object)
-        for idx, item in np.ndenumerate(v):
-            out[idx] = _constant(ev, item)
-        return out
-    return x.Const(ev.fold(v))
+    return a.elementwise(lambda item: x.Const(ev.fold(item)), v)
 
 
 def _folded(v: a.Value) -> a.Value:
