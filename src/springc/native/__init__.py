@@ -3,6 +3,7 @@ no numpy, numba or scipy is imported (:mod:`.runner`). The library is built by
 :func:`springc.pipeline.loop_library` from the text of
 :func:`springc.integrate.native_loop.loop_text`; see ``docs/c_model.md``."""
 
+from .compiler import COMPILERS, ZIG_MODULE, CCompilerMissing, find_compiler
 from .runner import (
     FIRST_STRETCH,
     LIBRARY_FILE,
@@ -15,5 +16,18 @@ from .runner import (
     read_verified,
 )
 
-__all__ = ["FIRST_STRETCH", "LIBRARY_FILE", "MAX_STEPS", "METHODS", "STRETCH_GROWTH",
-           "LoopLibrary", "LoopRun", "cached_library", "read_verified"]
+__all__ = [
+    "COMPILERS",
+    "FIRST_STRETCH",
+    "LIBRARY_FILE",
+    "MAX_STEPS",
+    "METHODS",
+    "STRETCH_GROWTH",
+    "ZIG_MODULE",
+    "CCompilerMissing",
+    "LoopLibrary",
+    "LoopRun",
+    "cached_library",
+    "find_compiler",
+    "read_verified",
+]

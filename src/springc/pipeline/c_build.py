@@ -1,6 +1,6 @@
 """CompiledModel -> CLibrary: the model's C file (:func:`springc.codegen.generate_c`)
-compiled by a C compiler (:func:`find_compiler`: the system's, else ``zig cc`` from the
-``ziglang`` package of PyPI) into a shared library, loaded with ctypes.
+compiled by a C compiler (:func:`springc.native.find_compiler`: the system's, else
+``zig cc`` from the ``ziglang`` package of PyPI) into a shared library, loaded with ctypes.
 
 The C file and the library are additions to the model's cache entry (``cmodel.c``,
 ``libcmodel.so``, each with its hash record, :func:`.cache.add_to_entry`); a library is
@@ -15,12 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import importlib.util
-import os
-import shlex
-import shutil
 import subprocess
-import sys
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -29,9 +24,13 @@ import numpy as np
 import numpy.typing as npt
 
 from ..codegen import CodegenBug
-from ..errors import SpringcError
+from ..native import ZIG_MODULE, CCompilerMissing, find_compiler
 from .cache import add_to_entry, read_addition
 from .compiler import CompiledModel
+
+__all__ = ["C_FLAGS", "C_LIBRARY_FILE", "C_SOURCE_FILE", "ZIG_MODULE", "CCompilerMissing",
+           "CLibrary", "CompilerRefused", "build_library", "c_library", "c_source",
+           "find_compiler"]
 
 C_SOURCE_FILE = "cmodel.c"
 C_LIBRARY_FILE = "libcmodel.so"
@@ -39,40 +38,7 @@ C_FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-ffp-contract=off", "-DSPRINGC_FN=
 """No -ffast-math, and no contraction into fused multiply-adds: the library computes
 what the Python module computes, operation for operation. No debug information (zig cc
 writes one by default, naming the private build folder): one text, the same bytes."""
-COMPILERS = ("cc", "gcc", "clang")
-ZIG_MODULE = "ziglang"
-"""The PyPI package whose ``python -m ziglang cc`` is the C compiler of last resort (a
-machine with Python and pip only: ``pip install ziglang``, in the ``test`` and ``c``
-extras)."""
-
 FloatArray = npt.NDArray[np.float64]
-
-
-class CCompilerMissing(SpringcError):
-    """No C compiler on this machine (the C library cannot be built)."""
-
-
-def find_compiler() -> list[str]:
-    """The C compiler's command, the one owner of this search (the C model, its kernels
-    and the FMU export): ``$CC`` (split as a shell would, never run by one), else the
-    first of :data:`COMPILERS` on the PATH, else ``zig cc`` run by this Python where
-    the ``ziglang`` package is installed (looked up, not imported)."""
-    given = os.environ.get("CC", "").strip()
-    if given:
-        argv = shlex.split(given)
-        if shutil.which(argv[0]) is not None:
-            return argv
-    for name in COMPILERS:
-        found = shutil.which(name)
-        if found is not None:
-            return [found]
-    if importlib.util.find_spec(ZIG_MODULE) is not None:
-        return [sys.executable, "-m", ZIG_MODULE, "cc"]
-    raise CCompilerMissing("no C compiler found (looked for $CC, cc, gcc and clang on "
-                           "the PATH, and the ziglang package)",
-                           hint="pip install ziglang (a C compiler from PyPI), or install "
-                           "a system C compiler (for example gcc), to build the C model; "
-                           "the Python module needs none")
 
 
 class CompilerRefused(CodegenBug):

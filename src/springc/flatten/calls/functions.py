@@ -107,7 +107,7 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
         for comp in comps:
             _declare(ev, scope, comp, given, call)
         if is_external(entry):
-            native: a.Value = external_value(ev, entry, scope.names, call)
+            native: a.Value = external_value(ev, entry, scope.names, call, comps, count)
             return native
         check_jumps(entry.defn.algorithm, in_function=True)
         for stmt in entry.defn.algorithm:

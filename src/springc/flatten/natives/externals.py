@@ -1,15 +1,16 @@
 """Calls of external functions (section 12.9) while flattening.
 
-springc calls no foreign code: the external functions it knows by their C names
-(``ir.native_externals``) are evaluated here, the ModelicaStandardTables by ``tables``
-and the ModelicaStrings functions of ``Modelica.Utilities.Strings`` on their string
-arguments (which are known while flattening: springc has no string variables). A call
-of any other external function is a located error naming it; declaring one is not.
+The external functions springc knows by their C names (``ir.native_externals``) are
+evaluated here, the ModelicaStandardTables by ``tables`` and the ModelicaStrings
+functions of ``Modelica.Utilities.Strings`` on their string arguments (which are known
+while flattening: springc has no string variables). Any other ``external "C"`` function
+whose C sources the library ships (``library_sources``) is compiled and called
+(``foreign_calls``); a call of one without them is a located error naming it and where
+its sources would be; declaring one is not.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from ...errors import FlattenError, Note
@@ -18,6 +19,15 @@ from ...ir import syntax as s
 from ...ir.native_externals import NATIVE_EXTERNALS
 from ...parse import ClassEntry
 from ..scopes import ExpressionEvaluator
+from .foreign_calls import foreign_value
+from .library_sources import (
+    CSources,
+    annotation_strings,
+    c_sources,
+    include_uri,
+    resolved,
+    top_class,
+)
 from .tables import native_call
 
 
@@ -27,19 +37,27 @@ def is_external(entry: ClassEntry) -> bool:
 
 
 def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, Any],
-                   call: s.Call) -> Any:
-    """The value of ``call`` of the external function ``entry``, its inputs bound in
-    ``names``; an error naming the function where springc does not implement it."""
+                   call: s.Call, comps: list[s.Component], count: int = 1) -> Any:
+    """The value of ``call`` of the external function ``entry`` (the first output, or
+    the first ``count`` as a list), its variables (``comps``) bound in ``names``; an
+    error naming the function where springc neither implements it nor finds its C
+    sources in the library."""
     external = entry.defn.external
     assert external is not None
     c_name = external.name or entry.defn.name
     known = NATIVE_EXTERNALS.get(c_name)
     if known is None:
+        sources = c_sources(entry, external) if external.language == "C" else []
+        if isinstance(sources, CSources):
+            return foreign_value(ev, entry, names, comps, call, sources, count)
         raise FlattenError(
             f"the external function '{entry.full_name}' ({external.language} function "
-            f"'{c_name}') is not supported yet", call.span,
-            [Note("its external clause", external.span), *_sources(entry, external)],
-            "springc calls no foreign code yet; it evaluates the tables "
+            f"'{c_name}') is not supported: its library does not ship its C sources",
+            call.span,
+            [Note("its external clause", external.span),
+             *_sources(entry, external, sources)],
+            "springc compiles and calls the C functions whose sources the library ships "
+            "(its Resources/C-Sources, or the Include annotation); it evaluates the tables "
             "(ModelicaStandardTables) and string functions (ModelicaStrings) of the "
             "Modelica Standard Library itself")
     operation, roles = known
@@ -93,26 +111,24 @@ def _index(ev: ExpressionEvaluator, given: dict[str, Any], role: str, call: s.Ca
                            call.span) from None
 
 
-def _sources(entry: ClassEntry, external: s.ExternalCall) -> list[Note]:
+def _sources(entry: ClassEntry, external: s.ExternalCall, missing: list[str]) -> list[Note]:
     """Where the external clause's annotation (12.9.4) says the function's C code is:
-    its libraries, and its include directory (``modelica://Top/Resources/Include`` by
-    default) with whether the library at hand ships it."""
-    notes: dict[str, list[str]] = {}
-    for arg in external.annotation.arguments if external.annotation else ():
-        value = arg.modification.value if arg.modification else None
-        items = value.items if isinstance(value, s.ArrayLit) else (value,)
-        notes[".".join(arg.path)] = [i.value for i in items if isinstance(i, s.String)]
+    its libraries (those whose C files this copy of the library lacks), and its include
+    directory (``modelica://Top/Resources/Include`` by default) with whether the
+    library at hand ships it."""
+    notes = annotation_strings(external)
     found: list[Note] = []
     if notes.get("Library"):
         found.append(Note("it links the librar" + ("y " if len(notes["Library"]) == 1
                                                    else "ies ")
                           + ", ".join(f"'{name}'" for name in notes["Library"])))
-    top = entry
-    while top.parent is not None and top.parent.parent is not None:
-        top = top.parent  # up to the top-level class, below the tree's root
-    include = (notes.get("IncludeDirectory") or
-               [f"modelica://{top.defn.name}/Resources/Include"])[0]
-    folder = _resolved(include, top)
+    if missing:
+        found.append(Note("the C sources of " + ", ".join(f"'{name}'" for name in missing)
+                          + " are not in this copy of the library (looked for in its "
+                          "include directory and Resources/C-Sources)"))
+    top = top_class(entry)
+    include = include_uri(external, top)
+    folder = resolved(include, top)
     if folder is None:
         return found
     where = f"its include directory {include} ({folder})"
@@ -124,12 +140,3 @@ def _sources(entry: ClassEntry, external: s.ExternalCall) -> list[Note]:
         found.append(Note(f"{where} holds its C sources" + (
             f" ({listed})" if sources else "")))
     return found
-
-
-def _resolved(uri: str, top: ClassEntry) -> Path | None:
-    """The folder a ``modelica://Top/path`` URI names, where ``Top`` is the library
-    ``top`` stored as a folder; None where it is another library or not a folder."""
-    prefix = f"modelica://{top.defn.name}/"
-    if not uri.startswith(prefix) or top.folder is None:
-        return None
-    return top.folder.joinpath(*uri[len(prefix):].split("/"))
