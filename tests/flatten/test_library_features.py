@@ -85,9 +85,12 @@ def test_an_unknown_external_function_is_located_where_called(tmp_path: Path) ->
     call = next(i for i, line in enumerate(lines, 1) if "foreign(time)" in line)
     text = outcome(tmp_path, STRINGS + "model Top\n  P.Foreign f;\nend Top;\n")
     assert text == (f"{call}:14: the external function 'P.foreign' (C function "
-                    "'my_c_function') is not supported yet\nhelp: springc calls no foreign "
-                    "code yet; it evaluates the tables (ModelicaStandardTables) and string "
-                    "functions (ModelicaStrings) of the Modelica Standard Library itself")
+                    "'my_c_function') is not supported: its library does not ship its C "
+                    "sources\nhelp: springc compiles and calls the C functions whose "
+                    "sources the library ships (its Resources/C-Sources, or the Include "
+                    "annotation); it evaluates the tables (ModelicaStandardTables) and "
+                    "string functions (ModelicaStrings) of the Modelica Standard Library "
+                    "itself")
 
 
 def test_declaring_an_external_function_is_not_an_error(tmp_path: Path) -> None:
@@ -332,12 +335,14 @@ def test_an_external_function_names_its_libraries_and_sources(tmp_path: Path,
         flatten_files([], "Lib.M", [tmp_path / "libs"])
     (err,) = errors_of(info.value)
     assert err.message == ("the external function 'Lib.twice' (C function 'lib_twice') is "
-                           "not supported yet")
+                           "not supported: its library does not ship its C sources")
     assert err.span is not None and (err.span.line, err.span.column) == (10, 14)
     where = f"its include directory modelica://Lib/Resources/C-Sources ({sources})"
     assert [n.message for n in err.notes] == [
         "its external clause", "it links the libraries 'LibC', 'm'",
-        f"{where} holds its C sources (twice.c)" if shipped
+        "the C sources of 'LibC' are not in this copy of the library (looked for in its "
+        "include directory and Resources/C-Sources)",
+        f"{where} holds C sources (twice.c)" if shipped
         else f"{where} is not in this copy of the library"]
 
 

@@ -51,3 +51,19 @@ NATIVE_EXTERNALS.update({
     _STRINGS + "skipWhiteSpace": ("strings.skipWhiteSpace", ("string", "startIndex")),
 })
 """The string functions of ``Modelica.Utilities.Strings`` (``flatten/externals.py``)."""
+
+_FILES = "it writes or removes files, folders or the environment"
+_CLOCK = "its result depends on when or where the translation runs"
+REFUSED_EXTERNALS: dict[str, str] = {
+    **{f"ModelicaInternal_{name}": _FILES for name in (
+        "print", "removeFile", "copyFile", "rename", "mkdir", "rmdir", "chdir", "setenv")},
+    "ModelicaIO_writeRealMatrix": _FILES,
+    "ModelicaStreams_closeFile": _FILES,
+    **{f"ModelicaInternal_{name}": _CLOCK for name in (
+        "getTime", "getpid", "temporaryFileName")},
+    "ModelicaRandom_automaticGlobalSeed": _CLOCK,
+}
+"""The MSL's C functions springc does not call although their sources compile: it calls
+foreign functions while translating a model (once per compilation, not at the model's
+events), so a function with effects outside its outputs would act at the wrong moment,
+and one that reads the clock would make the model depend on it (``docs/msl.md``)."""

@@ -78,7 +78,11 @@ class ForeignLibrary:
         self._folder = tempfile.TemporaryDirectory(prefix="springc-foreign-")  # 0700
         path = Path(self._folder.name) / "foreign.so"
         path.write_bytes(data)
-        self.lib = ctypes.CDLL(str(path))
+        try:
+            self.lib = ctypes.CDLL(str(path))
+        except OSError as failed:  # a symbol no source defines
+            text = str(failed).replace(str(path), "the library")
+            raise ForeignBuildFailed(f"it does not load: {text}") from None
         self.lib.springc_error_message.restype = ctypes.c_char_p
         self.lib.springc_error_message.argtypes = []
 

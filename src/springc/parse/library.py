@@ -20,6 +20,7 @@ from pathlib import Path
 from ..resources import models_dir
 
 SUFFIXES = (".mo", ".mdl")
+C_FOLDERS = (("Resources", "C-Sources"), ("Resources", "Include"))
 PACKAGE_FILES = tuple(f"package{suffix}" for suffix in SUFFIXES)
 ORDER_FILE = "package.order"
 
@@ -120,7 +121,8 @@ def loose_files(root: Path) -> list[Path]:
 def source_files(folder: Path) -> list[Path]:
     """Every file loading may read below the root or package folder ``folder`` (``.mo``,
     ``.mdl``, ``package.order`` in it and, recursively, in its subfolders that are
-    packages), sorted: what a cache key must cover. Folders that cannot be read (gone,
+    packages; the C files of a package's external functions, :func:`_c_files`), sorted:
+    what a cache key must cover. Folders that cannot be read (gone,
     a path too long, no permission) are skipped: loading cannot read them either."""
     found: list[Path] = []
     pending = [folder]
@@ -134,6 +136,7 @@ def source_files(folder: Path) -> list[Path]:
         if real in visited:  # a symbolic link back to a parent folder
             continue
         visited.add(real)
+        found += _c_files(current)
         for child in _entries(current):
             if child.suffix in SUFFIXES or child.name == ORDER_FILE:
                 if _is_file(child):
@@ -141,6 +144,22 @@ def source_files(folder: Path) -> list[Path]:
             elif _FILE_NAME.match(child.name) and _is_package_folder(child):
                 pending.append(child)
     return sorted(found)
+
+
+def _c_files(folder: Path) -> list[Path]:
+    """The C files of a package's ``Resources/C-Sources`` (and its subfolders) and
+    ``Resources/Include``: a library's external functions are compiled from them."""
+    found: list[Path] = []
+    for sub in C_FOLDERS:
+        pending = [folder.joinpath(*sub)]
+        while pending:
+            current = pending.pop()
+            for child in _entries(current):
+                if child.suffix in (".c", ".h") and _is_file(child):
+                    found.append(child)
+                elif child.is_dir() and not child.is_symlink():
+                    pending.append(child)
+    return found
 
 
 def key_sources(files: Iterable[str], libraries: Iterable[str]) -> list[Path]:

@@ -16,7 +16,7 @@ from typing import Any
 from ...errors import FlattenError, Note
 from ...ir import expr as x
 from ...ir import syntax as s
-from ...ir.native_externals import NATIVE_EXTERNALS
+from ...ir.native_externals import NATIVE_EXTERNALS, REFUSED_EXTERNALS
 from ...parse import ClassEntry
 from ..scopes import ExpressionEvaluator
 from .foreign_calls import foreign_value
@@ -46,6 +46,13 @@ def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, 
     assert external is not None
     c_name = external.name or entry.defn.name
     known = NATIVE_EXTERNALS.get(c_name)
+    if c_name in REFUSED_EXTERNALS:
+        raise FlattenError(
+            f"springc does not call the external function '{entry.full_name}' ('{c_name}'): "
+            f"{REFUSED_EXTERNALS[c_name]}", call.span, [Note("its external clause",
+                                                            external.span)],
+            "springc calls a library's C functions while translating the model, once; "
+            "it writes no file a model names (docs/msl.md, External C functions)")
     if known is None:
         sources = c_sources(entry, external) if external.language == "C" else []
         if isinstance(sources, CSources):
@@ -137,6 +144,6 @@ def _sources(entry: ClassEntry, external: s.ExternalCall, missing: list[str]) ->
     else:
         sources = sorted(p.name for p in folder.glob("*.c"))
         listed = ", ".join(sources[:4]) + (", ..." if len(sources) > 4 else "")
-        found.append(Note(f"{where} holds its C sources" + (
-            f" ({listed})" if sources else "")))
+        found.append(Note(f"{where} holds C sources ({listed})" if sources
+                          else f"{where} holds no C source"))
     return found

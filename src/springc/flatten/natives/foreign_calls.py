@@ -177,7 +177,8 @@ def _folded(ev: ExpressionEvaluator, entry: ClassEntry, name: str, value: Any,
         raise FlattenError(
             f"the external function '{entry.full_name}' is called with its input '{name}' "
             f"known only during the simulation (it depends on {missing.args[0]})",
-            call.span, [],
+            call.span, [Note("its external clause", entry.defn.external.span)]
+            if entry.defn.external else [],
             "springc calls a library's C functions while translating the model, on "
             "values known before the simulation (constants and parameters)") from None
     if not isinstance(value, str):

@@ -29,6 +29,8 @@ LIBRARY_FILES: dict[str, tuple[str, ...]] = {
 """The MSL's libraries (``Resources/C-Sources/readme.txt``), with the libraries each
 needs to load (a shared library springc builds resolves every symbol itself)."""
 SOURCES_FOLDER = ("Resources", "C-Sources")
+SYSTEM_LIBRARIES = frozenset({"m"})
+"""Libraries every build links (the C math library, ``-lm``)."""
 
 
 @dataclass(frozen=True)
@@ -99,6 +101,8 @@ def c_sources(entry: ClassEntry, external: s.ExternalCall) -> CSources | list[st
     missing: list[str] = []
     root = None
     for library in notes.get("Library", []):
+        if library in SYSTEM_LIBRARIES:
+            continue
         found = _library_files(library, folders, top)
         if found is None:
             missing.append(library)
@@ -107,6 +111,8 @@ def c_sources(entry: ClassEntry, external: s.ExternalCall) -> CSources | list[st
         files += [f for f in found[1] if f not in files]
     if missing:
         return missing
+    if not files and not notes.get("Include"):
+        return []  # nothing holds the function's code
     return CSources("\n".join(notes.get("Include", [])), include_folder, tuple(files), root)
 
 

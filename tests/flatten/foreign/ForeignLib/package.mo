@@ -1,0 +1,65 @@
+package ForeignLib "External C functions whose sources the library ships (tests)"
+  function stats "The sum of u, k*u (negated if neg) and the count of positive entries"
+    input Real u[:];
+    input Integer k;
+    input Boolean neg;
+    output Real total;
+    output Real scaled[size(u, 1)];
+    output Integer count;
+  external "C" total = foreignlib_stats(u, size(u, 1), k, neg, scaled, count)
+    annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
+  end stats;
+
+  function transposed "A 2-D array, row-major, with both sizes"
+    input Real A[:, :];
+    output Real T[size(A, 2), size(A, 1)];
+  external "C" foreignlib_transpose(A, size(A, 1), size(A, 2), T)
+    annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
+  end transposed;
+
+  function root "sqrt(x); ModelicaError for x < 0"
+    input Real x;
+    output Real y;
+  external "C" y = foreignlib_root(x)
+    annotation(Include="#include \"foreignlib.h\"", Library={"ForeignLib", "m"});
+  end root;
+
+  function cube "Defined by its Include annotation alone, the default external call"
+    input Real x;
+    output Real y;
+  external "C"
+    annotation(Include="static double cube(double x) { return x * x * x; }");
+  end cube;
+
+  function missing "A library this copy does not ship"
+    input Real x;
+    output Real y;
+  external "C" y = other_function(x) annotation(Library="OtherLib");
+  end missing;
+
+  model M
+    parameter Real u[3] = {1.5, -2, 4};
+    parameter Integer k = 3;
+    Real total;
+    Real scaled[3];
+    Integer count;
+    Real T[3, 2] = transposed([1, 2, 3; 4, 5, 6]);
+    Real r = root(6.25);
+    Real c = cube(-1.5);
+  equation
+    (total, scaled, count) = stats(u, k, true);
+  end M;
+
+  model Fails
+    parameter Real x = -4;
+    Real y = root(x);
+  end Fails;
+
+  model RunTime
+    Real y = root(time);
+  end RunTime;
+
+  model Missing
+    Real y = missing(1);
+  end Missing;
+end ForeignLib;

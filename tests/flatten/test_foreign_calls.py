@@ -1,0 +1,182 @@
+"""External C functions compiled from the C sources a library ships (Modelica 12.9):
+the test library ``foreign/ForeignLib`` (its own Resources/C-Sources/ForeignLib.c and
+Resources/Include/foreignlib.h), built with the system C compiler or zig cc, called
+while flattening; exact values from its C code, exact located errors."""
+
+from __future__ import annotations
+
+import hashlib
+import shutil
+from pathlib import Path
+
+import pytest
+
+from springc.errors import SpringcError, errors_of
+from springc.ir.flat import format_flat
+from springc.pipeline.files import flatten_files
+
+LIBRARY = Path(__file__).parent / "foreign"
+PACKAGE = LIBRARY / "ForeignLib" / "package.mo"
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def _equations(model: str) -> list[str]:
+    text = format_flat(flatten_files([], model, [LIBRARY]))
+    return text.split("equation\n")[1].splitlines()[:-1]
+
+
+def _error(model: str, libraries: list[Path] | None = None) -> SpringcError:
+    with pytest.raises(SpringcError) as info:
+        flatten_files([], model, libraries or [LIBRARY])
+    (err,) = errors_of(info.value)
+    return err
+
+
+def _line(needle: str) -> int:
+    lines = PACKAGE.read_text().splitlines()
+    return next(i for i, line in enumerate(lines, 1) if needle in line)
+
+
+def test_scalar_and_array_arguments_and_outputs() -> None:
+    # stats({1.5, -2, 4}, 3, true): sum 3.5, -3*u, 2 positive entries; the transpose of
+    # [1, 2, 3; 4, 5, 6] (row-major both ways); sqrt(6.25) = 2.5; (-1.5)^3 = -3.375
+    # through a function defined by the Include annotation alone (the default call)
+    assert _equations("ForeignLib.M") == [
+        "  'T[1,1]' = 1.0;", "  'T[1,2]' = 4.0;", "  'T[2,1]' = 2.0;", "  'T[2,2]' = 5.0;",
+        "  'T[3,1]' = 3.0;", "  'T[3,2]' = 6.0;", "  r = 2.5;", "  c = -3.375;",
+        "  total = 3.5;", "  'scaled[1]' = -4.5;", "  'scaled[2]' = 6.0;",
+        "  'scaled[3]' = -12.0;", "  count = 2;"]
+
+
+def test_the_parameters_a_call_reads_become_structural() -> None:
+    model = flatten_files([], "ForeignLib.M", [LIBRARY])
+    assert {"u[1]", "u[2]", "u[3]", "k"} <= set(model.evaluated)
+
+
+def test_modelica_error_is_a_located_error() -> None:
+    err = _error("ForeignLib.Fails")
+    assert err.message == ("the external function 'ForeignLib.root' ('foreignlib_root') "
+                           "failed: foreignlib_root: x = -4 is negative")
+    assert err.span is not None and (err.span.line, err.span.column) == (
+        _line("Real y = root(x);"), 14)
+    assert [n.message for n in err.notes] == ["its external clause"]
+
+
+def test_an_argument_known_only_during_the_simulation_is_refused() -> None:
+    err = _error("ForeignLib.RunTime")
+    assert err.message == ("the external function 'ForeignLib.root' is called with its "
+                           "input 'x' known only during the simulation (it depends on "
+                           "time)")
+    assert err.span is not None and err.span.line == _line("Real y = root(time);")
+
+
+def test_a_library_without_its_sources_keeps_the_located_error() -> None:
+    err = _error("ForeignLib.Missing")
+    assert err.message == ("the external function 'ForeignLib.missing' (C function "
+                           "'other_function') is not supported: its library does not "
+                           "ship its C sources")
+    assert err.span is not None and err.span.line == _line("Real y = missing(1);")
+    include = LIBRARY / "ForeignLib" / "Resources" / "Include"
+    assert [n.message for n in err.notes] == [
+        "its external clause", "it links the library 'OtherLib'",
+        "the C sources of 'OtherLib' are not in this copy of the library (looked for in "
+        "its include directory and Resources/C-Sources)",
+        f"its include directory modelica://ForeignLib/Resources/Include ({include}) "
+        "holds no C source"]
+
+
+def test_the_library_is_built_once_and_verified(_cache: Path) -> None:
+    expected = _equations("ForeignLib.M")
+    built = sorted((_cache / "foreign").glob("*.so"))
+    assert len(built) == 4  # one per function: stats, transposed, root, cube
+    for library in built:
+        record = library.with_name(library.name + ".sha256").read_text().strip()
+        assert hashlib.sha256(library.read_bytes()).hexdigest() == record
+    built[0].write_bytes(b"not a library")  # damaged: never loaded, built again
+    assert _equations("ForeignLib.M") == expected
+    record = built[0].with_name(built[0].name + ".sha256").read_text().strip()
+    assert hashlib.sha256(built[0].read_bytes()).hexdigest() == record
+
+
+LIB = '''package Lib
+  function f
+    input Real x;
+    output Real y;
+  external "C" y = evil(x) annotation(IncludeDirectory="modelica://Lib/../outside",
+                                      Library="Evil");
+  end f;
+  function remove
+    input String name;
+  external "C" ModelicaInternal_removeFile(name) annotation(Library="ModelicaExternalC");
+  end remove;
+  function g
+    input Real x;
+    output Real y;
+  algorithm
+    remove("data.txt");
+    y := x;
+  end g;
+  model M
+    Real y = f(1);
+  end M;
+  model R
+    Real y = g(1);
+  end R;
+end Lib;
+'''
+
+
+def test_annotation_paths_stay_inside_the_library(tmp_path: Path) -> None:
+    libs = tmp_path / "libs"
+    (libs / "Lib").mkdir(parents=True)
+    (libs / "Lib" / "package.mo").write_text(LIB)
+    (libs / "outside").mkdir()
+    (libs / "outside" / "Evil.c").write_text("double evil(double x) { return x; }\n")
+    err = _error("Lib.M", [libs])
+    assert [n.message for n in err.notes][1:] == [
+        "it links the library 'Evil'",
+        "the C sources of 'Evil' are not in this copy of the library (looked for in its "
+        "include directory and Resources/C-Sources)"]
+
+
+def test_functions_that_write_files_are_not_called(tmp_path: Path) -> None:
+    libs = tmp_path / "libs"
+    (libs / "Lib" / "Resources" / "C-Sources").mkdir(parents=True)
+    (libs / "Lib" / "package.mo").write_text(LIB)
+    kept = tmp_path / "data.txt"
+    kept.write_text("kept")
+    err = _error("Lib.R", [libs])
+    assert err.message == ("springc does not call the external function 'Lib.remove' "
+                           "('ModelicaInternal_removeFile'): it writes or removes files, "
+                           "folders or the environment")
+    assert kept.read_text() == "kept"
+
+
+def test_a_compiler_error_is_located(tmp_path: Path) -> None:
+    libs = tmp_path / "libs"
+    shutil.copytree(LIBRARY / "ForeignLib", libs / "ForeignLib")
+    source = libs / "ForeignLib" / "Resources" / "C-Sources" / "ForeignLib.c"
+    source.write_text(source.read_text() + "\nthis is not C;\n")
+    err = _error("ForeignLib.Fails", [libs])
+    assert err.message.startswith("the external function 'ForeignLib.root' "
+                                  "('foreignlib_root') could not be built: the C compiler "
+                                  "refused the library's C sources (")
+    assert err.span is not None and err.span.line == _line("Real y = root(x);")
+
+
+def test_a_symbol_no_source_defines_is_a_located_error(tmp_path: Path) -> None:
+    libs = tmp_path / "libs"
+    (libs / "Lib").mkdir(parents=True)
+    (libs / "Lib" / "package.mo").write_text(
+        'package Lib\n  function f\n    input Real x;\n    output Real y;\n'
+        '  external "C" y = nowhere(x) annotation(Include="double nowhere(double x);");\n'
+        '  end f;\n  model M\n    Real y = f(2);\n  end M;\nend Lib;\n')
+    err = _error("Lib.M", [libs])
+    assert err.message == ("the external function 'Lib.f' ('nowhere') could not be "
+                           "built: it does not load: the library: undefined symbol: "
+                           "nowhere")
