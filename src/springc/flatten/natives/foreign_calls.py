@@ -98,8 +98,8 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
         if arg.name is not None and arg.shape is not None:
             values[arg.name] = _read(arg)
     library.lib.springc_release_strings()
-    outputs = [values[c.name] for c in comps if c.causality == "output"][:max(count, 1)]
-    return outputs[0] if count == 1 else outputs
+    outputs = [values[c.name] for c in comps if c.causality == "output"]
+    return outputs[0] if count == 1 else outputs[:count]
 
 
 def _kind(ev: ExpressionEvaluator, entry: ClassEntry, comp: s.Component,
@@ -160,6 +160,11 @@ def _argument(ev: ExpressionEvaluator, entry: ClassEntry, e: s.Expr, names: dict
     if kind == "String":
         raise FlattenError(f"springc does not take String outputs of C functions as "
                            f"arguments ('{name}')", e.span)
+    dims = (*comp.dims, *comp.type_dims)
+    if dims and (not a.is_array(value) or any(isinstance(d, s.Colon) for d in dims)):
+        raise FlattenError(f"the size of '{name}' must be known before the external call "
+                           f"of '{entry.full_name}'", e.span, [Note("declared here",
+                                                                    comp.span)])
     shape = a.shape(value) if a.is_array(value) else ()
     size = math.prod(shape)
     buffer = (ctype * max(size, 1))() if shape else ctype()
