@@ -54,6 +54,9 @@ NATIVE_EXTERNALS.update({
 
 _FILES = "it writes or removes files, folders or the environment"
 _CLOCK = "its result depends on when or where the translation runs"
+_READS = ("it reads files, folders or the environment, which the compiled model's cache "
+          "key does not cover")
+_STATE = "it keeps a state between calls, which a call while translating would not"
 REFUSED_EXTERNALS: dict[str, str] = {
     **{f"ModelicaInternal_{name}": _FILES for name in (
         "print", "removeFile", "copyFile", "rename", "mkdir", "rmdir", "chdir", "setenv")},
@@ -62,8 +65,17 @@ REFUSED_EXTERNALS: dict[str, str] = {
     **{f"ModelicaInternal_{name}": _CLOCK for name in (
         "getTime", "getpid", "temporaryFileName")},
     "ModelicaRandom_automaticGlobalSeed": _CLOCK,
+    **{f"ModelicaInternal_{name}": _READS for name in (
+        "countLines", "fullPathName", "getNumberOfFiles", "getcwd", "getenv",
+        "readDirectory", "readFile", "readLine", "stat")},
+    "ModelicaIO_readMatrixSizes": _READS,
+    "ModelicaIO_readRealMatrix": _READS,
+    "ModelicaRandom_impureRandom_xorshift1024star": _STATE,
+    "ModelicaRandom_setInternalState_xorshift1024star": _STATE,
 }
 """The MSL's C functions springc does not call although their sources compile: it calls
 foreign functions while translating a model (once per compilation, not at the model's
 events), so a function with effects outside its outputs would act at the wrong moment,
-and one that reads the clock would make the model depend on it (``docs/msl.md``)."""
+one that reads the clock, files or the environment would make the cached model depend
+on what its key does not cover, and an impure one would be called once instead of at
+each of the model's calls (``docs/msl.md``)."""
