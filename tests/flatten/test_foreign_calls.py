@@ -75,6 +75,13 @@ def test_an_argument_known_only_during_the_simulation_is_refused() -> None:
     assert err.span is not None and err.span.line == _line("Real y = root(time);")
 
 
+def test_an_output_the_call_does_not_set_is_an_error() -> None:
+    err = _error("ForeignLib.Unset")
+    assert err.message == ("the external call of 'ForeignLib.unset' does not set its "
+                           "output 'z'")
+    assert err.span is not None and err.span.line == _line("(y, z) = unset(4);")
+
+
 def test_a_library_without_its_sources_keeps_the_located_error() -> None:
     err = _error("ForeignLib.Missing")
     assert err.message == ("the external function 'ForeignLib.missing' (C function "

@@ -63,12 +63,16 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
     where = [Note("its external clause", external.span)]
     if not IDENTIFIER.fullmatch(c_name):
         raise FlattenError(f"'{c_name}' is not a C function name", external.span)
-    kinds = {c.name: _kind(ev, entry, c, call) for c in comps}
     declared = {c.name: c for c in comps}
     returned = external.output if external.name else next(
         (c.name for c in comps if c.causality == "output"), None)
-    args = [_argument(ev, entry, e, names, declared, kinds, call)
-            for e in _call_args(external, comps)]
+    if returned is not None and returned not in declared:
+        raise FlattenError(f"'{returned}' is not a variable of '{entry.full_name}'",
+                           external.span)
+    passed = _call_args(external, comps)
+    used = {returned, *(n for e in passed for n in _names(e))}
+    kinds = {c.name: _kind(ev, entry, c, call) for c in comps if c.name in used}
+    args = [_argument(ev, entry, e, names, declared, kinds, call) for e in passed]
     result = kinds[returned] if returned else None
     glue = _glue(c_name, args, result, sources.include)
     try:
@@ -98,8 +102,22 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
         if arg.name is not None and arg.shape is not None:
             values[arg.name] = _read(arg)
     library.lib.springc_release_strings()
-    outputs = [values[c.name] for c in comps if c.causality == "output"]
-    return outputs[0] if count == 1 else outputs[:count]
+    outputs = [c for c in comps if c.causality == "output"][:count]
+    unset = [c for c in outputs if values[c.name] is None or c.name not in used]
+    if unset:
+        raise FlattenError(f"the external call of '{entry.full_name}' does not set its "
+                           f"output '{unset[0].name}'", call.span,
+                           [Note("declared here", unset[0].span), *where])
+    return values[outputs[0].name] if count == 1 else [values[c.name] for c in outputs]
+
+
+def _names(e: s.Expr) -> list[str]:
+    """The variables an argument of the external call names (``v``, ``size(v, k)``)."""
+    if isinstance(e, s.Ref):
+        return [e.dotted]
+    if isinstance(e, s.Call) and e.args:
+        return _names(e.args[0])
+    return []
 
 
 def _kind(ev: ExpressionEvaluator, entry: ClassEntry, comp: s.Component,

@@ -37,6 +37,14 @@ package ForeignLib "External C functions whose sources the library ships (tests)
   external "C" y = other_function(x) annotation(Library="OtherLib");
   end missing;
 
+  function unset "Its second output is not in the external call"
+    input Real x;
+    output Real y;
+    output Real z;
+  external "C" y = foreignlib_root(x)
+    annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
+  end unset;
+
   model M
     parameter Real u[3] = {1.5, -2, 4};
     parameter Integer k = 3;
@@ -62,4 +70,10 @@ package ForeignLib "External C functions whose sources the library ships (tests)
   model Missing
     Real y = missing(1);
   end Missing;
+  model Unset
+    Real y;
+    Real z;
+  equation
+    (y, z) = unset(4);
+  end Unset;
 end ForeignLib;
