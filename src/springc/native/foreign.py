@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import SpringcError
-from ..fileio import replace_private
+from ..fileio import keep_newest, replace_private
 from ..resources import CacheUnusable, private_folder, user_cache_dir
 from .compiler import find_compiler
 from .runner import read_verified
@@ -38,6 +38,10 @@ FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-DNDEBUG", "-DHAVE_UNISTD_H",
 (``Resources/BuildProjects/gcc/Makefile``), and a shared library's."""
 UTILITIES = Path(__file__).with_name("modelica_utilities.c")
 FOLDER = "foreign"
+KEY_LENGTH = 32
+KEEP = 256
+"""Libraries kept in the cache's folder, the most recently built (a record left without
+its library is harmless: the library is built again)."""
 HEADER_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.+-]*\.h")
 SUBFOLDER_NAME = re.compile(r"[A-Za-z0-9_]+")
 
@@ -67,7 +71,7 @@ class ForeignBuild:
             h.update(folder.encode() + b"\0" + hashlib.sha256(data).digest())
         for folder, name, data in self.headers:
             h.update(f"{folder}/{name}".encode() + b"\0" + hashlib.sha256(data).digest())
-        return h.hexdigest()[:32]
+        return h.hexdigest()[:KEY_LENGTH]
 
 
 class ForeignLibrary:
@@ -108,6 +112,7 @@ def load(build: ForeignBuild) -> ForeignLibrary:
             replace_private(folder / f"{key}.so.sha256",
                             (hashlib.sha256(data).hexdigest() + "\n").encode("ascii"))
             replace_private(folder / f"{key}.so", data)
+        keep_newest(folder, ".so", KEY_LENGTH + 3, KEEP)  # their records: see KEEP
     return ForeignLibrary(data)
 
 
