@@ -45,7 +45,7 @@ def _line(needle: str) -> int:
 def test_scalar_and_array_arguments_and_outputs() -> None:
     # stats({1.5, -2, 4}, 3, true): sum 3.5, -3*u, 2 positive entries; the transpose of
     # [1, 2, 3; 4, 5, 6] (row-major both ways); sqrt(6.25) = 2.5; (-1.5)^3 = -3.375
-    # through a function defined by the Include annotation alone (the default call)
+    # through the default call of the library's 'cube'
     assert _equations("ForeignLib.M") == [
         "  'T[1,1]' = 1.0;", "  'T[1,2]' = 4.0;", "  'T[2,1]' = 2.0;", "  'T[2,2]' = 5.0;",
         "  'T[3,1]' = 3.0;", "  'T[3,2]' = 6.0;", "  r = 2.5;", "  c = -3.375;",
@@ -187,3 +187,21 @@ def test_a_symbol_no_source_defines_is_a_located_error(tmp_path: Path) -> None:
     assert err.message == ("the external function 'Lib.f' ('nowhere') could not be "
                            "built: it does not load: the library: undefined symbol: "
                            "nowhere")
+
+
+def test_c_code_in_the_include_annotation_is_not_compiled(tmp_path: Path) -> None:
+    libs = tmp_path / "libs"
+    (libs / "Lib").mkdir(parents=True)
+    for code in ('static double f(double x) { return x; }', '#define f(x) (x)',
+                 '#include \\"../outside.h\\"'):
+        (libs / "Lib" / "package.mo").write_text(
+            'package Lib\n  function f\n    input Real x;\n    output Real y;\n'
+            f'  external "C" annotation(Include="{code}");\n'
+            '  end f;\n  model M\n    Real y = f(2);\n  end M;\nend Lib;\n')
+        err = _error("Lib.M", [libs])
+        shown = code.replace('\\"', '"')
+        assert err.message == ("the Include annotation of the external function 'Lib.f' "
+                               f"holds C code ('{shown}'); springc compiles only the C "
+                               "source files a library ships, never code written in model "
+                               "text")
+        assert err.span is not None and err.span.line == 5

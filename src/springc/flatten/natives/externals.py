@@ -64,7 +64,7 @@ def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, 
             [Note("its external clause", external.span),
              *_sources(entry, external, sources)],
             "springc compiles and calls the C functions whose sources the library ships "
-            "(its Resources/C-Sources, or the Include annotation); it evaluates the tables "
+            "(its Resources/C-Sources); it evaluates the tables "
             "(ModelicaStandardTables) and string functions (ModelicaStrings) of the "
             "Modelica Standard Library itself")
     operation, roles = known

@@ -37,6 +37,10 @@ C_TYPES: dict[str, tuple[str, Any]] = {
     "Real": ("double", ctypes.c_double), "Integer": ("int", ctypes.c_int),
     "Boolean": ("int", ctypes.c_int), "String": ("const char *", ctypes.c_char_p)}
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+INCLUDE_LINE = re.compile(r'\s*#\s*include\s*("[^"/\\]+(/[^"/\\]+)*"|<[^<>/\\]+(/[^<>/\\]+)*>)\s*'
+                          r"(//.*)?")
+"""An ``Include`` line springc compiles: ``#include "name.h"`` or ``<name.h>`` (a
+relative name, no ``..``), with a line comment at most."""
 
 
 @dataclass
@@ -74,6 +78,7 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
     kinds = {c.name: _kind(ev, entry, c, call) for c in comps if c.name in used}
     args = [_argument(ev, entry, e, names, declared, kinds, call) for e in passed]
     result = kinds[returned] if returned else None
+    _check_include(sources.include, entry, external.span)
     glue = _glue(c_name, args, result, sources.include)
     try:
         library = foreign.load(foreign.ForeignBuild(
@@ -236,6 +241,24 @@ def _read(arg: _Arg) -> Any:
     out = np.empty(arg.shape, dtype=object)
     out.ravel()[:] = [_constant(v, arg.kind) for v in items]
     return out
+
+
+def _check_include(text: str, entry: ClassEntry, span: Any) -> None:
+    """Model text is data: the ``Include`` annotation may name headers and declare
+    functions, but neither define code (a ``{``) nor macros, which would run when
+    springc calls the function while flattening; the C code itself must be in the
+    source files the library ships."""
+    for line in text.splitlines():
+        stripped = line.strip()
+        directive = stripped.startswith("#")
+        if (directive and (not INCLUDE_LINE.fullmatch(line) or ".." in stripped)) or \
+                (not directive and "{" in stripped):
+            raise FlattenError(
+                f"the Include annotation of the external function '{entry.full_name}' "
+                f"holds C code ('{stripped[:60]}'); springc compiles only the C source "
+                "files a library ships, never code written in model text", span,
+                hint="put the function into a .c file of the library's "
+                     "Resources/C-Sources folder and name it with Library=\"...\"")
 
 
 def _glue(c_name: str, args: list[_Arg], result: str | None, include: str) -> str:

@@ -24,11 +24,11 @@ package ForeignLib "External C functions whose sources the library ships (tests)
     annotation(Include="#include \"foreignlib.h\"", Library={"ForeignLib", "m"});
   end root;
 
-  function cube "Defined by its Include annotation alone, the default external call"
+  function cube "The default external call: the C function 'cube' of the library"
     input Real x;
     output Real y;
   external "C"
-    annotation(Include="static double cube(double x) { return x * x * x; }");
+    annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
   end cube;
 
   function missing "A library this copy does not ship"

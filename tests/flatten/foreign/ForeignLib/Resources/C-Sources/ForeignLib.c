@@ -31,3 +31,7 @@ double foreignlib_root(double x) {
     }
     return sqrt(x);
 }
+
+double cube(double x) {
+    return x * x * x;
+}
