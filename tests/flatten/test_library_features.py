@@ -87,8 +87,8 @@ def test_an_unknown_external_function_is_located_where_called(tmp_path: Path) ->
     assert text == (f"{call}:14: the external function 'P.foreign' (C function "
                     "'my_c_function') is not supported: its library does not ship its C "
                     "sources\nhelp: springc compiles and calls the C functions whose "
-                    "sources the library ships (its Resources/C-Sources, or the Include "
-                    "annotation); it evaluates the tables (ModelicaStandardTables) and "
+                    "sources the library ships (its Resources/C-Sources); it evaluates "
+                    "the tables (ModelicaStandardTables) and "
                     "string functions (ModelicaStrings) of the Modelica Standard Library "
                     "itself")
 
