@@ -161,6 +161,22 @@ def test_a_run_that_warns_keeps_no_record(folder: Path) -> None:
         (0, cold.stdout, cold.stderr)
 
 
+def test_a_left_out_initial_condition_is_said_once_located_and_again_next_time(
+        folder: Path) -> None:
+    (folder / "R.mo").write_text("model R\n  Real x(start = 1, fixed = true);\n"
+                                 "initial equation\n  x = 1;\nequation\n  der(x) = -x;\n"
+                                 "  annotation(experiment(StopTime = 1));\nend R;\n")
+    said = ("R.mo:4:3: warning: initial condition 'x = 1' left out: the other initial "
+            "conditions determine it and it holds\n    4 |   x = 1;\n      |   ^^^^^\n")
+    first = command_line(folder, "simulate", "R.mo", "-o", "r.csv")
+    assert first.stderr.startswith(said) and first.stderr.count("warning") == 1, first.stderr
+    again = springc_run(folder, "simulate", "R.mo", "-o", "r.csv")
+    assert not again.warm and (again.code, again.stderr) == (0, first.stderr)
+    rows = (folder / "r.csv").read_text().splitlines()
+    end, x = (float(v) for v in rows[-1].split(","))
+    assert end == 1 and abs(x - 0.36787944) < 1e-5  # exp(-1), rtol 1e-6
+
+
 def test_a_verbose_run_keeps_no_record(folder: Path) -> None:
     command_line(folder, *ARGS, "-v")
     again = springc_run(folder, *ARGS, "-v")

@@ -132,11 +132,12 @@ def test_a_time_event_is_hit_exactly(more: str, solver: str) -> None:
 def test_discrete_integer_boolean_and_real_variables(more: str) -> None:
     result = springc.simulate(more, model_name="Counter", stop=2.0, interval=0.125)
     t = result.time
-    # sample(0, 0.25) ticks at 0.25, 0.5, ..., 2.0 (the tick at the start is the
-    # initialization, where when-clauses without initial() stay inactive)
-    assert np.array_equal(result["n"], np.floor(t / 0.25 + 1e-9))
+    # sample(0, 0.25) ticks at 0, 0.25, ..., 2.0: "the first event iteration occurs
+    # after the initialization even if the start argument is identical to the start
+    # time of the simulation" (3.7.5); a row shows the values after its time's event
     ticks = np.floor(t / 0.25 + 1e-9)
-    assert np.array_equal(result["last"], np.where(t < 0.25, -1.0, ticks * 0.25))
+    assert np.array_equal(result["n"], ticks + 1)
+    assert np.array_equal(result["last"], ticks * 0.25)
     assert np.array_equal(result["high"], (t > 0.6).astype(float))
     crossing = [e.time for e in result.events if e.kind == "state"]
     assert crossing == pytest.approx([0.6], abs=1e-11)
@@ -191,10 +192,10 @@ def test_event_rows_add_the_left_and_right_limits(more: str) -> None:
     rows = springc.simulate(more, model_name="Counter", stop=0.55, interval=0.275,
                             event_rows=True)
     assert list(plain.time) == [0.0, 0.275, 0.55]
-    assert list(plain["n"]) == [0, 1, 2]
+    assert list(plain["n"]) == [1, 2, 3]  # the sample at t = 0 after the initialization
     assert list(rows.time) == [0.0, 0.25, 0.25, 0.275, 0.5, 0.5, 0.55]
-    assert list(rows["n"]) == [0, 0, 1, 1, 1, 2, 2]
-    assert list(rows["last"]) == [-1, -1, 0.25, 0.25, 0.25, 0.5, 0.5]
+    assert list(rows["n"]) == [1, 1, 2, 2, 2, 3, 3]
+    assert list(rows["last"]) == [0, 0, 0.25, 0.25, 0.25, 0.5, 0.5]
 
 
 def test_numba_backend_gives_the_python_backend_results(tmp_path: Path) -> None:
@@ -384,8 +385,10 @@ def test_samples_without_states_tick_at_every_multiple(tmp_path: Path, solver: s
                                                        step: float | None) -> None:
     result = springc.simulate(write(tmp_path, SAMPLES), solver=solver, step=step, stop=1.0,
                               interval=0.25)
-    assert list(result["n"]) == [0, 2, 5, 7, 10]
+    assert list(result["n"]) == [1, 3, 6, 8, 11]  # 0, 0.1, ..., 1: 0 after initialization
     assert result.stats.time_events == 10
+    assert [(e.kind, e.cause) for e in result.events[:2]] == [
+        ("initial", "initial()"), ("initial", "after initialization")]
 
 
 HOSTILE = r"""
@@ -465,10 +468,10 @@ def test_events_are_counted_and_kept_only_as_the_output_needs(
     path = tmp_path / "sampled.mo"
     path.write_text(SAMPLED)
     result = springc.simulate(str(path), stop=1.0, interval=0.5, event_rows=event_rows)
-    assert result.stats.time_events == 1000  # the one at t = 0 is the initial event
+    assert result.stats.time_events == 1000  # t = 0: the event after the initialization
     kept = [e for e in result.events if e.kind == "time"]
-    assert len(result.events) == (1001 if event_rows else 10)
-    assert result.events[0].kind == "initial"
-    assert abs(kept[-1].time - (1.0 if event_rows else 0.009)) < 1e-12
+    assert len(result.events) == (1002 if event_rows else 10)
+    assert result.events[0].kind == result.events[1].kind == "initial"
+    assert abs(kept[-1].time - (1.0 if event_rows else 0.008)) < 1e-12
     assert len(result.time) == (3 + 2 * 1000 if event_rows else 3)
     assert abs(result["h"][-1] - 1.0) < 1e-9

@@ -127,13 +127,14 @@ def test_a_sampled_controller_equals_its_closed_form(cache: None, tmp_path: Path
     table = _table(sampled, tmp_path / "s.parquet", "k=1:5:9", stop=1.0, interval=0.05)
     assert table["status"] == ["ok"] * 9
     for run, k in enumerate(np.linspace(1.0, 5.0, 9)):
-        # u = -k x at t = 0.1, 0.2, ..., 1.0 (a when-clause is not active at the
-        # initialization; the last sample is the time event at the stop time): x stays 1
-        # up to 0.1, then x(n T) = (1 - k T)^(n - 1)
-        x = (1 - 0.1 * k) ** 9
+        # u = -k x at t = 0, 0.1, ..., 1.0 (the sample at t = 0 fires at the event after
+        # the initialization, 3.7.5; the last is the time event at the stop time):
+        # x(n T) = (1 - k T)^n, and u rises from -k to -k x(1)
+        x = (1 - 0.1 * k) ** 10
         assert abs(table["x.final"][run] - x) <= 1e-12
         assert abs(table["u.final"][run] + k * x) <= 1e-12
-        assert abs(table["u.min"][run] + k) <= 1e-12 and table["u.max"][run] == 0.0
+        assert abs(table["u.min"][run] + k) <= 1e-12
+        assert abs(table["u.max"][run] + k * x) <= 1e-12
         single = springc.simulate(sampled, stop=1.0, interval=0.05, solver="dop853",
                                   rtol=RTOL, atol=ATOL, error_control="off",
                                   parameters={"k": float(k)})

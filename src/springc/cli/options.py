@@ -3,15 +3,17 @@ options, ``--set`` values, output paths refused before any work."""
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import sys
-from collections.abc import Callable, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import click
 
-from ..errors import ErrorGroup, OutputError, UnitError, UsageError, render
+from ..errors import ErrorGroup, OutputError, Span, SpringcError, UnitError, UsageError, render
 from ..simulation import (
     ALL_SOLVERS,
     DEFAULT_ENGINE,
@@ -99,6 +101,30 @@ def report_units(warnings: Sequence[UnitError], strict: bool) -> None:
         raise warnings[0] if len(warnings) == 1 else ErrorGroup(warnings)
     if warnings:  # separated as errors are
         click.echo("\n\n".join(render(w, kind="warning") for w in warnings), err=True)
+
+
+@contextlib.contextmanager
+def initial_warnings() -> Iterator[list[str]]:
+    """Say the redundant initial conditions a run left out as located warnings (each
+    once, after the run: the companion error run initializes again), and list them in
+    what it yields; other Python warnings pass on as they came."""
+    from ..simplify.initialize import RedundantInitialWarning
+
+    left_out: list[str] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RedundantInitialWarning)
+        yield left_out
+    said: dict[tuple[str, Span | None], None] = {}
+    for item in caught:
+        if not isinstance(item.message, RedundantInitialWarning):
+            warnings.warn_explicit(item.message, item.category, item.filename, item.lineno)
+            continue
+        said.update(((c.text, c.span), None) for c in item.message.conditions)
+    left_out.extend(text for text, _ in said)
+    for text, span in said:
+        warning = SpringcError(f"initial condition '{text}' left out: the other initial "
+                               "conditions determine it and it holds", span)
+        click.echo(render(warning, kind="warning"), err=True)
 
 
 def parse_set(values: tuple[str, ...]) -> dict[str, float]:

@@ -16,6 +16,7 @@ from .options import (
     TIMES,
     check_output_options,
     compile_options,
+    initial_warnings,
     model_options,
     release_compile_memory,
     report_units,
@@ -87,7 +88,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             check_trajectory_size(compiled, settings,
                                   f"-o {output}" if output else "the CSV on stdout")
         progress = None if quiet or not sys.stderr.isatty() else sys.stderr
-        with warnings.catch_warnings():  # said below as the command's own warning
+        with initial_warnings() as left_out, warnings.catch_warnings():  # accuracy: below
             warnings.simplefilter("ignore", AccuracyWarning)
             run_as = replace(settings, parameters={
                 k: v for k, v in settings.parameters.items() if k not in compiled.structural})
@@ -110,6 +111,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             click.echo(f"note: generated module {compiled.path}", err=True)
         if result.stats.warning:  # even with --quiet: the answer missed its tolerance
             click.echo(f"warning: {result.model}: {result.stats.warning}", err=True)
-        if not (plot or error_output or no_cache or error_estimate or level > 0) and \
+        if not (plot or error_output or no_cache or error_estimate or level > 0
+                or left_out) and \
                 (output is None or output.lower().endswith(".csv")):
             remember_run(compiled, run_as, result, files, libraries, output, quiet)

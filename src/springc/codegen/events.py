@@ -157,7 +157,10 @@ def event_begin(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
                 now = x.If(_truth("_zinit"), x.Var(slot_name), now)  # is its start
             out.append(Store(f"z[{layout.slot[slot_name]}]", now, f"pre({name})"))
     for (start, interval), name in zip(layout.events.samples, layout.samples):
-        out.append(Store(f"z[{layout.slot[name]}]", _flag(_sample_hit(x.TIME, start, interval))))
+        # false during the initialization (3.7.5): a sample at the start time is true at
+        # the event after it (after_initial)
+        hit = x.BinOp("and", _sample_hit(x.TIME, start, interval), x.Not(_truth("_zinit")))
+        out.append(Store(f"z[{layout.slot[name]}]", _flag(hit)))
     out += begin_event(layout)
     out.append(Raw("_zdone = 1.0"))
     return out
@@ -380,10 +383,12 @@ def constants(m: CodegenContext, layout: EventLayout) -> list[str]:
 
 
 def after_initial(layout: EventLayout) -> bool:
-    """Whether a when-condition reads ``initial()`` other than as the whole condition
-    (``not initial()``): then an event follows the initialization at the start time,
-    where such a condition may become true."""
-    return any(cond != x.Call("initial", ()) and any(
+    """Whether an event follows the initialization at the start time: where a
+    ``sample`` may start then (3.7.5: "the first event iteration occurs after the
+    initialization even if the start argument is identical to the start time"), or a
+    when-condition reads ``initial()`` other than as the whole condition (``not
+    initial()``), which may become true there."""
+    return bool(layout.samples) or any(cond != x.Call("initial", ()) and any(
         isinstance(n, x.Call) and n.name == "initial" for n in x.walk(cond))
         for _, _, cond in layout.conditions)
 

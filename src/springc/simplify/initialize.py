@@ -44,7 +44,12 @@ class InitializationError(SpringcError):
 
 
 class RedundantInitialWarning(UserWarning):
-    """Initial conditions that the others determine were left out (they hold)."""
+    """Initial conditions that the others determine were left out (they hold);
+    ``conditions`` are those left out, with where the model states them."""
+
+    def __init__(self, message: str, conditions: tuple[Condition, ...] = ()) -> None:
+        super().__init__(message)
+        self.conditions = conditions
 
 
 @dataclass(frozen=True, slots=True)
@@ -259,9 +264,9 @@ def _check_redundant(model: ode.ODE, conds: tuple[Condition, ...], kept: list[in
             raise _overdetermined(model, conds, fixed, free)
         raise _inconsistent(model, conds, len(kept), [(conds[i], values[i]) for i in wrong])
     names = "; ".join(conds[i].text for i in left[:5]) + ("; ..." if len(left) > 5 else "")
-    warnings.warn(f"{model.dae.name}: {len(left)} redundant initial condition(s) left "
-                  f"out, consistent with the others: {names}", RedundantInitialWarning,
-                  stacklevel=3)
+    warnings.warn(RedundantInitialWarning(
+        f"{model.dae.name}: {len(left)} redundant initial condition(s) left out, "
+        f"consistent with the others: {names}", tuple(conds[i] for i in left)), stacklevel=3)
 
 
 def _solve(model: ode.ODE, conds: tuple[Condition, ...], chosen: list[int], x0: np.ndarray,

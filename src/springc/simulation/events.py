@@ -240,8 +240,8 @@ class EventLoop:
         """The event at the start (``initial()`` is true)."""
         self.z[int(self.mod.Z_INITIAL)] = 1.0
         x = self.event(t, x, "initial", "initial()")
-        if getattr(self.mod, "AFTER_INITIAL", False):  # when not initial() fires now
-            x = self.event(t, x, "initial", "not initial()")
+        if getattr(self.mod, "AFTER_INITIAL", False):  # a sample at t, when not initial()
+            x = self.event(t, x, "initial", "after initialization")
         return x
 
     def terminal(self) -> None:
