@@ -1,5 +1,5 @@
 """The steps of a system as C statements: linear blocks solved in C, torn nonlinear
-blocks by Newton's method in C with the line search of :mod:`.newton_search` (the
+blocks by Newton's method in C with the backtracking of :mod:`.newton_search` (the
 tolerance and iteration limit of the Python module: :data:`.newton_search.NEWTON_TOLERANCE`,
 :data:`.context.NEWTON_ITERATIONS`).
 
@@ -23,7 +23,13 @@ from .context import (
     newton_trial,
     scalar_newton_step,
 )
-from .newton_search import search_accept, search_control, search_start, search_step
+from .newton_search import (
+    search_accept,
+    search_control,
+    search_end,
+    search_start,
+    search_step,
+)
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 SOLVE = """SPRINGC_FN void springc_solve(int n, int m, double *a, double *b, double *y)
@@ -129,6 +135,7 @@ class CContext(CodegenContext):
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
         loop += search_step(block.tearing, index)
         body.append(Loop(f"for (int _it = 0; _it < {NEWTON_ITERATIONS}; _it++) {{", loop))
+        body += search_end(block.tearing, index)
         body.append(Raw(f"if (!_ok{index}) {{\n    z[{self.flag_slot}] = {float(index + 1)!r};\n"
                         f"    _code = {index + 1};\n}}"))
         body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]

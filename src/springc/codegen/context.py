@@ -15,7 +15,7 @@ from typing import Any, TypeVar, cast
 
 from ..errors import Span
 from ..ir import flat, ode
-from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, sub, variables
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
 from .newton_search import (
@@ -23,6 +23,7 @@ from .newton_search import (
     residual_norm,
     search_accept,
     search_control,
+    search_end,
     search_start,
     search_step,
     search_trial,
@@ -225,6 +226,7 @@ class CodegenContext:
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
         loop += search_step(block.tearing, index)
         body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))
+        body += search_end(block.tearing, index)
         body.append(Raw(f"if not _ok{index}:\n    z[{self.flag_slot}] = "
                         f"{float(index + 1)}"))
         body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
