@@ -281,8 +281,8 @@ def newton_trial(block: ode.NonlinearBlock, index: int, guard: bool) -> list[Stm
 
 
 def block_names(block: ode.NonlinearBlock) -> set[str]:
-    """The names a torn block's statements define (its tearing variables, inner
-    assignments and sensitivities, and the search's base point)."""
+    """The names a torn block's statements define for the statements after it (its
+    tearing variables, inner assignments and sensitivities)."""
     return {*block.tearing, *(a.name for a in block.inner),
             *(s.name for s in block.sensitivities)}
 

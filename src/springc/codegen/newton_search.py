@@ -12,7 +12,8 @@ or whose evaluation raises an arithmetic or domain error (the Python backend:
 number), is retried with ``lam`` 10 times smaller (KINSOL's and Dennis and
 Schnabel's smallest backtracking factor, the one they take where the trial tells
 nothing about the residual's shape), down to :data:`LAMBDA_MIN`; below it the full
-step is taken, as before, and fails as before.
+step is taken, as before, and fails as before. A block that does not converge
+ends on its warm start (:func:`search_end`), not on its last iterate.
 
 Why not Armijo's sufficient decrease on the residual norm (KINSOL's line search)?
 It was tried (2026-11-28, branch semi) and made the MSL's HeatingNPN_NORGate fail
@@ -26,7 +27,7 @@ same iterates, bit for bit.
 The statements (the loop of :meth:`.context.CodegenContext._nonlinear` and of its C
 twin) are, per block ``i`` with tearing variables ``t_k``::
 
-    _base_k = t_k; _d_k = 0; _lam = 0; _ls = False            (before the loop)
+    _base_k = _warm_k = t_k; _d_k = 0; _lam = 0; _ls = False  (before the loop)
     loop:
         t_k = _base_k - _lam * _d_k                           (trial)
         inner assignments, residuals _r_k, _nr = sum _r_k^2   (Python: in a try)
@@ -34,6 +35,7 @@ twin) are, per block ``i`` with tearing variables ``t_k``::
         _base_k = t_k                                         (accepted)
         Jacobian, _d_k = J^-1 r
         _lam = 1; _ls = True; _done = every |_d_k| small
+    t_k = t_k if _ok else _warm_k                             (after the loop)
 """
 
 from __future__ import annotations
