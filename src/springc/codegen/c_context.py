@@ -1,6 +1,7 @@
 """The steps of a system as C statements: linear blocks solved in C, torn nonlinear
-blocks by Newton's method in C (the tolerance and iteration limit of the Python
-module: :data:`.context.NEWTON_TOLERANCE`, :data:`.context.NEWTON_ITERATIONS`).
+blocks by Newton's method in C with the backtracking of :mod:`.newton_search` (the
+tolerance and iteration limit of the Python module: :data:`.newton_search.NEWTON_TOLERANCE`,
+:data:`.context.NEWTON_ITERATIONS`).
 
 :class:`CContext` is the generator's :class:`.context.CodegenContext` whose blocks are
 written with fixed-size local arrays and ``springc_solve`` (:data:`SOLVE`) instead of
@@ -18,8 +19,16 @@ from .context import (
     NEWTON_ITERATIONS,
     CodegenBug,
     CodegenContext,
-    newton_update,
+    block_names,
+    newton_trial,
     scalar_newton_step,
+)
+from .newton_search import (
+    search_accept,
+    search_control,
+    search_end,
+    search_start,
+    search_step,
 )
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
@@ -106,10 +115,11 @@ class CContext(CodegenContext):
         slots = [self.guess_slots[t] for t in block.tearing]
         body: list[Stmt] = [Load(t, f"z[{s}]", f"{t} (warm start)")
                             for t, s in zip(block.tearing, slots)]
+        body += search_start(block.tearing, index)
         body.append(Raw(f"int _ok{index} = 0;\n_done{index} = 0.0;"))
-        loop: list[Stmt] = [Let(a.name, a.expr, f"{a.name}") for a in block.inner]
-        loop += [Let(f"_r{index}_{i}", r, "residual") for i, r in enumerate(block.residuals)]
-        loop.append(Raw(f"if (_done{index} != 0.0) {{\n    _ok{index} = 1;\n    break;\n}}"))
+        loop = newton_trial(block, index, guard=False)
+        loop.append(search_control(index, c=True))
+        loop += search_accept(block.tearing, index)
         loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
         entries = {(i, j): e for i, j, e in block.jacobian}
         if k == 1:
@@ -123,14 +133,13 @@ class CContext(CodegenContext):
             loop.append(Raw(f"double _D{index}[{k}];\n"
                             f"springc_solve({k}, 1, _J{index}, _R{index}, _D{index});"))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
-        loop += newton_update(block.tearing, index)
+        loop += search_step(block.tearing, index)
         body.append(Loop(f"for (int _it = 0; _it < {NEWTON_ITERATIONS}; _it++) {{", loop))
+        body += search_end(block.tearing, index)
         body.append(Raw(f"if (!_ok{index}) {{\n    z[{self.flag_slot}] = {float(index + 1)!r};\n"
                         f"    _code = {index + 1};\n}}"))
         body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
-        names = {*block.tearing, *(a.name for a in block.inner),
-                 *(s.name for s in block.sensitivities)}
-        return Block(body, comment, names)
+        return Block(body, comment, block_names(block))
 
 
 def _solve(result: str, matrix: str, rhs: str, n: int, m: int) -> str:

@@ -15,9 +15,19 @@ from typing import Any, TypeVar, cast
 
 from ..errors import Span
 from ..ir import flat, ode
-from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, sub, variables
+from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
+from .newton_search import (
+    guarded,
+    residual_norm,
+    search_accept,
+    search_control,
+    search_end,
+    search_start,
+    search_step,
+    search_trial,
+)
 from .newton_step import newton_solve
 from .statements import Block, Let, Load, Loop, Raw, Stmt, Store, guarded_solve
 
@@ -47,7 +57,6 @@ per step: the Zener clamp of tests/simulation/models/ZenerClamp.mo needs about 1
 vm = 3 V to its solution -0.03 V (the rhs starts from the last call's solution, which a
 stage of a large step can leave far away); with 50 its run with ``--stop 0.36`` stopped
 ("did not converge at time 0.338", 0.036 on scipy's loop)."""
-NEWTON_TOLERANCE = 1e-10
 
 
 @dataclass(frozen=True)
@@ -98,6 +107,10 @@ class GeneratedModel:
 class CodegenContext:
     """The system being generated: names and lookups shared by the generated functions
     and the module text (the parts of codegen below the generator take it)."""
+
+    guard_errors = False
+    """Whether a Newton trial's arithmetic errors are caught (the Python backend, whose
+    ``math`` functions raise where numba's and C's return inf or NaN)."""
 
     def __init__(self, system: ode.ODE, flat_model: flat.FlatModel | None) -> None:
         self.delays = DelayLayout(system)  # delay(...) calls read z slots (delays.py)
@@ -192,11 +205,11 @@ class CodegenContext:
         slots = [self.guess_slots[t] for t in block.tearing]
         body: list[Stmt] = [Load(t, f"float(z[{s}])", f"{t} (warm start)")
                             for t, s in zip(block.tearing, slots)]
+        body += search_start(block.tearing, index)
         body.append(Raw(f"_ok{index} = False\n_done{index} = False"))
-        loop: list[Stmt] = [Let(a.name, a.expr, source_comment(a.name, a.span))
-                            for a in block.inner]
-        loop += [Let(f"_r{index}_{i}", r, "residual") for i, r in enumerate(block.residuals)]
-        loop.append(Raw(f"if _done{index}:\n    _ok{index} = True\n    break"))
+        loop = newton_trial(block, index, self.guard_errors)
+        loop.append(search_control(index, c=False))
+        loop += search_accept(block.tearing, index)
         loop += [Let(s.name, s.expr, "sensitivity") for s in block.sensitivities]
         entries = {(i, j): e for i, j, e in block.jacobian}
         if k == 1:
@@ -211,14 +224,13 @@ class CodegenContext:
             loop.append(Raw(newton_solve(f"_D{index}", f"_J{index}", f"_R{index}",
                                          f"_T{index}", k)))
             loop += [Load(f"_d{index}_{i}", f"_D{index}[{i}]") for i in range(k)]
-        loop += newton_update(block.tearing, index)
+        loop += search_step(block.tearing, index)
         body.append(Loop(f"for _it in range({NEWTON_ITERATIONS}):", loop))
+        body += search_end(block.tearing, index)
         body.append(Raw(f"if not _ok{index}:\n    z[{self.flag_slot}] = "
                         f"{float(index + 1)}"))
         body += [Store(f"z[{s}]", Var(t)) for t, s in zip(block.tearing, slots)]
-        names = {*block.tearing, *(a.name for a in block.inner),
-                 *(s.name for s in block.sensitivities)}
-        return Block(body, comment, names)
+        return Block(body, comment, block_names(block))
 
     def alias_stmts(self, names: Sequence[str]) -> list[Stmt]:
         """Lets for the aliases among ``names`` and the aliases they read, in order."""
@@ -257,20 +269,22 @@ def scalar_newton_step(tearing: str, pivot: Expr, index: int) -> list[Stmt]:
                                    BinOp("/", r, d)))]
 
 
-def newton_update(tearing: Sequence[str], index: int) -> list[Stmt]:
-    """The Newton step of block ``index`` on its tearing variables (``_d{index}_{i}``
-    holds the solved correction) and its convergence flag ``_done{index}``: every
-    correction within :data:`NEWTON_TOLERANCE` of ``1 + |t|``. Both printers use it."""
-    stmts: list[Stmt] = []
-    done: Expr | None = None
-    for i, t in enumerate(tearing):
-        stmts.append(Let(t, sub(Var(t), Var(f"_d{index}_{i}")), f"{t} (Newton step)"))
-        small = BinOp("<=", Call("abs", (Var(f"_d{index}_{i}"),)),
-                      mul(Const(NEWTON_TOLERANCE), add(Const(1.0), Call("abs", (Var(t),)))))
-        done = small if done is None else BinOp("and", done, small)
-    assert done is not None
-    stmts.append(Let(f"_done{index}", done))
-    return stmts
+def newton_trial(block: ode.NonlinearBlock, index: int, guard: bool) -> list[Stmt]:
+    """The start of a Newton iteration's body: the trial point, the block's inner
+    assignments and residuals at it, and their squared norm (in Python's ``try`` where
+    ``guard``: :func:`.newton_search.guarded`)."""
+    part = search_trial(block.tearing, index)
+    part += [Let(a.name, a.expr, source_comment(a.name, a.span)) for a in block.inner]
+    part += [Let(f"_r{index}_{i}", r, "residual") for i, r in enumerate(block.residuals)]
+    part.append(residual_norm(index, len(block.residuals)))
+    return guarded(part, index, guard)
+
+
+def block_names(block: ode.NonlinearBlock) -> set[str]:
+    """The names a torn block's statements define for the statements after it (its
+    tearing variables, inner assignments and sensitivities)."""
+    return {*block.tearing, *(a.name for a in block.inner),
+            *(s.name for s in block.sensitivities)}
 
 
 def block_comment(kind: str, names: Sequence[str], spans: Sequence[Span]) -> str:

@@ -128,6 +128,7 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
     namer = Namer(m.model_names)
     helpers: set[str] = set()
     numba = options.backend == "numba"
+    m.guard_errors = not numba  # math.exp raises in Python: a Newton trial backtracks
     vector = options.vector
     if m.events is not None or len(m.delays):
         vector = False  # the event functions are written with scalar statements

@@ -106,9 +106,10 @@ _RESERVED = frozenset({
 # identifiers that start with ``_``, used verbatim.
 _INTERNAL = re.compile(r"_[A-Za-z]+[0-9]*(?:_[0-9]+)?\Z")
 # The internal names that statements bind through the namer (Newton residuals, steps,
-# convergence flags, pivots): a model variable of the same name would be the same
-# string in the statements, so such model names are refused (see reserved_name).
-_BOUND_INTERNAL = re.compile(r"_(?:r|d|done|J)[0-9]+(?:_[0-9]+)?\Z")
+# convergence flags, pivots; the Newton search's base points, step lengths, norms and
+# flags): a model variable of the same name would be the same string in the
+# statements, so such model names are refused (see reserved_name).
+_BOUND_INTERNAL = re.compile(r"_(?:r|d|done|J|base|warm|lam|nr|ls)[0-9]+(?:_[0-9]+)?\Z")
 
 
 def reserved_name(names: Iterable[str]) -> str | None:
