@@ -18,8 +18,9 @@ annotation) runs in its own process, capped at ``--cap`` seconds (default 120):
 - **match**: every signal of ``comparisonSignals.txt`` agrees with the reference:
   ``max |a - b| / max(1, |b|) <= --tol`` (default 1e-3) on the reference's times,
   every row of the reference inside springc's result (a result that ends before the
-  reference's last time is an error, never extrapolated), leaving out the rows of an event (a time written twice) and, with ``--guard``, the
-  rows within that many output intervals of one (default 1); an event springc locates
+  reference's last time is an error, never extrapolated), leaving out the rows of an
+  event (a time written twice) and, with ``--guard``, the rows within that many output
+  intervals of one (default 1); an event springc locates
   at most ``PAIRED_EVENTS`` intervals from the reference's also leaves out the rows
   between the two times (with the same guard).
 
