@@ -11,12 +11,16 @@ Every example (a class directly in the package's ``Examples`` with an ``experime
 annotation) runs in its own process, capped at ``--cap`` seconds (default 120):
 
 - **check**: it flattens and is balanced (``springc check``);
-- **simulate**: it compiles and runs at its experiment settings (start, stop, tolerance;
-  the output interval is the reference's, so the grid holds the reference's times);
+- **simulate**: it compiles and runs at its experiment settings (tolerance), from the
+  reference's first time to its last and at its output interval, so that the grid holds
+  the reference's times (Analog.DifferenceAmplifier's experiment stops at 1e-8 s, its
+  reference at 1 s: the line names such an example's spans);
 - **match**: every signal of ``comparisonSignals.txt`` agrees with the reference:
   ``max |a - b| / max(1, |b|) <= --tol`` (default 1e-3) on the reference's times,
-  leaving out the rows of an event (a time written twice) and, with ``--guard``, the
-  rows within that many output intervals of one (default 1); an event springc locates
+  every row of the reference inside springc's result (a result that ends before the
+  reference's last time is an error, never extrapolated), leaving out the rows of an
+  event (a time written twice) and, with ``--guard``, the rows within that many output
+  intervals of one (default 1); an event springc locates
   at most ``PAIRED_EVENTS`` intervals from the reference's also leaves out the rows
   between the two times (with the same guard).
 
@@ -106,6 +110,7 @@ class Reference:
     values: dict[str, object]
     interval: float
     events: tuple[float, ...] = ()  # the times written twice
+    span: tuple[float, float] = (0.0, 0.0)  # the first and last time, event rows included
 
 
 #: A reference event and springc's nearest one at most this many output intervals
@@ -156,7 +161,22 @@ def read_reference(refs: Path, example: str, guard: float) -> Reference:
     for te in events:
         keep &= np.abs(t - te) > guard * interval * (1 + 1e-9) if guard else t != te
     return Reference(signals, t[keep], {s: table[keep, column[s]] for s in signals},
-                     interval, tuple(float(te) for te in np.unique(events)))
+                     interval, tuple(float(te) for te in np.unique(events)),
+                     (float(t[0]), float(t[-1])) if len(t) else (0.0, 0.0))
+
+
+def uncovered(reference: Reference, time: object) -> str:
+    """Why springc's result over ``time`` cannot be compared with every row of the
+    reference (it starts after its first time or ends before its last), or ``""``."""
+    import numpy as np
+
+    t = np.asarray(time)
+    first, last = reference.span
+    width = 1e-9 * max(1.0, abs(first), abs(last))
+    if not len(t) or t[0] > first + width or t[-1] < last - width:
+        ends = f"{t[0]:g} to {t[-1]:g} s" if len(t) else "no rows"
+        return f"the result covers {ends}, the reference {first:g} to {last:g} s"
+    return ""
 
 
 def _stage(out: dict[str, object], stage: str) -> None:
@@ -186,12 +206,23 @@ def one(args: argparse.Namespace, out: dict[str, object]) -> None:
 
     model = springc.compile_model(files, example, libraries=[str(args.msl)],
                                   backend=args.backend)
-    result = springc.simulate(model, interval=reference.interval if reference else None,
-                              engine=args.engine, error_control=args.error_control)
+    span = {} if reference is None else \
+        {"start": reference.span[0], "stop": reference.span[1], "interval": reference.interval}
+    result = springc.simulate(model, engine=args.engine, error_control=args.error_control,
+                              **span)
     _stage(out, "compare")
     if reference is None:
         out["note"] = "no reference result"
         return
+    experiment = model.module.EXPERIMENT
+    own = (float(experiment.get("start") or 0.0), float(experiment.get("stop") or 1.0))
+    if own != reference.span:  # the reference tool's stop time differs (its creation.txt)
+        out["span"] = (f"reference {reference.span[0]:g} to {reference.span[1]:g} s, "
+                       f"experiment {own[0]:g} to {own[1]:g} s")
+    out["error"] = uncovered(reference, result.time)
+    if out["error"]:
+        return
+    del out["error"]
     worst, where = 0.0, ""
     keep = paired_rows(reference, [e.time for e in result.events
                                    if e.kind in ("state", "time")], args.guard)
@@ -283,6 +314,8 @@ def main(argv: list[str] | None = None) -> int:
             counts = [c + f for c, f in zip(counts, flags)]
             what = out.get("error") or out.get("note") or \
                 f"worst {out.get('worst', 0):.2e} ({out.get('signal')})"
+            if out.get("span"):
+                what += f"; {out['span']}"
             print(f"{package:13} {example.split('.')[-1]:32} "
                   f"{'CSM'[:sum(flags)]:3} {out.get('seconds', 0):6.1f}s  {what}"[:300],
                   flush=True)

@@ -81,12 +81,13 @@ class Reduced:
     blocks: tuple[DummyBlock, ...] = field(default=())
 
 
-def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[int]]:
+def _number_variables(system: dae.DAE, prefer: bool = False
+                      ) -> tuple[list[str], dict[str, int], list[int]]:
     names = [u.name for u in system.unknowns]
     index = {n: i for i, n in enumerate(names)}
     derivative = [-1] * len(names)
     pending = sorted({n for r in system.equations for n in r.variables
-                      if dae.is_derivative(n)} | forced_derivatives(system),
+                      if dae.is_derivative(n)} | forced_derivatives(system, prefer),
                      key=lambda n: (len(n), n))
     for name in pending:
         base = dae.derivative_base(name)
@@ -100,20 +101,57 @@ def _number_variables(system: dae.DAE) -> tuple[list[str], dict[str, int], list[
     return names, index, derivative
 
 
-def forced_derivatives(system: dae.DAE) -> set[str]:
+def forced_derivatives(system: dae.DAE, prefer: bool = False) -> set[str]:
     """The derivative variables of the unknowns declared ``StateSelect.always``
-    (Modelica 3.6, section 4.8.7.1: "always: do use it as a state"), whether or not an
-    equation differentiates them. Where none does, ``der(v)`` enters with no equation:
-    ``v`` becomes a candidate state, Pantelides differentiates the equations that
-    determine it, and the dummy-derivative choice keeps ``v`` (it ranks first), as
-    OpenModelica and Dymola make such a variable a state."""
-    return {dae.derivative_name(u.name) for u in system.unknowns
-            if u.state_select == "always"}
+    (Modelica 3.6, section 4.8.7.1: "always: do use it as a state"), and with ``prefer``
+    those declared ``StateSelect.prefer`` ("use it preferably as a state") that are the
+    derivative of another variable (:func:`_preferred_velocities`), whether or not an
+    equation differentiates them. Where none does, ``der(v)`` enters with no
+    equation: ``v`` becomes a candidate state, Pantelides differentiates the equations
+    that determine it, and the dummy-derivative choice keeps ``v`` where the structure
+    allows (it ranks above default variables; ``always`` first), as OpenModelica and
+    Dymola make such a variable a state: a spring's ``v_rel = der(s_rel)`` between two
+    masses keeps ``s_rel`` and ``v_rel`` rather than a mass's ``s`` and ``v``, which
+    decides what a ``reinit`` of the other mass's velocity leaves unchanged."""
+    forced = {dae.derivative_name(u.name) for u in system.unknowns
+              if u.state_select == "always"}
+    return forced | _preferred_velocities(system) if prefer else forced
+
+
+def _preferred_velocities(system: dae.DAE) -> set[str]:
+    """``der(v)`` of each ``StateSelect.prefer`` variable ``v`` that an equation makes
+    the derivative of another variable (``v = der(x)``: a preferred relative position's
+    velocity). Only those: a preferred variable that is some algebraic function of the
+    states (``y = g(x)``) stays algebraic, rather than a state whose equation must be
+    solved backwards for ``x``."""
+    preferred = {u.name for u in system.unknowns if u.state_select == "prefer"}
+    found = set()
+    for r in system.equations:
+        names = r.incident
+        if len(names) == 2:
+            (a, b) = sorted(names, key=dae.is_derivative)
+            if a in preferred and dae.is_derivative(b) and dae.derivative_base(b) != a:
+                found.add(dae.derivative_name(a))
+    return found
 
 
 def index_reduce(system: dae.DAE, at: Mapping[str, float] | None = None) -> Reduced:
-    """Pantelides, then dummy derivatives (see the module docstring for ``at``)."""
-    names, index, derivative = _number_variables(system)
+    """Pantelides, then dummy derivatives (see the module docstring for ``at``).
+    ``StateSelect.prefer`` variables are candidate states (:func:`forced_derivatives`)
+    unless that makes the reduction fail (an equation that determines one and cannot
+    be differentiated, a singular choice): then they are candidates only where an
+    equation differentiates them, as before."""
+    written = {n for r in system.equations for n in r.variables if dae.is_derivative(n)}
+    if forced_derivatives(system, prefer=True) <= written | forced_derivatives(system):
+        return _index_reduce(system, at, False)
+    try:
+        return _index_reduce(system, at, True)
+    except SimplifyError:
+        return _index_reduce(system, at, False)
+
+
+def _index_reduce(system: dae.DAE, at: Mapping[str, float] | None, prefer: bool) -> Reduced:
+    names, index, derivative = _number_variables(system, prefer)
     exprs = [r.expr for r in system.equations]
     sources = list(system.equations)
     orders = [0] * len(exprs)

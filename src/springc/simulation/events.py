@@ -137,7 +137,11 @@ class EventLoop:
                k: int) -> float:
         """The first time in ``(ta, tb]`` at which relation ``k`` has switched (to
         :data:`LOCATE_RELATIVE`), by regula falsi with the Illinois rule on its
-        zero-crossing function, keeping a bracket."""
+        zero-crossing function, keeping a bracket. Where the function is exactly 0 at
+        the bracket's left end (a velocity that starts from rest at the event before:
+        a friction's ``v > 0`` after it starts forward) every secant point is that end,
+        and halving the other end's value does not move it: the bracket is bisected
+        instead (before, the time was the bracket's right end, a whole step late)."""
         op, held = self.ops[k], self.z[self.first + k] != 0.0
 
         def g(t: float) -> float:
@@ -149,7 +153,7 @@ class EventLoop:
         for _ in range(200):
             if tb - ta <= tol:
                 break
-            if math.isfinite(ga) and math.isfinite(gb) and ga != gb:
+            if math.isfinite(ga) and math.isfinite(gb) and ga != gb and ga != 0.0:
                 tm = tb - gb * (tb - ta) / (gb - ga)
             else:
                 tm = 0.5 * (ta + tb)
