@@ -188,12 +188,16 @@ def simulate_switching(model: flat.FlatModel, t_span: tuple[float, float],
     if needs_switch(choice, values, threshold, t0):
         choice = _switch(model, choice, values, t0, threshold, switches)
         x0 = state_vector(choice, values)
+    # The flat model's unknowns, then every choice's states that are no flat variable:
+    # a derivative that index reduction made a state (``der(x)`` where ``v = der(x)``
+    # has ``v`` avoided), computed by every choice (a state, or a dummy derivative).
     names = [v.name for v in model.variables if v.is_unknown]
     times: list[float] = []
     rows: list[dict[str, float]] = []
     requested = None if t_eval is None else np.asarray(t_eval, dtype=float)
     t, state = t0, x0
     while True:
+        names += [s.name for s in choice.ode.states if s.name not in names]
         functions = make_functions(choice, params, values)
         event = conditioning_event(choice, functions, threshold)
         segment = None

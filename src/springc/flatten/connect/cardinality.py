@@ -54,8 +54,31 @@ def _replace(e: x.Expr, counts: Counter[str], memo: dict[int, tuple[x.Expr, x.Ex
         return e
     else:
         out = x.map_children(e, lambda c: _replace(c, counts, memo))
+        if out is not e:
+            out = _decided(out)
     memo[id(e)] = (e, out)
     return out
+
+
+_LOGICAL = x.RELATIONS | {"and", "or"}
+
+
+def _decided(e: x.Expr) -> x.Expr:
+    """``e`` with a condition that the counts made constant evaluated, and an ``if``
+    on it reduced to its branch: an if-equation on ``cardinality(flange_a) > 0``
+    (LineForceWithMass) keeps only the equations of the branch that holds. Else the
+    other branches' equations stay in the if-expressions as unknowns the equation
+    reads (``fb = if 1 > 0 then flange_b.f else -fa``), which couples variables the
+    model does not couple (a larger algebraic loop) and makes the constant relations
+    events."""
+    if isinstance(e, x.BinOp) and e.op in _LOGICAL and isinstance(e.left, x.Const) \
+            and isinstance(e.right, x.Const):
+        return x.Const(x.evaluate(e, {}))
+    if isinstance(e, x.Not) and isinstance(e.arg, x.Const):
+        return x.Const(not e.arg.value)
+    if isinstance(e, x.If) and isinstance(e.cond, x.Const):
+        return e.then if e.cond.value else e.otherwise
+    return e
 
 
 def apply_cardinalities(fl: FlatResults, counts: Counter[str]) -> None:
