@@ -202,10 +202,10 @@ SC_FN int si_colour(struct si_work *s) {
     sl_int n = s->n, nnz = s->nnz;
     sl_int *work = (sl_int *)calloc((size_t)(4 * n + nnz + 4), sizeof(sl_int));
     if (work == NULL) return 0;
-    sl_int *colour = work, *mark = colour + n + 1, *row_start = mark + n + 1;
-    sl_int *row_cols = row_start + n + 1;
+    sl_int *colour = work, *mark = colour + n + 1;
     s->n_colours = 0;
 #ifdef SI_PATTERN_NNZ
+    sl_int *row_start = mark + n + 1, *row_cols = row_start + n + 1;
     for (sl_int k = 0; k < nnz; k++) row_start[si_row_of(k) + 1] += 1;
     for (sl_int i = 0; i < n; i++) row_start[i + 1] += row_start[i];
     for (sl_int i = 0; i < n; i++) mark[i] = row_start[i];  /* each row's next slot */
