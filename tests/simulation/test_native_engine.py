@@ -121,11 +121,11 @@ def test_a_model_beyond_the_loops_size_rule_is_generated_for_numba(
     monkeypatch.setattr(c_kernels, "C_LOOP_STACK_BYTES", 10**9)
     without = c_kernels.c_source(model).replace("#define SPRINGC_HAS_JACOBIAN 1\n",
                                                 "#define SPRINGC_HAS_JACOBIAN 0\n")
-    assert c_kernels.loop_refusal(without) is None  # 4 states: a dense Jacobian is cheap
-    monkeypatch.setattr(c_kernels, "C_LOOP_DENSE_STATES", 3)
+    assert c_kernels.loop_refusal(without) is None  # 4 states: differenced in C
+    monkeypatch.setattr(c_kernels, "C_LOOP_DIFFERENCED_STATES", 3)
     assert c_kernels.loop_refusal(without) == (
-        "it has 4 states and no Jacobian in C (the C loop's implicit methods would "
-        "factorise a dense one; it takes at most 3 states without one)")
+        "it has 4 states and no Jacobian in C (the C loop takes at most 3 states "
+        "without one)")
 
 
 @pytest.mark.parametrize(("masses", "grouped"), [(20, False), (200, True)])
@@ -137,15 +137,15 @@ def test_a_refusal_the_module_tells_prints_no_c_and_agrees_with_the_c_file(
     from springc.pipeline import CLoopRefused, c_kernels
 
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path))
-    monkeypatch.setattr(c_kernels, "C_LOOP_DENSE_STATES", 8)
+    monkeypatch.setattr(c_kernels, "C_LOOP_DIFFERENCED_STATES", 8)
     model = springc.compile_model(SCENES, "Scenes.Chain", backend="python",
                                   parameters={"N": masses})
     assert hasattr(model.module, "_I") == grouped  # the vector layout's index table
     assert c_kernels.known_refusal(model) is None  # 2,000 non-zeros: a Jacobian in C
     monkeypatch.setattr(c_kernels, "JACOBIAN_LIMIT", 10)
     monkeypatch.setattr(c_model, "JACOBIAN_LIMIT", 10)
-    reason = (f"it has {2 * masses:,} states and no Jacobian in C (the C loop's implicit "
-              "methods would factorise a dense one; it takes at most 8 states without one)")
+    reason = (f"it has {2 * masses:,} states and no Jacobian in C (the C loop takes at "
+              "most 8 states without one)")
     assert c_kernels.known_refusal(model) == reason
     with pytest.raises(CLoopRefused, match="no Jacobian in C"):
         c_kernels.loop_library(model)

@@ -21,9 +21,14 @@
    the Jacobian's pattern there.
 
    The Jacobian is the C model's analytic springc_jacobian (non-zeros in CSC order); a
-   model printed without one (over codegen.c_model.JACOBIAN_LIMIT non-zeros) gets a
-   dense forward-difference Jacobian here (each column's evaluation counted as a
-   right-hand-side evaluation; the numba loops always have the analytic one).
+   model printed without one (over codegen.c_model.JACOBIAN_LIMIT non-zeros) gets
+   forward differences here (each evaluation counted as a right-hand-side evaluation;
+   the numba loops always have the analytic one): grouped by the pattern of the
+   generated module's Jacobian where native_loop.loop_text printed it (SI_PATTERN_NNZ,
+   si_pattern_indptr, si_pattern_indices: CSC), columns that share no row perturbed in
+   one evaluation (a greedy colouring in column order; a chain's banded pattern needs a
+   handful of evaluations, not one per state), else dense (one column per evaluation,
+   n*n non-zeros).
    Complex division is CPython's (and numba's) algorithm, not the C library's, so that
    the factors equal the numba loop's. */
 
@@ -46,6 +51,7 @@ struct si_work {
     int method;
     sl_int n, nnz, kl, ku, width;
     sl_int *order, *positions, *diagonal, *pivots, *pivots2, *solve_order;
+    sl_int n_colours, *colour_start, *colour_cols; /* forward differences' groups */
     double *J, *real, *D, *Z0, *Z, *Q, *W, *F, *dW, *vec, *tmp, *rescaled;
     si_complex *cplx, *f_complex, *work_complex;
     double newton_tol, h_abs_old, error_norm_old, t_old, h_dense, t_new, h_now;
@@ -175,6 +181,63 @@ SC_FN void si_solve_in_order_complex(const struct si_work *s, si_complex *b) {
     for (sl_int i = 0; i < s->n; i++) b[s->order[i]] = s->work_complex[i];
 }
 
+#if !SPRINGC_HAS_JACOBIAN
+/* The differenced Jacobian's pattern (CSC): where column j starts, the row of the
+   non-zero k. */
+#ifdef SI_PATTERN_NNZ
+#define SI_NNZ ((sl_int)SI_PATTERN_NNZ)
+SC_FN sl_int si_column_start(sl_int j) { return si_pattern_indptr[j]; }
+SC_FN sl_int si_row_of(sl_int k) { return si_pattern_indices[k]; }
+#else
+#define SI_NNZ ((sl_int)SC_NX * SC_NX)
+SC_FN sl_int si_column_start(sl_int j) { return j * SC_NX; }
+SC_FN sl_int si_row_of(sl_int k) { return k % SC_NX; }
+#endif
+
+/* The forward differences' groups (s->colour_start, s->colour_cols: the columns
+   colour by colour, each in column order): column j takes the first colour that no
+   earlier column sharing a row with it has (greedy, in column order; the dense
+   pattern: one column per colour). 0 where the work could not be allocated. */
+SC_FN int si_colour(struct si_work *s) {
+    sl_int n = s->n, nnz = s->nnz;
+    sl_int *work = (sl_int *)calloc((size_t)(4 * n + nnz + 4), sizeof(sl_int));
+    if (work == NULL) return 0;
+    sl_int *colour = work, *mark = colour + n + 1;
+    s->n_colours = 0;
+#ifdef SI_PATTERN_NNZ
+    sl_int *row_start = mark + n + 1, *row_cols = row_start + n + 1;
+    for (sl_int k = 0; k < nnz; k++) row_start[si_row_of(k) + 1] += 1;
+    for (sl_int i = 0; i < n; i++) row_start[i + 1] += row_start[i];
+    for (sl_int i = 0; i < n; i++) mark[i] = row_start[i];  /* each row's next slot */
+    for (sl_int j = 0; j < n; j++)
+        for (sl_int k = si_column_start(j); k < si_column_start(j + 1); k++)
+            row_cols[mark[si_row_of(k)]++] = j;
+    for (sl_int i = 0; i < n; i++) mark[i] = -1;
+    for (sl_int j = 0; j < n; j++) {
+        for (sl_int k = si_column_start(j); k < si_column_start(j + 1); k++) {
+            sl_int r = si_row_of(k);
+            for (sl_int q = row_start[r]; q < row_start[r + 1] && row_cols[q] < j; q++)
+                mark[colour[row_cols[q]]] = j;
+        }
+        sl_int c = 0;
+        while (c < s->n_colours && mark[c] == j) c++;
+        colour[j] = c;
+        if (c == s->n_colours) s->n_colours += 1;
+    }
+#else
+    for (sl_int j = 0; j < n; j++) colour[j] = j;
+    s->n_colours = n;
+#endif
+    for (sl_int c = 0; c <= s->n_colours; c++) s->colour_start[c] = 0;
+    for (sl_int j = 0; j < n; j++) s->colour_start[colour[j] + 1] += 1;
+    for (sl_int c = 0; c < s->n_colours; c++) s->colour_start[c + 1] += s->colour_start[c];
+    for (sl_int c = 0; c < s->n_colours; c++) mark[c] = s->colour_start[c];
+    for (sl_int j = 0; j < n; j++) s->colour_cols[mark[colour[j]]++] = j;
+    free(work);
+    return 1;
+}
+#endif
+
 /* The Jacobian's non-zeros at (t, y) into s->J (analytic, or forward differences),
    and its verdict. */
 SC_FN int si_jacobian(struct si_work *s, double t, const double *y, const double *p,
@@ -187,14 +250,20 @@ SC_FN int si_jacobian(struct si_work *s, double t, const double *y, const double
     double *f0 = scratch, *f1 = scratch + SC_NXS, *x = scratch + 2 * SC_NXS;
     si_rhs(t, y, p, z, f0);
     counts[SL_RHS_CALLS] += 1;
-    for (int j = 0; j < SC_NX && !sc_flagged(z); j++) {
+    for (sl_int c = 0; c < s->n_colours && !sc_flagged(z); c++) {
         sl_copy(x, y);
-        double h = sqrt(SI_EPS) * sc_max(1.0, fabs(y[j]));
-        x[j] = y[j] + h;
-        h = x[j] - y[j];
+        for (sl_int q = s->colour_start[c]; q < s->colour_start[c + 1]; q++) {
+            sl_int j = s->colour_cols[q];
+            x[j] = y[j] + sqrt(SI_EPS) * sc_max(1.0, fabs(y[j]));
+        }
         si_rhs(t, x, p, z, f1);
         counts[SL_RHS_CALLS] += 1;
-        for (int i = 0; i < SC_NX; i++) s->J[j * SC_NX + i] = (f1[i] - f0[i]) / h;
+        for (sl_int q = s->colour_start[c]; q < s->colour_start[c + 1]; q++) {
+            sl_int j = s->colour_cols[q];
+            double h = x[j] - y[j];
+            for (sl_int k = si_column_start(j); k < si_column_start(j + 1); k++)
+                s->J[k] = (f1[si_row_of(k)] - f0[si_row_of(k)]) / h;
+        }
     }
 #endif
     if (sc_flagged(z)) return SC_MODEL_FAILED;
@@ -253,10 +322,11 @@ SC_FN void si_layout(struct si_work *s, const sl_int *order, sl_int *where, int 
 #if SPRINGC_HAS_JACOBIAN
     springc_jacobian_pattern(rows, cols);
 #else
-    for (sl_int k = 0; k < s->nnz; k++) {
-        rows[k] = (int)(k % n);
-        cols[k] = (int)(k / n);
-    }
+    for (sl_int j = 0; j < n; j++)
+        for (sl_int k = si_column_start(j); k < si_column_start(j + 1); k++) {
+            rows[k] = (int)si_row_of(k);
+            cols[k] = (int)j;
+        }
 #endif
     for (sl_int i = 0; i < n; i++) s->order[i] = n > SI_DENSE_LIMIT && order ? order[i] : i;
     for (sl_int i = 0; i < n; i++) where[s->order[i]] = i;
@@ -284,12 +354,13 @@ SC_FN int si_setup(struct si_work *s, int method, const sl_int *order) {
 #if SPRINGC_HAS_JACOBIAN
     sl_int nnz = SPRINGC_N_JAC;
 #else
-    sl_int nnz = n * n;
+    sl_int nnz = SI_NNZ;
 #endif
     s->method = method;
     s->n = n;
     s->nnz = nnz;
-    s->order = (sl_int *)malloc((size_t)(7 * nx + nnz + 1) * sizeof(sl_int));
+    s->n_colours = 0;
+    s->order = (sl_int *)malloc((size_t)(9 * nx + nnz + 2) * sizeof(sl_int));
     s->J = NULL;
     s->cplx = NULL;
     if (s->order == NULL) return 0;
@@ -298,6 +369,11 @@ SC_FN int si_setup(struct si_work *s, int method, const sl_int *order) {
     s->pivots = s->diagonal + nx;
     s->pivots2 = s->pivots + nx;
     sl_int *where = s->pivots2 + nx;
+    s->colour_start = where + nx;
+    s->colour_cols = s->colour_start + nx + 1;
+#if !SPRINGC_HAS_JACOBIAN
+    if (!si_colour(s)) return 0;
+#endif
     int *pattern = (int *)malloc((size_t)(2 * nnz + 1) * sizeof(int));
     if (pattern == NULL) return 0;
     si_layout(s, order, where, pattern, pattern + nnz);

@@ -102,10 +102,25 @@ def implicit_prelude() -> str:
     return "".join(parts)
 
 
-def loop_text(model_c: str) -> str:
-    """The loop library's translation unit around the model's C text ``model_c``."""
+def pattern_prelude(indptr: np.ndarray, indices: np.ndarray) -> str:
+    """The pattern of a model's Jacobian (CSC: column starts, row of each non-zero) as
+    C (``SI_PATTERN_NNZ``, ``si_pattern_indptr``, ``si_pattern_indices``), for the
+    implicit methods' grouped forward differences of a C model with no Jacobian."""
+    def ints(name: str, values: np.ndarray) -> str:
+        items = [str(int(v)) for v in values] or ["0"]
+        rows = ",\n".join(", ".join(items[i:i + 20]) for i in range(0, len(items), 20))
+        return f"static const int {name}[{len(items)}] = {{\n{rows}}};\n"
+    return (f"#define SI_PATTERN_NNZ {int(indptr[-1])}\n" + ints("si_pattern_indptr", indptr)
+            + ints("si_pattern_indices", indices))
+
+
+def loop_text(model_c: str, pattern: tuple[np.ndarray, np.ndarray] | None = None) -> str:
+    """The loop library's translation unit around the model's C text ``model_c``;
+    ``pattern`` (CSC ``indptr``, ``indices``): the Jacobian's pattern that a C model
+    without a Jacobian differences by groups of columns (None: one column at a
+    time)."""
     head = ("#include <math.h>\n#undef SPRINGC_FN\n#define SPRINGC_FN static inline\n")
     return (head + model_c + "\n" + prelude(False) + rk45_prelude()
             + CORE.read_text(encoding="utf-8") + LOOP.read_text(encoding="utf-8")
-            + implicit_prelude()
+            + implicit_prelude() + (pattern_prelude(*pattern) if pattern else "")
             + "".join(path.read_text(encoding="utf-8") for path in IMPLICIT))

@@ -22,6 +22,8 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from ..codegen import JACOBIAN_LIMIT, CodegenBug
 from ..errors import CodegenError
 from ..integrate import locked, loop_text
@@ -109,12 +111,16 @@ loop's row of observed values (``SPRINGC_N_OBSERVED``); a quarter of Linux's usu
 8 MiB (the 10,000-mass chain: 1.3 MB); a model beyond runs on numba."""
 
 
-C_LOOP_DENSE_STATES = 256
+C_LOOP_DIFFERENCED_STATES = 2_000
 """The most states of a model whose C model has no Jacobian (``SPRINGC_HAS_JACOBIAN``
-0: over ``codegen.JACOBIAN_LIMIT`` non-zeros) the C loop takes: its radau and
-bdf (explicitly asked for, or run by ``auto``'s race) then difference and factorise a
-dense Jacobian, n**2 memory and n**3 work per factorisation; a larger one runs on
-numba, whose analytic Jacobian is sparse."""
+0: over ``codegen.JACOBIAN_LIMIT`` non-zeros) the C loop takes. Its radau and bdf
+(asked for, or run by ``auto``'s race) difference the Jacobian by groups of columns
+on the generated module's pattern (``integrate.native_loop.pattern_prelude``; the
+1,000-mass chain: a few evaluations per Jacobian, banded LU), so the limit is not
+theirs (it was 256 while they differenced a dense one): it is the largest such model
+measured on the C loop, the 1,000-mass chain's 2,000 states (warm, 0.9-1.1x the
+hand-written loop's time). Larger ones (the 10,000-mass chain's 12 MB of C printed
+cold, the 50x50 cloth's 14 MB and its memory) stay on numba until measured there."""
 
 
 class CLoopRefused(CodegenError):
@@ -137,7 +143,7 @@ def note_refused(error: CodegenError, instead: str) -> None:
 def loop_refusal(text: str) -> str | None:
     """Why the C loop does not take the model of the C file ``text`` (its size
     macros against :data:`C_LOOP_CODE_CHARS`, :data:`C_LOOP_STACK_BYTES` and
-    :data:`C_LOOP_DENSE_STATES`), or
+    :data:`C_LOOP_DIFFERENCED_STATES`), or
     None where it does. The loop runs continuous models only: the caller checks."""
     sizes = _sizes(text)
     code = sizes["SPRINGC_CODE_CHARS"]
@@ -149,32 +155,32 @@ def loop_refusal(text: str) -> str | None:
         return (f"its C functions need {stack:,} bytes of stack (the C loop takes at "
                 f"most {C_LOOP_STACK_BYTES:,})")
     states = sizes["SPRINGC_N_STATES"]
-    if not sizes["SPRINGC_HAS_JACOBIAN"] and states > C_LOOP_DENSE_STATES:
-        return _dense_refusal(states)
+    if not sizes["SPRINGC_HAS_JACOBIAN"] and states > C_LOOP_DIFFERENCED_STATES:
+        return _differenced_refusal(states)
     return None
 
 
 def known_refusal(model: CompiledModel) -> str | None:
     """Why the C loop does not take ``model``, where its generated module tells without
     printing its C file (the 10,000-mass chain's is 12 MB, about 8 s of CPU, printed
-    only to be refused): over :data:`C_LOOP_DENSE_STATES` states and Jacobian non-zeros
+    only to be refused): over :data:`C_LOOP_DIFFERENCED_STATES` states and Jacobian
+    non-zeros
     in more than :data:`~springc.codegen.JACOBIAN_LIMIT` rows (``JAC_ROWS``). The C
     file then has no Jacobian: its scalar one has the module's pattern, its grouped one
     is not printed where more derivatives than the limit read a state
     (``codegen.c_vector.jacobian_floor``), and each row holding a non-zero is such a
     derivative. None where only the C file tells (:func:`loop_refusal`)."""
     states = len(model.states)
-    if states <= C_LOOP_DENSE_STATES or len(model.module.JAC_ROWS) <= JACOBIAN_LIMIT:
+    if states <= C_LOOP_DIFFERENCED_STATES or len(model.module.JAC_ROWS) <= JACOBIAN_LIMIT:
         return None
     if len(set(model.module.JAC_ROWS.tolist())) <= JACOBIAN_LIMIT:
         return None
-    return _dense_refusal(states)
+    return _differenced_refusal(states)
 
 
-def _dense_refusal(states: int) -> str:
-    return (f"it has {states:,} states and no Jacobian in C (the C loop's implicit "
-            f"methods would factorise a dense one; it takes at most "
-            f"{C_LOOP_DENSE_STATES:,} states without one)")
+def _differenced_refusal(states: int) -> str:
+    return (f"it has {states:,} states and no Jacobian in C (the C loop takes at most "
+            f"{C_LOOP_DIFFERENCED_STATES:,} states without one)")
 
 
 def _sizes(text: str) -> dict[str, int]:
@@ -203,15 +209,19 @@ def loop_library(model: CompiledModel) -> LoopLibrary:
         with locked(entry, "cloop"):
             data = read_addition(entry, LIBRARY_FILE)  # built while this one waited
             if data is None:
-                data = _build_loop(model.name, text, _sizes(text)["SPRINGC_CODE_CHARS"])
+                data = _build_loop(model, text)
                 with contextlib.suppress(OSError):  # a read-only cache: built again
                     add_to_entry(entry, LIBRARY_FILE, data)
     return _loaded(hashlib.sha256(data).hexdigest(), data)
 
 
-def _build_loop(name: str, model_text: str, code: int) -> bytes:
-    text = loop_text(model_text)
-    seconds = max(1, round((code + len(text) - len(model_text)) / LOOP_CHARS_PER_SECOND))
+def _build_loop(model: CompiledModel, model_text: str) -> bytes:
+    name, sizes = model.name, _sizes(model_text)
+    pattern = None if sizes["SPRINGC_HAS_JACOBIAN"] else (
+        np.asarray(model.module.JAC_INDPTR), np.asarray(model.module.JAC_INDICES))
+    text = loop_text(model_text, pattern)
+    loop_code = len(loop_text(""))  # the loop's own code (tables cost little)
+    seconds = max(1, round((sizes["SPRINGC_CODE_CHARS"] + loop_code) / LOOP_CHARS_PER_SECOND))
     if seconds > 1 or ZIG_MODULE in find_compiler():
         say(LOOP_NOTE.format(model=name, seconds=seconds))
     with tempfile.TemporaryDirectory(prefix="springc-cc-") as folder:
