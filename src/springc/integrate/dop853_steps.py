@@ -57,6 +57,15 @@ def verdict(d: np.ndarray, z: np.ndarray) -> int:
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
+def shrinks(status: int, h_abs: float, min_step: float) -> bool:
+    """Whether a failed evaluation rejects the attempt rather than ending the run: a
+    non-finite derivative while a step MIN_FACTOR times shorter is still allowed (the
+    stage left the model's domain, as scipy's NaN error norm rejects the step; at the
+    smallest step the non-finite value is the run's error)."""
+    return status == NON_FINITE_DERIVATIVE and h_abs * MIN_FACTOR >= min_step
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
 def weighted_sum(K: np.ndarray, s: int, w: np.ndarray, out: np.ndarray, blas: bool | None) -> None:
     """``out = sum_{j<s} w[j] K[j]``.
 
@@ -215,8 +224,15 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
             status = verdict(d, z)
             if status != SUCCESS:
                 copy(end, stage)
+                if shrinks(status, h_abs, min_step):
+                    break
                 return status, t, h, h_abs, t + C[s] * h
             copy(K[s], d)
+        if status != SUCCESS:  # a non-finite stage: rejected, as scipy's NaN error is
+            h_abs *= MIN_FACTOR
+            step_rejected = True
+            counts[REJECTED] += 1
+            continue
         weighted_sum(K, STAGES, B, sums, blas)
         for i in range(n):
             y_new[i] = y[i] + h * sums[i]
@@ -225,6 +241,11 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
         status = verdict(d, z)
         if status != SUCCESS:
             copy(end, y_new)
+            if shrinks(status, h_abs, min_step):
+                h_abs *= MIN_FACTOR
+                step_rejected = True
+                counts[REJECTED] += 1
+                continue
             return status, t, h, h_abs, t + h
         copy(K[STAGES], d)
         error = error_norm(y, y_new, K, h, rtol, atol, scale, err5, err3, blas)

@@ -14,7 +14,7 @@ from numba import njit
 
 from . import rk45_tableau as tableau
 from .arrays import copy
-from .dop853_steps import rms, sum_of_squares, verdict, weighted_sum
+from .dop853_steps import rms, shrinks, sum_of_squares, verdict, weighted_sum
 from .signatures import ModelFunction
 from .status import REJECTED, RHS_CALLS, Status
 
@@ -97,8 +97,15 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
             status = verdict(d, z)
             if status != SUCCESS:
                 copy(end, stage)
+                if shrinks(status, h_abs, min_step):
+                    break
                 return status, t, h, h_abs, t + C[s] * h
             copy(K[s], d)
+        if status != SUCCESS:  # a non-finite stage: rejected, as scipy's NaN error is
+            h_abs *= MIN_FACTOR
+            step_rejected = True
+            counts[REJECTED] += 1
+            continue
         weighted_sum(K, STAGES, B, sums, blas)
         for i in range(n):
             y_new[i] = y[i] + h * sums[i]
@@ -107,6 +114,11 @@ def step(rhs: ModelFunction, jac: ModelFunction, t: float, y: np.ndarray, h_prop
         status = verdict(d, z)
         if status != SUCCESS:
             copy(end, y_new)
+            if shrinks(status, h_abs, min_step):
+                h_abs *= MIN_FACTOR
+                step_rejected = True
+                counts[REJECTED] += 1
+                continue
             return status, t, h, h_abs, t + h
         copy(K[STAGES], d)
         weighted_sum(K, STAGES + 1, E, err, blas)

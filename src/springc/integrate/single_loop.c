@@ -184,6 +184,12 @@ SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, do
         *h = *t_new - t;
         *h_abs = fabs(*h);
         int status = sl_stages(w, t, *h, p, z, counts, end, t_fail);
+        if (status == SC_NON_FINITE_DERIVATIVE && *h_abs * 0.2 >= min_step) {
+            *h_abs *= 0.2;  /* dop853_steps.shrinks: rejected, as scipy's NaN error is */
+            rejected = 1;
+            counts[SL_REJECTED] += 1;
+            continue;
+        }
         if (status != SC_SUCCESS) {
             *t_new = t;
             return status;
