@@ -75,3 +75,24 @@ def test_the_capacitor_after_five_switchings_is_the_closed_form(tmp_path: Path) 
     assert np.allclose(np.asarray(result["vC"]), expected, rtol=0, atol=1e-7)
     assert capacitor(2.9) > 0.5  # charged: the check is not of a constant
     assert result.stats.time_events == 5
+
+
+def test_the_switch_loop_keeps_one_matrix_per_switch_state(tmp_path: Path) -> None:
+    """The python backend keeps the block's matrix and inverse per value of its
+    entries (codegen/linear_cache.py): the switch is open or closed, two matrices, and
+    the run on them is the closed form above."""
+    path = tmp_path / "SwitchedRC.mo"
+    path.write_text(MODEL)
+    model = springc.compile_model([str(path)], "SwitchedRC", backend="python")
+    kept = model.module._LINEAR_FACTORS  # type: ignore[attr-defined]
+    kept.clear()
+    result = springc.simulate(model, engine="scipy", solver="radau", stop=1.2,
+                              interval=0.1, rtol=1e-9, atol=1e-12, error_control="off")
+    assert [len(matrices) for matrices in kept.values()] == [2]
+    (matrices,) = kept.values()
+    # row 1 is v = s*(if off then 1 else Ron): the coefficient of s, open and closed
+    assert sorted(-a[1, 2] for a, _ in matrices.values()) == [RON, 1.0]
+    for a, inverse in matrices.values():
+        assert np.allclose(inverse @ a, np.eye(3), rtol=0, atol=1e-12)
+    assert np.allclose(np.asarray(result["vC"]),
+                       [capacitor(float(t)) for t in result.time], rtol=0, atol=1e-7)

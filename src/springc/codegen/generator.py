@@ -128,6 +128,8 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
     namer = Namer(m.model_names)
     helpers: set[str] = set()
     numba = options.backend == "numba"
+    if not numba:
+        m.keep_linear_matrices()
     vector = options.vector
     if m.events is not None or len(m.delays):
         vector = False  # the event functions are written with scalar statements
