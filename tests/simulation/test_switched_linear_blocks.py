@@ -96,3 +96,32 @@ def test_the_switch_loop_keeps_one_matrix_per_switch_state(tmp_path: Path) -> No
         assert np.allclose(inverse @ a, np.eye(3), rtol=0, atol=1e-12)
     assert np.allclose(np.asarray(result["vC"]),
                        [capacitor(float(t)) for t in result.time], rtol=0, atol=1e-7)
+
+
+MOVING = '''\
+model Moving
+  Real x(start = 1, fixed = true);
+  Real y;
+  Real w;
+equation
+  der(x) = -y;
+  x*y + w = 1;
+  y - 2*w = 0;
+end Moving;
+'''
+
+
+def test_a_matrix_that_reads_a_state_is_solved_at_every_evaluation(tmp_path: Path) -> None:
+    """``x*y + w = 1``, ``y = 2 w``: the matrix reads the state ``x``, nothing is kept;
+    ``y = 1/(x + 1/2)``, so ``x = sqrt(9/4 - 2t) - 1/2``."""
+    path = tmp_path / "Moving.mo"
+    path.write_text(MOVING)
+    steps = simplify(flatten_files([path], "Moving")).ode.steps
+    assert [sorted(s.names) for s in steps if isinstance(s, ode.LinearBlock)] == [["w", "y"]]
+    model = springc.compile_model([str(path)], "Moving", backend="python")
+    assert not hasattr(model.module, "_LINEAR_FACTORS")
+    result = springc.simulate(model, engine="scipy", solver="radau", stop=1.0, interval=0.25,
+                              rtol=1e-10, atol=1e-12, error_control="off")
+    times = np.asarray(result.time)
+    assert np.allclose(np.asarray(result["x"]), np.sqrt(2.25 - 2 * times) - 0.5, rtol=0,
+                       atol=1e-7)
