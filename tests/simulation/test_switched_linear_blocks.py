@@ -125,3 +125,47 @@ def test_a_matrix_that_reads_a_state_is_solved_at_every_evaluation(tmp_path: Pat
     times = np.asarray(result.time)
     assert np.allclose(np.asarray(result["x"]), np.sqrt(2.25 - 2 * times) - 0.5, rtol=0,
                        atol=1e-7)
+
+
+STUCK = '''\
+model Stuck
+  parameter Real Goff = 0;
+  Real q(start = 0, fixed = true);
+  Real i;
+  Real s1;
+  Real s2;
+  Real v1;
+  Real v2;
+  Boolean off = time >= 0.5;
+equation
+  v1 = s1*(if off then 1 else 0);
+  i = s1*(if off then Goff else 1);
+  v2 = s2*(if off then 1 else 0);
+  i = s2*(if off then Goff else 1);
+  1 - v1 - v2 = 2*i;
+  der(q) = i;
+end Stuck;
+'''
+
+
+def test_two_open_switches_in_series_share_the_voltage_as_the_torn_blocks_did(
+        tmp_path: Path) -> None:
+    """Two ideal switches (Ron = 0, Goff = 0) in series with 2 ohms across 1 V: closed,
+    ``i = 0.5``; open, the kept matrix is singular but consistent (``s1 + s2 = 1``): the
+    basic solution, as the torn blocks' Newton step gives, one switch takes the voltage;
+    the charge ``q`` stops at 0.25."""
+    path = tmp_path / "Stuck.mo"
+    path.write_text(STUCK)
+    model = springc.compile_model([str(path)], "Stuck", backend="python")
+    kept = model.module._LINEAR_FACTORS  # type: ignore[attr-defined]
+    kept.clear()
+    result = springc.simulate(model, engine="scipy", solver="radau", stop=1.0,
+                              interval=0.25, rtol=1e-9, atol=1e-12, error_control="off")
+    (matrices,) = kept.values()
+    assert sorted(inverse is None for _, inverse in matrices.values()) == [False, True]
+    assert np.allclose(np.asarray(result["q"]), [0.0, 0.125, 0.25, 0.25, 0.25],
+                       rtol=0, atol=1e-9)
+    assert np.allclose(np.asarray(result["i"]), [0.5, 0.5, 0.0, 0.0, 0.0], rtol=0, atol=1e-9)
+    v1, v2 = np.asarray(result["v1"])[2:], np.asarray(result["v2"])[2:]
+    assert np.allclose(v1 + v2, 1.0, rtol=0, atol=1e-12)
+    assert np.allclose(v1 * v2, 0.0, rtol=0, atol=1e-12)

@@ -8,8 +8,10 @@ by the entries' values, so a hit is the very matrix; at most :data:`KEPT` of the
 block), and solves ``A y = b`` as ``M b`` with one step of iterative refinement
 (``y + M (b - A y)``) instead of a fresh ``np.linalg.solve`` with its checks at every
 evaluation: Electrical.Analog.Examples.CauerLowPassSC solves eleven such blocks in
-every right-hand side. A singular matrix raises where ``np.linalg.solve`` raised; a
-non-finite matrix gives NaN, as the solve's guard does. The numba and C backends solve
+every right-hand side. A singular matrix gets the basic solution of a consistent
+system, its free unknowns 0, NaN where inconsistent (``_newton_solve``, the torn blocks'
+rule: a loop of switches or stuck elements was a torn block before ``fold`` made it
+linear); a non-finite matrix gives NaN, as the solve's guard does. The numba and C backends solve
 each time (:func:`.statements.guarded_solve`, :mod:`.c_context`).
 """
 
@@ -34,7 +36,13 @@ def _linear_factors(block, key, where, n):
         a = np.zeros((n, n))
         for (i, j), v in zip(where, key):
             a[i, j] = v
-        m = np.linalg.inv(a) if np.isfinite(a).all() else np.full((n, n), np.nan)
+        if not np.isfinite(a).all():
+            m = np.full((n, n), np.nan)
+        else:
+            try:
+                m = np.linalg.inv(a)
+            except np.linalg.LinAlgError:
+                m = None
         if len(kept) >= {KEPT}:
             kept.clear()
         hit = kept[key] = (a, m)
@@ -78,7 +86,9 @@ def held_linear(block: ode.LinearBlock, index: int, varying: set[str]) -> list[S
     body.append(Raw(f"_A{index}, _M{index} = _linear_factors({index}, tuple(_k{index}), "
                     f"{where!r}, {n})"))
     body += _rhs(block.rhs, index)
-    body.append(Raw(f"if np.isfinite(_b{index}).all():\n"
+    body.append(Raw(f"if _M{index} is None:\n"
+                    f"    _y{index} = _newton_solve(_A{index}, _b{index}, np.zeros({n}))\n"
+                    f"elif np.isfinite(_b{index}).all():\n"
                     f"    _y{index} = _M{index} @ _b{index}\n"
                     f"    _y{index} = _y{index} + _M{index} @ (_b{index} - _A{index} @ _y{index})\n"
                     f"else:\n"
