@@ -18,6 +18,7 @@ from ..ir import flat, ode
 from ..ir.expr import ZERO, BinOp, Call, Const, Expr, If, Var, add, mul, variables
 from .delays import DelayLayout
 from .event_layout import EventLayout
+from .linear_cache import held_linear, solved_linear, varying_names
 from .newton_search import (
     guarded,
     residual_norm,
@@ -29,7 +30,7 @@ from .newton_search import (
     search_trial,
 )
 from .newton_step import newton_solve
-from .statements import Block, Let, Load, Loop, Raw, Stmt, Store, guarded_solve
+from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
 
 T = TypeVar("T")
 
@@ -142,6 +143,14 @@ class CodegenContext:
         self.flag_slot += len(self.delays)
         if self.events:
             self.model_names |= set(self.events.discrete)
+        # the python backend keeps the matrices of linear blocks that hold still between
+        # events (codegen/linear_cache.py): the names that may move, else None
+        self.varying: set[str] | None = None
+
+    def keep_linear_matrices(self) -> None:
+        """Linear blocks whose matrix reads no varying name keep it and its inverse
+        (:mod:`.linear_cache`; generated Python only)."""
+        self.varying = varying_names(self.ode)
 
     def source_files(self) -> list[str]:
         """The model's own file, then the other files its variables come from."""
@@ -191,12 +200,8 @@ class CodegenContext:
         return stmts, described
 
     def _linear(self, block: ode.LinearBlock, index: int, comment: str) -> Stmt:
-        n = len(block.names)
-        body: list[Stmt] = [Raw(f"_A{index} = np.zeros(({n}, {n}))")]
-        body += [Store(f"_A{index}[{i}, {j}]", e) for i, j, e in block.matrix]
-        body.append(Raw(f"_b{index} = np.empty({n})"))
-        body += [Store(f"_b{index}[{i}]", e) for i, e in enumerate(block.rhs)]
-        body.append(Raw(guarded_solve(f"_y{index}", f"_A{index}", f"_b{index}", f"{n}")))
+        held = None if self.varying is None else held_linear(block, index, self.varying)
+        body = held if held is not None else solved_linear(block, index)
         body += [Load(name, f"_y{index}[{k}]", name) for k, name in enumerate(block.names)]
         return Block(body, comment, {*block.names, f"_A{index}"})
 

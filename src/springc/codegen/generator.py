@@ -129,6 +129,8 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
     helpers: set[str] = set()
     numba = options.backend == "numba"
     m.guard_errors = not numba  # math.exp raises in Python: a Newton trial backtracks
+    if not numba:
+        m.keep_linear_matrices()
     vector = options.vector
     if m.events is not None or len(m.delays):
         vector = False  # the event functions are written with scalar statements

@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterator, Sequence
 
 from ..ir.builtins import BUILTINS, PYTHON_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
+from .linear_cache import LINEAR_FACTORS
 from .locate import untranslatable
 from .newton_step import NEWTON_SOLVE
 from .statements import (
@@ -36,7 +37,7 @@ from .statements import (
 _PREC = {"or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
          "+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
 _PY_OP = {"<>": "!=", "^": "**"}
-HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE}
+HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE, "_linear_factors": LINEAR_FACTORS}
 """The helper functions a generated module defines when it calls them (the registry's
 and the Newton correction of torn blocks, which a :class:`Raw` line calls)."""
 
@@ -171,6 +172,8 @@ class FunctionWriter:
         elif isinstance(stmt, Raw):
             if "_newton_solve(" in stmt.text:
                 self.helpers.add("_newton_solve")
+            if "_linear_factors(" in stmt.text:
+                self.helpers.add("_linear_factors")
             for line in stmt.text.splitlines():
                 self._emit(line)
         elif isinstance(stmt, Block):

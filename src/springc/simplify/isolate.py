@@ -143,7 +143,10 @@ def fold(e: x.Expr) -> x.Expr:
         cond = fold(e.cond)
         if isinstance(cond, x.Const):
             return fold(e.then) if cond.value else fold(e.otherwise)
-        return x.If(cond, fold(e.then), fold(e.otherwise))
+        then, otherwise = fold(e.then), fold(e.otherwise)
+        if then == otherwise:  # d/ds of s*(if c then 1 else R): linear in s, whatever c
+            return then
+        return x.If(cond, then, otherwise)
     return e
 
 
