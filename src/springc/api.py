@@ -23,6 +23,7 @@ from .pipeline import (
     Derived,
     ModuleKind,
     check_parameter_names,
+    collector_paused,
     compile_files,
     modification_value,
 )
@@ -169,6 +170,7 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
     return None if chosen == default_backend() else chosen
 
 
+@collector_paused()  # the whole compile, both backends (springc.pipeline.collector)
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
     compiled, base = _compile_as(options, parameters)

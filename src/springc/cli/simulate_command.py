@@ -71,19 +71,21 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
+    from ..pipeline import collector_paused
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()
     quiet = level < 0
     with silenced(quiet):  # the status lines of long steps (compiling)
-        compiled = compile_model(files, model, libraries=libraries,
-                                 backend=default_choice(backend, settings.engine,
-                                                        settings.solver),
-                                 outputs=patterns or None, parameters=settings.parameters,
-                                 cache=not no_cache)
-        report_units(compiled.warnings, strict_units)
-        if not compiled.cached:
-            release_compile_memory()
+        with collector_paused():  # until its one collection, release_compile_memory's
+            compiled = compile_model(files, model, libraries=libraries,
+                                     backend=default_choice(backend, settings.engine,
+                                                            settings.solver),
+                                     outputs=patterns or None,
+                                     parameters=settings.parameters, cache=not no_cache)
+            report_units(compiled.warnings, strict_units)
+            if not compiled.cached:
+                release_compile_memory()
         if not patterns and (output or not plot):  # the default trajectory of every output
             check_trajectory_size(compiled, settings,
                                   f"-o {output}" if output else "the CSV on stdout")

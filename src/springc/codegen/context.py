@@ -241,19 +241,21 @@ class CodegenContext:
         """Lets for the aliases among ``names`` and the aliases they read, in order."""
         out: list[Stmt] = []
         done: set[str] = set()
-
-        def visit(name: str) -> None:
-            if name in done or name not in self.aliases:
-                return
-            done.add(name)
-            a = self.aliases[name]
-            for v in sorted(variables(a.expr)):
-                visit(v)
-            out.append(Let(name, a.expr, f"{name} (alias)  {source_location(a.span)}"))
-
         for n in names:
-            visit(n)
+            self._alias_stmts(n, done, out)
         return out
+
+    def _alias_stmts(self, name: str, done: set[str], out: list[Stmt]) -> None:
+        # A method, not a recursive closure: that would be a reference cycle (closure
+        # -> its cell -> closure) holding the context and its system, left to the
+        # collector, paused while a model compiles (springc.pipeline.collector).
+        if name in done or name not in self.aliases:
+            return
+        done.add(name)
+        a = self.aliases[name]
+        for v in sorted(variables(a.expr)):
+            self._alias_stmts(v, done, out)
+        out.append(Let(name, a.expr, f"{name} (alias)  {source_location(a.span)}"))
 
 
 NEWTON_NUDGE = 1e-6

@@ -33,24 +33,27 @@ def topological(params: Sequence[dae.Parameter]) -> list[dae.Parameter]:
     by_name = {q.name: q for q in params}
     order: list[dae.Parameter] = []
     state: dict[str, int] = {}
-
-    def visit(q: dae.Parameter) -> None:
-        mark = state.get(q.name)
-        if mark == 2:
-            return
-        if mark == 1:
-            raise CodegenError(f"the binding of parameter '{q.name}' depends on itself",
-                               q.span)
-        state[q.name] = 1
-        for v in sorted(variables(parameter_value(q))):
-            if v in by_name:
-                visit(by_name[v])
-        state[q.name] = 2
-        order.append(q)
-
     for q in params:
-        visit(q)
+        _visit(q, by_name, state, order)
     return order
+
+
+def _visit(q: dae.Parameter, by_name: dict[str, dae.Parameter], state: dict[str, int],
+           order: list[dae.Parameter]) -> None:
+    # A function of the module, not a recursive closure: that would be a reference
+    # cycle (closure -> its cell -> closure) holding the parameters, left to the
+    # collector, paused while a model compiles (springc.pipeline.collector).
+    mark = state.get(q.name)
+    if mark == 2:
+        return
+    if mark == 1:
+        raise CodegenError(f"the binding of parameter '{q.name}' depends on itself", q.span)
+    state[q.name] = 1
+    for v in sorted(variables(parameter_value(q))):
+        if v in by_name:
+            _visit(by_name[v], by_name, state, order)
+    state[q.name] = 2
+    order.append(q)
 
 
 def parameter_value(q: dae.Parameter) -> Expr:

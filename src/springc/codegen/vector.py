@@ -257,14 +257,19 @@ class VectorLayout:
                           dtype=np.int64).reshape(len(group), -1)
         arrays = [self.arrays[group[0].out[0]]] + [self.arrays[k] for k in group[0].kinds]
         spans: list[tuple[int, int]] = []  # maximal runs of constant strides
+        # Row differences compared once, for the whole group (not per row pair):
+        # forward[k]: the stride from row k to k + 1 is >= 0 and moves the output;
+        # same[k]: the stride from row k + 1 equals the one from row k.
+        strides = matrix[1:] - matrix[:-1]
+        forward = ((strides >= 0).all(axis=1) & (strides[:, 0] > 0)).tolist()
+        same = (strides[1:] == strides[:-1]).all(axis=1).tolist()
         i = 0
         while i < len(group):
             j = i + 1
-            if j < len(group):
-                stride = matrix[j] - matrix[i]
-                if (stride >= 0).all() and stride[0] > 0:
-                    while j < len(group) and (matrix[j] - matrix[j - 1] == stride).all():
-                        j += 1
+            if j < len(group) and forward[i]:
+                j += 1
+                while j < len(group) and same[j - 2]:
+                    j += 1
             spans.append((i, j))
             i = j
         if len(spans) == 1:

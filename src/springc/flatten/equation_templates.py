@@ -109,23 +109,33 @@ def _equations_only(equations: Iterable[s.Equation]) -> bool:
 
 def renamer(old: str, new: str) -> Callable[[x.Expr], x.Expr]:
     """A function that renames the variables ``old.*`` to ``new.*`` in an expression."""
-    cut = len(old)
-    names: dict[str, x.Var] = {}
+    return _Renamer(old, new)
 
-    def rename(e: x.Expr) -> x.Expr:
+
+class _Renamer:
+    """:func:`renamer`'s function: an object, not a recursive closure, which would be a
+    reference cycle (function -> cell -> function) left to the cyclic collector with
+    its names, one per instance, while a model compiles with the collector paused."""
+
+    __slots__ = ("cut", "names", "new")
+
+    def __init__(self, old: str, new: str) -> None:
+        self.cut = len(old)
+        self.new = new
+        self.names: dict[str, x.Var] = {}
+
+    def __call__(self, e: x.Expr) -> x.Expr:
         if isinstance(e, x.Var):
-            found = names.get(e.name)
+            found = self.names.get(e.name)
             if found is None:
-                found = names[e.name] = x.Var(new + e.name[cut:])
+                found = self.names[e.name] = x.Var(self.new + e.name[self.cut:])
             return found
         if isinstance(e, x.BinOp):
-            return x.BinOp(e.op, rename(e.left), rename(e.right))
+            return x.BinOp(e.op, self(e.left), self(e.right))
         if isinstance(e, (x.Const, x.Time)):
             return e
         if isinstance(e, x.Call):
-            return x.Call(e.name, tuple(rename(a) for a in e.args))
+            return x.Call(e.name, tuple(self(a) for a in e.args))
         if isinstance(e, x.If):
-            return x.If(rename(e.cond), rename(e.then), rename(e.otherwise))
-        return type(e)(rename(e.arg))  # Neg, Not, Der
-
-    return rename
+            return x.If(self(e.cond), self(e.then), self(e.otherwise))
+        return type(e)(self(e.arg))  # Neg, Not, Der

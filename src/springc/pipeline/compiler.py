@@ -50,6 +50,7 @@ from .closed import (
     needs_run_system,
     run_system_of,
 )
+from .collector import collector_paused
 from .diagnostics import decode_warnings
 from .equations import Equations
 from .notes import compiling_note
@@ -262,6 +263,7 @@ def split_values(model: CompiledModel, values: Mapping[str, float]
 # ------------------------------------------------------------------ compile
 
 
+@collector_paused()
 def compile_files(options: CompileOptions, derived: Derived | None = None) -> CompiledModel:
     """The compiled model for ``options``: from the cache, or generated now (from
     ``derived``, the system of the same files, model and modifications, where given).

@@ -9,37 +9,22 @@ tree as the user's files), and simplifies it.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import gc
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
 from ..flatten import flatten, select_model
 from ..ir import flat, syntax
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
 from ..units import check_units
+from .collector import collector_paused
 from .options import CompileOptions, Derived
 
 WRAPPER_FILE = "<springc: structural parameters>"
 """The file name of the class that applies ``--set`` values of structural parameters."""
 
 
-@contextlib.contextmanager
-def fewer_collections() -> Iterator[None]:
-    """Python's cyclic garbage collector run less often, restored on exit: compiling a
-    model makes millions of objects that live to its end, which the collector walked
-    every 700 allocations (a third of compile_model's CPU time on the 1,000-mass chain:
-    1.44 s instead of 2.07 s; compiling makes few cycles)."""
-    threshold = gc.get_threshold()
-    gc.set_threshold(100_000, 50, 100)
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-
-
-@fewer_collections()
+@collector_paused()
 def derive_system(options: CompileOptions) -> Derived:
     """Flatten and simplify the model of ``options`` (structural values applied)."""
     tree = load(list(options.files), options.libraries, options.texts)

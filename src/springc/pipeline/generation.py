@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from ..codegen import CodegenOptions, generate
 from .cache import Names
-from .derive import derive_system, fewer_collections
+from .collector import collector_paused
+from .derive import derive_system
 from .diagnostics import encode_warnings
 from .options import CompileOptions, Derived
 from .selection import select_names
@@ -30,7 +31,7 @@ def generate_source(options: CompileOptions) -> str:
     return generate_from(derive_system(options), options)
 
 
-@fewer_collections()
+@collector_paused()
 def generate_from(derived: Derived, options: CompileOptions) -> str:
     """The module text of a derived model with the outputs ``options`` selects."""
     system, flat_model = derived.system, derived.flat_model

@@ -27,32 +27,40 @@ def parameter_values(parameters: Iterable[dae.Parameter],
                      overrides: Mapping[str, float] | None = None) -> dict[str, float]:
     """Numeric values of all parameters: ``overrides``, else the binding, else the
     start value, else 0; bindings may refer to other parameters (in any order)."""
-    params = {p.name: p for p in parameters}
-    values: dict[str, float] = dict(overrides or {})
-    active: set[str] = set()
+    values = _ParameterValues({p.name: p for p in parameters}, dict(overrides or {}))
+    for name in values.params:
+        values.value(name)
+    return values.values
 
-    def value(name: str) -> float:
+
+class _ParameterValues:
+    """:func:`parameter_values`'s work: an object, not a recursive closure, which would
+    be a reference cycle (closure -> its cell -> closure) holding the parameters, left
+    to the collector, paused while a model compiles (springc.pipeline.collector)."""
+
+    def __init__(self, params: dict[str, dae.Parameter], values: dict[str, float]) -> None:
+        self.params, self.values = params, values
+        self.active: set[str] = set()
+
+    def value(self, name: str) -> float:
+        values = self.values
         if name in values:
             return values[name]
-        p = params[name]
-        if name in active:
+        p = self.params[name]
+        if name in self.active:
             raise SimplifyError(f"the binding of parameter '{name}' depends on itself", p.span)
-        active.add(name)
+        self.active.add(name)
         e = p.binding if p.binding is not None else p.start
         try:
             # Parameters are computed in initialization: initial() holds.
-            values[name] = 0.0 if e is None else evaluate_with(e, value, initial=True)
+            values[name] = 0.0 if e is None else evaluate_with(e, self.value, initial=True)
         except (ArithmeticError, ValueError) as err:
             raise SimplifyError(f"the value of parameter '{name}' cannot be computed: "
                                 f"{describe_failure(err)}", p.span,
                                 hint="check the parameters its binding uses (--set)"
                                 ) from None
-        active.discard(name)
+        self.active.discard(name)
         return values[name]
-
-    for name in params:
-        value(name)
-    return values
 
 
 class _Lazy(dict[str, float]):

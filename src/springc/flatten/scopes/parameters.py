@@ -70,21 +70,23 @@ def check_powers(e: x.Expr, values: Mapping[str, Any]) -> None:
     node shared by several parents is visited once (the values a function's loop
     builds share their sub-expressions: walking them as trees took 160 s for
     ``Blocks.Examples.Filter``)."""
-    seen: set[int] = set()
+    _check_powers(e, values, set())
 
-    def visit(node: x.Expr) -> None:
-        if id(node) in seen:
-            return
-        seen.add(id(node))
-        for child in x.children(node):
-            visit(child)
-        if isinstance(node, x.BinOp) and node.op == "^":
-            base, exponent = x.evaluate(node.left, values), x.evaluate(node.right, values)
-            if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
-                    and abs(exponent) > MAX_INTEGER_EXPONENT:
-                raise OverflowError(f"{base} ^ {exponent} is too large")
 
-    visit(e)
+def _check_powers(node: x.Expr, values: Mapping[str, Any], seen: set[int]) -> None:
+    # A function of the module, not a recursive closure: that would be a reference
+    # cycle (closure -> its cell -> closure) left to the collector, paused while a
+    # model compiles (springc.pipeline.collector).
+    if id(node) in seen:
+        return
+    seen.add(id(node))
+    for child in x.children(node):
+        _check_powers(child, values, seen)
+    if isinstance(node, x.BinOp) and node.op == "^":
+        base, exponent = x.evaluate(node.left, values), x.evaluate(node.right, values)
+        if isinstance(base, int) and isinstance(exponent, int) and abs(base) > 1 \
+                and abs(exponent) > MAX_INTEGER_EXPONENT:
+            raise OverflowError(f"{base} ^ {exponent} is too large")
 
 
 def binding_errors(variables: Iterable[flat.Variable], values: ParameterValues
