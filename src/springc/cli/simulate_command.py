@@ -70,16 +70,22 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
+    from ..pipeline import CompiledModel
+    from ..pipeline.apart import compiled_apart
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()
     quiet = level < 0
     with silenced(quiet):  # the status lines of long steps (compiling)
-        compiled = compile_model(files, model, libraries=libraries,
+        def compiled_here() -> CompiledModel:
+            return compile_model(files, model, libraries=libraries,
                                  backend=default_choice(backend, settings.engine,
                                                         settings.solver),
                                  outputs=patterns or None, parameters=settings.parameters,
                                  cache=not no_cache)
+
+        # a model not in the cache: compiled in a child process that exits before the run
+        compiled = compiled_here() if no_cache else compiled_apart(compiled_here)
         report_units(compiled.warnings, strict_units)
         if not compiled.cached:
             release_compile_memory()
