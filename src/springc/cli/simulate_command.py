@@ -70,8 +70,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
-    from ..pipeline import CompiledModel
-    from ..pipeline.apart import compiled_apart
+    from ..pipeline import CompiledModel, compiled_apart
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()

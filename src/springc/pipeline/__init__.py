@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .apart import compiled_apart
 from .compiler import (
     CompiledModel,
     ModuleKind,
@@ -31,7 +32,7 @@ if TYPE_CHECKING:
 __all__ = ["CCompilerMissing", "CLibrary", "CLoopRefused", "CompileOptions", "CompiledModel",
            "Derived", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
-           "compile_files", "derive_system", "find_compiler", "flatten_files",
+           "compile_files", "compiled_apart", "derive_system", "find_compiler", "flatten_files",
            "generate_source", "kernel_library", "loop_library", "modification_value",
            "note_refused", "openmp_flags", "select_names", "split_values"]
 
