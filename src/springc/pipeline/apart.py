@@ -7,8 +7,9 @@ returns, but their pages stay in Python's partly used arenas (the 50x50 cloth: a
 400 MB more when its run starts than a warm run of the same model). A forked child
 compiles and writes the cache entry, then exits, handing every page back; the caller
 then takes the warm path (the cache entry's module), so a cold run starts from a warm
-run's memory. The child shares the caller's pages (fork), so the machine holds about
-the child's resident set while it compiles, not the two sets added up.
+run's memory (but for the model's numba functions, which its run compiles). The child
+shares the caller's pages (fork), so the machine holds about the child's resident set
+while it compiles, not the two sets added up.
 
 Where the model is in the cache, nothing is forked: the caller's compile runs with
 :func:`cached_only`, which makes the compile path's first step (deriving a system)
