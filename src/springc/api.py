@@ -180,10 +180,10 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     elif chosen and options.backend == "python" and _numba_instead(compiled):
         other = "numba"
     if other is not None:  # generated from the system derived for the first backend
-        first = compiled
-        compiled, _ = _compile_as(replace(options, backend=other), parameters,
-                                  compiled.compiled_from, base)
-        first.let_go()
+        derived = compiled.compiled_from
+        compiled.let_go()  # its module freed before the other one is generated
+        del compiled
+        compiled, _ = _compile_as(replace(options, backend=other), parameters, derived, base)
     return compiled.settled()
 
 

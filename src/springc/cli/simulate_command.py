@@ -71,18 +71,23 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
-    from ..pipeline import collector_paused
+    from ..pipeline import CompiledModel, collector_paused, compiled_apart
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()
     quiet = level < 0
     with silenced(quiet):  # the status lines of long steps (compiling)
+        def compiled_here() -> CompiledModel:
+            return compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend, settings.engine,
+                                                        settings.solver),
+                                 outputs=patterns or None, parameters=settings.parameters,
+                                 cache=not no_cache)
+
         with collector_paused():  # until its one collection, release_compile_memory's
-            compiled = compile_model(files, model, libraries=libraries,
-                                     backend=default_choice(backend, settings.engine,
-                                                            settings.solver),
-                                     outputs=patterns or None,
-                                     parameters=settings.parameters, cache=not no_cache)
+            # a model not in the cache: compiled in a child process that exits before
+            # the run
+            compiled = compiled_here() if no_cache else compiled_apart(compiled_here)
             report_units(compiled.warnings, strict_units)
             if not compiled.cached:
                 release_compile_memory()

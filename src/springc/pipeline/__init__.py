@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from .apart import compiled_apart
 from .collector import collector_paused
 from .compiler import (
     CompiledModel,
@@ -32,8 +33,8 @@ if TYPE_CHECKING:
 __all__ = ["CCompilerMissing", "CLibrary", "CLoopRefused", "CompileOptions", "CompiledModel",
            "Derived", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
-           "collector_paused", "compile_files", "derive_system", "find_compiler",
-           "flatten_files",
+           "collector_paused", "compile_files", "compiled_apart", "derive_system",
+           "find_compiler", "flatten_files",
            "generate_source", "kernel_library", "loop_library", "modification_value",
            "note_refused", "openmp_flags", "select_names", "split_values"]
 

@@ -25,6 +25,7 @@ from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
 from ..status_line import say
+from .apart import deriving
 from .cache import (
     MODULE_FILE,
     SYSTEM_FILE,
@@ -200,6 +201,7 @@ class CompiledModel:
             else:
                 self.check_files("its equations are no longer those of the files",
                                  "compile the model again to see its equations")
+                deriving()
                 from . import generation  # the compile path (not loaded for a cached model)
 
                 self.derived = generation.derive_system(self.options)
@@ -285,6 +287,8 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
+            if derived is None and folder is not None:
+                deriving()
             from . import generation  # the compile path, loaded on a miss only
 
             if derived is None:
@@ -300,6 +304,8 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
         if hit is not None:
             hit.compile_time = time.perf_counter() - began
             return hit
+        if derived is None:
+            deriving()
     from . import generation  # the compile path, loaded on a miss only
 
     if derived is None:

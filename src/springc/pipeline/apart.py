@@ -1,0 +1,108 @@
+"""A model not in the cache compiled in a child process, the caller loading it from the
+cache once the child is done (:func:`compiled_apart`).
+
+Compiling a large scene leaves most of its memory behind: flattening's million
+expression nodes, simplify's and the generators' objects are freed when the compile
+returns, but their pages stay in Python's partly used arenas (the 50x50 cloth: about
+400 MB more when its run starts than a warm run of the same model). A forked child
+compiles and writes the cache entry, then exits, handing every page back; the caller
+then takes the warm path (the cache entry's module), so a cold run starts from a warm
+run's memory (but for the model's numba functions, which its run compiles). The child
+shares the caller's pages (fork), so the machine holds about the child's resident set
+while it compiles, not the two sets added up.
+
+Where the model is in the cache, nothing is forked: the caller's compile runs with
+:func:`cached_only`, which makes the compile path's first step (deriving a system)
+raise :class:`CacheMiss` before anything of the compile path is imported.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+from collections.abc import Callable, Iterator
+from contextvars import ContextVar
+from typing import TypeVar
+
+from ..status_line import silenced
+from .closed import MODULE_PREFIX
+
+T = TypeVar("T")
+
+CACHED_ONLY: ContextVar[bool] = ContextVar("springc_cached_only", default=False)
+"""Whether a compile in this context stops where it would derive a system."""
+
+
+class CacheMiss(Exception):
+    """A compile under :func:`cached_only` would derive a system (the model, or a part
+    of its cache entry, is not in the cache)."""
+
+
+@contextlib.contextmanager
+def cached_only() -> Iterator[None]:
+    """Inside the block, a compile that would derive raises :class:`CacheMiss`."""
+    token = CACHED_ONLY.set(True)
+    try:
+        yield
+    finally:
+        CACHED_ONLY.reset(token)
+
+
+def deriving() -> None:
+    """Called where the compile path starts deriving a model whose result is cached:
+    :class:`CacheMiss` under :func:`cached_only`."""
+    if CACHED_ONLY.get():
+        raise CacheMiss
+
+
+def compiled_apart(compile: Callable[[], T]) -> T:
+    """``compile()``'s result, where it misses the cache compiled first in a forked
+    child that writes the cache entry and exits, then loaded here from the cache.
+
+    Without ``os.fork`` (not POSIX), or where stderr is not a file the child can
+    write to (an in-memory stream), ``compile()`` runs here. A child that fails
+    (an error in the model: it writes nothing but its status lines) leaves the error
+    to ``compile()`` here, which meets it again, its status lines silenced (the child
+    said them); a child killed by a signal leaves the compile to this process."""
+    if not hasattr(os, "fork") or not _real_stream(sys.stderr):
+        return compile()
+    before = set(sys.modules)
+    with cached_only():
+        try:
+            return compile()
+        except CacheMiss:  # the modules this attempt imported from the cache let go
+            for name in set(sys.modules) - before:
+                if name.startswith(MODULE_PREFIX):
+                    del sys.modules[name]
+    status = _child_status(compile)
+    with silenced(True) if status == 1 else contextlib.nullcontext():
+        return compile()
+
+
+def _child_status(compile: Callable[[], object]) -> int:
+    """The exit status of a forked child running ``compile()``: 0 when it returned,
+    1 when it raised, -N when signal N ended it."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child (measured by the tests' outcome)
+        status = 1
+        try:
+            compile()
+            status = 0
+        except BaseException:  # the caller's own compile meets it again
+            pass
+        finally:
+            with contextlib.suppress(Exception):
+                sys.stderr.flush()
+            os._exit(status)
+    _, waited = os.waitpid(pid, 0)
+    return os.waitstatus_to_exitcode(waited)
+
+
+def _real_stream(stream: object) -> bool:
+    try:
+        return isinstance(stream.fileno(), int)  # type: ignore[attr-defined]
+    except (AttributeError, OSError, ValueError):
+        return False

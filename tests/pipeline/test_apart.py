@@ -1,0 +1,98 @@
+"""A model not in the cache is compiled in a forked child (``pipeline.apart``): this
+process derives nothing and loads the child's cache entry; a model in the cache forks
+nothing; a model with an error raises the error of an in-process compile."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import springc
+from springc.errors import SpringcError
+from springc.pipeline import apart, generation
+from springc.pipeline.closed import MODULE_PREFIX
+
+MODEL = ("model Decay\n  parameter Real k = 2;\n  Real x(start = 3, fixed = true);\n"
+         "equation\n  der(x) = -k*x;\nend Decay;\n")
+
+
+def _derivations(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The models this process derives from now on (a forked child's are not seen)."""
+    calls: list[str] = []
+    derive = generation.derive_system
+
+    def counted(options: springc.pipeline.CompileOptions) -> springc.pipeline.Derived:
+        calls.append(str(options.model))
+        return derive(options)
+
+    monkeypatch.setattr(generation, "derive_system", counted)
+    return calls
+
+
+@pytest.fixture
+def decay(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    path = tmp_path / "decay.mo"
+    path.write_text(MODEL)
+    return path
+
+
+def test_a_missed_model_is_compiled_in_a_child_and_loaded_from_the_cache(
+        decay: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    calls = _derivations(monkeypatch)
+    model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="python"))
+    assert calls == []  # derived in the child only
+    assert model.cached and model.states == ("x",)
+    here = springc.compile_model(str(decay), backend="python", cache=False)
+    assert calls == ["None"]
+    assert model.source == here.source
+    result = springc.simulate(model, stop=1.0, solver="dop853", rtol=1e-10, atol=1e-12)
+    assert result["x"][-1] == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
+
+
+def test_a_cached_model_forks_nothing(decay: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    springc.compile_model(str(decay), backend="python")
+
+    def no_fork() -> int:
+        raise AssertionError("forked for a cached model")
+
+    monkeypatch.setattr(os, "fork", no_fork)
+    model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="python"))
+    assert model.cached and model.states == ("x",)
+
+
+def test_the_error_of_a_model_is_the_in_process_one(tmp_path: Path,
+                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    path = tmp_path / "bad.mo"
+    path.write_text(MODEL.replace("-k*x", "-k*y"))
+    with pytest.raises(SpringcError) as here:
+        springc.compile_model(str(path), cache=False)
+    with pytest.raises(SpringcError) as apart_error:
+        apart.compiled_apart(lambda: springc.compile_model(str(path)))
+    assert str(apart_error.value) == str(here.value)
+    assert str(here.value) == (f"{path}:5:15: error: undefined name 'y'\n"
+                               "    5 |   der(x) = -k*y;\n"
+                               "      |               ^\n"
+                               "help: declare it, or check the spelling")
+
+
+def test_a_miss_under_cached_only_raises_and_keeps_no_module(
+        decay: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    calls = _derivations(monkeypatch)
+    before = {name for name in sys.modules if name.startswith(MODULE_PREFIX)}
+    with apart.cached_only(), pytest.raises(apart.CacheMiss):
+        springc.compile_model(str(decay), backend="python")
+    assert calls == []
+    assert {name for name in sys.modules if name.startswith(MODULE_PREFIX)} == before
+
+
+def test_an_in_memory_stderr_compiles_here(decay: Path, monkeypatch: pytest.MonkeyPatch,
+                                           capsys: pytest.CaptureFixture[str]) -> None:
+    calls = _derivations(monkeypatch)
+    model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="python"))
+    assert not model.cached and calls == ["None"]
