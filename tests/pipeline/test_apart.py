@@ -72,8 +72,10 @@ def test_the_error_of_a_model_is_the_in_process_one(tmp_path: Path,
     path.write_text(MODEL.replace("-k*x", "-k*y"))
     with pytest.raises(SpringcError) as here:
         springc.compile_model(str(path), cache=False)
+    calls = _derivations(monkeypatch)
     with pytest.raises(SpringcError) as apart_error:
         apart.compiled_apart(lambda: springc.compile_model(str(path)))
+    assert calls == []  # the child's error, sent back: the model is not compiled again
     assert str(apart_error.value) == str(here.value)
     assert str(here.value) == (f"{path}:5:15: error: undefined name 'y'\n"
                                "    5 |   der(x) = -k*y;\n"

@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import contextlib
 import os
+import pickle
 import sys
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from typing import TypeVar
 
+from ..errors import ErrorGroup, SpringcError
 from ..status_line import silenced
 from .closed import MODULE_PREFIX
 
@@ -61,10 +63,12 @@ def compiled_apart(compile: Callable[[], T]) -> T:
     child that writes the cache entry and exits, then loaded here from the cache.
 
     Without ``os.fork`` (not POSIX), or where stderr is not a file the child can
-    write to (an in-memory stream), ``compile()`` runs here. A child that fails
-    (an error in the model: it writes nothing but its status lines) leaves the error
-    to ``compile()`` here, which meets it again, its status lines silenced (the child
-    said them); a child killed by a signal leaves the compile to this process."""
+    write to (an in-memory stream), ``compile()`` runs here. The error of a model
+    (:class:`SpringcError`) that the child met is raised here as the child raised it
+    (sent back pickled through a pipe: the model is not compiled twice); a child that
+    failed otherwise (a bug, a signal) leaves the compile to this process, whose own
+    run of ``compile()`` then meets it, its status lines silenced (the child said
+    them)."""
     if not hasattr(os, "fork") or not _real_stream(sys.stderr):
         return compile()
     before = set(sys.modules)
@@ -75,30 +79,47 @@ def compiled_apart(compile: Callable[[], T]) -> T:
             for name in set(sys.modules) - before:
                 if name.startswith(MODULE_PREFIX):
                     del sys.modules[name]
-    status = _child_status(compile)
+    status, error = _child_status(compile)
+    if error is not None:
+        raise error
     with silenced(True) if status == 1 else contextlib.nullcontext():
         return compile()
 
 
-def _child_status(compile: Callable[[], object]) -> int:
-    """The exit status of a forked child running ``compile()``: 0 when it returned,
-    1 when it raised, -N when signal N ended it."""
+def _child_status(compile: Callable[[], object]
+                  ) -> tuple[int, SpringcError | ErrorGroup | None]:
+    """The exit status of a forked child running ``compile()`` (0 when it returned, 1
+    when it raised, -N when signal N ended it) and the model's error it raised."""
     sys.stdout.flush()
     sys.stderr.flush()
+    read_end, write_end = os.pipe()
     pid = os.fork()
     if pid == 0:  # pragma: no cover - the child (measured by the tests' outcome)
+        os.close(read_end)
         status = 1
         try:
             compile()
             status = 0
+        except (SpringcError, ErrorGroup) as err:
+            with contextlib.suppress(Exception), os.fdopen(write_end, "wb") as sent:
+                sent.write(pickle.dumps(err))
         except BaseException:  # the caller's own compile meets it again
             pass
         finally:
             with contextlib.suppress(Exception):
                 sys.stderr.flush()
             os._exit(status)
+    os.close(write_end)
+    with os.fdopen(read_end, "rb") as received:
+        data = received.read()  # before waiting: the child may fill the pipe
     _, waited = os.waitpid(pid, 0)
-    return os.waitstatus_to_exitcode(waited)
+    try:
+        error = pickle.loads(data) if data else None
+    except Exception:
+        error = None
+    if not isinstance(error, (SpringcError, ErrorGroup)):
+        error = None
+    return os.waitstatus_to_exitcode(waited), error
 
 
 def _real_stream(stream: object) -> bool:
