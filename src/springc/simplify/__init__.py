@@ -3,7 +3,7 @@ causalization), plus the balance check, the initial problem and state choice."""
 
 from ..errors import describe_failure
 from .balance import check_balance
-from .initialize import conditions, initial_state
+from .initialize import RedundantInitialWarning, conditions, initial_state
 from .ode_eval import OdeEvaluator, parameter_values
 from .passes import simplify
 from .state_choice import (
@@ -21,6 +21,7 @@ __all__ = [
     "CHECK_MESSAGE",
     "THRESHOLD",
     "OdeEvaluator",
+    "RedundantInitialWarning",
     "StateChoice",
     "check_balance",
     "conditioning",
