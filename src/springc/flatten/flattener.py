@@ -7,14 +7,13 @@ turns ``connect`` statements into potential equalities and flow sums.
 
 from __future__ import annotations
 
-import gc
 from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import replace
 from typing import cast
 
 import numpy as np
 
+from ..collector import collector_paused
 from ..errors import ErrorGroup, FlattenError, FollowUpError, Span, SpringcError
 from ..ir import expr as x
 from ..ir import flat
@@ -158,22 +157,8 @@ def flatten(tree: ClassTree, model: str | None = None, max_size: int | None = No
     ``max_size`` caps the scalar variables of the flat model and the iterations of its
     loops (default: ``$SPRINGC_MAX_SIZE``, else 2 million; see :mod:`.limits`)."""
     cap = max_size_setting(max_size)
-    with _gc_paused():
+    with collector_paused():
         return _flatten(tree, model, cap)
-
-
-@contextmanager
-def _gc_paused() -> Iterator[None]:
-    """Pause the cyclic garbage collector: flattening allocates millions of long-lived
-    objects and frees almost none, so collections only re-scan live data (a 40% cost
-    on large models). Reference counting still frees acyclic garbage."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatModel:

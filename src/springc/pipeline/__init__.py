@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from ..collector import collector_paused
 from .apart import compiled_apart
-from .collector import collector_paused
 from .compiler import (
     CompiledModel,
     ModuleKind,

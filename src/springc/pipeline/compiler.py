@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..codegen import GeneratedModule, ModuleKind
+from ..collector import collector_paused
 from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..resources import CacheUnusable, private_folder
@@ -51,7 +52,6 @@ from .closed import (
     needs_run_system,
     run_system_of,
 )
-from .collector import collector_paused
 from .diagnostics import decode_warnings
 from .equations import Equations
 from .notes import compiling_note

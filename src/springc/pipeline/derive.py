@@ -12,12 +12,12 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 
+from ..collector import collector_paused
 from ..flatten import flatten, select_model
 from ..ir import flat, syntax
 from ..parse import ClassEntry, ClassTree, load, parse_text
 from ..simplify import simplify
 from ..units import check_units
-from .collector import collector_paused
 from .options import CompileOptions, Derived
 
 WRAPPER_FILE = "<springc: structural parameters>"

@@ -10,8 +10,8 @@ module generates the text of a derived model's module.
 from __future__ import annotations
 
 from ..codegen import CodegenOptions, generate
+from ..collector import collector_paused
 from .cache import Names
-from .collector import collector_paused
 from .derive import derive_system
 from .diagnostics import encode_warnings
 from .options import CompileOptions, Derived

@@ -20,10 +20,10 @@ The pipeline is a short list of passes, each in its own module:
 
 from __future__ import annotations
 
-import gc
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+from ..collector import collector_paused
 from ..errors import Note, Span
 from ..ir import flat, ode
 from .alias import eliminate_aliases
@@ -65,13 +65,8 @@ def simplify(model: flat.FlatModel, at: Mapping[str, float] | None = None) -> Si
     small acyclic nodes, and its full collections, each scanning the whole (large)
     flat model, made the run superlinear in the model size.
     """
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
+    with collector_paused():
         return _simplify(model, at)
-    finally:
-        if enabled:
-            gc.enable()
 
 
 def _pivot_checks(blocks: Sequence[DummyBlock], span: Span) -> tuple[flat.Assertion, ...]:
