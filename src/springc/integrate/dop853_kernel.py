@@ -3,7 +3,10 @@ of :mod:`.loop` specialised on :mod:`.dop853_steps` (with scipy's sums, or plain
 
 :func:`dop853_run` is the entry point other compiled code calls (the ensemble of
 :mod:`.ensemble_kernel` runs it once per row); Python calls go through
-:func:`springc.integrate.dop853`, which compiles only the arithmetic it asks for.
+:func:`springc.integrate.dop853`, which compiles only the arithmetic it asks for. A
+stage whose derivative is not finite rejects its attempt where a shorter step is allowed
+(:func:`.dop853_steps.shrinks`; numba's cache of this file does not see a change of
+that one: edit this docstring with it).
 """
 
 import numpy as np

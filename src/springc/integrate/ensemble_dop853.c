@@ -473,16 +473,35 @@ SC_FN int sc_attempt(sc_lane *L, const sc_job *job) {
     return 1;
 }
 
-/* Stage st of the attempt; 0 if the evaluation failed (the run has ended). */
-SC_FN int sc_stage_of(sc_lane *L, const sc_job *job, int st) {
+/* A failed evaluation of an attempt: a non-finite derivative while a step 0.2 times
+   shorter is allowed rejects the attempt (dop853_steps.shrinks: as scipy's NaN error
+   norm does; the lane attempts again), else the run ends. Returns 0 either way. */
+SC_FN int sc_failed_attempt(sc_lane *L, const sc_job *job, int status, double t,
+                            const double *at) {
+    if (status == SC_NON_FINITE_DERIVATIVE && L->h_abs * 0.2 >= L->min_step) {
+        L->h_abs *= 0.2;
+        L->retry = 1;
+        L->rejected += 1;
+        L->ready = 0;
+        return 0;
+    }
+    sc_end(L, job, status, t, at);
+    return 0;
+}
+
+/* Stage st of the attempt (trial: a failed evaluation rejects it where it may, see
+   sc_failed_attempt) or of the dense output (the run ends); 0 if it failed. */
+SC_FN int sc_stage_of(sc_lane *L, const sc_job *job, int st, int trial) {
     double *w = L->w, *K = w, *sums = w + 25 * SC_NXS, *work = w + 24 * SC_NXS;
     double *z = w + SC_AT_Z, t = L->t + DOP_C[st] * L->h;
     sc_stage(w + SC_AT_Y, K, st, L->h, sums, work);
     springc_rhs(t, work, w + SC_AT_P, z, K + st * SC_NXS);
     L->nfev += 1;
     int status = sc_verdict(K + st * SC_NXS, z);
-    if (status != SC_SUCCESS) { sc_end(L, job, status, t, work); return 0; }
-    return 1;
+    if (status == SC_SUCCESS) return 1;
+    if (trial) return sc_failed_attempt(L, job, status, t, work);
+    sc_end(L, job, status, t, work);
+    return 0;
 }
 
 /* The end of an attempt: the new state, its error, accepted or rejected; an accepted
@@ -499,7 +518,7 @@ SC_FN int sc_conclude(sc_lane *L, const sc_job *job) {
     springc_rhs(t + h, y_new, p, z, K + SC_STAGES * SC_NXS);
     L->nfev += 1;
     int status = sc_verdict(K + SC_STAGES * SC_NXS, z);
-    if (status != SC_SUCCESS) { sc_end(L, job, status, t + h, y_new); return 0; }
+    if (status != SC_SUCCESS) return sc_failed_attempt(L, job, status, t + h, y_new);
     double error = sc_error_norm(y, y_new, K, h, s->rtol, s->atol, scale, err5, err3);
     if (!(error < 1)) {
         L->h_abs *= sc_max(0.2, 0.9 * pow(error, -0.125));
@@ -528,7 +547,7 @@ SC_FN int sc_conclude(sc_lane *L, const sc_job *job) {
 #endif
     if (event || (L->filled < last && s->grid[L->filled] <= L->t_new)) {
         for (int st = SC_STAGES + 1; st < SC_EXTENDED; st++)
-            if (!sc_stage_of(L, job, st)) return 0;
+            if (!sc_stage_of(L, job, st, 0)) return 0;
         sc_interpolant(y, y_new, K, h, F, sums);
     }
 #if SPRINGC_HYBRID
@@ -613,7 +632,7 @@ SC_FN void sc_work(sc_job *job, double *block) {
         if (!any) return;
         for (int st = 1; st < SC_STAGES; st++)
             for (int l = 0; l < SC_LANES; l++)
-                if (lanes[l].ready) lanes[l].ready = sc_stage_of(&lanes[l], job, st);
+                if (lanes[l].ready) lanes[l].ready = sc_stage_of(&lanes[l], job, st, 1);
         for (int l = 0; l < SC_LANES; l++)
             if (lanes[l].ready) sc_conclude(&lanes[l], job);
     }

@@ -3,9 +3,10 @@
 Every row of ``P`` (and of ``X0``, ``Z``) is one run: :func:`ensemble_run` integrates
 the runs in a ``numba.prange`` loop over the rows, each by :func:`.dop853_kernel.dop853_run`
 (the same steps, error control and dense output as a single compiled DOP853 run) with
-its own adaptive steps and its own status code. A failed run (non-finite derivative,
-step too small, too many steps, the model's failure flag) writes its status and NaN
-summaries and never stops the others.
+its own adaptive steps and its own status code. A failed run (non-finite derivative
+at the smallest step, step too small, too many steps, the model's failure flag) writes
+its status and NaN summaries and never stops the others; a non-finite stage with room
+for a shorter step only rejects its attempt, as in ``ensemble_dop853.c``.
 
 Per run and chosen column (an index into ``[states | observed]`` on the output grid):
 the final value, the minimum, the maximum, the time-weighted mean (the trapezoidal
