@@ -170,7 +170,7 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
     return None if chosen == default_backend() else chosen
 
 
-@collector_paused()  # the whole compile, both backends (springc.pipeline.collector)
+@collector_paused()  # the whole compile, both backends (springc.collector)
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
     compiled, base = _compile_as(options, parameters)

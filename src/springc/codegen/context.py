@@ -248,7 +248,7 @@ class CodegenContext:
     def _alias_stmts(self, name: str, done: set[str], out: list[Stmt]) -> None:
         # A method, not a recursive closure: that would be a reference cycle (closure
         # -> its cell -> closure) holding the context and its system, left to the
-        # collector, paused while a model compiles (springc.pipeline.collector).
+        # collector, paused while a model compiles (springc.collector).
         if name in done or name not in self.aliases:
             return
         done.add(name)

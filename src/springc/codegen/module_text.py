@@ -42,7 +42,7 @@ def _visit(q: dae.Parameter, by_name: dict[str, dae.Parameter], state: dict[str,
            order: list[dae.Parameter]) -> None:
     # A function of the module, not a recursive closure: that would be a reference
     # cycle (closure -> its cell -> closure) holding the parameters, left to the
-    # collector, paused while a model compiles (springc.pipeline.collector).
+    # collector, paused while a model compiles (springc.collector).
     mark = state.get(q.name)
     if mark == 2:
         return

@@ -36,7 +36,7 @@ def parameter_values(parameters: Iterable[dae.Parameter],
 class _ParameterValues:
     """:func:`parameter_values`'s work: an object, not a recursive closure, which would
     be a reference cycle (closure -> its cell -> closure) holding the parameters, left
-    to the collector, paused while a model compiles (springc.pipeline.collector)."""
+    to the collector, paused while a model compiles (springc.collector)."""
 
     def __init__(self, params: dict[str, dae.Parameter], values: dict[str, float]) -> None:
         self.params, self.values = params, values

@@ -76,7 +76,7 @@ def check_powers(e: x.Expr, values: Mapping[str, Any]) -> None:
 def _check_powers(node: x.Expr, values: Mapping[str, Any], seen: set[int]) -> None:
     # A function of the module, not a recursive closure: that would be a reference
     # cycle (closure -> its cell -> closure) left to the collector, paused while a
-    # model compiles (springc.pipeline.collector).
+    # model compiles (springc.collector).
     if id(node) in seen:
         return
     seen.add(id(node))
