@@ -3,7 +3,7 @@ no numpy, numba or scipy is imported (:mod:`.runner`). The library is built by
 :func:`springc.pipeline.loop_library` from the text of
 :func:`springc.integrate.native_loop.loop_text`; see ``docs/c_model.md``."""
 
-from .compiler import COMPILERS, ZIG_MODULE, CCompilerMissing, find_compiler
+from .compiler import COMPILERS, ZIG_MODULE, CCompilerMissing, find_compiler, first_error
 from .runner import (
     FIRST_STRETCH,
     LIBRARY_FILE,
@@ -29,5 +29,6 @@ __all__ = [
     "LoopRun",
     "cached_library",
     "find_compiler",
+    "first_error",
     "read_verified",
 ]

@@ -45,3 +45,11 @@ def find_compiler() -> list[str]:
                            hint="pip install ziglang (a C compiler from PyPI), or install "
                            "a system C compiler (for example gcc), to build the C model; "
                            "the Python module needs none")
+
+
+def first_error(stderr: str, limit: int) -> str:
+    """The compiler's first line that names an error (else its first line), at most
+    ``limit`` characters: the one reading of a compiler's complaint."""
+    lines = [line.strip() for line in stderr.splitlines() if line.strip()]
+    named = [line for line in lines if "error" in line]
+    return (named or lines or ["no message"])[0][:limit]

@@ -29,7 +29,7 @@ from pathlib import Path
 from ..errors import SpringcError
 from ..fileio import keep_newest, replace_private
 from ..resources import CacheUnusable, private_folder, user_cache_dir
-from .compiler import find_compiler
+from .compiler import find_compiler, first_error
 from .runner import read_verified
 
 FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-DNDEBUG", "-DHAVE_UNISTD_H",
@@ -155,16 +155,10 @@ def _compile(build: ForeignBuild, compiler: list[str]) -> bytes:
         if done.returncode != 0 or not out.is_file():
             raise ForeignBuildFailed(
                 f"the C compiler refused the library's C sources ({argv[0]} exit "
-                f"{done.returncode}): " + _first_error(done.stderr))
+                f"{done.returncode}): " + first_error(done.stderr, 300))
         return out.read_bytes()
 
 
 def _checked_folder(folder: str) -> None:
     if folder and not SUBFOLDER_NAME.fullmatch(folder):
         raise ValueError(f"not a plain folder name: {folder!r}")
-
-
-def _first_error(stderr: str) -> str:
-    lines = [line.strip() for line in stderr.splitlines() if line.strip()]
-    named = [line for line in lines if "error" in line]
-    return (named or lines or ["no message"])[0][:300]

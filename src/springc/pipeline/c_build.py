@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..codegen import CodegenBug
-from ..native import ZIG_MODULE, CCompilerMissing, find_compiler
+from ..native import ZIG_MODULE, CCompilerMissing, find_compiler, first_error
 from .cache import add_to_entry, read_addition
 from .compiler import CompiledModel
 
@@ -51,9 +51,7 @@ class CompilerRefused(CodegenBug):
 
     def first_error(self) -> str:
         """The compiler's first line that names an error (else its first line)."""
-        lines = [line.strip() for line in self.stderr.splitlines() if line.strip()]
-        named = [line for line in lines if "error" in line]
-        return (named or lines or ["no message"])[0][:200]
+        return first_error(self.stderr, 200)
 
 
 def build_library(source: str, folder: Path, extra: Sequence[str] = ()) -> bytes:
