@@ -17,7 +17,7 @@ each time (:func:`.statements.guarded_solve`, :mod:`.c_context`).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 
 from ..ir import expr as x
 from ..ir import ode
@@ -57,16 +57,8 @@ def varying_names(system: ode.ODE) -> set[str]:
     for step in system.steps:
         if isinstance(step, ode.Assign) and not moves(step.expr, varying):
             continue
-        varying.update(step_names(step))
+        varying.update(ode.computed_names(step))
     return varying
-
-
-def step_names(step: ode.Step) -> Iterable[str]:
-    if isinstance(step, ode.Assign):
-        return (step.name,)
-    if isinstance(step, ode.LinearBlock):
-        return step.names
-    return (*step.tearing, *(a.name for a in step.inner))
 
 
 def moves(e: x.Expr, varying: set[str]) -> bool:

@@ -72,10 +72,8 @@ def state_dependencies(system: ode.ODE) -> dict[str, frozenset[str]]:
         if isinstance(step, ode.Assign):
             deps[step.name] = reads([step.expr])
             continue
-        names = step.names if isinstance(step, ode.LinearBlock) else \
-            step.tearing + tuple(a.name for a in step.inner)
         found = reads(ode.step_expressions(step))
-        for name in names:
+        for name in ode.computed_names(step):
             deps[name] = found
     for alias in system.observed:
         deps[alias.name] = reads([alias.expr])

@@ -65,6 +65,16 @@ def step_expressions(step: Step) -> list[Expr]:
             + [a.expr for a in step.sensitivities] + [e for _, _, e in step.jacobian])
 
 
+def computed_names(step: Step) -> tuple[str, ...]:
+    """The names a solve step computes (a nonlinear block's tearing variables, then its
+    inner assignments)."""
+    if isinstance(step, Assign):
+        return (step.name,)
+    if isinstance(step, LinearBlock):
+        return step.names
+    return step.tearing + tuple(a.name for a in step.inner)
+
+
 def map_step(step: Step, f: Callable[[Expr], Expr]) -> Step:
     """``step`` with ``f`` applied to every expression it evaluates (the names it
     solves for and its structure unchanged)."""
@@ -105,15 +115,7 @@ class ODE:
 
     def step_names(self) -> list[str]:
         """Every name computed by the steps, in order."""
-        out: list[str] = []
-        for step in self.steps:
-            if isinstance(step, Assign):
-                out.append(step.name)
-            elif isinstance(step, LinearBlock):
-                out += step.names
-            else:
-                out += step.tearing + tuple(a.name for a in step.inner)
-        return out
+        return [name for step in self.steps for name in computed_names(step)]
 
     def observed_names(self) -> list[str]:
         """Algebraic variables the user can ask for (derivative variables excluded)."""
