@@ -102,3 +102,5 @@ def test_a_cached_module_whose_functions_numba_has_not_cached_says_so(
     announce_functions(module, path, cached=True)  # type: ignore[arg-type]
     assert capsys.readouterr().err == ("springc: compiling the functions of Decay for this "
                                        "machine (once)\n")
+    announce_functions(module, path, cached=True)  # type: ignore[arg-type]
+    assert capsys.readouterr().err == ""  # the probe's and the run's problems: one line

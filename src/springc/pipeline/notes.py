@@ -19,6 +19,10 @@ from .options import CompileOptions
 FUNCTIONS_NOTE = "compiling the functions of {name} for this machine (once)"
 """The status line before a cached numba module's functions compile."""
 
+_ANNOUNCED: set[Path] = set()
+"""The module paths whose functions this process announced (a run, its probe and its
+companion run each build a problem of the same module: one line, not one each)."""
+
 
 def compiling_note(options: CompileOptions, folder: Path | None) -> str:
     """The status line of a model that is not in the cache (``folder``: the cache
@@ -42,5 +46,6 @@ def announce_functions(module: GeneratedModule, path: Path, cached: bool) -> Non
     """Say that the functions of a module loaded from the cache (``cached``) compile at
     their first call, where numba has not cached them (a model compiled just now was
     announced by :func:`compiling_note` already)."""
-    if cached and not functions_cached(module, path):
+    if cached and path not in _ANNOUNCED and not functions_cached(module, path):
+        _ANNOUNCED.add(path)
         say(FUNCTIONS_NOTE.format(name=module.MODEL))
