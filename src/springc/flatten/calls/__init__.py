@@ -5,7 +5,7 @@
 from __future__ import annotations
 
 from .assertions import assertion, check_conditions, guard_assertions, unique
-from .builtins import CONSTANTS, Builtins, without_events
+from .builtins import CONSTANTS, Builtins, switches, without_events
 from .control import Jumped, branch_jumps, check_jumps, folded, run_loop_body, run_while, stray
 from .functions import call_for_effect, call_function, function_of, multiple_outputs
 from .short_functions import short_defaults
@@ -38,6 +38,7 @@ __all__ = [
     "run_while",
     "short_defaults",
     "stray",
+    "switches",
     "string_binary",
     "string_component",
     "string_equation",

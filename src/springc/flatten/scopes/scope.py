@@ -321,6 +321,7 @@ class ExpressionEvaluator(Protocol):
 
     def record_value(self, record: ClassScope) -> Any: ...
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
+    literal: int  # > 0 inlining a function body without GenerateEvents = true (12.8)
     call_depth: int  # nesting of user-defined function calls being inlined
     events: EventUses  # pre/edge/change uses and when-clause nesting (event_calls.py)
 
