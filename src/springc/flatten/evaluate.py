@@ -277,8 +277,7 @@ class Evaluator(ReferenceResolver):
         check_enum_relation(e, left, right, scope, self)
         result: a.Value = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
         if self.literal and op in x.RELATIONS:
-            # in a function body: taken literally, without events (12.8)
-            return without_events(result)  # type: ignore[arg-type]
+            return self._quiet(result)  # in a function body (12.8)
         return result  # a relation on variables generates events (simplify/events.py)
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
@@ -369,13 +368,19 @@ class Evaluator(ReferenceResolver):
         if handler is not None:
             value = handler(e, scope)
             if self.literal and switches(name):
-                # abs, div, integer... in a function body switch without events (12.8)
-                return a.elementwise(without_events, value)
+                return self._quiet(value)  # abs, div, integer... in a function body
             return value
         entry, named = short_defaults(self, function_of(self, e.func, scope), e.func, scope)
         args = [self.value(arg, scope) for arg in e.args]
         named.update({n.name: (self.value(n.value, scope), n.span) for n in e.named})
         return call_function(self, entry, args, named, e)
+
+    def _quiet(self, v: a.Value) -> a.Value:
+        """``v`` taken literally, as inside ``noEvent``: a relation or switching
+        built-in of a function body without ``GenerateEvents = true`` (12.8); one on
+        parameters only switches at no event anyway and stays as it is."""
+        return a.elementwise(lambda e: e if self.flattener.is_parameter_expression(e)
+                             else without_events(e), v)
 
     def _FieldOf(self, e: s.FieldOf, scope: Scope) -> a.Value:
         key = (Ident(e.record), Ident(scope))  # one evaluation for all the fields
