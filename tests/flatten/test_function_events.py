@@ -91,3 +91,36 @@ end M;
 """)
     assert equations(m) == ["a = if time - 1 > 0 then 1 else 0",
                             "b = 2 * (if noEvent(time - 1 > 0) then 1 else 0)"]
+
+
+def test_functions_in_a_when_condition_keep_their_events(tmp_path: Path) -> None:
+    # above(x, 0.5) is no discrete-time expression (3.8.3) without GenerateEvents; a
+    # literal condition would be read at events only and never fire: its relations stay
+    # events, as in the clause's own relations
+    m = flat_of(tmp_path, """model M
+  function above
+    input Real u;
+    input Real k;
+    output Boolean y;
+  algorithm
+    y := u > k;
+  end above;
+  Real x(start = 0, fixed = true);
+  discrete Real tHit(start = -1, fixed = true);
+  discrete Real y(start = 0, fixed = true);
+equation
+  der(x) = 1;
+  when above(x, 0.5) then
+    tHit = time;
+  end when;
+algorithm
+  when above(x, 0.75) then
+    y := if above(x, 2) then 1 else 2;
+  end when;
+end M;
+""")
+    assert [x.to_text(c) for clause in m.whens for b in clause.branches
+            for c in b.conditions] == ["x > 0.5", "x > 0.75"]
+    # the body's values are literal anyway (8.5: the clause wraps them in noEvent too)
+    assert [x.to_text(a.value) for clause in m.whens for b in clause.branches
+            for a in b.assignments] == ["time", "noEvent(if noEvent(x > 2) then 1 else 2)"]

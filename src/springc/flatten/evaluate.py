@@ -72,6 +72,7 @@ class Evaluator(ReferenceResolver):
         # > 0 while inlining the body of a function without GenerateEvents = true: its
         # relations and switching built-ins are literal, as inside noEvent (12.8)
         self.literal = 0
+        self.eventful = 0  # > 0 in a when-condition: its functions generate events
         self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)

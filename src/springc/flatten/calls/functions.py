@@ -103,7 +103,7 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
                                    f"scalar, given {ev.describe(arg)} (section 12.4.6)",
                                    call.span, [Note("declared here", comp.span)])
     ev.call_depth = depth + 1
-    quiet = not generates_events(entry)
+    quiet = not (generates_events(entry) or ev.eventful)
     ev.literal += quiet
     try:
         for comp in comps:
@@ -153,6 +153,19 @@ def generates_events(entry: ClassEntry) -> bool:
         arg.path == ("GenerateEvents",) and arg.modification is not None
         and isinstance(arg.modification.value, s.Bool) and arg.modification.value.value
         for arg in annotation.arguments)
+
+
+def condition_value(ev: ExpressionEvaluator, cond: s.Expr, scope: Scope) -> a.Value:
+    """The value of a when-clause's condition. The functions it calls generate events
+    as if they had ``GenerateEvents = true``: a condition of the form ``f(x)``
+    (a Boolean of a function of continuous variables, not a discrete-time expression,
+    3.8.3) fires its clause where ``f``'s relations switch, as before 12.8 was kept,
+    instead of never (a literal condition is read at events only)."""
+    ev.eventful += 1
+    try:
+        return ev.value(cond, scope)
+    finally:
+        ev.eventful -= 1
 
 
 def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry:
