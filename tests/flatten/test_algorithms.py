@@ -198,7 +198,9 @@ algorithm
 end M;
 """)
     assert asserts(m) == [
-        ("if x > 0 then x < 100 else true", "u too large: limit 100", "error"),
+        # the guard is f's branch condition: literal, as relations in function bodies
+        # are (12.8); the assertion's own condition stays as written
+        ("if noEvent(x > 0) then x < 100 else true", "u too large: limit 100", "error"),
         ("k > 0", "k must be positive", "warning"),
         ("y >= 0", 'y\\ "neg"', "error")]
     assert [(a.span.line, a.span.column) for a in m.assertions] == [(7, 7), (17, 3), (19, 3)]
@@ -303,5 +305,6 @@ def test_functions_called_in_a_branch_of_a_function(tmp_path: Path) -> None:
   Real y = noEvent(g(x));
 end M;
 """)
-    assert asserts(m) == [("if x > 1 then x - 1 > 0 else true", "u must be positive",
-                           "error")]
+    # g's branch condition guards f's assertion: literal, as in any function body (12.8)
+    assert asserts(m) == [("if noEvent(x > 1) then x - 1 > 0 else true",
+                           "u must be positive", "error")]

@@ -48,14 +48,15 @@ def test_a_counted_search_unrolls_to_a_sum_of_its_conditions(tmp_path: Path) -> 
                  for e in flatten_files([path], None).equations}
     # at most size(tab) = 4 checks let the loop go on; the fourth (i0 + 3 < 4) is
     # false from i0 = 1, the third from i0 = 2; each check reads the counter at
-    # i0 + k, never the value of the iteration before
+    # i0 + k, never the value of the iteration before; the conditions are f's own,
+    # literal (a function body generates no events, 12.8)
     assert equations["k"] == (
-        "1 + ((if time >= tab[1] then 1 else 0) + (if time >= tab[1] and time >= tab[2] "
-        "then 1 else 0) + (if time >= tab[1] and time >= tab[2] and time >= tab[3] then 1 "
-        "else 0))")
+        "1 + ((if noEvent(time >= tab[1]) then 1 else 0) + (if noEvent(time >= tab[1]) "
+        "and noEvent(time >= tab[2]) then 1 else 0) + (if noEvent(time >= tab[1]) and "
+        "noEvent(time >= tab[2]) and noEvent(time >= tab[3]) then 1 else 0))")
     assert equations["m"] == (
-        "2 + ((if 2 * time >= tab[2] then 1 else 0) + (if 2 * time >= tab[2] and "
-        "2 * time >= tab[3] then 1 else 0))")
+        "2 + ((if noEvent(2 * time >= tab[2]) then 1 else 0) + (if noEvent(2 * time >= "
+        "tab[2]) and noEvent(2 * time >= tab[3]) then 1 else 0))")
 
 
 def test_a_counted_search_simulates_to_its_closed_form(tmp_path: Path) -> None:

@@ -380,6 +380,7 @@ end M;
 """)
     model = flatten_files([path])
     equations = {x.to_text(e.lhs): x.to_text(e.rhs) for e in model.equations}
-    assert equations["y"] == "if time > 1 then 2 * (time - 1) else 0"
+    # f's branch condition is literal: a function body generates no events (12.8)
+    assert equations["y"] == "if noEvent(time > 1) then 2 * (time - 1) else 0"
     (when,) = model.whens
     assert [x.to_text(c) for c in when.branches[0].conditions] == ["pre(reset[1])"]

@@ -28,6 +28,8 @@ from .calls import (
     guard_assertions,
     short_defaults,
     string_binary,
+    switches,
+    without_events,
 )
 from .checks import check_enum_relation
 from .connect import (
@@ -67,6 +69,10 @@ class Evaluator(ReferenceResolver):
     def __init__(self, flattener: FlattenContext) -> None:
         self.flattener = flattener
         self.no_event = 0  # > 0 inside noEvent(...) and smooth(...)
+        # > 0 while inlining the body of a function without GenerateEvents = true: its
+        # relations and switching built-ins are literal, as inside noEvent (12.8)
+        self.literal = 0
+        self.eventful = 0  # > 0 in a when-condition: its functions generate events
         self.call_depth = 0  # nesting of user-defined function calls being inlined
         self.events = EventUses()  # pre/edge/change uses, when-clause nesting
         self.builtins = Builtins(self)
@@ -271,6 +277,8 @@ class Evaluator(ReferenceResolver):
                                hint="check the sizes of both operands") from None
         check_enum_relation(e, left, right, scope, self)
         result: a.Value = a.scalar_op(op)(left, right)  # type: ignore[arg-type]
+        if self.literal and op in x.RELATIONS:
+            return self._quiet(result)  # in a function body (12.8)
         return result  # a relation on variables generates events (simplify/events.py)
 
     def _IfExpr(self, e: s.IfExpr, scope: Scope) -> a.Value:
@@ -359,11 +367,21 @@ class Evaluator(ReferenceResolver):
             return delay_call(self, e, scope)
         handler = self.builtins.lookup(name, scope)
         if handler is not None:
-            return handler(e, scope)
+            value = handler(e, scope)
+            if self.literal and switches(name):
+                return self._quiet(value)  # abs, div, integer... in a function body
+            return value
         entry, named = short_defaults(self, function_of(self, e.func, scope), e.func, scope)
         args = [self.value(arg, scope) for arg in e.args]
         named.update({n.name: (self.value(n.value, scope), n.span) for n in e.named})
         return call_function(self, entry, args, named, e)
+
+    def _quiet(self, v: a.Value) -> a.Value:
+        """``v`` taken literally, as inside ``noEvent``: a relation or switching
+        built-in of a function body without ``GenerateEvents = true`` (12.8); one on
+        parameters only switches at no event anyway and stays as it is."""
+        return a.elementwise(lambda e: e if self.flattener.is_parameter_expression(e)
+                             else without_events(e), v)
 
     def _FieldOf(self, e: s.FieldOf, scope: Scope) -> a.Value:
         key = (Ident(e.record), Ident(scope))  # one evaluation for all the fields

@@ -5,9 +5,15 @@
 from __future__ import annotations
 
 from .assertions import assertion, check_conditions, guard_assertions, unique
-from .builtins import CONSTANTS, Builtins, without_events
+from .builtins import CONSTANTS, Builtins, switches, without_events
 from .control import Jumped, branch_jumps, check_jumps, folded, run_loop_body, run_while, stray
-from .functions import call_for_effect, call_function, function_of, multiple_outputs
+from .functions import (
+    call_for_effect,
+    call_function,
+    condition_value,
+    function_of,
+    multiple_outputs,
+)
 from .short_functions import short_defaults
 from .strings import (
     is_string,
@@ -28,6 +34,7 @@ __all__ = [
     "call_function",
     "check_conditions",
     "check_jumps",
+    "condition_value",
     "folded",
     "function_of",
     "guard_assertions",
@@ -41,6 +48,7 @@ __all__ = [
     "string_binary",
     "string_component",
     "string_equation",
+    "switches",
     "undefined_strings",
     "unique",
     "without_events",

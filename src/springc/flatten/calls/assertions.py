@@ -49,11 +49,15 @@ def assertion(ev: ExpressionEvaluator, call: s.Call, scope: Scope, origin: flat.
         raise FlattenError(f"'assert' needs a {missing}", call.span,
                            hint="write assert(condition, \"message\") or add "
                                 "AssertionLevel.warning as a third argument")
+    # a condition is checked, never switched: inside a function body too it stays as
+    # written (no noEvent around its relations)
     ev.no_event += 1
+    literal, ev.literal = ev.literal, 0
     try:
         value = ev.value(cond_expr, scope)
     finally:
         ev.no_event -= 1
+        ev.literal = literal
     if isinstance(value, str) or a.is_array(value):
         raise FlattenError(f"the condition of 'assert' must be a scalar Boolean, found "
                            f"{ev.describe(value)}", cond_expr.span)

@@ -247,6 +247,12 @@ def _call(name: str, args: tuple[x.Expr, ...]) -> x.Expr:
 _SWITCHING_CALLS = names(lambda b: b.switching)
 
 
+def switches(name: str) -> bool:
+    """Whether the built-in called ``name`` (``abs``, ``Modelica.Math.floor``...) jumps
+    where its arguments cross a switch: an event outside ``noEvent``."""
+    return _ALIASES.get(name, name) in _SWITCHING_CALLS
+
+
 def without_events(e: x.Expr) -> x.Expr:
     """``noEvent(e)``: ``noEvent`` only matters around relations and the built-ins that
     would switch at events (3.7.2); elsewhere it is dropped."""

@@ -103,6 +103,8 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
                                    f"scalar, given {ev.describe(arg)} (section 12.4.6)",
                                    call.span, [Note("declared here", comp.span)])
     ev.call_depth = depth + 1
+    quiet = not (generates_events(entry) or ev.eventful)
+    ev.literal += quiet
     try:
         for comp in comps:
             _declare(ev, scope, comp, given, call)
@@ -123,6 +125,7 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
                 raise stray(jumped) from None
     finally:
         ev.call_depth = depth
+        ev.literal -= quiet
     if count > len(outputs):
         raise FlattenError(f"'{entry.full_name}' has {len(outputs)} output(s), "
                            f"{count} are used", call.span,
@@ -137,6 +140,32 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
     if count == 1:
         return results[0]
     return results  # type: ignore[return-value]  # a list only for count != 1
+
+
+def generates_events(entry: ClassEntry) -> bool:
+    """Whether the function has ``annotation(GenerateEvents = true)``: without it, the
+    relations and switching built-ins of its body generate no events, "similar to
+    inlining the function body while wrapping all expressions in noEvent" (Modelica
+    3.6, section 12.8; 8.5: "all assignment statements within function classes are
+    implicitly treated with noEvent"). A body inlined inside such a body stays literal."""
+    annotation = entry.defn.annotation
+    return annotation is not None and any(
+        arg.path == ("GenerateEvents",) and arg.modification is not None
+        and isinstance(arg.modification.value, s.Bool) and arg.modification.value.value
+        for arg in annotation.arguments)
+
+
+def condition_value(ev: ExpressionEvaluator, cond: s.Expr, scope: Scope) -> a.Value:
+    """The value of a when-clause's condition. The functions it calls generate events
+    as if they had ``GenerateEvents = true``: a condition of the form ``f(x)``
+    (a Boolean of a function of continuous variables, not a discrete-time expression,
+    3.8.3) fires its clause where ``f``'s relations switch, as before 12.8 was kept,
+    instead of never (a literal condition is read at events only)."""
+    ev.eventful += 1
+    try:
+        return ev.value(cond, scope)
+    finally:
+        ev.eventful -= 1
 
 
 def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry:

@@ -20,7 +20,7 @@ from ...ir import syntax as s
 from ...ir import when as w
 from ...ir.builtins import BUILTINS, SAME, names
 from .. import arrays as a
-from ..calls import assertion, string_equation, without_events
+from ..calls import assertion, condition_value, string_equation, without_events
 from ..connect import check_branches, check_no_connect
 from ..scopes import ClassScope, FlattenContext, LocalScope, Scope, equations
 from .when_rules import check_when_target
@@ -42,7 +42,8 @@ def flatten_when(ctx: FlattenContext, eq: s.WhenEquation, where: Scope, owner: C
         branches = []
         earlier: list[x.Expr] = []  # the conditions of the branches before
         for cond_expr, body in eq.branches:
-            conditions = when_conditions(ctx.evaluator.value(cond_expr, where), cond_expr)
+            conditions = when_conditions(condition_value(ctx.evaluator, cond_expr, where),
+                                         cond_expr)
             parts = _Body(phase_guard(conditions, earlier), owner)
             earlier += conditions
             for item in body:

@@ -21,6 +21,7 @@ from ...errors import FlattenError, Span
 from ...ir import expr as x
 from ...ir import syntax as s
 from ...ir import when as w
+from ..calls import condition_value
 from ..scopes import ExpressionEvaluator, Scope
 from .when import phase_guard, when_conditions
 
@@ -70,7 +71,7 @@ def when_statement(ev: ExpressionEvaluator, stmt: s.WhenStatement, where: Scope,
         branches = []
         earlier: list[x.Expr] = []
         for cond_expr, body in stmt.branches:
-            value = read(ev.value(cond_expr, where), cond_expr.span)
+            value = read(condition_value(ev, cond_expr, where), cond_expr.span)
             conditions = when_conditions(value, cond_expr)  # type: ignore[arg-type]
             parts = WhenParts(phase_guard(conditions, earlier))
             earlier += conditions

@@ -321,6 +321,8 @@ class ExpressionEvaluator(Protocol):
 
     def record_value(self, record: ClassScope) -> Any: ...
     no_event: int  # > 0 inside noEvent(...) and smooth(...)
+    literal: int  # > 0 inlining a function body without GenerateEvents = true (12.8)
+    eventful: int  # > 0 evaluating a when-condition: the functions it calls switch at events
     call_depth: int  # nesting of user-defined function calls being inlined
     events: EventUses  # pre/edge/change uses and when-clause nesting (event_calls.py)
 
