@@ -168,12 +168,18 @@ class Problem:
         solution is far from the one inside the step (HeatingNPN_NORGate: ``C1.v`` =
         -1.39 V at 81.16 s, V1's falling ramp held past its end at 80 s, from which
         Newton cycles at 78.11 s, a stage of the step's dense output)."""
-        dx = self.mod.rhs(t, x, self.p, self.z)
+        return self.solved(self.mod.rhs, t, x)
+
+    def solved(self, function: Callable[..., Any], t: float, x: np.ndarray) -> Any:
+        """``function(t, x, p, z)`` (the generated ``rhs`` or a Jacobian), evaluated
+        again from the accepted warm starts where a Newton block did not converge
+        (see :meth:`evaluate`)."""
+        out = function(t, x, self.p, self.z)
         for warm in (self.accepted, self.step_start):
             if self.z[-1] == 0.0 or not self.retry_warm(warm):
                 continue
-            dx = self.mod.rhs(t, x, self.p, self.z)
-        return dx
+            out = function(t, x, self.p, self.z)
+        return out
 
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         self.nfev += 1
@@ -310,10 +316,8 @@ class Problem:
         self.njev += 1
         began = time.perf_counter()
         try:
-            if len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda":
-                out = self.mod.jacobian_dense(t, x, self.p, self.z)
-            else:
-                out = self.mod.jacobian(t, x, self.p, self.z)
+            dense = len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda"
+            out = self.solved(self.mod.jacobian_dense if dense else self.mod.jacobian, t, x)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise self.fail(err, t, x, "the Jacobian") from err
         self.model_time += time.perf_counter() - began
