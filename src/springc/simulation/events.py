@@ -187,6 +187,7 @@ class EventLoop:
             raise self.problem.newton_failure(t, x_left)
         if self.z[int(self.mod.Z_STATUS)] != 0.0:
             raise Stop(self.unsettled(t, x_left, z_left))
+        self.problem.accept()  # the consistent point: the next warm starts
         self.last_event = Event(t, kind, cause, x_left, z_left, x_right, self.z.copy())
         self.counts[kind] = self.counts.get(kind, 0) + 1
         if self.keep_events or len(self.events) < KEPT_EVENTS:
@@ -320,7 +321,7 @@ class EventLoop:
                                     np.array(integrator.y), solver)
                 t_new = float(integrator.t)
                 self.note_step(t_new)
-                dense = integrator.dense_output()
+                dense = problem.dense_output(integrator)
                 y = np.asarray(integrator.y, dtype=float)
                 t_end, switched = self.first_switch(dense, t_old, t_new, y)
                 if switched:
@@ -331,9 +332,13 @@ class EventLoop:
                     xe = np.asarray(dense(te), dtype=float)
                     self.fill(te, dense, t_new, y, False)
                     t = te
+                    # the event iteration starts from the step's start, not from its
+                    # end past the event (on the held branch) nor a location probe
+                    problem.restore(problem.step_start)
                     x = self.event(te, xe, "state", self.mod.ZERO_CROSSINGS[k])
                     self.fill(te, None, te, x, True)
                     break
+                problem.restore()  # (the relations' probes may have moved them)
                 if integrator.status == "finished":
                     self.fill(t_new, dense, t_new, y, False)
                     t, x = float(bound), y

@@ -31,17 +31,12 @@ from typing import Any
 import numpy as np
 
 from .compiled import observed_on_grid
-from .steps import Problem
+from .steps import Problem, warm_slots
 
 CONTINUATION_LEVELS = 8
 """At most 2**8 = 256 steps of continuation from the previous row to a failing one."""
 
 _ERRORS = (ArithmeticError, ValueError, np.linalg.LinAlgError)
-
-
-def warm_slots(module: Any) -> int:
-    """How many leading slots of ``z`` hold the Newton warm starts of ``module``."""
-    return len(getattr(module, "GUESSES", ()))
 
 
 def continuation(module: Any, p: np.ndarray, before: tuple[float, np.ndarray, np.ndarray],

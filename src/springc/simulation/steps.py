@@ -78,8 +78,24 @@ class Progress:
             self.stream.flush()
 
 
+def warm_slots(module: Any) -> int:
+    """How many leading slots of ``z`` hold the Newton warm starts of ``module``."""
+    return len(getattr(module, "GUESSES", ()))
+
+
 class Problem:
-    """The generated functions wrapped for scipy: counting, timing, checking."""
+    """The generated functions wrapped for scipy: counting, timing, checking.
+
+    The Newton warm starts (the first :func:`warm_slots` slots of ``z``) carry from
+    evaluation to evaluation, but only those of an accepted point are kept
+    (:attr:`accepted`: the end of an accepted step, the event iteration's consistent
+    point): a point a step only tries (its first step's probe, a step rejected or not
+    yet cut at an event) may lie on a held branch past an event, where the block has a
+    solution far from the one after the event (HeatingNPN_NORGate: the probe of the
+    step after the 85 s event at 99.9 s, on V2's falling ramp held past its end at
+    90 s, left ``C3.v`` = -11.9 V, from which Newton diverged at 85.01 s). A Newton
+    block that does not converge from another warm start is solved again from the
+    accepted one (:meth:`retry_warm`)."""
 
     def __init__(self, model: CompiledModel, p: np.ndarray, solver: str,
                  progress: Progress, limits: Limits | None = None) -> None:
@@ -99,6 +115,29 @@ class Problem:
         self.loop_library: Any = None  # the C loop's, loaded once per run (.native)
         self.trial: np.ndarray | None = None  # z before the step being tried (try_step)
         self.rejected: Stop | None = None
+        self.warm = warm_slots(mod)
+        self.accepted = self.z[:self.warm].copy()  # warm starts of the last accepted point
+        self.step_start = self.accepted  # those of the last accepted step's start
+
+    def accept(self) -> None:
+        """The warm starts in ``z`` are those of an accepted point."""
+        self.accepted = self.z[:self.warm].copy()
+
+    def restore(self, warm: np.ndarray | None = None) -> None:
+        """The warm starts ``warm`` (default: the last accepted point's) back in ``z``."""
+        self.z[:self.warm] = self.accepted if warm is None else warm
+
+    def retry_warm(self, warm: np.ndarray) -> bool:
+        """After a Newton block did not converge (the flag ``z[-1]`` set): ``z`` gets the
+        warm starts ``warm`` and a clear flag, to be evaluated again; False where those
+        are the ones that just failed (a block that does not converge keeps its warm
+        start: nothing else to try)."""
+        n = self.warm
+        if not n or np.array_equal(self.z[:n], warm):
+            return False
+        self.z[:n] = warm
+        self.z[-1] = 0.0
+        return True
 
     def fail(self, err: BaseException, t: float, x: np.ndarray, what: str) -> Stop:
         where = code_location(err, self.path)
@@ -121,11 +160,32 @@ class Problem:
             hint="the model may have reached a singular configuration (a rod or "
                  "pendulum at the end of its range?); check the start values"))
 
+    def evaluate(self, t: float, x: np.ndarray) -> Any:
+        """The generated ``rhs`` at ``(t, x)``; a Newton block that does not converge
+        from the warm starts in ``z`` is solved again from the last accepted point's,
+        then from those of the start of the last accepted step (:meth:`retry_warm`):
+        an accepted step may end past an event not yet located, on a held branch whose
+        solution is far from the one inside the step (HeatingNPN_NORGate: ``C1.v`` =
+        -1.39 V at 81.16 s, V1's falling ramp held past its end at 80 s, from which
+        Newton cycles at 78.11 s, a stage of the step's dense output)."""
+        return self.solved(self.mod.rhs, t, x)
+
+    def solved(self, function: Callable[..., Any], t: float, x: np.ndarray) -> Any:
+        """``function(t, x, p, z)`` (the generated ``rhs`` or a Jacobian), evaluated
+        again from the accepted warm starts where a Newton block did not converge
+        (see :meth:`evaluate`)."""
+        out = function(t, x, self.p, self.z)
+        for warm in (self.accepted, self.step_start):
+            if self.z[-1] == 0.0 or not self.retry_warm(warm):
+                continue
+            out = function(t, x, self.p, self.z)
+        return out
+
     def rhs(self, t: float, x: np.ndarray) -> np.ndarray:
         self.nfev += 1
         began = time.perf_counter()
         try:
-            dx = self.mod.rhs(t, x, self.p, self.z)
+            dx = self.evaluate(t, x)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             failure = self.fail(err, t, x, "the derivatives")
             if self.trial is None:
@@ -165,14 +225,25 @@ class Problem:
         solution, a transistor's held exponential branch overflows, far past the point
         where it switches), as established tools do; where the step then fails, the
         run stops with that failure."""
-        self.trial, self.rejected = np.array(self.z), None
+        start = self.trial = np.array(self.z)
+        self.rejected = None
         try:
             message: str | None = integrator.step()
         finally:
             self.trial = None
         if integrator.status == "failed" and self.rejected is not None:
             raise self.rejected
+        if integrator.status != "failed":  # z holds the accepted end's warm starts
+            self.step_start = start[:self.warm]
+            self.accept()
         return message
+
+    def dense_output(self, integrator: Any) -> Any:
+        """``integrator.dense_output()`` (DOP853's evaluates three more stages inside
+        the step), with ``z`` keeping the accepted end's warm starts."""
+        dense = integrator.dense_output()
+        self.restore()
+        return dense
 
     def start(self, make: Callable[[], Any], t: float, x: np.ndarray) -> Any:
         """scipy's integrator ``make()`` from the accepted point ``(t, x)``: the probe
@@ -181,13 +252,16 @@ class Problem:
         step tries, as in :meth:`try_step`: where it fails, the probe is NaN, the
         step size comes from ``t`` alone and the first step is rejected smaller (a
         transistor's Newton system, warm started 20 s before, has no converging
-        iterate there). The evaluation at ``(t, x)`` itself must succeed."""
+        iterate there). The evaluation at ``(t, x)`` itself must succeed. Whatever the
+        probe's Newton blocks converged to, ``z`` keeps the accepted warm starts (the
+        event iteration's, :meth:`accept`)."""
         self.trial, self.rejected = np.array(self.z), None
         try:
             integrator = make()
             failed = self.rejected is not None
         finally:
             self.trial, self.rejected = None, None
+            self.restore()  # the probe's warm starts are not an accepted point's
         if failed:  # the probe or (t, x) itself (scipy's BDF and LSODA keep no f)
             self.rhs(t, np.asarray(x))  # raises the located failure at (t, x)
         return integrator
@@ -242,10 +316,8 @@ class Problem:
         self.njev += 1
         began = time.perf_counter()
         try:
-            if len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda":
-                out = self.mod.jacobian_dense(t, x, self.p, self.z)
-            else:
-                out = self.mod.jacobian(t, x, self.p, self.z)
+            dense = len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda"
+            out = self.solved(self.mod.jacobian_dense if dense else self.mod.jacobian, t, x)
         except (ArithmeticError, ValueError, np.linalg.LinAlgError) as err:
             raise self.fail(err, t, x, "the Jacobian") from err
         self.model_time += time.perf_counter() - began
@@ -422,7 +494,7 @@ class StepLoop:
                 self.check_limits(integrator, self.steps + taken, sizes)
             j = int(np.searchsorted(grid, integrator.t, side="right"))
             if j > self.k:
-                dense = integrator.dense_output()
+                dense = problem.dense_output(integrator)
                 states[self.k:j] = dense(grid[self.k:j]).T
                 if grid[j - 1] == integrator.t:
                     states[j - 1] = integrator.y
