@@ -33,9 +33,12 @@ from .compiler import find_compiler, first_error
 from .runner import read_verified
 
 FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-DNDEBUG", "-DHAVE_UNISTD_H",
-         "-DHAVE_STDARG_H", "-DHAVE_HIDDEN", "-DHAVE_MEMCPY")
+         "-DHAVE_STDARG_H", "-DHAVE_HIDDEN", "-DHAVE_MEMCPY",
+         "-Werror=implicit-function-declaration")
 """Those of the Modelica Standard Library's own gcc build project
-(``Resources/BuildProjects/gcc/Makefile``), and a shared library's."""
+(``Resources/BuildProjects/gcc/Makefile``), and a shared library's; a function called
+without a declaration is an error (C would assume it returns ``int``, and springc
+would read a wrong value: an ``Include`` that names a header without the prototype)."""
 UTILITIES = Path(__file__).with_name("modelica_utilities.c")
 FOLDER = "foreign"
 KEY_LENGTH = 32
@@ -161,4 +164,4 @@ def _compile(build: ForeignBuild, compiler: list[str]) -> bytes:
 
 def _checked_folder(folder: str) -> None:
     if folder and not SUBFOLDER_NAME.fullmatch(folder):
-        raise ValueError(f"not a plain folder name: {folder!r}")
+        raise ForeignBuildFailed(f"'{folder}' is not a folder name springc builds in")
