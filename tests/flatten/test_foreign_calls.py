@@ -253,3 +253,12 @@ def test_a_function_called_without_its_declaration_is_an_error(tmp_path: Path) -
     assert err.message.startswith("the external function 'Lib.f' ('lib_f') could not be "
                                   "built: the C compiler refused the library's C sources (")
     assert "implicit" in err.message and "lib_f" in err.message
+
+
+def test_springc_gives_modelica_utilities_h_to_a_library_without_it(tmp_path: Path) -> None:
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "ModelicaUtilities.h"\n#include "h.h"\n'
+        'double lib_f(double x) { ModelicaFormatError("x = %g, H = %d", x, H); return x; }\n')
+    err = _error("Lib.M", [libs])
+    assert err.message == "the external function 'Lib.f' ('lib_f') failed: x = 2, H = 3"
