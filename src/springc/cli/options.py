@@ -155,18 +155,18 @@ def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str]
     from ..simulation import file_format
 
     given = [(option, path, formats) for option, path, formats in outputs if path]
-    try:
-        for option, path, formats in given:
-            if formats is not None:
-                file_format(path, formats, option)
-            try:
-                check_target(path, protected)
-            except OutputError as err:
-                raise UsageError(f"{option}: {err.message}", option=option,
-                                 hint=err.hint) from None
+    try:  # two names of one file first: a link to the other output's new file
         check_distinct((option, path) for option, path, _ in given)
     except OutputError as err:
         raise UsageError(err.message, hint=err.hint) from None
+    for option, path, formats in given:
+        if formats is not None:
+            file_format(path, formats, option)
+        try:
+            check_target(path, protected)
+        except OutputError as err:
+            raise UsageError(f"{option}: {err.message}", option=option,
+                             hint=err.hint) from None
 
 
 RUN_OPTIONS: dict[str, Callable[[Callable[..., Any]], Callable[..., Any]]] = {
