@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+import os
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -38,6 +39,21 @@ class NumberRange(click.FloatRange):
         if math.isnan(number):
             self.fail(f"{value!r} is not a number", param, ctx)
         return number
+
+
+class FolderPath(click.Path):
+    """``click.Path`` for an existing folder that also refuses a FIFO, device or socket
+    (``click.Path(file_okay=False)`` lets them through: they are no regular files)."""
+
+    def __init__(self) -> None:
+        super().__init__(exists=True, file_okay=False)
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        path = super().convert(value, param, ctx)
+        if not os.path.isdir(path):
+            self.fail(f"{value!r} is not a folder.", param, ctx)
+        return path
 
 
 LEVEL_KEY = "springc.verbosity"
@@ -79,7 +95,7 @@ CLI_NAMES = OPTION_NAMES
 
 def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
     func = click.option("-L", "--library", "libraries", multiple=True,
-                        type=click.Path(exists=True, file_okay=False),
+                        type=FolderPath(),
                         help="Library folder to search for classes (repeatable); "
                         "then SPRINGC_PATH and MODELICAPATH.")(func)
     func = click.option("--model", "model", default=None,
