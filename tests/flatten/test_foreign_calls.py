@@ -262,3 +262,21 @@ def test_springc_gives_modelica_utilities_h_to_a_library_without_it(tmp_path: Pa
         'double lib_f(double x) { ModelicaFormatError("x = %g, H = %d", x, H); return x; }\n')
     err = _error("Lib.M", [libs])
     assert err.message == "the external function 'Lib.f' ('lib_f') failed: x = 2, H = 3"
+
+
+def test_a_crash_in_the_c_code_is_a_located_error(tmp_path: Path) -> None:
+    # an invalid memory access ends the call, not springc (it died of SIGSEGV, silently)
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "h.h"\n'
+        "double lib_f(double x) { volatile double *p = (volatile double *)(long)(x - 2);"
+        " return *p; }\n")
+    err = _error("Lib.M", [libs])
+    assert err.message == ("the external function 'Lib.f' ('lib_f') failed: the C code "
+                           "crashed: an invalid memory access (segmentation fault)")
+    assert err.span is not None and err.span.line == 8
+    # the handlers are restored and the library's next call runs
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "h.h"\ndouble lib_f(double x) { return x * H; }\n')
+    text = format_flat(flatten_files([], "Lib.M", [libs]))
+    assert text.split("equation\n")[1].splitlines()[:-1] == ["  y = 6.0;"]

@@ -277,11 +277,14 @@ def _glue(c_name: str, args: list[_Arg], result: str | None, include: str) -> st
         f"{value} {c_name}({', '.join(arg.c_type for arg in args) or 'void'});\n")
     return ("#include <setjmp.h>\n"
             "extern jmp_buf springc_error_jump;\n"
+            "void springc_guard_begin(void);\nvoid springc_guard_end(void);\n"
             f"{include}\n{prototype}\n"
             f"int springc_call({', '.join(params) or 'void'}) {{\n"
-            "    if (setjmp(springc_error_jump)) {\n        return 1;\n    }\n"
+            "    if (setjmp(springc_error_jump)) {\n        springc_guard_end();\n"
+            "        return 1;\n    }\n"
+            "    springc_guard_begin();\n"
             f"    {'*springc_result = ' if result else ''}{call_text};\n"
-            "    return 0;\n}\n")
+            "    springc_guard_end();\n    return 0;\n}\n")
 
 
 def _source(path: Path, sources: CSources) -> tuple[str, bytes]:
