@@ -8,7 +8,8 @@ The policy, for every output (``-o``, ``--plot``, ``--save-reference``, the cach
   honoured even when springc runs as root).
 - **Symbolic links are followed**, as ``cp`` and a shell's ``>`` follow them: the file
   the link points to is replaced (the same checks apply to it) and the link itself
-  stays a link. Replacing the link by a plain file would silently cut it.
+  stays a link. Replacing the link by a plain file would silently cut it. A link
+  to nothing is refused: the file it would create elsewhere is one the user never named.
 - **Nothing half-written.** Data goes to a temporary file (``.NAME.XXXX.part``) in the
   target's folder, created exclusively (never through a link) with the permissions
   ``open()`` would give (0666 less the umask; a replaced file keeps its mode). Only a
@@ -72,6 +73,12 @@ def check_target(path: PathLike, protected: Iterable[PathLike] = ()) -> Path:
     try:
         st = real.stat()
     except FileNotFoundError:
+        if os.path.islink(path):
+            raise OutputError(f"refusing to write '{shown}': it is a symbolic link to "
+                              f"'{real}', which does not exist",
+                              hint="springc replaces the file a link points to, and "
+                              "creates no file where a link points: remove the link or "
+                              "choose another path") from None
         return real
     except OSError as err:
         raise OutputError(f"cannot write '{shown}': {err.strerror}") from None

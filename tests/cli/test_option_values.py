@@ -193,3 +193,14 @@ def test_api_misuse_raises_springcs_own_errors(model: str) -> None:
     assert isinstance(unknown.value, KeyError) and isinstance(unknown.value, SpringcError)
     assert str(unknown.value) == ("error: 'x[3]' matches no state or observed variable of "
                                   "this result\nhelp: did you mean 'x[2]'?")
+
+
+def test_a_library_that_is_a_fifo_is_a_bad_option(model: str, tmp_path: Path) -> None:
+    # click's Path(file_okay=False) lets a FIFO through (it is no regular file); it was
+    # then "library folder ... does not exist", exit 1
+    fifo = tmp_path / "lib"
+    os.mkfifo(fifo)
+    result = CliRunner().invoke(main, ["check", model, "-L", str(fifo)])
+    assert result.exit_code == 2
+    assert result.stderr.splitlines()[-1] == (
+        f"Error: Invalid value for '-L' / '--library': '{fifo}' is not a folder.")

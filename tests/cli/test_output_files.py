@@ -370,3 +370,18 @@ def test_api_writers_choose_by_suffix(model: Path, tmp_path: Path) -> None:
     assert estimated.error_estimate is not None
     estimated.save(tmp_path / "r2.csv")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["Decay.mdl", "r.csv", "r2.csv"]
+
+
+def test_a_symlink_to_nothing_is_refused(model: Path, tmp_path: Path) -> None:
+    """Following it would create a file the user never named (in another folder)."""
+    (tmp_path / "elsewhere").mkdir()
+    target = tmp_path / "elsewhere" / "planted.py"
+    link = tmp_path / "out.py"
+    link.symlink_to(target)
+    code, _, err = run("compile", model, "-q", "-o", link)
+    assert code == 2
+    assert err == (f"error: -o: refusing to write '{link}': it is a symbolic link to "
+                   f"'{target}', which does not exist\nhelp: springc replaces the file a "
+                   "link points to, and creates no file where a link points: remove the "
+                   "link or choose another path\n")
+    assert not target.exists() and link.is_symlink()

@@ -193,7 +193,8 @@ def test_c_code_in_the_include_annotation_is_not_compiled(tmp_path: Path) -> Non
     libs = tmp_path / "libs"
     (libs / "Lib").mkdir(parents=True)
     for code in ('static double f(double x) { return x; }', '#define f(x) (x)',
-                 '#include \\"../outside.h\\"'):
+                 '#include \\"../outside.h\\"', 'double f(double x) <% return x; %>',
+                 '%:define f(x) (x)', '??=define f(x) (x)', '__asm__(\\".text\\");'):
         (libs / "Lib" / "package.mo").write_text(
             'package Lib\n  function f\n    input Real x;\n    output Real y;\n'
             f'  external "C" annotation(Include="{code}");\n'
@@ -205,3 +206,77 @@ def test_c_code_in_the_include_annotation_is_not_compiled(tmp_path: Path) -> Non
                                "source files a library ships, never code written in model "
                                "text")
         assert err.span is not None and err.span.line == 5
+
+
+def _library(libs: Path, include_folder: str, header: str | None) -> Path:
+    """Lib, whose f(x) = x * H, H from h.h in its include directory ``include_folder``
+    (a link to ``header`` where given)."""
+    folder = libs / "Lib" / "Resources"
+    (folder / "C-Sources").mkdir(parents=True)
+    (folder / include_folder).mkdir()
+    (folder / "C-Sources" / "Lib.c").write_text(
+        '#include "h.h"\ndouble lib_f(double x) { return x * H; }\n')
+    target = folder / include_folder / "h.h"
+    if header is None:
+        target.write_text("#define H 3\ndouble lib_f(double x);\n")
+    else:
+        target.symlink_to(header)
+    (libs / "Lib" / "package.mo").write_text(
+        'package Lib\n  function f\n    input Real x;\n    output Real y;\n'
+        '  external "C" y = lib_f(x) annotation(Library="Lib", Include="#include \\"h.h\\"",'
+        f' IncludeDirectory="modelica://Lib/Resources/{include_folder}");\n'
+        '  end f;\n  model M\n    Real y = f(2);\n  end M;\nend Lib;\n')
+    return libs
+
+
+def test_an_include_directory_of_any_name_is_built(tmp_path: Path) -> None:
+    # 'My Include' is no plain name: it is built as springc's 'include'; 2 * 3 = 6
+    libs = _library(tmp_path / "libs", "My Include", None)
+    text = format_flat(flatten_files([], "Lib.M", [libs]))
+    assert text.split("equation\n")[1].splitlines()[:-1] == ["  y = 6.0;"]
+
+
+def test_a_header_linked_out_of_the_library_is_not_read(tmp_path: Path) -> None:
+    outside = tmp_path / "outside.h"
+    outside.write_text("#define H 3\ndouble lib_f(double x);\n")
+    err = _error("Lib.M", [_library(tmp_path / "libs", "Include", str(outside))])
+    assert err.message.startswith("the external function 'Lib.f' ('lib_f') could not be "
+                                  "built: the C compiler refused the library's C sources (")
+    assert err.message.endswith("h.h: No such file or directory")
+
+
+def test_a_function_called_without_its_declaration_is_an_error(tmp_path: Path) -> None:
+    # C would take lib_f to return an int and springc would read a wrong value
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "Include" / "h.h").write_text("#define H 3\n")
+    err = _error("Lib.M", [libs])
+    assert err.message.startswith("the external function 'Lib.f' ('lib_f') could not be "
+                                  "built: the C compiler refused the library's C sources (")
+    assert "implicit" in err.message and "lib_f" in err.message
+
+
+def test_springc_gives_modelica_utilities_h_to_a_library_without_it(tmp_path: Path) -> None:
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "ModelicaUtilities.h"\n#include "h.h"\n'
+        'double lib_f(double x) { ModelicaFormatError("x = %g, H = %d", x, H); return x; }\n')
+    err = _error("Lib.M", [libs])
+    assert err.message == "the external function 'Lib.f' ('lib_f') failed: x = 2, H = 3"
+
+
+def test_a_crash_in_the_c_code_is_a_located_error(tmp_path: Path) -> None:
+    # an invalid memory access ends the call, not springc (it died of SIGSEGV, silently)
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "h.h"\n'
+        "double lib_f(double x) { volatile double *p = (volatile double *)(long)(x - 2);"
+        " return *p; }\n")
+    err = _error("Lib.M", [libs])
+    assert err.message == ("the external function 'Lib.f' ('lib_f') failed: the C code "
+                           "crashed: an invalid memory access (segmentation fault)")
+    assert err.span is not None and err.span.line == 8
+    # the handlers are restored and the library's next call runs
+    (libs / "Lib" / "Resources" / "C-Sources" / "Lib.c").write_text(
+        '#include "h.h"\ndouble lib_f(double x) { return x * H; }\n')
+    text = format_flat(flatten_files([], "Lib.M", [libs]))
+    assert text.split("equation\n")[1].splitlines()[:-1] == ["  y = 6.0;"]

@@ -99,7 +99,34 @@ CASES = {
         "    6 |     assert(x > 0, \"x stays positive\");\n"
         "      |     ^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^^\n"
         "help: springc supports a subset of Modelica; see \"Not supported yet\" in "
-        "docs/language.md\n"),
+        "docs/language.md\n"),    "sample with a negative interval": (
+        "model M\n  parameter Real T = -0.5;\n  discrete Real y(start = 0);\nequation\n"
+        "  when sample(0, 2*T) then\n    y = pre(y) + 1;\n  end when;\nend M;\n",
+        "check",
+        "M.mo:5:18: error: the interval of sample(start, interval) must be positive, "
+        "found -1\n"
+        "    5 |   when sample(0, 2*T) then\n"
+        "      |                  ^^^\n"
+        "help: sample(start, interval) is true at start, start + interval, start + "
+        "2*interval... (Modelica 3.6, section 3.7.5)\n"),
+    "sample with a zero interval": (
+        "model M\n  discrete Real y(start = 0);\nequation\n"
+        "  when sample(0, 0) then\n    y = pre(y) + 1;\n  end when;\nend M;\n",
+        "check",
+        "M.mo:4:18: error: the interval of sample(start, interval) must be positive, "
+        "found 0\n"
+        "    4 |   when sample(0, 0) then\n"
+        "      |                  ^\n"
+        "help: sample(start, interval) is true at start, start + interval, start + "
+        "2*interval... (Modelica 3.6, section 3.7.5)\n"),
+    "sample interval 0/0": (
+        "model M\n  discrete Real y(start = 0);\nequation\n"
+        "  when sample(1, 0/0) then\n    y = pre(y) + 1;\n  end when;\nend M;\n",
+        "check",
+        "M.mo:4:18: error: cannot evaluate the interval of sample(start, interval): "
+        "division by zero\n"
+        "    4 |   when sample(1, 0/0) then\n"
+        "      |                  ^^^\n"),
 }
 
 

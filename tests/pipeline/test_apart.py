@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -98,3 +99,27 @@ def test_an_in_memory_stderr_compiles_here(decay: Path, monkeypatch: pytest.Monk
     calls = _derivations(monkeypatch)
     model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="python"))
     assert not model.cached and calls == ["None"]
+
+
+def test_an_interrupted_caller_ends_its_child(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Ctrl-C or SIGTERM while the child compiles: the child is killed and reaped, not
+    # left compiling on its own
+    forked: list[int] = []
+    fork = os.fork
+
+    def recorded() -> int:
+        pid = fork()
+        if pid:
+            forked.append(pid)
+        return pid
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "fork", recorded)
+    monkeypatch.setattr(os, "fdopen", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        apart._child_status(lambda: time.sleep(600))
+    (pid,) = forked
+    with pytest.raises(ChildProcessError):  # reaped: no child of that id is left
+        os.waitpid(pid, os.WNOHANG)

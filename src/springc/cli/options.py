@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+import os
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -38,6 +39,21 @@ class NumberRange(click.FloatRange):
         if math.isnan(number):
             self.fail(f"{value!r} is not a number", param, ctx)
         return number
+
+
+class FolderPath(click.Path):
+    """``click.Path`` for an existing folder that also refuses a FIFO, device or socket
+    (``click.Path(file_okay=False)`` lets them through: they are no regular files)."""
+
+    def __init__(self) -> None:
+        super().__init__(exists=True, file_okay=False)
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        path = super().convert(value, param, ctx)
+        if not os.path.isdir(path):
+            self.fail(f"{value!r} is not a folder.", param, ctx)
+        return path
 
 
 LEVEL_KEY = "springc.verbosity"
@@ -79,7 +95,7 @@ CLI_NAMES = OPTION_NAMES
 
 def model_options(func: Callable[..., Any]) -> Callable[..., Any]:
     func = click.option("-L", "--library", "libraries", multiple=True,
-                        type=click.Path(exists=True, file_okay=False),
+                        type=FolderPath(),
                         help="Library folder to search for classes (repeatable); "
                         "then SPRINGC_PATH and MODELICAPATH.")(func)
     func = click.option("--model", "model", default=None,
@@ -155,18 +171,18 @@ def check_output_options(outputs: Sequence[tuple[str, str | None, dict[str, str]
     from ..simulation import file_format
 
     given = [(option, path, formats) for option, path, formats in outputs if path]
-    try:
-        for option, path, formats in given:
-            if formats is not None:
-                file_format(path, formats, option)
-            try:
-                check_target(path, protected)
-            except OutputError as err:
-                raise UsageError(f"{option}: {err.message}", option=option,
-                                 hint=err.hint) from None
+    try:  # two names of one file first: a link to the other output's new file
         check_distinct((option, path) for option, path, _ in given)
     except OutputError as err:
         raise UsageError(err.message, hint=err.hint) from None
+    for option, path, formats in given:
+        if formats is not None:
+            file_format(path, formats, option)
+        try:
+            check_target(path, protected)
+        except OutputError as err:
+            raise UsageError(f"{option}: {err.message}", option=option,
+                             hint=err.hint) from None
 
 
 RUN_OPTIONS: dict[str, Callable[[Callable[..., Any]], Callable[..., Any]]] = {

@@ -274,7 +274,7 @@ def mul(a: Expr, b: Expr) -> Expr:
 def div(a: Expr, b: Expr) -> Expr:
     if b == ONE:
         return a
-    if a == ZERO:
+    if a == ZERO and b != ZERO:  # 0/0 stays, to be refused where it is evaluated
         return ZERO
     return BinOp("/", a, b)
 

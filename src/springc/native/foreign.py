@@ -4,7 +4,8 @@ C sources the library ships and loaded with ctypes. Standard library only.
 :class:`ForeignBuild` is what one build compiles: the library's C files and headers
 (read by the caller from inside the library's folder), and springc's glue, C text that
 holds the ``Include`` annotation's text and the wrapper of each function. springc's own
-ModelicaUtilities (``modelica_utilities.c``: ModelicaError jumps back to the wrapper,
+ModelicaUtilities (``modelica_utilities.c``, and ``.h`` for sources that include
+``ModelicaUtilities.h`` where the library ships none; ModelicaError jumps back to the wrapper,
 which returns 1) is compiled with them. :func:`load` builds it once into
 ``<user cache>/foreign/<key>.so``, the key a digest of the compiler's command, the flags
 and every byte compiled, with a hash record beside it; a library is loaded only from
@@ -33,10 +34,15 @@ from .compiler import find_compiler, first_error
 from .runner import read_verified
 
 FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-DNDEBUG", "-DHAVE_UNISTD_H",
-         "-DHAVE_STDARG_H", "-DHAVE_HIDDEN", "-DHAVE_MEMCPY")
+         "-DHAVE_STDARG_H", "-DHAVE_HIDDEN", "-DHAVE_MEMCPY",
+         "-Werror=implicit-function-declaration")
 """Those of the Modelica Standard Library's own gcc build project
-(``Resources/BuildProjects/gcc/Makefile``), and a shared library's."""
+(``Resources/BuildProjects/gcc/Makefile``), and a shared library's; a function called
+without a declaration is an error (C would assume it returns ``int``, and springc
+would read a wrong value: an ``Include`` that names a header without the prototype)."""
 UTILITIES = Path(__file__).with_name("modelica_utilities.c")
+UTILITIES_HEADER = Path(__file__).with_name("modelica_utilities.h")
+"""``ModelicaUtilities.h`` for a library that includes it without shipping it."""
 FOLDER = "foreign"
 KEY_LENGTH = 32
 KEEP = 256
@@ -65,7 +71,7 @@ class ForeignBuild:
         h = hashlib.sha256()
         for part in (*compiler, *FLAGS):
             h.update(part.encode() + b"\0")
-        h.update(UTILITIES.read_bytes())
+        h.update(UTILITIES.read_bytes() + UTILITIES_HEADER.read_bytes())
         h.update(self.glue.encode())
         for folder, data in self.sources:
             h.update(folder.encode() + b"\0" + hashlib.sha256(data).digest())
@@ -139,6 +145,8 @@ def _compile(build: ForeignBuild, compiler: list[str]) -> bytes:
             (root / folder).mkdir(exist_ok=True)
             (root / folder / header).write_bytes(data)
             includes.add(folder)
+        if all(header != "ModelicaUtilities.h" for _, header, _ in build.headers):
+            (root / "ModelicaUtilities.h").write_bytes(UTILITIES_HEADER.read_bytes())
         files = ["glue.c", "utilities.c"]
         (root / "glue.c").write_text(build.glue, encoding="utf-8")
         (root / "utilities.c").write_bytes(UTILITIES.read_bytes())
@@ -161,4 +169,4 @@ def _compile(build: ForeignBuild, compiler: list[str]) -> bytes:
 
 def _checked_folder(folder: str) -> None:
     if folder and not SUBFOLDER_NAME.fullmatch(folder):
-        raise ValueError(f"not a plain folder name: {folder!r}")
+        raise ForeignBuildFailed(f"'{folder}' is not a folder name springc builds in")

@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import os
 import pickle
+import signal
 import sys
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
@@ -110,8 +111,13 @@ def _child_status(compile: Callable[[], object]
                 sys.stderr.flush()
             os._exit(status)
     os.close(write_end)
-    with os.fdopen(read_end, "rb") as received:
-        data = received.read()  # before waiting: the child may fill the pipe
+    try:
+        with os.fdopen(read_end, "rb") as received:
+            data = received.read()  # before waiting: the child may fill the pipe
+    except BaseException:  # Ctrl-C, SIGTERM: the child's compile ends with this one
+        os.kill(pid, signal.SIGKILL)
+        os.waitpid(pid, 0)
+        raise
     _, waited = os.waitpid(pid, 0)
     try:
         error = pickle.loads(data) if data else None

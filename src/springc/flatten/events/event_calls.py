@@ -12,7 +12,9 @@ non-Boolean when-conditions).
 
 from __future__ import annotations
 
-from ...errors import FlattenError
+import math
+
+from ...errors import FlattenError, describe_failure
 from ...ir import expr as x
 from ...ir import syntax as s
 from ...ir.builtins import BUILTINS, EQUATION, names
@@ -48,6 +50,7 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
                 raise FlattenError(f"the {what} of sample(start, interval) must be a "
                                    "parameter expression", arg.span)
             args.append(value)
+        _check_sample(ev, args, e)
         return x.Call("sample", tuple(args))
     argument = ev.value(e.args[0], scope)
 
@@ -61,6 +64,28 @@ def event_call(ev: ExpressionEvaluator, uses: EventUses, e: s.Call, scope: Scope
         return x.Call(name, (item,))
 
     return a.elementwise(one, argument)
+
+
+def _check_sample(ev: ExpressionEvaluator, args: list[x.Expr], e: s.Call) -> None:
+    """sample's start must be finite and its interval positive (3.7.5), where their
+    values are known (a parameter without a value is left to the run)."""
+    for value, arg, what in zip(args, e.args, ("start", "interval")):
+        try:
+            number = float(ev.fold(value))
+        except ArithmeticError as err:
+            raise FlattenError(f"cannot evaluate the {what} of sample(start, interval): "
+                               f"{describe_failure(err)}", arg.span) from None
+        except (KeyError, TypeError, ValueError):
+            continue  # known only at run time (a parameter without a value)
+        if what == "start" and not math.isfinite(number):
+            raise FlattenError(f"the start of sample(start, interval) must be a finite "
+                               f"time, found {number:g}", arg.span)
+        if what == "interval" and not number > 0:
+            raise FlattenError(f"the interval of sample(start, interval) must be positive, "
+                               f"found {number:g}", arg.span,
+                               hint="sample(start, interval) is true at start, "
+                               "start + interval, start + 2*interval... (Modelica 3.6, "
+                               "section 3.7.5)")
 
 
 #: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.

@@ -31,7 +31,7 @@ from ...native import foreign
 from ...parse import ClassEntry
 from .. import arrays as a
 from ..scopes import ExpressionEvaluator
-from .library_sources import CSources
+from .library_sources import CSources, inside
 
 C_TYPES: dict[str, tuple[str, Any]] = {
     "Real": ("double", ctypes.c_double), "Integer": ("int", ctypes.c_int),
@@ -41,6 +41,10 @@ INCLUDE_LINE = re.compile(r'\s*#\s*include\s*("[^"/\\]+(/[^"/\\]+)*"|<[^<>/\\]+(
                           r"(//.*)?")
 """An ``Include`` line springc compiles: ``#include "name.h"`` or ``<name.h>`` (a
 relative name, no ``..``), with a line comment at most."""
+CODE_TOKENS = re.compile(r"<%|%>|%:|\?\?[=/'()!<>-]|\b(?:__)?asm(?:__)?\b|\\\s*$")
+"""What would let model text define code or macros without a ``{`` or a ``#``: the
+digraphs ``<%`` ``%>`` ``%:`` (``{`` ``}`` ``#``), trigraphs, file-scope ``asm`` and a
+line continued by a backslash."""
 
 
 @dataclass
@@ -252,7 +256,7 @@ def _check_include(text: str, entry: ClassEntry, span: Any) -> None:
         stripped = line.strip()
         directive = stripped.startswith("#")
         if (directive and (not INCLUDE_LINE.fullmatch(line) or ".." in stripped)) or \
-                (not directive and "{" in stripped):
+                (not directive and "{" in stripped) or CODE_TOKENS.search(line):
             raise FlattenError(
                 f"the Include annotation of the external function '{entry.full_name}' "
                 f"holds C code ('{stripped[:60]}'); springc compiles only the C source "
@@ -273,11 +277,14 @@ def _glue(c_name: str, args: list[_Arg], result: str | None, include: str) -> st
         f"{value} {c_name}({', '.join(arg.c_type for arg in args) or 'void'});\n")
     return ("#include <setjmp.h>\n"
             "extern jmp_buf springc_error_jump;\n"
+            "void springc_guard_begin(void);\nvoid springc_guard_end(void);\n"
             f"{include}\n{prototype}\n"
             f"int springc_call({', '.join(params) or 'void'}) {{\n"
-            "    if (setjmp(springc_error_jump)) {\n        return 1;\n    }\n"
+            "    if (setjmp(springc_error_jump)) {\n        springc_guard_end();\n"
+            "        return 1;\n    }\n"
+            "    springc_guard_begin();\n"
             f"    {'*springc_result = ' if result else ''}{call_text};\n"
-            "    return 0;\n}\n")
+            "    springc_guard_end();\n    return 0;\n}\n")
 
 
 def _source(path: Path, sources: CSources) -> tuple[str, bytes]:
@@ -286,7 +293,11 @@ def _source(path: Path, sources: CSources) -> tuple[str, bytes]:
 
 
 def _subfolder(folder: Path, sources: CSources) -> str:
-    return "" if sources.root is None or folder == sources.root else folder.name
+    """The folder's name in the build: ``""`` for the sources' own folder, else its name
+    where springc puts it on a command line (a plain name), else ``include``."""
+    if sources.root is None or folder == sources.root:
+        return ""
+    return folder.name if foreign.SUBFOLDER_NAME.fullmatch(folder.name) else "include"
 
 
 def _headers(sources: CSources) -> tuple[tuple[str, str, bytes], ...]:
@@ -299,6 +310,6 @@ def _headers(sources: CSources) -> tuple[tuple[str, str, bytes], ...]:
     for folder in sorted(folders):
         sub = _subfolder(folder, sources)
         for header in sorted(folder.glob("*.h")):
-            if header.is_file():
+            if header.is_file() and inside(header, folder):  # no link out of it
                 found.setdefault((sub, header.name), header.read_bytes())
     return tuple((sub, name, data) for (sub, name), data in found.items())

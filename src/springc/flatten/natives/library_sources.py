@@ -135,7 +135,13 @@ def _library_files(library: str, folders: list[Path], top: ClassEntry
 
 def _inside(path: Path, top: ClassEntry) -> bool:
     assert top.folder is not None
+    return inside(path, top.folder)
+
+
+def inside(path: Path, folder: Path) -> bool:
+    """Whether ``path``, links followed, is inside ``folder`` (links followed): the one
+    test that a file springc reads for a library's C code is the library's own."""
     try:
-        return path.resolve().is_relative_to(top.folder.resolve())
+        return path.resolve().is_relative_to(folder.resolve())
     except (OSError, RuntimeError):
         return False
