@@ -36,8 +36,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .compiled import (C_SOLVERS, FIXED_CHUNK, adaptive_run, c_loop_available, failure,
-                       jitted, load_kernel, time_limit_reached)
+from .compiled import (
+    C_SOLVERS,
+    FIXED_CHUNK,
+    adaptive_run,
+    c_loop_available,
+    failure,
+    jitted,
+    load_kernel,
+    time_limit_reached,
+)
 from .events import LOCATE_TOLERANCE, EventLoop
 from .limits import OverLimit
 from .native import event_run
