@@ -48,6 +48,7 @@ typedef struct {
     double *K;      /* the stages: 16 rows (DOP853), 7 (RK45) */
     double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
     double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
+    double *z_step; /* z at the step's start (a hybrid model's trial points: sl_step) */
     int method;
     struct si_work *implicit;  /* Radau's or BDF's work (implicit_core.c), else NULL */
 } sl_work;
@@ -165,13 +166,19 @@ SC_FN double sl_rk45_error(const sl_work *w, double h, double rtol, const double
 }
 
 /* One accepted step from (t, y) (the step hook of dop853_steps / rk45_steps: rejected
-   attempts inside); *h_abs in: the clamped size, out: the next one. */
+   attempts inside); *h_abs in: the clamped size, out: the next one. A hybrid model's
+   attempt whose evaluation sets the failure flag (a Newton iteration that does not
+   converge at a stage's trial point) is rejected as a non-finite one is, z put back
+   as it was at the step's start: the rule of the scipy engine's event loop
+   (springc.simulation.steps.Problem.rhs), which ran these models before. */
 SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, double limit,
                   const double *p, double *z, double rtol, const double *atol,
                   sl_int *counts, double *end, double *t_new, double *h, double *t_fail) {
     int dop = w->method == SL_DOP853, stages = dop ? SC_STAGES : SL_RK_STAGES;
     double exponent = dop ? -1.0 / 8.0 : -1.0 / (4 + 1);
     sl_copy(w->K, w->K + stages * SC_NXS);
+    if (SPRINGC_HYBRID)
+        for (int i = 0; i < SPRINGC_N_Z; i++) w->z_step[i] = z[i];
     int rejected = 0;
     for (;;) {
         if (*h_abs < min_step) {
@@ -186,7 +193,10 @@ SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, do
         *h = *t_new - t;
         *h_abs = fabs(*h);
         int status = sl_stages(w, t, *h, p, z, counts, end, t_fail);
-        if (status == SC_NON_FINITE_DERIVATIVE && *h_abs * 0.2 >= min_step) {
+        int retried = SPRINGC_HYBRID && status == SC_MODEL_FAILED && *h_abs * 0.2 >= min_step;
+        if (retried)
+            for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = w->z_step[i];
+        if ((retried || status == SC_NON_FINITE_DERIVATIVE) && *h_abs * 0.2 >= min_step) {
             *h_abs *= 0.2;  /* dop853_steps.shrinks: rejected, as scipy's NaN error is */
             rejected = 1;
             counts[SL_REJECTED] += 1;
@@ -517,10 +527,11 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
                                          sl_int *fired) {
     sl_work w;
     sl_int n_g = signs != NULL ? SPRINGC_N_CROSSINGS : 0, n_gs = n_g > 0 ? n_g : 1;
-    double *block = (double *)malloc(((size_t)32 * SC_NXS + 5 * (size_t)n_gs)
-                                     * sizeof(double));
+    double *block = (double *)malloc(((size_t)32 * SC_NXS + 5 * (size_t)n_gs
+                                      + SPRINGC_N_Z) * sizeof(double));
     if (block == NULL) return -1;
     double *g_block = block + 32 * SC_NXS;
+    w.z_step = g_block + 5 * n_gs;
     sl_events ev = {n_g, signs, fired, (sl_int *)(g_block + 3 * n_gs), g_block,
                     g_block + n_gs, g_block + 2 * n_gs, t_stop};
     if (n_g > 0) {
