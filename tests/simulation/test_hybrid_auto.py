@@ -144,3 +144,48 @@ def test_a_stiff_start_that_rings_goes_to_radau_past_its_first_probe(tmp_path: P
     assert np.max(np.abs(auto["x"] - x)) < 1e-6
     assert np.max(np.abs(auto["y"] - (1 - np.exp(-t)))) < 1e-5
     assert np.array_equal(auto["n"], np.floor(t + 1e-9))
+
+
+def test_dop853_is_probed_again_where_radaus_stretch_reaches_further(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A run quiet for its first second, busy after (CauerLowPassSC's input steps at 1 s):
+    dop853's probe of 500 steps ends at 1.0 and projects the quiet rate; radau's second
+    stretch reaches 1.1, so dop853 runs again 4x longer and is projected from the steps
+    it added past 1.0. Counted reaches and work (13 RHS a dop853 step, 40 a radau step)
+    give the projections in closed form."""
+    from types import SimpleNamespace
+
+    from springc.simulation import hybrid_auto
+    from springc.simulation.limits import OverLimit
+    from springc.simulation.solvers import AutoChoice
+
+    stop, per_step = 60.0, {"dop853": 13.0, "radau": 40.0}
+
+    def reach(solver: str, steps: int) -> float:
+        if solver == "dop853":  # 500 steps a second, then 1e5
+            return steps / 500 if steps <= 500 else 1.0 + (steps - 500) * 1e-5
+        return 0.008 * steps if steps <= 100 else 0.8 + (steps - 100) * 1e-3
+
+    made: list[tuple[str, int | None]] = []
+
+    def attempt(solver: str, cap: int | None) -> hybrid_auto.Attempt:
+        made.append((solver, cap))
+        problem = SimpleNamespace(solver=solver, jac=lambda t, y: np.eye(1))
+        loop = SimpleNamespace(steps=cap or 0)
+        capped = None if cap is None else OverLimit("cap", reach(solver, cap), np.zeros(1),
+                                                    solver)
+        return hybrid_auto.Attempt(problem, loop, True, 0.0, capped)
+
+    monkeypatch.setattr(hybrid_auto, "_work", lambda probe, implicit: probe.loop.steps
+                        * per_step["radau" if implicit else "dop853"])
+    monkeypatch.setattr(hybrid_auto, "estimate", lambda jac, span: AutoChoice(
+        "race", "stiff", 1e6, span))
+    run, reason = hybrid_auto.choose(attempt, np.zeros(1), 0.0, stop, 10**9)
+    assert made == [("dop853", 500), ("radau", 100), ("radau", 400), ("dop853", 2000),
+                    ("radau", None)]
+    assert run.problem.solver == "radau" and run.capped is None
+    radau = (stop - 1.1) * 300 / 0.3  # the marginal rate of radau's second stretch
+    dop853 = (stop - 1.015) * 1500 / 0.015  # of the 1,500 steps dop853 added past 1.0
+    assert reason == (f"stiff; counted: radau ~{radau:.2g} steps x 40 = ~{radau * 40:.2g} "
+                      f"RHS evaluations to go, dop853 ~{dop853:.2g} steps x 13 = "
+                      f"~{dop853 * 13:.2g}")

@@ -28,7 +28,7 @@ from .native_ensemble import CORE, c_array, c_switch, c_weighted_sum, prelude
 LOOP = Path(__file__).with_name("single_loop.c")
 IMPLICIT = tuple(Path(__file__).with_name(name) for name in (
     "implicit_core.c", "radau_steps.c", "bdf_steps.c"))
-ABI = 2
+ABI = 3
 """The interface version of the library's exports (``springc_loop_abi()``): a change of
 an export's arguments moves it, and the runner refuses a library of another."""
 METHODS = {"dop853": 0, "rk45": 1, "radau": 2, "bdf": 3}

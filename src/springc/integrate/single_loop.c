@@ -10,8 +10,10 @@
    si_begin, si_step, si_dense, declared here).
 
    The contract is springc.integrate.loop's adaptive_loop specialised on
-   dop853_steps / rk45_steps with plain-loop sums (scipy_arithmetic off), without zero
-   crossings and time events: the same start, initial step (scipy's
+   dop853_steps / rk45_steps with plain-loop sums (scipy_arithmetic off), with its zero
+   crossings against held signs (crossings.py, no direction filters) and its time event
+   t_stop where the run has them (a hybrid model's run between two events, the Python
+   side doing the event update): the same start, initial step (scipy's
    select_initial_step), step-size clamp, controller, step limit (accepted and
    rejected steps), dense output on the grid and result record, every operation in the
    same order, so that on one machine the states equal the numba loop's within
@@ -26,7 +28,7 @@
 #ifndef SPRINGC_LOOP_EXPORT
 #define SPRINGC_LOOP_EXPORT __attribute__((visibility("default")))
 #endif
-#define SL_ABI 2
+#define SL_ABI 3
 #define SL_DOP853 0
 #define SL_RK45 1
 #define SL_RADAU 2
@@ -46,6 +48,7 @@ typedef struct {
     double *K;      /* the stages: 16 rows (DOP853), 7 (RK45) */
     double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
     double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
+    double *z_step; /* z at the step's start (a hybrid model's trial points: sl_step) */
     int method;
     struct si_work *implicit;  /* Radau's or BDF's work (implicit_core.c), else NULL */
 } sl_work;
@@ -163,13 +166,19 @@ SC_FN double sl_rk45_error(const sl_work *w, double h, double rtol, const double
 }
 
 /* One accepted step from (t, y) (the step hook of dop853_steps / rk45_steps: rejected
-   attempts inside); *h_abs in: the clamped size, out: the next one. */
+   attempts inside); *h_abs in: the clamped size, out: the next one. A hybrid model's
+   attempt whose evaluation sets the failure flag (a Newton iteration that does not
+   converge at a stage's trial point) is rejected as a non-finite one is, z put back
+   as it was at the step's start: the rule of the scipy engine's event loop
+   (springc.simulation.steps.Problem.rhs), which ran these models before. */
 SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, double limit,
                   const double *p, double *z, double rtol, const double *atol,
                   sl_int *counts, double *end, double *t_new, double *h, double *t_fail) {
     int dop = w->method == SL_DOP853, stages = dop ? SC_STAGES : SL_RK_STAGES;
     double exponent = dop ? -1.0 / 8.0 : -1.0 / (4 + 1);
     sl_copy(w->K, w->K + stages * SC_NXS);
+    if (SPRINGC_HYBRID)
+        for (int i = 0; i < SPRINGC_N_Z; i++) w->z_step[i] = z[i];
     int rejected = 0;
     for (;;) {
         if (*h_abs < min_step) {
@@ -184,7 +193,10 @@ SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, do
         *h = *t_new - t;
         *h_abs = fabs(*h);
         int status = sl_stages(w, t, *h, p, z, counts, end, t_fail);
-        if (status == SC_NON_FINITE_DERIVATIVE && *h_abs * 0.2 >= min_step) {
+        int retried = SPRINGC_HYBRID && status == SC_MODEL_FAILED && *h_abs * 0.2 >= min_step;
+        if (retried)
+            for (int i = 0; i < SPRINGC_N_Z; i++) z[i] = w->z_step[i];
+        if ((retried || status == SC_NON_FINITE_DERIVATIVE) && *h_abs * 0.2 >= min_step) {
             *h_abs *= 0.2;  /* dop853_steps.shrinks: rejected, as scipy's NaN error is */
             rejected = 1;
             counts[SL_REJECTED] += 1;
@@ -268,10 +280,69 @@ typedef struct {
     double *end;      /* the failure state */
 } sl_record;
 
-/* The output times in (t, t_new]: the states there; the new number filled. */
+/* The zero crossings of a run between events (adaptive_loop's Steps 4 and 6): n_g
+   indicators, their held signs, the crossing found (fired: +1 rising, -1 falling, 0),
+   the indicators at the step's start and end (g0, g1) and at a bisection point (gt),
+   and the time event t_stop (INFINITY: none). n_g 0 and t_stop INFINITY: a continuous
+   run, step for step the loop without events. */
+typedef struct {
+    sl_int n_g;
+    const double *signs;
+    sl_int *fired, *trial;
+    double *g0, *g1, *gt;
+    double t_stop;
+} sl_events;
+
+/* crossings.crossings without direction filters: whether some indicator went from its
+   held side (or zero) at g_start strictly to the other at g_end; fired[i] its direction. */
+SC_FN int sl_crossed(const sl_events *ev, const double *g_start, const double *g_end,
+                     sl_int *fired) {
+    int any = 0;
+    for (sl_int i = 0; i < ev->n_g; i++) {
+        double s = ev->signs[i];
+        fired[i] = 0;
+        if (s * g_start[i] >= 0.0 && s * g_end[i] < 0.0) {
+            fired[i] = s < 0 ? 1 : -1;
+            any = 1;
+        }
+    }
+    return any;
+}
+
+/* crossings.time_tolerance: the bracket width at which a crossing counts as located. */
+SC_FN double sl_time_tolerance(double t, double t_new) {
+    double width = 1e-12 * sc_max(sc_max(fabs(t), fabs(t_new)), t_new - t);
+    double ulp = nextafter(fabs(t_new), INFINITY) - fabs(t_new);
+    return sc_max(width, 4.0 * ulp);
+}
+
+/* The earliest crossing in (t, t_new] by bisection on the step's dense output (Step 6):
+   its time; ev->fired the indicators crossed there; y_new the state there. */
+SC_FN double sl_locate(sl_work *w, const sl_events *ev, double t, double t_new, double h,
+                       const double *p, double *z) {
+    double low = t, high = t_new, tolerance = sl_time_tolerance(t, t_new);
+    while (high - low > tolerance) {
+        double middle = low + 0.5 * (high - low);
+        if (middle <= low || middle >= high) break;
+        sl_dense(w, t, h, middle, w->stage);
+        springc_zero_crossings(middle, w->stage, p, z, ev->gt);
+        if (sl_crossed(ev, ev->g0, ev->gt, ev->trial)) {
+            high = middle;
+            for (sl_int i = 0; i < ev->n_g; i++) ev->fired[i] = ev->trial[i];
+        } else {
+            low = middle;
+        }
+    }
+    if (high < t_new) sl_dense(w, t, h, high, w->y_new);
+    return high;
+}
+
+/* The output times in (t, t_event) and t_event itself unless the run stops there (at
+   an event): the states there; the new number filled. */
 SC_FN sl_int sl_fill(const sl_work *w, sl_int filled, sl_int m, const double *grid,
-                     double t, double t_new, double h, double *states) {
-    while (filled < m && grid[filled] <= t_new) {
+                     double t, double t_new, double h, double t_event, int stops,
+                     double *states) {
+    while (filled < m && (grid[filled] < t_event || (grid[filled] == t_event && !stops))) {
         double *row = states + filled * SC_NX;
         if (grid[filled] == t_new) sl_copy(row, w->y_new);
         else sl_dense(w, t, h, grid[filled], row);
@@ -280,13 +351,14 @@ SC_FN sl_int sl_fill(const sl_work *w, sl_int filled, sl_int m, const double *gr
     return filled;
 }
 
-/* The steps from (t, y) until the end of the grid (adaptive_loop's Step 3 on). */
-SC_FN int sl_steps(sl_work *w, sl_int m, const double *grid, const double *p, double *z,
-                   double rtol, const double *atol, double max_step, sl_int max_steps,
-                   double *states, sl_int *filled, double *t_io, double *h_abs,
-                   sl_record *rec) {
+/* The steps from (t, y) until the end of the grid, the time event or the first
+   crossing (adaptive_loop's Step 3 on). */
+SC_FN int sl_steps(sl_work *w, const sl_events *ev, sl_int m, const double *grid,
+                   const double *p, double *z, double rtol, const double *atol,
+                   double max_step, sl_int max_steps, double *states, sl_int *filled,
+                   double *t_io, double *h_abs, sl_record *rec) {
     sl_int *counts = rec->counts;
-    double t = *t_io, limit = grid[m - 1], t_fail = t;
+    double t = *t_io, t_end = grid[m - 1], limit = sc_min(t_end, ev->t_stop), t_fail = t;
     int status = SC_SUCCESS;
     while (t < limit) {
         if (max_steps > 0 && counts[SL_ACCEPTED] + counts[SL_REJECTED] >= max_steps) {
@@ -307,13 +379,33 @@ SC_FN int sl_steps(sl_work *w, sl_int m, const double *grid, const double *p, do
                              rec->end, &t_new, &h, &t_fail);
         if (status != SC_SUCCESS) break;
         counts[SL_ACCEPTED] += 1;
-        if (*filled < m && grid[*filled] <= t_new) {
+        int event = 0;
+        if (ev->n_g > 0) {
+            springc_zero_crossings(t_new, w->y_new, p, z, ev->g1);
+            if (sc_flagged(z)) {
+                status = SC_MODEL_FAILED;
+                t_fail = t_new;
+                sl_copy(rec->end, w->y_new);
+                break;
+            }
+            event = sl_crossed(ev, ev->g0, ev->g1, ev->fired);
+        }
+        if (event || (*filled < m && grid[*filled] <= t_new)) {
             status = sl_prepare_dense(w, t, h, p, z, counts, rec->end, &t_fail);
             if (status != SC_SUCCESS) break;
-            *filled = sl_fill(w, *filled, m, grid, t, t_new, h, states);
+        }
+        double t_event = event ? sl_locate(w, ev, t, t_new, h, p, z) : t_new;
+        int stops = event || (t_new == ev->t_stop && ev->t_stop < t_end);
+        *filled = sl_fill(w, *filled, m, grid, t, t_new, h, t_event, stops, states);
+        if (event) {
+            status = SC_STATE_EVENT;
+            t_fail = t_event;
+            sl_copy(rec->end, w->y_new);
+            break;
         }
         t = t_new;
         sl_copy(w->y, w->y_new);
+        for (sl_int i = 0; i < ev->n_g; i++) ev->g0[i] = ev->g1[i];
     }
     rec->reals[0] = t_fail;
     *t_io = t;
@@ -321,16 +413,17 @@ SC_FN int sl_steps(sl_work *w, sl_int m, const double *grid, const double *p, do
 }
 
 /* The whole run (adaptive_loop): see springc.native.runner for the arguments. */
-SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
-                 const double *p, double *z, double rtol, const double *atol,
-                 double max_step, double first_step, sl_int max_steps, double *states,
-                 sl_record *rec) {
+SC_FN int sl_run(sl_work *w, const sl_events *ev, sl_int m, const double *grid,
+                 const double *x0, const double *p, double *z, double rtol,
+                 const double *atol, double max_step, double first_step, sl_int max_steps,
+                 double *states, sl_record *rec) {
     sl_int *counts = rec->counts, filled = 1;
-    double t = grid[0], h_abs = 0.0, t_fail = t;
+    double t = grid[0], h_abs = 0.0, t_fail = t, limit = sc_min(grid[m - 1], ev->t_stop);
     int status = SC_SUCCESS;
     sl_copy(w->y, x0);
     sl_copy(rec->end, x0);
     sl_copy(states, x0);
+    if (ev->n_g > 0 && !sc_flagged(z)) springc_zero_crossings(t, w->y, p, z, ev->g0);
     if (sc_flagged(z)) {
         status = SC_MODEL_FAILED;
         filled = 0;
@@ -352,7 +445,7 @@ SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
             if (first_step > 0.0) {
                 h_abs = first_step;
             } else {
-                status = sl_initial_step(t, w->y, f, grid[m - 1], p, z, rtol, atol,
+                status = sl_initial_step(t, w->y, f, limit, p, z, rtol, atol,
                                          max_step, 1.0 / (order + 1), w, rec->end, counts,
                                          &h_abs, &t_fail);
             }
@@ -360,12 +453,13 @@ SC_FN int sl_run(sl_work *w, sl_int m, const double *grid, const double *x0,
         if (status == SC_SUCCESS && w->implicit)
             status = si_begin(w->implicit, t, w->y, f, h_abs, p, z, rtol, counts, rec->end);
         if (status == SC_SUCCESS) {
-            status = sl_steps(w, m, grid, p, z, rtol, atol, max_step, max_steps, states,
-                              &filled, &t, &h_abs, rec);
+            status = sl_steps(w, ev, m, grid, p, z, rtol, atol, max_step, max_steps,
+                              states, &filled, &t, &h_abs, rec);
             t_fail = rec->reals[0];
         }
     }
     if (status == SC_SUCCESS) {
+        if (running && limit < grid[m - 1]) status = SC_TIME_EVENT;
         t_fail = t;
         sl_copy(rec->end, w->y);
     }
@@ -386,6 +480,9 @@ SPRINGC_LOOP_EXPORT void springc_loop_sizes(sl_int *n) {
     n[4] = SPRINGC_INITIAL_CONDITIONS;
     n[5] = SPRINGC_HYBRID;
 }
+
+/* The model's zero-crossing indicators (a hybrid model's relations; 0 otherwise). */
+SPRINGC_LOOP_EXPORT sl_int springc_loop_crossings(void) { return SPRINGC_N_CROSSINGS; }
 
 /* Entry i of a name table (0: states, 1: parameters, 2: observed; 3: the model's name),
    NULL past its end. */
@@ -413,6 +510,11 @@ SPRINGC_LOOP_EXPORT int springc_loop_start(const double *p, double *x, double *z
    time, next step size; end: the state there; z updated in place. first_step 0:
    scipy's initial step; max_steps 0: no limit. order: the implicit methods' ordering of
    the states in their band LU above 64 states (position -> state; NULL: state order).
+   Events (a hybrid model): with signs (the held sign of each of the model's
+   SPRINGC_N_CROSSINGS zero-crossing indicators; NULL: none) the run stops at the first
+   crossing (STATE_EVENT: reals[0] its time, end the state there, fired[i] +1 rising,
+   -1 falling, 0), and a t_stop before the grid's end is a time event (TIME_EVENT at
+   t_stop; INFINITY: none); the output rows before the event are written.
    Returns a springc.integrate.Status code, or -1 if the work arrays could not be
    allocated. */
 SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *grid,
@@ -420,10 +522,21 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
                                          double rtol, const double *atol, double max_step,
                                          double first_step, sl_int max_steps,
                                          double *states, sl_int *counts, double *reals,
-                                         double *end, const sl_int *order) {
+                                         double *end, const sl_int *order,
+                                         const double *signs, double t_stop,
+                                         sl_int *fired) {
     sl_work w;
-    double *block = (double *)malloc((size_t)32 * SC_NXS * sizeof(double));
+    sl_int n_g = signs != NULL ? SPRINGC_N_CROSSINGS : 0, n_gs = n_g > 0 ? n_g : 1;
+    double *block = (double *)malloc(((size_t)32 * SC_NXS + 5 * (size_t)n_gs
+                                      + SPRINGC_N_Z) * sizeof(double));
     if (block == NULL) return -1;
+    double *g_block = block + 32 * SC_NXS;
+    w.z_step = g_block + 5 * n_gs;
+    sl_events ev = {n_g, signs, fired, (sl_int *)(g_block + 3 * n_gs), g_block,
+                    g_block + n_gs, g_block + 2 * n_gs, t_stop};
+    if (n_g > 0) {
+        for (sl_int i = 0; i < n_g; i++) fired[i] = 0;
+    }
     w.method = method >= SL_RK45 && method <= SL_BDF ? method : SL_DOP853;
     w.implicit = NULL;
     if (w.method == SL_RADAU || w.method == SL_BDF) {
@@ -444,8 +557,8 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
     w.y_new = block + 29 * SC_NXS;
     for (int k = 0; k < 5; k++) counts[k] = 0;
     sl_record rec = {counts, reals, end};
-    int status = sl_run(&w, m, grid, x0, p, z, rtol, atol, max_step, first_step, max_steps,
-                        states, &rec);
+    int status = sl_run(&w, &ev, m, grid, x0, p, z, rtol, atol, max_step, first_step,
+                        max_steps, states, &rec);
     if (w.implicit) si_free(w.implicit);
     free(block);
     return status;

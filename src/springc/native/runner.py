@@ -32,7 +32,7 @@ from typing import Any
 
 LIBRARY_FILE = "cloop.so"
 RECORD_FILE = "cloop.sha256"
-ABI = 2
+ABI = 3
 """The library's interface version (``springc_loop_abi()``; the same number as
 ``springc.integrate.native_loop.ABI``)."""
 METHODS = {"dop853": 0, "rk45": 1, "radau": 2, "bdf": 3}
@@ -127,6 +127,9 @@ class LoopRun:
     failure_state: array.array[float]
     next_step: float
     jacobian_evaluations: int = 0
+    fired: tuple[int, ...] = ()
+    """Of a run with ``signs``: each zero-crossing indicator's crossing at the state
+    event it stopped at (+1 rising, -1 falling, 0 not crossed)."""
 
     @property
     def ok(self) -> bool:
@@ -152,6 +155,8 @@ class LoopLibrary:
         self.lib.springc_loop_sizes(sizes)
         (self.n_states, self.n_params, self.n_z, self.n_observed,
          self.initial_conditions, self.hybrid) = (int(s) for s in sizes)
+        self.lib.springc_loop_crossings.restype = _int64
+        self.n_crossings = int(self.lib.springc_loop_crossings())
         self.lib.springc_loop_name.restype = ctypes.c_char_p
         self.lib.springc_loop_name.argtypes = [ctypes.c_int, _int64]
         self.lib.springc_loop_start.restype = ctypes.c_int
@@ -159,7 +164,8 @@ class LoopLibrary:
         self.lib.springc_loop_run.argtypes = [
             ctypes.c_int, _int64, _double_p, _double_p, _double_p, _double_p,
             ctypes.c_double, _double_p, ctypes.c_double, ctypes.c_double, _int64,
-            _double_p, _int64_p, _double_p, _double_p, _int64_p]
+            _double_p, _int64_p, _double_p, _double_p, _int64_p, _double_p, ctypes.c_double,
+            _int64_p]
         self.lib.springc_loop_observed.restype = _int64
         self.lib.springc_loop_observed.argtypes = [_int64, _double_p, _double_p, _double_p,
                                                    _double_p, _double_p]
@@ -193,7 +199,8 @@ class LoopLibrary:
     def run(self, method: str, grid: Any, x0: Any, p: Any, z: Any, *, rtol: float,
             atol: float | Sequence[float], max_step: float = math.inf,
             first_step: float = 0.0, max_steps: int = 0,
-            order: Sequence[int] | None = None, out: Any = None) -> LoopRun:
+            order: Sequence[int] | None = None, out: Any = None,
+            signs: Sequence[float] | None = None, t_stop: float = math.inf) -> LoopRun:
         """Integrate from ``(grid[0], x0)`` over the increasing ``grid`` with ``method``
         (dop853, rk45, radau or bdf); ``z`` is updated in place. ``first_step`` 0 selects
         the first step as scipy does; ``max_steps`` counts accepted and rejected steps
@@ -203,7 +210,10 @@ class LoopLibrary:
         None: state order). ``out``: a writable C-contiguous float64 buffer of at least
         ``len(grid)`` rows of the states, which the run's rows are written into (no
         other row is touched) and which :attr:`LoopRun.states` then is; None: a new
-        buffer of zeros."""
+        buffer of zeros. A hybrid model's run between events: ``signs``, the held sign
+        of each zero-crossing indicator (+1/-1, ``n_crossings`` of them), stops it at the
+        first crossing (status 6, :attr:`LoopRun.fired`); a ``t_stop`` before the grid's
+        end at that time (status 7)."""
         n = self.n_states
         grid_ = doubles(grid)
         m = len(grid_) if len(grid) else 0
@@ -218,15 +228,20 @@ class LoopLibrary:
             if sorted(int(i) for i in order) != list(range(n)):
                 raise ValueError(f"order must be a permutation of the {n} states")
             ordering = (_int64 * max(n, 1))(*(int(i) for i in order))
+        held = None if signs is None else doubles(signs, self.n_crossings)
+        fired = (_int64 * max(self.n_crossings, 1))()
         status = self.lib.springc_loop_run(
             METHODS[method], m, grid_, doubles(x0, n), doubles(p, self.n_params), z_,
             float(rtol), doubles(atol, n), float(max_step), float(first_step),
-            int(max_steps), doubles(states), counts, reals, doubles(end), ordering)
+            int(max_steps), doubles(states), counts, reals, doubles(end), ordering,
+            held, float(t_stop), fired)
         if status < 0:
             raise MemoryError("the loop could not allocate its work arrays")
         return LoopRun(int(status), states if n else zeros(0), int(counts[4]),
                        int(counts[0]), int(counts[1]), int(counts[2]), float(reals[0]),
-                       end[:n], float(reals[1]), int(counts[3]))
+                       end[:n], float(reals[1]), int(counts[3]),
+                       tuple(int(f) for f in fired[:self.n_crossings]) if held is not None
+                       else ())
 
     def observed(self, ts: Any, states: Any, p: Any, z: Any
                  ) -> tuple[int, array.array[float]]:

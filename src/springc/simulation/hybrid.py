@@ -25,7 +25,7 @@ from .events import EventLoop
 from .events_fixed import run_fixed_events
 from .failures import Stop, state_notes
 from .hybrid_auto import Attempt, choose
-from .hybrid_compiled import run_compiled_events
+from .hybrid_compiled import c_events, run_compiled_events
 from .limits import OverLimit, check_outputs, over_limit
 from .observed_rows import observed_at_rows
 from .planning import RunPlan
@@ -51,7 +51,9 @@ def simulate_hybrid(model: CompiledModel, plan: RunPlan) -> SimulationResult:
         capped = limits if cap is None else replace(limits, max_steps=cap)
         problem = Problem(model, p, solver, progress, capped)
         loop = EventLoop(problem, grid, keep_events=event_rows)
-        compiled, loop_time = engine == COMPILED and len(x0) > 0 and jitted(model.module), 0.0
+        compiled = engine == COMPILED and len(x0) > 0 and (
+            jitted(model.module) or c_events(problem, solver))
+        loop_time = 0.0
         try:
             if compiled:
                 loop_time = run_compiled_events(loop, solver, x0, rtol, atol, step)

@@ -24,6 +24,12 @@ takes exactly the first steps of the full one, so ``auto -> X`` gives ``X``'s re
    :data:`~springc.simulation.race.STALL` of the last and the probes' work stays within
    :data:`~springc.simulation.race.BUDGET` of ``dop853``'s projection (the continuous
    race's rules). ``radau`` runs where a projection wins by ``SURE``, else ``dop853``.
+   Where a ``radau`` stretch has reached further in model time than ``dop853``'s probe,
+   ``dop853`` first runs again from the start, ``GROWTH`` times longer, and is
+   projected at the rate of the steps it added (:func:`_explicit_ahead`): the two
+   projections then come from the same part of the run (Analog.CauerLowPassSC's
+   ``dop853`` probe ends 5 ms after its input steps at 1 s, and projected from the
+   quiet second before it ~3e4 steps, where the run takes ~4e6).
    The reason gives both projections (steps to go x RHS evaluations per step = work).
 
 The probes cost at most ``CHEAP_STEPS`` steps of ``dop853`` and a fifth of its projected
@@ -94,6 +100,7 @@ def choose(attempt: Callable[[str, int | None], Attempt], x0: np.ndarray, start:
             return second, (f"{choice.reason}; counted: {RACE_IMPLICIT} finished the run "
                             f"in its {cap} trial steps, {EXPLICIT} {ahead.text()} to go")
         behind = _projection(second, True, start, stop, before)
+        first, ahead = _explicit_ahead(attempt, first, ahead, second, start, stop)
         text = counted(behind, ahead)
         if SURE * behind.work <= ahead.work:
             return attempt(RACE_IMPLICIT, None), f"{choice.reason}; {text}"
@@ -105,6 +112,26 @@ def choose(attempt: Callable[[str, int | None], Attempt], x0: np.ndarray, start:
             return attempt(EXPLICIT, None), (f"{choice.reason}, but the fast modes must be "
                                              f"resolved anyway; {text}")
         before, cap = second, cap * GROWTH
+
+
+def _explicit_ahead(attempt: Callable[[str, int | None], Attempt], first: Attempt,
+                    ahead: Projection, second: Attempt, start: float, stop: float
+                    ) -> tuple[Attempt, Projection]:
+    """``dop853``'s probe and projection to compare with ``radau``'s probe ``second``:
+    ``first`` and ``ahead`` where ``first`` reached at least as far in model time, else
+    a probe :data:`GROWTH` times longer projected at the rate of the steps it added to
+    ``first`` (a failure there keeps ``first``'s, and a probe that finishes is
+    projected at no steps to go: it is then the cheaper run)."""
+    assert first.capped is not None and second.capped is not None
+    if float(second.capped.t) <= float(first.capped.t):
+        return first, ahead
+    try:
+        longer = attempt(EXPLICIT, GROWTH * first.loop.steps)
+    except Stop:
+        return first, ahead
+    if longer.capped is None:
+        return first, Projection(0.0, ahead.per_step)
+    return longer, _projection(longer, False, start, stop, first)
 
 
 def _projection(probe: Attempt, implicit: bool, start: float, stop: float,

@@ -8,7 +8,9 @@ as its zero-crossing function, the held relations as its signs and the next time
 (``next_time_event``) as its ``t_stop``; it stops at the earliest state event (located
 on the method's dense output (or interpolant) or on split fixed steps, to about
 1e-12 relative in time, the left limit there), at the time event, or at the end.
-Python then runs the same event update as the scipy path
+On a python module (``--backend python``) the adaptive methods run in the C loop
+library instead (:func:`.native.event_run`: the same loop, its crossings and time event
+in C, :func:`c_events` says where). Python then runs the same event update as the scipy path
 (:meth:`.events.EventLoop.event`) and restarts the kernel from the state after the
 event: the adaptive methods with a fresh initial step, as the scipy path starts a new
 integrator; the fixed-step methods on the rest of the output interval, cut into equal
@@ -34,14 +36,24 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .compiled import FIXED_CHUNK, adaptive_run, failure, load_kernel, time_limit_reached
+from .compiled import (
+    C_SOLVERS,
+    FIXED_CHUNK,
+    adaptive_run,
+    c_loop_available,
+    failure,
+    jitted,
+    load_kernel,
+    time_limit_reached,
+)
 from .events import LOCATE_TOLERANCE, EventLoop
 from .limits import OverLimit
+from .native import event_run
 from .solver_names import FIXED_STEP
 from .solvers import detect_pairs
 
 if TYPE_CHECKING:
-    pass
+    from .steps import Problem
 
 ADAPTIVE_CHUNK = 100_000
 """Steps (accepted and rejected) of one adaptive kernel run between checks of the limits."""
@@ -56,16 +68,29 @@ def held_signs(loop: EventLoop) -> np.ndarray:
     return np.where(held == positive, 1.0, -1.0)
 
 
+def c_events(problem: Problem, solver: str) -> bool:
+    """Whether a hybrid run of ``solver`` on ``problem``'s module, compiled engine, takes
+    the C loop: an adaptive method of the C loop (:data:`.compiled.C_SOLVERS`), a module
+    whose functions are not numba's, and the model's loop library (built now where
+    needed; a model C cannot spell runs on scipy's loop, as before)."""
+    from .native import loop_ready
+
+    return solver in C_SOLVERS and not jitted(problem.mod) and c_loop_available() \
+        and loop_ready(problem)
+
+
 def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: float,
                         atol: float, step: float | None) -> float:
     """Fill ``loop``'s grid with ``solver`` (one of :data:`.solver_names.COMPILED_SOLVERS`;
-    a fixed-step method of nominal ``step``) in the compiled kernels; returns the seconds
-    spent in them."""
+    a fixed-step method of nominal ``step``) in the compiled kernels (on a python module:
+    the C loop's, :func:`c_events`); returns the seconds spent in them."""
     from springc.integrate import Crossings, Status, fixed_step
 
     problem, grid = loop.problem, loop.grid
     mod: Any = loop.mod  # a hybrid module (codegen's HybridModule)
-    load_kernel(solver)
+    native = not jitted(mod)
+    if not native:
+        load_kernel(solver)
     limit = problem.limits.max_steps
     t, stop = float(grid[0]), float(grid[-1])
     x = loop.initial(t, np.asarray(x0, dtype=float))
@@ -95,11 +120,14 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
             times[-1] = t_event
         crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
         began = time.perf_counter()
-        if adaptive:
+        steps = max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1)
+        if native:
+            run = event_run(problem, solver, times, x, rtol, atol, first_step,
+                            None if crossings is None else held_signs(loop), t_stop, steps)
+        elif adaptive:
             run = adaptive_run(solver, mod, times, x, problem.p, problem.z, rtol=rtol,
                                atol=atol, first_step=first_step, crossings=crossings,
-                               t_stop=t_stop,
-                               max_steps=max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1))
+                               t_stop=t_stop, max_steps=steps)
         else:
             assert step is not None
             run = fixed_step(solver, mod.rhs, times, x, problem.p, problem.z, step=step,

@@ -94,6 +94,23 @@ def _kernel(loop: StepLoop, method: str) -> Kernel:
 
 
 
+def event_run(problem: Problem, method: str, times: np.ndarray, x: np.ndarray, rtol: float,
+              atol: Any, first_step: float | None, signs: np.ndarray | None,
+              t_stop: float, max_steps: int) -> Run:
+    """One run of a hybrid model between events in the C loop (``method``: dop853,
+    rk45, radau, bdf): from ``(times[0], x)`` over ``times``, stopping at the first
+    crossing of a zero-crossing indicator against its held sign ``signs`` (None: the
+    model has none) or at the time event ``t_stop`` (inf: none), as the numba kernel
+    :func:`.compiled.adaptive_run` with ``crossings`` and ``t_stop`` does."""
+    lib = library(problem)
+    order = band_order(problem.mod) if method in IMPLICIT else None
+    done = lib.run(method, times, np.ascontiguousarray(x, dtype=float), problem.p, problem.z,
+                   rtol=rtol, atol=atol, first_step=first_step or 0.0, max_steps=max_steps,
+                   order=order, signs=None if signs is None else signs.tolist(),
+                   t_stop=t_stop)
+    return as_run(done, times)
+
+
 def as_run(done: LoopRun, times: np.ndarray) -> Run:
     """The C loop's outcome as :class:`springc.integrate.Run` (numpy views, no copy: of
     the ``out`` rows where the run wrote its states there)."""
@@ -104,7 +121,8 @@ def as_run(done: LoopRun, times: np.ndarray) -> Run:
     return Run(Status(done.status), times, states, np.empty((len(times), 0)), done.filled,
                done.accepted_steps, done.rejected_steps, done.rhs_evaluations,
                done.failure_time, np.frombuffer(done.failure_state, dtype=float).copy(),
-               np.empty(0, dtype=np.int64), done.next_step, done.jacobian_evaluations)
+               np.asarray(done.fired, dtype=np.int64), done.next_step,
+               done.jacobian_evaluations)
 
 
 def native_observed(problem: Problem, grid: np.ndarray, states: np.ndarray,
