@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from . import flat
 from .expr import Expr, to_text
+from .records import quick_init
 
 DERIVATIVE_PREFIX = "der("
 
@@ -35,6 +36,7 @@ def is_derivative(name: str) -> bool:
     return derivative_base(name) is not None
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Unknown:
     """A continuous unknown of the DAE (never a derivative variable)."""
@@ -49,6 +51,7 @@ class Unknown:
     span: Span
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Parameter:
     name: str
@@ -57,6 +60,7 @@ class Parameter:
     span: Span
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Residual:
     """``expr = 0``, with the flat equation it came from."""
