@@ -106,9 +106,12 @@ _SUBSCRIPT = re.compile(r"\[([0-9, ]+)\]")
 def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
     """Members' loop order: by name pattern, then a trailing vector component
     (``pos[2]`` in ``p[3,4].pos[2]``), then the other subscripts in order."""
-    groups = [tuple(int(i) for i in g.split(",")) for g in _SUBSCRIPT.findall(name)]
+    parts = _SUBSCRIPT.split(name)  # text, subscripts, text, ...: one scan of the name
+    if len(parts) == 1:
+        return name, (), ()
+    groups = [tuple(int(i) for i in g.split(",")) for g in parts[1::2]]
     component = groups.pop() if len(groups) > 1 else ()
-    return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
+    return "[]".join(parts[::2]), component, tuple(i for g in groups for i in g)
 
 
 _LIFTED_OPS = frozenset("+-*/")
@@ -176,6 +179,7 @@ class VectorLayout:
         self.location.update({q: ("p", i) for i, q in enumerate(m.params)})
         self.location.update({d: ("d", i) for i, d in enumerate(m.derivatives)})
         self.assignments: dict[str, _Assignment] = {}
+        self._needed: dict[tuple[str, ...], list[_Assignment]] = {}
         groups: dict[tuple[object, ...], int] = {}  # compared once here, not per grouping
         for name, e, span in statements:
             slots: list[str] = []
@@ -232,7 +236,14 @@ class VectorLayout:
         return [sorted(g, key=lambda a: a.order) for g in ordered]
 
     def needed(self, targets: Sequence[str]) -> list[_Assignment]:
-        """The assignments that ``targets`` depend on."""
+        """The assignments that ``targets`` depend on (found once per list of targets:
+        ``rhs`` and the Jacobian ask for the derivatives' three times)."""
+        key = tuple(targets)
+        if key not in self._needed:
+            self._needed[key] = self._dependencies(targets)
+        return list(self._needed[key])
+
+    def _dependencies(self, targets: Sequence[str]) -> list[_Assignment]:
         seen: set[str] = set()
         stack = [t for t in targets if t in self.assignments]
         while stack:
