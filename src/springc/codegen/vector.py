@@ -193,12 +193,7 @@ class VectorLayout:
                 shape = Var("$0")
             else:
                 shape = _shape(e, slots, self._lift if lift_constants else None)
-            for v in slots:
-                if v not in self.location and v not in self.assignments:
-                    raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
-            level = 1 + max((self.assignments[v].level for v in slots
-                             if v in self.assignments), default=0)
-            kinds = tuple(self._kind(v) for v in slots)
+            level, kinds = self._reads(name, slots)
             self.assignments[name] = _Assignment(
                 name, shape, slots, kinds, level, e, span,
                 groups.setdefault((level, shape, kinds), len(groups)), _order(name))
@@ -222,10 +217,24 @@ class VectorLayout:
         self.floats.append(value)
         return name
 
-    def _kind(self, name: str) -> str:
-        if name in self.location:
-            return self.location[name][0]
-        return "d" if name in self.m.derivative_set else "w"
+    def _reads(self, name: str, slots: list[str]) -> tuple[int, tuple[str, ...]]:
+        """The dependency level of an assignment ``name`` reading ``slots`` (one more
+        than the deepest assignment it reads) and the kind of array each slot reads
+        (one pass over the slots: this runs for every assignment of a chain)."""
+        level = 0
+        kinds: list[str] = []
+        for v in slots:
+            done = self.assignments.get(v)
+            if done is not None and done.level > level:
+                level = done.level
+            where = self.location.get(v)
+            if where is not None:
+                kinds.append(where[0])
+            elif done is None:
+                raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
+            else:
+                kinds.append("d" if v in self.m.derivative_set else "w")
+        return level + 1, tuple(kinds)
 
     @staticmethod
     def _groups(assignments: list[_Assignment]) -> list[list[_Assignment]]:
