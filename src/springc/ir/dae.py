@@ -32,8 +32,9 @@ def derivative_base(name: str) -> str | None:
 
 
 def is_derivative(name: str) -> bool:
-    """Is ``name`` a derivative variable (``der(x)``)?"""
-    return derivative_base(name) is not None
+    """Is ``name`` a derivative variable (``der(x)``)? (:func:`derivative_base`'s test,
+    without its slice: asked of every name of every equation.)"""
+    return name.startswith(DERIVATIVE_PREFIX) and name.endswith(")")
 
 
 @quick_init
