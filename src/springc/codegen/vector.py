@@ -134,11 +134,11 @@ def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None
     shape."""
     if isinstance(e, Var):
         slots.append(e.name)
-        return Var(f"${len(slots) - 1}")
+        return _slot(len(slots) - 1)
     if every and lift is not None and isinstance(e, Const) \
             and isinstance(e.value, (int, float)) and not isinstance(e.value, bool):
         slots.append(lift(float(e.value)))
-        return Var(f"${len(slots) - 1}")
+        return _slot(len(slots) - 1)
     if isinstance(e, (Const, Time)):
         return e
     if isinstance(e, (Neg, Not)):
@@ -157,6 +157,16 @@ def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None
         return If(_shape(e.cond, slots, lift, every), _shape(e.then, slots, lift, every),
                   _shape(e.otherwise, slots, lift, every))
     raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
+
+
+_SLOTS: list[Var] = []
+"""``$0, $1, ...``: made once per process, not once per operand of every assignment."""
+
+
+def _slot(k: int) -> Var:
+    while len(_SLOTS) <= k:
+        _SLOTS.append(Var(f"${len(_SLOTS)}"))
+    return _SLOTS[k]
 
 
 def _fixed(text: str) -> Callable[[str], str]:
