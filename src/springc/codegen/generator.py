@@ -219,7 +219,10 @@ def _check_defined(m: CodegenContext, computed: Sequence[str]) -> None:
         if isinstance(step, ode.NonlinearBlock):
             inner = {*step.tearing, *(s.name for s in step.sensitivities)}
         for e in ode.step_expressions(step):
-            unknown = variables(e) - known - inner
+            read = variables(e)
+            if read <= known:  # the common case, without two new sets
+                continue
+            unknown = read - known - inner
             if unknown:
                 name = sorted(unknown)[0]
                 raise CodegenBug(f"the simplified system reads '{name}' but nothing "

@@ -106,9 +106,12 @@ _SUBSCRIPT = re.compile(r"\[([0-9, ]+)\]")
 def _order(name: str) -> tuple[str, tuple[int, ...], tuple[int, ...]]:
     """Members' loop order: by name pattern, then a trailing vector component
     (``pos[2]`` in ``p[3,4].pos[2]``), then the other subscripts in order."""
-    groups = [tuple(int(i) for i in g.split(",")) for g in _SUBSCRIPT.findall(name)]
+    parts = _SUBSCRIPT.split(name)  # text, subscripts, text, ...: one scan of the name
+    if len(parts) == 1:
+        return name, (), ()
+    groups = [tuple(int(i) for i in g.split(",")) for g in parts[1::2]]
     component = groups.pop() if len(groups) > 1 else ()
-    return _SUBSCRIPT.sub("[]", name), component, tuple(i for g in groups for i in g)
+    return "[]".join(parts[::2]), component, tuple(i for g in groups for i in g)
 
 
 _LIFTED_OPS = frozenset("+-*/")
@@ -131,11 +134,11 @@ def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None
     shape."""
     if isinstance(e, Var):
         slots.append(e.name)
-        return Var(f"${len(slots) - 1}")
+        return _slot(len(slots) - 1)
     if every and lift is not None and isinstance(e, Const) \
             and isinstance(e.value, (int, float)) and not isinstance(e.value, bool):
         slots.append(lift(float(e.value)))
-        return Var(f"${len(slots) - 1}")
+        return _slot(len(slots) - 1)
     if isinstance(e, (Const, Time)):
         return e
     if isinstance(e, (Neg, Not)):
@@ -154,6 +157,16 @@ def _shape(e: Expr, slots: list[str], lift: Callable[[float], str] | None = None
         return If(_shape(e.cond, slots, lift, every), _shape(e.then, slots, lift, every),
                   _shape(e.otherwise, slots, lift, every))
     raise untranslatable(f"cannot generate code for {type(e).__name__} expressions", e)
+
+
+_SLOTS: list[Var] = []
+"""``$0, $1, ...``: made once per process, not once per operand of every assignment."""
+
+
+def _slot(k: int) -> Var:
+    while len(_SLOTS) <= k:
+        _SLOTS.append(Var(f"${len(_SLOTS)}"))
+    return _SLOTS[k]
 
 
 def _fixed(text: str) -> Callable[[str], str]:
@@ -176,6 +189,7 @@ class VectorLayout:
         self.location.update({q: ("p", i) for i, q in enumerate(m.params)})
         self.location.update({d: ("d", i) for i, d in enumerate(m.derivatives)})
         self.assignments: dict[str, _Assignment] = {}
+        self._needed: dict[tuple[str, ...], list[_Assignment]] = {}
         groups: dict[tuple[object, ...], int] = {}  # compared once here, not per grouping
         for name, e, span in statements:
             slots: list[str] = []
@@ -189,12 +203,7 @@ class VectorLayout:
                 shape = Var("$0")
             else:
                 shape = _shape(e, slots, self._lift if lift_constants else None)
-            for v in slots:
-                if v not in self.location and v not in self.assignments:
-                    raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
-            level = 1 + max((self.assignments[v].level for v in slots
-                             if v in self.assignments), default=0)
-            kinds = tuple(self._kind(v) for v in slots)
+            level, kinds = self._reads(name, slots)
             self.assignments[name] = _Assignment(
                 name, shape, slots, kinds, level, e, span,
                 groups.setdefault((level, shape, kinds), len(groups)), _order(name))
@@ -218,10 +227,24 @@ class VectorLayout:
         self.floats.append(value)
         return name
 
-    def _kind(self, name: str) -> str:
-        if name in self.location:
-            return self.location[name][0]
-        return "d" if name in self.m.derivative_set else "w"
+    def _reads(self, name: str, slots: list[str]) -> tuple[int, tuple[str, ...]]:
+        """The dependency level of an assignment ``name`` reading ``slots`` (one more
+        than the deepest assignment it reads) and the kind of array each slot reads
+        (one pass over the slots: this runs for every assignment of a chain)."""
+        level = 0
+        kinds: list[str] = []
+        for v in slots:
+            done = self.assignments.get(v)
+            if done is not None and done.level > level:
+                level = done.level
+            where = self.location.get(v)
+            if where is not None:
+                kinds.append(where[0])
+            elif done is None:
+                raise CodegenBug(f"'{name}' reads '{v}', which nothing computes")
+            else:
+                kinds.append("d" if v in self.m.derivative_set else "w")
+        return level + 1, tuple(kinds)
 
     @staticmethod
     def _groups(assignments: list[_Assignment]) -> list[list[_Assignment]]:
@@ -232,7 +255,14 @@ class VectorLayout:
         return [sorted(g, key=lambda a: a.order) for g in ordered]
 
     def needed(self, targets: Sequence[str]) -> list[_Assignment]:
-        """The assignments that ``targets`` depend on."""
+        """The assignments that ``targets`` depend on (found once per list of targets:
+        ``rhs`` and the Jacobian ask for the derivatives' three times)."""
+        key = tuple(targets)
+        if key not in self._needed:
+            self._needed[key] = self._dependencies(targets)
+        return list(self._needed[key])
+
+    def _dependencies(self, targets: Sequence[str]) -> list[_Assignment]:
         seen: set[str] = set()
         stack = [t for t in targets if t in self.assignments]
         while stack:

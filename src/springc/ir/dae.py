@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from ..errors import Span
 from . import flat
 from .expr import Expr, to_text
+from .records import quick_init
 
 DERIVATIVE_PREFIX = "der("
 
@@ -31,10 +32,12 @@ def derivative_base(name: str) -> str | None:
 
 
 def is_derivative(name: str) -> bool:
-    """Is ``name`` a derivative variable (``der(x)``)?"""
-    return derivative_base(name) is not None
+    """Is ``name`` a derivative variable (``der(x)``)? (:func:`derivative_base`'s test,
+    without its slice: asked of every name of every equation.)"""
+    return name.startswith(DERIVATIVE_PREFIX) and name.endswith(")")
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Unknown:
     """A continuous unknown of the DAE (never a derivative variable)."""
@@ -49,6 +52,7 @@ class Unknown:
     span: Span
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Parameter:
     name: str
@@ -57,6 +61,7 @@ class Parameter:
     span: Span
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Residual:
     """``expr = 0``, with the flat equation it came from."""

@@ -13,9 +13,11 @@ from dataclasses import dataclass, field
 from ..errors import Span
 from . import latex
 from .expr import Expr, format_number, to_text
+from .records import quick_init
 from .when import When, format_when
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Origin:
     """Why an equation exists.
@@ -37,6 +39,7 @@ class Origin:
         return f"{self.kind}{where}{extra}"
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Attributes:
     """The attributes of a scalar variable, as expressions of parameters or ``None``."""
@@ -51,6 +54,7 @@ class Attributes:
     state_select: str | None = None
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Variable:
     """A scalar variable, parameter or constant of the flat model.
@@ -77,6 +81,7 @@ class Variable:
         return self.variability in ("continuous", "discrete")
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Equation:
     """``lhs = rhs`` between scalar expressions."""
@@ -87,6 +92,7 @@ class Equation:
     origin: Origin
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Assertion:
     """``assert(condition, message, level)`` (section 8.3.7): ``condition`` must hold
@@ -99,6 +105,7 @@ class Assertion:
     origin: Origin
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Experiment:
     start: float | None = None

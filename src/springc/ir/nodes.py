@@ -14,12 +14,16 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TypeVar
 
+from .records import quick_init
 
+
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Const:
     value: float | int | bool
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Var:
     """A flat scalar variable or parameter, by its flat name (``mass.pos[1]``)."""
@@ -27,11 +31,13 @@ class Var:
     name: str
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Time:
     """The built-in variable ``time``."""
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Der:
     """``der(arg)``; after flattening ``arg`` may be any expression of variables."""
@@ -39,16 +45,19 @@ class Der:
     arg: Expr
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Neg:
     arg: Expr
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Not:
     arg: Expr
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class BinOp:
     """``op`` is one of ``+ - * / ^ < <= > >= == <> and or`` (scalar semantics)."""
@@ -58,6 +67,7 @@ class BinOp:
     right: Expr
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Call:
     """A built-in scalar function (``sqrt``, ``atan2``, ``noEvent``, ...)."""
@@ -66,6 +76,7 @@ class Call:
     args: tuple[Expr, ...]
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class If:
     cond: Expr

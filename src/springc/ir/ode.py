@@ -15,8 +15,10 @@ from ..errors import Span
 from . import dae, flat, latex
 from .expr import ZERO, Expr, Var, add, mul, to_text
 from .hybrid import EventSystem
+from .records import quick_init
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class Assign:
     """``name := expr``, solved from the equation at ``span``."""
@@ -26,6 +28,7 @@ class Assign:
     span: Span
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class LinearBlock:
     """Solve ``matrix @ names = rhs``; ``matrix`` entries ``(row, col, expr)``, sparse."""
@@ -36,6 +39,7 @@ class LinearBlock:
     spans: tuple[Span, ...]
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class NonlinearBlock:
     """Newton iteration on ``tearing`` variables: ``inner`` computes the other block
@@ -90,6 +94,7 @@ def map_step(step: Step, f: Callable[[Expr], Expr]) -> Step:
         tuple((i, j, f(e)) for i, j, e in step.jacobian), step.spans)
 
 
+@quick_init
 @dataclass(frozen=True, slots=True)
 class State:
     name: str

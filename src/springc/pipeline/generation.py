@@ -35,9 +35,10 @@ def generate_source(options: CompileOptions) -> str:
 def generate_from(derived: Derived, options: CompileOptions) -> str:
     """The module text of a derived model with the outputs ``options`` selects."""
     system, flat_model = derived.system, derived.flat_model
-    candidates = [s.name for s in system.states] + system.observed_names()
+    observed_names = system.observed_names()
+    candidates = [s.name for s in system.states] + observed_names
     selected = set(select_names(candidates, options.outputs))
-    observed = tuple(n for n in system.observed_names() if n in selected)
+    observed = tuple(n for n in observed_names if n in selected)
     codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
                              warnings=encode_warnings(derived.warnings),
                              shared=derived.parts)

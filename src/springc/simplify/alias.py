@@ -72,8 +72,12 @@ def _signed_sum(terms: list[tuple[int, x.Expr]]) -> x.Expr:
 def _classify(r: dae.Residual, unknowns: set[str]
               ) -> tuple[str, str, int, x.Expr] | None:
     """``(a, b, sign, 0)`` for ``a = sign*b``, ``(a, "", 0, value)`` for ``a = value``."""
-    if sum(n in unknowns for n in r.variables) > 2 or any(
-            dae.is_derivative(n) for n in r.variables):
+    count = 0  # one loop over the names: this runs for every equation, twice
+    for n in r.variables:
+        if dae.is_derivative(n):
+            return None
+        count += n in unknowns
+    if count > 2:
         return None
     terms: list[tuple[int, str]] = []
     rest: list[tuple[int, x.Expr]] = []

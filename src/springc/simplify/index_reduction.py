@@ -198,15 +198,17 @@ def _index_reduce(system: dae.DAE, at: Mapping[str, float] | None, prefer: bool)
         raise _numerically_singular(system, err, names, sources, at is not None) from None
     states = tuple(zip(selection.states, selection.state_derivatives))
     base = {d: v for v, d in enumerate(reduction.var_derivative) if d != -1}
-    known = _parameters_or_none(system)
+    known: list[dict[str, float] | None] = []  # evaluated for the first block asking
     blocks = []
     for b in selection.blocks:
         equations = tuple(exprs[e] for e in b.equations)
         dummies = tuple(names[v] for v in b.dummies)
         candidates = tuple(names[v] for v in b.candidates)
-        static = at is None and len(candidates) > len(dummies) and static_block(
-            equations, candidates, dummies, [priority[base[v]] for v in b.candidates],
-            known)
+        static = False
+        if at is None and len(candidates) > len(dummies):
+            known += [] if known else [_parameters_or_none(system)]
+            static = static_block(equations, candidates, dummies,
+                                  [priority[base[v]] for v in b.candidates], known[0])
         span = sources[b.equations[0]].span if b.equations else None
         blocks.append(DummyBlock(b.level, equations, dummies, candidates, b.tiers, static,
                                  span))

@@ -68,13 +68,27 @@ def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual
     residual = x.sub(lhs, rhs)
     names = free_variables(residual)
     return dae.Residual(residual, eq.span, eq.origin, eq, frozenset(names),
-                        pre_only(residual) if "pre" in _calls(eq) else frozenset())
+                        pre_only(residual) if _reads_pre(eq) else frozenset())
 
 
-def _calls(eq: flat.Equation) -> set[str]:
-    """The names of the calls in ``eq`` (cheap: most equations hold none)."""
-    return {n.name for side in (eq.lhs, eq.rhs) for n in x.walk(side)
-            if isinstance(n, x.Call)}
+def _reads_pre(eq: flat.Equation) -> bool:
+    """Whether ``eq`` calls ``pre`` (one loop without :func:`ir.expr.walk`'s generator:
+    this runs for every equation, and most hold no call)."""
+    stack: list[x.Expr] = [eq.lhs, eq.rhs]
+    seen: set[int] = set()
+    while stack:
+        node = stack.pop()
+        kind = type(node)
+        if kind is x.Var or kind is x.Const or id(node) in seen:
+            continue
+        seen.add(id(node))
+        if kind is x.BinOp:
+            stack += (node.left, node.right)  # type: ignore[union-attr]
+            continue
+        if kind is x.Call and node.name == "pre":  # type: ignore[union-attr]
+            return True
+        stack.extend(x.children(node))
+    return False
 
 
 def _has_der(e: x.Expr) -> bool:

@@ -54,31 +54,39 @@ def check_pair(ca: ClassScope, cb: ClassScope, eq: s.Connect) -> dict[str, str]:
         pb = right.get(name)
         if pb is None:
             continue
-        notes = (Note(f"'{name}' of '{ca.entry.full_name}' is declared here", pa.decl.span),
-                 Note(f"'{name}' of '{cb.entry.full_name}' is declared here", pb.decl.span))
         if pa.type != pb.type:
             raise rule_error(f"{head}: '{name}' is {_a(pa.type)} in one and {_a(pb.type)} "
                              "in the other", eq.span, "connected variables must have the same "
-                             "primitive type", "9.3", notes)
+                             "primitive type", "9.3",
+                             _notes(ca, cb, name, pa, pb))
         if _kind(pa) != _kind(pb):
             raise rule_error(f"{head}: '{name}' is a {_kind(pa)} in one and a {_kind(pb)} "
                              "in the other", eq.span, "connect may join parameters only to "
-                             "parameters and constants only to constants", "9.3", notes)
+                             "parameters and constants only to constants", "9.3",
+                             _notes(ca, cb, name, pa, pb))
         if bool(pa.causality) != bool(pb.causality):
             raise rule_error(f"{head}: '{name}' is causal ({pa.causality or pb.causality}) "
                              "in one but not in the other", eq.span, "input and output "
                              "variables connect only to input or output variables", "9.3",
-                             notes)
+                             _notes(ca, cb, name, pa, pb))
         if pa.variability == "constant" and not _same(pa.value, pb.value):
             raise rule_error(f"{head}: the constant '{name}' has different values",
                              eq.span, "connected constants must have the same value", "9.3",
-                             notes)
+                             _notes(ca, cb, name, pa, pb))
         for prim in (pa, pb):
             if prim.causality:
                 for flat_name in ([prim.names] if isinstance(prim.names, str)
                                   else list(prim.names.flat)):
                     causal[flat_name] = prim.causality
     return causal
+
+
+def _notes(ca: ClassScope, cb: ClassScope, name: str, pa: Primitive, pb: Primitive
+           ) -> tuple[Note, Note]:
+    """Where the two sides of a mismatch declare ``name`` (made only for an error: a
+    chain connects thousands of flanges)."""
+    return (Note(f"'{name}' of '{ca.entry.full_name}' is declared here", pa.decl.span),
+            Note(f"'{name}' of '{cb.entry.full_name}' is declared here", pb.decl.span))
 
 
 def _same(a: Any, b: Any) -> bool:
