@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 from .errors import CodegenError, OutputError, UsageError
 from .ir.expr import recursion_room
+from .native.foreign_calls import calls_foreign
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -194,8 +195,8 @@ def _numba_instead(compiled: CompiledModel) -> bool:
     the compiled engine runs others on numba: events, delays, switching states, a
     model beyond the loop's size rule, one the C printer cannot print (a function with
     no C spelling), and one whose C the compiler refused (with a one-line note)."""
-    if not (c_loop_runs(AUTO, None) and numba_available()):
-        return False
+    if not (c_loop_runs(AUTO, None) and numba_available()) or calls_foreign(compiled.source):
+        return False  # numba calls no C function at run time (native.foreign_calls)
     if compiled.kind != ModuleKind.CONTINUOUS:
         return True
     from .pipeline import loop_library, note_refused  # the C printer: on this choice only

@@ -67,6 +67,18 @@ package ForeignLib "External C functions whose sources the library ships (tests)
     Real y = root(time);
   end RunTime;
 
+  model Sampled "stats of the four samples of time before each sample, at each sample"
+    Real buf[4](each start = 0, each fixed = true);
+    Real total(start = 0, fixed = true);
+    Real scaled[4](each start = 0, each fixed = true);
+    Integer count(start = 0, fixed = true);
+  algorithm
+    when sample(0.1, 0.1) then
+      (total, scaled, count) := stats(buf, 2, false);
+      buf := {buf[2], buf[3], buf[4], time};
+    end when;
+  end Sampled;
+
   model Missing
     Real y = missing(1);
   end Missing;
