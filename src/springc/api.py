@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 from .errors import CodegenError, OutputError, UsageError
 from .ir.expr import recursion_room
-from .native.foreign_calls import calls_foreign
+from .native.foreign_calls import RunTimeCallRefused, calls_foreign
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -174,7 +174,13 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
 @collector_paused()  # the whole compile, both backends (springc.collector)
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
-    compiled, base = _compile_as(options, parameters)
+    try:
+        compiled, base = _compile_as(options, parameters)
+    except RunTimeCallRefused as refused:  # numba calls no C function at run time
+        if not (chosen and options.backend == "numba"):
+            raise
+        options = replace(options, backend="python")
+        compiled, base = _compile_as(options, parameters, refused.derived)
     other = None
     if chosen and options.backend == "numba" and compiled.source.count("\n") > NUMBA_LINES:
         other = "python"

@@ -28,7 +28,7 @@ from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Var, variables
 from ..ir.hybrid import event_expressions
-from ..native.foreign_calls import REFUSAL, function_of
+from ..native.foreign_calls import REFUSAL, RunTimeCallRefused, function_of
 from .assertions import assertion_function
 from .context import (
     BACKENDS,
@@ -167,7 +167,7 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
                        function_lines(namer, helpers, prologue + m.delays.inputs_body(base)),
                        "di"))
     if numba and "_foreign" in helpers:
-        raise CodegenError(REFUSAL.format("the numba backend", foreign_function(bodies)))
+        raise RunTimeCallRefused(REFUSAL.format("the numba backend", foreign_function(bodies)))
     structural = shared_part(options, "structural",
                              lambda: structural_parameters(system, flat_model))
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,

@@ -303,7 +303,8 @@ class FunctionWriter:
         only where an element is (a when-clause's branch); it is defined again after
         the loop that defined it ends or one of those variables is assigned."""
         call = e.args[2] if e.name == OUTPUT else e
-        if not self.foreign_calls or not isinstance(call, Call):
+        assert isinstance(call, Call), call
+        if not self.foreign_calls:
             raise untranslatable(REFUSAL.format(self.writes, function_of(call.name)), e)
         slot, index = (e.args[0], e.args[1]) if e.name == OUTPUT else (Const(0), Const(0))
         cid = self._id(call)

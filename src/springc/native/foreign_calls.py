@@ -21,7 +21,7 @@ import ctypes
 from dataclasses import dataclass
 from typing import Any
 
-from ..errors import SpringcError
+from ..errors import CodegenError, SpringcError
 from .foreign import ForeignLibrary, loaded
 
 PREFIX = "foreign:"
@@ -36,12 +36,20 @@ HELPER = ("def _foreign(name, args):\n"
           "    return run_call(name, args)\n")
 """The function a generated python module calls for a run-time foreign call."""
 
-_SCALAR = {"R": ctypes.c_double, "I": ctypes.c_int, "B": ctypes.c_int}
+_SCALAR: dict[str, Any] = {"R": ctypes.c_double, "I": ctypes.c_int, "B": ctypes.c_int}
 
 
 def calls_foreign(source: str) -> bool:
     """Whether a generated module's text calls foreign functions at run time."""
     return HELPER.splitlines()[0] in source
+
+
+class RunTimeCallRefused(CodegenError):
+    """A backend that calls no foreign function at run time (numba) refused the model;
+    ``derived``: the system derived for it, from which springc generates the python
+    backend's module where it chose the backend itself (``api``)."""
+
+    derived: Any = None
 
 
 class ForeignCallFailed(SpringcError):
@@ -141,9 +149,8 @@ def _call(library: ForeignLibrary, signature: Signature, args: tuple[Any, ...]
         ctype, size = _SCALAR[code[0]], _count(code)
         taken = args[at:at + size]
         at += size
-        convert = float if code[0] == "R" else int
-        values.append((ctype * max(size, 1))(*map(convert, taken)) if len(code) > 1
-                      else ctype(convert(taken[0])))
+        items = [float(v) for v in taken] if code[0] == "R" else [int(v) for v in taken]
+        values.append((ctype * max(size, 1))(*items) if len(code) > 1 else ctype(items[0]))
     if signature.result:
         buffers[-1] = _SCALAR[signature.result]()
         values.append(ctypes.byref(buffers[-1]))
@@ -164,10 +171,8 @@ def _read(signature: Signature, slot: int, buffer: Any) -> Any:
     if buffer is None:
         return None
     code = signature.result if slot == len(signature.params) else signature.params[slot][1:]
-    if isinstance(buffer, ctypes.Array):
-        items = list(buffer[:_count(code)])
-    else:
-        items = [buffer.value]
+    items = list(buffer[:_count(code)]) if isinstance(buffer, ctypes.Array) \
+        else [buffer.value]
     if code[0] == "R":
         return [float(v) for v in items]
     return [bool(v) for v in items] if code[0] == "B" else [int(v) for v in items]

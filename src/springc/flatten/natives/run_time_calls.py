@@ -96,7 +96,7 @@ def run_time_outputs(entry: ClassEntry, c_name: str, key: str, names: dict[str, 
                           _CODES[result] if result else "")
     node = x.Call(call_name(signature), tuple(v for r in run for v in r[2]))
     slots = {r[3]: k for k, r in enumerate(run) if r[3] is not None}
-    values = []
+    values: list[Any] = []
     for comp in outputs:
         if comp.name == returned:
             values.append(_element(len(run), 0, node))

@@ -45,6 +45,13 @@ package ForeignLib "External C functions whose sources the library ships (tests)
     annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
   end unset;
 
+  function writeText "The MSL's Streams.print: a line on a file (none: the standard output)"
+    input String string;
+    input String fileName = "";
+  external "C" ModelicaInternal_print(string, fileName)
+    annotation(Library="ModelicaExternalC");
+  end writeText;
+
   model M
     parameter Real u[3] = {1.5, -2, 4};
     parameter Integer k = 3;
