@@ -17,8 +17,9 @@ from collections.abc import Callable, Sequence
 
 from ..ir.builtins import BUILTINS, C_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time
+from ..native.foreign_calls import is_foreign
 from .locate import untranslatable
-from .printer import FunctionWriter, is_foreign
+from .printer import FunctionWriter
 from .statements import Stmt, prune
 
 # The C spelling of each built-in function is the registry's (``Builtin.c_call``); a

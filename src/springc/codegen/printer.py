@@ -16,7 +16,7 @@ from collections.abc import Callable, Iterator, Sequence
 
 from ..ir.builtins import BUILTINS, PYTHON_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
-from ..native.foreign_calls import HELPER, OUTPUT, PREFIX, REFUSAL, function_of
+from ..native.foreign_calls import HELPER, OUTPUT, REFUSAL, function_of, is_foreign
 from .linear_cache import LINEAR_FACTORS
 from .locate import untranslatable
 from .newton_step import NEWTON_SOLVE
@@ -42,11 +42,6 @@ HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE, "_linear_factors": L
            "_foreign": HELPER}
 """The helper functions a generated module defines when it calls them (the registry's
 and the Newton correction of torn blocks, which a :class:`Raw` line calls)."""
-
-
-def is_foreign(name: str) -> bool:
-    """Whether a call node is a run-time foreign call or reads one's outputs."""
-    return name == OUTPUT or name.startswith(PREFIX)
 
 
 def _spelled(spelling: str, args: str) -> str:

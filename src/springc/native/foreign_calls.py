@@ -39,6 +39,11 @@ HELPER = ("def _foreign(name, args):\n"
 _SCALAR: dict[str, Any] = {"R": ctypes.c_double, "I": ctypes.c_int, "B": ctypes.c_int}
 
 
+def is_foreign(name: str) -> bool:
+    """Whether a call node is a run-time foreign call or reads one's outputs."""
+    return name == OUTPUT or name.startswith(PREFIX)
+
+
 def calls_foreign(source: str) -> bool:
     """Whether a generated module's text calls foreign functions at run time."""
     return HELPER.splitlines()[0] in source

@@ -26,6 +26,7 @@ from ..ir import expr as x
 from ..ir.builtins import BUILTINS
 from ..ir.flat import Equation, FlatModel, quote
 from ..ir.when import When
+from ..native.foreign_calls import is_foreign
 from .algebra import ONE, SECOND, Unit, UnitSyntaxError, parse_unit
 
 
@@ -94,6 +95,8 @@ class UnitChecker:
         return _named(a * b if e.op == "*" else a / b)
 
     def call(self, e: x.Call) -> Unit | None:
+        if is_foreign(e.name):  # a C function's outputs: no unit (and its many inputs
+            return None  # are read once per element: not walked)
         args = [self.unit(a) for a in e.args]
         name = e.name
         builtin = BUILTINS.get(name)
