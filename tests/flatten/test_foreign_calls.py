@@ -229,7 +229,7 @@ def test_a_call_at_events_takes_values_of_the_simulation() -> None:
 
 def test_springc_chooses_the_python_backend_for_a_call_at_run_time() -> None:
     compiled = springc.compile_model([], "ForeignLib.Sampled", libraries=[LIBRARY])
-    assert compiled.backend == "python"
+    assert compiled.options.backend == "python"
     assert springc.simulate(compiled, stop=0.95)["total"][-1] == pytest.approx(2.6)
 
 
