@@ -58,20 +58,19 @@ class UnitChecker:
         if isinstance(e, x.Not):
             self.unit(e.arg)
             return None
-        if isinstance(e, x.BinOp):
+        if isinstance(e, (x.BinOp, x.If, x.Call)):
             found = self.shared.get(id(e))  # a node shared by several parents: once
             if found is not None and found[0] is e:
                 return found[1]
-            unit = self.binop(e)
+            unit = self.binop(e) if isinstance(e, x.BinOp) else \
+                self.call(e) if isinstance(e, x.Call) else self.branches(e)
             self.shared[id(e)] = (e, unit)
             return unit
-        if isinstance(e, x.If):
-            self.unit(e.cond)
-            return agree(self.unit(e.then), self.unit(e.otherwise), "if-branches",
-                         "and")
-        if isinstance(e, x.Call):
-            return self.call(e)
         return None  # a literal takes the unit it is needed in
+
+    def branches(self, e: x.If) -> Unit | None:
+        self.unit(e.cond)
+        return agree(self.unit(e.then), self.unit(e.otherwise), "if-branches", "and")
 
     def declared(self, e: x.Expr) -> bool:
         """Whether a variable with a known unit occurs in ``e``."""
