@@ -295,8 +295,9 @@ class FunctionWriter:
         The call's arguments are computed by a local function defined before the
         statement, the values of the variables they read bound then (its default
         arguments): they are printed once, whichever elements are read, and computed
-        only where an element is (a when-clause's branch); it is defined again after
-        the loop that defined it ends or one of those variables is assigned."""
+        only where an element is (a when-clause's branch), once per definition; it is
+        defined again after the loop that defined it ends or one of those variables is
+        assigned."""
         call = e.args[2] if e.name == OUTPUT else e
         assert isinstance(call, Call), call
         if not self.foreign_calls:
@@ -313,11 +314,15 @@ class FunctionWriter:
             read = sorted(variables(call))
             for v in read:  # defined again after any of them is assigned
                 self._readers.setdefault(v, set()).add(cid)
-            bound = [self.name(v) for v in read if self.name(v).isidentifier()]
-            self._emit(f"def {function}({', '.join(f'{n}={n}' for n in bound)}):")
+            bound = [f"{n}={n}" for n in map(self.name, read) if n.isidentifier()]
+            # its arguments are fixed when it is defined: computed once (_memo)
+            self._emit(f"def {function}({', '.join([*bound, '_memo=[]'])}):")
+            self._emit("    if _memo:")
+            self._emit("        return _memo[0]")
             self.lines += inner.lines
-            self._emit(f"    return _foreign({call.name!r}, "
-                       f"({''.join(text + ', ' for text in texts)}))")
+            self._emit(f"    _memo.append(_foreign({call.name!r}, "
+                       f"({''.join(text + ', ' for text in texts)})))")
+            self._emit("    return _memo[0]")
             self.helpers.add("_foreign")
             self._scopes[-1].add(cid)
         return f"{function}()[{slot.value!r}][{index.value!r}]" \
