@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 from .errors import CodegenError, OutputError, UsageError
 from .ir.expr import recursion_room
+from .native.foreign_calls import RunTimeCallRefused, calls_foreign
 from .pipeline import (
     CompiledModel,
     CompileOptions,
@@ -173,7 +174,13 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
 @collector_paused()  # the whole compile, both backends (springc.collector)
 def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
              chosen: bool = False) -> CompiledModel:
-    compiled, base = _compile_as(options, parameters)
+    try:
+        compiled, base = _compile_as(options, parameters)
+    except RunTimeCallRefused as refused:  # numba calls no C function at run time
+        if not (chosen and options.backend == "numba"):
+            raise
+        options = replace(options, backend="python")
+        compiled, base = _compile_as(options, parameters, refused.derived)
     other = None
     if chosen and options.backend == "numba" and compiled.source.count("\n") > NUMBA_LINES:
         other = "python"
@@ -194,8 +201,8 @@ def _numba_instead(compiled: CompiledModel) -> bool:
     the compiled engine runs others on numba: events, delays, switching states, a
     model beyond the loop's size rule, one the C printer cannot print (a function with
     no C spelling), and one whose C the compiler refused (with a one-line note)."""
-    if not (c_loop_runs(AUTO, None) and numba_available()):
-        return False
+    if not (c_loop_runs(AUTO, None) and numba_available()) or calls_foreign(compiled.source):
+        return False  # numba calls no C function at run time (native.foreign_calls)
     if compiled.kind != ModuleKind.CONTINUOUS:
         return True
     from .pipeline import loop_library, note_refused  # the C printer: on this choice only

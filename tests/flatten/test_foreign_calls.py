@@ -11,8 +11,10 @@ from pathlib import Path
 
 import pytest
 
-from springc.errors import SpringcError, errors_of
+import springc
+from springc.errors import CodegenError, SpringcError, errors_of
 from springc.ir.flat import format_flat
+from springc.pipeline import c_source
 from springc.pipeline.files import flatten_files
 
 LIBRARY = Path(__file__).parent / "foreign"
@@ -67,12 +69,10 @@ def test_modelica_error_is_a_located_error() -> None:
     assert [n.message for n in err.notes] == ["its external clause"]
 
 
-def test_an_argument_known_only_during_the_simulation_is_refused() -> None:
-    err = _error("ForeignLib.RunTime")
-    assert err.message == ("the external function 'ForeignLib.root' is called with its "
-                           "input 'x' known only during the simulation (it depends on "
-                           "time)")
-    assert err.span is not None and err.span.line == _line("Real y = root(time);")
+def test_an_argument_known_only_during_the_simulation_is_called_then() -> None:
+    # y = root(time): the C function at each evaluation of the model, sqrt(t)
+    rows = _simulated("ForeignLib.RunTime", backend="python")
+    assert rows["y"] == pytest.approx([t ** 0.5 for t in rows["time"]], rel=1e-12)
 
 
 def test_an_output_the_call_does_not_set_is_an_error() -> None:
@@ -280,3 +280,72 @@ def test_a_crash_in_the_c_code_is_a_located_error(tmp_path: Path) -> None:
         '#include "h.h"\ndouble lib_f(double x) { return x * H; }\n')
     text = format_flat(flatten_files([], "Lib.M", [libs]))
     assert text.split("equation\n")[1].splitlines()[:-1] == ["  y = 6.0;"]
+
+
+def _simulated(model: str, **options: object) -> dict[str, list[float]]:
+    compiled = springc.compile_model([], model, libraries=[LIBRARY], **options)
+    result = springc.simulate(compiled, stop=0.95, interval=0.05)
+    return {"time": list(result.time), **{name: list(result[name]) for name in result.names}}
+
+
+def test_a_call_at_events_takes_values_of_the_simulation() -> None:
+    # at each sample t = 0.1 k, stats of the four samples before it: after t = 0.2 the
+    # buffer held {0, 0, 0, 0.1}; after t = 0.9 it held {0.5, 0.6, 0.7, 0.8}
+    rows = _simulated("ForeignLib.Sampled", backend="python")
+    at = rows["time"].index(0.25)
+    assert rows["total"][at] == pytest.approx(0.1, rel=1e-12)
+    assert rows["count"][at] == 1
+    assert rows["scaled[4]"][at] == pytest.approx(0.2, rel=1e-12)
+    assert rows["total"][-1] == pytest.approx(2.6, rel=1e-12)
+    assert rows["count"][-1] == 4
+    assert [rows[f"scaled[{k}]"][-1] for k in range(1, 5)] == pytest.approx(
+        [1.0, 1.2, 1.4, 1.6], rel=1e-12)
+
+
+def test_springc_chooses_the_python_backend_for_a_call_at_run_time() -> None:
+    compiled = springc.compile_model([], "ForeignLib.Sampled", libraries=[LIBRARY])
+    assert compiled.options.backend == "python"
+    assert springc.simulate(compiled, stop=0.95)["total"][-1] == pytest.approx(2.6)
+
+
+def test_numba_refuses_a_call_at_run_time() -> None:
+    with pytest.raises(CodegenError) as info:
+        springc.compile_model([], "ForeignLib.Sampled", libraries=[LIBRARY],
+                              backend="numba")
+    assert info.value.message == (
+        "the numba backend cannot call the external C function 'ForeignLib.stats' during "
+        "the simulation; the python backend does")
+
+
+def test_the_c_model_refuses_a_call_at_run_time() -> None:
+    compiled = springc.compile_model([], "ForeignLib.Sampled", libraries=[LIBRARY],
+                                     backend="python")
+    with pytest.raises(CodegenError) as info:
+        c_source(compiled)
+    assert info.value.message.startswith(
+        "the C model cannot call the external C function 'ForeignLib.stats' during the "
+        "simulation; the python backend does")
+
+
+WRITES = '''model W
+  Real x(start = 1, fixed = true);
+algorithm
+  when time > 0.5 then
+    ForeignLib.writeText("x", "{file}");
+  end when;
+equation
+  der(x) = -x;
+end W;
+'''
+
+
+def test_a_model_writes_no_file(tmp_path: Path) -> None:
+    target = tmp_path / "written.txt"
+    source = tmp_path / "W.mo"
+    source.write_text(WRITES.format(file=target))
+    model = flatten_files([source], "W", [LIBRARY])
+    assert model.notes == (
+        f"{source}:5:5: warning: springc does not write or read files named by a model "
+        "nor call impure functions; the call of 'ForeignLib.writeText' is skipped (it "
+        f"calls 'ForeignLib.writeText' on the file '{target}')",)
+    assert not target.exists()

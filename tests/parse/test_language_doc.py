@@ -53,11 +53,6 @@ REJECTED = {
     "model M\n  Real x = f(1);\nend M;\n":
         "7:12: error: the external function 'f' (C function 'f') is not supported: its "
         "library does not ship its C sources",
-    "function f\n  input Real u;\n  output Real y;\nexternal \"C\" annotation(Include=\n"
-    "  \"double f(double u) { return 2 * u; }\");\nend f;\nmodel M\n  Real x = f(time);\n"
-    "end M;\n":
-        "8:12: error: the external function 'f' is called with its input 'u' known only "
-        "during the simulation (it depends on time)",
     "connector C\n  Real p;\n  flow Real f;\n  stream Real h;\nend C;\nmodel M\n  C c;\nend M;\n":
         "4:3: error: `stream` connectors are not supported yet",
     "function f\n  input Real u;\n  output Real y;\nalgorithm\n  y := u;\n"

@@ -17,6 +17,7 @@ from collections.abc import Callable, Sequence
 
 from ..ir.builtins import BUILTINS, C_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time
+from ..native.foreign_calls import is_foreign
 from .locate import untranslatable
 from .printer import FunctionWriter
 from .statements import Stmt, prune
@@ -97,6 +98,9 @@ class CWriter(FunctionWriter):
     """Prints one C function body; every local it assigns is a ``double`` declared at
     the top (:func:`c_function_body`)."""
 
+    foreign_calls = False
+    writes = "the C model"
+
     block_end = "}"
 
     def __init__(self, namer: Callable[[str], str], helpers: set[str],
@@ -158,6 +162,8 @@ class CWriter(FunctionWriter):
 
     def _print_Call(self, e: Call) -> tuple[str, int]:
         name = e.name
+        if is_foreign(name):
+            return self._foreign_output(e), 9  # refused: foreign_calls is False
         entry = BUILTINS.get(name)
         if entry is not None and entry.transparent is not None:
             return self._shared(e.args[entry.transparent])

@@ -19,6 +19,7 @@ or escaped comments (``printer.escaped``).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -27,6 +28,7 @@ from ..ir import flat, ode
 from ..ir.dae import derivative_name
 from ..ir.expr import Var, variables
 from ..ir.hybrid import event_expressions
+from ..native.foreign_calls import REFUSAL, RunTimeCallRefused, function_of
 from .assertions import assertion_function
 from .context import (
     BACKENDS,
@@ -164,6 +166,8 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
         bodies.append(("delay_inputs", "The delayed expressions, then the delay times.",
                        function_lines(namer, helpers, prologue + m.delays.inputs_body(base)),
                        "di"))
+    if numba and "_foreign" in helpers:
+        raise RunTimeCallRefused(REFUSAL.format("the numba backend", foreign_function(bodies)))
     structural = shared_part(options, "structural",
                              lambda: structural_parameters(system, flat_model))
     source = module_text(m, options, bodies, helpers, pattern, outputs, structural, namer,
@@ -172,6 +176,17 @@ def _generate(system: ode.ODE, flat_model: flat.FlatModel | None,
                           tuple(outputs), tuple(m.params), tuple(structural))
 
 
+def foreign_function(bodies: list[tuple[str, str, list[str], str]]) -> str:
+    """The Modelica name of the first function the bodies call at run time."""
+    for _, _, lines, _ in bodies:
+        for line in lines:
+            found = _FOREIGN_LINE.search(line)
+            if found:
+                return function_of(found.group(2))
+    return "?"
+
+
+_FOREIGN_LINE = re.compile(r"_foreign\((['\"])(.+?)\1")
 _JAC_DOC = "Non-zeros of d(rhs)/dx in CSC order (JAC_INDICES, JAC_INDPTR)."
 
 

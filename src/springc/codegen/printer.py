@@ -16,6 +16,7 @@ from collections.abc import Callable, Iterator, Sequence
 
 from ..ir.builtins import BUILTINS, PYTHON_HELPERS
 from ..ir.expr import BinOp, Call, Const, Expr, If, Neg, Not, Time, Var, variables
+from ..native.foreign_calls import HELPER, OUTPUT, REFUSAL, function_of, is_foreign
 from .linear_cache import LINEAR_FACTORS
 from .locate import untranslatable
 from .newton_step import NEWTON_SOLVE
@@ -37,7 +38,8 @@ from .statements import (
 _PREC = {"or": 1, "and": 2, "<": 4, "<=": 4, ">": 4, ">=": 4, "==": 4, "<>": 4,
          "+": 5, "-": 5, "*": 6, "/": 6, "^": 8}
 _PY_OP = {"<>": "!=", "^": "**"}
-HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE, "_linear_factors": LINEAR_FACTORS}
+HELPERS = {**PYTHON_HELPERS, "_newton_solve": NEWTON_SOLVE, "_linear_factors": LINEAR_FACTORS,
+           "_foreign": HELPER}
 """The helper functions a generated module defines when it calls them (the registry's
 and the Newton correction of torn blocks, which a :class:`Raw` line calls)."""
 
@@ -78,6 +80,7 @@ class FunctionWriter:
         self._scopes: list[set[int]] = [set()]
         self._in_branch = 0
         self._indent = indent
+        self._calls: dict[int, str] = {}  # run-time foreign calls: their local functions
 
     # Step 1: canonical ids and use counts.
     def _id(self, e: Expr) -> int:
@@ -190,6 +193,7 @@ class FunctionWriter:
             self.write(stmt.body)
             for cid in self._scopes.pop():
                 self._temps.pop(cid, None)
+                self._calls.pop(cid, None)
             self._indent = outer
             if self.block_end is not None:
                 self._emit(self.block_end)
@@ -198,6 +202,7 @@ class FunctionWriter:
         ident = self.name(name)
         for cid in self._readers.pop(name, set()):
             self._temps.pop(cid, None)
+            self._calls.pop(cid, None)
         for cid in self._holders.pop(ident, set()):
             if self._temps.get(cid) == ident:
                 del self._temps[cid]
@@ -268,7 +273,14 @@ class FunctionWriter:
             left, right = self.expr(e.left, prec), self.expr(e.right, prec + 1)
         return f"{left} {_PY_OP.get(op, op)} {right}", prec
 
+    foreign_calls = True
+    """Whether this printer calls a library's C functions at run time (python only);
+    where not, the refusal names ``writes``."""
+    writes = "this printer"
+
     def _print_Call(self, e: Call) -> tuple[str, int]:
+        if is_foreign(e.name):
+            return self._foreign_output(e), 9
         builtin = BUILTINS.get(e.name)
         if builtin is not None and builtin.transparent is not None:
             return self._shared(e.args[builtin.transparent])
@@ -277,6 +289,44 @@ class FunctionWriter:
         if spelling in HELPERS:
             self.helpers.add(spelling)
         return _spelled(spelling, args), 9
+
+    def _foreign_output(self, e: Call) -> str:
+        """``_fcallN()[slot][index]``: an element of a run-time foreign call's outputs.
+        The call's arguments are computed by a local function defined before the
+        statement, the values of the variables they read bound then (its default
+        arguments): they are printed once, whichever elements are read, and computed
+        only where an element is (a when-clause's branch), once per definition; it is
+        defined again after the loop that defined it ends or one of those variables is
+        assigned."""
+        call = e.args[2] if e.name == OUTPUT else e
+        assert isinstance(call, Call), call
+        if not self.foreign_calls:
+            raise untranslatable(REFUSAL.format(self.writes, function_of(call.name)), e)
+        slot, index = (e.args[0], e.args[1]) if e.name == OUTPUT else (Const(0), Const(0))
+        cid = self._id(call)
+        function = self._calls.get(cid)
+        if function is None:
+            function = self._calls[cid] = f"_fcall{cid}"
+            inner = type(self)(self.name, self.helpers, self._indent + "    ")
+            for arg in call.args:
+                inner._visit(arg)
+            texts = [inner.expr(arg) for arg in call.args]
+            read = sorted(variables(call))
+            for v in read:  # defined again after any of them is assigned
+                self._readers.setdefault(v, set()).add(cid)
+            bound = [f"{n}={n}" for n in map(self.name, read) if n.isidentifier()]
+            # its arguments are fixed when it is defined: computed once (_memo)
+            self._emit(f"def {function}({', '.join([*bound, '_memo=[]'])}):")
+            self._emit("    if _memo:")
+            self._emit("        return _memo[0]")
+            self.lines += inner.lines
+            self._emit(f"    _memo.append(_foreign({call.name!r}, "
+                       f"({''.join(text + ', ' for text in texts)})))")
+            self._emit("    return _memo[0]")
+            self.helpers.add("_foreign")
+            self._scopes[-1].add(cid)
+        return f"{function}()[{slot.value!r}][{index.value!r}]" \
+            if isinstance(slot, Const) and isinstance(index, Const) else function + "()"
 
     def _spelling(self, e: Call) -> str:
         """How this printer calls the built-in of ``e`` (the registry's ``python``)."""
@@ -323,6 +373,9 @@ def function_lines(namer: Callable[[str], str], helpers: set[str], stmts: Sequen
 
 class NumpyWriter(FunctionWriter):
     """Prints expressions over numpy arrays: ufuncs, ``np.where``, logical functions."""
+
+    foreign_calls = False
+    writes = "the vector layout"
 
     def _spelling(self, e: Call) -> str:
         builtin = BUILTINS.get(e.name)

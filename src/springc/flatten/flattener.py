@@ -70,6 +70,7 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
         self.initial_equations: list[flat.Equation] = []
         self.whens: list[When] = []
         self.assertions: list[tuple[flat.Assertion, Span]] = []
+        self.warnings: list[str] = []
         self.algorithm_sections: list[Section] = []
         self.statement_conditions: list[tuple[x.Expr, Span]] = []
         self.parameter_decisions = 0
@@ -200,7 +201,8 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
     flat_model = flat.FlatModel(entry.full_name, variables, tuple(flattener.equations),
                                 tuple(flattener.initial_equations),
                                 experiment_of(flattener, entry, top), entry.defn.span,
-                                notes=(*tree.notes, *added_inner_notes(top)),
+                                notes=(*tree.notes, *added_inner_notes(top),
+                                       *flattener.warnings),
                                 whens=tuple(flattener.whens),
                                 assertions=unique(flattener.assertions),
                                 evaluated=tuple(sorted(flattener.evaluated)))

@@ -52,24 +52,24 @@ NATIVE_EXTERNALS.update({
 })
 """The string functions of ``Modelica.Utilities.Strings`` (``flatten/externals.py``)."""
 
-_FILES = "it writes or removes files, folders or the environment"
+FILES = "it writes or removes files, folders or the environment"
 _CLOCK = "its result depends on when or where the translation runs"
-_READS = ("it reads files, folders or the environment, which the compiled model's cache "
+READS = ("it reads files, folders or the environment, which the compiled model's cache "
           "key does not cover")
 _STATE = "it keeps a state between calls, which a call while translating would not"
 REFUSED_EXTERNALS: dict[str, str] = {
-    **{f"ModelicaInternal_{name}": _FILES for name in (
+    **{f"ModelicaInternal_{name}": FILES for name in (
         "print", "removeFile", "copyFile", "rename", "mkdir", "rmdir", "chdir", "setenv")},
-    "ModelicaIO_writeRealMatrix": _FILES,
-    "ModelicaStreams_closeFile": _FILES,
+    "ModelicaIO_writeRealMatrix": FILES,
+    "ModelicaStreams_closeFile": FILES,
     **{f"ModelicaInternal_{name}": _CLOCK for name in (
         "getTime", "getpid", "temporaryFileName")},
     "ModelicaRandom_automaticGlobalSeed": _CLOCK,
-    **{f"ModelicaInternal_{name}": _READS for name in (
+    **{f"ModelicaInternal_{name}": READS for name in (
         "countLines", "fullPathName", "getNumberOfFiles", "getcwd", "getenv",
         "readDirectory", "readFile", "readLine", "stat")},
-    "ModelicaIO_readMatrixSizes": _READS,
-    "ModelicaIO_readRealMatrix": _READS,
+    "ModelicaIO_readMatrixSizes": READS,
+    "ModelicaIO_readRealMatrix": READS,
     "ModelicaRandom_impureRandom_xorshift1024star": _STATE,
     "ModelicaRandom_setInternalState_xorshift1024star": _STATE,
 }

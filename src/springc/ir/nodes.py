@@ -124,12 +124,13 @@ def map_children(e: Expr, f: Callable[[Expr], Expr]) -> Expr:
     return If(new[0], new[1], new[2])
 
 
-def walk(e: Expr) -> Iterator[Expr]:
+def walk(e: Expr, seen: set[int] | None = None) -> Iterator[Expr]:
     """All nodes of ``e``, parents before children; a node object shared by several
     parents (inlined functions build such graphs, whose trees can be thousands of
-    times larger) once."""
+    times larger) once, and not at all where its id is in ``seen`` (given: shared by
+    several walks; variables and constants are yielded each time)."""
     stack = [e]
-    seen: set[int] = set()
+    seen = set() if seen is None else seen
     while stack:
         node = stack.pop()
         if type(node) is Const or type(node) is Var:

@@ -82,9 +82,10 @@ class ForeignBuild:
 
 class ForeignLibrary:
     """A loaded library of foreign functions: ``lib`` (ctypes), kept in a private
-    temporary folder for as long as this object lives."""
+    temporary folder for as long as this object lives; ``key`` names it in the cache."""
 
-    def __init__(self, data: bytes) -> None:
+    def __init__(self, data: bytes, key: str = "") -> None:
+        self.key = key
         self._folder = tempfile.TemporaryDirectory(prefix="springc-foreign-")  # 0700
         path = Path(self._folder.name) / "foreign.so"
         path.write_bytes(data)
@@ -102,16 +103,38 @@ class ForeignLibrary:
         return text.decode("utf-8", "replace")
 
 
+_LOADED: dict[str, ForeignLibrary] = {}
+"""The libraries this process loaded, by key: a model's run-time calls
+(:mod:`.foreign_calls`) find theirs here."""
+
+
 def load(build: ForeignBuild) -> ForeignLibrary:
     """The library of ``build``: from springc's cache where a verified copy is there,
     else compiled (and kept there where the cache folder can be used)."""
     compiler = find_compiler()
     key = build.key(compiler)
+    library = _LOADED[key] = ForeignLibrary(_built(build, compiler, key), key)
+    return library
+
+
+def loaded(key: str) -> ForeignLibrary | None:
+    """The library of ``key`` this process loaded, else the verified copy in springc's
+    cache (a compiled model loaded from the cache by another process), else None."""
+    library = _LOADED.get(key)
+    folder = _cache_folder() if library is None else None
+    if folder is not None:
+        data = read_verified(folder / f"{key}.so", folder / f"{key}.so.sha256")
+        if data is not None:
+            library = _LOADED[key] = ForeignLibrary(data, key)
+    return library
+
+
+def _built(build: ForeignBuild, compiler: list[str], key: str) -> bytes:
     folder = _cache_folder()
     if folder is not None:
         data = read_verified(folder / f"{key}.so", folder / f"{key}.so.sha256")
         if data is not None:
-            return ForeignLibrary(data)
+            return data
     data = _compile(build, compiler)
     if folder is not None:
         with contextlib.suppress(OSError):
@@ -119,7 +142,7 @@ def load(build: ForeignBuild) -> ForeignLibrary:
                             (hashlib.sha256(data).hexdigest() + "\n").encode("ascii"))
             replace_private(folder / f"{key}.so", data)
         keep_newest(folder, ".so", KEY_LENGTH + 3, KEEP)  # their records: see KEEP
-    return ForeignLibrary(data)
+    return data
 
 
 def _cache_folder() -> Path | None:

@@ -24,6 +24,7 @@ from ..codegen import GeneratedModule, ModuleKind
 from ..collector import collector_paused
 from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
+from ..native.foreign_calls import RunTimeCallRefused
 from ..resources import CacheUnusable, private_folder
 from ..status_line import say
 from .apart import deriving
@@ -312,7 +313,11 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
         say(compiling_note(options, folder))
         derived = _derive(options)
         write_names(folder, model_key, generation.candidate_names(derived))
-    generated = generation.generate_from(derived, options)
+    try:
+        generated = generation.generate_from(derived, options)
+    except RunTimeCallRefused as refused:  # api generates it for python instead
+        refused.derived = derived
+        raise
     run = run_system_of(derived.system, derived.flat_model, derived.switchable)
     temporary = None
     if folder is not None:

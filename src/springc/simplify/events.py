@@ -88,13 +88,18 @@ def when_exprs(whens: Iterable[w.When]) -> Iterator[x.Expr]:
             yield from (r.value for r in b.reinits)
 
 
-def switching(e: x.Expr) -> Iterator[x.Expr]:
-    """The nodes of ``e`` outside ``noEvent(...)`` and ``smooth(...)``."""
+def switching(e: x.Expr, seen: set[int] | None = None) -> Iterator[x.Expr]:
+    """The nodes of ``e`` outside ``noEvent(...)`` and ``smooth(...)``; those whose
+    ids are in ``seen`` (given: shared by the expressions of one search) not again."""
     stack = [e]
     while stack:
         node = stack.pop()
         if isinstance(node, x.Call) and node.name in _QUIET:
             continue
+        if seen is not None:
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
         yield node
         stack.extend(x.children(node))
 
@@ -121,8 +126,10 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
     samples: dict[tuple[x.Expr, x.Expr], None] = {}
     pre: dict[str, None] = {}
     floors: dict[x.Call, None] = {}
+    visited: set[int] = set()  # nodes shared by several expressions: once
+    read: set[int] = set()
     for e in exprs:
-        for node in switching(e):
+        for node in switching(e, visited):
             if isinstance(node, x.BinOp) and node.op in STATE_RELATIONS:
                 kind = _time_relation(node, params)
                 if kind is not None:
@@ -134,13 +141,14 @@ def event_system(model: flat.FlatModel, system: ode.ODE) -> EventSystem | None:
             elif (isinstance(node, x.Call) and node.name == "floor"
                   and _continuous(node, params | held_set)):
                 floors.setdefault(node, None)
-        for node in x.walk(e):
+        for node in x.walk(e, read):
             if isinstance(node, x.Call) and node.name in _READS_PRE:
                 arg = node.args[0]
                 if isinstance(arg, x.Var):
                     pre.setdefault(arg.name, None)
+    walked: set[int] = set()
     phases = {n.name for e in [*exprs, *(a.condition for a in model.assertions)]
-              for n in x.walk(e) if isinstance(n, x.Call) and n.name in _PHASES}
+              for n in x.walk(e, walked) if isinstance(n, x.Call) and n.name in _PHASES}
     if not (held or relations or timed or samples or model.whens or floors or phases):
         return None
     by_name = {v.name: v for v in model.variables}
@@ -293,8 +301,9 @@ def _sorted_whens(whens: tuple[w.When, ...]) -> tuple[w.When, ...]:
     reads = []
     for c in whens:
         names: set[str] = set()
+        seen: set[int] = set()  # a node shared by the clause's expressions: once
         for e in when_exprs((c,)):
-            names |= _reads(e)
+            names |= _reads(e, seen)
         reads.append(names)
     order: list[int] = []
     state = [0] * len(whens)
@@ -314,14 +323,16 @@ def _sorted_whens(whens: tuple[w.When, ...]) -> tuple[w.When, ...]:
     return tuple(whens[i] for i in order)
 
 
-def _reads(e: x.Expr) -> set[str]:
-    """Variables ``e`` reads, except through ``pre``."""
+def _reads(e: x.Expr, seen: set[int]) -> set[str]:
+    """Variables ``e`` reads, except through ``pre``; the nodes in ``seen`` (ids) are
+    not visited again."""
     out: set[str] = set()
     stack = [e]
     while stack:
         node = stack.pop()
-        if isinstance(node, x.Call) and node.name == "pre":
+        if (isinstance(node, x.Call) and node.name == "pre") or id(node) in seen:
             continue
+        seen.add(id(node))
         if isinstance(node, x.Var):
             out.add(node.name)
         stack.extend(x.children(node))

@@ -26,6 +26,7 @@ from ..ir import expr as x
 from ..ir.builtins import BUILTINS
 from ..ir.flat import Equation, FlatModel, quote
 from ..ir.when import When
+from ..native.foreign_calls import is_foreign
 from .algebra import ONE, SECOND, Unit, UnitSyntaxError, parse_unit
 
 
@@ -57,20 +58,19 @@ class UnitChecker:
         if isinstance(e, x.Not):
             self.unit(e.arg)
             return None
-        if isinstance(e, x.BinOp):
+        if isinstance(e, (x.BinOp, x.If, x.Call)):
             found = self.shared.get(id(e))  # a node shared by several parents: once
             if found is not None and found[0] is e:
                 return found[1]
-            unit = self.binop(e)
+            unit = self.binop(e) if isinstance(e, x.BinOp) else \
+                self.call(e) if isinstance(e, x.Call) else self.branches(e)
             self.shared[id(e)] = (e, unit)
             return unit
-        if isinstance(e, x.If):
-            self.unit(e.cond)
-            return agree(self.unit(e.then), self.unit(e.otherwise), "if-branches",
-                         "and")
-        if isinstance(e, x.Call):
-            return self.call(e)
         return None  # a literal takes the unit it is needed in
+
+    def branches(self, e: x.If) -> Unit | None:
+        self.unit(e.cond)
+        return agree(self.unit(e.then), self.unit(e.otherwise), "if-branches", "and")
 
     def declared(self, e: x.Expr) -> bool:
         """Whether a variable with a known unit occurs in ``e``."""
@@ -94,6 +94,8 @@ class UnitChecker:
         return _named(a * b if e.op == "*" else a / b)
 
     def call(self, e: x.Call) -> Unit | None:
+        if is_foreign(e.name):  # a C function's outputs: no unit (and its many inputs
+            return None  # are read once per element: not walked)
         args = [self.unit(a) for a in e.args]
         name = e.name
         builtin = BUILTINS.get(name)

@@ -20,7 +20,7 @@ from typing import cast
 
 import numpy as np
 
-from ...errors import FlattenError, Span
+from ...errors import FlattenError, Span, SpringcError
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
@@ -43,6 +43,7 @@ from ..calls import (
     without_events,
 )
 from ..connect import GRAPH_EQUATIONS, misplaced
+from ..natives import skipped_call
 from ..scopes import ClassScope, FlatResults, FlattenContext, LocalScope, Scope
 from .loop_break import (
     BROKEN_TERMS,
@@ -336,7 +337,15 @@ class _Run:
             self.parts[-1].terminates.append(terminate_of(self.ev, stmt, where))
             return
         if name != "assert":
-            call_for_effect(self.ev, stmt.call, where, "a statement")
+            start = len(self.fl.assertions)
+            try:
+                call_for_effect(self.ev, stmt.call, where, "a statement")
+            except SpringcError as refused:  # springc writes no file a model names
+                warning = skipped_call(refused, stmt.call)
+                if warning is None:
+                    raise
+                del self.fl.assertions[start:]
+                self.fl.warnings.append(warning)
             return
         if self.parts:
             guard = self.parts[-1].guard

@@ -4,8 +4,8 @@ ModelicaStrings ones evaluated, the others a located error (``externals``)."""
 
 from __future__ import annotations
 
-from .externals import external_value, is_external
+from .externals import external_value, is_external, skipped_call
 from .tables import is_external_object, native_call, table_object
 
 __all__ = ["external_value", "is_external", "is_external_object", "native_call",
-           "table_object"]
+           "skipped_call", "table_object"]

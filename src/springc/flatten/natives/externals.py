@@ -13,10 +13,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from ...errors import FlattenError, Note
+from ...errors import FlattenError, Note, SpringcError
 from ...ir import expr as x
 from ...ir import syntax as s
-from ...ir.native_externals import NATIVE_EXTERNALS, REFUSED_EXTERNALS
+from ...ir.native_externals import FILES, NATIVE_EXTERNALS, READS, REFUSED_EXTERNALS
 from ...parse import ClassEntry
 from ..scopes import ExpressionEvaluator
 from .foreign_calls import foreign_value
@@ -29,6 +29,39 @@ from .library_sources import (
     top_class,
 )
 from .tables import native_call
+
+SKIPPED = (FILES, READS)
+"""The refusals a model's call statement is skipped for (:func:`skipped_call`)."""
+
+
+class FileCallRefused(FlattenError):
+    """A call of a function that writes or reads files (``REFUSED_EXTERNALS``): the
+    model's call statement that made it is skipped (:func:`skipped_call`)."""
+
+    function = ""
+    file: str | None = None
+
+
+IMPURE = "`impure` functions are"
+"""How the parser's refusal of an ``impure`` function begins (``parse.rules_classes``)."""
+
+
+def skipped_call(refused: SpringcError, call: s.Call) -> str | None:
+    """The located warning of a model's call statement skipped because the function it
+    calls writes or reads files (a :class:`FileCallRefused`) or calls an ``impure``
+    function, which springc does not call (a file's ``removeFile``, ``print``): springc
+    writes no file a model names (model text is data) and reads none its cache key
+    does not cover. None where ``refused`` is another error (raised again)."""
+    if isinstance(refused, FileCallRefused):
+        file = f" on the file '{refused.file}'" if refused.file is not None else ""
+        inner = f"'{refused.function}'{file}"
+    elif refused.message.startswith(IMPURE):
+        inner = f"the impure function declared at {refused.span}"
+    else:
+        return None
+    return (f"{call.span}: warning: springc does not write or read files named by a model "
+            f"nor call impure functions; the call of '{call.func.dotted}' is skipped (it "
+            f"calls {inner})")
 
 
 def is_external(entry: ClassEntry) -> bool:
@@ -47,12 +80,18 @@ def external_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, 
     c_name = external.name or entry.defn.name
     known = NATIVE_EXTERNALS.get(c_name)
     if c_name in REFUSED_EXTERNALS:
-        raise FlattenError(
-            f"springc does not call the external function '{entry.full_name}' ('{c_name}'): "
-            f"{REFUSED_EXTERNALS[c_name]}", call.span, [Note("its external clause",
-                                                            external.span)],
-            "springc calls a library's C functions while translating the model, once; "
-            "it writes no file a model names (docs/msl.md, External C functions)")
+        message = (f"springc does not call the external function '{entry.full_name}' "
+                   f"('{c_name}'): {REFUSED_EXTERNALS[c_name]}")
+        notes = [Note("its external clause", external.span)]
+        hint = ("springc calls a library's C functions while translating the model, once; "
+                "it writes no file a model names (docs/msl.md, External C functions)")
+        if REFUSED_EXTERNALS[c_name] in SKIPPED:
+            file = names.get("fileName")
+            refused = FileCallRefused(message, call.span, notes, hint)
+            refused.function = entry.full_name
+            refused.file = file if isinstance(file, str) else None
+            raise refused
+        raise FlattenError(message, call.span, notes, hint)
     if known is None:
         sources = c_sources(entry, external) if external.language == "C" else []
         if isinstance(sources, CSources):

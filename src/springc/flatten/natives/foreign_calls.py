@@ -32,10 +32,8 @@ from ...parse import ClassEntry
 from .. import arrays as a
 from ..scopes import ExpressionEvaluator
 from .library_sources import CSources, inside
+from .run_time_calls import C_TYPES, run_time_argument, run_time_outputs
 
-C_TYPES: dict[str, tuple[str, Any]] = {
-    "Real": ("double", ctypes.c_double), "Integer": ("int", ctypes.c_int),
-    "Boolean": ("int", ctypes.c_int), "String": ("const char *", ctypes.c_char_p)}
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 INCLUDE_LINE = re.compile(r'\s*#\s*include\s*("[^"/\\]+(/[^"/\\]+)*"|<[^<>/\\]+(/[^<>/\\]+)*>)\s*'
                           r"(//.*)?")
@@ -80,20 +78,19 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
     passed = _call_args(external, comps)
     used = {returned, *(n for e in passed for n in _names(e))}
     kinds = {c.name: _kind(ev, entry, c, call) for c in comps if c.name in used}
-    args = [_argument(ev, entry, e, names, declared, kinds, call) for e in passed]
     result = kinds[returned] if returned else None
     _check_include(sources.include, entry, external.span)
-    glue = _glue(c_name, args, result, sources.include)
-    try:
-        library = foreign.load(foreign.ForeignBuild(
-            tuple(_source(path, sources) for path in sources.files),
-            _headers(sources), glue))
-    except SpringcError as failed:
-        raise FlattenError(f"the external function '{entry.full_name}' ('{c_name}') could "
-                           f"not be built: {failed.message}", call.span, where,
-                           "springc compiles a library's C sources (Resources/C-Sources) "
-                           "with the system C compiler, or zig cc (pip install ziglang)"
-                           ) from None
+    late = _run_time_input(ev, passed, names, declared)
+    if late is not None:
+        run = [run_time_argument(entry, e, names, declared, kinds, call) for e in passed]
+        library = _library(entry, c_name, sources, _glue(c_name, [r[0] for r in run],
+                                                         result, sources.include), call)
+        return run_time_outputs(entry, c_name, library.key, names, run, returned, result,
+                                [c for c in comps if c.causality == "output"][:count],
+                                call, count)
+    args = [_argument(ev, entry, e, names, declared, kinds, call) for e in passed]
+    library = _library(entry, c_name, sources,
+                       _glue(c_name, [arg.c_type for arg in args], result, sources.include), call)
     out = C_TYPES[result][1]() if result else None
     wrapper = library.lib.springc_call
     wrapper.restype = ctypes.c_int
@@ -118,6 +115,39 @@ def foreign_value(ev: ExpressionEvaluator, entry: ClassEntry, names: dict[str, A
                            f"output '{unset[0].name}'", call.span,
                            [Note("declared here", unset[0].span), *where])
     return values[outputs[0].name] if count == 1 else [values[c.name] for c in outputs]
+
+
+def _library(entry: ClassEntry, c_name: str, sources: CSources, glue: str,
+             call: s.Call) -> foreign.ForeignLibrary:
+    external = entry.defn.external
+    assert external is not None
+    try:
+        return foreign.load(foreign.ForeignBuild(
+            tuple(_source(path, sources) for path in sources.files),
+            _headers(sources), glue))
+    except SpringcError as failed:
+        raise FlattenError(f"the external function '{entry.full_name}' ('{c_name}') could "
+                           f"not be built: {failed.message}", call.span,
+                           [Note("its external clause", external.span)],
+                           "springc compiles a library's C sources (Resources/C-Sources) "
+                           "with the system C compiler, or zig cc (pip install ziglang)"
+                           ) from None
+
+
+def _run_time_input(ev: ExpressionEvaluator, passed: tuple[s.Expr, ...],
+                    names: dict[str, Any], declared: dict[str, s.Component]) -> str | None:
+    """The first input of the call known only during the simulation, else None."""
+    for e in passed:
+        if isinstance(e, s.Ref) and e.dotted in declared \
+                and declared[e.dotted].causality == "input":
+            value = names[e.dotted]
+            if isinstance(value, str):
+                continue
+            try:
+                ev.fold(value)
+            except KeyError:
+                return e.dotted
+    return None
 
 
 def _names(e: s.Expr) -> list[str]:
@@ -265,16 +295,16 @@ def _check_include(text: str, entry: ClassEntry, span: Any) -> None:
                      "Resources/C-Sources folder and name it with Library=\"...\"")
 
 
-def _glue(c_name: str, args: list[_Arg], result: str | None, include: str) -> str:
+def _glue(c_name: str, args: list[str], result: str | None, include: str) -> str:
     """springc's C wrapper of the call: the ``Include`` text, the function's prototype
     where it gives none, and ``springc_call``, which returns 1 after a ModelicaError."""
-    params = [f"{arg.c_type} a{k}" for k, arg in enumerate(args)]
+    params = [f"{c_type} a{k}" for k, c_type in enumerate(args)]
     value = C_TYPES[result][0] if result else "void"
     if result:
         params.append(f"{value} *springc_result")
     call_text = f"{c_name}({', '.join(f'a{k}' for k in range(len(args)))})"
     prototype = "" if include.strip() else (
-        f"{value} {c_name}({', '.join(arg.c_type for arg in args) or 'void'});\n")
+        f"{value} {c_name}({', '.join(args) or 'void'});\n")
     return ("#include <setjmp.h>\n"
             "extern jmp_buf springc_error_jump;\n"
             "void springc_guard_begin(void);\nvoid springc_guard_end(void);\n"

@@ -372,6 +372,8 @@ class FlatResults(Protocol):
     whens: list[When]
     # assertions and the spans of their conditions (flatten/calls/assertions.py)
     assertions: list[tuple[flat.Assertion, Span]]
+    # located warnings, the flat model's notes (a call skipped: natives.skipped_call)
+    warnings: list[str]
 
 
 class FlattenContext(ClassViews, FlatResults, Protocol):

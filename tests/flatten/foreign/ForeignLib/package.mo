@@ -45,6 +45,13 @@ package ForeignLib "External C functions whose sources the library ships (tests)
     annotation(Include="#include \"foreignlib.h\"", Library="ForeignLib");
   end unset;
 
+  function writeText "The MSL's Streams.print: a line on a file (none: the standard output)"
+    input String string;
+    input String fileName = "";
+  external "C" ModelicaInternal_print(string, fileName)
+    annotation(Library="ModelicaExternalC");
+  end writeText;
+
   model M
     parameter Real u[3] = {1.5, -2, 4};
     parameter Integer k = 3;
@@ -66,6 +73,18 @@ package ForeignLib "External C functions whose sources the library ships (tests)
   model RunTime
     Real y = root(time);
   end RunTime;
+
+  model Sampled "stats of the four samples of time before each sample, at each sample"
+    Real buf[4](each start = 0, each fixed = true);
+    Real total(start = 0, fixed = true);
+    Real scaled[4](each start = 0, each fixed = true);
+    Integer count(start = 0, fixed = true);
+  algorithm
+    when sample(0.1, 0.1) then
+      (total, scaled, count) := stats(buf, 2, false);
+      buf := {buf[2], buf[3], buf[4], time};
+    end when;
+  end Sampled;
 
   model Missing
     Real y = missing(1);
