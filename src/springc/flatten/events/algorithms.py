@@ -58,6 +58,7 @@ from .when_statements import (
     WhenParts,
     check_nesting,
     check_place,
+    reads_before_assignment,
     terminate_of,
     when_statement,
 )
@@ -90,6 +91,9 @@ class _Run:
         self.broken: x.Expr = FALSE
         self.body: tuple[s.Statement, ...] = ()  # the section's statements
         self.starts: dict[str, x.Const] | None = None  # see while_condition
+        # each when statement's index in the flattener's list and the names when
+        # statements had assigned before it (reads_before_assignment)
+        self.whens: list[tuple[int, frozenset[str]]] = []
 
     def read(self, value: a.Value, span: Span) -> a.Value:
         if is_string(value):
@@ -325,6 +329,7 @@ class _Run:
                 self.parts.pop()
                 self.env, self.spans = before, spans
 
+        self.whens.append((len(self.fl.whens), frozenset(self.held)))
         self.fl.whens.append(when_statement(
             self.ev, stmt, where, self.env, self.held,
             lambda v, span: self.read(cast(a.Value, v), span), branch, self.owner.prefix))
@@ -426,6 +431,10 @@ def algorithm_section(fl: FlattenContext, section: s.AlgorithmSection, where: Sc
         run.run(section.body, where, None)
     except Jumped as jumped:
         raise stray(jumped) from None
+    for index, before in run.whens:
+        later = run.held - before
+        if later:
+            fl.whens[index] = reads_before_assignment(fl.whens[index], later)
     origin = flat.Origin("algorithm", owner.prefix)
     for name, value in run.env.items():
         target.append(flat.Equation(x.Var(name), value, run.spans[name], origin))

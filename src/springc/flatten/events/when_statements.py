@@ -15,7 +15,7 @@ the simulation, in an initial algorithm (or in a function: :mod:`.functions`).
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ...errors import FlattenError, Span
 from ...ir import expr as x
@@ -118,3 +118,28 @@ def check_nesting(body: tuple[s.Statement, ...], initial: bool,
             for _, branch in stmt.branches:
                 check_nesting(branch, initial, context)
             check_nesting(stmt.otherwise, initial, context)
+
+
+def reads_before_assignment(when: w.When, names: set[str]) -> w.When:
+    """``when`` with its assignments' reads of ``names`` as ``pre(name)``: the
+    variables when statements of the section assign that had not been assigned where
+    this one runs. An algorithm runs in order and such a variable still holds its
+    value from before the event there (11.1.2: a discrete variable starts from its
+    ``pre`` value), while the when-equation ``v = name`` would read its new value."""
+    memo: dict[int, x.Expr] = {}
+
+    def held(e: x.Expr) -> x.Expr:
+        if isinstance(e, x.Var):
+            return x.Call("pre", (e,)) if e.name in names else e
+        if isinstance(e, x.Call) and e.name in ("pre", "edge", "change"):
+            return e
+        found = memo.get(id(e))
+        if found is None:
+            found = memo[id(e)] = x.map_children(e, held)
+        return found
+
+    branches = tuple(
+        replace(b, assignments=tuple(replace(a, value=held(a.value))
+                                     for a in b.assignments))
+        for b in when.branches)
+    return replace(when, branches=branches)
