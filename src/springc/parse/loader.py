@@ -106,6 +106,10 @@ class ClassTree:
         self.parsed_paths: list[Path] = []
         self._loose_done: set[Path] = set()
         self._missing: set[tuple[ClassEntry, str]] = set()
+        #: What :func:`member_class` found (a class declared or inherited, or none),
+        #: until a class is added to the tree: a warm ``check`` of a MultiBody example
+        #: asks 400,000 such lookups, most of them the same.
+        self.members: dict[tuple[ClassEntry, str], ClassEntry | None] = {}
         #: Diagnostics that are not errors (a top-level class hiding another one).
         self.notes: list[str] = []
         #: What this load asked the file system, with the answers (a cache checks them).
@@ -116,6 +120,7 @@ class ClassTree:
         """Insert a file's classes; user files (``override``) clash with each other only.
         ``folder`` is the package folder of a ``package.mo`` file."""
         self.files.append(stored)
+        self.members.clear()
         errors: list[SpringcError] = []
         package = self.root
         if stored.within:
@@ -254,6 +259,21 @@ def member_class(entry: ClassEntry, name: str,
                  active: frozenset[tuple[ClassEntry, str]] = frozenset()) -> ClassEntry | None:
     """A class named ``name`` declared in ``entry`` or inherited by it. ``active``: the
     (class, name) lookups in progress, to stop a lookup that would need itself."""
+    key = (entry, name)
+    root = entry
+    while root.parent is not None:
+        root = root.parent
+    tree = root.tree
+    if tree is not None and key in tree.members:  # (never one in progress: not known yet)
+        return tree.members[key]
+    found = _member_class(entry, name, active)
+    if tree is not None:
+        tree.members[key] = found
+    return found
+
+
+def _member_class(entry: ClassEntry, name: str,
+                  active: frozenset[tuple[ClassEntry, str]]) -> ClassEntry | None:
     found = entry.child(name)
     if found is not None:
         return found
