@@ -1,8 +1,8 @@
 """CompileOptions -> CompiledModel: the cache lookup, and the compiled model itself.
 
-Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
-could be loaded, the model name, the options and springc's own code; verified by a
-recorded hash before import). A warm hit imports the module without flattening
+Generated modules are cached (see :mod:`.cache`: keyed by the options, springc's own
+code and what the compile read, checked again on each use; verified by a recorded hash
+before import). A warm hit imports the module without flattening
 anything, and without importing the compile path (:mod:`.derive`: the parser, the
 flattener, unit checks and simplify; :mod:`.generation`: codegen's generator), which
 loads only on a miss. What a run needs beyond the module is captured at compile time
