@@ -28,9 +28,9 @@ FORBIDDEN = ("lark", "springc.flatten", "springc.units", "springc.simplify",
              "springc.pipeline.generation", "scipy.sparse", "sympy", "matplotlib")
 """Packages (with their submodules) that a warm simulate of the seed must not import."""
 
-PARSE_ALLOWED = {"springc.parse", "springc.parse.library"}
-"""Of ``springc.parse``, the face and the library file walk (the cache key reads the
-library folders' files) load; the parser does not."""
+PARSE_ALLOWED = {"springc.parse", "springc.parse.library", "springc.parse.lookups"}
+"""Of ``springc.parse``, the face, the library file walk and the lookups record (the cache
+key asks again what the compile read) load; the parser does not."""
 
 WARM_RUN = """
 import sys

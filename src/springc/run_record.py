@@ -11,8 +11,9 @@ record format. Its **content** (a JSON object, :data:`FORMAT`):
 - ``code``: the stamp of springc's code and C sources (:func:`code_stamp`: moved by any
   change of a module, ``CODEGEN_VERSION`` and the version included);
 - ``files``, ``libraries``, ``inputs``: the model files and library folders of the
-  command, and every file a load of them may read
-  (:func:`springc.parse.key_sources`), each with its SHA-256;
+  command, and what the model's load read (:class:`springc.parse.Lookups`: each file
+  with its SHA-256, each class file found or not found, each listing that decided a
+  name), asked again by :func:`verified`;
 - ``library``: the loop library's path in the model's cache entry and its SHA-256;
 - ``run``: the run as it was resolved: the output grid, parameter vector, start state
   and ``z``, the answer run's solver and tolerances, its companion's (or none), the
@@ -22,10 +23,11 @@ record format. Its **content** (a JSON object, :data:`FORMAT`):
   it may never replace, the verbosity, and what the run printed, to check the replay
   against: the summary line without its time, and the SHA-256 of the CSV text.
 
-Nothing in a record is trusted: :func:`verified` re-reads and re-hashes every input and
-the library, and a record that is missing, unreadable, malformed, of another format or
-for other code is no record. The replay itself is checked against the recorded CSV
-digest and summary before anything is written (:mod:`springc.launcher`).
+Nothing in a record is trusted: :func:`verified` re-reads and re-hashes every input
+(:func:`springc.parse.still_hold`) and the library, and a record that is missing,
+unreadable, malformed, of another format or for other code is no record. The replay
+itself is checked against the recorded CSV digest and summary before anything is
+written (:mod:`springc.launcher`).
 """
 
 from __future__ import annotations
@@ -40,10 +42,10 @@ from pathlib import Path
 from typing import Any, TypeGuard
 
 from .fileio import keep_newest, replace_private
-from .parse import key_sources  # the face and its library walk: no parser, no lark
+from .parse import still_hold  # the face and its lookups: no parser, no lark
 from .resources import PACKAGE_ROOT, CacheUnusable, grammar_path, private_folder, user_cache_dir
 
-FORMAT = 1
+FORMAT = 2
 """The version of the record's layout: a record of another is no record."""
 RECORDS_FOLDER = "runs"
 """The cache folder's subfolder of run records."""
@@ -85,20 +87,6 @@ def code_stamp() -> str:
     found.sort()
     found.append(("grammar", info.st_size, info.st_mtime_ns))
     return hashlib.sha256(repr(found).encode()).hexdigest()
-
-
-def file_digest(path: str | os.PathLike[str]) -> str | None:
-    """The SHA-256 of a file's bytes (hex), None if it cannot be read."""
-    try:
-        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    except OSError:
-        return None
-
-
-def input_digests(files: Sequence[str], libraries: Sequence[str]) -> list[list[str | None]]:
-    """``[path, sha256]`` of every file a load of ``files`` with ``libraries`` may read
-    (resolved paths, in :func:`springc.parse.key_sources`'s order)."""
-    return [[str(p.resolve()), file_digest(p)] for p in key_sources(files, libraries)]
 
 
 def _records(create: bool) -> Path | None:
@@ -163,7 +151,7 @@ def verified(record: Mapping[str, Any]) -> bytes | None:
     files, libraries = record.get("files"), record.get("libraries")
     if not (_strings(files) and _strings(libraries)):
         return None
-    if input_digests(files, libraries) != record.get("inputs"):
+    if not still_hold(record.get("inputs")):
         return None
     library = record.get("library")
     if not (isinstance(library, dict) and isinstance(library.get("path"), str)):

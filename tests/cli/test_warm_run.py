@@ -202,16 +202,30 @@ def test_a_changed_model_file_goes_back_to_the_command_line(folder: Path) -> Non
     assert changed.stderr == again.stderr
 
 
+def first_row(csv_text: str) -> dict[str, str]:
+    header, first = csv_text.splitlines()[:2]
+    return dict(zip(header.split(","), first.split(","), strict=True))
+
+
 def test_a_changed_library_file_or_environment_goes_back_to_the_command_line(
         folder: Path) -> None:
-    cold = command_line(folder, *ARGS, "-L", "lib", "-q")
-    assert springc_run(folder, *ARGS, "-L", "lib", "-q").warm
-    (folder / "lib" / "Extra.mo").write_text("model Extra\n  Real y;\nequation\n"
-                                             "  y = 2;\nend Extra;\n")
-    edited = springc_run(folder, *ARGS, "-L", "lib", "-q")
-    assert not edited.warm and (edited.code, edited.stdout) == (0, cold.stdout)
+    """A library file the model read, edited, sends the run back; one it never read
+    (the seed reads nothing of ``lib``) does not (the record holds what the load read)."""
+    (folder / "U.mo").write_text("model U\n  Extra e;\n  Real z(start = 1);\nequation\n"
+                                 "  der(z) = -e.x * z;\nend U;\n")
+    uses = ("simulate", "U.mo", "--stop", "1", "--interval", "0.5", "-L", "lib", "-q")
+    cold, seed = command_line(folder, *uses), command_line(folder, *ARGS, "-L", "lib", "-q")
+    assert springc_run(folder, *uses).warm and springc_run(folder, *ARGS, "-L", "lib", "-q").warm
+    assert first_row(cold.stdout) == {"time": "0.0", "z": "1.0", "e.x": "1.0"}
+    (folder / "lib" / "Extra.mo").write_text("model Extra\n  Real x;\nequation\n"
+                                             "  x = 2;\nend Extra;\n")
+    edited = springc_run(folder, *uses)
+    assert not edited.warm and edited.code == 0
+    assert first_row(edited.stdout) == {"time": "0.0", "z": "1.0", "e.x": "2.0"}
+    unread = springc_run(folder, *ARGS, "-L", "lib", "-q")
+    assert unread.warm and (unread.code, unread.stdout) == (0, seed.stdout)
     other_env = springc_run(folder, *ARGS, "-L", "lib", "-q", SPRINGC_TEST_FLAG="1")
-    assert not other_env.warm and (other_env.code, other_env.stdout) == (0, cold.stdout)
+    assert not other_env.warm and (other_env.code, other_env.stdout) == (0, seed.stdout)
 
 
 def test_a_tampered_loop_library_is_not_loaded_and_is_built_again(folder: Path) -> None:

@@ -15,9 +15,7 @@ import springc
 from springc.errors import SpringcError, render
 from springc.ir.flat import format_equation, format_flat
 from springc.parse import load
-from springc.parse.library import source_files as library_sources
 from springc.pipeline import flatten_files
-from springc.pipeline.cache import cache_key
 
 
 @pytest.fixture(autouse=True)
@@ -245,22 +243,6 @@ def test_quoted_names_never_name_files(tmp_path: Path) -> None:
         f"{user}:2:3: error: class 'Pkg' has no member class '../Secret'")
 
 
-def test_cache_key_covers_every_library_file(tmp_path: Path) -> None:
-    lib = write(tmp_path / "lib", MECH)
-    user = write(tmp_path, {"m.mo": "model M\n  Mech.Oscillator osc;\nend M;\n"}) / "m.mo"
-    keys = {cache_key(("M", "python"), [str(user)], [str(lib)])}
-    for name, text in [("Mech/package.order", "Oscillator\nParts\n"),
-                       ("Mech/Parts/Spring.mo", MECH["Mech/Parts/Spring.mo"] + "\n"),
-                       ("Mech/Parts/Damper.mo", "within Mech.Parts;\nmodel Damper\nend Damper;\n")]:
-        write(lib, {name: text})
-        keys.add(cache_key(("M", "python"), [str(user)], [str(lib)]))
-    # A named package.mo covers its folder too.
-    package = lib / "Mech" / "package.mo"
-    before = cache_key(("M", "python"), [str(package)], [])
-    write(lib, {"Mech/Parts/Mass.mo": MECH["Mech/Parts/Mass.mo"] + "\n"})
-    assert len(keys) == 4 and cache_key(("M", "python"), [str(package)], []) != before
-
-
 def test_an_older_style_mdl_file_may_hold_several_classes(tmp_path: Path) -> None:
     lib = write(tmp_path / "lib", {
         "Parts.mdl": "package Parts\n  model A\n    Real a = 1;\n  end A;\nend Parts;\n"
@@ -277,8 +259,6 @@ def test_a_symbolic_link_back_to_a_parent_folder_is_walked_once(tmp_path: Path) 
     user = write(tmp_path, {"m.mo": "model M\n  Parts.A a;\nend M;\n"}) / "m.mo"
     assert [format_equation(e) for e in flatten_files([user], None, [lib]).equations] == [
         "'a.a' = 1;"]
-    assert cache_key(("M", "python"), [str(user)], [lib]) == cache_key(
-        ("M", "python"), [str(user)], [lib])
 
 
 def test_an_mdl_file_in_a_folder_that_is_not_a_package_is_not_read(tmp_path: Path) -> None:
@@ -293,12 +273,13 @@ def test_an_mdl_file_in_a_folder_that_is_not_a_package_is_not_read(tmp_path: Pat
     with pytest.raises(SpringcError) as exc:
         flatten_files([user], None, [lib])
     assert error_text(exc).splitlines()[0] == f"{user}:3:12: error: undefined name 'Evil'"
-    assert not any("junk" in str(p) for p in library_sources(lib))
 
 
-def test_an_unreadable_library_tree_is_skipped_by_the_cache_key(tmp_path: Path) -> None:
+def test_a_library_tree_deeper_than_a_path_may_be_is_cached_by_what_was_read(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A package tree deeper than the longest path the system accepts: loading never
-    reaches its bottom, and the cache key skips what it cannot read."""
+    reaches its bottom, and the cache key (what the load read) never walks it."""
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
     lib = tmp_path / "lib"
     lib.mkdir()
     name = "P" * 100
@@ -312,9 +293,9 @@ def test_an_unreadable_library_tree_is_skipped_by_the_cache_key(tmp_path: Path) 
         fds.append(fd)
     try:
         user = write(tmp_path, {"m.mo": "model M\n  Real x = 1;\nend M;\n"}) / "m.mo"
-        first = cache_key(("M", "python"), [str(user)], [lib])
-        assert cache_key(("M", "python"), [str(user)], [lib]) == first
-        assert 30 < len(library_sources(lib)) < 45  # those within PATH_MAX
+        first = springc.compile_model(str(user), libraries=[str(lib)], backend="python")
+        again = springc.compile_model(str(user), libraries=[str(lib)], backend="python")
+        assert (first.cached, again.cached, again.path) == (False, True, first.path)
     finally:
         for fd, parent in zip(fds[:0:-1], fds[-2::-1], strict=True):
             os.unlink("package.mo", dir_fd=fd)

@@ -224,9 +224,9 @@ def test_cache_key_follows_the_text_of_codegen_modules(tmp_path: Path) -> None:
     for name in ("grammar", "models"):  # resources.resource_dir finds them here
         if not (copy / name).exists():
             os.symlink(PACKAGE_ROOT.parents[1] / name, tmp_path / name)
-    script = ("from springc.pipeline.cache import cache_key\n"
+    script = ("from springc.pipeline.cache import request_key\n"
               "import springc\n"
-              "print(springc.__file__, cache_key(('M', 'python'), [], []))\n")
+              "print(springc.__file__, request_key(('M', 'python'), [], []))\n")
 
     def key() -> str:
         env = {**os.environ, "PYTHONPATH": str(tmp_path / "src"),

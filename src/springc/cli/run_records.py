@@ -65,8 +65,9 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
     )
 
     stats, module = result.stats, compiled.module
-    if (compiled.warnings or stats.warning or result.events or settings.event_rows
-            or stats.solver not in LOOP_SOLVERS or not ran_on_c_loop(compiled, result)
+    if (compiled.lookups is None or compiled.warnings or stats.warning or result.events
+            or settings.event_rows or stats.solver not in LOOP_SOLVERS
+            or not ran_on_c_loop(compiled, result)
             or (stats.solver in IMPLICIT_SOLVERS and stats.reason)
             or getattr(module, "KIND", None) != ModuleKind.CONTINUOUS
             or getattr(module, "ASSERTIONS", ()) or stats.rtol is None
@@ -88,7 +89,7 @@ def record_content(compiled: Any, settings: Any, result: Any, files: Sequence[st
     return {
         "code": run_record.code_stamp(),
         "files": list(files), "libraries": list(libraries),
-        "inputs": run_record.input_digests(files, libraries),
+        "inputs": compiled.lookups,
         "library": {"path": str(entry / LIBRARY_FILE),
                     "sha256": hashlib.sha256(data).hexdigest()},
         "run": {"model": result.model, "grid": grid, "p": asked.p.tolist(),

@@ -1,15 +1,17 @@
 """Parse: Modelica text -> ``ir.syntax``; files and library folders -> ``ClassTree``.
 
-The library path and its file walk (:mod:`.library`, which parses nothing) load with
-the package; the parser (lark) and the class tree load on first use (PEP 562), so that
-the cache key of a cached model is computed without importing lark.
+The library path and its file walk (:mod:`.library`, which parses nothing) and the
+record of what a load read (:mod:`.lookups`) load with the package; the parser (lark)
+and the class tree load on first use (PEP 562), so that the cache key of a cached
+model is checked without importing lark.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from .library import key_sources, library_folders, library_roots, source_files
+from .library import library_folders, library_roots
+from .lookups import Lookups, still_hold
 
 if TYPE_CHECKING:
     from .loader import ClassEntry, ClassTree, imported_element, lookup_class, member_class
@@ -17,10 +19,10 @@ if TYPE_CHECKING:
     from .parser import parse_expression, parse_file, parse_text
     from .user_sources import load
 
-__all__ = ["ClassEntry", "ClassTree", "clear_parse_cache", "imported_element",
-           "key_sources", "library_folders", "library_roots",
+__all__ = ["ClassEntry", "ClassTree", "Lookups", "clear_parse_cache", "imported_element",
+           "library_folders", "library_roots",
            "load", "lookup_class", "member_class", "parse_expression", "parse_file", "parse_text",
-           "source_files"]
+           "still_hold"]
 
 
 def __getattr__(name: str) -> Any:

@@ -20,7 +20,6 @@ from pathlib import Path
 from ..resources import models_dir
 
 SUFFIXES = (".mo", ".mdl")
-C_FOLDERS = (("Resources", "C-Sources"), ("Resources", "Include"))
 PACKAGE_FILES = tuple(f"package{suffix}" for suffix in SUFFIXES)
 ORDER_FILE = "package.order"
 
@@ -116,63 +115,6 @@ def loose_files(root: Path) -> list[Path]:
     package is not part of the library, and ``.mo`` files are found by their names only,
     as the specification says."""
     return [p for p in _entries(root) if p.suffix == ".mdl" and _is_file(p)]
-
-
-def source_files(folder: Path) -> list[Path]:
-    """Every file loading may read below the root or package folder ``folder`` (``.mo``,
-    ``.mdl``, ``package.order`` in it and, recursively, in its subfolders that are
-    packages; the C files of a package's external functions, :func:`_c_files`), sorted:
-    what a cache key must cover. Folders that cannot be read (gone,
-    a path too long, no permission) are skipped: loading cannot read them either."""
-    found: list[Path] = []
-    pending = [folder]
-    visited: set[Path] = set()
-    while pending:
-        current = pending.pop()
-        try:
-            real = current.resolve()
-        except (OSError, RuntimeError):
-            continue
-        if real in visited:  # a symbolic link back to a parent folder
-            continue
-        visited.add(real)
-        found += _c_files(current)
-        for child in _entries(current):
-            if child.suffix in SUFFIXES or child.name == ORDER_FILE:
-                if _is_file(child):
-                    found.append(child)
-            elif _FILE_NAME.match(child.name) and _is_package_folder(child):
-                pending.append(child)
-    return sorted(found)
-
-
-def _c_files(folder: Path) -> list[Path]:
-    """The C files of a package's ``Resources/C-Sources`` (and its subfolders) and
-    ``Resources/Include``: a library's external functions are compiled from them."""
-    found: list[Path] = []
-    for sub in C_FOLDERS:
-        pending = [folder.joinpath(*sub)]
-        while pending:
-            current = pending.pop()
-            for child in _entries(current):
-                if child.suffix in (".c", ".h") and _is_file(child):
-                    found.append(child)
-                elif child.is_dir() and not child.is_symlink():
-                    pending.append(child)
-    return found
-
-
-def key_sources(files: Iterable[str], libraries: Iterable[str]) -> list[Path]:
-    """Every file a load of ``files`` with the library folders ``libraries`` may read,
-    in a fixed order: the files, then the :func:`source_files` of the folders of named
-    ``package.mo`` files and of the library path (:func:`library_folders`). What a
-    cache key must cover: the generated modules' and the run records'."""
-    named = [Path(f) for f in files]
-    folders = [p.parent for p in named if p.name in ("package.mo", "package.mdl")]
-    sources = list(named)
-    for folder in folders + library_folders(libraries):
-        sources += source_files(folder)
-    return sources
 
 
 def _entries(folder: Path) -> list[Path]:

@@ -25,14 +25,8 @@ from ..errors import (
     close_names,
 )
 from ..ir import syntax as s
-from .library import (
-    LibraryRoot,
-    class_file,
-    is_package_file,
-    loose_files,
-    package_order,
-    stored_names,
-)
+from .library import LibraryRoot, is_package_file
+from .lookups import Lookups
 from .parse_cache import parse_cached
 
 
@@ -54,10 +48,11 @@ class ClassEntry:
         folder in ``package.order`` order, then the other loaded classes, then the other
         files and folders of the package (sorted)."""
         names = list(self.classes)
-        if self.folder is None:
+        if self.folder is None or self.tree is None:
             return names
-        stored = stored_names(self.folder)
-        ordered = [n for n in package_order(self.folder) if n in names or n in stored]
+        stored = self.tree.lookups.stored_names(self.folder)
+        ordered = [n for n in self.tree.lookups.package_order(self.folder)
+                   if n in names or n in stored]
         return list(dict.fromkeys(ordered + names + stored))
 
     def child(self, name: str) -> ClassEntry | None:
@@ -111,14 +106,21 @@ class ClassTree:
         self.parsed_paths: list[Path] = []
         self._loose_done: set[Path] = set()
         self._missing: set[tuple[ClassEntry, str]] = set()
+        #: What :func:`member_class` found (a class declared or inherited, or none),
+        #: until a class is added to the tree: a warm ``check`` of a MultiBody example
+        #: asks 400,000 such lookups, most of them the same.
+        self.members: dict[tuple[ClassEntry, str], ClassEntry | None] = {}
         #: Diagnostics that are not errors (a top-level class hiding another one).
         self.notes: list[str] = []
+        #: What this load asked the file system, with the answers (a cache checks them).
+        self.lookups = Lookups()
 
     def add(self, stored: s.StoredDefinition, override: bool,
             folder: Path | None = None) -> list[SpringcError]:
         """Insert a file's classes; user files (``override``) clash with each other only.
         ``folder`` is the package folder of a ``package.mo`` file."""
         self.files.append(stored)
+        self.members.clear()
         errors: list[SpringcError] = []
         package = self.root
         if stored.within:
@@ -159,12 +161,12 @@ class ClassTree:
             if name in PREDEFINED_TYPES:
                 return None
             for root in self.roots:
-                path = class_file(root.folder, name)
+                path = self.lookups.class_file(root.folder, name)
                 if path is not None:
                     self._load_library_file(path, (), name)
                 elif root.folder not in self._loose_done:
                     self._loose_done.add(root.folder)
-                    for loose in loose_files(root.folder):
+                    for loose in self.lookups.loose_files(root.folder):
                         self._load_library_file(loose, None, None)
                 if name in self.root.classes:
                     found = self.root.classes[name]
@@ -173,7 +175,7 @@ class ClassTree:
             return None
         if package.folder is None:
             return None
-        path = class_file(package.folder, name)
+        path = self.lookups.class_file(package.folder, name)
         if path is None:
             return None
         self._load_library_file(path, tuple(package.full_name.split(".")), name)
@@ -184,7 +186,7 @@ class ClassTree:
         (taken from ``taken``): the library path's order hides it."""
         name, first = found.defn.name, found.defn.span.file
         for root in self.roots[self.roots.index(taken) + 1:]:
-            other = class_file(root.folder, name)
+            other = self.lookups.class_file(root.folder, name)
             if other is not None and Path(first).resolve() != other.resolve():
                 self.notes.append(f"note: the top-level class '{name}' is taken from "
                                   f"{first}; it hides {other} ({root.describe()})")
@@ -193,9 +195,11 @@ class ClassTree:
                            name: str | None) -> None:
         """Parse and place a library file; ``within`` (unless ``None``) is the package
         its place in the folders implies and ``name`` the class it must hold."""
-        if path.resolve() in self.parsed_paths:
+        resolved = self.lookups.read(path)  # (its bytes' hash taken before the parse)
+        real = Path(resolved) if resolved is not None else path.resolve()
+        if real in self.parsed_paths:
             return
-        self.parsed_paths.append(path.resolve())
+        self.parsed_paths.append(real)
         stored = parse_cached(path)
         span = stored.classes[0].span if stored.classes else Span(str(path), 1, 1, 1, 1)
         if within is not None and (stored.within or ()) != within:
@@ -255,6 +259,21 @@ def member_class(entry: ClassEntry, name: str,
                  active: frozenset[tuple[ClassEntry, str]] = frozenset()) -> ClassEntry | None:
     """A class named ``name`` declared in ``entry`` or inherited by it. ``active``: the
     (class, name) lookups in progress, to stop a lookup that would need itself."""
+    key = (entry, name)
+    root = entry
+    while root.parent is not None:
+        root = root.parent
+    tree = root.tree
+    if tree is not None and key in tree.members:  # (never one in progress: not known yet)
+        return tree.members[key]
+    found = _member_class(entry, name, active)
+    if tree is not None:
+        tree.members[key] = found
+    return found
+
+
+def _member_class(entry: ClassEntry, name: str,
+                  active: frozenset[tuple[ClassEntry, str]]) -> ClassEntry | None:
     found = entry.child(name)
     if found is not None:
         return found

@@ -26,17 +26,20 @@ def load(files: Sequence[str | Path], libraries: Iterable[str | Path] = (),
     """
     errors: list[SpringcError] = []
     roots = library_roots(libraries)
+    tree = ClassTree()
     for root in roots:
-        if not root.folder.is_dir() and root.origin != "MODELICAPATH":
+        if not tree.lookups.is_dir(root.folder) and root.origin != "MODELICAPATH":
             errors.append(LoadError(f"library folder '{root.folder}' does not exist",
                                     hint="check the -L option and SPRINGC_PATH"))
-    tree = ClassTree([r for r in roots if r.folder.is_dir()])
+    tree.roots = [r for r in roots if tree.lookups.is_dir(r.folder)]
     parsed: list[tuple[s.StoredDefinition, Path | None]] = []
     for name in files:
         path = Path(name)
-        if path.resolve() in tree.parsed_paths:
+        resolved = tree.lookups.read(path)  # (its bytes' hash taken before the parse)
+        real = Path(resolved) if resolved is not None else path.resolve()
+        if real in tree.parsed_paths:
             continue
-        tree.parsed_paths.append(path.resolve())
+        tree.parsed_paths.append(real)
         try:
             parsed.append((parse_cached(path), path))
         except ErrorGroup as group:

@@ -5,8 +5,16 @@ Entries live in ``$SPRINGC_CACHE_DIR``, else ``$XDG_CACHE_HOME/springc``, else
 SHA-256 of the module recorded when it was written, and for a model whose runs need more
 than the module (an initial problem, dynamic state selection) ``system.pickle`` with
 ``system.sha256``, read only after its hash matched, as the module is. A module's key is
-that of the model (:func:`cache_key`) combined with the observed variables it computes
-(:func:`selection_key`); the model's key also names an entry holding ``names.json``
+that of the model combined with the observed variables it computes (:func:`selection_key`).
+The model's key (:func:`model_key_for`) is made of what the compile was asked
+(:func:`request_key`: options, files and library path as named, springc's code) and of
+what loading read to answer it: the lookups record (``parse.Lookups``: each file read
+with its SHA-256, each class file found or not found, each listing that decided a
+name), kept in the request's own entry (:data:`LOOKUPS_FILE`). A compile checks that
+record again (:func:`read_lookups`: the files it names hashed again, the lookups asked
+again), so that it reads only the files the model used, not every file of the library
+path; any edit of one of them, or a new file that a lookup would now find, misses. The
+model's key also names an entry holding ``names.json``
 (with ``names.sha256``), its states and observed variables, so that a new ``--vars`` is
 resolved to those variables without flattening the model again. The cache folder is
 private (created 0700, whatever the umask; a shared sticky folder is used through a
@@ -36,7 +44,7 @@ from typing import cast
 
 from ..codegen import CODEGEN_VERSION, MODULE_NAMES, GeneratedModule
 from ..fileio import replace_private
-from ..parse import key_sources
+from ..parse import library_folders, still_hold
 from ..resources import PACKAGE_ROOT, CacheUnusable, grammar_path, user_cache_dir
 
 CACHE_ENTRIES = 200
@@ -46,6 +54,9 @@ MODULE_FILE = "model.py"
 HASH_FILE = "model.sha256"
 NAMES_FILE = "names.json"
 """The record of a model's output names (states, observed), in an entry of its own."""
+LOOKUPS_FILE = "lookups.json"
+"""What the last compile of a request read (``parse.Lookups.record``), in the request's
+entry of its own (:func:`request_key`), with its hash record."""
 SYSTEM_FILE = "system.pickle"
 """What a run needs beyond the module (:class:`springc.pipeline.closed.RunSystem`), next
 to ``model.py`` in a module's entry when the model has one, with its hash record."""
@@ -76,7 +87,7 @@ def prune_cache(folder: Path, keep: str, limit: int | None = None) -> list[Path]
     (a key's name, holding the file and its hash record) are counted or removed."""
     limit = CACHE_ENTRIES if limit is None else limit
     removed = []
-    for name in (MODULE_FILE, NAMES_FILE):
+    for name in (MODULE_FILE, NAMES_FILE, LOOKUPS_FILE):
         entries = []
         for entry in folder.iterdir() if folder.is_dir() else ():
             if not _is_key(entry.name) or not (entry / _hash_file(name)).is_file():
@@ -115,21 +126,51 @@ def selection_key(model_key: str, observed: object) -> str:
     return hashlib.sha256(repr((model_key, observed)).encode()).hexdigest()[:24]
 
 
-def cache_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
-    """A digest of everything a generated module depends on: ``settings`` (by ``repr``:
-    model, backend, outputs, modifications), the text of ``files``, of every file loading
-    may read below the library folders and the folders of named ``package.mo`` files
-    (``.mo``, ``.mdl``, ``package.order``), and springc's own code."""
+def request_key(settings: object, files: Sequence[str], libraries: Sequence[str]) -> str:
+    """A digest of what a compile is asked, before any file is read: ``settings`` (by
+    ``repr``: model, backend, outputs, modifications), the files as named, the library
+    path (``-L``, ``SPRINGC_PATH``, ``MODELICAPATH``, the bundled models) and springc's
+    own code. Its entry holds the lookups record of the last compile (:data:`LOOKUPS_FILE`),
+    whose answers, checked again, complete the model's key (:func:`model_key_for`)."""
     h = hashlib.sha256()
-    h.update(repr((CODEGEN_VERSION, settings)).encode())
+    h.update(repr((CODEGEN_VERSION, settings, tuple(files), tuple(libraries),
+                   [str(p) for p in library_folders(libraries)])).encode())
     h.update(springc_digest())
-    for path in key_sources(files, libraries):
-        h.update(str(path.resolve()).encode() + b"\0")
-        try:
-            h.update(hashlib.sha256(path.read_bytes()).digest())
-        except OSError:
-            h.update(b"missing")
     return h.hexdigest()[:24]
+
+
+def model_key_for(request: str, lookups: Mapping[str, object]) -> str:
+    """The key of a model: its :func:`request_key` and what loading read for it (the
+    lookups record, ``parse.Lookups.record``: every file with its SHA-256, every class
+    file found or not found, every folder listing that decided a name)."""
+    text = json.dumps(lookups, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(f"{request}\0{text}".encode()).hexdigest()[:24]
+
+
+def read_lookups(folder: Path | None, request: str) -> dict[str, object] | None:
+    """The lookups record of the last compile of ``request`` if its hash matches its
+    record and the file system still answers every question of it as then (a file read
+    changed, or a file added that lookup would find first: None); None without one."""
+    data = read_addition(folder / request, LOOKUPS_FILE) if folder is not None else None
+    if data is None:
+        return None
+    try:
+        record = json.loads(data)
+    except ValueError:
+        return None
+    return record if still_hold(record) else None
+
+
+def write_lookups(folder: Path | None, request: str, lookups: Mapping[str, object]) -> None:
+    """Keep the lookups record of a compile of ``request`` (replacing the last one);
+    silently nothing where the cache cannot hold it."""
+    if folder is None:
+        return
+    with contextlib.suppress(OSError):
+        with contextlib.suppress(FileExistsError):
+            (folder / request).mkdir(mode=0o700)
+        add_to_entry(folder / request, LOOKUPS_FILE,
+                     json.dumps(lookups, separators=(",", ":")).encode("utf-8"))
 
 
 # ------------------------------------------------------------------ entries

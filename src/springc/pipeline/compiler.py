@@ -1,8 +1,8 @@
 """CompileOptions -> CompiledModel: the cache lookup, and the compiled model itself.
 
-Generated modules are cached (see :mod:`.cache`: keyed by the text of every file that
-could be loaded, the model name, the options and springc's own code; verified by a
-recorded hash before import). A warm hit imports the module without flattening
+Generated modules are cached (see :mod:`.cache`: keyed by the options, springc's own
+code and what the compile read, checked again on each use; verified by a recorded hash
+before import). A warm hit imports the module without flattening
 anything, and without importing the compile path (:mod:`.derive`: the parser, the
 flattener, unit checks and simplify; :mod:`.generation`: codegen's generator), which
 loads only on a miss. What a run needs beyond the module is captured at compile time
@@ -25,6 +25,7 @@ from ..collector import collector_paused
 from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
 from ..ir.expr import recursion_room
 from ..native.foreign_calls import RunTimeCallRefused
+from ..parse import still_hold
 from ..resources import CacheUnusable, private_folder
 from ..status_line import say
 from .apart import deriving
@@ -32,16 +33,19 @@ from .cache import (
     MODULE_FILE,
     SYSTEM_FILE,
     cache_dir,
-    cache_key,
     discard,
     import_module,
+    model_key_for,
     note,
     prune_cache,
     read_entry,
+    read_lookups,
     read_names,
+    request_key,
     selection_key,
     touch,
     write_entry,
+    write_lookups,
     write_names,
 )
 from .closed import (
@@ -89,19 +93,23 @@ class CompiledModel:
     # from it (api), and a python module's C model (c_build.c_source) is printed from
     # it rather than derived again; :meth:`settled` lets it go where neither follows.
     compiled_from: Derived | None = field(default=None, repr=False)
+    # what loading read when it was compiled (``parse.Lookups.record``), checked again
+    # before its files are read for it (:meth:`check_files`)
+    lookups: dict[str, Any] | None = field(default=None, repr=False)
 
     def __getstate__(self) -> dict[str, object]:
         return {"text": self.source, "name": getattr(self.module, "__name__", ""),
                 "options": self.options, "cached": self.cached,
                 "compile_time": self.compile_time, "outputs": self.outputs,
-                "run_system": self.run_system, "model_key": self.model_key}
+                "run_system": self.run_system, "model_key": self.model_key,
+                "lookups": self.lookups}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         imported = import_text(state["text"], state["name"])
         self.__init__(imported.module, state["options"], imported.path,  # type: ignore[misc]
                       state["cached"], state["compile_time"], state["outputs"],
                       imported.temporary, state["text"], None, state["run_system"],
-                      state["model_key"])
+                      state["model_key"], lookups=state.get("lookups"))
 
     def settled(self) -> CompiledModel:
         """This model, keeping the system it was generated from only where its C model
@@ -210,8 +218,9 @@ class CompiledModel:
 
     def check_files(self, consequence: str, hint: str) -> None:
         """Refuse to read this model's files again (for what a run never needs: its
-        equations, a new structural value) when they changed since it was compiled."""
-        if self.model_key and model_key_of(self.options) != self.model_key:
+        equations, a new structural value) when they changed since it was compiled
+        (what its load read, :attr:`lookups`, is no longer what a load would read)."""
+        if self.lookups is not None and not still_hold(self.lookups):
             raise SimulationError(f"the files of {self.name} changed since it was "
                                   f"compiled: {consequence}", hint=hint)
 
@@ -283,18 +292,24 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
             folder = private_folder(cache_dir())
         except CacheUnusable as err:
             note(f"cannot use the cache folder: {err}; compiling in a temporary folder")
-    model_key = model_key_of(options)
+    request = request_key_of(options)
+    lookups = derived.lookups if derived is not None else None
+    if lookups is None:
+        lookups = read_lookups(folder, request)  # checked again: still what it read
+    if lookups is None:  # not compiled, or its files changed: derive (and record)
+        derived = _derive_now(options, folder)
+        lookups = derived.lookups or {}
+    if derived is not None:
+        write_lookups(folder, request, lookups)
+    model_key = model_key_for(request, lookups)
     observed: object = ALL_OBSERVED
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
-            if derived is None and folder is not None:
-                deriving()
             from . import generation  # the compile path, loaded on a miss only
 
             if derived is None:
-                say(compiling_note(options, folder))
-                derived = _derive(options)
+                derived = _derive_now(options, folder)
             names = generation.candidate_names(derived)
             write_names(folder, model_key, names)
         observed = selected_observed(names, options.outputs)
@@ -304,15 +319,13 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
         hit = _cached(folder / key, module_name, options, model_key)
         if hit is not None:
             hit.compile_time = time.perf_counter() - began
+            hit.lookups = lookups
             return hit
-        if derived is None:
-            deriving()
     from . import generation  # the compile path, loaded on a miss only
 
     if derived is None:
-        say(compiling_note(options, folder))
-        derived = _derive(options)
-        write_names(folder, model_key, generation.candidate_names(derived))
+        derived = _derive_now(options, folder)
+    write_names(folder, model_key, generation.candidate_names(derived))
     try:
         generated = generation.generate_from(derived, options)
     except RunTimeCallRefused as refused:  # api generates it for python instead
@@ -341,23 +354,29 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
         raise too_deep_for_python(err) from None
     return CompiledModel(module, options, path, False, time.perf_counter() - began,
                          outputs_of(module, options), temporary, generated,
-                         run_system=run, model_key=model_key, compiled_from=derived)
+                         run_system=run, model_key=model_key, compiled_from=derived,
+                         lookups=lookups)
 
 
-def _derive(options: CompileOptions) -> Derived:
-    """The flat model and simplified system of ``options``."""
+def _derive_now(options: CompileOptions, folder: Path | None) -> Derived:
+    """The flat model and simplified system of ``options``, derived now (the compile
+    path: :class:`CacheMiss` under ``cached_only`` where the model is cached)."""
+    if folder is not None:
+        deriving()
     from . import generation  # the compile path, loaded on a miss only
 
+    say(compiling_note(options, folder))
     return generation.derive_system(options)
 
 
-def model_key_of(options: CompileOptions) -> str:
-    """The cache key of the model of ``options`` (the text of its files as they are now,
-    the model, backend and structural values; not the selected outputs)."""
+def request_key_of(options: CompileOptions) -> str:
+    """What a compile of ``options`` is asked (the model, backend, structural values,
+    files and library path as named; not the selected outputs): with what loading read
+    (a lookups record), the model's cache key (:func:`.cache.model_key_for`)."""
     settings: tuple[object, ...] = (options.model, options.backend, options.modifications)
-    if options.texts:  # (the keys of file-only models are unchanged)
+    if options.texts:
         settings += (options.texts,)
-    return cache_key(settings, options.files, options.libraries)
+    return request_key(settings, options.files, options.libraries)
 
 
 def _cached(entry: Path, module_name: str, options: CompileOptions, model_key: str

@@ -45,7 +45,7 @@ def derive_system(options: CompileOptions) -> Derived:
         system = dataclasses.replace(
             system, name=base.name,
             dae=dataclasses.replace(system.dae, experiment=base.experiment, span=base.span))
-    return Derived(system, flat_model, switchable, warnings)
+    return Derived(system, flat_model, switchable, warnings, lookups=tree.lookups.record())
 
 
 def _add_wrapper(tree: ClassTree, entry: ClassEntry,

@@ -40,12 +40,15 @@ class CompileOptions:
 class Derived:
     """The simplified system of a model, its flat model, whether index reduction
     left a choice of states that may turn singular during a run (``switchable``), and
-    the unit mismatches of the flat model; ``parts``: what its generations share
-    (``codegen.CodegenOptions.shared``: a second backend's module reuses the first's
-    backend-independent parts)."""
+    the unit mismatches of the flat model; ``lookups``: what loading read; ``parts``:
+    what its generations share (``codegen.CodegenOptions.shared``: a second backend's
+    module reuses the first's backend-independent parts)."""
 
     system: ode.ODE
     flat_model: flat.FlatModel
     switchable: bool
     warnings: tuple[UnitError, ...] = ()
     parts: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
+    #: what loading asked the file system (``parse.Lookups.record``): the cache key's
+    #: part that a cached compile checks again; None where it is not known
+    lookups: dict[str, Any] | None = field(default=None, compare=False, repr=False)

@@ -97,6 +97,9 @@ def c_sources(entry: ClassEntry, external: s.ExternalCall) -> CSources | list[st
         include_folder = None
     folders = [f for f in (include_folder, resolved("/".join(
         (f"modelica://{top.defn.name}", *SOURCES_FOLDER)), top)) if f is not None]
+    if top.tree is not None:  # what a cached compile's check must look at again
+        for folder in folders:
+            top.tree.lookups.c_sources(folder)
     files: list[Path] = []
     missing: list[str] = []
     root = None
