@@ -123,3 +123,42 @@ def test_an_interrupted_caller_ends_its_child(monkeypatch: pytest.MonkeyPatch) -
     (pid,) = forked
     with pytest.raises(ChildProcessError):  # reaped: no child of that id is left
         os.waitpid(pid, os.WNOHANG)
+
+
+def _compiles(model: springc.pipeline.CompiledModel) -> dict[str, tuple[int, int]]:
+    """(loads from numba's cache, compiles) in this process of each function of
+    ``model``'s numba module that a run hands to the compiled loops."""
+    counts = {}
+    for name in apart.RUN_FUNCTIONS:
+        stats = getattr(model.module, name).stats
+        counts[name] = (sum(stats.cache_hits.values()), sum(stats.cache_misses.values()))
+    return counts
+
+
+def test_the_functions_a_run_compiles_are_compiled_in_a_child(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    decay = tmp_path / "decay.mo"  # with an observed variable, v
+    decay.write_text(MODEL.replace("fixed = true);", "fixed = true);\n  Real v;")
+                     .replace("-k*x;", "v;\n  v = -k*x;"))
+
+    def run(model: springc.pipeline.CompiledModel) -> float:
+        result = springc.simulate(model, stop=1.0, solver="dop853", engine="compiled",
+                                  rtol=1e-10, atol=1e-12)
+        assert result["v"][-1] == pytest.approx(-2 * result["x"][-1], rel=1e-12)
+        return float(result["x"][-1])
+
+    # the reference: a model whose functions this process compiles at the run
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "here"))
+    here = springc.compile_model(str(decay), backend="numba")
+    assert run(here) == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
+    assert _compiles(here) == {"rhs": (0, 1), "jacobian_values": (0, 0), "observed": (0, 1)}
+
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "apart"))
+    model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="numba"))
+    assert model.cached and model.module.BACKEND == "numba"
+    assert apart.functions_apart(model.module, model.path)  # the child compiled them
+    assert run(model) == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
+    # each loaded from numba's cache, none compiled here; the child's compile of
+    # jacobian_values, which this run does not call, stays on disk
+    assert _compiles(model) == {"rhs": (1, 0), "jacobian_values": (0, 0), "observed": (1, 0)}
+    assert not apart.functions_apart(model.module, model.path)  # cached: no child

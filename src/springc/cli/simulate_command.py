@@ -71,7 +71,7 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
     unmapped_large_buffers()
     from ..api import AccuracyWarning, compile_model, default_choice
     from ..api import simulate as run
-    from ..pipeline import CompiledModel, collector_paused, compiled_apart
+    from ..pipeline import CompiledModel, collector_paused, compiled_apart, functions_apart
     from ..simulation import check_trajectory_size, save_outputs, write_csv
 
     level = verbosity()
@@ -91,6 +91,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
             report_units(compiled.warnings, strict_units)
             if not compiled.cached:
                 release_compile_memory()
+        if compiled.cached:  # its numba functions compiled (LLVM) in a child too
+            functions_apart(compiled.module, compiled.path)
         if not patterns and (output or not plot):  # the default trajectory of every output
             check_trajectory_size(compiled, settings,
                                   f"-o {output}" if output else "the CSV on stdout")

@@ -70,10 +70,12 @@ from .hybrid import HybridRun, run_hybrid
 from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
 from .native_ensemble import OPENMP, NativeEnsemble, Outputs, Runs, kernel_text
 from .native_loop import loop_text
+from .signatures import MODEL_FUNCTION_SIGNATURE
 from .status import Status
 
 __all__ = [
     "FIXED_STEP_METHODS",
+    "MODEL_FUNCTION_SIGNATURE",
     "OPENMP",
     "Crossings",
     "Ensemble",

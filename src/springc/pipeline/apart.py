@@ -7,9 +7,14 @@ returns, but their pages stay in Python's partly used arenas (the 50x50 cloth: a
 400 MB more when its run starts than a warm run of the same model). A forked child
 compiles and writes the cache entry, then exits, handing every page back; the caller
 then takes the warm path (the cache entry's module), so a cold run starts from a warm
-run's memory (but for the model's numba functions, which its run compiles). The child
-shares the caller's pages (fork), so the machine holds about the child's resident set
-while it compiles, not the two sets added up.
+run's memory. The child shares the caller's pages (fork), so the machine holds about
+the child's resident set while it compiles, not the two sets added up.
+
+A numba module's functions compile (LLVM) at their first call, into numba's cache
+beside the module: a run of a model whose functions numba has not cached would hold
+that compile's memory on top of its own. :func:`functions_apart` compiles them in a
+forked child from the loaded module (its pages shared), the child writing numba's cache
+and exiting; the caller's run then loads them from numba's cache, as a warm run does.
 
 Where the model is in the cache, nothing is forked: the caller's compile runs with
 :func:`cached_only`, which makes the compile path's first step (deriving a system)
@@ -25,11 +30,14 @@ import signal
 import sys
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
+from pathlib import Path
 from typing import TypeVar
 
+from ..codegen import GeneratedModule
 from ..errors import ErrorGroup, SpringcError
-from ..status_line import silenced
+from ..status_line import say, silenced
 from .closed import MODULE_PREFIX
+from .notes import FUNCTIONS_NOTE, functions_cached
 
 T = TypeVar("T")
 
@@ -85,6 +93,43 @@ def compiled_apart(compile: Callable[[], T]) -> T:
         raise error
     with silenced(True) if status == 1 else contextlib.nullcontext():
         return compile()
+
+
+RUN_FUNCTIONS = ("rhs", "jacobian_values", "observed")
+"""The functions of a numba module that a run hands to springc's compiled loops (the
+model function's signature of :data:`springc.integrate.MODEL_FUNCTION_SIGNATURE`):
+compiled by :func:`functions_apart` (``observed`` where the module has observed
+variables: a run calls it only then)."""
+
+
+def functions_apart(module: GeneratedModule, path: Path) -> bool:
+    """Compile the :data:`RUN_FUNCTIONS` of the numba ``module`` imported from the cache
+    entry ``path`` in a forked child, which writes them into numba's cache beside the
+    module and exits, where numba has not cached them (:func:`functions_cached`);
+    whether a child compiled them. The child says the status line of the compile; one
+    that fails leaves the functions to this process's first call (numba compiles them
+    there, as before). Nothing is forked without ``os.fork`` or a stderr with a file
+    descriptor (as :func:`compiled_apart`)."""
+    if (functions_cached(module, path) or not hasattr(os, "fork")
+            or not _real_stream(sys.stderr)):
+        return False
+
+    def compile_functions() -> None:
+        from numba.core.dispatcher import Dispatcher
+
+        from ..integrate import MODEL_FUNCTION_SIGNATURE
+
+        say(FUNCTIONS_NOTE.format(name=module.MODEL))
+        for name in RUN_FUNCTIONS:
+            function = getattr(module, name, None)
+            if name == "observed" and not module.OBSERVED:
+                continue  # a run computes no observed variable
+            if isinstance(function, Dispatcher):  # by its arguments, as a run's first
+                # call from Python compiles it (numba's cache is keyed by the signature)
+                function.compile(MODEL_FUNCTION_SIGNATURE.args)
+
+    status, _ = _child_status(compile_functions)
+    return status == 0
 
 
 def _child_status(compile: Callable[[], object]
