@@ -97,6 +97,22 @@ def test_a_cloth_grid_in_two_level_loops_equals_the_scalar_file(tmp_path: Path) 
     assert "for (int _r = 0; _r < " in source  # rows of the grid, each a run of columns
 
 
+def test_a_group_with_one_member_left_over_from_its_runs_is_indexed_directly(
+        tmp_path: Path) -> None:
+    # the 8x8 cloth's parameters leave one member of a group outside its affine runs:
+    # printed without a loop, its index read from a table at `_q` (no such variable:
+    # the C compiler refused the file, and the 20x20 cloth ran on numba's loop)
+    model = springc.compile_model(SCENES, "Scenes.Cloth", backend="python",
+                                  parameters={"N": 8, "M": 8})
+    source = _compare(tmp_path, model, {"h": 0.12, "k_shear": 150.0})
+    body = source[source.index("springc_parameters(double *p"):]
+    body = body[:body.index("\n}\n")]
+    loops = body.count("for (int _q")
+    assert loops and body.count("_q]") > 0
+    assert all("for (int _q" in line or line.startswith("        ")
+               for line in body.splitlines() if "_q" in line)
+
+
 def test_the_text_of_a_small_grouped_file(tmp_path: Path) -> None:
     model = springc.load_model_from_string(ROW, "Row", backend="python", outputs=["f[2]"])
     derived = model.compiled_from or model.derive()

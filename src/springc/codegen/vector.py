@@ -365,6 +365,8 @@ class VectorLayout:
         n = len(members)
 
         def access(array: str, column: np.ndarray) -> Callable[[str], str]:
+            if self.numba and n == 1:  # no loop around a single member: its own index
+                return lambda q: f"{array}[{int(column[0])}]"
             offset = self._index(column.tolist())
             t = self.table_name
             if self.numba:
