@@ -37,7 +37,8 @@ end M;
 def test_assigning_with_a_run_time_subscript_chooses_each_element(tmp_path: Path) -> None:
     # the MSL's RealFFT: buf[iTick] := u in a when statement; the subscript is read
     # as it stands at the assignment, and the last element is chosen by k == 3 (an
-    # index out of range assigns none); a when statement's relations are literal
+    # index out of range assigns none); a when statement's relations are literal; an
+    # element not chosen keeps its value from before the event, pre (11.1.2)
     path = tmp_path / "m.mo"
     path.write_text("""model M
   Real buf[3](each start = 0, each fixed = true);
@@ -56,11 +57,11 @@ end M;
     equations = {e.name: x.to_text(e.value) for e in when.branches[0].assignments}
     assert equations == {
         "k": "pre(k) + 1",
-        "buf[1]": "noEvent(if pre(k) + 1 == 1 then time else buf[1])",
-        "buf[2]": "noEvent(if pre(k) + 1 == 2 then time else buf[2])",
-        "buf[3]": "noEvent(if pre(k) + 1 == 3 then time else buf[3])",
-        "m[2,1]": "noEvent(if pre(k) + 1 == 1 then -time else m[2,1])",
-        "m[2,2]": "noEvent(if pre(k) + 1 == 2 then -time else m[2,2])"}
+        "buf[1]": "noEvent(if pre(k) + 1 == 1 then time else pre(buf[1]))",
+        "buf[2]": "noEvent(if pre(k) + 1 == 2 then time else pre(buf[2]))",
+        "buf[3]": "noEvent(if pre(k) + 1 == 3 then time else pre(buf[3]))",
+        "m[2,1]": "noEvent(if pre(k) + 1 == 1 then -time else pre(m[2,1]))",
+        "m[2,2]": "noEvent(if pre(k) + 1 == 2 then -time else pre(m[2,2]))"}
 
 
 def test_a_function_assigns_with_a_run_time_subscript(tmp_path: Path) -> None:

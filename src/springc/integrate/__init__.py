@@ -50,6 +50,8 @@ How ``springc.simulate`` uses it (with ``mod`` a generated numba module)::
   returns the wrong length) raise ``ValueError``/``TypeError`` before the loop starts.
 """
 
+from typing import Any
+
 from .batch import Ensemble, ensemble
 from .compile_lock import locked
 from .engine import (
@@ -70,7 +72,6 @@ from .hybrid import HybridRun, run_hybrid
 from .kernels import FIXED_STEP_METHODS, compile_seconds, kernel_cached, load
 from .native_ensemble import OPENMP, NativeEnsemble, Outputs, Runs, kernel_text
 from .native_loop import loop_text
-from .signatures import MODEL_FUNCTION_SIGNATURE
 from .status import Status
 
 __all__ = [
@@ -105,3 +106,13 @@ __all__ = [
     "rk45",
     "run_hybrid",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """``MODEL_FUNCTION_SIGNATURE`` on first use: it is numba's type, and importing
+    this package must not import numba (a warm run on the C loop never does)."""
+    if name == "MODEL_FUNCTION_SIGNATURE":
+        from .signatures import MODEL_FUNCTION_SIGNATURE
+
+        return MODEL_FUNCTION_SIGNATURE
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
