@@ -32,7 +32,13 @@ from ...parse import ClassEntry
 from .. import arrays as a
 from ..scopes import ExpressionEvaluator
 from .library_sources import CSources, inside
-from .run_time_calls import C_TYPES, run_time_argument, run_time_outputs
+from .run_time_calls import (
+    C_TYPES,
+    argument_source,
+    check_output_size,
+    run_time_argument,
+    run_time_outputs,
+)
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 INCLUDE_LINE = re.compile(r'\s*#\s*include\s*("[^"/\\]+(/[^"/\\]+)*"|<[^<>/\\]+(/[^<>/\\]+)*>)\s*'
@@ -183,28 +189,12 @@ def _call_args(external: s.ExternalCall, comps: list[s.Component]) -> tuple[s.Ex
 def _argument(ev: ExpressionEvaluator, entry: ClassEntry, e: s.Expr, names: dict[str, Any],
               declared: dict[str, s.Component], kinds: dict[str, str], call: s.Call) -> _Arg:
     """The C parameter and the value of the external call's argument ``e``."""
-    if isinstance(e, s.Number):
-        kind = "Integer" if isinstance(e.value, int) else "Real"
-        return _Arg(C_TYPES[kind][0], C_TYPES[kind][1](e.value))
-    if isinstance(e, s.Bool):
-        return _Arg("int", ctypes.c_int(int(e.value)))
-    if isinstance(e, s.String):
-        return _Arg("const char *", ctypes.c_char_p(e.value.encode()))
-    if (isinstance(e, s.Call) and e.func.dotted == "size" and len(e.args) == 2
-            and isinstance(e.args[0], s.Ref) and e.args[0].dotted in declared
-            and isinstance(e.args[1], s.Number)):
-        shape = a.shape(names[e.args[0].dotted])
-        if not 1 <= int(e.args[1].value) <= len(shape):
-            raise FlattenError(f"'{e.args[0].dotted}' has no dimension {e.args[1].value}",
-                               e.span)
-        return _Arg("int", ctypes.c_int(shape[int(e.args[1].value) - 1]))
-    name = e.dotted if isinstance(e, s.Ref) and not any(
-        p.subscripts for p in e.parts) else None
-    if name is None or name not in declared:
-        raise FlattenError("springc passes to C only the function's variables, "
-                           "'size(v, k)' and literals", e.span,
-                           [Note(f"in the external clause of '{entry.full_name}'",
-                                 call.span)])
+    source = argument_source(entry, e, names, declared, kinds, call)
+    if source.name is None:
+        if source.kind == "String":
+            return _Arg("const char *", ctypes.c_char_p(source.literal.encode()))
+        return _Arg(C_TYPES[source.kind][0], C_TYPES[source.kind][1](source.literal))
+    name = source.name
     comp, kind, value = declared[name], kinds[name], names[name]
     ctype = C_TYPES[kind][1]
     if comp.causality == "input":
@@ -217,11 +207,7 @@ def _argument(ev: ExpressionEvaluator, entry: ClassEntry, e: s.Expr, names: dict
     if kind == "String":
         raise FlattenError(f"springc does not take String outputs of C functions as "
                            f"arguments ('{name}')", e.span)
-    dims = (*comp.dims, *comp.type_dims)
-    if dims and (not a.is_array(value) or any(isinstance(d, s.Colon) for d in dims)):
-        raise FlattenError(f"the size of '{name}' must be known before the external call "
-                           f"of '{entry.full_name}'", e.span, [Note("declared here",
-                                                                    comp.span)])
+    check_output_size(entry, e, name, comp, value)
     shape = a.shape(value) if a.is_array(value) else ()
     size = math.prod(shape)
     buffer = (ctype * max(size, 1))() if shape else ctype()

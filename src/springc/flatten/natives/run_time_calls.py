@@ -10,7 +10,7 @@ that node. The C parameters follow the same mapping as a call while flattening.
 from __future__ import annotations
 
 import ctypes
-from typing import Any
+from typing import Any, NamedTuple
 
 from ...errors import FlattenError, Note
 from ...ir import expr as x
@@ -29,17 +29,27 @@ RunTimeArg = tuple[str, str, list[x.Expr], str | None]
 expressions it passes, the variable it names (an output's)."""
 
 
-def run_time_argument(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
-                      declared: dict[str, s.Component], kinds: dict[str, str],
-                      call: s.Call) -> RunTimeArg:
-    """The C parameter of the external call's argument ``e`` for a run-time call."""
+class Source(NamedTuple):
+    """What an argument of an external clause passes: a literal or a dimension
+    (``name`` None: ``kind`` and the ``literal`` value) or the function's variable
+    ``name`` (of type ``kind``)."""
+
+    kind: str
+    literal: Any
+    name: str | None
+
+
+def argument_source(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
+                    declared: dict[str, s.Component], kinds: dict[str, str],
+                    call: s.Call) -> Source:
+    """The one reading of what springc passes to C (a call while flattening and a
+    run-time call alike): literals, ``size(v, k)`` and the function's variables."""
     if isinstance(e, s.Number):
-        kind = "Integer" if isinstance(e.value, int) else "Real"
-        return C_TYPES[kind][0], _CODES[kind], [x.Const(e.value)], None
+        return Source("Integer" if isinstance(e.value, int) else "Real", e.value, None)
     if isinstance(e, s.Bool):
-        return "int", "I", [x.Const(int(e.value))], None
+        return Source("Integer", int(e.value), None)
     if isinstance(e, s.String):
-        return "const char *", "S" + e.value.encode().hex(), [], None
+        return Source("String", e.value, None)
     if (isinstance(e, s.Call) and e.func.dotted == "size" and len(e.args) == 2
             and isinstance(e.args[0], s.Ref) and e.args[0].dotted in declared
             and isinstance(e.args[1], s.Number)):
@@ -47,7 +57,7 @@ def run_time_argument(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
         if not 1 <= int(e.args[1].value) <= len(shape):
             raise FlattenError(f"'{e.args[0].dotted}' has no dimension {e.args[1].value}",
                                e.span)
-        return "int", "I", [x.Const(shape[int(e.args[1].value) - 1])], None
+        return Source("Integer", shape[int(e.args[1].value) - 1], None)
     name = e.dotted if isinstance(e, s.Ref) and not any(
         p.subscripts for p in e.parts) else None
     if name is None or name not in declared:
@@ -55,6 +65,30 @@ def run_time_argument(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
                            "'size(v, k)' and literals", e.span,
                            [Note(f"in the external clause of '{entry.full_name}'",
                                  call.span)])
+    return Source(kinds[name], None, name)
+
+
+def check_output_size(entry: ClassEntry, e: s.Expr, name: str, comp: s.Component,
+                      value: Any) -> None:
+    """An output array passed to C has a size known before the call."""
+    dims = (*comp.dims, *comp.type_dims)
+    if dims and (not a.is_array(value) or any(isinstance(d, s.Colon) for d in dims)):
+        raise FlattenError(f"the size of '{name}' must be known before the external call "
+                           f"of '{entry.full_name}'", e.span, [Note("declared here",
+                                                                    comp.span)])
+
+
+def run_time_argument(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
+                      declared: dict[str, s.Component], kinds: dict[str, str],
+                      call: s.Call) -> RunTimeArg:
+    """The C parameter of the external call's argument ``e`` for a run-time call."""
+    source = argument_source(entry, e, names, declared, kinds, call)
+    if source.name is None:
+        if source.kind == "String":
+            return "const char *", "S" + source.literal.encode().hex(), [], None
+        return (C_TYPES[source.kind][0], _CODES[source.kind], [x.Const(source.literal)],
+                None)
+    name = source.name
     comp, kind, value = declared[name], kinds[name], names[name]
     if kind == "String":
         if comp.causality != "input" or not isinstance(value, str):
@@ -67,11 +101,7 @@ def run_time_argument(entry: ClassEntry, e: s.Expr, names: dict[str, Any],
             return c_type, _CODES[kind], [_expr(value)], None
         items = [_expr(v) for v in a.scalars(value)]
         return f"const {c_type} *", f"{_CODES[kind]}{len(items)}", items, None
-    dims = (*comp.dims, *comp.type_dims)
-    if dims and (not a.is_array(value) or any(isinstance(d, s.Colon) for d in dims)):
-        raise FlattenError(f"the size of '{name}' must be known before the external call "
-                           f"of '{entry.full_name}'", e.span, [Note("declared here",
-                                                                    comp.span)])
+    check_output_size(entry, e, name, comp, value)
     size = len(a.scalars(value)) if a.is_array(value) else 0
     code = f"o{_CODES[kind]}{size}" if a.is_array(value) else f"o{_CODES[kind]}"
     return f"{c_type} *", code, [], name
