@@ -24,22 +24,8 @@ NAME = "delay"
 
 def _calls(e: x.Expr, out: dict[x.Call, None]) -> None:
     """The delay calls of ``e`` into ``out``, in :func:`ir.expr.walk`'s order (their
-    slots' order), by one loop without its generator: every expression of the system
-    is searched, and few hold a call."""
-    stack = [e]
-    seen: set[int] = set()
-    while stack:
-        node = stack.pop()
-        kind = type(node)
-        if kind is x.Var or kind is x.Const or id(node) in seen:
-            continue
-        seen.add(id(node))
-        if kind is x.BinOp:
-            stack += (node.left, node.right)  # type: ignore[union-attr]
-            continue
-        if kind is x.Call and node.name == NAME:  # type: ignore[union-attr]
-            out.setdefault(node, None)  # type: ignore[arg-type]
-        stack.extend(x.children(node))
+    slots' order)."""
+    x.calls_named([e], NAME, out)
 
 
 def _replace(e: x.Expr, names: dict[x.Call, x.Var]) -> x.Expr:

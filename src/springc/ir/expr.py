@@ -39,6 +39,7 @@ from .nodes import (
     Time,
     Var,
     add,
+    calls_named,
     children,
     derivatives,
     div,
@@ -58,8 +59,8 @@ from .nodes import (
 __all__ = [
     "FOLD_CHUNK", "INITIAL", "MATH", "MAX_DEPTH", "ONE", "RELATIONS", "TIME", "ZERO",
     "BinOp", "Call", "Const", "Der", "Expr", "If", "Neg", "Not", "NotEvaluable", "Time",
-    "Var", "add", "children", "derivatives", "diff", "div", "evaluate", "fold_chunked",
-    "format_number", "map_children", "mul", "neg", "power", "recursion_limit",
+    "Var", "add", "calls_named", "children", "derivatives", "diff", "div", "evaluate",
+    "fold_chunked", "format_number", "map_children", "mul", "neg", "power", "recursion_limit",
     "recursion_room", "sub", "substitute", "time_derivative", "to_text", "variables",
     "walk",
 ]

@@ -172,6 +172,33 @@ def variables(e: Expr) -> set[str]:
     return out
 
 
+def calls_named(roots: list[Expr], name: str, out: dict[Call, None] | None = None) -> bool:
+    """Whether ``roots`` call the function ``name`` (stopping at the first call), or,
+    with ``out``, every such call added to ``out`` in :func:`walk`'s order (and whether
+    there was one). One loop without :func:`walk`'s generator: the stages ask this of
+    every equation, and few hold a call. A node shared by several parents is visited
+    once."""
+    stack: list[Expr] = list(roots)
+    seen: set[int] = set()
+    found = False
+    while stack:
+        node = stack.pop()
+        kind = type(node)
+        if kind is Var or kind is Const or id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, BinOp):
+            stack += (node.left, node.right)
+            continue
+        if isinstance(node, Call) and node.name == name:
+            if out is None:
+                return True
+            out.setdefault(node, None)
+            found = True
+        stack.extend(children(node))
+    return found
+
+
 def derivatives(e: Expr) -> set[str]:
     """Names ``x`` of all ``der(x)`` in ``e`` whose argument is a plain variable."""
     return {n.arg.name for n in walk(e) if isinstance(n, Der) and isinstance(n.arg, Var)}

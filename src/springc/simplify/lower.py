@@ -72,23 +72,8 @@ def _residual(eq: flat.Equation, varying: Callable[[str], bool]) -> dae.Residual
 
 
 def _reads_pre(eq: flat.Equation) -> bool:
-    """Whether ``eq`` calls ``pre`` (one loop without :func:`ir.expr.walk`'s generator:
-    this runs for every equation, and most hold no call)."""
-    stack: list[x.Expr] = [eq.lhs, eq.rhs]
-    seen: set[int] = set()
-    while stack:
-        node = stack.pop()
-        kind = type(node)
-        if kind is x.Var or kind is x.Const or id(node) in seen:
-            continue
-        seen.add(id(node))
-        if kind is x.BinOp:
-            stack += (node.left, node.right)  # type: ignore[union-attr]
-            continue
-        if kind is x.Call and node.name == "pre":  # type: ignore[union-attr]
-            return True
-        stack.extend(x.children(node))
-    return False
+    """Whether ``eq`` calls ``pre``."""
+    return x.calls_named([eq.lhs, eq.rhs], "pre")
 
 
 def _has_der(e: x.Expr) -> bool:
