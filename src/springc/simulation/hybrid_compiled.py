@@ -118,12 +118,13 @@ def run_compiled_events(loop: EventLoop, solver: str, x0: np.ndarray, rtol: floa
         times = np.concatenate(([t], grid[loop.k:last]))
         if snapped:
             times[-1] = t_event
-        crossings = Crossings(mod.zero_crossings, held_signs(loop)) if loop.ops else None
+        signs = held_signs(loop) if loop.ops else None
+        crossings = None if signs is None or native else Crossings(mod.zero_crossings, signs)
         began = time.perf_counter()
         steps = max(min(ADAPTIVE_CHUNK, limit - loop.steps), 1)
         if native:
             run = event_run(problem, solver, times, x, rtol, atol, first_step,
-                            None if crossings is None else held_signs(loop), t_stop, steps)
+                            signs, t_stop, steps)
         elif adaptive:
             run = adaptive_run(solver, mod, times, x, problem.p, problem.z, rtol=rtol,
                                atol=atol, first_step=first_step, crossings=crossings,
