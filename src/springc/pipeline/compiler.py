@@ -325,7 +325,8 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
 
     if derived is None:
         derived = _derive_now(options, folder)
-    write_names(folder, model_key, generation.candidate_names(derived))
+    if folder is not None and options.outputs is None:  # (with outputs: read or written above)
+        write_names(folder, model_key, generation.candidate_names(derived))
     try:
         generated = generation.generate_from(derived, options)
     except RunTimeCallRefused as refused:  # api generates it for python instead
