@@ -58,6 +58,18 @@ def test_a_changed_file_replaces_its_tree(tmp_path: Path) -> None:
     assert (len(cache), cache.size) == (1, a.stat().st_size)
 
 
+def test_an_edit_that_keeps_the_size_and_the_time_is_seen(tmp_path: Path) -> None:
+    cache = ParseCache(max_bytes=1000)
+    a = tmp_path / "A.mo"
+    a.write_text("model A\n  Real x;\nend A;\n")
+    when = a.stat().st_mtime_ns
+    assert [c.name for c in cache.parse(a).classes[0].elements] == ["x"]
+    a.write_text("model A\n  Real z;\nend A;\n")  # same size, as `cp -p` keeps a time
+    os.utime(a, ns=(when, when))
+    assert [c.name for c in cache.parse(a).classes[0].elements] == ["z"]
+    assert (len(cache), cache.size) == (1, a.stat().st_size)
+
+
 def test_a_file_larger_than_the_cache_is_parsed_and_not_kept(tmp_path: Path) -> None:
     cache = ParseCache(max_bytes=50)
     a = _file(tmp_path, "A", 100)

@@ -24,48 +24,43 @@ Standard Library that one model reaches, many times over)."""
 
 
 class ParseCache:
-    """Syntax trees of files by path, while the file's modification time and size are
-    those it was parsed at; least recently used first out beyond ``max_bytes`` of
-    source text (a single larger file is parsed and not kept)."""
+    """Syntax trees of files by path, while the file holds the bytes it was parsed
+    from (compared whole: a modification time and size can stay the same across an
+    edit); least recently used first out beyond ``max_bytes`` of source text (a single
+    larger file is parsed and not kept)."""
 
     def __init__(self, max_bytes: int = MAX_SOURCE_BYTES,
                  store: ParsedStore | None = None) -> None:
         self.max_bytes = max_bytes
         self.store = store
         self.size = 0  # source bytes of the files kept
-        self._trees: OrderedDict[str, tuple[tuple[int, int], s.StoredDefinition]] = \
-            OrderedDict()
+        self._trees: OrderedDict[str, tuple[bytes, s.StoredDefinition]] = OrderedDict()
 
     def __len__(self) -> int:
         return len(self._trees)
 
     def parse(self, path: Path) -> s.StoredDefinition:
         """The tree of ``path``, parsed again only where the file changed."""
-        try:
-            stat = path.stat()
-        except OSError:
-            return self._read(path)  # the error names the file
-        name, version = str(path), (stat.st_mtime_ns, stat.st_size)
+        name, data = str(path), _read_bytes(path)
         found = self._trees.get(name)
-        if found is not None and found[0] == version:
+        if found is not None and found[0] == data:
             self._trees.move_to_end(name)
             return found[1]
-        stored = self._read(path)
+        stored = self._read(path, data)
         self._forget(name)
-        if stat.st_size <= self.max_bytes:
-            self._trees[name] = (version, stored)
-            self.size += stat.st_size
+        if len(data) <= self.max_bytes:
+            self._trees[name] = (data, stored)
+            self.size += len(data)
             while self.size > self.max_bytes:
                 self._forget(next(iter(self._trees)))
         return stored
 
-    def _read(self, path: Path) -> s.StoredDefinition:
-        """The tree of ``path``: from the store where it holds the file's bytes, else
-        parsed (and stored)."""
+    def _read(self, path: Path, data: bytes) -> s.StoredDefinition:
+        """The tree of ``path`` holding ``data``: from the store where it holds these
+        bytes, else parsed (and stored)."""
         try:
-            data = path.read_bytes()
             text = data.decode("utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
+        except UnicodeDecodeError as exc:
             raise LoadError(f"cannot read '{path}': {exc}") from None
         if self.store is not None:
             found = self.store.load(path, data)
@@ -88,7 +83,16 @@ class ParseCache:
     def _forget(self, name: str) -> None:
         found = self._trees.pop(name, None)
         if found is not None:
-            self.size -= found[0][1]
+            self.size -= len(found[0])
+
+
+def _read_bytes(path: Path) -> bytes:
+    """The bytes of ``path``; a file that cannot be read is a :class:`LoadError`
+    naming it."""
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise LoadError(f"cannot read '{path}': {exc}") from None
 
 
 SHARED = ParseCache(store=ParsedStore())
