@@ -19,6 +19,7 @@ from scipy.special import gammainc
 
 import springc
 from springc.cli import main
+from springc.errors import SimulationError
 from springc.pipeline import CompiledModel
 from springc.simulation import SimulationOptions, SimulationResult
 from springc.simulation.error_control import Asked, controlled, short
@@ -159,8 +160,9 @@ def test_tighten_takes_the_companion_and_estimates_it_again() -> None:
 
 
 def test_tighten_stops_at_the_tightest_rtol_and_warns() -> None:
-    runs = {1e-6: fake(BASE), 1e-9: fake(off_by(3 * TOL)), 1e-12: fake(off_by(6 * TOL)),
-            1e-13: fake(off_by(9 * TOL))}
+    # each run's error falls 100x with the tolerance, not enough to meet the rule
+    runs = {1e-6: fake(BASE), 1e-9: fake(off_by(30_000 * TOL)),
+            1e-12: fake(off_by(30_300 * TOL)), 1e-13: fake(off_by(30_303 * TOL))}
     result = controlled(SimulationOptions(), Asked("tighten", 1e-6, 1e-9),
                         scripted(runs, []))
     assert result.stats.rtol == 1e-12
@@ -171,6 +173,53 @@ def test_tighten_stops_at_the_tightest_rtol_and_warns() -> None:
         "the estimated error 6e-5 of a (at t = 1.5 s) exceeds its tolerance 2e-5 (10 x "
         "(rtol 1e-6 x its largest magnitude + atol 1e-9)), also at rtol 1e-12, the "
         "tightest springc tries")
+
+
+def test_tighten_stops_where_the_error_does_not_follow_the_tolerance() -> None:
+    # 1000x tighter, the error fell from 3x to 2x its tolerance: no run at 1e-12 answers
+    asked: list[SimulationOptions] = []
+    runs = {1e-6: fake(BASE), 1e-9: fake(off_by(3 * TOL)), 1e-12: fake(off_by(5 * TOL))}
+    result = controlled(SimulationOptions(), Asked("tighten", 1e-6, 1e-9),
+                        scripted(runs, asked))
+    assert [o.rtol for o in asked] == [1e-6, 1e-9, 1e-12]
+    np.testing.assert_array_equal(result.values, runs[1e-9].values)
+    assert result.stats.rtol == 1e-9 and result.stats.estimated_error == \
+        pytest.approx(2 * TOL)
+    assert result.stats.warning == (
+        "the estimated error 4e-5 of a (at t = 1.5 s) exceeds its tolerance 2e-5 (10 x "
+        "(rtol 1e-6 x its largest magnitude + atol 1e-9)), also at rtol 1e-9; it hardly "
+        "falls with the tolerance (6e-5 of a at rtol 1e-6): not tightened further")
+
+
+def counted(values: np.ndarray, steps: int) -> SimulationResult:
+    result = fake(values)
+    return replace(result, stats=replace(result.stats, steps=steps))
+
+
+def test_the_companions_share_a_step_budget() -> None:
+    # the run takes 2,000 steps: its companions 40,000 together; the first takes 30,000,
+    # the second would take 80,000 and stops at the 10,000 left
+    asked: list[SimulationOptions] = []
+    runs = {1e-6: counted(BASE, 2_000), 1e-9: counted(off_by(3 * TOL), 30_000)}
+
+    def run(options: SimulationOptions) -> SimulationResult:
+        asked.append(options)
+        if options.rtol == 1e-12:
+            raise SimulationError(f"the simulation stopped at time 1: {options.max_steps} "
+                                  "steps of dop853 reached the step limit (--max-steps "
+                                  f"{options.max_steps})")
+        return runs[float(f"{options.rtol:.12g}")]
+
+    result = controlled(SimulationOptions(), Asked("tighten", 1e-6, 1e-9), run)
+    assert [o.max_steps for o in asked] == [None, 40_000, 10_000]
+    np.testing.assert_array_equal(result.values, runs[1e-9].values)
+    assert result.stats.rtol == 1e-9 and result.error_estimate is None
+    why = ("its companion run failed (error control's step budget is spent: the "
+           "companions may take 40,000 steps, 20 x the run's 2,000 (at least 20,000)); at "
+           "rtol 1e-6 it was 6e-5 > tolerance 2e-5 (a at t = 1.5 s)")
+    assert result.stats.error == f"tightened rtol 1e-6 -> 1e-9: error not estimated: {why}"
+    assert result.stats.warning == \
+        f"the error of the run at rtol 1e-9 could not be estimated: {why}"
 
 
 def test_off_runs_once_and_an_implicit_run_keeps_its_method() -> None:

@@ -218,7 +218,9 @@ RUN_OPTIONS: dict[str, Callable[[Callable[..., Any]], Callable[..., Any]]] = {
         "1000x tighter, or half the step for fixed-step solvers: in the summary line, in "
         "a .mat trajectory and in --error-output) and hold every output variable v to 10 "
         "* (rtol * max|v| + atol). tighten: run 1000x tighter until it holds (at most "
-        "rtol 1e-12, within --max-steps and --time-limit), else warn; warn: only warn; "
+        "rtol 1e-12, within --max-steps, --time-limit and, for the companions together, "
+        "20x the run's steps; not again where the error stops falling), else warn; "
+        "warn: only warn; "
         f"off: no estimate (fastest). [default: {DEFAULT_ERROR_CONTROL}]"),
     "error_estimate": click.option(
         "--error-estimate", type=click.Choice(("off", "on", "auto"), case_sensitive=False),
