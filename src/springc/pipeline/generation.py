@@ -42,7 +42,7 @@ def generate_from(derived: Derived, options: CompileOptions,
     if selection is None:
         selection = ALL_OBSERVED if options.outputs is None else \
             selected_observed(candidate_names(derived), options.outputs)
-    observed = tuple(system.observed_names()) if selection == ALL_OBSERVED else selection
+    observed = selection if isinstance(selection, tuple) else tuple(system.observed_names())
     codegen = CodegenOptions(options.backend, observed, switchable=derived.switchable,
                              warnings=encode_warnings(derived.warnings),
                              shared=derived.parts)
