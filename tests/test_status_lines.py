@@ -88,6 +88,13 @@ def test_numba_functions_are_cached_where_their_index_is(tmp_path: Path,
     assert functions_cached(types.SimpleNamespace(BACKEND="python"), path)  # type: ignore[arg-type]
     (path.parent / "__pycache__" / "model.rhs-129.py311.nbi").write_bytes(b"")
     assert functions_cached(numba_module, path)  # type: ignore[arg-type]
+    # by name: the function's own index, or its body's where the module passes its
+    # index table (``_observed_indexed``)
+    assert functions_cached(numba_module, path, ["rhs"])  # type: ignore[arg-type]
+    assert not functions_cached(numba_module, path, ["rhs", "observed"])  # type: ignore[arg-type]
+    assert not functions_cached(numba_module, path, ["jacobian_values"])  # type: ignore[arg-type]
+    (path.parent / "__pycache__" / "model._observed_indexed-80.py311.nbi").write_bytes(b"")
+    assert functions_cached(numba_module, path, ["rhs", "observed"])  # type: ignore[arg-type]
 
 
 def test_a_cached_module_whose_functions_numba_has_not_cached_says_so(

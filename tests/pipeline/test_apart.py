@@ -16,6 +16,7 @@ import springc
 from springc.errors import SpringcError
 from springc.pipeline import apart, generation
 from springc.pipeline.closed import MODULE_PREFIX
+from springc.pipeline.notes import functions_cached
 
 MODEL = ("model Decay\n  parameter Real k = 2;\n  Real x(start = 3, fixed = true);\n"
          "equation\n  der(x) = -k*x;\nend Decay;\n")
@@ -129,20 +130,21 @@ def _compiles(model: springc.pipeline.CompiledModel) -> dict[str, tuple[int, int
     """(loads from numba's cache, compiles) in this process of each function of
     ``model``'s numba module that a run hands to the compiled loops."""
     counts = {}
-    for name in apart.RUN_FUNCTIONS:
+    for name in (*apart.RUN_FUNCTIONS, *apart.JACOBIAN_FUNCTIONS):
         stats = getattr(model.module, name).stats
         counts[name] = (sum(stats.cache_hits.values()), sum(stats.cache_misses.values()))
     return counts
 
 
 def test_the_functions_a_run_compiles_are_compiled_in_a_child(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capfd: pytest.CaptureFixture[str]) -> None:
     decay = tmp_path / "decay.mo"  # with an observed variable, v
     decay.write_text(MODEL.replace("fixed = true);", "fixed = true);\n  Real v;")
                      .replace("-k*x;", "v;\n  v = -k*x;"))
 
-    def run(model: springc.pipeline.CompiledModel) -> float:
-        result = springc.simulate(model, stop=1.0, solver="dop853", engine="compiled",
+    def run(model: springc.pipeline.CompiledModel, solver: str = "dop853") -> float:
+        result = springc.simulate(model, stop=1.0, solver=solver, engine="compiled",
                                   rtol=1e-10, atol=1e-12)
         assert result["v"][-1] == pytest.approx(-2 * result["x"][-1], rel=1e-12)
         return float(result["x"][-1])
@@ -152,13 +154,27 @@ def test_the_functions_a_run_compiles_are_compiled_in_a_child(
     here = springc.compile_model(str(decay), backend="numba")
     assert run(here) == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
     assert _compiles(here) == {"rhs": (0, 1), "jacobian_values": (0, 0), "observed": (0, 1)}
+    assert not apart.jacobian_apart(here.module)  # not given to functions_apart: here
+    assert run(here, "radau") == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
+    assert _compiles(here)["jacobian_values"] == (0, 1)
 
     monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "apart"))
     model = apart.compiled_apart(lambda: springc.compile_model(str(decay), backend="numba"))
     assert model.cached and model.module.BACKEND == "numba"
     assert apart.functions_apart(model.module, model.path)  # the child compiled them
     assert run(model) == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
-    # each loaded from numba's cache, none compiled here; the child's compile of
-    # jacobian_values, which this run does not call, stays on disk
+    # each loaded from numba's cache, none compiled here; jacobian_values, which this
+    # run does not call, was not compiled (by the child either: not in numba's cache)
     assert _compiles(model) == {"rhs": (1, 0), "jacobian_values": (0, 0), "observed": (1, 0)}
     assert not apart.functions_apart(model.module, model.path)  # cached: no child
+    assert not functions_cached(model.module, model.path, apart.JACOBIAN_FUNCTIONS)
+    # a run that needs the Jacobian: a child compiles it at the first use, saying so,
+    # and this process loads it from numba's cache
+    capfd.readouterr()
+    monkeypatch.delenv("SPRINGC_QUIET", raising=False)  # (the suite silences them)
+    assert run(model, "radau") == pytest.approx(3 * np.exp(-2.0), rel=1e-8)
+    assert capfd.readouterr().err == ("springc: compiling the Jacobian of Decay for this "
+                                      "machine (once)\n")
+    assert _compiles(model) == {"rhs": (1, 0), "jacobian_values": (1, 0), "observed": (1, 0)}
+    assert functions_cached(model.module, model.path, apart.JACOBIAN_FUNCTIONS)
+    assert not apart.jacobian_apart(model.module)  # once per module

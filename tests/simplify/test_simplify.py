@@ -80,6 +80,34 @@ def test_alias_chains_signs_and_constants(tmp_path: Path) -> None:
     assert [to_text(r.expr) for r in result.dae.equations] == ["der(a) - (-a + 2.0 + 2 * p)"]
 
 
+SECOND_ROUND = """
+model B
+  Real a(start = 1, fixed = true);
+  Real s;
+  Real f;
+  Real z;
+  Real w;
+equation
+  der(a) = -a + s + w;
+  s = f - z;
+  z = 0;
+  f = 3*a;
+  w = sin(a) + f*z;
+end B;
+"""
+
+
+def test_alias_made_by_a_substitution_is_eliminated_in_a_second_round(
+        tmp_path: Path) -> None:
+    # ``s = f - z`` is an alias only once ``z = 0`` is substituted (the rewritten
+    # equations are classified again); ``w``'s equation, rewritten too, is none
+    result = eliminate_aliases(lower(flat(tmp_path, SECOND_ROUND)))
+    assert {a.name: to_text(a.value) for a in result.aliases} == {"f": "s", "z": "0"}
+    assert [u.name for u in result.dae.unknowns] == ["a", "s", "w"]
+    assert [to_text(r.expr) for r in result.dae.equations] == [
+        "der(a) - (-a + s + w)", "s - 3 * a", "w - sin(a)"]
+
+
 def test_alias_keeps_fixed_start_then_state_select(tmp_path: Path) -> None:
     text = """
 model P

@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from ..collector import collector_paused
-from .apart import compiled_apart, functions_apart
+from .apart import compiled_apart, functions_apart, jacobian_apart
 from .compiler import (
     CompiledModel,
     ModuleKind,
@@ -34,8 +34,8 @@ __all__ = ["CCompilerMissing", "CLibrary", "CLoopRefused", "CompileOptions", "Co
            "Derived", "ModuleKind",
            "announce_functions", "c_library", "c_source", "check_parameter_names",
            "collector_paused", "compile_files", "compiled_apart", "derive_system",
-           "find_compiler", "flatten_files", "functions_apart",
-           "generate_source", "kernel_library", "loop_library", "modification_value",
+           "find_compiler", "flatten_files", "functions_apart", "generate_source",
+           "jacobian_apart", "kernel_library", "loop_library", "modification_value",
            "note_refused", "openmp_flags", "select_names", "split_values"]
 
 

@@ -15,6 +15,8 @@ beside the module: a run of a model whose functions numba has not cached would h
 that compile's memory on top of its own. :func:`functions_apart` compiles them in a
 forked child from the loaded module (its pages shared), the child writing numba's cache
 and exiting; the caller's run then loads them from numba's cache, as a warm run does.
+The Jacobian's function, which only some runs call, is compiled so at its first use
+(:func:`jacobian_apart`), not before every run.
 
 Where the model is in the cache, nothing is forked: the caller's compile runs with
 :func:`cached_only`, which makes the compile path's first step (deriving a system)
@@ -28,7 +30,8 @@ import os
 import pickle
 import signal
 import sys
-from collections.abc import Callable, Iterator
+import weakref
+from collections.abc import Callable, Iterator, Sequence
 from contextvars import ContextVar
 from pathlib import Path
 from typing import TypeVar
@@ -37,7 +40,7 @@ from ..codegen import GeneratedModule
 from ..errors import ErrorGroup, SpringcError
 from ..status_line import say, silenced
 from .closed import MODULE_PREFIX
-from .notes import FUNCTIONS_NOTE, functions_cached
+from .notes import FUNCTIONS_NOTE, JACOBIAN_NOTE, functions_cached
 
 T = TypeVar("T")
 
@@ -95,11 +98,21 @@ def compiled_apart(compile: Callable[[], T]) -> T:
         return compile()
 
 
-RUN_FUNCTIONS = ("rhs", "jacobian_values", "observed")
-"""The functions of a numba module that a run hands to springc's compiled loops (the
+RUN_FUNCTIONS = ("rhs", "observed")
+"""The functions of a numba module that every run hands to springc's compiled loops (the
 model function's signature of :data:`springc.integrate.MODEL_FUNCTION_SIGNATURE`):
-compiled by :func:`functions_apart` (``observed`` where the module has observed
-variables: a run calls it only then)."""
+compiled by :func:`functions_apart` before the run (``observed`` where the module has
+observed variables: a run calls it only then)."""
+
+JACOBIAN_FUNCTIONS = ("jacobian_values",)
+"""The functions only a run that needs the Jacobian calls (an implicit solver, ``auto``'s
+stiffness estimate): compiled by :func:`jacobian_apart` at that run's first use, not
+before every run (the 10,000-mass chain's ``dop853`` run never calls its
+``jacobian_values``: 1.9 s of CPU to compile)."""
+
+_DEFERRED: weakref.WeakKeyDictionary[object, Path] = weakref.WeakKeyDictionary()
+"""The modules given to :func:`functions_apart`, whose :data:`JACOBIAN_FUNCTIONS` a
+child compiles at the first use (:func:`jacobian_apart`), with their cache paths."""
 
 
 def functions_apart(module: GeneratedModule, path: Path) -> bool:
@@ -109,8 +122,31 @@ def functions_apart(module: GeneratedModule, path: Path) -> bool:
     whether a child compiled them. The child says the status line of the compile; one
     that fails leaves the functions to this process's first call (numba compiles them
     there, as before). Nothing is forked without ``os.fork`` or a stderr with a file
-    descriptor (as :func:`compiled_apart`)."""
-    if (functions_cached(module, path) or not hasattr(os, "fork")
+    descriptor (as :func:`compiled_apart`).
+
+    The module's :data:`JACOBIAN_FUNCTIONS` are left to :func:`jacobian_apart`, which
+    the run calls where it needs them."""
+    _DEFERRED[module] = path
+    names = [name for name in RUN_FUNCTIONS if name != "observed" or module.OBSERVED]
+    return _compiled_in_child(module, path, names, FUNCTIONS_NOTE)
+
+
+def jacobian_apart(module: GeneratedModule) -> bool:
+    """Called before a run's first call of ``module``'s :data:`JACOBIAN_FUNCTIONS`:
+    where ``module`` was given to :func:`functions_apart` (``springc simulate``; once per
+    module) and numba has not cached them, a forked child compiles them into numba's
+    cache, as :func:`functions_apart` does the others; whether a child compiled them.
+    A module that was not (the API's runs) compiles them at its first call."""
+    path = _DEFERRED.pop(module, None)
+    return path is not None and _compiled_in_child(module, path, JACOBIAN_FUNCTIONS,
+                                                   JACOBIAN_NOTE)
+
+
+def _compiled_in_child(module: GeneratedModule, path: Path, names: Sequence[str],
+                       note: str) -> bool:
+    """Whether a forked child compiled the numba functions ``names`` of ``module`` (not
+    where numba has cached them, without ``os.fork`` or a real stderr)."""
+    if (functions_cached(module, path, names) or not hasattr(os, "fork")
             or not _real_stream(sys.stderr)):
         return False
 
@@ -119,11 +155,9 @@ def functions_apart(module: GeneratedModule, path: Path) -> bool:
 
         from ..integrate import MODEL_FUNCTION_SIGNATURE
 
-        say(FUNCTIONS_NOTE.format(name=module.MODEL))
-        for name in RUN_FUNCTIONS:
+        say(note.format(name=module.MODEL))
+        for name in names:
             function = getattr(module, name, None)
-            if name == "observed" and not module.OBSERVED:
-                continue  # a run computes no observed variable
             if isinstance(function, Dispatcher):  # by its arguments, as a run's first
                 # call from Python compiles it (numba's cache is keyed by the signature)
                 function.compile(MODEL_FUNCTION_SIGNATURE.args)

@@ -302,7 +302,7 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
     if derived is not None:
         write_lookups(folder, request, lookups)
     model_key = model_key_for(request, lookups)
-    observed: object = ALL_OBSERVED
+    observed: tuple[str, ...] | str = ALL_OBSERVED  # the key's selection, the module's too
     if options.outputs is not None:
         names = read_names(folder, model_key)
         if names is None:
@@ -328,7 +328,7 @@ def compile_files(options: CompileOptions, derived: Derived | None = None) -> Co
     if folder is not None and options.outputs is None:  # (with outputs: read or written above)
         write_names(folder, model_key, generation.candidate_names(derived))
     try:
-        generated = generation.generate_from(derived, options)
+        generated = generation.generate_from(derived, options, observed)
     except RunTimeCallRefused as refused:  # api generates it for python instead
         refused.derived = derived
         raise

@@ -10,6 +10,7 @@ the simulation before it calls them: ``springc compile`` never calls them).
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from ..codegen import GeneratedModule
@@ -18,6 +19,10 @@ from .options import CompileOptions
 
 FUNCTIONS_NOTE = "compiling the functions of {name} for this machine (once)"
 """The status line before a cached numba module's functions compile."""
+
+JACOBIAN_NOTE = "compiling the Jacobian of {name} for this machine (once)"
+"""The status line before a cached numba module's ``jacobian_values`` compiles, at the
+first use of a run that needs it (:func:`springc.pipeline.apart.jacobian_apart`)."""
 
 _ANNOUNCED: set[Path] = set()
 """The module paths whose functions this process announced (a run, its probe and its
@@ -33,13 +38,22 @@ def compiling_note(options: CompileOptions, folder: Path | None) -> str:
     return f"compiling {name} for this machine (once; later runs load it from the cache)"
 
 
-def functions_cached(module: GeneratedModule, path: Path) -> bool:
+def functions_cached(module: GeneratedModule, path: Path,
+                     names: Iterable[str] | None = None) -> bool:
     """Whether the numba functions of the module imported from ``path`` load from
     numba's cache (an index next to the module; assumed where ``NUMBA_CACHE_DIR`` moves
-    numba's cache elsewhere); a python module's always do (nothing compiles)."""
+    numba's cache elsewhere); a python module's always do (nothing compiles).
+
+    ``names``: whether each of these functions has its index (numba's
+    ``model.<name>-<line>.pyXY.nbi``, or its body's ``model._<name>_indexed-...`` where
+    the module passes its index table to the bodies); by default, whether any has."""
     if module.BACKEND != "numba" or os.environ.get("NUMBA_CACHE_DIR"):
         return True
-    return any((path.parent / "__pycache__").glob("model.*.nbi"))
+    folder = path.parent / "__pycache__"
+    if names is None:
+        return any(folder.glob("model.*.nbi"))
+    return all(any(folder.glob(f"model.{name}-*.nbi"))
+               or any(folder.glob(f"model._{name}_indexed-*.nbi")) for name in names)
 
 
 def announce_functions(module: GeneratedModule, path: Path, cached: bool) -> None:

@@ -95,7 +95,7 @@ def select_names(candidates: Sequence[str], patterns: Sequence[str] | None) -> l
 
 
 def selected_observed(names: tuple[tuple[str, ...], tuple[str, ...]],
-                      patterns: Sequence[str]) -> object:
+                      patterns: Sequence[str]) -> tuple[str, ...] | str:
     """The observed variables ``patterns`` select (an error names a pattern that matches
     nothing), or :data:`ALL_OBSERVED` when they select every one."""
     states, observed = names

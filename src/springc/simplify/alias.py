@@ -208,8 +208,12 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     # Step 4: a substitution may have made an alias of a kept equation (``s = f - z``
     # with ``z = 0``): eliminate again, and express the first aliases through what is
     # left (observed values name only unknowns).
+    # Only a rewritten equation can have become one: the others read no eliminated
+    # name, so ``_classify`` sees them in ``left`` as it did in ``names``, where it found
+    # nothing (a kept equation it classified reads an eliminated name: rewritten).
     left = {u.name for u in remaining}
-    if mapping and any(_classify(r, left) is not None for r in equations):
+    if mapping and any(_classify(r, left) is not None
+                       for r, before in zip(equations, kept) if r is not before):
         again = eliminate_aliases(reduced)
         later = {a.name: a.value for a in again.aliases}
         earlier = tuple(replace(a, value=x.substitute(a.value, later)) for a in aliases)

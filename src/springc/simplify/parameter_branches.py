@@ -29,6 +29,9 @@ def parameter_branches(model: flat.FlatModel) -> flat.FlatModel:
     changed = False
     equations = []
     for eq in model.equations:
+        if not (_has_if(eq.lhs) or _has_if(eq.rhs)):  # one walk, for most equations
+            equations.append(eq)
+            continue
         lhs, rhs = _choose(eq.lhs, values), _choose(eq.rhs, values)
         if lhs is not eq.lhs or rhs is not eq.rhs:
             changed = True
@@ -55,6 +58,10 @@ def _structural_values(model: flat.FlatModel) -> dict[str, object]:
             pending.remove(v)
             added = True
     return values
+
+
+def _has_if(e: x.Expr) -> bool:
+    return any(isinstance(n, x.If) for n in x.walk(e))
 
 
 def _reads_der(e: x.Expr) -> bool:

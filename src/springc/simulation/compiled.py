@@ -359,6 +359,9 @@ def adaptive_run(solver: str, mod: Any, times: np.ndarray, x: np.ndarray, p: np.
 
     try:
         if solver in (RACE_IMPLICIT, "bdf"):
+            from ..pipeline import jacobian_apart
+
+            jacobian_apart(mod)  # at its first use, compiled apart (springc simulate)
             implicit = radau if solver == RACE_IMPLICIT else bdf
             return implicit(mod.rhs, mod.jacobian_values, mod.JAC_INDPTR, mod.JAC_INDICES,
                             times, x, p, z, **options)

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import Note, SimulationError, describe_failure
 from ..ir.dae import derivative_name
-from ..pipeline import CompiledModel, announce_functions
+from ..pipeline import CompiledModel, announce_functions, jacobian_apart
 from .assertions import AssertionCheck
 from .failures import Stop, code_location, format_time, remedy, state_notes
 from .limits import CHECK_EVERY, HOPELESS, Limits, OverBudget, OverLimit, projected_steps
@@ -308,12 +308,14 @@ class Problem:
 
     def jacobian(self, t: float, x: np.ndarray) -> Any:
         """The Jacobian for diagnostics: not counted, no failure checks."""
+        jacobian_apart(self.mod)  # at its first use, compiled apart (springc simulate)
         z = np.array(self.z)
         return self.mod.jacobian_dense(t, x, self.p, z) if len(x) <= DENSE_JACOBIAN_LIMIT \
             else self.mod.jacobian(t, x, self.p, z)
 
     def jac(self, t: float, x: np.ndarray) -> Any:
         self.njev += 1
+        jacobian_apart(self.mod)  # at its first use, compiled apart (springc simulate)
         began = time.perf_counter()
         try:
             dense = len(x) <= DENSE_JACOBIAN_LIMIT or self.solver == "lsoda"
