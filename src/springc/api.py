@@ -162,7 +162,8 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
                    ) -> str | None:
     """``backend`` as given; else ``None`` where the run's backend is the one
     :func:`compile_model` chooses itself (which also checks a numba module's size, and
-    generates a model with events for numba where it chose python for the C loop),
+    generates a model with delays or switching states for numba where it chose python
+    for the C loop),
     else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for a solver the
     C loop does not run, the fixed-step ones, where it runs the others)."""
     if backend:
