@@ -162,7 +162,8 @@ def default_choice(backend: str | None, engine: str = "auto", solver: str = "aut
                    ) -> str | None:
     """``backend`` as given; else ``None`` where the run's backend is the one
     :func:`compile_model` chooses itself (which also checks a numba module's size, and
-    generates a model with events for numba where it chose python for the C loop),
+    generates a model with delays or switching states for numba where it chose python
+    for the C loop),
     else the run's (``"python"`` for ``--engine scipy``, ``"numba"`` for a solver the
     C loop does not run, the fixed-step ones, where it runs the others)."""
     if backend:
@@ -194,16 +195,25 @@ def _compile(options: CompileOptions, parameters: Mapping[str, float] | None,
     return compiled.settled()
 
 
+C_LOOP_KINDS = (ModuleKind.CONTINUOUS, ModuleKind.HYBRID)
+"""The kinds of model the C loop runs: continuous ones, and hybrid ones between their
+events (:mod:`springc.simulation.hybrid_compiled`; the event update in Python). A
+hybrid model on numba would first compile its functions and numba's hybrid kernels
+(minutes on a loaded machine: SimpleTriacCircuit), where the C loop library builds
+in seconds."""
+
+
 def _numba_instead(compiled: CompiledModel) -> bool:
     """Whether springc, having chosen python for the C loop, generates ``compiled``'s
-    model for numba instead: the C loop runs continuous models whose loop library
-    builds (:func:`springc.pipeline.loop_library`, built here once per cache entry);
-    the compiled engine runs others on numba: events, delays, switching states, a
-    model beyond the loop's size rule, one the C printer cannot print (a function with
-    no C spelling), and one whose C the compiler refused (with a one-line note)."""
+    model for numba instead: the C loop runs continuous and hybrid models whose loop
+    library builds (:data:`C_LOOP_KINDS`; :func:`springc.pipeline.loop_library`, built
+    here once per cache entry); the compiled engine runs others on numba: delays,
+    switching states, a model beyond the loop's size rule, one the C printer cannot
+    print (a function with no C spelling), and one whose C the compiler refused (with a
+    one-line note)."""
     if not (c_loop_runs(AUTO, None) and numba_available()) or calls_foreign(compiled.source):
         return False  # numba calls no C function at run time (native.foreign_calls)
-    if compiled.kind != ModuleKind.CONTINUOUS:
+    if compiled.kind not in C_LOOP_KINDS:
         return True
     from .pipeline import loop_library, note_refused  # the C printer: on this choice only
 

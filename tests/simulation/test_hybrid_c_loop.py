@@ -11,6 +11,8 @@ import numpy as np
 import pytest
 
 import springc
+from simulation.test_newton_warm_starts import MODEL as WARM_MODEL
+from simulation.test_newton_warm_starts import charge, diode_voltage, source
 from springc.simulation.compiled import engine_reason
 
 G, E = 9.81, 0.8
@@ -114,3 +116,26 @@ def test_the_engine_of_a_hybrid_run_follows_its_options_only() -> None:
     assert engine_reason("auto", solver, model.module, True) == C_REASON.format(solver)
     # both engines solve the same model: within their tolerances of one another
     assert np.abs(first["v"] - scipy["v"]).max() <= 1e-5
+
+
+@pytest.mark.parametrize("solver", ["dop853", "rk45"])
+def test_newton_warm_starts_in_the_c_loop_come_from_accepted_points(
+        tmp_path: Path, solver: str) -> None:
+    """test_newton_warm_starts' diode on the C loop: the first step's probe after the
+    time event at 1 s evaluates at 15.1 s (source held at -105 V) and must not leave
+    its warm start, and a block that does not converge is solved again from the
+    step's start (before: "did not converge at time 1", as HeatingNPN_NORGate at
+    79.88 s)."""
+    path = tmp_path / "ProbeWarmStart.mo"
+    path.write_text(WARM_MODEL)
+    result = springc.simulate(str(path), backend="python", engine="compiled", stop=20.0,
+                              interval=0.25, solver=solver, rtol=1e-9, atol=1e-9,
+                              error_control="off")
+    assert result.stats.engine == "compiled"
+    times = [float(t) for t in result.time]
+    assert times[-1] == 20.0
+    expected_v = [diode_voltage(source(t)) for t in times]
+    assert np.allclose(np.asarray(result["v"]), expected_v, rtol=0, atol=1e-11)
+    assert np.allclose(np.asarray(result["q"]), [charge(t) for t in times], rtol=0,
+                       atol=5e-5)
+    assert [e.cause for e in result.events if e.kind == "state"] == ["c < 1002"]

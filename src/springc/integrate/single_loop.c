@@ -49,6 +49,7 @@ typedef struct {
     double *F;      /* DOP853's dense output rows (7); RK45's Q (n x 4) */
     double *stage, *sums, *scale, *err5, *err3, *y, *y_new;
     double *z_step; /* z at the step's start (a hybrid model's trial points: sl_step) */
+    double *z_end;  /* z at the accepted step's end (kept across its dense output) */
     int method;
     struct si_work *implicit;  /* Radau's or BDF's work (implicit_core.c), else NULL */
 } sl_work;
@@ -70,6 +71,32 @@ SC_FN void sl_copy(double *dst, const double *src) {
     for (int i = 0; i < SC_NX; i++) dst[i] = src[i];
 }
 
+SC_FN void sl_copy_z(double *dst, const double *src) {
+    for (int i = 0; i < SPRINGC_N_Z; i++) dst[i] = src[i];
+}
+
+/* springc_rhs at (t, x) into out, its verdict. A hybrid model's Newton block that did
+   not converge from the warm starts in z is solved again from those of the step's
+   start (w->z_step, an accepted point), where they differ: the rule of the scipy
+   engine's Problem.solved (springc.simulation.steps). An accepted step may end past an
+   event not yet located, on a held branch whose solution is far from the one inside
+   the step (HeatingNPN_NORGate: from C1.v = -1.39 V past V1's ramp end at 80 s,
+   Newton cycles at a stage of the step's dense output at 79.88 s). */
+SC_FN int sl_rhs(const sl_work *w, double t, const double *x, const double *p, double *z,
+                 double *out, sl_int *counts) {
+    springc_rhs(t, x, p, z, out);
+    counts[SL_RHS_CALLS] += 1;
+    int status = sc_verdict(out, z);
+    if (!SPRINGC_HYBRID || status != SC_MODEL_FAILED) return status;
+    int same = 1;
+    for (int i = 0; i < SPRINGC_N_Z - 1; i++) same = same && z[i] == w->z_step[i];
+    if (same) return status;
+    sl_copy_z(z, w->z_step);  /* its failure flag clear: an accepted point's */
+    springc_rhs(t, x, p, z, out);
+    counts[SL_RHS_CALLS] += 1;
+    return sc_verdict(out, z);
+}
+
 /* numba's rms of plain sums: sqrt(x . x) / n ** 0.5 */
 SC_FN double sl_rms(const double *x) {
     double total = 0.0;
@@ -78,7 +105,10 @@ SC_FN double sl_rms(const double *x) {
 }
 
 /* scipy's select_initial_step from (t, y) with the derivative f there (loop.initial_step);
-   the status; h_abs, or the time of a failed evaluation (its state left in end). */
+   the status; h_abs, or the time of a failed evaluation (its state left in end). A
+   hybrid model's probe at t + h0 is a point a step only tries (Problem.start): z keeps
+   the warm starts of (t, y), and a probe that fails counts as scipy's NaN there (its
+   max(d1, NaN) is d1), the step size then from (t, y) alone. */
 SC_FN int sl_initial_step(double t, const double *y, const double *f, double limit,
                           const double *p, double *z, double rtol, const double *atol,
                           double max_step, double exponent, sl_work *w, double *end,
@@ -94,10 +124,23 @@ SC_FN int sl_initial_step(double t, const double *y, const double *f, double lim
     double h0 = d0 < 1e-5 || d1 < 1e-5 ? 1e-6 : 0.01 * d0 / d1;
     h0 = sc_min(h0, interval);
     for (int i = 0; i < SC_NX; i++) end[i] = y[i] + h0 * f[i];
+    if (SPRINGC_HYBRID) sl_copy_z(w->z_end, z);
     springc_rhs(t + h0, end, p, z, d);
     counts[SL_RHS_CALLS] += 1;
     int status = sc_verdict(d, z);
     *t_fail = t;
+    if (SPRINGC_HYBRID) {
+        sl_copy_z(z, w->z_end);
+        if (status != SC_SUCCESS) {
+            double h1 = pow(0.01 / d1, exponent);
+            *h_abs = sc_min(sc_min(sc_min(100 * h0, h1), interval), max_step);
+            if (!(*h_abs > 0.0)) {
+                sl_copy(end, y);
+                return SC_STEP_TOO_SMALL;
+            }
+            return SC_SUCCESS;
+        }
+    }
     if (status != SC_SUCCESS) {
         *h_abs = 0.0;
         *t_fail = t + h0;
@@ -130,9 +173,7 @@ SC_FN int sl_stages(const sl_work *w, double t, double h, const double *p, doubl
             rk_a_row(s, K, sums);
             for (int i = 0; i < SC_NX; i++) stage[i] = y[i] + sums[i] * h;
         }
-        springc_rhs(t + c * h, stage, p, z, K + s * SC_NXS);
-        counts[SL_RHS_CALLS] += 1;
-        int status = sc_verdict(K + s * SC_NXS, z);
+        int status = sl_rhs(w, t + c * h, stage, p, z, K + s * SC_NXS, counts);
         if (status != SC_SUCCESS) {
             sl_copy(end, stage);
             *t_fail = t + c * h;
@@ -142,9 +183,7 @@ SC_FN int sl_stages(const sl_work *w, double t, double h, const double *p, doubl
     if (dop) sc_b_sum(K, sums);
     else rk_b_sum(K, sums);
     for (int i = 0; i < SC_NX; i++) y_new[i] = y[i] + h * sums[i];
-    springc_rhs(t + h, y_new, p, z, K + stages * SC_NXS);
-    counts[SL_RHS_CALLS] += 1;
-    int status = sc_verdict(K + stages * SC_NXS, z);
+    int status = sl_rhs(w, t + h, y_new, p, z, K + stages * SC_NXS, counts);
     if (status != SC_SUCCESS) {
         sl_copy(end, y_new);
         *t_fail = t + h;
@@ -223,23 +262,25 @@ SC_FN int sl_step(const sl_work *w, double t, double *h_abs, double min_step, do
 }
 
 /* What the dense output of the step needs (prepare_dense): DOP853's three extra stages
-   and its rows F; RK45's Q = K^T P. */
+   and its rows F; RK45's Q = K^T P. A hybrid model's z keeps the accepted end's warm
+   starts (Problem.dense_output): the extra stages lie inside the step. */
 SC_FN int sl_prepare_dense(const sl_work *w, double t, double h, const double *p, double *z,
                            sl_int *counts, double *end, double *t_fail) {
     double *K = w->K;
     if (w->implicit) return SC_SUCCESS;  /* the step's polynomial is its dense output */
     if (w->method == SL_DOP853) {
+        if (SPRINGC_HYBRID) sl_copy_z(w->z_end, z);
         for (int s = SC_STAGES + 1; s < SC_EXTENDED; s++) {
             sc_stage(w->y, K, s, h, w->sums, w->stage);
-            springc_rhs(t + DOP_C[s] * h, w->stage, p, z, K + s * SC_NXS);
-            counts[SL_RHS_CALLS] += 1;
-            int status = sc_verdict(K + s * SC_NXS, z);
+            int status = sl_rhs(w, t + DOP_C[s] * h, w->stage, p, z, K + s * SC_NXS,
+                                counts);
             if (status != SC_SUCCESS) {
                 sl_copy(end, w->stage);
                 *t_fail = t + DOP_C[s] * h;
                 return status;
             }
         }
+        if (SPRINGC_HYBRID) sl_copy_z(z, w->z_end);
         sc_interpolant(w->y, w->y_new, K, h, w->F, w->sums);
         return SC_SUCCESS;
     }
@@ -424,6 +465,7 @@ SC_FN int sl_run(sl_work *w, const sl_events *ev, sl_int m, const double *grid,
     sl_copy(rec->end, x0);
     sl_copy(states, x0);
     if (ev->n_g > 0 && !sc_flagged(z)) springc_zero_crossings(t, w->y, p, z, ev->g0);
+    if (SPRINGC_HYBRID) sl_copy_z(w->z_step, z);  /* an accepted point (sl_rhs) */
     if (sc_flagged(z)) {
         status = SC_MODEL_FAILED;
         filled = 0;
@@ -528,10 +570,11 @@ SPRINGC_LOOP_EXPORT int springc_loop_run(int method, sl_int m, const double *gri
     sl_work w;
     sl_int n_g = signs != NULL ? SPRINGC_N_CROSSINGS : 0, n_gs = n_g > 0 ? n_g : 1;
     double *block = (double *)malloc(((size_t)32 * SC_NXS + 5 * (size_t)n_gs
-                                      + SPRINGC_N_Z) * sizeof(double));
+                                      + 2 * (size_t)SPRINGC_N_Z) * sizeof(double));
     if (block == NULL) return -1;
     double *g_block = block + 32 * SC_NXS;
     w.z_step = g_block + 5 * n_gs;
+    w.z_end = w.z_step + SPRINGC_N_Z;
     sl_events ev = {n_g, signs, fired, (sl_int *)(g_block + 3 * n_gs), g_block,
                     g_block + n_gs, g_block + 2 * n_gs, t_stop};
     if (n_g > 0) {

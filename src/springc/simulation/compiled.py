@@ -109,9 +109,10 @@ def default_backend(engine: str = AUTO, solver: str = AUTO) -> str:
     run can take the compiled loop (numba importable, ``engine`` not ``scipy``,
     ``solver`` with a compiled loop or ``auto``), else ``python``: a run on scipy's loop
     calls the model's functions from Python, where numba's compilation of a new model
-    (seconds) costs more than it saves on most runs. (A model with events, delays or
-    switching states compiled for the C loop is generated again for numba: see
-    :func:`springc.api.compile_model`.)"""
+    (seconds) costs more than it saves on most runs. (A model with delays or switching
+    states compiled for the C loop is generated again for numba: see
+    :func:`springc.api.compile_model`; one with events stays on python, its runs
+    between events in the C loop.)"""
     name = engine.lower() if isinstance(engine, str) else engine
     if name != SCIPY and c_loop_runs(solver, None):
         return "python"

@@ -31,7 +31,7 @@ from .observed_rows import observed_at_rows
 from .planning import RunPlan
 from .results import SimulationResult, SimulationStats
 from .solver_names import AUTO, EXPLICIT, FIXED_STEP
-from .steps import Problem, Progress
+from .steps import Problem, Progress, warm_slots
 
 
 def simulate_hybrid(model: CompiledModel, plan: RunPlan) -> SimulationResult:
@@ -83,8 +83,13 @@ def simulate_hybrid(model: CompiledModel, plan: RunPlan) -> SimulationResult:
             solver = problem.solver
             loop.terminal()
             times, states, zs = rows(loop, event_rows)
+            try:
+                obs = _observed(model, problem, times, states, zs)
+            except Stop:  # an assertion that fails at an earlier row is reported first
+                check_assertions(problem, times, states, zs)
+                raise
             check_assertions(problem, times, states, zs)
-            outputs = _outputs(model, problem, times, states, zs)
+            outputs = _outputs(model, times, states, obs)
     except Stop as stop_:
         raise stop_.error from None
     except OverLimit as over:
@@ -159,15 +164,29 @@ def check_assertions(problem: Problem, times: np.ndarray, states: np.ndarray,
             problem.asserts.step(float(t), x, z)
 
 
-def _outputs(model: CompiledModel, problem: Problem, times: np.ndarray, states: np.ndarray,
-             zs: np.ndarray) -> np.ndarray:
-    """The selected outputs at every row, each with its own discrete values."""
+def _observed(model: CompiledModel, problem: Problem, times: np.ndarray,
+              states: np.ndarray, zs: np.ndarray) -> np.ndarray | None:
+    """The observed variables at every row, each with its own discrete values, where
+    an output or an assertion needs them (None where none does). Each row's Newton
+    warm starts in ``zs`` become its solution, solved from the row before
+    (:func:`.observed_rows.observed_at_rows`): the assertions are then evaluated from
+    them. A run on the compiled engine gives all the rows of one kernel run the ``z``
+    of its end, whose warm starts may be far from a row's solution
+    (HeatingNPN_NORGate: from those at 140 s, the assertion's Newton block at 135.08 s
+    found a negative temperature)."""
+    selected = set(model.outputs)
+    wanted = any(o in selected for o in model.observed)
+    if not (wanted or (problem.asserts and warm_slots(model.module))):
+        return None
+    return observed_at_rows(model.module, problem, times, states, zs, keep=True)
+
+
+def _outputs(model: CompiledModel, times: np.ndarray, states: np.ndarray,
+             obs: np.ndarray | None) -> np.ndarray:
+    """The selected outputs at every row (``obs``: the observed variables there)."""
     names = model.outputs
     columns: dict[str, np.ndarray] = {s: states[:, i] for i, s in enumerate(model.states)}
-    selected = set(names)
-    wanted = [o for o in model.observed if o in selected]
-    if wanted:
-        obs = observed_at_rows(model.module, problem, times, states, zs)
+    if obs is not None:
         columns.update({o: obs[:, i] for i, o in enumerate(model.observed)})
     out = np.empty((len(times), len(names)))
     for i, name in enumerate(names):

@@ -71,11 +71,12 @@ def continuation(module: Any, p: np.ndarray, before: tuple[float, np.ndarray, np
 
 
 def observed_at_rows(module: Any, problem: Problem, times: np.ndarray, states: np.ndarray,
-                     zs: np.ndarray) -> np.ndarray:
+                     zs: np.ndarray, keep: bool = False) -> np.ndarray:
     """The observed variables at every row ``(times[i], states[i], zs[i])``, rows in
     time order, each warm started from the row before (see the module docstring);
     raises the located error of an expression, or the nonlinear-system error of a row
-    that does not converge."""
+    that does not converge. ``keep``: each row's solved warm starts are written into
+    ``zs[i]`` (for later evaluations at the row: the assertions)."""
     n = warm_slots(module)
     p = problem.p
     out = np.empty((len(times), len(module.OBSERVED)))
@@ -98,6 +99,8 @@ def observed_at_rows(module: Any, problem: Problem, times: np.ndarray, states: n
                 raise problem.newton_failure(t, x)
         out[i] = row
         before = (t, x, z[:n].copy())
+        if keep:
+            zs[i, :n] = z[:n]
     return out
 
 
