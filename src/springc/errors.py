@@ -114,6 +114,20 @@ class SimulationError(SpringcError):
     """The solver failed; the message names the time and the quantity at fault."""
 
 
+class UnknownParameterError(SimulationError):
+    """A value given for ``name``, which is neither a parameter nor a start value of
+    the model. The command line reports it as a misuse of the option that gave the
+    value (:meth:`given_as`, exit 2)."""
+
+    def __init__(self, message: str, *, name: str = "", hint: str | None = None) -> None:
+        super().__init__(message, hint=hint)
+        self.name = name
+
+    def given_as(self, option: str) -> UsageError:
+        return UsageError(f"{option} {self.name}: {self.message}", option=option,
+                          hint=self.hint)
+
+
 class CodegenError(SpringcError):
     """The model uses something the code generator cannot translate."""
 
