@@ -372,8 +372,8 @@ def _derive_now(options: CompileOptions, folder: Path | None) -> Derived:
         deriving()
     from . import generation  # the compile path, loaded on a miss only
 
-    say(compiling_note(options, folder))
-    return generation.derive_system(options)
+    return generation.derive_system(options,
+                                    parsed=lambda: say(compiling_note(options, folder)))
 
 
 def request_key_of(options: CompileOptions) -> str:
