@@ -25,6 +25,12 @@ class Span:
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.column}"
 
+    def width(self, default: int = 1) -> int:
+        """The columns it covers on its first line; ``default`` where it spans lines."""
+        if self.end_line == self.line and self.end_column > self.column:
+            return self.end_column - self.column
+        return default
+
     def __reduce__(self) -> tuple[type[Span], tuple[str, int, int, int, int]]:
         # a call, not dataclass's generic state of slots (a fields() walk per span)
         return Span, (self.file, self.line, self.column, self.end_line, self.end_column)

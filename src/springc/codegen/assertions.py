@@ -1,10 +1,11 @@
 """The assertions of a generated module: ``ASSERTIONS`` and ``assertions(t, x, p, z)``.
 
-``ASSERTIONS`` is a tuple of ``(message, level, location, parameters_only)`` per
-``assert`` of the model, written as a ``repr`` literal (model text is data: the
-message reaches the module only so). ``assertions(t, x, p, z)`` returns one number
-per assertion, 1.0 where its condition holds and 0.0 where it fails; it computes the
-steps and aliases its conditions read, as ``observed`` does.
+``ASSERTIONS`` is a tuple of ``(message, level, location, parameters_only, width)``
+per ``assert`` of the model (``width``: of the caret under the location), written as a
+``repr`` literal (model text is data: the message reaches the module only so).
+``assertions(t, x, p, z)`` returns one number per assertion, 1.0 where its condition
+holds and 0.0 where it fails; it computes the steps and aliases its conditions read, as
+``observed`` does.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ def assertion_table(system: ode.ODE) -> str:
     """The ``ASSERTIONS`` constant's value as Python text."""
     rows = tuple((item.message, item.level,
                   f"{item.span.file}:{item.span.line}:{item.span.column}",
-                  parameters_only(item, system)) for item in system.assertions)
+                  parameters_only(item, system), item.span.width(len("assert")))
+                 for item in system.assertions)
     return repr(rows)
 
 

@@ -16,6 +16,7 @@ import math
 
 from ...errors import FlattenError, describe_failure
 from ...ir import expr as x
+from ...ir import flat
 from ...ir import syntax as s
 from ...ir.builtins import BUILTINS, EQUATION, names
 from .. import arrays as a
@@ -81,11 +82,19 @@ def _check_sample(ev: ExpressionEvaluator, args: list[x.Expr], e: s.Call) -> Non
             raise FlattenError(f"the start of sample(start, interval) must be a finite "
                                f"time, found {number:g}", arg.span)
         if what == "interval" and not number > 0:
-            raise FlattenError(f"the interval of sample(start, interval) must be positive, "
-                               f"found {number:g}", arg.span,
+            raise FlattenError(f"{POSITIVE_INTERVAL}, found {number:g}", arg.span,
                                hint="sample(start, interval) is true at start, "
                                "start + interval, start + 2*interval... (Modelica 3.6, "
                                "section 3.7.5)")
+    interval = args[1]
+    if not isinstance(interval, x.Const):  # a run's parameter values may make it 0
+        positive = x.Call("noEvent", (x.BinOp(">", interval, x.Const(0.0)),))
+        ev.flattener.assertions.append((flat.Assertion(
+            positive, f"{POSITIVE_INTERVAL}: {x.to_text(interval)} <= 0", "error",
+            e.args[1].span, flat.Origin("equation", "", "sample")), e.args[1].span))
+
+
+POSITIVE_INTERVAL = "the interval of sample(start, interval) must be positive"
 
 
 #: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.
