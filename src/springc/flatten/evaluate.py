@@ -241,7 +241,7 @@ class Evaluator(ReferenceResolver):
                 raise
             return x.Const(decided)
         scalar = _ARITHMETIC.get(e.op)
-        if scalar is not None and (type(left) is x.Call or type(right) is x.Call):
+        if scalar is not None:
             check_arithmetic_operands(e.op, (left, right), e)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check

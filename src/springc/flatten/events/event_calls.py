@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ...errors import FlattenError, describe_failure
 from ...ir import expr as x
 from ...ir import flat
@@ -102,15 +104,30 @@ BOOLEAN_CALLS = names(lambda b: b.boolean)
 
 
 def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary) -> None:
-    """``2.0*terminal()`` is a type error: the Boolean event built-ins are no numbers."""
+    """``true + 1`` and ``2.0*terminal()`` are type errors: a Boolean (a literal, a
+    relation, ``not``/``and``/``or``, a Boolean event built-in) is no number (Modelica
+    3.6, section 3.4: arithmetic operates on numeric types)."""
     for value, side in zip(operands, (e.left, e.right)):
-        if type(value) is x.Call and value.name in BOOLEAN_CALLS:
+        if surely_boolean(value):
+            assert isinstance(value, x.Expr)
+            text = x.to_text(value)
             raise FlattenError(
-                f"'{x.to_text(value)}' is a Boolean and cannot be an operand of '{op}'",
-                side.span, hint=f"{value.name} returns a Boolean, and arithmetic needs "
-                "Integer or Real operands; choose a number with an if-expression "
-                f"('if {x.to_text(value)} then 1.0 else 0.0') (Modelica 3.6, section "
-                "3.7.5)")
+                f"'{text}' is a Boolean and cannot be an operand of '{op}'",
+                side.span, hint="arithmetic needs Integer or Real operands (Modelica 3.6, "
+                f"section 3.4); choose a number with an if-expression ('if {text} then "
+                "1.0 else 0.0')")
+
+
+def surely_boolean(value: object) -> bool:
+    """Whether ``value`` is a Boolean whatever the variables' types."""
+    kind = type(value)
+    if kind is x.Const:
+        return isinstance(value.value, (bool, np.bool_))  # type: ignore[attr-defined]
+    if kind is x.Call:
+        return value.name in BOOLEAN_CALLS  # type: ignore[attr-defined]
+    if kind is x.BinOp:
+        return value.op in x.RELATIONS or value.op in ("and", "or")  # type: ignore[attr-defined]
+    return kind is x.Not
 
 
 def event_dependent(e: x.Expr) -> bool:

@@ -135,9 +135,9 @@ def _library(entry: ClassEntry, c_name: str, sources: CSources, glue: str,
         raise FlattenError(f"the external function '{entry.full_name}' ('{c_name}') could "
                            f"not be built: {failed.message}", call.span,
                            [Note("its external clause", external.span)],
-                           "springc compiles a library's C sources (Resources/C-Sources) "
-                           "with the system C compiler, or zig cc (pip install ziglang)"
-                           ) from None
+                           failed.hint or "springc compiles a library's C sources "
+                           "(Resources/C-Sources) with the system C compiler, or zig cc "
+                           "(pip install ziglang)") from None
 
 
 def _run_time_input(ev: ExpressionEvaluator, passed: tuple[s.Expr, ...],
