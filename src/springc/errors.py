@@ -9,7 +9,8 @@ from __future__ import annotations
 import unicodedata
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from pathlib import Path
+
+from .source_files import read_regular
 
 
 @dataclass(frozen=True, slots=True)
@@ -197,8 +198,8 @@ def read_source(path: str) -> str | None:
     if path.startswith("<") and path.endswith(">"):
         return path.text if isinstance(path, SourceName) else None
     try:
-        return Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        return read_regular(path).decode("utf-8", "replace")
+    except OSError:
         return None
 
 

@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections import OrderedDict
 from pathlib import Path
 
-from ..errors import LoadError
 from ..ir import syntax as s
 from .parsed_store import ParsedStore
+from .source_text import read_source_file
 
 MAX_SOURCE_BYTES = 32 << 20
 """Source text whose trees the shared cache keeps (32 MiB: the files of the Modelica
@@ -62,11 +62,7 @@ class ParseCache:
     def _read(self, path: Path) -> s.StoredDefinition:
         """The tree of ``path``: from the store where it holds the file's bytes, else
         parsed (and stored)."""
-        try:
-            data = path.read_bytes()
-            text = data.decode("utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise LoadError(f"cannot read '{path}': {exc}") from None
+        data, text = read_source_file(path)
         if self.store is not None:
             found = self.store.load(path, data)
             if found is not None:
@@ -104,3 +100,4 @@ def parse_cached(path: Path) -> s.StoredDefinition:
 def clear_parse_cache() -> None:
     """Forget every parsed file (benchmarks measure loading from scratch with it)."""
     SHARED.clear()
+
