@@ -233,11 +233,23 @@ def _excerpt(span: Span, lookup: SourceLookup) -> list[str]:
     def at(column: int) -> int:  # 0-based position of a 1-based column in the shown line
         return starts[min(max(column - 1, 0), len(pieces))]
 
+    start = at(span.column)
     end = at(span.end_column) if span.end_line == span.line else len(line)
-    width = max(1, end - at(span.column))
+    width = max(1, end - start)
+    if len(line) > EXCERPT_WIDTH:  # a window around the caret, not 40,000 columns
+        lo = max(0, min(start - EXCERPT_BEFORE, len(line) - EXCERPT_WIDTH))
+        hi = lo + EXCERPT_WIDTH
+        line = ("..." if lo else "") + line[lo:hi] + ("..." if hi < len(line) else "")
+        width = max(1, min(width, hi - start))
+        start += 3 - lo if lo else 0
     gutter = f"{span.line:>5} | "
-    return [gutter + line,
-            " " * (len(gutter) - 2) + "| " + " " * at(span.column) + "^" * width]
+    return [gutter + line, " " * (len(gutter) - 2) + "| " + " " * start + "^" * width]
+
+
+EXCERPT_WIDTH = 160
+"""The columns of a source line shown under a message; a longer line is shown around
+the caret, from :data:`EXCERPT_BEFORE` columns before it, with ``...`` where cut."""
+EXCERPT_BEFORE = 40
 
 
 def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -> list[str]:
