@@ -39,7 +39,14 @@ from .connect import (
     cardinality_call,
     graph_value,
 )
-from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
+from .events import (
+    DELAY,
+    EVENT_CALLS,
+    check_arithmetic_operands,
+    check_unary_operand,
+    delay_call,
+    event_call,
+)
 from .names import ReferenceResolver
 from .scopes import (
     ClassScope,
@@ -216,6 +223,7 @@ class Evaluator(ReferenceResolver):
     def _Unary(self, e: s.Unary, scope: Scope) -> a.Value:
         v = self.value(e.operand, scope)
         self._numeric(v, e.operand.span)
+        check_unary_operand(e.op, v, e.operand.span)
         if e.op == "-":
             return a.elementwise(x.neg, v)
         if e.op == "+":

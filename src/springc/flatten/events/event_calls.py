@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ...errors import FlattenError, describe_failure
+from ...errors import FlattenError, Span, describe_failure
 from ...ir import expr as x
 from ...ir import flat
 from ...ir import syntax as s
@@ -116,6 +116,23 @@ def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary
                 side.span, hint="arithmetic needs Integer or Real operands (Modelica 3.6, "
                 f"section 3.4); choose a number with an if-expression ('if {text} then "
                 "1.0 else 0.0')")
+
+
+def check_unary_operand(op: str, value: object, span: Span) -> None:
+    """``-true`` is a type error (section 3.4), and so is ``not 2`` (section 3.5: not
+    takes a Boolean)."""
+    if op == "not":
+        if type(value) is x.Const and not isinstance(value.value, (bool, np.bool_)) \
+                and isinstance(value.value, (int, float, np.integer, np.floating)):
+            raise FlattenError(f"'not' needs a Boolean operand, found the number "
+                               f"{x.to_text(value)}", span,
+                               hint="compare the number, e.g. 'not (i <> 0)' (Modelica "
+                               "3.6, section 3.5)")
+    elif surely_boolean(value):
+        assert isinstance(value, x.Expr)
+        raise FlattenError(f"'{x.to_text(value)}' is a Boolean and cannot be an operand "
+                           f"of unary '{op}'", span, hint="arithmetic needs Integer or "
+                           "Real operands (Modelica 3.6, section 3.4)")
 
 
 def surely_boolean(value: object) -> bool:
