@@ -40,8 +40,10 @@ def assertion_function(m: CodegenContext, namer: Namer, helpers: set[str], numba
     items = m.ode.assertions
     stmts: list[Stmt] = []
     if items:
-        steps, _ = m.step_stmts()
         read = sorted({n for item in items for n in variables(item.condition)})
+        # conditions on parameters only (a sample interval's): no step of the model
+        steps = [] if all(parameters_only(item, m.ode) for item in items) \
+            else m.step_stmts()[0]
         stmts = m.loads() + steps + m.alias_stmts(read)
     stmts.append(Raw(f"ok = np.empty({len(items)})"))
     layout = m.events  # initial() and terminal() read their event slots
