@@ -54,6 +54,24 @@ def test_a_model_not_in_the_cache_says_it_compiles_once(tmp_path: Path) -> None:
     assert not any(line.startswith("springc: ") for line in again)
 
 
+@pytest.mark.parametrize("no_cache", [[], ["--no-cache"]])
+def test_no_status_line_before_a_syntax_error_or_a_file_without_a_model(
+        tmp_path: Path, no_cache: list[str]) -> None:
+    """The line says a model compiles: not said for files that hold none."""
+    bad = tmp_path / "bad.mo"
+    bad.write_text("model Bad\n  Real x\nend Bad;\n")
+    run = CliRunner().invoke(main, ["simulate", str(bad), *no_cache])
+    assert (run.exit_code, run.stderr.splitlines()[0]) == (
+        1, f"{bad}:3:1: error: unexpected 'end', expected one of: ';', ',', '=', '(', "
+        "'[', ...")
+    empty = tmp_path / "empty.mo"
+    empty.write_text("")
+    run = CliRunner().invoke(main, ["simulate", str(empty), *no_cache])
+    assert (run.exit_code, run.stderr) == (
+        1, f"error: no model found in {empty}\n"
+        "help: name a file that defines a model, or use --model\n")
+
+
 def test_quiet_silences_the_status_line(tmp_path: Path) -> None:
     assert _simulate(tmp_path, "--quiet") == []
 

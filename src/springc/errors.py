@@ -9,7 +9,8 @@ from __future__ import annotations
 import unicodedata
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
-from pathlib import Path
+
+from .source_files import read_regular
 
 
 @dataclass(frozen=True, slots=True)
@@ -24,6 +25,12 @@ class Span:
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.column}"
+
+    def width(self, default: int = 1) -> int:
+        """The columns it covers on its first line; ``default`` where it spans lines."""
+        if self.end_line == self.line and self.end_column > self.column:
+            return self.end_column - self.column
+        return default
 
     def __reduce__(self) -> tuple[type[Span], tuple[str, int, int, int, int]]:
         # a call, not dataclass's generic state of slots (a fields() walk per span)
@@ -114,6 +121,20 @@ class SimulationError(SpringcError):
     """The solver failed; the message names the time and the quantity at fault."""
 
 
+class UnknownParameterError(SimulationError):
+    """A value given for ``name``, which is neither a parameter nor a start value of
+    the model. The command line reports it as a misuse of the option that gave the
+    value (:meth:`given_as`, exit 2)."""
+
+    def __init__(self, message: str, *, name: str = "", hint: str | None = None) -> None:
+        super().__init__(message, hint=hint)
+        self.name = name
+
+    def given_as(self, option: str) -> UsageError:
+        return UsageError(f"{option} {self.name}: {self.message}", option=option,
+                          hint=self.hint)
+
+
 class CodegenError(SpringcError):
     """The model uses something the code generator cannot translate."""
 
@@ -177,8 +198,8 @@ def read_source(path: str) -> str | None:
     if path.startswith("<") and path.endswith(">"):
         return path.text if isinstance(path, SourceName) else None
     try:
-        return Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        return read_regular(path).decode("utf-8", "replace")
+    except OSError:
         return None
 
 
@@ -212,11 +233,23 @@ def _excerpt(span: Span, lookup: SourceLookup) -> list[str]:
     def at(column: int) -> int:  # 0-based position of a 1-based column in the shown line
         return starts[min(max(column - 1, 0), len(pieces))]
 
+    start = at(span.column)
     end = at(span.end_column) if span.end_line == span.line else len(line)
-    width = max(1, end - at(span.column))
+    width = max(1, end - start)
+    if len(line) > EXCERPT_WIDTH:  # a window around the caret, not 40,000 columns
+        lo = max(0, min(start - EXCERPT_BEFORE, len(line) - EXCERPT_WIDTH))
+        hi = lo + EXCERPT_WIDTH
+        line = ("..." if lo else "") + line[lo:hi] + ("..." if hi < len(line) else "")
+        width = max(1, min(width, hi - start))
+        start += 3 - lo if lo else 0
     gutter = f"{span.line:>5} | "
-    return [gutter + line,
-            " " * (len(gutter) - 2) + "| " + " " * at(span.column) + "^" * width]
+    return [gutter + line, " " * (len(gutter) - 2) + "| " + " " * start + "^" * width]
+
+
+EXCERPT_WIDTH = 160
+"""The columns of a source line shown under a message; a longer line is shown around
+the caret, from :data:`EXCERPT_BEFORE` columns before it, with ``...`` where cut."""
+EXCERPT_BEFORE = 40
 
 
 def _located(kind: str, message: str, span: Span | None, lookup: SourceLookup) -> list[str]:

@@ -96,6 +96,5 @@ def test_terminal_is_no_number(tmp_path: Path) -> None:
         "operand of '*'\n"
         "    4 |   t = 2.0*terminal();\n"
         "      |           ^^^^^^^^^^\n"
-        "help: terminal returns a Boolean, and arithmetic needs Integer or Real operands; "
-        "choose a number with an if-expression ('if terminal() then 1.0 else 0.0') "
-        "(Modelica 3.6, section 3.7.5)")
+        "help: arithmetic needs Integer or Real operands (Modelica 3.6, section 3.4); "
+        "choose a number with an if-expression ('if terminal() then 1.0 else 0.0')")

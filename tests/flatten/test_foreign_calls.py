@@ -349,3 +349,20 @@ def test_a_model_writes_no_file(tmp_path: Path) -> None:
         "nor call impure functions; the call of 'ForeignLib.writeText' is skipped (it "
         f"calls 'ForeignLib.writeText' on the file '{target}')",)
     assert not target.exists()
+
+
+def test_a_header_that_never_finishes_compiling_is_stopped(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A header that includes itself twice (2^200 inclusions) would keep the compiler
+    busy for ever: each of its processes has a CPU-time limit (1 s here)."""
+    monkeypatch.setenv("SPRINGC_COMPILE_CPU_SECONDS", "1")
+    libs = _library(tmp_path / "libs", "Include", None)
+    (libs / "Lib" / "Resources" / "Include" / "h.h").write_text(
+        '#include "h.h"\n#include "h.h"\ndouble lib_f(double x);\n')
+    err = _error("Lib.M", [libs])
+    assert err.message == ("the external function 'Lib.f' ('lib_f') could not be built: "
+                           "the C compiler did not finish the library's C sources within "
+                           "its limit of 1 CPU seconds")
+    assert err.hint == ("a header or source that never finishes compiling (one that "
+                        "includes itself?); if the code really needs longer, set "
+                        "SPRINGC_COMPILE_CPU_SECONDS=N")

@@ -9,6 +9,7 @@ import pytest
 
 from springc.errors import ErrorGroup, FlattenError
 from springc.flatten import flatten
+from springc.ir.nodes import Const
 from springc.parse import load
 
 # 2 scalars in `a`, an array of 3 components, 1 scalar in each (8 elements in all), and a
@@ -183,3 +184,38 @@ def test_string_widths_past_the_cap_are_refused(tmp_path: Path, call: str,
         flatten(load([path]), "W", max_size=2000)
     err = caught.value.errors[0] if isinstance(caught.value, ErrorGroup) else caught.value
     assert isinstance(err, FlattenError) and err.message == message
+
+
+COUNTING = """
+model W
+  function count
+    input Integer n;
+    output Integer i = 0;
+  algorithm
+    while i < n loop
+      i := i + 1;
+    end while;
+  end count;
+  parameter Integer k = count({n});
+  Real x = k;
+end W;
+"""
+
+
+def test_one_while_loop_runs_a_hundredth_of_the_cap(tmp_path: Path) -> None:
+    """A while loop whose condition never becomes false fails after max_size / 100
+    iterations (1000 here), at the loop, long before the cap of all loops (100 s at the
+    default cap of 2 million)."""
+    path = tmp_path / "w.mdl"
+    path.write_text(COUNTING.format(n=1000))
+    flat = flatten(load([path]), "W", max_size=100_000)
+    assert [p.binding for p in flat.parameters] == [Const(1000)]
+    path.write_text(COUNTING.format(n=1001))
+    with pytest.raises(FlattenError) as caught:
+        flatten(load([path]), "W", max_size=100_000)
+    err = caught.value
+    assert err.message == "this while loop did not end within 1000 iterations"
+    assert err.span is not None and (err.span.line, err.span.column) == (7, 5)
+    assert err.hint is not None and err.hint.endswith(
+        "raise the cap with springc --max-size N, SPRINGC_MAX_SIZE=N or "
+        "flatten(..., max_size=N)")

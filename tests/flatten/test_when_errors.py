@@ -140,3 +140,24 @@ def test_bad_hybrid_input_is_located(tmp_path: Path, monkeypatch: pytest.MonkeyP
     result = CliRunner().invoke(main, [command, "M.mo"], prog_name="springc",
                                 env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
     assert (result.exit_code, result.stderr) == (1, expected)
+
+
+def test_a_sample_interval_set_to_zero_for_a_run_is_located(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A parameter interval is checked when the model is flattened with its own value,
+    and by an assertion in the flat model when a run sets another (``--set T=0``)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    Path("M.mo").write_text("model M\n  parameter Real T = 0.5;\n  discrete Real y(start = 0);"
+                            "\nequation\n  when sample(0, 2*T) then\n    y = pre(y) + 1;\n"
+                            "  end when;\nend M;\n")
+    result = CliRunner().invoke(main, ["simulate", "M.mo", "--set", "T=0"],
+                                prog_name="springc",
+                                env={"SPRINGC_PATH": "", "MODELICAPATH": ""})
+    assert (result.exit_code, result.stderr) == (1, (
+        "M.mo:5:18: error: assertion failed before the simulation started: the interval "
+        "of sample(start, interval) must be positive: 2 * T <= 0\n"
+        "    5 |   when sample(0, 2*T) then\n"
+        "      |                  ^^^\n"
+        "help: the model left the range its author allowed; check the parameters (--set) "
+        "and start values\n"))

@@ -143,6 +143,6 @@ def test_windows_newlines_and_unreadable_bytes_read_as_from_text(tmp_path: Path)
     b.write_bytes(b"model B\n  Real \xff;\nend B;\n")
     with pytest.raises(LoadError) as caught:
         _fresh(tmp_path / "store").parse(b)
-    assert caught.value.message == (
-        f"cannot read '{b}': 'utf-8' codec can't decode byte 0xff in position 15: "
-        "invalid start byte")
+    assert caught.value.message == f"'{b}' is not UTF-8 text: byte 0xff invalid start byte"
+    assert caught.value.span is not None and \
+        (caught.value.span.line, caught.value.span.column) == (2, 8)

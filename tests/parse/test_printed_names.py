@@ -55,3 +55,14 @@ def test_the_summary_lines_escape_the_model_name(tmp_path: Path) -> None:
                                     "-o", str(tmp_path / "m.csv")])
     assert run.exit_code == 0, run.output
     assert run.stderr.startswith("M\\nerror: forged: ") and run.stderr.count("\n") == 1
+
+
+def test_a_long_source_line_is_shown_around_the_caret() -> None:
+    """A 1,000-column line shows 160 columns from 40 before the caret, cut with ..."""
+    text = "x" * 500 + "BAD" + "y" * 497
+    error = SpringcError("bad", Span("m.mo", 1, 501, 1, 504))
+    assert render(error, lambda _: text).splitlines()[1:] == [
+        "    1 | ..." + "x" * 40 + "BAD" + "y" * 117 + "...",
+        "      | " + " " * 43 + "^^^"]
+    short = SpringcError("bad", Span("m.mo", 1, 2, 1, 3))
+    assert render(short, lambda _: "abc").splitlines()[1:] == ["    1 | abc", "      |  ^"]

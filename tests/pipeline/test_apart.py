@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -27,9 +28,10 @@ def _derivations(monkeypatch: pytest.MonkeyPatch) -> list[str]:
     calls: list[str] = []
     derive = generation.derive_system
 
-    def counted(options: springc.pipeline.CompileOptions) -> springc.pipeline.Derived:
+    def counted(options: springc.pipeline.CompileOptions,
+                parsed: Callable[[], None] | None = None) -> springc.pipeline.Derived:
         calls.append(str(options.model))
-        return derive(options)
+        return derive(options, parsed)
 
     monkeypatch.setattr(generation, "derive_system", counted)
     return calls

@@ -171,9 +171,9 @@ def test_a_module_too_long_for_numba_reuses_the_derived_system(
     calls: list[str | None] = []
     derive = generation.derive_system
 
-    def counted(options):
+    def counted(options, parsed=None):
         calls.append(options.backend)
-        return derive(options)
+        return derive(options, parsed)
 
     monkeypatch.setattr(generation, "derive_system", counted)
     monkeypatch.setattr(api, "NUMBA_LINES", 1)
@@ -198,9 +198,9 @@ def test_a_structural_model_too_long_for_numba_is_derived_once(
     calls: list[tuple[tuple[str, str], ...]] = []
     derive = generation.derive_system
 
-    def counted(options):
+    def counted(options, parsed=None):
         calls.append(options.modifications)
-        return derive(options)
+        return derive(options, parsed)
 
     monkeypatch.setattr(generation, "derive_system", counted)
     monkeypatch.setattr(api, "NUMBA_LINES", 1)

@@ -108,12 +108,12 @@ def test_cli_exit_code_and_location(tmp_path: Path) -> None:
 
 def test_generated_module_holds_the_messages_as_literals(tmp_path: Path) -> None:
     path = tmp_path / "q.mo"
-    path.write_text('model Q\n  Real x = time;\nequation\n'
-                    '  assert(x < 2, "\\"\\"\\" + __import__(\'os\')");\nend Q;\n')
+    statement = 'assert(x < 2, "\\"\\"\\" + __import__(\'os\')")'
+    path.write_text(f'model Q\n  Real x = time;\nequation\n  {statement};\nend Q;\n')
     compiled = springc.compile_model(str(path))
     module = compiled.module
     assert (('""" + __import__(\'os\')', "error",
-                                  f"{path}:4:3", False),) == module.ASSERTIONS
+             f"{path}:4:3", False, len(statement)),) == module.ASSERTIONS
     p = module.parameters()
     assert module.assertions(1.0, np.zeros(0), p, module.guesses(p)).tolist() == [1.0]
     assert module.assertions(2.5, np.zeros(0), p, module.guesses(p)).tolist() == [0.0]

@@ -13,7 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import springc
-from springc.errors import SimulationError, UsageError
+from springc.errors import UsageError
 from springc.studies import (
     Study,
     StudyOptions,
@@ -163,9 +163,11 @@ def test_resume_refuses_the_partial_results_of_another_study(cache: Path,
 
 def test_bad_studies_are_refused_before_any_run(cache: Path) -> None:
     model = springc.compile_model(SEED)
-    with pytest.raises(SimulationError, match=r"'spring\.q' is not a parameter or a state of "
-                       "SpringMass"):
+    with pytest.raises(UsageError) as unknown:
         run_study(model, StudyOptions((parse_parameter("spring.q=1,2"),)))
+    assert (unknown.value.option, unknown.value.message) == (
+        "--param", "--param spring.q: 'spring.q' is not a parameter or a state of SpringMass")
+    assert unknown.value.hint == "did you mean 'spring.k' or 'spring.l'?"
     with pytest.raises(UsageError, match="both swept"):
         run_study(model, StudyOptions((parse_parameter("spring.k=1,2"),),
                                       fixed=(("spring.k", 3.0),)))

@@ -14,7 +14,16 @@ from typing import Any
 
 import click
 
-from ..errors import ErrorGroup, OutputError, Span, SpringcError, UnitError, UsageError, render
+from ..errors import (
+    ErrorGroup,
+    OutputError,
+    Span,
+    SpringcError,
+    UnitError,
+    UnknownParameterError,
+    UsageError,
+    render,
+)
 from ..simulation import (
     ALL_SOLVERS,
     DEFAULT_ENGINE,
@@ -80,6 +89,16 @@ def verbosity_options(quiet_help: str) -> Callable[[Callable[..., Any]], Callabl
                             "debugging (tracebacks of internal errors, the generated "
                             "module's path).")(func)
     return decorate
+
+
+@contextlib.contextmanager
+def values_named_by(option: str) -> Iterator[None]:
+    """A value for a name the model lacks, given by ``option`` (``--set``), is a
+    misuse of that option: exit 2 naming it, with the did-you-mean hint."""
+    try:
+        yield
+    except UnknownParameterError as err:
+        raise err.given_as(option) from None
 
 
 def verbosity() -> int:

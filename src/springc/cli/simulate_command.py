@@ -24,6 +24,7 @@ from .options import (
     single_threaded_blas,
     units_option,
     unmapped_large_buffers,
+    values_named_by,
     verbosity,
     verbosity_options,
 )
@@ -87,7 +88,8 @@ def simulate(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
         with collector_paused():  # until its one collection, release_compile_memory's
             # a model not in the cache: compiled in a child process that exits before
             # the run
-            compiled = compiled_here() if no_cache else compiled_apart(compiled_here)
+            with values_named_by("--set"):
+                compiled = compiled_here() if no_cache else compiled_apart(compiled_here)
             report_units(compiled.warnings, strict_units)
             if not compiled.cached:
                 release_compile_memory()

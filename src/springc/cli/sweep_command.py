@@ -19,6 +19,7 @@ from .options import (
     run_settings_options,
     sampling_options,
     single_threaded_blas,
+    values_named_by,
     verbosity,
     verbosity_options,
 )
@@ -90,7 +91,7 @@ def sweep(files: tuple[str, ...], model: str | None, libraries: tuple[str, ...],
                            scheduler=scheduler, energy=energy).running(settings)
     parameter_table(options)  # refuse bad specifications before compiling
 
-    with silenced(quiet):  # the status line of a model that compiles
+    with silenced(quiet), values_named_by("--set"):  # the status line of a compile
         compiled = compile_model(files, model, libraries=libraries,
                                  backend=default_choice(backend, solver=settings.solver),
                                  outputs=patterns or None, parameters=settings.parameters,

@@ -17,6 +17,7 @@ from .options import (
     model_options,
     run_settings_options,
     single_threaded_blas,
+    values_named_by,
     verbosity,
     verbosity_options,
 )
@@ -150,10 +151,11 @@ def tradeoff(files: tuple[str, ...], model: str | None, libraries: tuple[str, ..
 
     # numba by default: the runs of solvers with a compiled loop run there (many runs
     # share one compilation)
-    compiled = compile_model(files, model, libraries=libraries,
-                             backend=default_choice(backend),
-                             outputs=patterns or None, parameters=values,
-                             cache=not no_cache)
+    with values_named_by("--set"):
+        compiled = compile_model(files, model, libraries=libraries,
+                                 backend=default_choice(backend),
+                                 outputs=patterns or None, parameters=values,
+                                 cache=not no_cache)
     if not patterns:
         compiled = compare_states(compiled)
     rest = {k: v for k, v in values.items() if k not in compiled.structural}

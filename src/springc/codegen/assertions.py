@@ -1,10 +1,11 @@
 """The assertions of a generated module: ``ASSERTIONS`` and ``assertions(t, x, p, z)``.
 
-``ASSERTIONS`` is a tuple of ``(message, level, location, parameters_only)`` per
-``assert`` of the model, written as a ``repr`` literal (model text is data: the
-message reaches the module only so). ``assertions(t, x, p, z)`` returns one number
-per assertion, 1.0 where its condition holds and 0.0 where it fails; it computes the
-steps and aliases its conditions read, as ``observed`` does.
+``ASSERTIONS`` is a tuple of ``(message, level, location, parameters_only, width)``
+per ``assert`` of the model (``width``: of the caret under the location), written as a
+``repr`` literal (model text is data: the message reaches the module only so).
+``assertions(t, x, p, z)`` returns one number per assertion, 1.0 where its condition
+holds and 0.0 where it fails; it computes the steps and aliases its conditions read, as
+``observed`` does.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ def assertion_table(system: ode.ODE) -> str:
     """The ``ASSERTIONS`` constant's value as Python text."""
     rows = tuple((item.message, item.level,
                   f"{item.span.file}:{item.span.line}:{item.span.column}",
-                  parameters_only(item, system)) for item in system.assertions)
+                  parameters_only(item, system), item.span.width(len("assert")))
+                 for item in system.assertions)
     return repr(rows)
 
 
@@ -38,8 +40,10 @@ def assertion_function(m: CodegenContext, namer: Namer, helpers: set[str], numba
     items = m.ode.assertions
     stmts: list[Stmt] = []
     if items:
-        steps, _ = m.step_stmts()
         read = sorted({n for item in items for n in variables(item.condition)})
+        # conditions on parameters only (a sample interval's): no step of the model
+        steps = [] if all(parameters_only(item, m.ode) for item in items) \
+            else m.step_stmts()[0]
         stmts = m.loads() + steps + m.alias_stmts(read)
     stmts.append(Raw(f"ok = np.empty({len(items)})"))
     layout = m.events  # initial() and terminal() read their event slots

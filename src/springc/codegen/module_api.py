@@ -89,7 +89,8 @@ class GeneratedModule(Protocol):
     JAC_INDICES: IntArray
     JAC_INDPTR: IntArray
     EVENTS: bool  # a hybrid module: it has the names of HybridModule too
-    ASSERTIONS: tuple[tuple[str, str, str, bool], ...]  # message, level, location, params only
+    # message, level, location, params only, caret width
+    ASSERTIONS: tuple[tuple[str, str, str, bool, int], ...]
 
     def parameters(self, values: Mapping[str, float] | None = None) -> FloatArray: ...
 

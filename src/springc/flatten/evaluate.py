@@ -39,7 +39,14 @@ from .connect import (
     cardinality_call,
     graph_value,
 )
-from .events import DELAY, EVENT_CALLS, check_arithmetic_operands, delay_call, event_call
+from .events import (
+    DELAY,
+    EVENT_CALLS,
+    check_arithmetic_operands,
+    check_unary_operand,
+    delay_call,
+    event_call,
+)
 from .names import ReferenceResolver
 from .scopes import (
     ClassScope,
@@ -216,6 +223,7 @@ class Evaluator(ReferenceResolver):
     def _Unary(self, e: s.Unary, scope: Scope) -> a.Value:
         v = self.value(e.operand, scope)
         self._numeric(v, e.operand.span)
+        check_unary_operand(e.op, v, e.operand.span)
         if e.op == "-":
             return a.elementwise(x.neg, v)
         if e.op == "+":
@@ -241,7 +249,7 @@ class Evaluator(ReferenceResolver):
                 raise
             return x.Const(decided)
         scalar = _ARITHMETIC.get(e.op)
-        if scalar is not None and (type(left) is x.Call or type(right) is x.Call):
+        if scalar is not None:
             check_arithmetic_operands(e.op, (left, right), e)
         if scalar is not None and type(left) in _SCALARS and type(right) in _SCALARS:
             # the common case: no sizes to check

@@ -12,7 +12,6 @@ A machine without a C compiler gets a sources-only FMU: the caller reports the n
 from __future__ import annotations
 
 import os
-import subprocess
 import tempfile
 import zipfile
 from collections.abc import Iterable, Mapping, Sequence
@@ -21,6 +20,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..fileio import atomic_write
+from ..native import run_compiler
 from ..pipeline import CCompilerMissing, find_compiler
 
 WRAPPER = {
@@ -78,10 +78,10 @@ def build_binary(sources: Mapping[str, bytes], version: int, identifier: str,
         argv = [*compiler, *COMPILER_FLAGS, "-I", str(root),
                 *(str(root / name) for name in compile_sources(version)), "-lm",
                 "-o", str(target)]
-        done = subprocess.run(argv, capture_output=True, text=True, check=False)
-        if done.returncode != 0:
+        code, messages = run_compiler(argv, None, "the FMU's sources")
+        if code != 0:
             raise BuildError(f"the C compiler failed on the FMU's sources: "
-                             f"{done.stderr.strip()[:2000]}")
+                             f"{messages.strip()[:2000]}")
         return target.read_bytes()
 
 

@@ -3,7 +3,15 @@ no numpy, numba or scipy is imported (:mod:`.runner`). The library is built by
 :func:`springc.pipeline.loop_library` from the text of
 :func:`springc.integrate.native_loop.loop_text`; see ``docs/c_model.md``."""
 
-from .compiler import COMPILERS, ZIG_MODULE, CCompilerMissing, find_compiler, first_error
+from .compiler import (
+    COMPILERS,
+    ZIG_MODULE,
+    CCompilerMissing,
+    CompilerOutOfTime,
+    find_compiler,
+    first_error,
+    run_compiler,
+)
 from .runner import (
     FIRST_STRETCH,
     LIBRARY_FILE,
@@ -25,10 +33,12 @@ __all__ = [
     "STRETCH_GROWTH",
     "ZIG_MODULE",
     "CCompilerMissing",
+    "CompilerOutOfTime",
     "LoopLibrary",
     "LoopRun",
     "cached_library",
     "find_compiler",
     "first_error",
     "read_verified",
+    "run_compiler",
 ]

@@ -22,7 +22,6 @@ import contextlib
 import ctypes
 import hashlib
 import re
-import subprocess
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,7 +29,7 @@ from pathlib import Path
 from ..errors import SpringcError
 from ..fileio import keep_newest, replace_private
 from ..resources import CacheUnusable, private_folder, user_cache_dir
-from .compiler import find_compiler, first_error
+from .compiler import find_compiler, first_error, run_compiler
 from .runner import read_verified
 
 FLAGS = ("-O2", "-g0", "-shared", "-fPIC", "-DNDEBUG", "-DHAVE_UNISTD_H",
@@ -181,12 +180,12 @@ def _compile(build: ForeignBuild, compiler: list[str]) -> bytes:
             files.append(path)
         flags = [f"-I{folder or '.'}" for folder in sorted(includes)]
         argv = [*compiler, *FLAGS, *flags, "-o", "foreign.so", *files, "-lm"]
-        done = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=root)
+        code, messages = run_compiler(argv, root, "the library's C sources")
         out = root / "foreign.so"
-        if done.returncode != 0 or not out.is_file():
+        if code != 0 or not out.is_file():
             raise ForeignBuildFailed(
                 f"the C compiler refused the library's C sources ({argv[0]} exit "
-                f"{done.returncode}): " + first_error(done.stderr, 300))
+                f"{code}): " + first_error(messages, 300))
         return out.read_bytes()
 
 

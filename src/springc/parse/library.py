@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..resources import models_dir
+from ..source_files import read_regular
 
 SUFFIXES = (".mo", ".mdl")
 PACKAGE_FILES = tuple(f"package{suffix}" for suffix in SUFFIXES)
@@ -89,7 +90,7 @@ def class_file(folder: Path, name: str) -> Path | None:
 def package_order(folder: Path) -> list[str]:
     """The class names listed in ``folder/package.order`` (empty if there is none)."""
     try:
-        text = (folder / ORDER_FILE).read_text(encoding="utf-8")
+        text = read_regular(folder / ORDER_FILE).decode("utf-8")
     except (OSError, UnicodeDecodeError):
         return []
     return [line.strip() for line in text.splitlines() if _FILE_NAME.match(line.strip())]

@@ -26,6 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..source_files import read_regular
 from .library import class_file, loose_files, package_order, stored_names
 
 FORMAT = 1
@@ -38,7 +39,7 @@ Record = dict[str, Any]
 def digest(path: Path) -> str | None:
     """The SHA-256 of a file's bytes (hex), None if it cannot be read."""
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        return hashlib.sha256(read_regular(path)).hexdigest()
     except OSError:
         return None
 

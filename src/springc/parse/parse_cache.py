@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections import OrderedDict
 from pathlib import Path
 
-from ..errors import LoadError
 from ..ir import syntax as s
 from .parsed_store import ParsedStore
+from .source_text import read_source_file
 
 MAX_SOURCE_BYTES = 32 << 20
 """Source text whose trees the shared cache keeps (32 MiB: the files of the Modelica
@@ -41,12 +41,12 @@ class ParseCache:
 
     def parse(self, path: Path) -> s.StoredDefinition:
         """The tree of ``path``, parsed again only where the file changed."""
-        name, data = str(path), _read_bytes(path)
+        name, (data, text) = str(path), read_source_file(path)
         found = self._trees.get(name)
         if found is not None and found[0] == data:
             self._trees.move_to_end(name)
             return found[1]
-        stored = self._read(path, data)
+        stored = self._read(path, data, text)
         self._forget(name)
         if len(data) <= self.max_bytes:
             self._trees[name] = (data, stored)
@@ -55,13 +55,9 @@ class ParseCache:
                 self._forget(next(iter(self._trees)))
         return stored
 
-    def _read(self, path: Path, data: bytes) -> s.StoredDefinition:
-        """The tree of ``path`` holding ``data``: from the store where it holds these
-        bytes, else parsed (and stored)."""
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise LoadError(f"cannot read '{path}': {exc}") from None
+    def _read(self, path: Path, data: bytes, text: str) -> s.StoredDefinition:
+        """The tree of ``path`` holding ``data`` (``text``): from the store where it
+        holds these bytes, else parsed (and stored)."""
         if self.store is not None:
             found = self.store.load(path, data)
             if found is not None:
@@ -86,15 +82,6 @@ class ParseCache:
             self.size -= len(found[0])
 
 
-def _read_bytes(path: Path) -> bytes:
-    """The bytes of ``path``; a file that cannot be read is a :class:`LoadError`
-    naming it."""
-    try:
-        return path.read_bytes()
-    except OSError as exc:
-        raise LoadError(f"cannot read '{path}': {exc}") from None
-
-
 SHARED = ParseCache(store=ParsedStore())
 """The cache of this process, used by :func:`parse_cached`, over the trees of the user's
 cache folder."""
@@ -108,3 +95,4 @@ def parse_cached(path: Path) -> s.StoredDefinition:
 def clear_parse_cache() -> None:
     """Forget every parsed file (benchmarks measure loading from scratch with it)."""
     SHARED.clear()
+

@@ -26,10 +26,11 @@ import lark
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedCharacters, UnexpectedInput, UnexpectedToken
 
-from ..errors import LoadError, ParseError, Span
+from ..errors import ParseError, Span
 from ..ir.syntax import Expr, StoredDefinition
 from ..resources import CacheUnusable, grammar_path, private_folder, user_cache_dir
 from .builder import build
+from .source_text import read_source_file
 
 __all__ = ["parse_expression", "parse_file", "parse_text"]
 
@@ -126,11 +127,7 @@ def parse_text(text: str, file: str, defer: bool = False) -> StoredDefinition:
 
 def parse_file(path: str | Path, defer: bool = False) -> StoredDefinition:
     """Read and parse one ``.mo``/``.mdl`` file; :class:`LoadError` if it cannot be read."""
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise LoadError(f"cannot read '{path}': {exc}") from None
-    return parse_text(text, str(path), defer)
+    return parse_text(read_source_file(path)[1], str(path), defer)
 
 
 def parse_expression(text: str, file: str = "<expr>") -> Expr:

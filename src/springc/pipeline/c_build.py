@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import subprocess
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -24,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ..codegen import CodegenBug
-from ..native import ZIG_MODULE, CCompilerMissing, find_compiler, first_error
+from ..native import ZIG_MODULE, CCompilerMissing, find_compiler, first_error, run_compiler
 from .cache import add_to_entry, read_addition
 from .compiler import CompiledModel
 
@@ -62,11 +61,11 @@ def build_library(source: str, folder: Path, extra: Sequence[str] = ()) -> bytes
     # names relative to the folder: the library records "build.c", not a random path,
     # so two builds of one text give the same bytes
     argv = [*find_compiler(), *C_FLAGS, *extra, "-o", "build.so", "build.c", "-lm"]
-    done = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=folder)
-    if done.returncode != 0 or not out.is_file():
+    code, messages = run_compiler(argv, folder, "springc's C model")
+    if code != 0 or not out.is_file():
         raise CompilerRefused("the C compiler refused springc's C model "
-                              f"({' '.join(argv[:1])} exit {done.returncode}): "
-                              + done.stderr.strip()[-2000:], done.stderr)
+                              f"({' '.join(argv[:1])} exit {code}): "
+                              + messages.strip()[-2000:], messages)
     return out.read_bytes()
 
 

@@ -22,7 +22,13 @@ from typing import Any
 
 from ..codegen import GeneratedModule, ModuleKind
 from ..collector import collector_paused
-from ..errors import CodegenError, SimulationError, UnitError, did_you_mean
+from ..errors import (
+    CodegenError,
+    SimulationError,
+    UnitError,
+    UnknownParameterError,
+    did_you_mean,
+)
 from ..ir.expr import recursion_room
 from ..native.foreign_calls import RunTimeCallRefused
 from ..parse import still_hold
@@ -247,12 +253,12 @@ def check_parameter_names(model: CompiledModel, values: Mapping[str, object]) ->
         if name in known or name in starts:
             continue
         if name in model.observed:
-            raise SimulationError(
+            raise UnknownParameterError(
                 f"'{name}' is not a parameter or a state of {model.name}: it is computed "
-                "from the states, so its start value is not an initial value",
+                "from the states, so its start value is not an initial value", name=name,
                 hint=f"set a parameter or the start of a state ({_listed(starts)})")
-        raise SimulationError(
-            f"'{name}' is not a parameter or a state of {model.name}",
+        raise UnknownParameterError(
+            f"'{name}' is not a parameter or a state of {model.name}", name=name,
             hint=did_you_mean(name, known + starts)
             or "parameters and states are named by their flat names, e.g. 'spring.k'")
 
@@ -366,8 +372,8 @@ def _derive_now(options: CompileOptions, folder: Path | None) -> Derived:
         deriving()
     from . import generation  # the compile path, loaded on a miss only
 
-    say(compiling_note(options, folder))
-    return generation.derive_system(options)
+    return generation.derive_system(options,
+                                    parsed=lambda: say(compiling_note(options, folder)))
 
 
 def request_key_of(options: CompileOptions) -> str:

@@ -10,7 +10,7 @@ tree as the user's files), and simplifies it.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from ..collector import collector_paused
 from ..flatten import flatten, select_model
@@ -25,13 +25,18 @@ WRAPPER_FILE = "<springc: structural parameters>"
 
 
 @collector_paused()
-def derive_system(options: CompileOptions) -> Derived:
-    """Flatten and simplify the model of ``options`` (structural values applied)."""
+def derive_system(options: CompileOptions,
+                  parsed: Callable[[], None] | None = None) -> Derived:
+    """Flatten and simplify the model of ``options`` (structural values applied);
+    ``parsed()`` is called once the given files parsed and hold the model (the status
+    line: never before a syntax error)."""
     tree = load(list(options.files), options.libraries, options.texts)
     model = options.model
+    entry = select_model(tree, model)
+    if parsed is not None:
+        parsed()
     base = None
     if options.modifications:
-        entry = select_model(tree, model)
         base = flatten(tree, model)
         model = _add_wrapper(tree, entry, options.modifications)
     flat_model = flatten(tree, model)

@@ -27,14 +27,14 @@ from ..ir import flat
 from .failures import format_time, state_notes
 
 
-def _span(location: str) -> Span | None:
+def _span(location: str, width: int) -> Span | None:
     file, _, rest = location.rpartition(":")
     file, _, line = file.rpartition(":")
     try:
         row, column = int(line), int(rest)
     except ValueError:
         return None
-    return Span(file, row, column, row, column + len("assert"))
+    return Span(file, row, column, row, column + width)
 
 
 class AssertionCheck:
@@ -42,7 +42,7 @@ class AssertionCheck:
 
     def __init__(self, module: Any, p: np.ndarray, names: tuple[str, ...],
                  stream: TextIO | None = None) -> None:
-        self.table: tuple[tuple[str, str, str, bool], ...] = tuple(
+        self.table: tuple[tuple[str, str, str, bool, int], ...] = tuple(
             getattr(module, "ASSERTIONS", ()))
         self.function = getattr(module, "assertions", None)
         self.p, self.names = p, names
@@ -122,7 +122,7 @@ class AssertionCheck:
         if held is None:
             return
         for i in map(int, np.flatnonzero(held == 0.0)):
-            message, level, location, constant = self.table[i]
+            message, level, location, constant, width = self.table[i]
             if constant and not first:
                 continue
             if before is not None and dense is not None and i not in self.warned:
@@ -139,7 +139,8 @@ class AssertionCheck:
                 continue
             notes = () if constant else state_notes(self.names, np.asarray(x), None)
             # not a solver failure (Stop): no other solver is tried
-            raise SimulationError(f"assertion failed {when}: {message}", _span(location),
+            raise SimulationError(f"assertion failed {when}: {message}",
+                                  _span(location, width),
                                   notes, hint="the model left the range its author "
                                   "allowed; check the parameters (--set) and start values")
 
@@ -171,6 +172,7 @@ def check_trajectory(assertions: Sequence[flat.Assertion], times: np.ndarray,
                               f"{format_time(float(t))}: {item.message}\n")
                 continue
             raise SimulationError(f"assertion failed at t = {format_time(float(t))}: "
-                                  f"{item.message}", _span(location),
+                                  f"{item.message}",
+                                  _span(location, item.span.width(len("assert"))),
                                   hint="the model left the range its author allowed; "
                                   "check the parameters (--set) and start values")

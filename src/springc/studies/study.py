@@ -16,7 +16,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from ..errors import SimulationError, UsageError, printable
+from ..errors import SimulationError, UnknownParameterError, UsageError, printable
 from ..pipeline import CompiledModel, check_parameter_names
 from ..simulation import output_grid, resolve
 from .engines import (
@@ -87,7 +87,10 @@ def check_names(model: CompiledModel, names: Sequence[str]) -> None:
     """Swept parameters must be parameters of ``model`` and not structural (Integer and
     Boolean parameters, array sizes: they change the equations). A start value is
     set for every run (``--set``), not swept: its column would be its variable's."""
-    check_parameter_names(model, dict.fromkeys(names, 0.0))
+    try:
+        check_parameter_names(model, dict.fromkeys(names, 0.0))
+    except UnknownParameterError as err:
+        raise err.given_as("--param") from None
     for name in names:
         if name not in model.parameter_names:
             raise UsageError(f"--param {name}: '{name}' is a start value, not a parameter; "

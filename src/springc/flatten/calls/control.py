@@ -46,6 +46,7 @@ def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
     """Run ``body`` while ``condition()`` (re-evaluated each time) is true; where the
     condition is known only during the simulation, ``at_run_time()`` runs the rest of
     the loop if it can (a counted search in a function: :mod:`.counted`)."""
+    done = 0
     while True:
         value = folded(condition())
         if not isinstance(value, x.Const) and ev.flattener.is_parameter_expression(value):
@@ -63,7 +64,8 @@ def run_while(ev: ExpressionEvaluator, stmt: s.WhileStatement,
                                hint="loop over a range (for i in 1:n) with break")
         if not value.value:
             return
-        ev.flattener.limits.add_iterations(1, stmt.span)
+        ev.flattener.limits.while_iteration(done, stmt.span)
+        done += 1
         try:
             body()
         except Jumped as jumped:

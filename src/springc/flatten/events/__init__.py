@@ -11,13 +11,25 @@ from .event_calls import (
     EVENT_CALLS,
     EVENT_EQUATIONS,
     check_arithmetic_operands,
+    check_unary_operand,
     event_call,
     event_dependent,
 )
 from .when import check_events, flatten_when, variable_if_equation
 
 __all__ = [
-    "DELAY", "EVENT_CALLS", "EVENT_EQUATIONS", "Section", "algorithm_section", "apply_starts",
-    "check_arithmetic_operands", "check_events", "delay_call", "event_call", "event_dependent",
-    "flatten_when", "variable_if_equation",
+    "DELAY",
+    "EVENT_CALLS",
+    "EVENT_EQUATIONS",
+    "Section",
+    "algorithm_section",
+    "apply_starts",
+    "check_arithmetic_operands",
+    "check_events",
+    "check_unary_operand",
+    "delay_call",
+    "event_call",
+    "event_dependent",
+    "flatten_when",
+    "variable_if_equation",
 ]

@@ -14,8 +14,11 @@ from __future__ import annotations
 
 import math
 
-from ...errors import FlattenError, describe_failure
+import numpy as np
+
+from ...errors import FlattenError, Span, describe_failure
 from ...ir import expr as x
+from ...ir import flat
 from ...ir import syntax as s
 from ...ir.builtins import BUILTINS, EQUATION, names
 from .. import arrays as a
@@ -81,11 +84,19 @@ def _check_sample(ev: ExpressionEvaluator, args: list[x.Expr], e: s.Call) -> Non
             raise FlattenError(f"the start of sample(start, interval) must be a finite "
                                f"time, found {number:g}", arg.span)
         if what == "interval" and not number > 0:
-            raise FlattenError(f"the interval of sample(start, interval) must be positive, "
-                               f"found {number:g}", arg.span,
+            raise FlattenError(f"{POSITIVE_INTERVAL}, found {number:g}", arg.span,
                                hint="sample(start, interval) is true at start, "
                                "start + interval, start + 2*interval... (Modelica 3.6, "
                                "section 3.7.5)")
+    interval = args[1]
+    if not isinstance(interval, x.Const):  # a run's parameter values may make it 0
+        positive = x.Call("noEvent", (x.BinOp(">", interval, x.Const(0.0)),))
+        ev.flattener.assertions.append((flat.Assertion(
+            positive, f"{POSITIVE_INTERVAL}: {x.to_text(interval)} <= 0", "error",
+            e.args[1].span, flat.Origin("equation", "", "sample")), e.args[1].span))
+
+
+POSITIVE_INTERVAL = "the interval of sample(start, interval) must be positive"
 
 
 #: Event built-ins whose value is a Boolean (3.7.5): never operands of arithmetic.
@@ -93,15 +104,47 @@ BOOLEAN_CALLS = names(lambda b: b.boolean)
 
 
 def check_arithmetic_operands(op: str, operands: tuple[object, ...], e: s.Binary) -> None:
-    """``2.0*terminal()`` is a type error: the Boolean event built-ins are no numbers."""
+    """``true + 1`` and ``2.0*terminal()`` are type errors: a Boolean (a literal, a
+    relation, ``not``/``and``/``or``, a Boolean event built-in) is no number (Modelica
+    3.6, section 3.4: arithmetic operates on numeric types)."""
     for value, side in zip(operands, (e.left, e.right)):
-        if type(value) is x.Call and value.name in BOOLEAN_CALLS:
+        if surely_boolean(value):
+            assert isinstance(value, x.Expr)
+            text = x.to_text(value)
             raise FlattenError(
-                f"'{x.to_text(value)}' is a Boolean and cannot be an operand of '{op}'",
-                side.span, hint=f"{value.name} returns a Boolean, and arithmetic needs "
-                "Integer or Real operands; choose a number with an if-expression "
-                f"('if {x.to_text(value)} then 1.0 else 0.0') (Modelica 3.6, section "
-                "3.7.5)")
+                f"'{text}' is a Boolean and cannot be an operand of '{op}'",
+                side.span, hint="arithmetic needs Integer or Real operands (Modelica 3.6, "
+                f"section 3.4); choose a number with an if-expression ('if {text} then "
+                "1.0 else 0.0')")
+
+
+def check_unary_operand(op: str, value: object, span: Span) -> None:
+    """``-true`` is a type error (section 3.4), and so is ``not 2`` (section 3.5: not
+    takes a Boolean)."""
+    if op == "not":
+        if type(value) is x.Const and not isinstance(value.value, (bool, np.bool_)) \
+                and isinstance(value.value, (int, float, np.integer, np.floating)):
+            raise FlattenError(f"'not' needs a Boolean operand, found the number "
+                               f"{x.to_text(value)}", span,
+                               hint="compare the number, e.g. 'not (i <> 0)' (Modelica "
+                               "3.6, section 3.5)")
+    elif surely_boolean(value):
+        assert isinstance(value, x.Expr)
+        raise FlattenError(f"'{x.to_text(value)}' is a Boolean and cannot be an operand "
+                           f"of unary '{op}'", span, hint="arithmetic needs Integer or "
+                           "Real operands (Modelica 3.6, section 3.4)")
+
+
+def surely_boolean(value: object) -> bool:
+    """Whether ``value`` is a Boolean whatever the variables' types."""
+    kind = type(value)
+    if kind is x.Const:
+        return isinstance(value.value, (bool, np.bool_))  # type: ignore[attr-defined]
+    if kind is x.Call:
+        return value.name in BOOLEAN_CALLS  # type: ignore[attr-defined]
+    if kind is x.BinOp:
+        return value.op in x.RELATIONS or value.op in ("and", "or")  # type: ignore[attr-defined]
+    return kind is x.Not
 
 
 def event_dependent(e: x.Expr) -> bool:

@@ -11,7 +11,16 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any
 
-from ...errors import ErrorGroup, FlattenError, FollowUpError, Note, Span, close_names, did_you_mean
+from ...errors import (
+    ErrorGroup,
+    FlattenError,
+    FollowUpError,
+    Note,
+    Span,
+    close_names,
+    did_you_mean,
+    printable,
+)
 from ...ir import expr as x
 from ...ir import syntax as s
 from ...parse import ClassEntry, ClassTree, imported_element, lookup_class, member_class
@@ -429,7 +438,8 @@ def select_model(tree: ClassTree, model: str | None) -> ClassEntry:
         raise FlattenError("no model at the top level of the given files: their models sit "
                            f"in packages ({listed})",
                            hint=f"choose one by its dotted name, e.g. --model {nested[0]}")
-    raise FlattenError("no model found in the given files",
+    named = ", ".join(printable(f.file) for f in tree.user_files) or "the given files"
+    raise FlattenError(f"no model found in {named}",
                        hint="name a file that defines a model, or use --model")
 
 

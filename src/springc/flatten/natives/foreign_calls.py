@@ -29,6 +29,7 @@ from ...ir import expr as x
 from ...ir import syntax as s
 from ...native import foreign
 from ...parse import ClassEntry
+from ...source_files import read_regular
 from .. import arrays as a
 from ..scopes import ExpressionEvaluator
 from .library_sources import CSources, inside
@@ -135,9 +136,9 @@ def _library(entry: ClassEntry, c_name: str, sources: CSources, glue: str,
         raise FlattenError(f"the external function '{entry.full_name}' ('{c_name}') could "
                            f"not be built: {failed.message}", call.span,
                            [Note("its external clause", external.span)],
-                           "springc compiles a library's C sources (Resources/C-Sources) "
-                           "with the system C compiler, or zig cc (pip install ziglang)"
-                           ) from None
+                           failed.hint or "springc compiles a library's C sources "
+                           "(Resources/C-Sources) with the system C compiler, or zig cc "
+                           "(pip install ziglang)") from None
 
 
 def _run_time_input(ev: ExpressionEvaluator, passed: tuple[s.Expr, ...],
@@ -305,7 +306,11 @@ def _glue(c_name: str, args: list[str], result: str | None, include: str) -> str
 
 def _source(path: Path, sources: CSources) -> tuple[str, bytes]:
     """A library C file as the build takes it: its subfolder (MSL's ``zlib``) and text."""
-    return _subfolder(path.parent, sources), path.read_bytes()
+    try:
+        return _subfolder(path.parent, sources), read_regular(path)
+    except OSError as exc:
+        raise foreign.ForeignBuildFailed(f"cannot read '{path}': {exc.strerror or exc}"
+                                         ) from None
 
 
 def _subfolder(folder: Path, sources: CSources) -> str:
@@ -327,5 +332,5 @@ def _headers(sources: CSources) -> tuple[tuple[str, str, bytes], ...]:
         sub = _subfolder(folder, sources)
         for header in sorted(folder.glob("*.h")):
             if header.is_file() and inside(header, folder):  # no link out of it
-                found.setdefault((sub, header.name), header.read_bytes())
+                found.setdefault((sub, header.name), read_regular(header))
     return tuple((sub, name, data) for (sub, name), data in found.items())

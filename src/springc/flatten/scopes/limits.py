@@ -24,6 +24,10 @@ __all__ = ["DEFAULT_MAX_SIZE", "ENVIRONMENT_VARIABLE", "Limits", "max_size_setti
 #: within about a minute instead of running for hours or exhausting memory.
 DEFAULT_MAX_SIZE = 2_000_000
 ENVIRONMENT_VARIABLE = "SPRINGC_MAX_SIZE"
+#: One run of a ``while`` loop may take a hundredth of the cap (20,000 iterations by
+#: default, under a second): a loop whose condition never becomes false fails fast,
+#: where the cap for all loops together would let it run for about 100 s.
+WHILE_SHARE = 100
 
 
 def max_size_setting(max_size: int | None = None) -> int:
@@ -82,6 +86,19 @@ class Limits:
                 "components (this declaration crosses the limit)", span, hint=self.hint)
         if self.exceeded is not None:
             raise self.exceeded
+
+    def while_iteration(self, done: int, span: Span | None) -> None:
+        """One more iteration of a ``while`` loop that has run ``done`` iterations."""
+        bound = max(1000, self.max_size // WHILE_SHARE)
+        if done >= bound:
+            raise FlattenError(
+                f"this while loop did not end within {bound} iterations",
+                span, hint=f"springc runs a while loop while it flattens the model and "
+                f"stops it after 1/{WHILE_SHARE} of its cap of {self.max_size} elements; "
+                f"check that the loop's condition becomes false; if the loop really "
+                f"needs more iterations, raise the cap with springc --max-size N, "
+                f"{ENVIRONMENT_VARIABLE}=N or flatten(..., max_size=N)")
+        self.add_iterations(1, span)
 
     def add_iterations(self, count: float, span: Span | None) -> None:
         """``count`` more loop iterations (``for`` equations and statements, array

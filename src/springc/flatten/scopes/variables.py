@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import FlattenError, close_names
+from ...ir import expr as x
 from ...ir import flat
 from .. import arrays as a
 from .identity import Ident
@@ -111,12 +112,42 @@ def _evaluate(flattener: FlattenContext, mod: Mod, name: str,
             if isinstance(value, (str, np.ndarray)):
                 raise FlattenError("the attribute 'fixed' must be a scalar Boolean",
                                    child.value.span)
-            values["fixed"] = bool(_fold(flattener, value, child, "'fixed'"))
+            fixed = _fold(flattener, value, child, "'fixed'")
+            if not isinstance(fixed, (bool, np.bool_)):
+                raise FlattenError(f"the attribute 'fixed' must be a Boolean, found "
+                                   f"{fixed!r}", child.value.span,
+                                   hint="write fixed = true or fixed = false (Modelica "
+                                   "3.6, section 4.9: fixed is a BooleanType)")
+            values["fixed"] = bool(fixed)
         else:
             if isinstance(value, str):
                 raise FlattenError(f"the attribute '{key}' must be a number", child.value.span)
             values[key] = value
+    _check_bounds(values, mod, name)
     return flat.Attributes(**values) if values else _EMPTY
+
+
+def _check_bounds(values: dict[str, Any], mod: Mod, name: str) -> None:
+    """Literal bounds with min > max: the implicit ``assert(min <= value and value <=
+    max)`` of every Real and Integer (Modelica 3.6, section 4.9) fails for any value."""
+    low, high = (_number(values.get(key)) for key in ("min", "max"))
+    if low is None or high is None or not low > high:
+        return
+    span = mod.children["min"].value.span  # type: ignore[union-attr]
+    raise FlattenError(f"the min of '{name}' ({low:g}) is greater than its max ({high:g}): "
+                       "no value lies within them", span,
+                       hint="every variable holds assert(min <= value and value <= max) "
+                       "(Modelica 3.6, section 4.9): swap or correct the bounds")
+
+
+def _number(value: Any) -> float | None:
+    """The number of a literal attribute value; None otherwise."""
+    if isinstance(value, x.Const):
+        value = value.value
+    if isinstance(value, (int, float, np.integer, np.floating)) and \
+            not isinstance(value, (bool, np.bool_)):
+        return float(value)
+    return None
 
 
 _EMPTY = flat.Attributes()
