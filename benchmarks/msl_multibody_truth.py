@@ -75,47 +75,61 @@ def skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
 
 
+WHEEL_RADIUS, WHEEL_MASS, WHEEL_INERTIA = 0.3, 2.0, np.diag([0.12, 0.06, 0.12])
+
+
+def wheel_t(a: np.ndarray) -> np.ndarray:
+    """World to wheel frame for Joints.RollingWheel's angles (sequence {3, 2, 1})."""
+    return rot(1, a[2]) @ rot(2, a[1]) @ rot(3, a[0])
+
+
+def wheel_jac(a: np.ndarray) -> np.ndarray:
+    """w_a = wheel_jac(angles) @ der_angles (Frames.axesRotations)."""
+    return np.column_stack([rot(1, a[2]) @ rot(2, a[1]) @ E3, rot(1, a[2]) @ E2, E1])
+
+
+def wheel_delta(a: np.ndarray) -> np.ndarray:
+    """From the wheel centre to the contact point on the plane z = 0, world frame."""
+    axis = wheel_t(a).T @ E2
+    aux = np.cross(E3, axis)
+    return WHEEL_RADIUS * np.cross(aux / np.sqrt(aux @ aux), axis)
+
+
+def wheel_vel(a: np.ndarray) -> np.ndarray:
+    """v_0 = wheel_vel(angles) @ der_angles: the contact point does not move."""
+    return skew(wheel_delta(a)) @ wheel_t(a).T @ wheel_jac(a)
+
+
+def wheel_rhs(_t: float, s: np.ndarray) -> np.ndarray:
+    """State angles, der_angles, x, y: Newton-Euler with the contact force eliminated."""
+    a, d = s[:3], s[3:6]
+    jdot = np.imag(wheel_jac(a + 1e-20j * d) @ d) / 1e-20  # complex-step d/dt
+    vdot = np.imag(wheel_vel(a + 1e-20j * d) @ d) / 1e-20
+    arm = WHEEL_MASS * wheel_t(a) @ skew(wheel_delta(a))
+    w, inertia = wheel_jac(a) @ d, WHEEL_INERTIA
+    dd = np.linalg.solve(inertia @ wheel_jac(a) - arm @ wheel_vel(a),
+                         arm @ (vdot + G_N * E3) - inertia @ jdot - np.cross(w, inertia @ w))
+    return np.concatenate([d, dd, (wheel_vel(a) @ d)[:2]])
+
+
+def wheel_energy(a: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Kinetic plus potential energy along columns of angles and der_angles."""
+    out = []
+    for ak, dk in zip(a.T, d.T):
+        w, v = wheel_jac(ak) @ dk, wheel_vel(ak) @ dk
+        out.append(0.5 * WHEEL_MASS * v @ v + 0.5 * w @ WHEEL_INERTIA @ w
+                   - WHEEL_MASS * G_N * wheel_delta(ak)[2])
+    return np.array(out)
+
+
 def rolling_wheel(refs: Path) -> None:
     """Parts.RollingWheel: radius 0.3, m 2, I diag(0.12, 0.06, 0.12); angles {3,2,1}."""
-    radius, m, inertia = 0.3, 2.0, np.diag([0.12, 0.06, 0.12])
-
-    def t_of(a: np.ndarray) -> np.ndarray:
-        return rot(1, a[2]) @ rot(2, a[1]) @ rot(3, a[0])
-
-    def jac(a: np.ndarray) -> np.ndarray:  # w_a = jac(angles) @ der_angles
-        return np.column_stack([rot(1, a[2]) @ rot(2, a[1]) @ E3, rot(1, a[2]) @ E2, E1])
-
-    def delta(a: np.ndarray) -> np.ndarray:  # wheel centre to contact point
-        axis = t_of(a).T @ E2
-        aux = np.cross(E3, axis)
-        return radius * np.cross(aux / np.sqrt(aux @ aux), axis)
-
-    def vel(a: np.ndarray) -> np.ndarray:  # v_0 = vel(angles) @ der_angles (no slip)
-        return skew(delta(a)) @ t_of(a).T @ jac(a)
-
-    def rhs(_t: float, s: np.ndarray) -> np.ndarray:
-        a, d = s[:3], s[3:6]
-        jdot = np.imag(jac(a + 1e-20j * d) @ d) / 1e-20  # complex-step d/dt
-        vdot = np.imag(vel(a + 1e-20j * d) @ d) / 1e-20
-        arm = m * t_of(a) @ skew(delta(a))
-        w = jac(a) @ d
-        dd = np.linalg.solve(inertia @ jac(a) - arm @ vel(a),
-                             arm @ (vdot + G_N * E3) - inertia @ jdot - np.cross(w, inertia @ w))
-        return np.concatenate([d, dd, (vel(a) @ d)[:2]])
-
-    def energy(a: np.ndarray, d: np.ndarray) -> np.ndarray:
-        out = []
-        for ak, dk in zip(a.T, d.T):
-            w, v = jac(ak) @ dk, vel(ak) @ dk
-            out.append(0.5 * m * v @ v + 0.5 * w @ inertia @ w - m * G_N * delta(ak)[2])
-        return np.array(out)
-
     grid, col = reference(refs, "RollingWheel")
-    y = solve(rhs, np.array([0, 0, 0, 0, 5, 1, 0.2, 0.2], float), 4.0, grid)
+    y = solve(wheel_rhs, np.array([0, 0, 0, 0, 5, 1, 0.2, 0.2], float), 4.0, grid)
     names = [f"wheel1.angles[{i}]" for i in (1, 2, 3)] + \
         [f"wheel1.der_angles[{i}]" for i in (1, 2, 3)] + ["wheel1.x", "wheel1.y"]
     ref = np.array([col(n) for n in names])
-    report("RollingWheel", grid, energy(y[:3], y[3:6]), energy(ref[:3], ref[3:6]),
+    report("RollingWheel", grid, wheel_energy(y[:3], y[3:6]), wheel_energy(ref[:3], ref[3:6]),
            dict(zip(names, y)), col)
     np.save("/tmp/truth-RollingWheel.npy", np.vstack([grid, y]))
 
