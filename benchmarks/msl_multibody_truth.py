@@ -1,10 +1,11 @@
-"""Independent models of five MultiBody.Examples.Elementary examples (issue 25).
+"""Independent models of six MultiBody.Examples.Elementary examples (issue 25).
 
     python benchmarks/msl_multibody_truth.py --refs REFS [EXAMPLE...]
 
 Each example is written here again from its physics, not from MSL's equations (no
 springc): RollingWheel (Newton-Euler with the contact force eliminated, no slip),
 DoublePendulumInitTip (Lagrange's equations of two BodyBox links and the damper),
+ForceAndTorque (Lagrange's equations of the cylinder on two revolute joints),
 PointGravity and PointGravityWithPointMasses (point masses, mu = 1, the spring c = 10)
 and PointGravityWithPointMasses2 (a rigid body of six unit point masses, mu = 5). Each
 runs with scipy's DOP853 and Radau at rtol 1e-12, prints how far the two differ, the
@@ -270,9 +271,51 @@ def rigid_point_masses(refs: Path) -> None:
     np.save("/tmp/truth-PointGravityWithPointMasses2.npy", np.vstack([grid, y]))
 
 
+def force_and_torque(refs: Path) -> None:
+    """BodyCylinder (1 m, diameter 0.05, steel) on revolute z then y at (0, -0.5, 0); the
+    force {0, 1000, 0} at its tip and the torque {-100, 100, 0}, both in a frame turned
+    30 degrees about z; Lagrange's equations by sympy, the applied loads as generalized
+    forces. The constant torque makes no invariant: the check is the two methods."""
+    import sympy
+
+    q1, q2, u1, u2 = sympy.symbols("q1 q2 u1 u2")
+    rz = sympy.Matrix([[sympy.cos(q1), -sympy.sin(q1), 0], [sympy.sin(q1), sympy.cos(q1), 0],
+                       [0, 0, 1]])
+    ry = sympy.Matrix([[sympy.cos(q2), 0, sympy.sin(q2)], [0, 1, 0],
+                       [-sympy.sin(q2), 0, sympy.cos(q2)]])
+    m = 7700.0 * np.pi * 0.025**2
+    inertia = sympy.diag(m * 0.025**2 / 2, m * (1 / 12 + 0.025**2 / 4), m * (1 / 12 + 0.025**2 / 4))
+    q, u, axis = sympy.Matrix([q1, q2]), sympy.Matrix([u1, u2]), rz * ry * sympy.Matrix([1, 0, 0])
+    centre, tip = sympy.Matrix([0, -0.5, 0]) + axis / 2, sympy.Matrix([0, -0.5, 0]) + axis
+    w0 = sympy.Matrix([0, 0, u1]) + rz * sympy.Matrix([0, u2, 0])
+    wb, vc = (rz * ry).T * w0, centre.jacobian(q) * u
+    kinetic = m / 2 * vc.dot(vc) + (wb.T * inertia * wb)[0] / 2
+    c, s = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    force = sympy.Matrix([-1000 * s, 1000 * c, 0])
+    torque = sympy.Matrix([-100 * (c + s), 100 * (c - s), 0])
+    applied = tip.jacobian(q).T * force + w0.jacobian(u).T * torque \
+        - sympy.Matrix([m * G_N * centre[1]]).jacobian(q).T
+    energy = sympy.Matrix([kinetic])
+    rest = energy.jacobian(u).T.jacobian(q) * u - energy.jacobian(q).T
+    mass = sympy.lambdify((q1, q2), sympy.hessian(kinetic, u), "numpy")
+    right = sympy.lambdify((q1, q2, u1, u2), applied - rest, "numpy")
+
+    def rhs(_t: float, z: np.ndarray) -> np.ndarray:
+        acc = np.linalg.solve(np.array(mass(z[0], z[1]), float),
+                              np.array(right(*z), float).ravel())
+        return np.array([z[2], z[3], acc[0], acc[1]])
+
+    grid, col = reference(refs, "ForceAndTorque")
+    y = solve(rhs, np.zeros(4), float(grid[-1]), grid)
+    names = ["revolute1.phi", "revolute2.phi", "revolute1.w", "revolute2.w"]
+    report("ForceAndTorque", grid, np.zeros(1), np.zeros(1), dict(zip(names, y)), col)
+    np.save("/tmp/truth-ForceAndTorque.npy", np.vstack([grid, y]))
+
+
 EXAMPLES: dict[str, Callable[[Path], None]] = {
     "RollingWheel": rolling_wheel,
     "DoublePendulumInitTip": double_pendulum,
+    "ForceAndTorque": force_and_torque,
     "PointGravity": lambda refs: point_masses(refs, "PointGravity"),
     "PointGravityWithPointMasses": lambda refs: point_masses(refs, "PointGravityWithPointMasses"),
     "PointGravityWithPointMasses2": rigid_point_masses,
