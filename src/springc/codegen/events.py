@@ -33,7 +33,7 @@ from .hysteresis import (
     first_values,
     pass_value,
 )
-from .statements import Let, Load, Raw, Stmt, Store
+from .statements import Let, Load, Raw, Stmt, Store, guarded
 
 EVENT_ITERATIONS = 100
 SIMULTANEOUS_PASSES = 20
@@ -257,9 +257,12 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             active[i, j] = _truth(f"_za{i}_{j}")
             earlier.append(active[i, j])
         for j, branch in enumerate(clause.branches):
-            for a in branch.assignments:
-                value = layout.hold(a.value, new)
-                out.append(Let(a.name, x.If(active[i, j], value, x.Var(a.name)), a.name))
+            # one guard per branch: its values computed only where it fires, the
+            # subexpressions they share (an FFT's outputs, a buffer's sum) once
+            if branch.assignments:
+                out.append(guarded(active[i, j], [
+                    Let(a.name, layout.hold(a.value, new), a.name)
+                    for a in branch.assignments]))
             for r in branch.reinits:  # from the values before any reinit
                 reinits[r.name] = x.If(active[i, j], layout.hold(r.value, new),
                                        reinits.get(r.name, x.Var(r.name)))

@@ -22,6 +22,7 @@ from .locate import untranslatable
 from .newton_step import NEWTON_SOLVE
 from .statements import (
     Block,
+    Guard,
     Let,
     Load,
     Loop,
@@ -183,20 +184,31 @@ class FunctionWriter:
             if stmt.comment:
                 self._comment(stmt.comment)
             self.write(stmt.body)
+        elif isinstance(stmt, Guard):
+            self._nested(self.guard_header(self.expr(stmt.cond, 1)), stmt.body)
         else:
             for name in sorted(defines_inside(stmt.body)):  # set order varies by run
                 self._reassigned(name)
-            self._emit(stmt.header)
-            outer = self._indent
-            self._indent += "    "
-            self._scopes.append(set())
-            self.write(stmt.body)
-            for cid in self._scopes.pop():
-                self._temps.pop(cid, None)
-                self._calls.pop(cid, None)
-            self._indent = outer
-            if self.block_end is not None:
-                self._emit(self.block_end)
+            self._nested(stmt.header, stmt.body)
+
+    def guard_header(self, cond: str) -> str:
+        """The line that opens a :class:`Guard`'s body (C: ``if (cond) {``)."""
+        return f"if {cond}:"
+
+    def _nested(self, header: str, body: Sequence[Stmt]) -> None:
+        """``header`` and ``body`` indented below it; the shared values computed in
+        the body (and the run-time calls defined there) are forgotten after it."""
+        self._emit(header)
+        outer = self._indent
+        self._indent += "    "
+        self._scopes.append(set())
+        self.write(body)
+        for cid in self._scopes.pop():
+            self._temps.pop(cid, None)
+            self._calls.pop(cid, None)
+        self._indent = outer
+        if self.block_end is not None:
+            self._emit(self.block_end)
 
     def _reassigned(self, name: str) -> None:
         ident = self.name(name)
@@ -356,6 +368,9 @@ def _exprs(stmts: Sequence[Stmt]) -> Iterator[Expr]:
     for s in stmts:
         if isinstance(s, (Let, Store)):
             yield s.expr
+        elif isinstance(s, Guard):
+            yield s.cond
+            yield from _exprs(s.body)
         elif isinstance(s, (Loop, Block)):
             yield from _exprs(s.body)
 
