@@ -16,7 +16,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 from ..ir.builtins import BUILTINS
-from ..ir.expr import Call, Expr, If, Not, variables
+from ..ir.expr import BinOp, Call, Der, Expr, If, Neg, Not, variables
 
 # ------------------------------------------------------------------ statements
 
@@ -102,11 +102,12 @@ def _split(lets: Sequence[Let]) -> list[Stmt]:
     while i < len(lets):
         first = _test(lets[i].expr)
         end = i
-        if isinstance(first, If):  # the run ends before a value of the test is assigned
-            reads = variables(first.cond)
-            while end < len(lets) and _same_test(_test(lets[end].expr), first.cond) \
-                    and lets[end].name not in reads:
+        if isinstance(first, If):
+            while end < len(lets) and _same_test(_test(lets[end].expr), first.cond):
                 end += 1
+        if end - i > 1:  # the run ends before a value of the test is assigned
+            reads = variables(first.cond)  # type: ignore[union-attr]
+            end = next((k for k in range(i, end) if lets[k].name in reads), end)
         if end - i < 2:
             out.append(lets[i])
             i += 1
@@ -121,14 +122,41 @@ def _split(lets: Sequence[Let]) -> list[Stmt]:
 
 
 def _test(e: Expr) -> Expr:
-    """``e`` without the calls printed as their argument (``noEvent``)."""
-    while isinstance(e, Call) and e.name in BUILTINS and BUILTINS[e.name].transparent is not None:
-        e = e.args[BUILTINS[e.name].transparent]  # type: ignore[index]
-    return e
+    """``e`` without the calls printed as their argument (``noEvent``) and the
+    if-expressions whose branches are one node."""
+    while True:
+        if isinstance(e, Call) and e.name in BUILTINS \
+                and BUILTINS[e.name].transparent is not None:
+            e = e.args[BUILTINS[e.name].transparent]  # type: ignore[index]
+        elif isinstance(e, If) and e.then is e.otherwise:
+            e = e.then
+        else:
+            return e
 
 
 def _same_test(e: Expr, cond: Expr) -> bool:
-    return isinstance(e, If) and (e.cond is cond or e.cond == cond)
+    """Whether ``e`` is an if-expression on ``cond``: the same node, or an equal one
+    of a few nodes (an equality of large shared trees would walk them as trees)."""
+    return isinstance(e, If) and (e.cond is cond or (
+        _small(cond) and _small(e.cond) and e.cond == cond))
+
+
+def _small(e: Expr, limit: int = 64) -> bool:
+    stack = [e]
+    while stack:
+        limit -= 1
+        if limit < 0:
+            return False
+        node = stack.pop()
+        if isinstance(node, If):
+            stack += (node.cond, node.then, node.otherwise)
+        elif isinstance(node, Call):
+            stack += node.args
+        elif isinstance(node, BinOp):
+            stack += (node.left, node.right)
+        elif isinstance(node, (Neg, Not, Der)):
+            stack.append(node.arg)
+    return True
 
 
 def guarded_solve(result: str, matrix: str, rhs: str, shape: str) -> str:
