@@ -140,3 +140,18 @@ def test_a_sampled_when_clause_equals_its_closed_form(
         assert result["b"][k] == pytest.approx(b, rel=1e-14)
         assert result["c"][k] == pytest.approx(c, rel=1e-14)
     assert result["n"][at[1.0]] == 4.0
+
+
+def test_a_left_fold_of_max_prints_as_one_call() -> None:
+    # RealFFT's 0.0001*max(amplitudes) of 401 values: nested, Python refuses it
+    # (too many nested parentheses)
+    fold = Var("v0")
+    for k in range(1, 401):
+        fold = Call("max", (fold, BinOp("*", Const(float(k % 7)), Var("w"))))
+    body = function_lines(Namer(), set(), [Load("v0", "-1.0"), Load("w", "w_in"),
+                                           Raw("out = [0.0]"), Store("out[0]", fold)])
+    assert body[-1].count("max(") == 1
+    scope: dict[str, object] = {"math": math}
+    exec("def f(w_in):\n" + "\n".join(body) + "\n    return out\n", scope)
+    assert scope["f"](2.0) == [12.0]  # type: ignore[operator]
+    assert scope["f"](-2.0) == [0.0]  # type: ignore[operator]

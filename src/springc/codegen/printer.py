@@ -297,10 +297,26 @@ class FunctionWriter:
         if builtin is not None and builtin.transparent is not None:
             return self._shared(e.args[builtin.transparent])
         spelling = self._spelling(e)
-        args = ", ".join(self.expr(a) for a in e.args)
+        args = ", ".join(self.expr(a) for a in self._operands(e, spelling))
         if spelling in HELPERS:
             self.helpers.add(spelling)
         return _spelled(spelling, args), 9
+
+    def _operands(self, e: Call, spelling: str) -> list[Expr]:
+        """The arguments of ``e``; Python's ``max``/``min`` of a left fold of the same
+        call (``max(max(a, b), c)``) take its operands at once, in order (the same
+        comparisons; a fold of 400 would pass Python's limit of nested parentheses)."""
+        if spelling not in ("max", "min") or len(e.args) != 2:
+            return list(e.args)
+        out = [e.args[1]]
+        head: Expr = e.args[0]
+        while (isinstance(head, Call) and head.name == e.name and len(head.args) == 2
+               and self._id(head) not in self._temps):
+            out.append(head.args[1])
+            head = head.args[0]
+        out.append(head)
+        out.reverse()
+        return out
 
     def _foreign_output(self, e: Call) -> str:
         """``_fcallN()[slot][index]``: an element of a run-time foreign call's outputs.
