@@ -30,7 +30,7 @@ from .newton_search import (
     search_start,
     search_step,
 )
-from .statements import Block, Let, Load, Loop, Raw, Stmt, Store
+from .statements import Block, Guard, Let, Load, Loop, Raw, Stmt, Store
 
 SOLVE = """SPRINGC_FN void springc_solve(int n, int m, double *a, double *b, double *y)
 {
@@ -182,6 +182,8 @@ def c_jacobian(stmts: Sequence[Stmt]) -> list[Stmt]:
                 out.append(Block(walk(s.body), s.comment, s.defines, s.uses))
             elif isinstance(s, Loop):
                 out.append(Loop(s.header, walk(s.body)))
+            elif isinstance(s, Guard):
+                out.append(Guard(s.cond, walk(s.body)))
             else:
                 out.append(s)
         return out
@@ -228,6 +230,8 @@ def c_statements(stmts: Sequence[Stmt], outputs: Sequence[str]) -> list[Stmt]:
             out.append(Block(c_statements(s.body, outputs), s.comment, s.defines, s.uses))
         elif isinstance(s, Loop):
             out.append(Loop(s.header, c_statements(s.body, outputs)))
+        elif isinstance(s, Guard):
+            out.append(Guard(s.cond, c_statements(s.body, outputs)))
         else:
             out.append(s)
     return out

@@ -120,6 +120,9 @@ class CWriter(FunctionWriter):
     def _comment(self, text: str) -> None:
         self._emit("/* " + c_comment(text) + " */")
 
+    def guard_header(self, cond: str) -> str:
+        return f"if ({cond}) {{"
+
     def _reassigned(self, name: str) -> None:
         self.declared[self.name(name)] = None
         super()._reassigned(name)

@@ -68,6 +68,7 @@ class EventLayout:
         self.size = len(names)
         self.held = self._held()
         self._hold: _Hold | None = None
+        self._other: _Hold | None = None  # the last other mapping's walk
         self.uses_terminal = events.reads_terminal or any(
             isinstance(n, x.Call) and n.name == "terminal"
             for _, _, c in self.conditions for n in x.walk(c))
@@ -94,12 +95,19 @@ class EventLayout:
         values (``held``: another mapping, e.g. the new values during an event pass),
         ``floor`` calls their held values, ``sample``/``initial``/``terminal`` their
         flags, ``pre(v)`` its slot,
-        ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``."""
+        ``edge(b)`` is ``b and not pre(b)``, ``change(v)`` is ``v <> pre(v)``.
+
+        One walk per mapping (``held`` the same object again, not changed since):
+        the expressions share nodes (a when-clause's values, the sum of a buffer
+        that each of an FFT's outputs reads), and a shared node held once stays one
+        node, which the printer then computes once."""
         if held is None:  # one walk for every expression of the system: they share nodes
             if self._hold is None:
                 self._hold = _Hold(self.held, {_head(k) for k in self.held}, self, {})
             return _replace(e, self._hold, False)
-        return _replace(e, _Hold(held, {_head(k) for k in held}, self, {}), False)
+        if self._other is None or self._other.held is not held:
+            self._other = _Hold(held, {_head(k) for k in held}, self, {})
+        return _replace(e, self._other, False)
 
     def sample_name(self, call: x.Call) -> str:
         return self.samples[self.events.samples.index((call.args[0], call.args[1]))]

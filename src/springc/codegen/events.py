@@ -33,7 +33,7 @@ from .hysteresis import (
     first_values,
     pass_value,
 )
-from .statements import Let, Load, Raw, Stmt, Store
+from .statements import Let, Load, Raw, Stmt, Store, guarded
 
 EVENT_ITERATIONS = 100
 SIMULTANEOUS_PASSES = 20
@@ -60,10 +60,16 @@ def _truth(name: str) -> x.Expr:
 
 
 def _any(items: list[x.Expr]) -> x.Expr:
-    out: x.Expr = x.Const(False)
-    for item in items:
-        out = item if out == x.Const(False) else x.BinOp("or", out, item)
-    return out
+    """``items[0] or items[1] or ...``, joined pairwise (``RealFFT``'s 4,800 changed
+    discrete values: a left fold that deep passes Python's recursion limit when
+    printed), evaluated left to right as the fold."""
+    level = [item for item in items if item != x.Const(False)]
+    if not level:
+        return x.Const(False)
+    while len(level) > 1:
+        level = [x.BinOp("or", level[k], level[k + 1]) for k in range(0, len(level) - 1, 2)
+                 ] + level[len(level) - len(level) % 2:]
+    return level[0]
 
 
 def _eps(t: x.Expr) -> x.Expr:
@@ -257,9 +263,12 @@ def event_pass(m: CodegenContext, layout: EventLayout) -> list[Stmt]:
             active[i, j] = _truth(f"_za{i}_{j}")
             earlier.append(active[i, j])
         for j, branch in enumerate(clause.branches):
-            for a in branch.assignments:
-                value = layout.hold(a.value, new)
-                out.append(Let(a.name, x.If(active[i, j], value, x.Var(a.name)), a.name))
+            # one guard per branch: its values computed only where it fires, the
+            # subexpressions they share (an FFT's outputs, a buffer's sum) once
+            if branch.assignments:
+                out.append(guarded(active[i, j], [
+                    Let(a.name, layout.hold(a.value, new), a.name)
+                    for a in branch.assignments]))
             for r in branch.reinits:  # from the values before any reinit
                 reinits[r.name] = x.If(active[i, j], layout.hold(r.value, new),
                                        reinits.get(r.name, x.Var(r.name)))

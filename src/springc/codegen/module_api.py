@@ -17,7 +17,7 @@ import numpy.typing as npt
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-CODEGEN_VERSION = 14
+CODEGEN_VERSION = 15
 """The version of the generated code's layout and of a cache entry's contents: part of
 every cache key (here, not with the module text, so that the cache reads it without
 loading the generator). 5: a cache entry holds the captured system (``system.pickle``,
@@ -25,7 +25,8 @@ loading the generator). 5: a cache entry holds the captured system (``system.pic
 ``PARAMETER_BOUNDS``; 9: torn blocks take ``_newton_solve`` (``codegen.newton_step``);
 10: relations switch past a band (``codegen.hysteresis``; slots ``_zb``, ``_zw``,
 ``_zpass``); 11: the Newton iterations of torn blocks search their steps
-(``codegen.newton_search``)."""
+(``codegen.newton_search``); 15: a when-clause branch's assignments under one guard
+(``codegen.statements.Guard``)."""
 
 
 JACOBIAN_LIMIT = 2000

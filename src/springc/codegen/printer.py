@@ -22,6 +22,7 @@ from .locate import untranslatable
 from .newton_step import NEWTON_SOLVE
 from .statements import (
     Block,
+    Guard,
     Let,
     Load,
     Loop,
@@ -183,20 +184,31 @@ class FunctionWriter:
             if stmt.comment:
                 self._comment(stmt.comment)
             self.write(stmt.body)
+        elif isinstance(stmt, Guard):
+            self._nested(self.guard_header(self.expr(stmt.cond, 1)), stmt.body)
         else:
             for name in sorted(defines_inside(stmt.body)):  # set order varies by run
                 self._reassigned(name)
-            self._emit(stmt.header)
-            outer = self._indent
-            self._indent += "    "
-            self._scopes.append(set())
-            self.write(stmt.body)
-            for cid in self._scopes.pop():
-                self._temps.pop(cid, None)
-                self._calls.pop(cid, None)
-            self._indent = outer
-            if self.block_end is not None:
-                self._emit(self.block_end)
+            self._nested(stmt.header, stmt.body)
+
+    def guard_header(self, cond: str) -> str:
+        """The line that opens a :class:`Guard`'s body (C: ``if (cond) {``)."""
+        return f"if {cond}:"
+
+    def _nested(self, header: str, body: Sequence[Stmt]) -> None:
+        """``header`` and ``body`` indented below it; the shared values computed in
+        the body (and the run-time calls defined there) are forgotten after it."""
+        self._emit(header)
+        outer = self._indent
+        self._indent += "    "
+        self._scopes.append(set())
+        self.write(body)
+        for cid in self._scopes.pop():
+            self._temps.pop(cid, None)
+            self._calls.pop(cid, None)
+        self._indent = outer
+        if self.block_end is not None:
+            self._emit(self.block_end)
 
     def _reassigned(self, name: str) -> None:
         ident = self.name(name)
@@ -285,10 +297,26 @@ class FunctionWriter:
         if builtin is not None and builtin.transparent is not None:
             return self._shared(e.args[builtin.transparent])
         spelling = self._spelling(e)
-        args = ", ".join(self.expr(a) for a in e.args)
+        args = ", ".join(self.expr(a) for a in self._operands(e, spelling))
         if spelling in HELPERS:
             self.helpers.add(spelling)
         return _spelled(spelling, args), 9
+
+    def _operands(self, e: Call, spelling: str) -> list[Expr]:
+        """The arguments of ``e``; Python's ``max``/``min`` of a left fold of the same
+        call (``max(max(a, b), c)``) take its operands at once, in order (the same
+        comparisons; a fold of 400 would pass Python's limit of nested parentheses)."""
+        if spelling not in ("max", "min") or len(e.args) != 2:
+            return list(e.args)
+        out = [e.args[1]]
+        head: Expr = e.args[0]
+        while (isinstance(head, Call) and head.name == e.name and len(head.args) == 2
+               and self._id(head) not in self._temps):
+            out.append(head.args[1])
+            head = head.args[0]
+        out.append(head)
+        out.reverse()
+        return out
 
     def _foreign_output(self, e: Call) -> str:
         """``_fcallN()[slot][index]``: an element of a run-time foreign call's outputs.
@@ -356,6 +384,9 @@ def _exprs(stmts: Sequence[Stmt]) -> Iterator[Expr]:
     for s in stmts:
         if isinstance(s, (Let, Store)):
             yield s.expr
+        elif isinstance(s, Guard):
+            yield s.cond
+            yield from _exprs(s.body)
         elif isinstance(s, (Loop, Block)):
             yield from _exprs(s.body)
 

@@ -2,7 +2,7 @@
 
 The code generator describes each generated function as a list of small statements
 over flat names (:class:`Let`, :class:`Store`, :class:`Load`, :class:`Raw`, grouped in
-:class:`Block` and :class:`Loop`); :mod:`.printer` prints them. Model names become
+:class:`Block`, :class:`Loop` and :class:`Guard`); :mod:`.printer` prints them. Model names become
 Python identifiers only through :class:`Namer` and reach comments only through
 :func:`escaped`: model text is data, never code.
 """
@@ -15,7 +15,8 @@ import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ..ir.expr import Expr, variables
+from ..ir.builtins import BUILTINS
+from ..ir.expr import BinOp, Call, Der, Expr, If, Neg, Not, variables
 
 # ------------------------------------------------------------------ statements
 
@@ -72,7 +73,90 @@ class Block:
     uses: set[str] = field(default_factory=set)
 
 
-Stmt = Let | Load | Store | Raw | Loop | Block
+@dataclass
+class Guard:
+    """``if cond:`` with an indented body: statements that run only where ``cond``
+    holds (a when-clause's branch: its assignments under one condition, the values
+    they share computed once inside it). A name the body assigns keeps its value
+    before the guard where ``cond`` is false."""
+
+    cond: Expr
+    body: list[Stmt]
+
+
+Stmt = Let | Load | Store | Raw | Loop | Block | Guard
+
+
+def guarded(cond: Expr, lets: Sequence[Let]) -> Guard:
+    """``lets`` (run in order) where ``cond`` holds, as one :class:`Guard`; a run of
+    them whose values are if-expressions on one condition that none of them assigns
+    becomes two guards, that condition's and its negation's, each holding its
+    branches (recursively): the values the branches share (the amplitudes an FFT's
+    phases all compare with) are then computed once instead of once per value."""
+    return Guard(cond, _split(lets))
+
+
+def _split(lets: Sequence[Let]) -> list[Stmt]:
+    out: list[Stmt] = []
+    i = 0
+    while i < len(lets):
+        first = _test(lets[i].expr)
+        end = i
+        if isinstance(first, If):
+            while end < len(lets) and _same_test(_test(lets[end].expr), first.cond):
+                end += 1
+        if end - i > 1:  # the run ends before a value of the test is assigned
+            reads = variables(first.cond)  # type: ignore[union-attr]
+            end = next((k for k in range(i, end) if lets[k].name in reads), end)
+        if end - i < 2:
+            out.append(lets[i])
+            i += 1
+            continue
+        run = [(let, e) for let in lets[i:end] if isinstance(e := _test(let.expr), If)]
+        test = run[0][1].cond
+        out.append(Guard(test, _split([Let(let.name, e.then, let.comment) for let, e in run])))
+        out.append(Guard(Not(test), _split(
+            [Let(let.name, e.otherwise, let.comment) for let, e in run])))
+        i = end
+    return out
+
+
+def _test(e: Expr) -> Expr:
+    """``e`` without the calls printed as their argument (``noEvent``) and the
+    if-expressions whose branches are one node."""
+    while True:
+        if isinstance(e, Call) and e.name in BUILTINS \
+                and BUILTINS[e.name].transparent is not None:
+            e = e.args[BUILTINS[e.name].transparent]  # type: ignore[index]
+        elif isinstance(e, If) and e.then is e.otherwise:
+            e = e.then
+        else:
+            return e
+
+
+def _same_test(e: Expr, cond: Expr) -> bool:
+    """Whether ``e`` is an if-expression on ``cond``: the same node, or an equal one
+    of a few nodes (an equality of large shared trees would walk them as trees)."""
+    return isinstance(e, If) and (e.cond is cond or (
+        _small(cond) and _small(e.cond) and e.cond == cond))
+
+
+def _small(e: Expr, limit: int = 64) -> bool:
+    stack = [e]
+    while stack:
+        limit -= 1
+        if limit < 0:
+            return False
+        node = stack.pop()
+        if isinstance(node, If):
+            stack += (node.cond, node.then, node.otherwise)
+        elif isinstance(node, Call):
+            stack += node.args
+        elif isinstance(node, BinOp):
+            stack += (node.left, node.right)
+        elif isinstance(node, (Neg, Not, Der)):
+            stack.append(node.arg)
+    return True
 
 
 def guarded_solve(result: str, matrix: str, rhs: str, shape: str) -> str:
@@ -172,6 +256,8 @@ def uses_of(stmt: Stmt) -> set[str]:
         return variables(stmt.expr)
     if isinstance(stmt, (Load, Raw)):
         return set()
+    if isinstance(stmt, Guard):
+        return variables(stmt.cond) | _sequential_uses(stmt.body)
     body = stmt.body
     used: set[str] = set()
     for s in body:
@@ -180,13 +266,28 @@ def uses_of(stmt: Stmt) -> set[str]:
     return (used - defines_inside(body)) | extra
 
 
+def _sequential_uses(body: Sequence[Stmt]) -> set[str]:
+    """Names ``body`` reads before it assigns them itself (in order). Its expressions
+    share nodes (the values of one when-clause): each node is visited once, and the
+    names a node reads count where it is first read (``bound`` only grows)."""
+    used: set[str] = set()
+    bound: set[str] = set()
+    seen: set[int] = set()
+    for s in body:
+        read = variables(s.expr, seen) if isinstance(s, (Let, Store)) else uses_of(s)
+        used |= read - bound
+        if isinstance(s, (Let, Load)):
+            bound.add(s.name)
+    return used
+
+
 def defines_inside(body: Sequence[Stmt]) -> set[str]:
     """Names bound anywhere inside ``body`` (nested loops and blocks included)."""
     out: set[str] = set()
     for s in body:
         if isinstance(s, (Let, Load)):
             out.add(s.name)
-        elif isinstance(s, (Loop, Block)):
+        elif isinstance(s, (Loop, Block, Guard)):
             out |= defines_inside(s.body)
     return out
 
@@ -197,7 +298,7 @@ def defines_of(stmt: Stmt) -> set[str]:
         return {stmt.name}
     if isinstance(stmt, Block):
         return stmt.defines or defines_inside(stmt.body)
-    if isinstance(stmt, Loop):
+    if isinstance(stmt, (Loop, Guard)):
         return defines_inside(stmt.body)
     return set()
 
@@ -210,6 +311,9 @@ def prune(stmts: Sequence[Stmt]) -> list[Stmt]:
         defines = defines_of(stmt)
         if isinstance(stmt, (Let, Load, Block)) and not defines & live:
             continue
+        if isinstance(stmt, Guard) and not defines & live and all(
+                isinstance(s, (Let, Load)) for s in stmt.body):
+            continue  # assigns only names nobody reads
         live -= defines if isinstance(stmt, (Let, Load)) else set()
         live |= uses_of(stmt)
         kept.append(stmt)

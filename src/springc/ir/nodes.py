@@ -143,13 +143,16 @@ def walk(e: Expr, seen: set[int] | None = None) -> Iterator[Expr]:
         stack.extend(children(node))
 
 
-def variables(e: Expr) -> set[str]:
+def variables(e: Expr, seen: set[int] | None = None) -> set[str]:
     """Names of all variables referenced in ``e`` (inside ``der`` too). One loop over
     the nodes, without :func:`walk`'s generator: code generation asks this of every
     binding and assignment of a large model (a third of the time it took). A node shared
-    by several parents is visited once, as :func:`walk` does."""
+    by several parents is visited once, as :func:`walk` does; ``seen`` (node ids) shared
+    by several calls visits a node once over all of them (its variables counted at its
+    first visit only)."""
     out: set[str] = set()
-    seen: set[int] = set()
+    if seen is None:
+        seen = set()
     stack = [e]
     while stack:
         node = stack.pop()

@@ -423,7 +423,10 @@ def _if(ev: ExpressionEvaluator, stmt: s.IfStatement, scope: FunctionScope,
         if is_flag(name):  # a return or break flag (jumps.py): folded Boolean logic
             scope.names[name] = merged_flag(cond, then_value, other)
             continue
-        scope.names[name] = a.elementwise(lambda t, o: x.If(cond, t, o), then_value, other)
+        # an element the branch left as it was stays itself (not 'if c then v else v':
+        # a loop over a vector would nest one such if per iteration in every element)
+        scope.names[name] = a.elementwise(
+            lambda t, o: t if t is o else x.If(cond, t, o), then_value, other)
 
 
 def _known(ev: ExpressionEvaluator, cond: x.Expr) -> bool | None:
