@@ -144,6 +144,8 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
             except FlattenError:
                 return
         _check_inherited_classes(entry, base)
+        if not inherited:
+            check_operator_base(element, base)
         base_kind = base.defn.kind
         if allowed is not None and base_kind not in allowed:
             raise rule_error(
@@ -160,6 +162,30 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
                 "other components, equations or base classes", element.span,
                 "a class extending an array class, a class with type prefixes or a simple "
                 "type holds nothing else", "4.5.2")
+
+
+def check_operator_base(element: s.Extends, base: ClassEntry) -> None:
+    """A long ``extends`` may name neither an operator record nor a class enclosing one
+    (section 4.6; a short class definition ``operator record R2 = R(...)`` may)."""
+    if base.defn.operator and base.defn.kind == "record":
+        raise rule_error(f"extending the operator record '{element.base.dotted}'",
+                         element.base.span, "an operator record can be extended only by a "
+                         "short class definition modifying its components", "4.6",
+                         (Note(f"'{base.full_name}' is defined here", base.defn.span),))
+    inner = next(_operator_records(base.defn), None)
+    if inner is not None:
+        raise rule_error(f"extending '{element.base.dotted}', which encloses the operator "
+                         f"record '{inner.name}'", element.base.span, "no class may extend "
+                         "a class enclosing an operator record", "4.6",
+                         (Note("the operator record is defined here", inner.span),))
+
+
+def _operator_records(defn: s.ClassDef) -> Iterator[s.ClassDef]:
+    for element in defn.elements:
+        if isinstance(element, s.ClassDef):
+            if element.operator and element.kind == "record":
+                yield element
+            yield from _operator_records(element)
 
 
 def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
