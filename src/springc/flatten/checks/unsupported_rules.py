@@ -12,11 +12,14 @@ or a :class:`FlattenError`.
 
 from __future__ import annotations
 
-from ...errors import FlattenError
+from ...errors import FlattenError, Note
 from ...ir import syntax as s
 from ...parse import ClassEntry
 from ..scopes import ClassViews
 from .rules import check_operator_base, rule_error
+
+#: The operators that are only binary (section 14.5; '-' is unary or binary).
+_BINARY = frozenset({"+", "*", "/", "^", "==", "<>", "<", "<=", ">", ">=", "and", "or"})
 
 _OPERATOR_RECORD = ("an operator record may have only public components: no equation, "
                     "algorithm or protected section")
@@ -50,6 +53,9 @@ def _check_operator_class(ctx: ClassViews, entry: ClassEntry, defn: s.ClassDef) 
     for element in defn.elements:
         if isinstance(element, s.ClassDef) and element.operator:
             _check_operator(element)
+            inner = entry.classes.get(element.name)
+            if inner is not None:
+                _check_operator_functions(ctx, entry, inner)
 
 
 def _check_operator(defn: s.ClassDef) -> None:
@@ -65,6 +71,60 @@ def _check_operator(defn: s.ClassDef) -> None:
                 else "an extends clause")
         raise rule_error(f"the operator '{defn.name}' holds {what}", element.span,
                          "an operator may hold only declarations of functions", "4.6")
+
+
+def _check_operator_functions(ctx: ClassViews, record: ClassEntry, op: ClassEntry) -> None:
+    """The functions of the operator ``op`` of the operator record ``record``: one output
+    each, of the record for a constructor and a String for 'String', two inputs or more
+    for a binary operator, no two constructors taking the same inputs (section 14)."""
+    functions = [op] if op.defn.kind == "function" else [
+        e for e in op.classes.values() if e.defn.kind == "function"]
+    signatures: dict[tuple[str, ...], s.ClassDef] = {}
+    for function in functions:
+        defn = function.defn
+        inputs = [e for e in defn.elements if isinstance(e, s.Component)
+                  and e.causality == "input"]
+        outputs = [e for e in defn.elements if isinstance(e, s.Component)
+                   and e.causality == "output"]
+        if len(outputs) != 1:
+            raise rule_error(f"the function '{defn.name}' of the operator '{op.name}' has "
+                             f"{len(outputs)} outputs", defn.span, "every function of an "
+                             "operator returns exactly one output", "14.1")
+        if op.name in _BINARY and len(inputs) < 2:
+            raise rule_error(f"the function '{defn.name}' of the binary operator "
+                             f"'{op.name}' has {len(inputs)} input", defn.span, "a binary "
+                             "operator's function takes at least two inputs", "14.5")
+        if op.name in ("constructor", "String"):
+            _check_output_type(ctx, record, op, function, outputs[0])
+        if op.name == "constructor":
+            key = tuple(f"{c.type_name.dotted}{len(c.dims) + len(c.type_dims)}"
+                        for c in inputs if c.modification is None
+                        or c.modification.value is None)
+            if key in signatures:
+                raise rule_error(f"the constructors '{signatures[key].name}' and "
+                                 f"'{defn.name}' take the same inputs", defn.span,
+                                 "no call of an operator record's constructor may match "
+                                 "two of its functions", "14.3",
+                                 (Note("the other constructor", signatures[key].span),))
+            signatures[key] = defn
+
+
+def _check_output_type(ctx: ClassViews, record: ClassEntry, op: ClassEntry,
+                       function: ClassEntry, output: s.Component) -> None:
+    try:
+        found = ctx.resolve_type(output.type_name, function)
+    except FlattenError:
+        return
+    if op.name == "String":
+        if found.primitive != "String":
+            raise rule_error(f"the output '{output.name}' of the operator 'String' is "
+                             f"of type {output.type_name.dotted}", output.type_name.span,
+                             "an overloaded String conversion returns a String", "14.4")
+    elif found.entry is not record:
+        raise rule_error(f"the output '{output.name}' of the constructor "
+                         f"'{function.name}' is of type {output.type_name.dotted}",
+                         output.type_name.span, "a constructor of an operator record "
+                         f"returns the operator record ('{record.name}')", "14.3")
 
 
 def _check_streams(ctx: ClassViews, entry: ClassEntry) -> None:
