@@ -31,7 +31,7 @@ from .calls import (
     switches,
     without_events,
 )
-from .checks import check_enum_relation
+from .checks import check_enum_relation, check_stream_argument
 from .connect import (
     CARDINALITY,
     GRAPH_FUNCTIONS,
@@ -355,6 +355,7 @@ class Evaluator(ReferenceResolver):
         if name in GRAPH_FUNCTIONS:
             return graph_value(self, self.graph, e, scope)
         if name in UNSUPPORTED_CALLS:
+            check_stream_argument(self, e, scope)  # inStream(v) of a v that is no stream
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")

@@ -15,7 +15,7 @@ from __future__ import annotations
 from ...errors import FlattenError, Note
 from ...ir import syntax as s
 from ...parse import ClassEntry
-from ..scopes import ClassViews
+from ..scopes import ClassViews, ExpressionEvaluator, Scope
 from .rules import check_operator_base, rule_error
 
 #: The operators that are only binary (section 14.5; '-' is unary or binary).
@@ -172,3 +172,24 @@ def _check_stream_type(ctx: ClassViews, entry: ClassEntry, comp: s.Component) ->
         raise rule_error(f"the stream variable '{comp.name}' has the "
                          f"{'flow' if inner[0].flow else 'stream'} element "
                          f"'{inner[0].name}'", comp.type_name.span, rule, "4.4.2.2")
+
+
+#: The operators of stream variables (sections 15.2 and 15.3).
+STREAM_OPERATORS = {"inStream": "15.2", "actualStream": "15.3"}
+
+
+def check_stream_argument(ev: ExpressionEvaluator, e: s.Call, scope: Scope) -> None:
+    """``inStream(v)`` or ``actualStream(v)`` met while flattening: no class springc
+    flattens declares a stream variable (one that does is refused first), so a ``v``
+    naming a component is not a stream variable."""
+    name = e.func.dotted
+    if len(e.args) != 1 or e.named or not isinstance(e.args[0], s.Ref):
+        return
+    try:
+        ev.reference(e.args[0], scope)
+    except FlattenError:
+        return
+    raise rule_error(f"the argument of {name} must be a stream variable, and "
+                     f"'{e.args[0].dotted}' is not one", e.args[0].span,
+                     f"{name}(v) is defined for a stream variable v of a connector",
+                     STREAM_OPERATORS[name])
