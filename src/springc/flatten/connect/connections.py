@@ -29,7 +29,13 @@ from ..scopes import (
     Primitive,
     Scope,
 )
-from .connect_rules import check_pair, check_reference_form, check_sources, overdetermined
+from .connect_rules import (
+    check_pair,
+    check_reference_form,
+    check_signal_types,
+    check_sources,
+    overdetermined,
+)
 from .connection_graph import ConnectionGraph, Edge
 from .expandable import absent, augmenting, undeclared_member
 
@@ -130,6 +136,7 @@ class ConnectionSets:
         self.flow: dict[Key, bool] = {}
         self.link: dict[Key, Link] = {}
         self.causal: dict[str, str] = {}  # flat name -> input/output, for check_sources
+        self.leaf_types: dict[str, Primitive] = {}  # flat name -> its signal's declaration
         self.counts: Counter[str] = Counter()  # connect equations per connector (cardinality)
         # protected outside connectors: a signal's source only when public (9.3)
         self.protected: set[str] = set()
@@ -180,7 +187,7 @@ class ConnectionSets:
         check_reference_form(ref, owner)
         value = direct_reference(ref, where)
         if value is None:
-            signal = _signal_connector(ev, ref, where, self.causal)
+            signal = _signal_connector(ev, ref, where, self.causal, self.leaf_types)
             if signal is not None:
                 return signal
             value = ev.reference(ref, where)
@@ -255,6 +262,9 @@ class ConnectionSets:
             raise FlattenError(f"connectors '{names[0]}' and '{names[1]}' do not match",
                                eq.span, hint="connect a signal connector (such as "
                                "RealInput) only to another signal connector")
+        pa, pb = self.leaf_types.get(ca.name), self.leaf_types.get(cb.name)
+        if pa is not None and pb is not None:
+            check_signal_types(ca.name, cb.name, pa, pb, eq)
         link = Link(eq.span, owner.prefix, f"connect({ca.name}, {cb.name})")
         ka, kb = (ca.name, out_a), (cb.name, out_b)
         self._add(ka, ca.flow, link)
@@ -337,10 +347,12 @@ class ConnectionSets:
 
 
 def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
-                      causal: dict[str, str]) -> tuple[tuple[int, ...], list[Any], bool] | None:
+                      causal: dict[str, str], types: dict[str, Primitive]
+                      ) -> tuple[tuple[int, ...], list[Any], bool] | None:
     """``connect(u, gain.u)`` where ``u`` is declared ``RealInput u``: the scalar
     variables as leaves (shape, leaves, outside), or None for any other reference.
-    Their causality goes to ``causal``, for the one-source rule (9.3)."""
+    Their causality goes to ``causal``, for the one-source rule (9.3), and their
+    declarations to ``types``, for the type rule."""
     last = ref.parts[-1]
     owners: list[Any]
     if len(ref.parts) == 1:
@@ -365,6 +377,7 @@ def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
     flow = members[0].flow
     if members[0].causality:
         causal.update((v.name, members[0].causality) for v in array.flat)
+    types.update((v.name, members[0]) for v in array.flat)
     leaves = [Leaf("", v.name, flow) for v in array.flat]
     return array.shape, leaves, len(ref.parts) == 1
 
