@@ -223,3 +223,22 @@ end M;
 def test_rule(tmp_path: Path, name: str) -> None:
     text, expected = CASES[name]
     assert outcome(tmp_path, text) == expected
+
+
+def test_equivalent_enumerations_connect(tmp_path: Path) -> None:
+    """Two enumeration types with the same literals in the same order are equivalent
+    (section 6.4): their signals connect."""
+    text = """\
+model M
+  type E = enumeration(a, b);
+  type F = enumeration(a, b);
+  connector EIn = input E;
+  connector FOut = output F;
+  EIn u;
+  FOut y = F.b;
+equation
+  connect(u, y);
+end M;
+"""
+    assert outcome(tmp_path, text) == "M: 2 unknowns (2 discrete), 2 equations, " \
+        "0 parameters: balanced"
