@@ -37,7 +37,14 @@ from .connect_rules import (
     overdetermined,
 )
 from .connection_graph import ConnectionGraph, Edge
-from .expandable import absent, augmenting, undeclared_member
+from .expandable import (
+    absent,
+    augmented_declaration,
+    augmenting,
+    both_undeclared,
+    lone_input,
+    undeclared_member,
+)
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -142,6 +149,10 @@ class ConnectionSets:
         self.protected: set[str] = set()
         self.graph = ConnectionGraph()  # overdetermined elements (section 9.4)
         self._special: dict[str, dict[str, int]] = {}  # by connector class
+        # inputs added to expandable connectors (9.1.3), and the expandable connectors
+        # connected to another one: an added input needs one (see expandable.lone_input)
+        self.added_inputs: list[tuple[ClassScope, str, Span]] = []
+        self.joined: set[int] = set()
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -161,6 +172,7 @@ class ConnectionSets:
                 owner: ClassScope) -> None:
         """Record ``connect(a, b)``; both sides may be arrays of connectors. A connection
         naming a disabled conditional component is dropped (Modelica 4.4.5)."""
+        self._augment(ev, eq, where)
         try:
             sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
         except DisabledReference:
@@ -210,6 +222,24 @@ class ConnectionSets:
             and first.outer is owner
         return shape, items, outside
 
+    def _augment(self, ev: ExpressionEvaluator, eq: s.Connect, where: Scope) -> None:
+        """``connect(u, bus.x)`` with ``x`` not declared in the expandable ``bus``:
+        ``x`` added to ``bus`` (9.1.3), where springc can."""
+        buses = [_undeclared_in(ev, ref, where) for ref in (eq.a, eq.b)]
+        if buses[0] is not None and buses[1] is not None:
+            raise both_undeclared(eq.a, eq.span)
+        for bus, ref, other in ((buses[0], eq.a, eq.b), (buses[1], eq.b, eq.a)):
+            if bus is None:
+                continue
+            prim = _signal_primitive(ev, other, where)
+            added = None if prim is None else augmented_declaration(
+                bus, ref.parts[-1], prim, len(other.parts) == 1)
+            if added is not None:  # else the located "not supported yet" follows
+                decl, deduced = added
+                bus.augmented[decl.decl.name] = decl
+                if deduced == "input":
+                    self.added_inputs.append((bus, bus.flat_name(decl.decl.name), eq.span))
+
     def _pair(self, ca: ClassScope | Leaf, cb: ClassScope | Leaf, out_a: bool, out_b: bool,
               eq: s.Connect, owner: ClassScope) -> None:
         if isinstance(ca, Leaf) or isinstance(cb, Leaf):
@@ -219,6 +249,8 @@ class ConnectionSets:
         if ca.connector_signature != cb.connector_signature and ca.expandable \
                 and cb.expandable:
             raise augmenting(ca, cb, eq.span)
+        if ca.expandable and cb.expandable:
+            self.joined.update((id(ca), id(cb)))
         if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
@@ -285,6 +317,9 @@ class ConnectionSets:
                   absent: AbstractSet[str] = frozenset()) -> list[flat.Equation]:
         """Equations of all sets (in order of first connection), then zero flows; none
         for the sets of ``absent`` variables (of expandable connectors, 9.1.3)."""
+        for bus, name, span in self.added_inputs:
+            if id(bus) not in self.joined:
+                raise lone_input(name, span)
         out: list[flat.Equation] = []
         for members in self._sets().values():
             if members[0][0] in absent:
@@ -380,6 +415,39 @@ def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
     types.update((v.name, members[0]) for v in array.flat)
     leaves = [Leaf("", v.name, flow) for v in array.flat]
     return array.shape, leaves, len(ref.parts) == 1
+
+
+def _undeclared_in(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> ClassScope | None:
+    """The expandable connector ``bus`` of a reference ``bus.x`` to a variable it does
+    not declare, else None."""
+    if len(ref.parts) < 2:
+        return None
+    try:
+        found = ev.reference(s.Ref(ref.parts[:-1], ref.span), where)
+    except FlattenError:
+        return None
+    if isinstance(found, ClassScope) and found.expandable and \
+            not found.has_member(ref.parts[-1].name):
+        return found
+    return None
+
+
+def _signal_primitive(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> Primitive | None:
+    """The signal variable (``RealInput u``) a reference without subscripts names."""
+    last = ref.parts[-1]
+    if any(p.subscripts for p in ref.parts):
+        return None
+    if len(ref.parts) == 1:
+        owner: Any = _owner_scope(where)
+    else:
+        try:
+            owner = ev.reference(s.Ref(ref.parts[:-1], ref.span), where)
+        except FlattenError:
+            return None
+    if not isinstance(owner, ClassScope) or not owner.has_member(last.name):
+        return None
+    member = owner.member(last.name, last.span)
+    return member if isinstance(member, Primitive) and member.connector else None
 
 
 def _owner_scope(where: Scope) -> ClassScope | None:
