@@ -119,7 +119,8 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
     kind = entry.defn.kind
     allowed = BASE_KINDS.get(kind)
     clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)
-               and e.base.dotted != "ExternalObject"]  # predefined (section 12.9.7)
+               and e.base.dotted != "ExternalObject"  # predefined (section 12.9.7)
+               and not (kind == "type" and e.base.dotted in RESERVED)]  # extends Real
     for element in clauses:
         inherited = entry.defn.class_extends and element is entry.defn.elements[0]
         base = inherited_class(ctx.resolve_class, entry, element.span) if inherited \

@@ -37,6 +37,8 @@ from .parameters import ParameterValues
 from .syntax_walk import same_text
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
+#: The predefined types, which no class may be named (section 4.8).
+PREDEFINED = frozenset({"Real", "Integer", "Boolean", "String"})
 
 
 
@@ -452,6 +454,8 @@ def build_view(entry: ClassEntry, flattener: ClassViews, seen: tuple[ClassEntry,
     for element in entry.defn.elements:
         if not isinstance(element, s.Extends) or element.base.dotted == "ExternalObject":
             continue  # the predefined base of external objects has no elements (12.9.7)
+        if entry.defn.kind == "type" and element.base.dotted in PREDEFINED:
+            continue  # type Angle extends Real: no components (its functions are members)
         if entry.defn.class_extends and element is entry.defn.elements[0]:
             base = inherited_class(flattener.resolve_class, entry, element.span)
         else:
