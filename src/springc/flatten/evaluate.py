@@ -23,6 +23,7 @@ from . import arrays as a
 from .array_ops import type_range, typed_range, typed_range_bounds, with_range
 from .calls import (
     Builtins,
+    argument_value,
     call_function,
     function_of,
     guard_assertions,
@@ -373,8 +374,9 @@ class Evaluator(ReferenceResolver):
                 return self._quiet(value)  # abs, div, integer... in a function body
             return value
         entry, named = short_defaults(self, function_of(self, e.func, scope), e.func, scope)
-        args = [self.value(arg, scope) for arg in e.args]
-        named.update({n.name: (self.value(n.value, scope), n.span) for n in e.named})
+        args = [argument_value(self, arg, scope) for arg in e.args]
+        named.update({n.name: (argument_value(self, n.value, scope), n.span)
+                      for n in e.named})
         return call_function(self, entry, args, named, e)
 
     def _quiet(self, v: a.Value) -> a.Value:

@@ -306,7 +306,7 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
             f"of the {type_kind} '{rtype.entry.full_name}'", decl.span,
             "type prefixes (flow, discrete, parameter, constant, input, output) apply "
             "only to components of a type, record or connector", "4.4.2.2")
-    if causality or flow:
+    if (causality or flow) and type_kind != "function":  # a functional input (12.4.2)
         prefix = causality or "flow"
         for inner, inner_decl in _elements(ctx, rtype.entry):
             # flow over an input/output element is accepted (the conformance suite

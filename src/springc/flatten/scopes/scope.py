@@ -284,6 +284,9 @@ class FunctionScope:
         value = self.names[name]
         if value is None:
             raise FlattenError(f"'{name}' is used before it is assigned", span)
+        if isinstance(value, a.FunctionArgument):
+            raise FlattenError(f"'{name}' is a function (a functional input), not a value",
+                               span, hint=f"call it: {name}(...) (section 12.4.2)")
         return value
 
 
