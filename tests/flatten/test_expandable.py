@@ -176,6 +176,21 @@ AUGMENT = """package A
   equation
     connect(b1.v, b2.v);
   end Both;
+  connector Pin
+    Real v;
+    flow Real i;
+  end Pin;
+  model Cell
+    Pin p;
+  equation
+    p.v = 1.5;
+  end Cell;
+  model Structured
+    Bus bus;
+    Cell cell;
+  equation
+    connect(cell.p, bus.pin);
+  end Structured;
 end A;
 """
 
@@ -220,3 +235,22 @@ def test_both_sides_undeclared(tmp_path: Path) -> None:
     assert error.message == ("'b1.v' and the other side of the connection are both "
                              "undeclared variables of expandable connectors")
     assert (error.span.line, error.span.column) == (42, 5)
+
+
+def test_a_connection_adds_a_connector_to_a_bus(tmp_path: Path) -> None:
+    """bus.pin is a Pin like cell.p; bus is an outside connector of the model, so its
+    flow enters the set with a minus sign and, connected nowhere else, is zero."""
+    path = tmp_path / "augment.mo"
+    path.write_text(AUGMENT)
+    assert format_flat(flatten_files([path], "A.Structured")) == """model 'A.Structured'
+  Real 'bus.pin.v';
+  flow Real 'bus.pin.i';
+  Real 'cell.p.v';
+  flow Real 'cell.p.i';
+equation
+  'cell.p.v' = 1.5;
+  'cell.p.v' = 'bus.pin.v';
+  'cell.p.i' - 'bus.pin.i' = 0;
+  'bus.pin.i' = 0;
+end 'A.Structured';
+"""

@@ -28,6 +28,7 @@ from ..scopes import (
     LocalScope,
     Primitive,
     Scope,
+    ViewComponent,
 )
 from .connect_rules import (
     check_pair,
@@ -39,6 +40,7 @@ from .connect_rules import (
 from .connection_graph import ConnectionGraph, Edge
 from .expandable import (
     absent,
+    augmented_connector,
     augmented_declaration,
     augmenting,
     both_undeclared,
@@ -231,9 +233,14 @@ class ConnectionSets:
         for bus, ref, other in ((buses[0], eq.a, eq.b), (buses[1], eq.b, eq.a)):
             if bus is None:
                 continue
-            prim = _signal_primitive(ev, other, where)
-            added = None if prim is None else augmented_declaration(
-                bus, ref.parts[-1], prim, len(other.parts) == 1)
+            found = _declared_member(ev, other, where)
+            member = found[0] if found is not None else None
+            added = None
+            if isinstance(member, Primitive) and member.connector:
+                added = augmented_declaration(bus, ref.parts[-1], member,
+                                              len(other.parts) == 1)
+            elif isinstance(member, ClassScope) and found is not None:
+                added = augmented_connector(ref.parts[-1], member, found[1])
             if added is not None:  # else the located "not supported yet" follows
                 decl, deduced = added
                 bus.augmented[decl.decl.name] = decl
@@ -432,8 +439,9 @@ def _undeclared_in(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> ClassSc
     return None
 
 
-def _signal_primitive(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> Primitive | None:
-    """The signal variable (``RealInput u``) a reference without subscripts names."""
+def _declared_member(ev: ExpressionEvaluator, ref: s.Ref, where: Scope
+                     ) -> tuple[Any, ViewComponent] | None:
+    """The member a reference without subscripts names, with its declaration."""
     last = ref.parts[-1]
     if any(p.subscripts for p in ref.parts):
         return None
@@ -446,8 +454,7 @@ def _signal_primitive(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> Prim
             return None
     if not isinstance(owner, ClassScope) or not owner.has_member(last.name):
         return None
-    member = owner.member(last.name, last.span)
-    return member if isinstance(member, Primitive) and member.connector else None
+    return owner.member(last.name, last.span), owner.component(last.name)
 
 
 def _owner_scope(where: Scope) -> ClassScope | None:

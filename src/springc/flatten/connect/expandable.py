@@ -11,14 +11,15 @@ and its connections give no equations.
 
 A connection naming an undeclared variable of an expandable connector adds it (the
 augmentation of 9.1.3, :func:`augmented_declaration`) when the other side is a signal
-variable of type Real, Integer or Boolean and the name has no subscripts: the new
-variable has the other side's type and sizes, its causality deduced as 9.1.3 says
+variable of type Real, Integer or Boolean, or a scalar connector (a component of its
+class, :func:`augmented_connector`), and the name has no subscripts: the new variable
+has the other side's type and sizes, its causality deduced as 9.1.3 says
 (copied from an inside connector, the opposite of an outside one), used only by the
 rule on added inputs (the variable is declared without causality). An input added so
 needs a non-input in another expandable connector of its augmentation set, so the
 connector must be connected to another expandable connector.
 
-Not supported yet (located errors): the other augmentations (a structured connector,
+Not supported yet (located errors): the other augmentations (an array of connectors,
 an array element, an enumeration), and connecting two expandable connectors that
 declare different variables.
 """
@@ -26,6 +27,7 @@ declare different variables.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
 from ...errors import FlattenError, Span
 from ...ir import expr as x
@@ -64,6 +66,21 @@ def augmented_declaration(bus: ClassScope, part: s.RefPart, other: Primitive,
         causality="", flow=other.flow, final=False, protected=False,
         description="", span=part.span)
     return ViewComponent(decl, bus.entry), causality
+
+
+def augmented_connector(part: s.RefPart, other: ClassScope, declared: ViewComponent
+                        ) -> tuple[ViewComponent, str] | None:
+    """The connector ``part`` added to an expandable connector by a connection to the
+    scalar connector ``other`` (declared by ``declared``): a component of the same
+    class, without modification, or None where springc does not add it."""
+    decl = declared.decl
+    if other.kind != "connector" or other.expandable or part.subscripts or decl.dims \
+            or decl.type_dims or decl.causality or decl.flow:
+        return None
+    added = replace(decl, name=part.name, modification=None, condition=None, inner=False,
+                    outer=False, replaceable=False, redeclare=False, protected=False,
+                    constraint=None, span=part.span)
+    return ViewComponent(added, declared.defined_in), ""
 
 
 def lone_input(name: str, span: Span) -> FlattenError:
