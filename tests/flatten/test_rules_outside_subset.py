@@ -242,3 +242,21 @@ end M;
 """
     assert outcome(tmp_path, text) == "M: 2 unknowns (2 discrete), 2 equations, " \
         "0 parameters: balanced"
+
+
+def test_flow_over_a_stream_element(tmp_path: Path) -> None:
+    """`flow C c` where C (outside the subset, never flattened) has a stream element."""
+    text = """\
+model M
+  connector C
+    Real p;
+    flow Real m;
+    stream Real h;
+  end C;
+  flow C c;
+end M;
+"""
+    assert outcome(tmp_path, text) == (
+        "7:10: 'c' is declared `flow`, but its element 'm' is already `flow`\nhelp: flow, "
+        "input and output on a structured component apply to its elements, which then "
+        "may not have any of these prefixes (Modelica 3.6, section 4.4.2.2)")

@@ -308,6 +308,8 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
             "only to components of a type, record or connector", "4.4.2.2")
     if (causality or flow) and type_kind != "function":  # a functional input (12.4.2)
         prefix = causality or "flow"
+        if flow and rtype.entry.defn.unsupported:  # not viewed: stream elements, ...
+            _check_flow_over_stream(decl, rtype.entry.defn)
         for inner, inner_decl in _elements(ctx, rtype.entry):
             # flow over an input/output element is accepted (the conformance suite
             # holds it valid: Components.Prefixes.FlowValidClassType)
@@ -332,6 +334,19 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
                     "constant (the prefix of a structured component applies to its "
                     "elements)", "4.4.2.2", (Note(f"'{inner}' is declared here",
                                                   inner_decl.span),))
+
+
+def _check_flow_over_stream(decl: s.Component, defn: s.ClassDef) -> None:
+    """``flow C c`` with a class C outside the subset (not viewed): its own elements
+    declared flow or stream (section 4.4.2.2)."""
+    for inner in defn.elements:
+        if isinstance(inner, s.Component) and (inner.flow or inner.stream):
+            raise rule_error(
+                f"'{decl.name}' is declared `flow`, but its element '{inner.name}' is "
+                f"already `{'flow' if inner.flow else 'stream'}`", decl.span,
+                "flow, input and output on a structured component apply to its "
+                "elements, which then may not have any of these prefixes", "4.4.2.2",
+                (Note(f"'{inner.name}' is declared here", inner.span),))
 
 
 def _elements(ctx: ClassViews, entry: ClassEntry, prefix: str = "",
