@@ -168,6 +168,21 @@ end M;
 """, "6:17: the stream connector 'C' has 2 flow declarations\nhelp: a connector with "
         "stream variables has exactly one scalar flow variable (Modelica 3.6, section "
         "15.1)"),
+    "stream_connector_unbalanced": ("""\
+model M
+  connector C
+    Real p;
+    Real q;
+    flow Real m;
+    stream Real h;
+    parameter Real k = 1;
+    input Real u;
+  end C;
+  C c;
+end M;
+""", "2:3: the connector 'C' has 1 flow and 2 potential variables\nhelp: a connector "
+        "has as many flow variables as variables that are neither parameter, constant, "
+        "input, output, stream nor flow (Modelica 3.6, section 9.3.1)"),
     "stream_valid": ("""\
 model M
   connector C

@@ -147,6 +147,25 @@ def _check_streams(ctx: ClassViews, entry: ClassEntry) -> None:
                          f"declarations{'' if len(flows) != 1 else ' (an array)'}",
                          streams[0].span, "a connector with stream variables has exactly "
                          "one scalar flow variable", "15.1")
+    _check_balance(defn, flows)
+
+
+def _check_balance(defn: s.ClassDef, flows: list[s.Component]) -> None:
+    """A stream connector of scalar variables of predefined types: as many flow
+    variables as variables that are neither parameter, constant, input, output, stream
+    nor flow (section 9.3.1)."""
+    comps = [e for e in defn.elements if isinstance(e, s.Component)]
+    if any(c.dims or c.type_dims or c.type_name.dotted not in ("Real", "Integer", "Boolean")
+           for c in comps):
+        return  # records, arrays, derived types: not counted here
+    potentials = [c for c in comps if not (c.flow or c.stream or c.causality)
+                  and c.variability not in ("parameter", "constant")]
+    if len(potentials) != len(flows):
+        raise rule_error(f"the connector '{defn.name}' has {len(flows)} flow and "
+                         f"{len(potentials)} potential variables", defn.span,
+                         "a connector has as many flow variables as variables that are "
+                         "neither parameter, constant, input, output, stream nor flow",
+                         "9.3.1")
 
 
 def _check_stream_type(ctx: ClassViews, entry: ClassEntry, comp: s.Component) -> None:
