@@ -191,6 +191,18 @@ AUGMENT = """package A
   equation
     connect(cell.p, bus.pin);
   end Structured;
+  model Fed
+    Bus bus;
+    Source source;
+    Sink sink;
+  equation
+    connect(source.y, bus.w);
+    connect(bus.w, sink.u);
+  end Fed;
+  model Many
+    Fed f[2];
+    Fed g;
+  end Many;
 end A;
 """
 
@@ -254,3 +266,16 @@ equation
   'bus.pin.i' = 0;
 end 'A.Structured';
 """
+
+
+def test_buses_of_instances_copied_from_a_template(tmp_path: Path) -> None:
+    """f[2] and g are copies of f[1]'s instance: each bus still gets its variable w,
+    and every sink.y = 2 * 3 t."""
+    path = tmp_path / "augment.mo"
+    path.write_text(AUGMENT)
+    result = springc.simulate([path], model_name="A.Many", stop=1.0, interval=0.25,
+                              engine="scipy", backend="python", error_control="off")
+    t = np.asarray(result.time)
+    for name in ("f[1]", "f[2]", "g"):
+        assert np.allclose(result[f"{name}.sink.y"], 6 * t, rtol=0, atol=1e-12)
+        assert np.allclose(result[f"{name}.bus.w"], 3 * t, rtol=0, atol=1e-12)

@@ -155,6 +155,7 @@ class ConnectionSets:
         # connected to another one: an added input needs one (see expandable.lone_input)
         self.added_inputs: list[tuple[ClassScope, str, Span]] = []
         self.joined: set[int] = set()
+        self.augmented_buses: list[ClassScope] = []  # in the order first augmented
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -243,6 +244,8 @@ class ConnectionSets:
                 added = augmented_connector(ref.parts[-1], member, found[1])
             if added is not None:  # else the located "not supported yet" follows
                 decl, deduced = added
+                if not bus.augmented:
+                    self.augmented_buses.append(bus)
                 bus.augmented[decl.decl.name] = decl
                 if deduced == "input":
                     self.added_inputs.append((bus, bus.flat_name(decl.decl.name), eq.span))
