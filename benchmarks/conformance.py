@@ -1,7 +1,7 @@
 """springc against the Modelica conformance suite (modelica/Modelica-Compliance).
 
     PYTHONPATH=src python benchmarks/conformance.py [SUITE] [--jobs N] [--timeout S]
-        [--section NAME]... [--list CATEGORY] [--simulate] [--json out.json]
+        [--section NAME]... [--match TEXT]... [--list CATEGORY] [--simulate] [--json out.json]
 
 SUITE is the folder holding ``ModelicaCompliance/`` (default /work/ref/compliance; the
 suite is never part of this repository). Every class annotated
@@ -315,6 +315,8 @@ def main() -> None:
     parser.add_argument("--timeout", type=float, default=30.0)
     parser.add_argument("--section", action="append", default=[],
                         help="only these top-level sections (repeatable)")
+    parser.add_argument("--match", action="append", default=[],
+                        help="only the models whose name contains this (repeatable)")
     parser.add_argument("--list", dest="list_category", action="append", default=[],
                         choices=CHECK_CATEGORIES + SIM_CATEGORIES + ("out-of-subset",),
                         help="print the models of a category (repeatable)")
@@ -328,6 +330,8 @@ def main() -> None:
     models = find_models(suite)
     if args.section:
         models = [m for m in models if m.section in args.section]
+    if args.match:
+        models = [m for m in models if any(text in m.name for text in args.match)]
     print(f"suite: {suite} at commit {suite_commit(suite)}; {len(models)} test models")
     tasks = [(m, str(suite), args.timeout, args.simulate) for m in models]
     if args.jobs == 1:

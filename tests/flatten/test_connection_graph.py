@@ -147,3 +147,44 @@ def test_overdetermined_elements_looked_up_once_per_connector_class(
     assert outcome(tmp_path, text).startswith(
         "18:5: connector 'c' (M.C) has 2 flow and 3 potential variables\n")
     assert calls == ["M.C"]
+
+
+SCALAR_LOOP = """model L
+  type Angle
+    extends Real;
+    function equalityConstraint
+      input Angle a1;
+      input Angle a2;
+      output Real residue[1];
+    algorithm
+      residue := {2 * (a1 - a2)};
+    end equalityConstraint;
+  end Angle;
+  connector C
+    Angle theta;
+    flow Real i;
+  end C;
+  C a, b, d;
+equation
+  a.theta = time;
+  b.i = 1;
+  d.i = 2;
+  connect(a, b);
+  connect(b, d);
+  connect(d, a);
+  Connections.root(a.theta);
+end L;
+"""
+
+
+def test_a_loop_of_a_scalar_overdetermined_type(tmp_path: Path) -> None:
+    """A type extending Real with an equalityConstraint (not a record): the loop a-b-d
+    is broken at b-d (the spanning tree from the root a keeps a-b and d-a), its
+    equality replaced by the residue 2 (b.theta - d.theta) of the type's function."""
+    path = tmp_path / "loop.mo"
+    path.write_text(SCALAR_LOOP)
+    model = flatten_files([path])
+    eqs = {f"{x.to_text(e.lhs)} = {x.to_text(e.rhs)}" for e in model.equations}
+    thetas = {e for e in eqs if "theta" in e}
+    assert thetas == {"a.theta = time", "a.theta = b.theta", "a.theta = d.theta",
+                      "0 = 2 * (b.theta - d.theta)"}

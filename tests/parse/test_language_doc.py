@@ -63,7 +63,7 @@ REJECTED = {
     "operator record C\n  Real re;\nend C;\nmodel M\n  C c;\nend M;\n":
         "1:1: error: `operator` classes are not supported yet",
     "connector RO = output Real;\nexpandable connector C\n  Real y;\nend C;\nmodel M\n"
-    "  RO s = time;\n  C bus;\nequation\n  connect(s, bus.x);\nend M;\n":
+    "  RO s = time;\n  C bus;\nequation\n  connect(s, bus.x[2]);\nend M;\n":
         "9:18: error: adding 'x' to the expandable connector 'bus' (C) by a connection is "
         "not supported yet",
     "model M\n  Real x := 1;\nend M;\n": "2:10: error: `:=` in a declaration is not supported yet",

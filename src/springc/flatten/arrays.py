@@ -29,6 +29,14 @@ class RecordValue:
     fields: dict[str, Any]
 
 
+@dataclass(frozen=True)
+class FunctionArgument:
+    """A function passed as the argument of a function's functional input (section
+    12.4.2: ``quadrature(0, 1, Parabola)``); a call of the input calls ``entry``."""
+
+    entry: Any  # the ClassEntry of the function
+
+
 #: A value; a record value (``RecordValue``) travels where a function returns or takes
 #: one, typed as this alias only by the few places that make or read it.
 Value = x.Expr | str | np.ndarray

@@ -23,6 +23,7 @@ from . import arrays as a
 from .array_ops import type_range, typed_range, typed_range_bounds, with_range
 from .calls import (
     Builtins,
+    argument_value,
     call_function,
     function_of,
     guard_assertions,
@@ -31,7 +32,7 @@ from .calls import (
     switches,
     without_events,
 )
-from .checks import check_enum_relation
+from .checks import check_enum_relation, check_stream_argument
 from .connect import (
     CARDINALITY,
     GRAPH_FUNCTIONS,
@@ -363,6 +364,7 @@ class Evaluator(ReferenceResolver):
         if name in GRAPH_FUNCTIONS:
             return graph_value(self, self.graph, e, scope)
         if name in UNSUPPORTED_CALLS:
+            check_stream_argument(self, e, scope)  # inStream(v) of a v that is no stream
             raise FlattenError(f"`{name}` is not supported yet", e.func.span,
                                hint="springc supports a subset of Modelica; see "
                                "\"Not supported yet\" in docs/language.md")
@@ -380,8 +382,9 @@ class Evaluator(ReferenceResolver):
                 return self._quiet(value)  # abs, div, integer... in a function body
             return value
         entry, named = short_defaults(self, function_of(self, e.func, scope), e.func, scope)
-        args = [self.value(arg, scope) for arg in e.args]
-        named.update({n.name: (self.value(n.value, scope), n.span) for n in e.named})
+        args = [argument_value(self, arg, scope) for arg in e.args]
+        named.update({n.name: (argument_value(self, n.value, scope), n.span)
+                      for n in e.named})
         return call_function(self, entry, args, named, e)
 
     def _quiet(self, v: a.Value) -> a.Value:

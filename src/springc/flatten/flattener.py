@@ -150,6 +150,22 @@ class Flattener(ClassLookup, Instantiation, EquationFlattening):
                     else:
                         yield from self.variables(item)
 
+    def augmented_variables(self, known: tuple[flat.Variable, ...]
+                            ) -> Iterator[flat.Variable]:
+        """The variables connections added to expandable connectors (9.1.3) that an
+        instance copied from a template does not list (its template has no record of
+        them)."""
+        names = {v.name for v in known}
+        for bus in self.connections.augmented_buses:
+            for name in bus.augmented:
+                member = bus.member(name)
+                found = attributes_of(self, bus, member) if isinstance(member, Primitive) \
+                    else self.variables(member) if isinstance(member, ClassScope) else ()
+                for v in found:
+                    if v.name not in names:
+                        names.add(v.name)
+                        yield v
+
 
 def flatten(tree: ClassTree, model: str | None = None, max_size: int | None = None
             ) -> flat.FlatModel:
@@ -188,6 +204,7 @@ def _flatten(tree: ClassTree, model: str | None, max_size: int) -> flat.FlatMode
             apply_cardinalities(flattener, flattener.connections.counts)
         if not flattener.errors:
             variables = tuple(flattener.variables(top))
+            variables += tuple(flattener.augmented_variables(variables))
             flattener.errors += binding_errors(variables, flattener.parameter_values)
             check_events(flattener, variables)
             apply_starts(flattener, flattener.algorithm_sections, variables)

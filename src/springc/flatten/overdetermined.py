@@ -19,7 +19,7 @@ from ..parse import member_class
 from . import arrays as a
 from .calls import call_function
 from .connect import Edge
-from .scopes import ClassScope
+from .scopes import ClassScope, Primitive
 
 if TYPE_CHECKING:
     from .equations import EquationFlattening as Flattener
@@ -54,13 +54,22 @@ def _residues(fl: Flattener, edge: Edge) -> list[flat.Equation]:
     """``0 = equalityConstraint(a, b)`` of a broken connection, one per residue."""
     ca, cb = edge.scopes
     elements = [c.member(edge.element) for c in (ca, cb)]
-    if not all(isinstance(e, ClassScope) and e.kind == "record" for e in elements):
+    if all(isinstance(e, ClassScope) and e.kind == "record" for e in elements):
+        constraint = member_class(elements[0].entry, "equalityConstraint")
+        values = [fl.evaluator.record_value(e) for e in elements]
+    elif all(isinstance(e, Primitive) and not e.dims for e in elements):
+        # a scalar of a type extending Real (`type Angle extends Real; function
+        # equalityConstraint ...`): the function of the type the connector declares
+        comp = ca.view.components[edge.element]
+        constraint = member_class(fl.resolve_class(comp.decl.type_name, comp.defined_in),
+                                  "equalityConstraint")
+        values = [e.value for e in elements]
+    else:
         raise FlattenError(f"breaking the connection of '{edge.a}' and '{edge.b}' needs "
-                           "the equalityConstraint of an overdetermined type that is not "
-                           "a record, which is not supported yet", edge.link.span)
-    constraint = member_class(elements[0].entry, "equalityConstraint")
+                           "the equalityConstraint of an overdetermined type that is "
+                           "neither a record nor a scalar type, which is not supported "
+                           "yet", edge.link.span)
     assert constraint is not None  # the element is overdetermined because of it
-    values = [fl.evaluator.record_value(e) for e in elements]
     span = edge.link.span
     call = s.Call(s.Ref((s.RefPart("equalityConstraint", (), span),), span), (), (), span)
     residue = call_function(fl.evaluator, constraint, values, {}, call)

@@ -246,6 +246,7 @@ class Component:
     # The type and modification of `constrainedby T(...)` (Modelica 7.3.2).
     constraint: tuple[Ref, Modification | None] | None = None
     redeclare: bool = False  # an element `redeclare T x;` replacing an inherited one
+    stream: bool = False  # `stream Real h` (section 15): outside the subset, rules checked
     # `annotation(Evaluate = true)` (Modelica 18.3): the parameter's value is folded into
     # the model as a constant's is
     evaluate: bool = False
@@ -453,6 +454,9 @@ class ClassDef:
     external: ExternalCall | None = None
     # `expandable connector C ... end C;` (section 9.1.3)
     expandable: bool = False
+    # `operator record`, `operator '+'`, `operator function` (section 14): outside the
+    # subset, but their static rules are checked (flatten/checks/unsupported_rules.py)
+    operator: bool = False
 
 
 Element = Component | Extends | Import | ClassDef

@@ -147,7 +147,7 @@ class ClassRules(RuleBase):
             class_extends=spec.class_extends,
             unsupported=self.take_deferred(span) if self.defer else (),
             external=body["external"][0] if body["external"] else None,
-            expandable="expandable" in words,
+            expandable="expandable" in words, operator="operator" in words,
         )
 
     def short_class_definition(self, meta: Meta, ch: list[Any]) -> Any:

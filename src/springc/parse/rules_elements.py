@@ -117,6 +117,7 @@ class ElementRules(RuleBase):
                 name=d.name, type_name=item.type_name, type_dims=item.type_dims, dims=d.dims,
                 modification=d.modification, variability=variability(words),
                 causality=causality(words), flow="flow" in words, final="final" in words,
+                stream="stream" in words,
                 protected=False, description=d.description, span=d.span,
                 condition=d.condition, inner="inner" in words, outer="outer" in words,
                 replaceable="replaceable" in words,

@@ -8,6 +8,7 @@ from .assertions import assertion, check_conditions, guard_assertions, unique
 from .builtins import CONSTANTS, Builtins, switches, without_events
 from .control import Jumped, branch_jumps, check_jumps, folded, run_loop_body, run_while, stray
 from .functions import (
+    argument_value,
     call_for_effect,
     call_function,
     condition_value,
@@ -28,6 +29,7 @@ __all__ = [
     "CONSTANTS",
     "Builtins",
     "Jumped",
+    "argument_value",
     "assertion",
     "branch_jumps",
     "call_for_effect",

@@ -32,6 +32,7 @@ from ..scopes import (
     ClassView,
     ExpressionEvaluator,
     FunctionScope,
+    LocalScope,
     Scope,
     ViewComponent,
 )
@@ -94,6 +95,7 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
         if name in given:
             raise FlattenError(f"input '{name}' is given twice", span)
         given[name] = value
+    _check_functional_inputs(ev, entry, inputs, given, call)
     if count > 1:
         for comp in inputs:
             arg = given.get(comp.name)
@@ -142,6 +144,27 @@ def _execute(ev: ExpressionEvaluator, entry: ClassEntry, args: list[a.Value],
     return results  # type: ignore[return-value]  # a list only for count != 1
 
 
+def _check_functional_inputs(ev: ExpressionEvaluator, entry: ClassEntry,
+                             inputs: list[s.Component], given: dict[str, a.Value],
+                             call: s.Call) -> None:
+    """A function passed as an argument goes to an input of a function type (12.4.2)."""
+    for comp in inputs:
+        value = given.get(comp.name)
+        if not isinstance(value, a.FunctionArgument):
+            continue
+        try:
+            kind = ev.flattener.resolve_class(comp.type_name, entry).defn.kind
+        except FlattenError:
+            kind = ""
+        if kind != "function":
+            raise FlattenError(f"the input '{comp.name}' of '{entry.full_name}' is given "
+                               f"the function '{value.entry.full_name}', but it is not a "
+                               "functional input", call.span,
+                               [Note("declared here", comp.span)],
+                               "only an input declared with a function type takes a "
+                               "function (Modelica 3.6, section 12.4.2)")
+
+
 def generates_events(entry: ClassEntry) -> bool:
     """Whether the function has ``annotation(GenerateEvents = true)``: without it, the
     relations and switching built-ins of its body generate no events, "similar to
@@ -170,7 +193,12 @@ def condition_value(ev: ExpressionEvaluator, cond: s.Expr, scope: Scope) -> a.Va
 
 def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry:
     """The function a call names: a class, or ``a.f`` with ``a`` a scalar component
-    whose class declares the function ``f`` (section 5.3.2)."""
+    whose class declares the function ``f`` (section 5.3.2), or the function passed to
+    a functional input of the function being run (section 12.4.2)."""
+    if len(ref.parts) == 1:
+        passed = _passed_function(ref.parts[0].name, scope)
+        if passed is not None:
+            return passed
     if len(ref.parts) > 1 and lookup_class(ref.parts[0].name, scope.entry) is None:
         owner: object = None
         k = len(ref.parts) - 1
@@ -198,6 +226,38 @@ def function_of(ev: ExpressionEvaluator, ref: s.Ref, scope: Scope) -> ClassEntry
     return ev.flattener.resolve_function(ref, scope)
 
 
+def _passed_function(name: str, scope: Scope) -> ClassEntry | None:
+    """The function held by the functional input ``name`` of the running function."""
+    where: Any = scope
+    while isinstance(where, LocalScope):
+        if name in where.names:
+            return None
+        where = where.parent
+    if isinstance(where, FunctionScope):
+        held = where.names.get(name)
+        if isinstance(held, a.FunctionArgument):
+            entry: ClassEntry = held.entry
+            return entry
+    return None
+
+
+def argument_value(ev: ExpressionEvaluator, arg: s.Expr, scope: Scope) -> a.Value:
+    """An argument of a user function: a value, or a function passed by its name to a
+    functional input (section 12.4.2: ``quadrature(0, 1, Parabola)``)."""
+    try:
+        return ev.value(arg, scope)
+    except FlattenError:
+        if not isinstance(arg, s.Ref):
+            raise
+        try:
+            entry = function_of(ev, arg, scope)
+        except FlattenError:
+            entry = None
+        if entry is None or entry.defn.kind != "function":
+            raise
+        return cast(a.Value, a.FunctionArgument(entry))
+
+
 def _redeclared_function(ev: ExpressionEvaluator, owner: ClassScope,
                          parts: tuple[s.RefPart, ...]) -> ClassEntry | None:
     """``b.f()`` where ``b``'s class was given ``redeclare function f = g`` (in an
@@ -217,8 +277,8 @@ def call_outputs(ev: ExpressionEvaluator, call: s.Call, scope: Scope, count: int
                  ) -> list[a.Value]:
     """The first ``count`` outputs of a call of a user-defined function."""
     entry, named = short_defaults(ev, function_of(ev, call.func, scope), call.func, scope)
-    args = [ev.value(arg, scope) for arg in call.args]
-    named.update({n.name: (ev.value(n.value, scope), n.span) for n in call.named})
+    args = [argument_value(ev, arg, scope) for arg in call.args]
+    named.update({n.name: (argument_value(ev, n.value, scope), n.span) for n in call.named})
     values = call_function(ev, entry, args, named, call, count)
     return values if count > 1 else [values]  # type: ignore[return-value]
 

@@ -25,6 +25,7 @@ from .type_rules import (
     declared,
     stronger,
 )
+from .unsupported_rules import check_stream_argument, check_unsupported_class
 
 __all__ = [
     "check_access_class", "check_access_component", "check_access_path",
@@ -32,5 +33,6 @@ __all__ = [
     "check_constant_binding", "check_der_argument", "check_discrete_binding",
     "check_enum_binding", "check_enum_relation", "check_extends", "check_inside",
     "check_integer_binding", "check_modified", "check_numeric_arguments", "check_outer_uses",
+    "check_stream_argument", "check_unsupported_class",
     "declared", "rule_error", "stronger",
 ]

@@ -119,7 +119,8 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
     kind = entry.defn.kind
     allowed = BASE_KINDS.get(kind)
     clauses = [e for e in entry.defn.elements if isinstance(e, s.Extends)
-               and e.base.dotted != "ExternalObject"]  # predefined (section 12.9.7)
+               and e.base.dotted != "ExternalObject"  # predefined (section 12.9.7)
+               and not (kind == "type" and e.base.dotted in RESERVED)]  # extends Real
     for element in clauses:
         inherited = entry.defn.class_extends and element is entry.defn.elements[0]
         base = inherited_class(ctx.resolve_class, entry, element.span) if inherited \
@@ -144,6 +145,8 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
             except FlattenError:
                 return
         _check_inherited_classes(entry, base)
+        if not inherited:
+            check_operator_base(element, base)
         base_kind = base.defn.kind
         if allowed is not None and base_kind not in allowed:
             raise rule_error(
@@ -160,6 +163,30 @@ def check_extends(ctx: ClassViews, entry: ClassEntry) -> None:
                 "other components, equations or base classes", element.span,
                 "a class extending an array class, a class with type prefixes or a simple "
                 "type holds nothing else", "4.5.2")
+
+
+def check_operator_base(element: s.Extends, base: ClassEntry) -> None:
+    """A long ``extends`` may name neither an operator record nor a class enclosing one
+    (section 4.6; a short class definition ``operator record R2 = R(...)`` may)."""
+    if base.defn.operator and base.defn.kind == "record":
+        raise rule_error(f"extending the operator record '{element.base.dotted}'",
+                         element.base.span, "an operator record can be extended only by a "
+                         "short class definition modifying its components", "4.6",
+                         (Note(f"'{base.full_name}' is defined here", base.defn.span),))
+    inner = next(_operator_records(base.defn), None)
+    if inner is not None:
+        raise rule_error(f"extending '{element.base.dotted}', which encloses the operator "
+                         f"record '{inner.name}'", element.base.span, "no class may extend "
+                         "a class enclosing an operator record", "4.6",
+                         (Note("the operator record is defined here", inner.span),))
+
+
+def _operator_records(defn: s.ClassDef) -> Iterator[s.ClassDef]:
+    for element in defn.elements:
+        if isinstance(element, s.ClassDef):
+            if element.operator and element.kind == "record":
+                yield element
+            yield from _operator_records(element)
 
 
 def _check_inherited_classes(entry: ClassEntry, base: ClassEntry) -> None:
@@ -279,8 +306,10 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
             f"of the {type_kind} '{rtype.entry.full_name}'", decl.span,
             "type prefixes (flow, discrete, parameter, constant, input, output) apply "
             "only to components of a type, record or connector", "4.4.2.2")
-    if causality or flow:
+    if (causality or flow) and type_kind != "function":  # a functional input (12.4.2)
         prefix = causality or "flow"
+        if flow and rtype.entry.defn.unsupported:  # not viewed: stream elements, ...
+            _check_flow_over_stream(decl, rtype.entry.defn)
         for inner, inner_decl in _elements(ctx, rtype.entry):
             # flow over an input/output element is accepted (the conformance suite
             # holds it valid: Components.Prefixes.FlowValidClassType)
@@ -305,6 +334,19 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
                     "constant (the prefix of a structured component applies to its "
                     "elements)", "4.4.2.2", (Note(f"'{inner}' is declared here",
                                                   inner_decl.span),))
+
+
+def _check_flow_over_stream(decl: s.Component, defn: s.ClassDef) -> None:
+    """``flow C c`` with a class C outside the subset (not viewed): its own elements
+    declared flow or stream (section 4.4.2.2)."""
+    for inner in defn.elements:
+        if isinstance(inner, s.Component) and (inner.flow or inner.stream):
+            raise rule_error(
+                f"'{decl.name}' is declared `flow`, but its element '{inner.name}' is "
+                f"already `{'flow' if inner.flow else 'stream'}`", decl.span,
+                "flow, input and output on a structured component apply to its "
+                "elements, which then may not have any of these prefixes", "4.4.2.2",
+                (Note(f"'{inner.name}' is declared here", inner.span),))
 
 
 def _elements(ctx: ClassViews, entry: ClassEntry, prefix: str = "",

@@ -54,8 +54,9 @@ def check_pair(ca: ClassScope, cb: ClassScope, eq: s.Connect) -> dict[str, str]:
         pb = right.get(name)
         if pb is None:
             continue
-        if pa.type != pb.type:
-            raise rule_error(f"{head}: '{name}' is {_a(pa.type)} in one and {_a(pb.type)} "
+        if _type_key(pa) != _type_key(pb):
+            raise rule_error(f"{head}: '{name}' is {_a(type_name(pa))} in one and "
+                             f"{_a(type_name(pb))} "
                              "in the other", eq.span, "connected variables must have the same "
                              "primitive type", "9.3",
                              _notes(ca, cb, name, pa, pb))
@@ -79,6 +80,30 @@ def check_pair(ca: ClassScope, cb: ClassScope, eq: s.Connect) -> dict[str, str]:
                                   else list(prim.names.flat)):
                     causal[flat_name] = prim.causality
     return causal
+
+
+def type_name(prim: Primitive) -> str:
+    """``Real``, ``Integer``, ..., or the full name of an enumeration type."""
+    return f"enumeration {prim.enumeration.name}" if prim.enumeration else prim.type
+
+
+def _type_key(prim: Primitive) -> tuple[str, tuple[str, ...] | None]:
+    """What must agree between connected variables: the primitive type, and of an
+    enumeration its literals in order (section 6.4: enumeration types with the same
+    literals in the same order are equivalent)."""
+    return prim.type, prim.enumeration.literals if prim.enumeration else None
+
+
+def check_signal_types(a: str, b: str, pa: Primitive, pb: Primitive, eq: s.Connect
+                       ) -> None:
+    """Two connected signals (``connect(u, bus.x)``) have the same type: an enumeration
+    connects only to the same enumeration (section 9.3; 4.9.5: no implicit conversion)."""
+    if _type_key(pa) != _type_key(pb):
+        raise rule_error(f"cannot connect '{a}' and '{b}': one is {_a(type_name(pa))} and "
+                         f"the other {_a(type_name(pb))}", eq.span, "connected variables "
+                         "must have the same primitive type", "9.3",
+                         (Note(f"'{a}' is declared here", pa.decl.span),
+                          Note(f"'{b}' is declared here", pb.decl.span)))
 
 
 def _notes(ca: ClassScope, cb: ClassScope, name: str, pa: Primitive, pb: Primitive

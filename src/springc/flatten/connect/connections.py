@@ -28,10 +28,25 @@ from ..scopes import (
     LocalScope,
     Primitive,
     Scope,
+    ViewComponent,
 )
-from .connect_rules import check_pair, check_reference_form, check_sources, overdetermined
+from .connect_rules import (
+    check_pair,
+    check_reference_form,
+    check_signal_types,
+    check_sources,
+    overdetermined,
+)
 from .connection_graph import ConnectionGraph, Edge
-from .expandable import absent, augmenting, undeclared_member
+from .expandable import (
+    absent,
+    augmented_connector,
+    augmented_declaration,
+    augmenting,
+    both_undeclared,
+    lone_input,
+    undeclared_member,
+)
 
 Key = tuple[str, bool]  # (flat variable name, outside)
 
@@ -130,11 +145,17 @@ class ConnectionSets:
         self.flow: dict[Key, bool] = {}
         self.link: dict[Key, Link] = {}
         self.causal: dict[str, str] = {}  # flat name -> input/output, for check_sources
+        self.leaf_types: dict[str, Primitive] = {}  # flat name -> its signal's declaration
         self.counts: Counter[str] = Counter()  # connect equations per connector (cardinality)
         # protected outside connectors: a signal's source only when public (9.3)
         self.protected: set[str] = set()
         self.graph = ConnectionGraph()  # overdetermined elements (section 9.4)
         self._special: dict[str, dict[str, int]] = {}  # by connector class
+        # inputs added to expandable connectors (9.1.3), and the expandable connectors
+        # connected to another one: an added input needs one (see expandable.lone_input)
+        self.added_inputs: list[tuple[ClassScope, str, Span]] = []
+        self.joined: set[int] = set()
+        self.augmented_buses: list[ClassScope] = []  # in the order first augmented
 
     def _find(self, key: Key) -> Key:
         root = key
@@ -154,6 +175,7 @@ class ConnectionSets:
                 owner: ClassScope) -> None:
         """Record ``connect(a, b)``; both sides may be arrays of connectors. A connection
         naming a disabled conditional component is dropped (Modelica 4.4.5)."""
+        self._augment(ev, eq, where)
         try:
             sides = [self._connectors(ev, ref, where, owner) for ref in (eq.a, eq.b)]
         except DisabledReference:
@@ -180,7 +202,7 @@ class ConnectionSets:
         check_reference_form(ref, owner)
         value = direct_reference(ref, where)
         if value is None:
-            signal = _signal_connector(ev, ref, where, self.causal)
+            signal = _signal_connector(ev, ref, where, self.causal, self.leaf_types)
             if signal is not None:
                 return signal
             value = ev.reference(ref, where)
@@ -203,6 +225,31 @@ class ConnectionSets:
             and first.outer is owner
         return shape, items, outside
 
+    def _augment(self, ev: ExpressionEvaluator, eq: s.Connect, where: Scope) -> None:
+        """``connect(u, bus.x)`` with ``x`` not declared in the expandable ``bus``:
+        ``x`` added to ``bus`` (9.1.3), where springc can."""
+        buses = [_undeclared_in(ev, ref, where) for ref in (eq.a, eq.b)]
+        if buses[0] is not None and buses[1] is not None:
+            raise both_undeclared(eq.a, eq.span)
+        for bus, ref, other in ((buses[0], eq.a, eq.b), (buses[1], eq.b, eq.a)):
+            if bus is None:
+                continue
+            found = _declared_member(ev, other, where)
+            member = found[0] if found is not None else None
+            added = None
+            if isinstance(member, Primitive) and member.connector:
+                added = augmented_declaration(bus, ref.parts[-1], member,
+                                              len(other.parts) == 1)
+            elif isinstance(member, ClassScope) and found is not None:
+                added = augmented_connector(ref.parts[-1], member, found[1])
+            if added is not None:  # else the located "not supported yet" follows
+                decl, deduced = added
+                if not bus.augmented:
+                    self.augmented_buses.append(bus)
+                bus.augmented[decl.decl.name] = decl
+                if deduced == "input":
+                    self.added_inputs.append((bus, bus.flat_name(decl.decl.name), eq.span))
+
     def _pair(self, ca: ClassScope | Leaf, cb: ClassScope | Leaf, out_a: bool, out_b: bool,
               eq: s.Connect, owner: ClassScope) -> None:
         if isinstance(ca, Leaf) or isinstance(cb, Leaf):
@@ -212,6 +259,8 @@ class ConnectionSets:
         if ca.connector_signature != cb.connector_signature and ca.expandable \
                 and cb.expandable:
             raise augmenting(ca, cb, eq.span)
+        if ca.expandable and cb.expandable:
+            self.joined.update((id(ca), id(cb)))
         if ca.connector_signature != cb.connector_signature:
             raise FlattenError(
                 f"connectors '{ca.prefix}' ({ca.entry.full_name}) and '{cb.prefix}' "
@@ -255,6 +304,9 @@ class ConnectionSets:
             raise FlattenError(f"connectors '{names[0]}' and '{names[1]}' do not match",
                                eq.span, hint="connect a signal connector (such as "
                                "RealInput) only to another signal connector")
+        pa, pb = self.leaf_types.get(ca.name), self.leaf_types.get(cb.name)
+        if pa is not None and pb is not None:
+            check_signal_types(ca.name, cb.name, pa, pb, eq)
         link = Link(eq.span, owner.prefix, f"connect({ca.name}, {cb.name})")
         ka, kb = (ca.name, out_a), (cb.name, out_b)
         self._add(ka, ca.flow, link)
@@ -275,6 +327,9 @@ class ConnectionSets:
                   absent: AbstractSet[str] = frozenset()) -> list[flat.Equation]:
         """Equations of all sets (in order of first connection), then zero flows; none
         for the sets of ``absent`` variables (of expandable connectors, 9.1.3)."""
+        for bus, name, span in self.added_inputs:
+            if id(bus) not in self.joined:
+                raise lone_input(name, span)
         out: list[flat.Equation] = []
         for members in self._sets().values():
             if members[0][0] in absent:
@@ -337,10 +392,12 @@ class ConnectionSets:
 
 
 def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
-                      causal: dict[str, str]) -> tuple[tuple[int, ...], list[Any], bool] | None:
+                      causal: dict[str, str], types: dict[str, Primitive]
+                      ) -> tuple[tuple[int, ...], list[Any], bool] | None:
     """``connect(u, gain.u)`` where ``u`` is declared ``RealInput u``: the scalar
     variables as leaves (shape, leaves, outside), or None for any other reference.
-    Their causality goes to ``causal``, for the one-source rule (9.3)."""
+    Their causality goes to ``causal``, for the one-source rule (9.3), and their
+    declarations to ``types``, for the type rule."""
     last = ref.parts[-1]
     owners: list[Any]
     if len(ref.parts) == 1:
@@ -365,8 +422,42 @@ def _signal_connector(ev: ExpressionEvaluator, ref: s.Ref, where: Scope,
     flow = members[0].flow
     if members[0].causality:
         causal.update((v.name, members[0].causality) for v in array.flat)
+    types.update((v.name, members[0]) for v in array.flat)
     leaves = [Leaf("", v.name, flow) for v in array.flat]
     return array.shape, leaves, len(ref.parts) == 1
+
+
+def _undeclared_in(ev: ExpressionEvaluator, ref: s.Ref, where: Scope) -> ClassScope | None:
+    """The expandable connector ``bus`` of a reference ``bus.x`` to a variable it does
+    not declare, else None."""
+    if len(ref.parts) < 2:
+        return None
+    try:
+        found = ev.reference(s.Ref(ref.parts[:-1], ref.span), where)
+    except FlattenError:
+        return None
+    if isinstance(found, ClassScope) and found.expandable and \
+            not found.has_member(ref.parts[-1].name):
+        return found
+    return None
+
+
+def _declared_member(ev: ExpressionEvaluator, ref: s.Ref, where: Scope
+                     ) -> tuple[Any, ViewComponent] | None:
+    """The member a reference without subscripts names, with its declaration."""
+    last = ref.parts[-1]
+    if any(p.subscripts for p in ref.parts):
+        return None
+    if len(ref.parts) == 1:
+        owner: Any = _owner_scope(where)
+    else:
+        try:
+            owner = ev.reference(s.Ref(ref.parts[:-1], ref.span), where)
+        except FlattenError:
+            return None
+    if not isinstance(owner, ClassScope) or not owner.has_member(last.name):
+        return None
+    return owner.member(last.name, last.span), owner.component(last.name)
 
 
 def _owner_scope(where: Scope) -> ClassScope | None:

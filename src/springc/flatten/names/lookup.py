@@ -33,6 +33,7 @@ from ..checks import (
     check_extends,
     check_inside,
     check_outer_uses,
+    check_unsupported_class,
     rule_error,
 )
 from ..natives import is_external_object
@@ -70,6 +71,7 @@ class ClassLookup(FlattenContext):
         if found is None and entry not in self.rule_errors:
             unsupported = entry.defn.unsupported
             if unsupported:  # a construct outside the subset, in a class the model uses
+                check_unsupported_class(self, entry)  # unless it breaks a rule of theirs
                 raise unsupported[0] if len(unsupported) == 1 else ErrorGroup(unsupported)
             try:
                 check_extends(self, entry)

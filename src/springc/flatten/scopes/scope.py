@@ -37,6 +37,8 @@ from .parameters import ParameterValues
 from .syntax_walk import same_text
 
 PRIMITIVES = frozenset({"Real", "Integer", "Boolean"})
+#: The predefined types, which no class may be named (section 4.8).
+PREDEFINED = frozenset({"Real", "Integer", "Boolean", "String"})
 
 
 
@@ -151,6 +153,9 @@ class ClassScope:
     # Of the model: the inner elements added for outer ones that have none (5.4), with
     # the outer declaration that caused each.
     added_inners: dict[str, tuple[Member, ViewComponent]] = field(default_factory=dict)
+    # Of an expandable connector: the variables connections added to it (9.1.3), each
+    # declared like the variable on the connection's other side.
+    augmented: dict[str, ViewComponent] = field(default_factory=dict)
 
     @property
     def entry(self) -> ClassEntry:
@@ -169,7 +174,12 @@ class ClassScope:
         return f"{self.prefix}.{name}" if self.prefix else name
 
     def has_member(self, name: str) -> bool:
-        return name in self.view.components
+        return name in self.view.components or name in self.augmented
+
+    def component(self, name: str) -> ViewComponent:
+        """The declaration of the member ``name``: of the class, or added (9.1.3)."""
+        found = self.view.components.get(name)
+        return found if found is not None else self.augmented[name]
 
     def member(self, name: str, span: Span | None = None) -> Member:
         """The member ``name``, instantiating it on first use."""
@@ -179,7 +189,7 @@ class ClassScope:
         if name in self.failed:
             raise FollowUpError(self.failed[name])
         if name in self.in_progress:
-            decl = self.view.components[name].decl
+            decl = self.component(name).decl
             chain = [*list(self.in_progress)[list(self.in_progress).index(name):], name]
             raise FlattenError(f"'{self.flat_name(name)}' is defined in terms of itself: "
                                + " -> ".join(self.flat_name(n) for n in chain),
@@ -187,7 +197,7 @@ class ClassScope:
                                "break the cycle in the bindings or array sizes")
         self.in_progress[name] = None
         try:
-            created = self.flattener.instantiate(self, self.view.components[name])
+            created = self.flattener.instantiate(self, self.component(name))
         except FlattenError as err:
             self.failed[name] = err.original if isinstance(err, FollowUpError) else err
             raise
@@ -218,9 +228,11 @@ class ClassScope:
                 yield name, member
         for name, (added, _) in self.added_inners.items():
             yield name, added  # type: ignore[misc]
+        for name in self.augmented:
+            yield name, self.member(name)  # type: ignore[misc]
 
     def lookup(self, name: str, span: Span) -> Any:
-        if name in self.view.components:
+        if name in self.view.components or name in self.augmented:
             return self.member(name, span)
         if self.package is not None and self.package.has_member(name):
             return self.package.member(name, span)
@@ -272,6 +284,9 @@ class FunctionScope:
         value = self.names[name]
         if value is None:
             raise FlattenError(f"'{name}' is used before it is assigned", span)
+        if isinstance(value, a.FunctionArgument):
+            raise FlattenError(f"'{name}' is a function (a functional input), not a value",
+                               span, hint=f"call it: {name}(...) (section 12.4.2)")
         return value
 
 
@@ -442,6 +457,8 @@ def build_view(entry: ClassEntry, flattener: ClassViews, seen: tuple[ClassEntry,
     for element in entry.defn.elements:
         if not isinstance(element, s.Extends) or element.base.dotted == "ExternalObject":
             continue  # the predefined base of external objects has no elements (12.9.7)
+        if entry.defn.kind == "type" and element.base.dotted in PREDEFINED:
+            continue  # type Angle extends Real: no components (its functions are members)
         if entry.defn.class_extends and element is entry.defn.elements[0]:
             base = inherited_class(flattener.resolve_class, entry, element.span)
         else:
