@@ -115,3 +115,50 @@ def test_a_shift_register_in_a_when_statement_simulates_in_order(
         samples = [0.1 * i for i in range(1, k + 1)]
         assert total == pytest.approx(sum(samples[-3:]), abs=1e-12)
         assert seen == pytest.approx(samples[-2] if k >= 2 else 0.0, abs=1e-12)
+
+
+PRE_AFTER = """model P
+  discrete Real a(start = 1, fixed = true);
+  discrete Real c(start = 0, fixed = true);
+  Boolean b(start = false, fixed = true);
+  Boolean rose(start = false, fixed = true);
+  Boolean moved(start = false, fixed = true);
+algorithm
+  when sample(0, 0.1) then
+    a := pre(a) + 1;
+    c := pre(a) + 10 * a;
+    b := not pre(b);
+    rose := edge(b);
+    moved := change(a);
+  end when;
+  annotation(experiment(StopTime = 0.35, Interval = 0.05));
+end P;
+"""
+
+
+def test_pre_after_an_assignment_reads_the_value_before_the_event(tmp_path: Path) -> None:
+    path = tmp_path / "P.mo"
+    path.write_text(PRE_AFTER)
+    text = format_flat(flatten_files((str(path),), "P"))
+    assert """  when sample(0, 0.1) then
+    a = pre(a) + 1;
+    c = pre(a) + 10 * (pre(a) + 1);
+    b = not pre(b);
+    rose = not pre(b) and not pre(b);
+    moved = noEvent(pre(a) + 1 <> pre(a));
+  end when;""" in text, text
+
+
+def test_pre_edge_and_change_after_an_assignment_simulate(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import springc  # a steps 2, 3, 4, 5 at t = 0, 0.1, 0.2, 0.3; c = pre(a) + 10 a
+
+    monkeypatch.setenv("SPRINGC_CACHE_DIR", str(tmp_path / "cache"))
+    path = tmp_path / "P.mo"
+    path.write_text(PRE_AFTER)
+    result = springc.simulate(str(path), backend="python", engine="scipy")
+    for t, a, c, b, rose, moved in zip(result.time, result["a"], result["c"], result["b"],
+                                       result["rose"], result["moved"]):
+        k = round(float(t) / 0.05) // 2 + 1  # samples up to t, the one at 0 included
+        assert (a, c) == (1 + k, k + 10 * (1 + k))
+        assert (b, rose, moved) == (k % 2, k % 2, 1)

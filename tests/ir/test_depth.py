@@ -104,7 +104,7 @@ def test_a_run_of_stray_unary_operators_is_one_error() -> None:
     text = "model M\n  Real y = 2 * " + "- " * 2000 + "1;\nend M;\n"
     assert errors(text) == (
         "t.mo:2:16: error: unexpected '-'\n"
-        f"    2 | {text.splitlines()[1]}\n"
+        f"    2 | {text.splitlines()[1][:160]}...\n"  # the 160 columns around the caret
         "      |                ^\n"
         "help: a unary '-' may only start an expression or an operand of a comparison; "
         "put it in parentheses, e.g. a * (-b)")

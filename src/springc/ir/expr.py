@@ -51,6 +51,7 @@ from .nodes import (
     power,
     sub,
     substitute,
+    substitute_at_event,
     to_text,
     variables,
     walk,
@@ -61,8 +62,8 @@ __all__ = [
     "BinOp", "Call", "Const", "Der", "Expr", "If", "Neg", "Not", "NotEvaluable", "Time",
     "Var", "add", "calls_named", "children", "derivatives", "diff", "div", "evaluate",
     "fold_chunked", "format_number", "map_children", "mul", "neg", "power", "recursion_limit",
-    "recursion_room", "sub", "substitute", "time_derivative", "to_text", "variables",
-    "walk",
+    "recursion_room", "sub", "substitute", "substitute_at_event", "time_derivative", "to_text",
+    "variables", "walk",
 ]
 
 # ------------------------------------------------------------------------ depth

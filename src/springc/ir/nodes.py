@@ -210,11 +210,18 @@ def derivatives(e: Expr) -> set[str]:
 def substitute(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
     """Replace variables by expressions; unchanged subtrees are shared, not copied, and
     a subtree shared by several parents is rewritten once (the result shares it too)."""
-    return _substitute(e, mapping, {})
+    return _substitute(e, mapping, {}, False)
 
 
-def _substitute(e: Expr, mapping: Mapping[str, Expr], memo: dict[int, tuple[Expr, Expr]]
-                ) -> Expr:
+def substitute_at_event(e: Expr, mapping: Mapping[str, Expr]) -> Expr:
+    """:func:`substitute` of the values assigned so far at an event (an algorithm's
+    statements): ``pre(v)`` is the value before the event and keeps ``v``; ``edge(v)``
+    and ``change(v)`` of a replaced ``v`` are spelled out with it (spec 3.7.5)."""
+    return _substitute(e, mapping, {}, True)
+
+
+def _substitute(e: Expr, mapping: Mapping[str, Expr], memo: dict[int, tuple[Expr, Expr]],
+                held: bool) -> Expr:
     if isinstance(e, Var):
         return mapping.get(e.name, e)
     if isinstance(e, (Const, Time)):
@@ -222,21 +229,25 @@ def _substitute(e: Expr, mapping: Mapping[str, Expr], memo: dict[int, tuple[Expr
     found = memo.get(id(e))
     if found is not None and found[0] is e:
         return found[1]
-    out = _substitute_node(e, mapping, memo)
+    out = _substitute_node(e, mapping, memo, held)
     memo[id(e)] = (e, out)
     return out
 
 
 def _substitute_node(e: Expr, mapping: Mapping[str, Expr],
-                     memo: dict[int, tuple[Expr, Expr]]) -> Expr:
+                     memo: dict[int, tuple[Expr, Expr]], held: bool) -> Expr:
     if isinstance(e, BinOp):
-        left, right = _substitute(e.left, mapping, memo), _substitute(e.right, mapping, memo)
+        left = _substitute(e.left, mapping, memo, held)
+        right = _substitute(e.right, mapping, memo, held)
         return e if left is e.left and right is e.right else BinOp(e.op, left, right)
     if isinstance(e, (Neg, Not, Der)):
-        arg = _substitute(e.arg, mapping, memo)
+        arg = _substitute(e.arg, mapping, memo, held)
         return e if arg is e.arg else type(e)(arg)
     if isinstance(e, Call):
-        args = tuple(_substitute(a, mapping, memo) for a in e.args)
+        if held and e.name in ("pre", "edge", "change") and len(e.args) == 1 \
+                and isinstance(e.args[0], Var):
+            return _held_call(e, e.args[0], mapping)
+        args = tuple(_substitute(a, mapping, memo, held) for a in e.args)
         if all(a is b for a, b in zip(args, e.args)):
             return e
         if e.name in ("pre", "edge", "change") and len(args) == 1 \
@@ -244,9 +255,18 @@ def _substitute_node(e: Expr, mapping: Mapping[str, Expr],
             return args[0] if e.name == "pre" else Const(False)
         return Call(e.name, args)
     if isinstance(e, If):
-        c, t, o = (_substitute(x, mapping, memo) for x in (e.cond, e.then, e.otherwise))
+        c, t, o = (_substitute(x, mapping, memo, held) for x in (e.cond, e.then, e.otherwise))
         return e if (c, t, o) == (e.cond, e.then, e.otherwise) else If(c, t, o)
     raise TypeError(f"not an expression: {e!r}")
+
+
+def _held_call(e: Call, v: Var, mapping: Mapping[str, Expr]) -> Expr:
+    """``pre(v)``, ``edge(v)`` or ``change(v)`` where ``v`` may have a new value."""
+    now = mapping.get(v.name)
+    if e.name == "pre" or now is None:
+        return e
+    before = Call("pre", (v,))
+    return BinOp("and", now, Not(before)) if e.name == "edge" else BinOp("<>", now, before)
 
 # ------------------------------------------------------------- construction
 

@@ -99,7 +99,8 @@ class _Run:
         if is_string(value):
             return value  # known while flattening (flatten/calls/strings.py)
         env = self.env
-        return a.elementwise(lambda e: folded(x.substitute(e, env)) if env else e, value)
+        return a.elementwise(lambda e: folded(x.substitute_at_event(e, env)) if env else e,
+                             value)
 
     def guard_new(self, start: int, guard: x.Expr | None) -> None:
         """Make the assertions of inlined functions recorded since ``start`` hold
