@@ -100,46 +100,12 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
     order = {u.name: i for i, u in enumerate(system.unknowns)}
     names = set(unknowns)
     # Step 1: classify equations and join alias classes (signed union-find).
-    parent: dict[str, tuple[str, int]] = {}
-    value_of: dict[str, tuple[x.Expr, dae.Residual]] = {}
-    members_eq: dict[str, dae.Residual] = {}
-    kept: list[dae.Residual] = []
-
-    def find(a: str) -> tuple[str, int]:
-        sign = 1
-        while a in parent:
-            a, s = parent[a]
-            sign *= s
-        return a, sign
-
-    for r in system.equations:
-        found = _classify(r, names)
-        if found is None:
-            kept.append(r)
-            continue
-        a, b, sign, value = found
-        ra, sa = find(a)
-        if not b:
-            if ra in value_of:
-                kept.append(r)  # a second value for the class: leave it to the checks
-                continue
-            value_of[ra] = (x.neg(value) if sa == -1 else value, r)
-            continue
-        rb, sb = find(b)
-        if ra == rb or (ra in value_of and rb in value_of):
-            kept.append(r)
-            continue
-        # a = sign*b, a = sa*ra, b = sb*rb  =>  rb = sa*sign*sb * ra
-        parent[rb] = (ra, sa * sign * sb)
-        members_eq[rb] = r
-        if rb in value_of:
-            v, eq = value_of.pop(rb)
-            value_of[ra] = (x.neg(v) if sa * sign * sb == -1 else v, eq)
+    parent, value_of, members_eq, kept = _join_classes(system.equations, names)
 
     # Step 2: pick the kept variable of each class and express the others through it.
     classes: dict[str, list[tuple[str, int]]] = {}
     for name in unknowns:
-        root, sign = find(name)
+        root, sign = _find(parent, name)
         classes.setdefault(root, []).append((name, sign))
     mapping: dict[str, x.Expr] = {}
     aliases: list[Alias] = []
@@ -220,6 +186,53 @@ def eliminate_aliases(system: dae.DAE) -> AliasResult:
         return AliasResult(again.dae, again.aliases + earlier,
                            tuple(warnings) + again.warnings)
     return AliasResult(reduced, tuple(aliases), tuple(warnings))
+
+
+Classes = tuple[dict[str, tuple[str, int]], dict[str, tuple[x.Expr, dae.Residual]],
+                dict[str, dae.Residual], list[dae.Residual]]
+"""A signed union-find's parents, each class's value (with its equation), the equation
+that joined each member, and the equations kept."""
+
+
+def _find(parent: dict[str, tuple[str, int]], a: str) -> tuple[str, int]:
+    """The root of ``a``'s class and the sign of ``a`` against it."""
+    sign = 1
+    while a in parent:
+        a, s = parent[a]
+        sign *= s
+    return a, sign
+
+
+def _join_classes(equations: tuple[dae.Residual, ...], names: set[str]) -> Classes:
+    """Classify ``equations`` and join the alias classes they state."""
+    parent: dict[str, tuple[str, int]] = {}
+    value_of: dict[str, tuple[x.Expr, dae.Residual]] = {}
+    members_eq: dict[str, dae.Residual] = {}
+    kept: list[dae.Residual] = []
+    for r in equations:
+        found = _classify(r, names)
+        if found is None:
+            kept.append(r)
+            continue
+        a, b, sign, value = found
+        ra, sa = _find(parent, a)
+        if not b:
+            if ra in value_of:
+                kept.append(r)  # a second value for the class: leave it to the checks
+                continue
+            value_of[ra] = (x.neg(value) if sa == -1 else value, r)
+            continue
+        rb, sb = _find(parent, b)
+        if ra == rb or (ra in value_of and rb in value_of):
+            kept.append(r)
+            continue
+        # a = sign*b, a = sa*ra, b = sb*rb  =>  rb = sa*sign*sb * ra
+        parent[rb] = (ra, sa * sign * sb)
+        members_eq[rb] = r
+        if rb in value_of:
+            v, eq = value_of.pop(rb)
+            value_of[ra] = (x.neg(v) if sa * sign * sb == -1 else v, eq)
+    return parent, value_of, members_eq, kept
 
 
 def _priority(u: dae.Unknown, differentiated: set[str], order: dict[str, int]
