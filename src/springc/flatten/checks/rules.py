@@ -314,13 +314,8 @@ def _check_component(ctx: ClassViews, entry: ClassEntry, comp: ViewComponent) ->
             # flow over an input/output element is accepted (the conformance suite
             # holds it valid: Components.Prefixes.FlowValidClassType)
             if inner_decl.flow or (inner_decl.causality and causality):
-                inner_prefix = inner_decl.causality or "flow"
-                raise rule_error(
-                    f"'{decl.name}' is declared `{prefix}`, but its element '{inner}' is "
-                    f"already `{inner_prefix}`", decl.span,
-                    "flow, input and output on a structured component apply to its "
-                    "elements, which then may not have any of these prefixes", "4.4.2.2",
-                    (Note(f"'{inner}' is declared here", inner_decl.span),))
+                raise _prefix_clash(decl, prefix, inner, inner_decl.causality or "flow",
+                                    inner_decl.span)
     if variability in ("parameter", "constant") and type_kind == "connector":
         raise rule_error(f"the connector '{decl.name}' cannot be declared `{variability}`",
                          decl.span, "a connector component cannot be a parameter or a "
@@ -341,12 +336,20 @@ def _check_flow_over_stream(decl: s.Component, defn: s.ClassDef) -> None:
     declared flow or stream (section 4.4.2.2)."""
     for inner in defn.elements:
         if isinstance(inner, s.Component) and (inner.flow or inner.stream):
-            raise rule_error(
-                f"'{decl.name}' is declared `flow`, but its element '{inner.name}' is "
-                f"already `{'flow' if inner.flow else 'stream'}`", decl.span,
-                "flow, input and output on a structured component apply to its "
-                "elements, which then may not have any of these prefixes", "4.4.2.2",
-                (Note(f"'{inner.name}' is declared here", inner.span),))
+            raise _prefix_clash(decl, "flow", inner.name,
+                                "flow" if inner.flow else "stream", inner.span)
+
+
+def _prefix_clash(decl: s.Component, prefix: str, inner: str, inner_prefix: str,
+                  inner_span: Span | None) -> FlattenError:
+    """The error of ``prefix`` on ``decl`` whose element ``inner`` has ``inner_prefix``
+    (section 4.4.2.2)."""
+    return rule_error(
+        f"'{decl.name}' is declared `{prefix}`, but its element '{inner}' is already "
+        f"`{inner_prefix}`", decl.span,
+        "flow, input and output on a structured component apply to its elements, which "
+        "then may not have any of these prefixes", "4.4.2.2",
+        (Note(f"'{inner}' is declared here", inner_span),))
 
 
 def _elements(ctx: ClassViews, entry: ClassEntry, prefix: str = "",
